@@ -1,0 +1,72 @@
+"""Command-line interface: ``python -m replication status|show|cite|index``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from . import reproduction as rp
+
+
+def _cmd_status(args) -> int:
+    status, errata = rp.build_index(write=args.write)
+    if args.source:
+        status = status[status["source"] == args.source]
+    width = max(len(i) for i in status["id"]) if len(status) else 10
+    print(f"{'id':<{width}}  {'status':<15} rows  description")
+    for _, r in status.iterrows():
+        print(f"{r['id']:<{width}}  {r['status']:<15} {r['rows']:>4}  {str(r['description'])[:70]}")
+    tally = status["status"].value_counts()
+    print()
+    print(f"{len(status)} artifacts: " + ", ".join(f"{s} {int(tally.get(s, 0))}" for s in rp.STATUSES))
+    print(f"errata proven: {len(errata)}")
+    return 0
+
+
+def _cmd_show(args) -> int:
+    df = rp.read_table(args.id)
+    if args.format == "csv":
+        sys.stdout.write(df.to_csv(index=False, lineterminator="\n"))
+    else:
+        path = rp.tables_dir() / f"{args.id}.{args.format}"
+        sys.stdout.write(path.read_text(encoding="utf-8"))
+    return 0
+
+
+def _cmd_cite(args) -> int:
+    sys.stdout.write(rp.bibtex_for(args.id))
+    return 0
+
+
+def _cmd_index(args) -> int:
+    status, errata = rp.build_index(write=True)
+    print(f"wrote tables/status.csv ({len(status)} artifacts) and tables/errata.csv ({len(errata)} errata)")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m replication", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("status", help="the reproduction dashboard: one line per seed artifact")
+    p.add_argument("--source", choices=rp.SOURCE_KEYS + ("toolkit",), help="only one source document")
+    p.add_argument("--write", action="store_true", help="also rewrite tables/status.csv and errata.csv")
+    p.set_defaults(func=_cmd_status)
+    p = sub.add_parser("show", help="print one exported table")
+    p.add_argument("id", help="table id, e.g. chen2019-eq-3-1")
+    p.add_argument("--format", choices=("csv", "md", "tex"), default="md")
+    p.set_defaults(func=_cmd_show)
+    p = sub.add_parser("cite", help="a BibTeX entry for one exported table")
+    p.add_argument("id")
+    p.set_defaults(func=_cmd_cite)
+    p = sub.add_parser("index", help="rebuild tables/status.csv and tables/errata.csv")
+    p.set_defaults(func=_cmd_index)
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except rp.RegistryError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

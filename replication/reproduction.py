@@ -1,0 +1,679 @@
+"""The reproduction registry: paper values in, citable comparison tables out.
+
+This module is the one way a chapter records a result.
+
+* Paper values live in ``data/paper/<key>/<id>.csv``.  Each file starts with ``#`` provenance
+  lines (``# document: chen2019`` ...) followed by a CSV body with at least the columns
+  ``quantity, unit, value``.  :func:`load_paper` reads and validates one.
+* A chapter compares its computed values with the paper's through :func:`compare`, which writes
+  ``tables/<id>.csv`` (long format), ``.md``, ``.tex`` and a ``.json`` sidecar.
+* :func:`build_index` aggregates every exported table into ``tables/status.csv`` (one row per
+  reproducible artifact listed in ``data/artifacts.csv``) and ``tables/errata.csv`` (every row
+  whose status is ``erratum``).
+
+Status vocabulary (:data:`STATUSES`):
+
+``reproduced``      within a tolerance stated before comparing;
+``erratum``         the printed value is proven wrong and the corrected value is reproduced;
+``qualitative``     ordering / shape / sign reproduced, magnitudes not comparable (reason stated);
+``analog``          the paper used unpublished data; a labelled simulation stands in;
+``not-reproduced``  tried, differs, with an honest reason;
+``pending``         not reached yet.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import math
+import os
+import re
+import subprocess
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+import numpy as np
+import pandas as pd
+
+from . import __version__
+
+STATUSES = ("reproduced", "erratum", "qualitative", "analog", "not-reproduced", "pending")
+"""The status vocabulary, in the order used for summaries (best first)."""
+
+SOURCE_KEYS = ("chen2019", "fang2020", "duan2023", "an2021")
+"""Citation keys of the four source documents."""
+
+REQUIRED_PROVENANCE = ("document", "location", "section", "notes")
+"""Provenance fields every paper-value file must carry."""
+
+TABLE_COLUMNS = (
+    "quantity", "unit", "paper", "reproduced", "abs_error", "rel_error",
+    "tolerance", "status", "note", "evidence", "corrected",
+)
+"""Columns of every exported comparison table, in order."""
+
+TRACKED_PACKAGES = (
+    "numpy", "scipy", "pandas", "statsmodels", "control", "matplotlib", "sympy", "numba",
+)
+
+_ID_RE = re.compile(r"^(chen2019|fang2020|duan2023|an2021|toolkit)-(table|figure|eq|claim|check)-[0-9a-z][0-9a-z.-]*$")
+
+
+class RegistryError(ValueError):
+    """A paper-value file, a table id or a comparison row is malformed."""
+
+
+# --------------------------------------------------------------------------- locations
+
+def project_root() -> Path:
+    """The repository root: ``$REPLICATION_ROOT`` or the folder holding ``pyproject.toml``."""
+    env = os.environ.get("REPLICATION_ROOT")
+    if env:
+        return Path(env).resolve()
+    here = Path(__file__).resolve().parent.parent
+    if (here / "pyproject.toml").exists():
+        return here
+    cwd = Path.cwd().resolve()
+    for p in (cwd, *cwd.parents):
+        if (p / "pyproject.toml").exists() and (p / "replication").is_dir():
+            return p
+    raise RegistryError("cannot find the project root; set REPLICATION_ROOT")
+
+
+def paper_dir() -> Path:
+    return project_root() / "data" / "paper"
+
+
+def tables_dir() -> Path:
+    return project_root() / "tables"
+
+
+def validate_id(table_id: str) -> str:
+    """Check a table id against ``<key>-(table|figure|eq|claim|check)-<n>``."""
+    if not isinstance(table_id, str) or not _ID_RE.match(table_id):
+        raise RegistryError(
+            f"malformed table id {table_id!r}: expected '<key>-table-<n>', '<key>-figure-<n>', "
+            f"'<key>-eq-<n>', '<key>-claim-<name>' or '<key>-check-<name>' with key one of "
+            f"{', '.join(SOURCE_KEYS)} (lower case, e.g. 'chen2019-table-2-3')"
+        )
+    return table_id
+
+
+# --------------------------------------------------------------------------- paper values
+
+@dataclass
+class PaperTable:
+    """Paper values of one printed table / equation set, with provenance."""
+
+    table_id: str
+    path: Path
+    provenance: dict[str, str]
+    data: pd.DataFrame = field(repr=False)
+
+    def value(self, quantity: str) -> Any:
+        """The printed value of ``quantity`` (float when numeric, else the printed text)."""
+        rows = self.data[self.data["quantity"] == quantity]
+        if rows.empty:
+            raise RegistryError(
+                f"{self.path.name}: no quantity {quantity!r}; known: {list(self.data['quantity'])[:8]}..."
+            )
+        if len(rows) > 1:
+            raise RegistryError(f"{self.path.name}: quantity {quantity!r} appears {len(rows)} times")
+        return _as_number(rows.iloc[0]["value"])
+
+    def unit(self, quantity: str) -> str:
+        rows = self.data[self.data["quantity"] == quantity]
+        if rows.empty:
+            raise RegistryError(f"{self.path.name}: no quantity {quantity!r}")
+        return str(rows.iloc[0]["unit"])
+
+    @property
+    def quantities(self) -> list[str]:
+        return list(self.data["quantity"])
+
+    def numeric(self) -> pd.Series:
+        """The numeric values indexed by quantity (non-numeric entries become NaN)."""
+        return pd.Series(
+            [_as_float_or_nan(v) for v in self.data["value"]], index=self.data["quantity"], name="paper"
+        )
+
+
+def _as_number(v: Any) -> Any:
+    f = _as_float_or_nan(v)
+    return v if math.isnan(f) and not _is_nan_text(v) else f
+
+
+def _is_nan_text(v: Any) -> bool:
+    return isinstance(v, str) and v.strip().lower() == "nan"
+
+
+def _as_float_or_nan(v: Any) -> float:
+    if v is None:
+        return float("nan")
+    if isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool):
+        return float(v)
+    try:
+        return float(str(v).strip())
+    except ValueError:
+        return float("nan")
+
+
+def parse_paper_file(path: str | os.PathLike) -> PaperTable:
+    """Read one paper-value CSV with its ``#`` provenance header and validate it.
+
+    Raises :class:`RegistryError` with the file name and what to fix when the header lacks a
+    provenance field, the body lacks a required column, a quantity is duplicated or empty.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise RegistryError(f"paper-value file not found: {path}")
+    text = path.read_text(encoding="utf-8")
+    provenance: dict[str, str] = {}
+    body_lines: list[str] = []
+    for lineno, line in enumerate(text.splitlines(), 1):
+        if line.startswith("#"):
+            m = re.match(r"#\s*([A-Za-z_]+)\s*:\s*(.*)$", line)
+            if not m:
+                raise RegistryError(f"{path}:{lineno}: provenance lines look like '# field: text'")
+            key = m.group(1).lower()
+            provenance[key] = (provenance[key] + " " + m.group(2).strip()).strip() if key in provenance else m.group(2).strip()
+        elif line.strip():
+            body_lines.append(line)
+    missing = [k for k in REQUIRED_PROVENANCE if not provenance.get(k)]
+    if missing:
+        raise RegistryError(
+            f"{path}: missing provenance {missing}; start the file with lines such as "
+            "'# document: chen2019', '# location: Table 1-1', '# section: ch. 1 §1', "
+            "'# notes: how it was transcribed'"
+        )
+    if provenance["document"] not in SOURCE_KEYS:
+        raise RegistryError(f"{path}: document {provenance['document']!r} is not one of {SOURCE_KEYS}")
+    if not body_lines:
+        raise RegistryError(f"{path}: no CSV body after the provenance header")
+    try:
+        df = pd.read_csv(io.StringIO("\n".join(body_lines)), dtype=str, keep_default_na=False)
+    except Exception as exc:  # pandas raises several parser errors
+        raise RegistryError(f"{path}: CSV body cannot be parsed: {exc}") from exc
+    for col in ("quantity", "unit", "value"):
+        if col not in df.columns:
+            raise RegistryError(f"{path}: CSV body needs a column {col!r}; it has {list(df.columns)}")
+    if (df["quantity"].str.strip() == "").any():
+        raise RegistryError(f"{path}: a row has an empty quantity")
+    dup = df["quantity"][df["quantity"].duplicated()].tolist()
+    if dup:
+        raise RegistryError(f"{path}: duplicated quantities {dup[:5]}")
+    table_id = path.stem
+    return PaperTable(table_id=table_id, path=path, provenance=provenance, data=df)
+
+
+def load_paper(table_id: str) -> PaperTable:
+    """Paper values of ``table_id`` from ``data/paper/<key>/<table_id>.csv``."""
+    validate_id(table_id)
+    key = table_id.split("-", 1)[0]
+    path = paper_dir() / key / f"{table_id}.csv"
+    if not path.exists():
+        known = sorted(p.stem for p in (paper_dir() / key).glob("*.csv")) if (paper_dir() / key).exists() else []
+        raise RegistryError(f"no paper values for {table_id!r} (looked for {path}); known for {key}: {known}")
+    return parse_paper_file(path)
+
+
+# --------------------------------------------------------------------------- comparisons
+
+def _fmt(v: Any) -> str:
+    """Deterministic text for a table cell: 10 significant digits for floats."""
+    if v is None:
+        return ""
+    if isinstance(v, (bool, np.bool_)):
+        return str(bool(v))
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        if math.isnan(v):
+            return ""
+        if v == 0:
+            return "0"
+        return format(float(v), ".10g")
+    return str(v)
+
+
+def _row_errors(paper: Any, reproduced: Any) -> tuple[float, float]:
+    p, r = _as_float_or_nan(paper), _as_float_or_nan(reproduced)
+    if math.isnan(p) or math.isnan(r):
+        return float("nan"), float("nan")
+    ae = abs(r - p)
+    re_ = ae / abs(p) if p != 0 else (0.0 if ae == 0 else float("inf"))
+    return ae, re_
+
+
+def _decide(row: Mapping[str, Any], ae: float, re_: float) -> str:
+    explicit = row.get("status")
+    tol = row.get("tolerance")
+    kind = row.get("tolerance_kind", "abs")
+    if kind not in ("abs", "rel"):
+        raise RegistryError(f"row {row.get('quantity')!r}: tolerance_kind must be 'abs' or 'rel', not {kind!r}")
+    if explicit not in (None, ""):
+        if explicit not in STATUSES:
+            raise RegistryError(f"row {row.get('quantity')!r}: unknown status {explicit!r}; use one of {STATUSES}")
+        if explicit in ("erratum", "qualitative", "analog", "not-reproduced") and not str(row.get("note", "")).strip():
+            raise RegistryError(f"row {row.get('quantity')!r}: status {explicit!r} needs a note saying why")
+        if explicit == "erratum" and not str(row.get("evidence", "")).strip():
+            raise RegistryError(f"row {row.get('quantity')!r}: an erratum needs evidence (notebook and test)")
+        if explicit == "reproduced":
+            if tol is None or math.isnan(ae):
+                raise RegistryError(f"row {row.get('quantity')!r}: 'reproduced' needs numeric values and a tolerance")
+        if explicit == "reproduced" or (explicit == "erratum" and tol is not None and not math.isnan(ae)):
+            # an explicit 'reproduced' must still be within tolerance; for an erratum the printed
+            # value must be *outside* tolerance (otherwise it is not wrong)
+            err = ae if kind == "abs" else re_
+            within = err <= float(tol)
+            if explicit == "reproduced" and not within:
+                raise RegistryError(f"row {row.get('quantity')!r}: error {err:.3g} exceeds tolerance {tol}")
+            if explicit == "erratum" and within:
+                raise RegistryError(
+                    f"row {row.get('quantity')!r}: printed value is within tolerance, so it is not an erratum"
+                )
+        return explicit
+    if tol is None:
+        raise RegistryError(
+            f"row {row.get('quantity')!r}: give a tolerance (stated before comparing) or an explicit status"
+        )
+    if math.isnan(ae):
+        raise RegistryError(f"row {row.get('quantity')!r}: non-numeric values need an explicit status")
+    err = ae if kind == "abs" else re_
+    return "reproduced" if err <= float(tol) else "not-reproduced"
+
+
+def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
+    """Build the long-format comparison table from row mappings.
+
+    Each row gives ``quantity``, ``unit``, ``paper``, ``reproduced`` and either ``tolerance``
+    (with ``tolerance_kind`` ``'abs'`` — the default — or ``'rel'``) or an explicit ``status``;
+    optional ``note``, ``evidence`` and ``corrected`` (the corrected text for an erratum whose
+    correction is not a single number).  The status is computed, never typed: a numeric row is
+    ``reproduced`` when its error is within the tolerance and ``not-reproduced`` otherwise.
+    """
+    out = []
+    seen = set()
+    for row in rows:
+        row = dict(row)
+        q = row.get("quantity")
+        if q in (None, ""):
+            raise RegistryError("every row needs a quantity")
+        if q in seen:
+            raise RegistryError(f"quantity {q!r} appears twice")
+        seen.add(q)
+        ae, re_ = _row_errors(row.get("paper"), row.get("reproduced"))
+        status = _decide(row, ae, re_)
+        tol = row.get("tolerance")
+        kind = row.get("tolerance_kind", "abs")
+        tol_txt = "" if tol is None else (f"{_fmt(tol)} (rel)" if kind == "rel" else _fmt(tol))
+        out.append({
+            "quantity": str(q),
+            "unit": _fmt(row.get("unit", "")),
+            "paper": _fmt(row.get("paper")),
+            "reproduced": _fmt(row.get("reproduced")),
+            "abs_error": _fmt(ae),
+            "rel_error": _fmt(re_),
+            "tolerance": tol_txt,
+            "status": status,
+            "note": _fmt(row.get("note", "")),
+            "evidence": _fmt(row.get("evidence", "")),
+            "corrected": _fmt(row.get("corrected", row.get("reproduced") if status == "erratum" else "")),
+        })
+    if not out:
+        raise RegistryError("a comparison needs at least one row")
+    return pd.DataFrame(out, columns=list(TABLE_COLUMNS))
+
+
+def _package_versions() -> dict[str, str]:
+    vers = {}
+    for name in TRACKED_PACKAGES:
+        try:
+            vers[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            vers[name] = "absent"
+    return vers
+
+
+def _git_head(root: Path) -> str | None:
+    try:
+        out = subprocess.run(
+            ["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True, timeout=10, check=False
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None if out.returncode == 0 else None
+
+
+def _sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def _notebook_digest(root: Path, notebook: str | None) -> str | None:
+    """Digest of a notebook's code-cell sources (outputs excluded)."""
+    if not notebook:
+        return None
+    path = root / notebook
+    if not path.exists():
+        return None
+    try:
+        nb = json.loads(path.read_text(encoding="utf-8"))
+        src = "\n\x00".join(
+            "".join(c.get("source", "")) for c in nb.get("cells", []) if c.get("cell_type") == "code"
+        )
+    except (ValueError, OSError):
+        return None
+    return _sha256(src.encode())
+
+
+def _markdown(df: pd.DataFrame, title: str) -> str:
+    cols = ["quantity", "unit", "paper", "reproduced", "abs_error", "rel_error", "tolerance", "status", "note"]
+    sub = df[cols]
+    lines = [f"**{title}**", "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for _, r in sub.iterrows():
+        cells = [str(r[c]).replace("|", "\\|").replace("\n", " ") for c in cols]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+_TEX_SPECIAL = {"&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}",
+                "~": r"\textasciitilde{}", "^": r"\textasciicircum{}", "\\": r"\textbackslash{}"}
+
+
+def _tex_escape(s: str) -> str:
+    return "".join(_TEX_SPECIAL.get(ch, ch) for ch in s)
+
+
+def _latex(df: pd.DataFrame, title: str, table_id: str) -> str:
+    cols = ["quantity", "unit", "paper", "reproduced", "abs_error", "tolerance", "status"]
+    lines = [
+        r"\begin{table}[htbp]", r"\centering", rf"\caption{{{_tex_escape(title)}}}", rf"\label{{tab:{table_id}}}",
+        r"\begin{tabular}{" + "l" * len(cols) + "}", r"\hline",
+        " & ".join(_tex_escape(c) for c in cols) + r" \\", r"\hline",
+    ]
+    for _, r in df.iterrows():
+        lines.append(" & ".join(_tex_escape(str(r[c])) for c in cols) + r" \\")
+    lines += [r"\hline", r"\end{tabular}", r"\end{table}"]
+    return "\n".join(lines) + "\n"
+
+
+def compare(
+    table_id: str,
+    rows: Iterable[Mapping[str, Any]] | pd.DataFrame,
+    *,
+    title: str,
+    notebook: str,
+    seeds: Mapping[str, int] | None = None,
+    paper_source: str | None = None,
+    description: str = "",
+) -> pd.DataFrame:
+    """Compare reproduced with paper values and export ``tables/<table_id>.*``.
+
+    The one call through which a chapter records a result.  ``rows`` as in
+    :func:`comparison_frame`; ``notebook`` is the chapter's path relative to the repository
+    root; ``seeds`` the random seeds used; ``paper_source`` the ``data/paper`` file (defaults to
+    the one named like ``table_id`` when it exists).  Writes ``.csv`` (long format), ``.md``,
+    ``.tex`` and a ``.json`` sidecar; returns the comparison table.
+
+    Writing is idempotent: when the table and its inputs are unchanged the files are not
+    touched, so re-running a chapter leaves ``git status`` clean.  The sidecar's ``git_commit`` is
+    the commit on top of which the values were last (re)computed.
+    """
+    validate_id(table_id)
+    if isinstance(rows, pd.DataFrame):
+        rows = rows.to_dict("records")
+    df = comparison_frame(rows)
+    root = project_root()
+    out_dir = tables_dir()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    if paper_source is None:
+        key = table_id.split("-", 1)[0]
+        cand = paper_dir() / key / f"{table_id}.csv"
+        paper_source = str(cand.relative_to(root)) if cand.exists() else None
+    paper_digest = None
+    if paper_source:
+        pth = root / paper_source
+        if not pth.exists():
+            raise RegistryError(f"paper_source {paper_source!r} does not exist")
+        paper_digest = _sha256(pth.read_bytes())
+    csv_text = df.to_csv(index=False, lineterminator="\n")
+    counts = {s: int((df["status"] == s).sum()) for s in STATUSES}
+    sidecar = {
+        "id": table_id,
+        "title": title,
+        "description": description,
+        "source": table_id.split("-", 1)[0],
+        "notebook": notebook,
+        "notebook_digest": _notebook_digest(root, notebook),
+        "paper_source": paper_source,
+        "paper_digest": paper_digest,
+        "table_digest": _sha256(csv_text.encode()),
+        "library_version": __version__,
+        "packages": _package_versions(),
+        "seeds": dict(seeds or {}),
+        "status_counts": counts,
+        "generated_by": "replication.reproduction.compare",
+    }
+    json_path = out_dir / f"{table_id}.json"
+    old = None
+    if json_path.exists():
+        try:
+            old = json.loads(json_path.read_text(encoding="utf-8"))
+        except ValueError:
+            old = None
+    if old is not None and {k: v for k, v in old.items() if k != "git_commit"} == sidecar and (out_dir / f"{table_id}.csv").exists():
+        sidecar["git_commit"] = old.get("git_commit")
+    else:
+        sidecar["git_commit"] = _git_head(root)
+    files = {
+        ".csv": csv_text,
+        ".md": _markdown(df, title),
+        ".tex": _latex(df, title, table_id),
+        ".json": json.dumps(sidecar, indent=2, sort_keys=True) + "\n",
+    }
+    for ext, content in files.items():
+        p = out_dir / f"{table_id}{ext}"
+        if not p.exists() or p.read_text(encoding="utf-8") != content:
+            p.write_text(content, encoding="utf-8")
+    return df
+
+
+def read_table(table_id: str) -> pd.DataFrame:
+    """An exported comparison table (``tables/<id>.csv``) as text columns."""
+    validate_id(table_id)
+    path = tables_dir() / f"{table_id}.csv"
+    if not path.exists():
+        known = list_tables()
+        near = [k for k in known if k.split("-")[0] == table_id.split("-")[0]][:10]
+        raise RegistryError(f"no exported table {table_id!r}; exported tables of that source: {near}")
+    return pd.read_csv(path, dtype=str, keep_default_na=False)
+
+
+def list_tables() -> list[str]:
+    d = tables_dir()
+    return sorted(p.stem for p in d.glob("*.json") if _ID_RE.match(p.stem)) if d.exists() else []
+
+
+def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterable[str] | None = None):
+    """A numbered, cross-referenceable MyST table of a comparison (for notebook output).
+
+    Returns an IPython ``Markdown`` object whose text is a ``{table}`` directive; the book
+    renders it as a numbered table labelled ``name`` (reference it with ``{numref}``).
+    """
+    from IPython.display import Markdown
+
+    cols = list(columns or ["quantity", "unit", "paper", "reproduced", "abs_error", "tolerance", "status"])
+    missing = [c for c in cols if c not in df.columns]
+    if missing:
+        raise RegistryError(f"display_table: columns {missing} not in the table")
+    if not re.match(r"^[a-z0-9][a-z0-9-]*$", name):
+        raise RegistryError(f"display_table: name {name!r} must be lower-case letters, digits and '-'")
+    lines = [f"```{{table}} {caption}", f":name: {name}", "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for _, r in df[cols].iterrows():
+        lines.append("| " + " | ".join(_fmt(r[c]).replace("|", "\\|").replace("\n", " ") for c in cols) + " |")
+    lines.append("```")
+    return Markdown("\n".join(lines))
+
+
+# --------------------------------------------------------------------------- index
+
+def load_artifacts() -> pd.DataFrame:
+    """The list of reproducible artifacts of every seed (``data/artifacts.csv``)."""
+    path = project_root() / "data" / "artifacts.csv"
+    df = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    need = {"id", "source", "artifact", "description"}
+    if not need <= set(df.columns):
+        raise RegistryError(f"{path}: needs columns {sorted(need)}")
+    bad = [i for i in df["id"] if not _ID_RE.match(i)]
+    if bad:
+        raise RegistryError(f"{path}: malformed ids {bad}")
+    if df["id"].duplicated().any():
+        raise RegistryError(f"{path}: duplicated ids {df['id'][df['id'].duplicated()].tolist()}")
+    return df
+
+
+def summarize_status(statuses: Iterable[str]) -> str:
+    """One status for an artifact from its rows: the weakest status present.
+
+    The order is ``reproduced`` < ``erratum`` < ``analog`` < ``qualitative`` <
+    ``not-reproduced`` < ``pending``: an artifact is only as reproduced as its worst row.
+    """
+    order = ["reproduced", "erratum", "analog", "qualitative", "not-reproduced", "pending"]
+    present = [s for s in statuses]
+    if not present:
+        return "pending"
+    for s in present:
+        if s not in order:
+            raise RegistryError(f"unknown status {s!r}")
+    return max(present, key=order.index)
+
+
+def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Aggregate the exported tables into ``tables/status.csv`` and ``tables/errata.csv``.
+
+    Status: one row per artifact of ``data/artifacts.csv`` (``pending`` until a chapter exports
+    it), followed by supplementary tables that a chapter exported beyond the seed artifacts.
+    Errata: every row with status ``erratum`` in any exported table.
+    """
+    arts = load_artifacts()
+    exported = {tid: json.loads((tables_dir() / f"{tid}.json").read_text(encoding="utf-8")) for tid in list_tables()}
+    rows = []
+    for _, a in arts.iterrows():
+        rows.append(_status_row(a["id"], a["source"], a["artifact"], a["description"], exported.get(a["id"])))
+    for tid in sorted(set(exported) - set(arts["id"])):
+        meta = exported[tid]
+        rows.append(_status_row(tid, meta.get("source", tid.split("-")[0]), "supplementary", meta.get("title", ""), meta))
+    status = pd.DataFrame(rows)
+    errata_rows = []
+    for tid in sorted(exported):
+        df = read_table(tid)
+        for _, r in df[df["status"] == "erratum"].iterrows():
+            errata_rows.append({
+                "source": tid.split("-")[0],
+                "location": f"{tid}: {r['quantity']}",
+                "printed": r["paper"],
+                "corrected": r["corrected"] or r["reproduced"],
+                "evidence": r["evidence"] or exported[tid].get("notebook", ""),
+                "note": r["note"],
+            })
+    errata = pd.DataFrame(errata_rows, columns=["source", "location", "printed", "corrected", "evidence", "note"])
+    if write:
+        d = tables_dir()
+        d.mkdir(exist_ok=True)
+        _write_if_changed(d / "status.csv", status.to_csv(index=False, lineterminator="\n"))
+        _write_if_changed(d / "errata.csv", errata.to_csv(index=False, lineterminator="\n"))
+        _write_if_changed(d / "status.md", _status_markdown(status))
+        _write_if_changed(d / "errata.md", _errata_markdown(errata))
+    return status, errata
+
+
+def _status_row(tid: str, source: str, artifact: str, description: str, meta: dict | None) -> dict:
+    counts = {s: 0 for s in STATUSES}
+    notebook = ""
+    if meta is not None:
+        df = read_table(tid)
+        for s in df["status"]:
+            counts[s] += 1
+        overall = summarize_status(df["status"])
+        notebook = meta.get("notebook", "")
+    else:
+        overall = "pending"
+    return {"id": tid, "source": source, "artifact": artifact, "description": description,
+            "status": overall, "rows": sum(counts.values()),
+            **{s.replace("-", "_"): counts[s] for s in STATUSES}, "notebook": notebook}
+
+
+def _write_if_changed(path: Path, content: str) -> None:
+    if not path.exists() or path.read_text(encoding="utf-8") != content:
+        path.write_text(content, encoding="utf-8")
+
+
+def _status_markdown(status: pd.DataFrame) -> str:
+    tally = status["status"].value_counts()
+    head = ", ".join(f"{s}: {int(tally.get(s, 0))}" for s in STATUSES)
+    lines = [f"Artifacts: {len(status)} ({head}).", "",
+             "| id | source | artifact | status | rows | reproduced | erratum | qualitative | analog | not-reproduced | description |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for _, r in status.iterrows():
+        lines.append(
+            f"| {r['id']} | {r['source']} | {r['artifact']} | {r['status']} | {r['rows']} | {r['reproduced']} | "
+            f"{r['erratum']} | {r['qualitative']} | {r['analog']} | {r['not_reproduced']} | "
+            f"{str(r['description']).replace('|', '/')} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def _errata_markdown(errata: pd.DataFrame) -> str:
+    if errata.empty:
+        return "No erratum has been proven yet.\n"
+    lines = ["| source | location | printed | corrected | evidence |", "|---|---|---|---|---|"]
+    for _, r in errata.iterrows():
+        cells = [str(r[c]).replace("|", "\\|").replace("\n", " ") for c in ("source", "location", "printed", "corrected", "evidence")]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def bibtex_for(table_id: str) -> str:
+    """A BibTeX entry citing the exported table ``table_id`` of this package.
+
+    The entry points at the original source through ``related`` / ``note`` and carries the
+    original document's own entry after it.
+    """
+    df = read_table(table_id)
+    meta = json.loads((tables_dir() / f"{table_id}.json").read_text(encoding="utf-8"))
+    source = meta.get("source", table_id.split("-")[0])
+    commit = _git_head(project_root()) or meta.get("git_commit") or "unknown"
+    overall = summarize_status(df["status"])
+    key = "repro-" + table_id
+    entry = (
+        f"@misc{{{key},\n"
+        f"  title        = {{{{Reproduction of {source}: {meta.get('title', table_id)}}}}},\n"
+        f"  author       = {{{{SINS/GNSS reproduction package contributors}}}},\n"
+        f"  howpublished = {{Table \\texttt{{tables/{table_id}.csv}}, reproduction package \\texttt{{replication}} v{meta.get('library_version', __version__)}}},\n"
+        f"  note         = {{Status: {overall} ({len(df)} rows). Reproduces {source}; cite the original as well. Commit {commit}}},\n"
+        f"  related      = {{{source}}},\n"
+        f"  version      = {{{meta.get('library_version', __version__)}}},\n"
+        f"}}\n"
+    )
+    original = source_bibtex(source)
+    return entry + ("\n" + original if original else "")
+
+
+def source_bibtex(key: str) -> str:
+    """The BibTeX entry of one of the four source documents (from ``data/sources.bib``)."""
+    path = project_root() / "data" / "sources.bib"
+    if not path.exists():
+        return ""
+    text = path.read_text(encoding="utf-8")
+    m = re.search(r"@\w+\{" + re.escape(key) + r",", text)
+    if not m:
+        return ""
+    depth, i = 0, m.start()
+    for j in range(text.index("{", m.start()), len(text)):
+        depth += {"{": 1, "}": -1}.get(text[j], 0)
+        if depth == 0:
+            return text[i : j + 1] + "\n"
+    raise RegistryError(f"{path}: unbalanced braces in entry {key}")
