@@ -1,0 +1,82 @@
+# The two commands a user needs: `make book` and `make test` (see README.md).
+SHELL := /bin/bash
+PY_BOOT ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.installed
+export PYTHONHASHSEED := 0
+export MPLBACKEND := module://matplotlib_inline.backend_inline
+export REPLICATION_ROOT := $(CURDIR)
+export PIP_DISABLE_PIP_VERSION_CHECK := 1
+
+NOTEBOOKS := $(shell find book -name '*.ipynb' -not -path '*/_build/*' -not -path '*/.ipynb_checkpoints/*' | sort)
+
+.PHONY: help env lock book notebooks notebook tables html test unit nbval check-notebooks \
+        check-tables html-strict browser bench clean
+
+help:
+	@echo "make book   - create the environment if missing, re-execute every notebook, regenerate tables/, build book/_build/html"
+	@echo "make test   - unit tests, strict nbval over every notebook, tables unchanged, strict book build, browser check"
+	@echo "make notebook NB=book/part/file.ipynb - execute one notebook in place"
+	@echo "make lock   - recompile requirements.lock from requirements.in (needs network to PyPI)"
+	@echo "make bench  - run the benchmark scripts (optional pyins comparison from requirements-bench.lock)"
+
+# ---------------------------------------------------------------- environment
+env: $(STAMP)
+
+$(STAMP): requirements.lock pyproject.toml
+	@test -x $(PY) || $(PY_BOOT) -m venv $(VENV)
+	$(PY) -m pip install --quiet --require-hashes --no-deps -r requirements.lock 2> >(grep -v "is ignored: it is neither a file nor a directory" >&2)
+	$(PY) -m pip install --quiet --no-deps --no-build-isolation -e . 2> >(grep -v "is ignored: it is neither a file nor a directory" >&2)
+	@touch $(STAMP)
+
+lock:
+	$(PY_BOOT) -m pip install --quiet uv
+	$(PY_BOOT) -m uv pip compile requirements.in --generate-hashes --python-version 3.11 \
+	    --python-platform x86_64-manylinux_2_28 -o requirements.lock
+
+# ---------------------------------------------------------------- book
+book: env notebooks tables html
+
+notebooks: env
+	$(PY) scripts/run_notebooks.py $(NOTEBOOKS)
+
+notebook: env
+	@test -n "$(NB)" || { echo "usage: make notebook NB=book/part/file.ipynb"; exit 2; }
+	$(PY) scripts/run_notebooks.py $(NB)
+
+tables: env
+	$(PY) -m replication index
+
+html: env
+	$(VENV)/bin/jupyter-book build book --path-output book --quiet
+
+# ---------------------------------------------------------------- tests
+test: env unit nbval check-notebooks tables check-tables html-strict browser
+
+unit: env
+	$(PY) -m pytest -q tests -m "not browser"
+
+nbval: env
+	$(PY) -m pytest -q -p no:cacheprovider --nbval $(NOTEBOOKS) --nbval-sanitize-with book/sanitize.cfg \
+	    --nbval-cell-timeout=900 -o testpaths=
+
+check-notebooks: env
+	$(PY) scripts/check_notebooks.py $(NOTEBOOKS)
+
+check-tables: tables
+	@git diff --exit-code --stat -- tables/ || { echo "tables/ changed after re-running the notebooks: run 'make book' and commit"; exit 1; }
+	@test -z "$$(git status --porcelain --untracked-files=all -- tables/)" || { git status --porcelain -- tables/; echo "untracked files in tables/: run 'make book' and commit"; exit 1; }
+
+html-strict: env
+	rm -rf book/_build
+	$(VENV)/bin/jupyter-book build book --path-output book --warningiserror --nitpick --keep-going --quiet
+
+browser: env
+	$(PY) -m pytest -q tests/test_book_browser.py -m browser
+
+bench: env
+	$(PY) scripts/benchmark_navigation.py
+
+clean:
+	rm -rf book/_build .pytest_cache

@@ -1,0 +1,200 @@
+"""The reproduction registry: paper-value files, comparisons, exports, index and CLI."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from replication import reproduction as rp
+from replication.__main__ import main as cli
+
+ROOT = Path(__file__).resolve().parent.parent
+
+GOOD = """# document: chen2019
+# location: Table 9-9
+# section: ch. 9 §1
+# notes: a test file
+quantity,unit,value,note
+alpha,m,1.5,
+beta,°,0.0025,
+range,m,0.05~0.3,kept as text
+"""
+
+
+@pytest.fixture()
+def sandbox(tmp_path, monkeypatch):
+    """A throw-away project root with data/ and tables/ so tests never touch the real ones."""
+    (tmp_path / "data" / "paper" / "chen2019").mkdir(parents=True)
+    (tmp_path / "tables").mkdir()
+    shutil.copy(ROOT / "data" / "sources.bib", tmp_path / "data" / "sources.bib")
+    (tmp_path / "data" / "artifacts.csv").write_text(
+        "id,source,artifact,description\nchen2019-table-9-9,chen2019,Table 9-9,a test table\n"
+        "chen2019-table-9-8,chen2019,Table 9-8,never exported\n",
+        encoding="utf-8",
+    )
+    (tmp_path / "data" / "paper" / "chen2019" / "chen2019-table-9-9.csv").write_text(GOOD, encoding="utf-8")
+    monkeypatch.setenv("REPLICATION_ROOT", str(tmp_path))
+    return tmp_path
+
+
+def test_load_paper_reads_values_and_provenance(sandbox):
+    p = rp.load_paper("chen2019-table-9-9")
+    assert p.provenance["location"] == "Table 9-9"
+    assert p.value("alpha") == 1.5
+    assert p.value("range") == "0.05~0.3"
+    assert math.isnan(p.numeric()["range"])
+    assert p.unit("beta") == "°"
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (GOOD.replace("# section: ch. 9 §1\n", ""), "missing provenance"),
+        (GOOD.replace("# document: chen2019", "# document: smith1999"), "is not one of"),
+        ("# document: chen2019\n# location: x\n# section: y\n# notes: z\nquantity,value\na,1\n", "needs a column 'unit'"),
+        (GOOD + "alpha,m,2,\n", "duplicated quantities"),
+        ("# document: chen2019\n# location: x\n# section: y\n# notes: z\n", "no CSV body"),
+        (GOOD.replace("# notes: a test file", "#notes a test file"), "provenance lines look like"),
+    ],
+)
+def test_malformed_paper_files_fail_clearly(sandbox, text, message):
+    path = sandbox / "data" / "paper" / "chen2019" / "chen2019-table-9-7.csv"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(rp.RegistryError, match=message):
+        rp.parse_paper_file(path)
+
+
+def test_unknown_and_malformed_ids(sandbox):
+    with pytest.raises(rp.RegistryError, match="no paper values"):
+        rp.load_paper("chen2019-table-9-1")
+    with pytest.raises(rp.RegistryError, match="malformed table id"):
+        rp.load_paper("Chen2019 table 1")
+
+
+def test_status_is_computed_from_the_tolerance():
+    df = rp.comparison_frame([
+        dict(quantity="in", unit="m", paper=1.0, reproduced=1.0004, tolerance=1e-3),
+        dict(quantity="out", unit="m", paper=1.0, reproduced=1.01, tolerance=1e-3),
+        dict(quantity="rel", unit="m", paper=100.0, reproduced=101.0, tolerance=0.02, tolerance_kind="rel"),
+    ])
+    assert list(df["status"]) == ["reproduced", "not-reproduced", "reproduced"]
+    assert df.loc[1, "abs_error"] == format(0.01, ".10g") or float(df.loc[1, "abs_error"]) == pytest.approx(0.01)
+    assert df.loc[2, "tolerance"] == "0.02 (rel)"
+
+
+def test_explicit_statuses_are_checked():
+    with pytest.raises(rp.RegistryError, match="needs a note"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper="up", reproduced="up", status="qualitative")])
+    with pytest.raises(rp.RegistryError, match="needs evidence"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=2, status="erratum", note="typo")])
+    with pytest.raises(rp.RegistryError, match="not an erratum"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=1.0, tolerance=0.1,
+                                  status="erratum", note="n", evidence="e")])
+    with pytest.raises(rp.RegistryError, match="exceeds tolerance"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=2, tolerance=0.1, status="reproduced")])
+    with pytest.raises(rp.RegistryError, match="unknown status"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=2, status="fine", note="x")])
+    with pytest.raises(rp.RegistryError, match="give a tolerance"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=2)])
+    with pytest.raises(rp.RegistryError, match="appears twice"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=1, tolerance=1)] * 2)
+
+
+def test_compare_exports_all_formats_and_is_idempotent(sandbox):
+    rows = [
+        dict(quantity="alpha", unit="m", paper=1.5, reproduced=1.5000001, tolerance=1e-6),
+        dict(quantity="beta", unit="°", paper=0.0025, reproduced=0.0035, status="erratum",
+             note="prose says 0.0035", evidence="tests/test_x.py::test_beta", tolerance=1e-4),
+    ]
+    df = rp.compare("chen2019-table-9-9", rows, title="Test table", notebook="book/x.ipynb", seeds={"mc": 1})
+    assert list(df.columns) == list(rp.TABLE_COLUMNS)
+    for ext in (".csv", ".md", ".tex", ".json"):
+        assert (sandbox / "tables" / f"chen2019-table-9-9{ext}").exists()
+    meta = json.loads((sandbox / "tables" / "chen2019-table-9-9.json").read_text())
+    assert meta["paper_source"] == "data/paper/chen2019/chen2019-table-9-9.csv"
+    assert meta["seeds"] == {"mc": 1} and meta["packages"]["numpy"] != "absent"
+    assert meta["status_counts"]["erratum"] == 1
+    stamp = {p.name: p.stat().st_mtime_ns for p in (sandbox / "tables").iterdir()}
+    rp.compare("chen2019-table-9-9", rows, title="Test table", notebook="book/x.ipynb", seeds={"mc": 1})
+    assert stamp == {p.name: p.stat().st_mtime_ns for p in (sandbox / "tables").iterdir()}
+    back = rp.read_table("chen2019-table-9-9")
+    assert back.loc[0, "status"] == "reproduced"
+
+
+def test_index_lists_every_artifact_and_collects_errata(sandbox):
+    rows = [dict(quantity="beta", unit="°", paper=0.0025, reproduced=0.0035, status="erratum",
+                 note="prose says 0.0035", evidence="tests/test_x.py::test_beta")]
+    rp.compare("chen2019-table-9-9", rows, title="T", notebook="book/x.ipynb")
+    rp.compare("chen2019-check-extra", [dict(quantity="q", unit="", paper=1, reproduced=1, tolerance=0)],
+               title="Extra", notebook="book/x.ipynb")
+    status, errata = rp.build_index()
+    assert list(status["id"]) == ["chen2019-table-9-9", "chen2019-table-9-8", "chen2019-check-extra"]
+    assert list(status["status"]) == ["erratum", "pending", "reproduced"]
+    assert status.iloc[2]["artifact"] == "supplementary"
+    assert len(errata) == 1 and errata.iloc[0]["evidence"] == "tests/test_x.py::test_beta"
+    on_disk = pd.read_csv(sandbox / "tables" / "errata.csv", dtype=str)
+    assert list(on_disk.columns[:5]) == ["source", "location", "printed", "corrected", "evidence"]
+
+
+def test_summary_status_is_the_weakest():
+    assert rp.summarize_status(["reproduced", "erratum"]) == "erratum"
+    assert rp.summarize_status(["reproduced", "not-reproduced", "analog"]) == "not-reproduced"
+    assert rp.summarize_status([]) == "pending"
+
+
+def test_cli_show_cite_and_unknown_id(sandbox, capsys):
+    rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=1.5, tolerance=0)],
+               title="Test table", notebook="book/x.ipynb")
+    assert cli(["show", "chen2019-table-9-9", "--format", "csv"]) == 0
+    assert "alpha,m,1.5,1.5" in capsys.readouterr().out
+    assert cli(["show", "chen2019-table-9-9", "--format", "tex"]) == 0
+    assert r"\begin{tabular}" in capsys.readouterr().out
+    assert cli(["cite", "chen2019-table-9-9"]) == 0
+    out = capsys.readouterr().out
+    assert "@misc{repro-chen2019-table-9-9," in out and "@techreport{chen2019," in out
+    assert cli(["show", "chen2019-table-4-99"]) == 2
+    assert "no exported table" in capsys.readouterr().err
+    assert cli(["status"]) == 0
+    assert "2 artifacts" in capsys.readouterr().out
+
+
+def test_cli_runs_as_module_on_the_real_project():
+    out = subprocess.run([sys.executable, "-m", "replication", "status"], cwd=ROOT, capture_output=True,
+                         text=True, check=True).stdout
+    arts = rp.load_artifacts()
+    for tid in arts["id"]:
+        assert tid in out
+    bad = subprocess.run([sys.executable, "-m", "replication", "cite", "an2021-table-77"], cwd=ROOT,
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "error:" in bad.stderr
+
+
+def test_every_source_has_a_bibtex_entry_also_in_the_book():
+    book_bib = (ROOT / "book" / "references.bib").read_text(encoding="utf-8")
+    for key in rp.SOURCE_KEYS:
+        entry = rp.source_bibtex(key)
+        assert entry.startswith("@"), key
+        assert entry.strip() in book_bib, f"book/references.bib differs from data/sources.bib for {key}"
+
+
+def test_every_paper_file_in_the_project_is_valid():
+    files = sorted((ROOT / "data" / "paper").rglob("*.csv"))
+    for f in files:
+        p = rp.parse_paper_file(f)
+        assert p.provenance["document"] == f.parent.name, f
+        rp.validate_id(f.stem)
+
+
+def test_citation_cff_lists_the_four_documents():
+    text = (ROOT / "CITATION.cff").read_text(encoding="utf-8")
+    assert "cff-version:" in text and "references:" in text
+    for doi_or_title in ("10.11918/201811112", "Influence of gravity disturbance", "Improved SINS/ADS",
+                         "Error Estimation of Airborne Gravimeter"):
+        assert doi_or_title in text
