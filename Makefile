@@ -58,8 +58,9 @@ unit: env
 	$(PY) -m pytest -q tests -m "not browser"
 
 nbval: env
-	$(PY) -m pytest -q -p no:cacheprovider --nbval $(NOTEBOOKS) --nbval-sanitize-with book/sanitize.cfg \
-	    --nbval-cell-timeout=900 -o testpaths=
+	@test -n "$(NOTEBOOKS)" || { echo "no notebooks under book/"; exit 1; }
+	$(PY) -m pytest -q -p no:cacheprovider --nbval --nbval-current-env $(NOTEBOOKS) \
+	    --nbval-sanitize-with book/sanitize.cfg --nbval-cell-timeout=900 -o testpaths= -o addopts=
 
 check-notebooks: env
 	$(PY) scripts/check_notebooks.py $(NOTEBOOKS)

@@ -1,0 +1,52 @@
+"""The notebook runner and checker that `make book` / `make test` rely on."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import nbformat
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scripts"))
+import check_notebooks  # noqa: E402
+import run_notebooks  # noqa: E402
+
+
+def _nb(tmp_path, sources, counts=None, outputs=None):
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_code_cell(s) for s in sources]
+    for i, c in enumerate(nb.cells):
+        c.execution_count = (counts or list(range(1, len(sources) + 1)))[i]
+        c.outputs = (outputs or {}).get(i, [])
+    path = tmp_path / "x.ipynb"
+    nbformat.write(nb, path)
+    return path
+
+
+def test_checker_accepts_a_clean_notebook(tmp_path):
+    assert check_notebooks.problems(_nb(tmp_path, ["1", "2"])) == []
+
+
+def test_checker_rejects_out_of_order_and_errors(tmp_path):
+    p = _nb(tmp_path, ["1", "2"], counts=[2, 1])
+    assert any("top to bottom" in m for m in check_notebooks.problems(p))
+    err = nbformat.v4.new_output("error", ename="ValueError", evalue="x", traceback=[])
+    p = _nb(tmp_path, ["1"], outputs={0: [err]})
+    assert any("error output" in m for m in check_notebooks.problems(p))
+    warn = nbformat.v4.new_output("stream", name="stderr", text="RuntimeWarning: overflow")
+    p = _nb(tmp_path, ["1"], outputs={0: [warn]})
+    assert any("warning" in m for m in check_notebooks.problems(p))
+
+
+def test_runner_strips_volatile_metadata(tmp_path):
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["widgets"] = {"state": 1}
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    cell = nbformat.v4.new_code_cell("1")
+    cell.metadata["execution"] = {"iopub.execute_input": "2026-01-01"}
+    nb.cells = [cell]
+    run_notebooks.clean(nb)
+    assert "widgets" not in nb.metadata and "kernelspec" in nb.metadata
+    assert "execution" not in nb.cells[0].metadata
+    assert json.loads(nbformat.writes(nb))["cells"][0]["metadata"] == {}
