@@ -1,0 +1,621 @@
+"""Time-series modelling of a gravity-disturbance series: chen2019 ch. 3 §3, step 2.
+
+The chain of chen2019 Fig. 3-4, with statsmodels doing the statistics:
+
+1. stationarity: the inversion (reverse-arrangement) test exactly as printed
+   (:func:`inversion_test`), cross-checked with ADF and KPSS (:func:`stationarity_report`);
+   differencing when needed (:func:`difference`, :func:`make_stationary`);
+2. identification: ACF (3-9) and PACF (3-10) with confidence bands (:func:`correlogram`) and the
+   rules of Table 3-1 applied computationally (:func:`identify_model`);
+3. estimation: AR least squares (3-11)-(3-12) (:func:`ar_least_squares`), identical to
+   statsmodels ``AutoReg`` (:func:`fit_ar`, which refuses non-stationary input);
+4. order: AIC (3-13) with the order cap sqrt(n) (:func:`aic_by_order`, :func:`select_order`),
+   in the normalizations in use (raw, per observation, log-variance);
+5. checks of a printed AR model before it is used as a shaping filter (:func:`check_ar_model`)
+   and the order-recovery Monte Carlo (:func:`order_recovery`).
+
+Sign convention throughout: ``y_t = phi_1 y_{t-1} + ... + phi_p y_{t-p} + w_t`` (chen2019
+eq. 3-11); the AR polynomial is ``1 - phi_1 z - ... - phi_p z^p`` (statsmodels ``ArmaProcess``
+takes ``np.r_[1, -phi]``).  The poles are the roots of ``z^p - phi_1 z^{p-1} - ... - phi_p``;
+the model is stationary when every pole lies strictly inside the unit circle.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy import linalg, signal, stats
+
+__all__ = [
+    "NonStationaryError", "InversionTest", "inversion_count", "inversion_moments", "inversion_test",
+    "stationarity_report", "difference", "make_stationary", "acf_printed", "pacf_printed",
+    "correlogram", "cutoff_lag", "Identification", "identify_model", "ar_design",
+    "ar_least_squares", "fit_ar", "order_cap", "aic_by_order", "select_order",
+    "aic_increment_bound", "ar_poles", "is_stationary", "ar_autocorrelation", "ar_variance",
+    "check_ar_model", "simulate_ar", "aic_batch", "order_recovery",
+]
+
+
+class NonStationaryError(ValueError):
+    """A series (or a fitted AR model) is not stationary where chen2019 step 2 requires it."""
+
+
+def _series(y, name: str = "y", min_length: int = 3) -> np.ndarray:
+    y = np.asarray(y, dtype=float)
+    if y.ndim != 1:
+        raise ValueError(f"{name} must be a one-dimensional series, got shape {y.shape}")
+    if y.size < min_length:
+        raise ValueError(f"{name} needs at least {min_length} samples, got {y.size}")
+    if not np.all(np.isfinite(y)):
+        raise ValueError(f"{name} contains NaN or infinite values; remove or interpolate them first")
+    return y
+
+
+def _phi(phi) -> np.ndarray:
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    if phi.ndim != 1 or phi.size == 0 or not np.all(np.isfinite(phi)):
+        raise ValueError("phi must be a non-empty 1-D array of finite AR coefficients [phi_1, ..., phi_p]")
+    return phi
+
+
+# --------------------------------------------------------------------------- stationarity
+
+def inversion_count(values) -> int:
+    """Total number of inversions A = sum_i A_i, A_i = #{j > i : y_j > y_i} (chen2019 §3 step 2).
+
+    Note the printed definition counts *larger* later values: an increasing sequence has the
+    maximum count m(m-1)/2, a decreasing one has zero.
+    """
+    v = np.asarray(values, dtype=float)
+    if v.ndim != 1 or v.size < 2:
+        raise ValueError("inversion_count needs a 1-D sequence of at least two values")
+    return int(np.sum(np.triu(v[None, :] > v[:, None], k=1)))
+
+
+def inversion_moments(m: int) -> tuple[float, float]:
+    """E(A) = m(m-1)/4 and D(A) = m(2m^2+3m-5)/72 for m exchangeable values (chen2019 §3 step 2).
+
+    D(A) equals the variance m(m-1)(2m+5)/72 of the number of inversions of a random
+    permutation (Kendall's statistic), since m(m-1)(2m+5) = m(2m^2+3m-5).
+    """
+    if int(m) != m or m < 2:
+        raise ValueError(f"the number of segments m must be an integer >= 2, got {m}")
+    return m * (m - 1) / 4.0, m * (2 * m**2 + 3 * m - 5) / 72.0
+
+
+@dataclass(frozen=True)
+class InversionTest:
+    """Result of the inversion (reverse-order) test of chen2019 §3 step 2."""
+
+    segments: int
+    means: np.ndarray
+    count: int
+    expected: float
+    variance: float
+    statistic: float
+    """B = (A + 0.5 - E(A)) / sqrt(D(A)) exactly as printed."""
+    critical: float
+    stationary_printed: bool
+    """The printed rule: stationary when B < critical (1.96 at alpha = 0.05)."""
+    statistic_two_sided: float
+    """(|A - E(A)| - 0.5) / sqrt(D(A)): the continuity correction taken toward E(A)."""
+    stationary: bool
+    """The two-sided rule: stationary when the two-sided statistic < critical."""
+
+
+def inversion_test(y, segments: int, *, alpha: float = 0.05) -> InversionTest:
+    """The inversion (reverse-arrangement) stationarity test, chen2019 ch. 3 §3 step 2.
+
+    The series is cut into ``segments`` (m, not stated in chen2019) consecutive pieces of equal
+    length (a remainder at the end is dropped), their means y_1..y_m are taken and the inversion
+    count A (:func:`inversion_count`) is compared with E(A) = m(m-1)/4, D(A) = m(2m²+3m-5)/72
+    through B = (A + 0.5 - E(A))/sqrt(D(A)) ~ N(0, 1).
+
+    Both decisions are returned.  As printed ("stationary if B < 1.96") the rule is one-sided:
+    it only detects an *increasing* level (many larger later values); a decreasing trend gives a
+    large negative B and passes.  ``stationary`` is the two-sided version |B| < z_{1-alpha/2}
+    (with the continuity correction toward E(A)), which is the test of Bendat & Piersol.
+    """
+    y = _series(y)
+    m = int(segments)
+    if m != segments or m < 2:
+        raise ValueError(f"segments must be an integer >= 2, got {segments}")
+    if y.size < 2 * m:
+        raise ValueError(f"a series of {y.size} samples cannot be cut into {m} segments of >= 2 samples; use fewer segments")
+    if not 0 < alpha < 1:
+        raise ValueError("alpha must lie in (0, 1)")
+    L = y.size // m
+    means = y[: L * m].reshape(m, L).mean(axis=1)
+    A = inversion_count(means)
+    EA, DA = inversion_moments(m)
+    z = float(stats.norm.ppf(1 - alpha / 2))
+    B = (A + 0.5 - EA) / math.sqrt(DA)
+    B2 = max(abs(A - EA) - 0.5, 0.0) / math.sqrt(DA)
+    return InversionTest(m, means, A, EA, DA, B, z, bool(B < z), B2, bool(B2 < z))
+
+
+def stationarity_report(y, segments: int, *, alpha: float = 0.05, regression: str = "c") -> pd.DataFrame:
+    """The inversion test next to statsmodels' ADF and KPSS tests (chen2019 §3 step 2 cross-check).
+
+    ADF: null = unit root (stationary when rejected).  KPSS: null = level stationarity
+    (stationary when *not* rejected; statsmodels' p-value is truncated to [0.01, 0.1]).
+    Returns one row per test: ``test``, ``statistic``, ``threshold``, ``stationary``.
+    """
+    from statsmodels.tsa.stattools import adfuller, kpss
+
+    y = _series(y, min_length=20)
+    inv = inversion_test(y, segments, alpha=alpha)
+    adf = adfuller(y, regression=regression, autolag="AIC", result_object=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # InterpolationWarning when the p-value is off the table
+        kp = kpss(y, regression=regression, nlags="auto", result_object=False)
+    return pd.DataFrame([
+        dict(test=f"inversion, as printed (m={segments})", statistic=inv.statistic, threshold=inv.critical,
+             stationary=inv.stationary_printed),
+        dict(test=f"inversion, two-sided (m={segments})", statistic=inv.statistic_two_sided,
+             threshold=inv.critical, stationary=inv.stationary),
+        dict(test="ADF (null: unit root)", statistic=adf[0], threshold=adf[4][f"{int(alpha * 100)}%"]
+             if f"{int(alpha * 100)}%" in adf[4] else adf[4]["5%"], stationary=bool(adf[1] < alpha)),
+        dict(test="KPSS (null: stationary)", statistic=kp[0], threshold=kp[3]["5%"], stationary=bool(kp[1] > alpha)),
+    ])
+
+
+def difference(y, d: int = 1) -> np.ndarray:
+    """The d-th difference (1 - B)^d y_t (chen2019 Fig. 3-4, 差分平稳处理)."""
+    y = _series(y)
+    if int(d) != d or d < 0:
+        raise ValueError(f"the differencing order d must be a non-negative integer, got {d}")
+    if y.size <= d + 2:
+        raise ValueError(f"a series of {y.size} samples is too short to difference {d} times")
+    return np.diff(y, n=int(d)) if d else y.copy()
+
+
+def make_stationary(y, segments: int, *, max_d: int = 2, alpha: float = 0.05) -> tuple[np.ndarray, int, InversionTest]:
+    """Difference until the (two-sided) inversion test accepts stationarity (chen2019 Fig. 3-4).
+
+    Returns ``(series, d, test)``.  Raises :class:`NonStationaryError` when ``max_d`` differences
+    do not suffice.
+    """
+    y = _series(y)
+    for d in range(max_d + 1):
+        yd = difference(y, d)
+        t = inversion_test(yd, segments, alpha=alpha)
+        if t.stationary:
+            return yd, d, t
+    raise NonStationaryError(
+        f"still non-stationary after {max_d} differences (inversion statistic {t.statistic_two_sided:.2f} >= "
+        f"{t.critical:.2f}); remove the deterministic trend or check the series"
+    )
+
+
+# --------------------------------------------------------------------------- identification
+
+def acf_printed(y, nlags: int) -> np.ndarray:
+    """Sample ACF exactly as chen2019 eq. (3-9): gamma_k = (1/n) sum_j y_j y_{j+k}, rho_k = gamma_k/gamma_0.
+
+    No mean is removed (the printed formula assumes a zero-mean series); equal to statsmodels
+    ``acf(y, adjusted=False, demean=False)``.
+    """
+    y = _series(y)
+    if not 1 <= nlags < y.size:
+        raise ValueError(f"nlags must lie in [1, {y.size - 1}], got {nlags}")
+    n = y.size
+    g = np.array([y[: n - k] @ y[k:] / n for k in range(nlags + 1)])
+    if g[0] == 0:
+        raise ValueError("the series is identically zero")
+    return g / g[0]
+
+
+def pacf_printed(y, nlags: int) -> np.ndarray:
+    """Sample PACF by solving the Yule-Walker system of chen2019 eq. (3-10) for k = 1..nlags.
+
+    phi_kk is the last element of the solution of R_k phi_k = rho_(1..k) with the Toeplitz
+    matrix R_k of the (3-9) autocorrelations.  Returns [1, phi_11, ..., phi_KK] (lag 0 = 1, as
+    statsmodels); equal to statsmodels ``pacf(y, method='ywm')`` on a zero-mean series.
+    """
+    rho = acf_printed(y, nlags)
+    out = [1.0]
+    for k in range(1, nlags + 1):
+        out.append(linalg.solve_toeplitz(rho[:k], rho[1 : k + 1])[-1])
+    return np.array(out)
+
+
+def correlogram(y, nlags: int, *, alpha: float = 0.05) -> pd.DataFrame:
+    """ACF (3-9) and PACF (3-10) with confidence bands, from statsmodels (chen2019 Fig. 4-23).
+
+    The series is demeaned.  ``acf_band``: Bartlett's half-width z sqrt((1 + 2 sum_{j<k} r_j²)/n)
+    (the band under the hypothesis that the ACF is zero beyond lag k-1, i.e. MA(k-1));
+    ``pacf_band``: z/sqrt(n) (the band under AR(k-1)).  Index: lag 1..nlags.
+    """
+    from statsmodels.tsa.stattools import acf, pacf
+
+    y = _series(y, min_length=10)
+    if not 1 <= nlags < y.size // 2:
+        raise ValueError(f"nlags must lie in [1, {y.size // 2 - 1}] for a series of {y.size} samples")
+    r, rci = acf(y, nlags=nlags, alpha=alpha, adjusted=False, fft=True, result_object=False)
+    pc, pci = pacf(y, nlags=nlags, alpha=alpha, method="ywm", result_object=False)
+    lags = np.arange(nlags + 1)
+    df = pd.DataFrame({
+        "lag": lags, "acf": r, "acf_band": rci[:, 1] - r, "pacf": pc, "pacf_band": pci[:, 1] - pc,
+    }).iloc[1:].set_index("lag")
+    return df
+
+
+def cutoff_lag(values, band, *, max_lag: int, alpha: float = 0.05) -> int | None:
+    """Where a correlation function 'cuts off' (截尾), or None when it 'tails off' (拖尾).
+
+    Decision rule (chen2019 Table 3-1 made computational).  For lags k = 1..K with values c_k
+    and band half-widths b_k at level ``alpha`` (z = z_{1-alpha/2}), the function cuts off after
+    lag q (0 <= q <= ``max_lag``) when
+
+    (i)   q = 0, or lag q itself is significant, |c_q| > b_q;
+    (ii)  the number of lags in q+1..K outside the band is no more than chance allows: at most
+          the 99 % quantile of Binomial(K - q, alpha);
+    (iii) no lag in q+1..K is strongly significant: |c_k| <= b_k z_B / z with the Bonferroni
+          quantile z_B = z_{1 - alpha/(2(K - q))}.
+
+    The smallest such q is returned; if there is none up to ``max_lag`` the function tails off.
+    """
+    c = np.asarray(values, dtype=float)
+    b = np.broadcast_to(np.asarray(band, dtype=float), c.shape)
+    if c.ndim != 1 or c.size < 2:
+        raise ValueError("values must be a 1-D array of lags 1..K (K >= 2)")
+    if max_lag < 0 or max_lag >= c.size:
+        raise ValueError(f"max_lag must lie in [0, {c.size - 1}] for {c.size} lags")
+    if not 0 < alpha < 1:
+        raise ValueError("alpha must lie in (0, 1)")
+    K = c.size
+    z = stats.norm.ppf(1 - alpha / 2)
+    ratio = np.abs(c) / b
+    for q in range(0, max_lag + 1):
+        if q > 0 and not ratio[q - 1] > 1:
+            continue
+        rest = ratio[q:]
+        allowed = stats.binom.ppf(0.99, K - q, alpha)
+        zb = stats.norm.ppf(1 - alpha / (2 * (K - q)))
+        if np.sum(rest > 1) <= allowed and np.all(rest <= zb / z):
+            return q
+    return None
+
+
+@dataclass(frozen=True)
+class Identification:
+    """Model class chosen by the Table 3-1 rules (:func:`identify_model`)."""
+
+    model: str
+    """'AR', 'MA', 'ARMA' or 'white noise'."""
+    order: int | None
+    """p for AR, q for MA, None for ARMA (orders then come from AIC)."""
+    acf_cutoff: int | None
+    pacf_cutoff: int | None
+    note: str
+
+
+def identify_model(y, *, nlags: int | None = None, max_order: int = 10, alpha: float = 0.05) -> Identification:
+    """Apply chen2019 Table 3-1 to the correlogram of ``y``.
+
+    ACF tails off and PACF cuts off after p -> AR(p); ACF cuts off after q and PACF tails off ->
+    MA(q); both tail off -> ARMA (orders by AIC).  When both cut off the shorter description is
+    taken (AR on a tie) and the note says so; both cutting off at 0 is white noise.  Cut-off as
+    defined in :func:`cutoff_lag` with ``max_lag = max_order``; ``nlags`` defaults to
+    min(4 max_order, n/4).
+    """
+    y = _series(y, min_length=4 * max_order + 10)
+    nlags = nlags or int(min(4 * max_order, y.size // 4))
+    cg = correlogram(y, nlags, alpha=alpha)
+    qa = cutoff_lag(cg["acf"], cg["acf_band"], max_lag=max_order, alpha=alpha)
+    qp = cutoff_lag(cg["pacf"], cg["pacf_band"], max_lag=max_order, alpha=alpha)
+    if qa is None and qp is None:
+        return Identification("ARMA", None, None, None, "ACF and PACF both tail off")
+    if qa is None:
+        return Identification("AR", qp, None, qp, f"ACF tails off, PACF cuts off after lag {qp}")
+    if qp is None:
+        return Identification("MA", qa, qa, None, f"ACF cuts off after lag {qa}, PACF tails off")
+    if qa == 0 and qp == 0:
+        return Identification("white noise", 0, 0, 0, "no significant correlation")
+    if qp <= qa:
+        return Identification("AR", qp, qa, qp, f"both cut off (ACF after {qa}, PACF after {qp}); the shorter, AR({qp}), is taken")
+    return Identification("MA", qa, qa, qp, f"both cut off (ACF after {qa}, PACF after {qp}); the shorter, MA({qa}), is taken")
+
+
+# --------------------------------------------------------------------------- estimation
+
+def ar_design(y, p: int) -> tuple[np.ndarray, np.ndarray]:
+    """The matrices C ((n-p) x p) and D (n-p) of chen2019 eq. (3-12).
+
+    Row t of C is [y_{t-1}, ..., y_{t-p}] for t = p+1..n (1-based), D = [y_{p+1}, ..., y_n].
+    """
+    y = _series(y)
+    if int(p) != p or p < 1:
+        raise ValueError(f"the AR order p must be a positive integer, got {p}")
+    if y.size <= 2 * p:
+        raise ValueError(f"a series of {y.size} samples is too short for AR({p}) (need > {2 * p})")
+    n = y.size
+    C = np.column_stack([y[p - i - 1 : n - i - 1] for i in range(p)])
+    return C, y[p:]
+
+
+def ar_least_squares(y, p: int) -> tuple[np.ndarray, float]:
+    """AR(p) least squares phi = (C^T C)^{-1} C^T D, chen2019 eqs. (3-11)-(3-12).
+
+    Returns ``(phi, sigma2)`` with sigma2 = RSS/(n-p), the maximum-likelihood residual variance
+    of the conditional fit (statsmodels' ``AutoReg(...).fit().sigma2``).  No intercept, as (3-11):
+    demean the series first if its mean is not zero.
+    """
+    C, D = ar_design(y, p)
+    phi, *_ = np.linalg.lstsq(C, D, rcond=None)
+    res = D - C @ phi
+    return phi, float(res @ res / D.size)
+
+
+def fit_ar(y, p: int, *, segments: int = 20, alpha: float = 0.05, check: bool = True, demean: bool = True):
+    """Fit AR(p) by conditional least squares with statsmodels ``AutoReg`` (chen2019 eq. 3-11/3-12).
+
+    Returns the statsmodels ``AutoRegResults`` (``.params`` = phi, ``.sigma2``, ``.aic`` ...).
+    With ``check`` (the default) the premise of chen2019 step 2 is enforced: the series must pass
+    the two-sided inversion test with ``segments`` and the ADF test (at most max(12, 2p)
+    augmentation lags, chosen by AIC) must reject a unit root, and
+    the fitted poles must lie inside the unit circle; otherwise :class:`NonStationaryError` says
+    which check failed and what to do.
+    """
+    from statsmodels.tsa.ar_model import AutoReg
+    from statsmodels.tsa.stattools import adfuller
+
+    y = _series(y, min_length=max(2 * segments, 2 * p + 2))
+    if int(p) != p or p < 1:
+        raise ValueError(f"the AR order p must be a positive integer, got {p}")
+    if demean:
+        y = y - y.mean()
+    if check:
+        t = inversion_test(y, segments, alpha=alpha)
+        if not t.stationary:
+            raise NonStationaryError(
+                f"the series is not stationary: inversion test statistic {t.statistic_two_sided:.2f} >= "
+                f"{t.critical:.2f} with m={segments} segments (A={t.count}, E(A)={t.expected:.1f}). "
+                f"chen2019 step 2 fits AR models to stationary series only: difference it first "
+                f"(timeseries.difference / make_stationary) or remove the trend"
+            )
+        adf_p = adfuller(y, maxlag=max(12, 2 * int(p)), regression="c", autolag="AIC", result_object=False)[1]
+        if adf_p >= alpha:
+            raise NonStationaryError(
+                f"the series is not stationary: the ADF test cannot reject a unit root (p = {adf_p:.3f} >= "
+                f"{alpha}). Difference it first (timeseries.difference / make_stationary)"
+            )
+    res = AutoReg(y, int(p), trend="n").fit()
+    if check and not is_stationary(res.params):
+        raise NonStationaryError(
+            f"the fitted AR({p}) model is not stationary (largest pole modulus "
+            f"{np.max(np.abs(ar_poles(res.params))):.4f} >= 1); difference the series or lower the order"
+        )
+    return res
+
+
+# --------------------------------------------------------------------------- order by AIC
+
+def order_cap(n: int) -> int:
+    """The order cap floor(sqrt(n)) of chen2019 §3 step 2 (模型阶数的上限为 sqrt(n))."""
+    if int(n) != n or n < 1:
+        raise ValueError(f"n must be a positive integer, got {n}")
+    return int(math.isqrt(int(n)))
+
+
+def aic_by_order(y, max_order: int | None = None, *, demean: bool = True) -> pd.DataFrame:
+    """AIC of AR(0..max_order) fitted on a common sample, in the normalizations in use (chen2019 eq. 3-13).
+
+    ``max_order`` defaults to (and may not exceed) the cap floor(sqrt(n)).  Every order is fitted
+    by statsmodels ``AutoReg(y, p, trend='n', hold_back=max_order)`` so that all fits use the same
+    N = n - max_order observations (as ``ar_select_order``).  Columns:
+
+    * ``aic`` — statsmodels' raw AIC, -2 ln L + 2(p + 1) (the +1 counts the noise variance);
+    * ``aic_printed_form`` — -2 ln L + 2p, the form of (3-13) with natural logarithms;
+    * ``aic_per_obs`` — aic / N = ln(2 pi sigma²) + 1 + 2(p + 1)/N;
+    * ``aic_log_sigma2`` — ln sigma² + 2p/N (Lütkepohl's / MATLAB's normalized AIC);
+    * ``sigma2`` (ML residual variance), ``llf``, ``nobs``.
+
+    All three normalizations select the same order.  A per-observation AIC can rise from one
+    order to the next by at most 2/N (a nested fit cannot lower the likelihood).
+    """
+    from statsmodels.tsa.ar_model import AutoReg
+
+    y = _series(y, min_length=8)
+    if demean:
+        y = y - y.mean()
+    cap = order_cap(y.size)
+    if max_order is None:
+        max_order = cap
+    if int(max_order) != max_order or max_order < 1:
+        raise ValueError(f"max_order must be a positive integer, got {max_order}")
+    if max_order > cap:
+        raise ValueError(f"max_order {max_order} exceeds the cap floor(sqrt(n)) = {cap} of chen2019 §3 step 2")
+    rows = []
+    for p in range(0, int(max_order) + 1):
+        r = AutoReg(y, p, trend="n", hold_back=int(max_order)).fit()
+        N = r.nobs
+        rows.append(dict(order=p, nobs=N, sigma2=r.sigma2, llf=r.llf, aic=r.aic,
+                         aic_printed_form=-2 * r.llf + 2 * p, aic_per_obs=r.aic / N,
+                         aic_log_sigma2=math.log(r.sigma2) + 2 * p / N))
+    return pd.DataFrame(rows).set_index("order")
+
+
+def select_order(y, max_order: int | None = None, *, demean: bool = True) -> int:
+    """AR order minimizing AIC over 1..min(max_order, sqrt(n)), by statsmodels ``ar_select_order``."""
+    from statsmodels.tsa.ar_model import ar_select_order
+
+    y = _series(y, min_length=8)
+    if demean:
+        y = y - y.mean()
+    cap = order_cap(y.size)
+    m = cap if max_order is None else min(int(max_order), cap)
+    sel = ar_select_order(y, m, ic="aic", trend="n")
+    return int(max(sel.ar_lags)) if sel.ar_lags else 0
+
+
+def aic_increment_bound(aic_values, *, penalty_per_order: float = 2.0) -> dict:
+    """What the order-to-order increments of an AIC column imply about its normalization.
+
+    For nested fits on one sample the likelihood never decreases with the order, so
+    AIC(p+1) - AIC(p) <= ``penalty_per_order`` x s, where s is the scale of the normalization
+    (s = 1 for raw AIC, 1/N for a per-observation AIC).  Returns the largest increment, the
+    smallest scale it requires (s >= increment/penalty) and, for a per-observation
+    normalization, the largest series length N <= penalty/increment compatible with it.
+    """
+    a = np.asarray(aic_values, dtype=float)
+    if a.ndim != 1 or a.size < 2 or not np.all(np.isfinite(a)):
+        raise ValueError("aic_values must be a 1-D array of AIC values for consecutive orders")
+    inc = np.diff(a)
+    k = int(np.argmax(inc))
+    mx = float(inc[k])
+    return dict(max_increment=mx, at_order=k + 1, min_scale=mx / penalty_per_order,
+                max_length_per_obs=(penalty_per_order / mx) if mx > 0 else math.inf)
+
+
+# --------------------------------------------------------------------------- AR model checks
+
+def ar_poles(phi) -> np.ndarray:
+    """Poles of y_t = sum phi_i y_{t-i} + w_t: roots of z^p - phi_1 z^{p-1} - ... - phi_p."""
+    phi = _phi(phi)
+    return np.roots(np.r_[1.0, -phi])
+
+
+def is_stationary(phi) -> bool:
+    """True when every pole lies strictly inside the unit circle (statsmodels ``ArmaProcess.isstationary``)."""
+    return bool(np.all(np.abs(ar_poles(phi)) < 1.0))
+
+
+def _require_stationary(phi, what: str = "the AR model") -> np.ndarray:
+    phi = _phi(phi)
+    if not is_stationary(phi):
+        raise NonStationaryError(
+            f"{what} is not stationary (largest pole modulus {np.max(np.abs(ar_poles(phi))):.4f} >= 1): "
+            f"it has no stationary autocorrelation or variance"
+        )
+    return phi
+
+
+def ar_autocorrelation(phi, nlags: int) -> np.ndarray:
+    """Theoretical ACF rho_0..rho_nlags of a stationary AR model (statsmodels ``ArmaProcess.acf``)."""
+    from statsmodels.tsa.arima_process import ArmaProcess
+
+    phi = _require_stationary(phi)
+    return ArmaProcess(np.r_[1.0, -phi], [1.0]).acf(nlags + 1)
+
+
+def ar_variance(phi, sigma2: float) -> float:
+    """Stationary variance gamma_0 = sigma2 / (1 - sum phi_i rho_i) of an AR model."""
+    phi = _require_stationary(phi)
+    if not sigma2 > 0:
+        raise ValueError("the noise variance sigma2 must be positive")
+    rho = ar_autocorrelation(phi, phi.size)
+    return float(sigma2 / (1.0 - phi @ rho[1 : phi.size + 1]))
+
+
+def check_ar_model(phi, sigma2: float, *, dt: float | None = None, speed: float | None = None) -> dict:
+    """The checks a careful analyst makes before using an AR model as a shaping filter.
+
+    Applied to chen2019 eq. (4-13).  Returns a dict with: ``max_pole_modulus`` and
+    ``stationary``; ``dominant_pole`` (largest modulus); ``negative_real_pole`` (a pole on the
+    negative real axis: the series alternates in sign and no real continuous-time process
+    sampled at dt has this model); and, for a stationary model, ``rho1``, ``variance``, ``std``,
+    ``variance_ratio`` (gamma_0/sigma2), ``peak_frequency`` (fraction of the Nyquist frequency
+    where the AR spectrum peaks), ``correlation_samples`` (-1/ln|dominant pole|), and with ``dt``
+    the correlation time (s), with ``speed`` the correlation distance (m).
+    """
+    phi = _phi(phi)
+    if not sigma2 > 0:
+        raise ValueError("the noise variance sigma2 must be positive")
+    poles = ar_poles(phi)
+    mod = np.abs(poles)
+    dom = poles[np.argmax(mod)]
+    neg = bool(np.any((np.abs(poles.imag) < 1e-12) & (poles.real < 0)))
+    out = dict(order=phi.size, max_pole_modulus=float(mod.max()), stationary=bool(mod.max() < 1),
+               dominant_pole=complex(dom), negative_real_pole=neg)
+    if out["stationary"]:
+        rho = ar_autocorrelation(phi, 1)
+        var = ar_variance(phi, sigma2)
+        w, h = signal.freqz([1.0], np.r_[1.0, -phi], worN=4096)
+        out.update(rho1=float(rho[1]), variance=var, std=math.sqrt(var), variance_ratio=var / sigma2,
+                   peak_frequency=float(w[np.argmax(np.abs(h))] / np.pi),
+                   correlation_samples=float(-1.0 / math.log(abs(dom))))
+        if dt is not None:
+            if not dt > 0:
+                raise ValueError("dt must be positive (s)")
+            out["correlation_time"] = out["correlation_samples"] * dt
+            if speed is not None:
+                if not speed > 0:
+                    raise ValueError("speed must be positive (m/s)")
+                out["correlation_distance"] = out["correlation_time"] * speed
+    return out
+
+
+# --------------------------------------------------------------------------- order recovery
+
+def simulate_ar(phi, sigma2: float, n: int, n_series: int, rng: np.random.Generator, *, burn: int | None = None) -> np.ndarray:
+    """``n_series`` independent AR(p) series of length ``n`` (rows), vectorized with ``scipy.signal.lfilter``.
+
+    A burn-in of ``burn`` samples (default: 10 correlation lengths, at least 100) is discarded.
+    """
+    phi = _require_stationary(phi, "the model to simulate")
+    if not isinstance(rng, np.random.Generator):
+        raise TypeError("pass a seeded numpy Generator, e.g. np.random.default_rng(2019)")
+    if n < 2 or n_series < 1:
+        raise ValueError("n >= 2 and n_series >= 1 are required")
+    if burn is None:
+        burn = int(max(100, 10 * -1.0 / math.log(np.max(np.abs(ar_poles(phi))) + 1e-300)))
+    e = rng.standard_normal((n_series, n + burn)) * math.sqrt(sigma2)
+    return signal.lfilter([1.0], np.r_[1.0, -phi], e, axis=1)[:, burn:]
+
+
+def aic_batch(Y, max_order: int, *, chunk: int = 16) -> np.ndarray:
+    """Raw AIC (statsmodels' definition) of AR(0..max_order) for every row of ``Y``, vectorized.
+
+    Same common-sample conditional least squares as :func:`aic_by_order` (hold-back
+    ``max_order``, no intercept, rows demeaned): N = n - max_order, sigma²_p = RSS_p/N,
+    AIC_p = N (ln 2 pi sigma²_p + 1) + 2 (p + 1).  Solved from the normal equations of all
+    orders at once, ``chunk`` series at a time.  Returns shape (n_series, max_order + 1).
+    """
+    Y = np.asarray(Y, dtype=float)
+    if Y.ndim != 2:
+        raise ValueError("Y must have shape (n_series, n)")
+    K, n = Y.shape
+    P = int(max_order)
+    if P < 1 or n <= 3 * P:
+        raise ValueError(f"max_order must be >= 1 and the series longer than 3*max_order (n={n})")
+    Y = Y - Y.mean(axis=1, keepdims=True)
+    N = n - P
+    out = np.empty((K, P + 1))
+    for s in range(0, K, chunk):
+        Yc = Y[s : s + chunk]
+        X = np.stack([Yc[:, P - i - 1 : n - i - 1] for i in range(P)], axis=2)  # (k, N, P)
+        t = Yc[:, P:]
+        G = np.einsum("kni,knj->kij", X, X)
+        b = np.einsum("kni,kn->ki", X, t)
+        tt = np.einsum("kn,kn->k", t, t)
+        rss = np.empty((Yc.shape[0], P + 1))
+        rss[:, 0] = tt
+        for p in range(1, P + 1):
+            beta = np.linalg.solve(G[:, :p, :p], b[:, :p, None])[..., 0]
+            rss[:, p] = tt - np.einsum("ki,ki->k", b[:, :p], beta)
+        sig = rss / N
+        out[s : s + chunk] = N * (np.log(2 * np.pi * sig) + 1) + 2 * (np.arange(P + 1) + 1)
+    return out
+
+
+def order_recovery(phi, sigma2: float, n: int, *, n_series: int, max_order: int, seed: int) -> pd.Series:
+    """How often AIC selects each order for series of length ``n`` from a known AR model.
+
+    Simulated with :func:`simulate_ar` (seeded), scored with :func:`aic_batch` (orders
+    0..max_order, capped at sqrt(n)).  Returns the selection frequency indexed by order; the
+    frequency at ``len(phi)`` is the recovery rate.
+    """
+    phi = _phi(phi)
+    if max_order > order_cap(n):
+        raise ValueError(f"max_order {max_order} exceeds the cap floor(sqrt({n})) = {order_cap(n)}")
+    rng = np.random.default_rng(seed)
+    Y = simulate_ar(phi, sigma2, n, n_series, rng)
+    sel = np.argmin(aic_batch(Y, max_order), axis=1)
+    freq = np.bincount(sel, minlength=max_order + 1) / n_series
+    return pd.Series(freq, index=pd.RangeIndex(0, max_order + 1, name="order"), name=f"n={n}")

@@ -1,0 +1,235 @@
+"""Tests of replication.timeseries (chen2019 ch. 3 §3 step 2)."""
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from statsmodels.tsa.ar_model import AutoReg, ar_select_order
+from statsmodels.tsa.stattools import acf, pacf
+
+from replication import reproduction as rp
+from replication import timeseries as ts
+
+# statistical tolerances below are stated from the sampling distributions before comparing
+
+
+@pytest.fixture(scope="module")
+def ar3():
+    """A stationary AR(3) series of 2 h at 1 Hz (the sign-reversed chen2019 east model)."""
+    return ts.simulate_ar([0.9168, -0.0758, 0.0991], 1.0, 7200, 1, np.random.default_rng(2019))[0]
+
+
+# --------------------------------------------------------------------------- inversion test
+
+@pytest.mark.parametrize("m", [2, 3, 5, 7])
+def test_inversion_moments_equal_exact_permutation_moments(m):
+    counts = [ts.inversion_count(np.array(p, float)) for p in itertools.permutations(range(m))]
+    ea, da = ts.inversion_moments(m)
+    assert np.mean(counts) == pytest.approx(ea, abs=1e-12)
+    assert np.var(counts) == pytest.approx(da, abs=1e-12)
+
+
+def test_inversion_count_counts_larger_later_values():
+    assert ts.inversion_count([1, 2, 3, 4]) == 6
+    assert ts.inversion_count([4, 3, 2, 1]) == 0
+    assert ts.inversion_count([2, 1, 3]) == 2
+
+
+def test_inversion_test_on_known_inputs():
+    rng = np.random.default_rng(1)
+    white = rng.standard_normal(4000)
+    t = np.arange(4000)
+    up = 0.002 * t + rng.standard_normal(4000)
+    down = -0.002 * t + rng.standard_normal(4000)
+    w = ts.inversion_test(white, 20)
+    assert w.stationary and w.stationary_printed
+    u = ts.inversion_test(up, 20)
+    assert not u.stationary and not u.stationary_printed
+    d = ts.inversion_test(down, 20)
+    # the printed one-sided rule "stationary if B < 1.96" accepts a decreasing trend
+    assert d.stationary_printed and d.statistic < -1.96
+    assert not d.stationary
+
+
+def test_inversion_test_rejects_bad_segments():
+    with pytest.raises(ValueError, match="segments"):
+        ts.inversion_test(np.zeros(10), 1)
+    with pytest.raises(ValueError, match="fewer segments"):
+        ts.inversion_test(np.zeros(10), 8)
+
+
+def test_stationarity_report_on_white_noise_and_random_walks():
+    rng = np.random.default_rng(7)
+    rep = ts.stationarity_report(rng.standard_normal(3000), 20).set_index("test")["stationary"]
+    assert rep.all()
+    # 40 random walks: ADF keeps the unit root and KPSS rejects stationarity in ~95 % of cases each;
+    # requiring >= 80 % leaves a binomial margin of > 3 sigma
+    walks = np.cumsum(rng.standard_normal((40, 1000)), axis=1)
+    verdicts = np.array([ts.stationarity_report(w, 20)["stationary"].to_numpy() for w in walks])
+    assert (~verdicts[:, 2]).mean() >= 0.8 and (~verdicts[:, 3]).mean() >= 0.8
+
+
+def test_difference_and_make_stationary():
+    rng = np.random.default_rng(3)
+    rw = np.cumsum(rng.standard_normal(3000))
+    np.testing.assert_array_equal(ts.difference(rw, 1), np.diff(rw))
+    y, d, t = ts.make_stationary(rw, 20)
+    assert d == 1 and t.stationary
+    with pytest.raises(ValueError, match="non-negative"):
+        ts.difference(rw, -1)
+
+
+# --------------------------------------------------------------------------- identification
+
+def test_acf_and_pacf_as_printed_equal_statsmodels(ar3):
+    y = ar3 - ar3.mean()
+    np.testing.assert_allclose(ts.acf_printed(y, 12), acf(ar3, nlags=12, adjusted=False, fft=False), atol=1e-12)
+    np.testing.assert_allclose(ts.pacf_printed(y, 12), pacf(ar3, nlags=12, method="ywm"), atol=1e-10)
+
+
+def test_correlogram_bands():
+    y = np.random.default_rng(0).standard_normal(2500)
+    cg = ts.correlogram(y, 10)
+    np.testing.assert_allclose(cg["pacf_band"], 1.959964 / math.sqrt(2500), rtol=1e-5)
+    assert cg["acf_band"].iloc[0] == pytest.approx(1.959964 / math.sqrt(2500), rel=1e-5)
+    assert (np.diff(cg["acf_band"]) >= 0).all()  # Bartlett's band widens with the lag
+
+
+def test_cutoff_lag_rule():
+    band = np.full(30, 0.05)
+    c = np.zeros(30)
+    c[:2] = [0.5, 0.3]
+    assert ts.cutoff_lag(c, band, max_lag=10) == 2
+    slow = 0.95 ** np.arange(1, 31)
+    assert ts.cutoff_lag(slow, band, max_lag=10) is None
+    gap = c.copy()
+    gap[4] = 0.5  # a strong value after a gap is not chance
+    assert ts.cutoff_lag(gap, band, max_lag=10) == 5
+
+
+@pytest.mark.parametrize("kind", ["AR2", "MA1", "white"])
+def test_identify_model_on_known_processes(kind):
+    rng = np.random.default_rng(11)
+    if kind == "AR2":
+        y = ts.simulate_ar([1.2, -0.5], 1.0, 5000, 1, rng)[0]
+        expect = ("AR", 2)
+    elif kind == "MA1":
+        e = rng.standard_normal(5001)
+        y = e[1:] + 0.7 * e[:-1]
+        expect = ("MA", 1)
+    else:
+        y = rng.standard_normal(5000)
+        expect = ("white noise", 0)
+    ident = ts.identify_model(y)
+    assert (ident.model, ident.order) == expect
+
+
+# --------------------------------------------------------------------------- estimation
+
+@pytest.mark.parametrize("p", [1, 3, 6])
+def test_least_squares_equals_autoreg(ar3, p):
+    y = ar3 - ar3.mean()
+    phi, s2 = ts.ar_least_squares(y, p)
+    r = AutoReg(y, p, trend="n").fit()
+    np.testing.assert_allclose(phi, r.params, rtol=1e-9, atol=1e-12)
+    assert s2 == pytest.approx(r.sigma2, rel=1e-10)
+    fit = ts.fit_ar(ar3, p)
+    np.testing.assert_allclose(fit.params, r.params, rtol=1e-9, atol=1e-12)
+
+
+def test_design_matrix_as_printed():
+    C, D = ts.ar_design(np.arange(1.0, 8.0), 3)
+    np.testing.assert_array_equal(C[0], [3, 2, 1])
+    np.testing.assert_array_equal(C[-1], [6, 5, 4])
+    np.testing.assert_array_equal(D, [4, 5, 6, 7])
+
+
+def test_fit_ar_refuses_non_stationary_input():
+    rng = np.random.default_rng(5)
+    rw = np.cumsum(rng.standard_normal(5000))
+    with pytest.raises(ts.NonStationaryError, match="not stationary.*difference"):
+        ts.fit_ar(rw, 2)
+    trend = 0.001 * np.arange(5000) + rng.standard_normal(5000)
+    with pytest.raises(ts.NonStationaryError, match="inversion test"):
+        ts.fit_ar(trend, 2)
+    ts.fit_ar(np.diff(rw), 2)  # the differenced walk is accepted
+
+
+def test_fit_ar_estimates_true_coefficients(ar3):
+    # 2 h at 1 Hz: standard errors ~ 1/sqrt(7200) = 0.012; 4 sigma = 0.05
+    fit = ts.fit_ar(ar3, 3)
+    np.testing.assert_allclose(fit.params, [0.9168, -0.0758, 0.0991], atol=0.05)
+
+
+# --------------------------------------------------------------------------- AIC
+
+def test_aic_normalizations_and_statsmodels(ar3):
+    tab = ts.aic_by_order(ar3, 10)
+    sel = ar_select_order(ar3 - ar3.mean(), 10, ic="aic", trend="n")
+    for p in range(1, 11):
+        assert tab.loc[p, "aic"] == pytest.approx(sel.aic[tuple(range(1, p + 1))], rel=1e-10)
+    assert len({tab[c].iloc[1:].idxmin() for c in ("aic", "aic_per_obs", "aic_log_sigma2", "aic_printed_form")}) == 1
+    N = tab["nobs"].iloc[0]
+    assert (np.diff(tab["aic_per_obs"]) <= 2 / N + 1e-12).all()
+    assert (np.diff(tab["aic_log_sigma2"]) <= 2 / N + 1e-12).all()
+    np.testing.assert_allclose(tab["aic_per_obs"] - tab["aic_log_sigma2"],
+                               np.log(2 * np.pi) + 1 + 2 / N, rtol=1e-12)
+    assert ts.select_order(ar3, 10) == tab["aic"].iloc[1:].idxmin()
+
+
+def test_order_cap():
+    assert ts.order_cap(7200) == 84
+    assert ts.order_cap(100) == 10
+    with pytest.raises(ValueError, match="cap"):
+        ts.aic_by_order(np.random.default_rng(0).standard_normal(50), 8)
+
+
+def test_batch_aic_equals_statsmodels():
+    Y = ts.simulate_ar([0.6, 0.2], 1.0, 600, 4, np.random.default_rng(9))
+    ab = ts.aic_batch(Y, 8)
+    for i in range(4):
+        np.testing.assert_allclose(ab[i], ts.aic_by_order(Y[i], 8)["aic"].values, rtol=1e-9)
+
+
+def test_printed_table_4_49_increments_need_very_short_series():
+    paper = rp.load_paper("chen2019-table-4-49")
+    east = [paper.value(f"AIC AR({p}) dg_E") for p in range(1, 11)]
+    b = ts.aic_increment_bound(east)
+    assert b["at_order"] == 8 and b["max_increment"] == pytest.approx(0.1711, abs=1e-9)
+    assert b["max_length_per_obs"] < 12  # far below the 100 samples the sqrt(n) cap needs for AR(10)
+
+
+# --------------------------------------------------------------------------- model checks
+
+def test_ar1_checks_closed_form():
+    c = ts.check_ar_model([0.5], 3.0, dt=2.0, speed=10.0)
+    assert c["stationary"] and c["variance"] == pytest.approx(3.0 / 0.75)
+    assert c["rho1"] == pytest.approx(0.5)
+    assert c["correlation_time"] == pytest.approx(2.0 / math.log(2.0))
+    assert c["correlation_distance"] == pytest.approx(20.0 / math.log(2.0))
+    neg = ts.check_ar_model([-0.5], 1.0)
+    assert neg["negative_real_pole"] and neg["peak_frequency"] == pytest.approx(1.0, abs=1e-3)
+
+
+def test_printed_east_model_is_not_stationary():
+    paper = rp.load_paper("chen2019-eq-4-13")
+    phi = [paper.value(f"phi{i} dg_E") for i in (1, 2, 3)]
+    c = ts.check_ar_model(phi, paper.value("noise variance dg_E"))
+    assert not c["stationary"] and c["max_pole_modulus"] > 1.07
+    assert ts.is_stationary(-np.asarray(phi))  # the sign-reversed (A-polynomial) reading is stable
+    with pytest.raises(ts.NonStationaryError):
+        ts.ar_variance(phi, 1.0)
+
+
+def test_simulated_variance_matches_theory():
+    phi = [0.9168, -0.0758, 0.0991]
+    Y = ts.simulate_ar(phi, 1.0, 20000, 20, np.random.default_rng(4))
+    # 20 x 20000 samples with a correlation length of ~18 samples: ~2e4 effective samples, 5 % is > 5 sigma
+    assert Y.var() == pytest.approx(ts.ar_variance(phi, 1.0), rel=0.05)
+
+
+def test_order_recovery_of_a_clear_ar1():
+    f = ts.order_recovery([0.7], 1.0, 2000, n_series=200, max_order=10, seed=1)
+    assert f.sum() == pytest.approx(1.0)
+    assert f[0] == 0 and f[1] > 0.5  # AIC never underfits here; overfitting keeps it below 1
