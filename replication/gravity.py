@@ -1,0 +1,461 @@
+"""Gravity disturbance: a synthetic field, the direct difference, AR shaping filters (chen2019 ch. 3).
+
+* :class:`PlanarGravityField` / :func:`synthetic_field` — a harmonic (Laplace-consistent)
+  random disturbance field on a local plane, vertical and horizontal components from one
+  disturbing potential, with a documented covariance; sampled along a track and converted from
+  space to time by the ground speed (:func:`survey_lines`, :meth:`PlanarGravityField.sample`).
+* :func:`direct_difference` — chen2019 eq. (3-7): SINS specific force against the GNSS
+  kinematic acceleration; :func:`direct_difference_error` — its perturbation (3-8).
+* :func:`gnss_acceleration`, :func:`lowpass`, :func:`differentiation_noise_std`,
+  :func:`filtered_differentiation_noise_std` — the noise that differentiating GNSS velocity or
+  position adds and the low-pass filtering it needs.
+* :func:`ar_companion`, :func:`ar_state_space`, :func:`gravity_augmentation`,
+  :func:`augment_transition`, :func:`specific_force_measurement` — the AR model of step 2 in
+  companion (state-space) form for the augmented filter of chen2019 eqs. (3-14)-(3-18).
+
+Frames: local-level ENU (x east, y north, z up), SI units inside; ``units.MGAL`` converts.
+The disturbance vector is delta g^n = g^n - g_m^n (chen2019 eq. 3-6), i.e. the gradient of the
+disturbing potential T: [dT/dx, dT/dy, dT/dz]; its up component is minus the scalar gravity
+disturbance of geodesy (a stronger downward pull gives a negative up component).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import integrate, interpolate, signal
+
+from . import earth
+from .timeseries import _phi, ar_poles, is_stationary
+from .units import MGAL
+
+__all__ = [
+    "PlanarGravityField", "vertical_psd", "field_std", "synthetic_field", "survey_lines",
+    "specific_force_nav", "direct_difference", "direct_difference_error", "attitude_error_equivalent",
+    "gnss_acceleration", "lowpass", "differentiation_noise_std", "filtered_differentiation_noise_std",
+    "ar_companion", "ar_state_space", "GravityAugmentation", "gravity_augmentation",
+    "augment_transition", "specific_force_measurement",
+]
+
+
+# --------------------------------------------------------------------------- synthetic field
+
+def vertical_psd(k, sigma: float, correlation_length: float, altitude: float = 0.0):
+    """2-D power spectral density of the vertical disturbance component ((m/s²)² m²).
+
+    Covariance model: at ground level (z = 0) the vertical component is an isotropic process
+    with the exponential (planar first-order Markov) covariance C(r) = sigma² exp(-r/D),
+    D = ``correlation_length``; its 2-D spectrum is S(k) = 2 pi sigma² D² / (1 + (k D)²)^{3/2}
+    (k in rad/m).  Harmonic upward continuation to ``altitude`` multiplies by exp(-2 k h).
+    For a harmonic field the horizontal components have S_x = (k_x/k)² S and S_y = (k_y/k)² S,
+    so each carries half of the vertical variance.
+    """
+    k = np.asarray(k, dtype=float)
+    if not (sigma > 0 and correlation_length > 0 and altitude >= 0):
+        raise ValueError("sigma and correlation_length must be positive and altitude >= 0 (SI units)")
+    D = correlation_length
+    return 2 * np.pi * sigma**2 * D**2 / (1 + (k * D) ** 2) ** 1.5 * np.exp(-2 * k * altitude)
+
+
+def field_std(sigma: float, correlation_length: float, altitude: float) -> tuple[float, float]:
+    """Standard deviations (vertical, each horizontal) of the model at ``altitude`` (m/s²).
+
+    var_z(h) = (1/2 pi) int_0^inf S(k) k dk = sigma² int_0^inf u (1 + u²)^{-3/2} exp(-2 u h / D) du
+    (u = k D; the integral is 1 at ground level), var_x = var_y = var_z / 2.
+    """
+    if not (sigma > 0 and correlation_length > 0 and altitude >= 0):
+        raise ValueError("sigma and correlation_length must be positive and altitude >= 0 (SI units)")
+    c = 2 * altitude / correlation_length
+    v, _ = integrate.quad(lambda u: u * (1 + u * u) ** -1.5 * math.exp(-c * u), 0, np.inf, limit=200)
+    v *= sigma**2
+    return math.sqrt(v), math.sqrt(v / 2)
+
+
+@dataclass
+class PlanarGravityField:
+    """A gravity-disturbance field on a regular east/north grid at a fixed altitude.
+
+    ``dg`` has shape (n_north, n_east, 3): the ENU disturbance vector (m/s²) at each node.
+    """
+
+    east: np.ndarray
+    north: np.ndarray
+    dg: np.ndarray = field(repr=False)
+    sigma: float
+    correlation_length: float
+    altitude: float
+    seed: int | None = None
+
+    def __post_init__(self):
+        self._interp = [
+            interpolate.RegularGridInterpolator((self.north, self.east), self.dg[..., i], method="linear")
+            for i in range(3)
+        ]
+
+    def sample(self, east, north) -> np.ndarray:
+        """Disturbance vector (m/s², shape (..., 3), ENU) at planar positions (m), bilinear.
+
+        Raises ``ValueError`` when a position lies outside the grid (enlarge the field).
+        """
+        e = np.asarray(east, dtype=float)
+        n = np.asarray(north, dtype=float)
+        e, n = np.broadcast_arrays(e, n)
+        if (e.min() < self.east[0] or e.max() > self.east[-1] or n.min() < self.north[0] or n.max() > self.north[-1]):
+            raise ValueError(
+                f"track leaves the field: east in [{e.min():.0f}, {e.max():.0f}] m, north in [{n.min():.0f}, "
+                f"{n.max():.0f}] m, field covers east [{self.east[0]:.0f}, {self.east[-1]:.0f}], north "
+                f"[{self.north[0]:.0f}, {self.north[-1]:.0f}]; generate a larger field"
+            )
+        pts = np.stack([n.ravel(), e.ravel()], axis=-1)
+        return np.stack([f(pts) for f in self._interp], axis=-1).reshape(e.shape + (3,))
+
+
+def synthetic_field(
+    extent_east: float, extent_north: float, spacing: float, *, sigma: float = 30 * MGAL,
+    correlation_length: float = 10e3, altitude: float = 500.0, seed: int,
+) -> PlanarGravityField:
+    """A random harmonic gravity-disturbance field (spectral synthesis by FFT).
+
+    One disturbing potential T generates all three components: with T-hat(k) exp(-k z) the
+    Fourier coefficients are dg_x = i k_x T-hat, dg_y = i k_y T-hat, dg_z = -k T-hat, so
+    dg_x = -i (k_x/k) dg_z and dg_y = -i (k_y/k) dg_z.  The vertical component has the
+    spectrum :func:`vertical_psd` (exponential covariance, sigma, D at ground level, upward
+    continued to ``altitude``).  Defaults: sigma = 30 mGal (the 20-50 mGal of chen2019
+    Fig. 3-2, Texas-Oklahoma), D = 10 km, altitude 500 m (Table 4-47 relative height).
+    The grid is periodic: make it several D larger than the track.  Grid origin at (0, 0).
+    """
+    if not (extent_east > 0 and extent_north > 0 and 0 < spacing < min(extent_east, extent_north) / 8):
+        raise ValueError("extents must be positive and spacing smaller than an eighth of each extent (m)")
+    if spacing > correlation_length / 5:
+        raise ValueError(f"spacing {spacing} m is too coarse for correlation length {correlation_length} m (use <= D/5)")
+    nx = int(math.ceil(extent_east / spacing)) + 1
+    ny = int(math.ceil(extent_north / spacing)) + 1
+    rng = np.random.default_rng(seed)
+    w = np.fft.fft2(rng.standard_normal((ny, nx)))
+    kx = 2 * np.pi * np.fft.fftfreq(nx, d=spacing)
+    ky = 2 * np.pi * np.fft.fftfreq(ny, d=spacing)
+    KX, KY = np.meshgrid(kx, ky)
+    K = np.hypot(KX, KY)
+    gz = w * np.sqrt(vertical_psd(K, sigma, correlation_length, altitude) / spacing**2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ux = np.where(K > 0, KX / K, 0.0)
+        uy = np.where(K > 0, KY / K, 0.0)
+    dg = np.stack([np.fft.ifft2(-1j * ux * gz).real, np.fft.ifft2(-1j * uy * gz).real, np.fft.ifft2(gz).real], axis=-1)
+    dg -= dg.mean(axis=(0, 1))  # the k = 0 term: a disturbance field has no mean over a large area
+    return PlanarGravityField(np.arange(nx) * spacing, np.arange(ny) * spacing, dg, sigma, correlation_length,
+                              altitude, seed)
+
+
+def survey_lines(n_lines: int, line_length: float, spacing: float, speed: float, dt: float, *,
+                 start=(0.0, 0.0)) -> dict:
+    """Planar east-west survey pattern (chen2019 Table 4-47: east-west strips) sampled in time.
+
+    Lines of ``line_length`` (m), ``spacing`` (m) apart northwards, flown alternately eastwards
+    and westwards and joined by semicircular turns of radius spacing/2, at constant ground
+    ``speed`` (m/s).  Space becomes time through t = s/speed (arc length s).  Returns a dict of
+    arrays: ``t`` (s), ``east``, ``north`` (m), ``heading`` (rad, from north, clockwise),
+    ``on_line`` (bool: straight segment, not a turn), ``line`` (index, -1 in turns).
+    """
+    if int(n_lines) != n_lines or n_lines < 1:
+        raise ValueError("n_lines must be a positive integer")
+    if not (line_length > 0 and spacing > 0 and speed > 0 and dt > 0):
+        raise ValueError("line_length, spacing, speed and dt must be positive (m, m, m/s, s)")
+    r = spacing / 2
+    turn = np.pi * r
+    seg_len = line_length + turn
+    total = n_lines * line_length + (n_lines - 1) * turn
+    s = np.arange(0.0, total + 1e-9, speed * dt)
+    east = np.empty_like(s)
+    north = np.empty_like(s)
+    heading = np.empty_like(s)
+    on = np.zeros(s.size, bool)
+    line = np.full(s.size, -1)
+    i = np.minimum((s // seg_len).astype(int), n_lines - 1)
+    u = s - i * seg_len
+    d = np.where(i % 2 == 0, 1.0, -1.0)  # +1 eastwards
+    x0 = np.where(d > 0, 0.0, line_length)
+    straight = u <= line_length
+    on[:] = straight
+    line[straight] = i[straight]
+    east[straight] = (x0 + d * u)[straight]
+    north[straight] = (i * spacing)[straight]
+    heading[straight] = np.where(d > 0, np.pi / 2, -np.pi / 2)[straight]
+    a = (u - line_length) / r  # turn angle
+    tu = ~straight
+    cx = np.where(d > 0, line_length, 0.0)
+    cy = i * spacing + r
+    east[tu] = (cx + d * r * np.sin(a))[tu]
+    north[tu] = (cy - r * np.cos(a))[tu]
+    heading[tu] = (np.where(d > 0, np.pi / 2, -np.pi / 2) - d * a)[tu]
+    return dict(t=s / speed, east=east + start[0], north=north + start[1], heading=np.mod(heading, 2 * np.pi),
+                on_line=on, line=line)
+
+
+# --------------------------------------------------------------------------- direct difference
+
+def specific_force_nav(C_bn, f_b) -> np.ndarray:
+    """f^n = C_b^n f^b for arrays of DCMs (..., 3, 3) and specific forces (..., 3)."""
+    C = np.asarray(C_bn, dtype=float)
+    f = np.asarray(f_b, dtype=float)
+    if C.shape[-2:] != (3, 3) or f.shape[-1] != 3:
+        raise ValueError(f"C_bn needs shape (..., 3, 3) and f_b (..., 3); got {C.shape} and {f.shape}")
+    return np.einsum("...ij,...j->...i", C, f)
+
+
+def _coriolis_transport(v, lat, h):
+    w = 2 * earth.earth_rate_enu(lat) + earth.transport_rate_enu(lat, h, v)
+    return np.cross(w, v)
+
+
+def direct_difference(v_dot, v, lat, h, *, f_n=None, C_bn=None, f_b=None) -> np.ndarray:
+    """Direct-difference gravity disturbance, chen2019 eq. (3-7) (m/s², ENU).
+
+    delta g^n = dV^n/dt - C_b^n f^b + (2 omega_ie^n + omega_en^n) x V^n - g_m^n, with the GNSS
+    kinematic acceleration ``v_dot``, the GNSS velocity ``v`` (both (..., 3) ENU), latitude (rad),
+    height (m), and either the navigation-frame specific force ``f_n`` or ``C_bn`` and ``f_b``.
+    g_m^n = [0, 0, -gamma(L, h)] is WGS-84 normal gravity (:func:`replication.earth.gravity_enu`;
+    the (0, 0, gamma) printed in (3-1) is the same vector with an up-positive magnitude).
+    """
+    if f_n is None:
+        if C_bn is None or f_b is None:
+            raise ValueError("give either f_n (navigation frame) or both C_bn and f_b")
+        f_n = specific_force_nav(C_bn, f_b)
+    v_dot = np.asarray(v_dot, dtype=float)
+    v = np.asarray(v, dtype=float)
+    f_n = np.asarray(f_n, dtype=float)
+    if not (v_dot.shape[-1] == v.shape[-1] == f_n.shape[-1] == 3):
+        raise ValueError("v_dot, v and the specific force need a last axis of length 3 (E, N, U)")
+    return v_dot - f_n + _coriolis_transport(v, lat, h) - earth.gravity_enu(lat, h)
+
+
+def direct_difference_error(psi, f_n, bias_n=0.0, v_dot_error=0.0) -> np.ndarray:
+    """First-order error of the direct difference, chen2019 eq. (3-8), dominant terms (m/s²).
+
+    delta(delta g^n) ~= delta(dV/dt) - psi^n x f^n - C_b^n nabla_b: the GNSS acceleration error,
+    the attitude error acting on the specific force and the accelerometer bias in the
+    navigation frame (``bias_n`` = C_b^n nabla_b).  The attitude error follows chen2019 (3-4),
+    delta f^n = psi^n x f^n + C_b^n nabla_b, i.e. the computed DCM is (I + [psi x]) C_b^n
+    (the opposite sign of psi to Titterton & Weston's convention).  The Coriolis/transport and normal-gravity
+    perturbation terms of (3-8) are below 0.1 mGal for an aircraft with metre-level position
+    and cm/s velocity errors and are omitted.
+    """
+    psi = np.asarray(psi, dtype=float)
+    f_n = np.asarray(f_n, dtype=float)
+    if psi.shape[-1] != 3 or f_n.shape[-1] != 3:
+        raise ValueError("psi (rad) and f_n (m/s²) need a last axis of length 3 (E, N, U)")
+    return np.asarray(v_dot_error, dtype=float) - np.cross(psi, f_n) - np.asarray(bias_n, dtype=float)
+
+
+def attitude_error_equivalent(level_error_rad, g: float = 9.8) -> float:
+    """Horizontal direct-difference error g x (level attitude error) (m/s²), chen2019 eq. (3-8).
+
+    In level flight f^n ~ [0, 0, g], so (psi x f)_E = psi_N g and (psi x f)_N = -psi_E g:
+    each radian of level error is g m/s² of apparent horizontal disturbance.
+    """
+    return float(abs(level_error_rad) * g)
+
+
+# --------------------------------------------------------------------------- GNSS acceleration
+
+def gnss_acceleration(x, dt: float, *, source: str = "velocity") -> np.ndarray:
+    """Kinematic acceleration from GNSS velocity (first derivative) or position (second), (..., 3) or 1-D.
+
+    Central differences along axis 0: velocity a_k = (v_{k+1} - v_{k-1}) / (2 dt); position
+    a_k = (p_{k+1} - 2 p_k + p_{k-1}) / dt².  The end samples repeat their neighbours.
+    """
+    x = np.asarray(x, dtype=float)
+    if not dt > 0:
+        raise ValueError("dt must be positive (s)")
+    if x.shape[0] < 3:
+        raise ValueError("need at least three samples to differentiate")
+    a = np.empty_like(x)
+    if source == "velocity":
+        a[1:-1] = (x[2:] - x[:-2]) / (2 * dt)
+    elif source == "position":
+        a[1:-1] = (x[2:] - 2 * x[1:-1] + x[:-2]) / dt**2
+    else:
+        raise ValueError("source must be 'velocity' or 'position'")
+    a[0], a[-1] = a[1], a[-2]
+    return a
+
+
+def differentiation_noise_std(sigma: float, dt: float, *, source: str = "velocity") -> float:
+    """Standard deviation of the acceleration noise that :func:`gnss_acceleration` makes from white noise.
+
+    Velocity noise sigma_v: sigma_a = sigma_v / (sqrt(2) dt); position noise sigma_p:
+    sigma_a = sqrt(6) sigma_p / dt².
+    """
+    if not (sigma >= 0 and dt > 0):
+        raise ValueError("sigma must be >= 0 and dt > 0")
+    if source == "velocity":
+        return sigma / (math.sqrt(2) * dt)
+    if source == "position":
+        return math.sqrt(6) * sigma / dt**2
+    raise ValueError("source must be 'velocity' or 'position'")
+
+
+def _butter(dt, cutoff_period, order):
+    fs = 1.0 / dt
+    fc = 1.0 / cutoff_period
+    if not 0 < fc < fs / 2:
+        raise ValueError(f"cutoff period {cutoff_period} s must exceed two samples ({2 * dt} s)")
+    return signal.butter(order, fc, fs=fs, output="sos")
+
+
+def lowpass(x, dt: float, cutoff_period: float, *, order: int = 4) -> np.ndarray:
+    """Zero-phase Butterworth low-pass (forward-backward, ``sosfiltfilt``) along axis 0.
+
+    ``cutoff_period`` (s) is the period of the -6 dB point of the forward-backward filter's
+    amplitude response (the half-power point of the single pass); airborne gravimetry uses
+    periods of the order of 100 s.
+    """
+    x = np.asarray(x, dtype=float)
+    return signal.sosfiltfilt(_butter(dt, cutoff_period, order), x, axis=0)
+
+
+def filtered_differentiation_noise_std(sigma: float, dt: float, cutoff_period: float, *,
+                                       source: str = "velocity", order: int = 4) -> float:
+    """Acceleration noise std after :func:`gnss_acceleration` and :func:`lowpass` of white noise.
+
+    var = sigma² (1/pi) int_0^pi |D(w)|² |H(w)|^4 dw with the central-difference responses
+    |D| = |sin w| / dt (velocity) or |2 cos w - 2| / dt² (position) and the single-pass
+    Butterworth response H (applied twice by the forward-backward filter).
+    """
+    sos = _butter(dt, cutoff_period, order)
+    w, H = signal.sosfreqz(sos, worN=1 << 16)
+    if source == "velocity":
+        D2 = (np.sin(w) / dt) ** 2
+    elif source == "position":
+        D2 = ((2 * np.cos(w) - 2) / dt**2) ** 2
+    else:
+        raise ValueError("source must be 'velocity' or 'position'")
+    var = sigma**2 * integrate.trapezoid(D2 * np.abs(H) ** 4, w) / np.pi
+    return math.sqrt(var)
+
+
+# --------------------------------------------------------------------------- AR shaping filters
+
+def ar_companion(phi) -> np.ndarray:
+    """Companion matrix of y_t = sum phi_i y_{t-i} + w_t for the state x_t = [y_t, ..., y_{t-p+1}].
+
+    x_{t+1} = A x_t + e_1 w_{t+1} with A's first row phi and ones on the sub-diagonal; its
+    eigenvalues are the poles (:func:`replication.timeseries.ar_poles`).  The gravity-disturbance
+    state delta d of chen2019 eq. (3-17) for one axis.
+    """
+    phi = _phi(phi)
+    p = phi.size
+    A = np.zeros((p, p))
+    A[0] = phi
+    A[1:, :-1] = np.eye(p - 1)
+    return A
+
+
+def ar_state_space(phi, dt: float):
+    """The AR shaping filter as a python-control discrete state-space system (sampling time ``dt``).
+
+    x_{k+1} = A x_k + B w_k, y_k = C x_k with A = :func:`ar_companion`, B = e_1, C = e_1^T, D = 0;
+    white input of variance sigma² gives the AR output.  (The one-step delay between w and y of
+    the state-space form does not change the output's statistics.)
+    """
+    import control
+
+    A = ar_companion(phi)
+    p = A.shape[0]
+    if not dt > 0:
+        raise ValueError("dt must be positive (s)")
+    B = np.zeros((p, 1))
+    B[0, 0] = 1.0
+    return control.ss(A, B, B.T, np.zeros((1, 1)), dt)
+
+
+@dataclass(frozen=True)
+class GravityAugmentation:
+    """Block-diagonal AR shaping filters of the three disturbance components (chen2019 eq. 3-17).
+
+    ``A`` (n x n) discrete transition of the augmented states delta d, ``Q`` (n x n) its
+    process-noise covariance, ``S`` (3 x n) the selection delta g^n = S delta d, ``orders``
+    the AR order per axis (E, N, U), ``dt`` the sampling interval (s).
+    """
+
+    A: np.ndarray
+    Q: np.ndarray
+    S: np.ndarray
+    orders: tuple
+    dt: float
+
+
+def gravity_augmentation(models, dt: float, *, require_stationary: bool = True) -> GravityAugmentation:
+    """Augmentation blocks F''' (discrete), G_2 Q G_2^T and the coupling selection of chen2019 (3-17).
+
+    ``models``: three (phi, sigma2) pairs for the E, N, U disturbance (sigma2 in (m/s²)² at the
+    filter's sampling interval ``dt``).  A non-stationary model is refused (its variance grows
+    without bound inside the filter) unless ``require_stationary=False``.
+    """
+    models = list(models)
+    if len(models) != 3:
+        raise ValueError("give three (phi, sigma2) models, for the east, north and up components")
+    blocks, qs, orders = [], [], []
+    for axis, (phi, s2) in zip("ENU", models):
+        phi = _phi(phi)
+        if not s2 > 0:
+            raise ValueError(f"{axis}: the noise variance must be positive")
+        if require_stationary and not is_stationary(phi):
+            raise ValueError(
+                f"{axis}: the AR model is not stationary (largest pole modulus {np.max(np.abs(ar_poles(phi))):.4f}); "
+                f"a shaping filter must be stable — check the sign convention of the coefficients"
+            )
+        blocks.append(ar_companion(phi))
+        q = np.zeros((phi.size, phi.size))
+        q[0, 0] = s2
+        qs.append(q)
+        orders.append(phi.size)
+    from scipy.linalg import block_diag
+
+    A = block_diag(*blocks)
+    Q = block_diag(*qs)
+    S = np.zeros((3, A.shape[0]))
+    S[[0, 1, 2], np.cumsum([0] + orders[:-1])] = 1.0
+    return GravityAugmentation(A, Q, S, tuple(orders), float(dt))
+
+
+def augment_transition(Phi, Q, aug: GravityAugmentation, velocity_rows=(3, 4, 5)):
+    """Augment a discrete error-state model with the disturbance states (chen2019 eqs. 3-15, 3-17).
+
+    Phi_aug = [[Phi, Gamma], [0, A]], Q_aug = blockdiag(Q, Q_d), with Gamma = dt S on the
+    velocity-error rows (delta V-dot^n = ... + delta g^n, first order in dt).  ``Phi``/``Q``
+    are the navigation error model's n x n transition and noise covariance.
+    """
+    Phi = np.asarray(Phi, dtype=float)
+    Q = np.asarray(Q, dtype=float)
+    n = Phi.shape[0]
+    if Phi.shape != (n, n) or Q.shape != (n, n):
+        raise ValueError("Phi and Q must be square and of the same size")
+    rows = list(velocity_rows)
+    if len(rows) != 3 or max(rows) >= n:
+        raise ValueError(f"velocity_rows must name three rows of the {n}-state model")
+    m = aug.A.shape[0]
+    out = np.zeros((n + m, n + m))
+    out[:n, :n] = Phi
+    out[n:, n:] = aug.A
+    out[np.ix_(rows, range(n, n + m))] = aug.dt * aug.S
+    Qa = np.zeros_like(out)
+    Qa[:n, :n] = Q
+    Qa[n:, n:] = aug.Q
+    return out, Qa
+
+
+def specific_force_measurement(f_n, v_gnss, a_gnss, lat, h) -> np.ndarray:
+    """The specific-force rows of the 9-dimensional measurement, chen2019 eq. (3-18) (m/s², ENU).
+
+    z_f = f^n + g_m^n - (2 omega_ie^n + omega_en^n) x V_GNSS - a_GNSS.  With true quantities
+    z_f = -delta g^n, so the gravity-state block of H is -S (:class:`GravityAugmentation`);
+    attitude and accelerometer-bias errors enter as psi x f^n and C_b^n nabla (3-4).
+    """
+    f_n = np.asarray(f_n, dtype=float)
+    v = np.asarray(v_gnss, dtype=float)
+    a = np.asarray(a_gnss, dtype=float)
+    if not (f_n.shape[-1] == v.shape[-1] == a.shape[-1] == 3):
+        raise ValueError("f_n, v_gnss and a_gnss need a last axis of length 3 (E, N, U)")
+    return f_n + earth.gravity_enu(lat, h) - _coriolis_transport(v, lat, h) - a

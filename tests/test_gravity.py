@@ -1,0 +1,218 @@
+"""Tests of replication.gravity (chen2019 ch. 3: field, direct difference, AR augmentation)."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import signal
+from scipy.spatial.transform import Rotation
+
+from replication import earth
+from replication import gravity as gr
+from replication import timeseries as ts
+from replication.units import MGAL, MICRO_G
+
+PHI_E = np.array([0.9168, -0.0758, 0.0991])  # sign-reversed chen2019 (4-13) east model (stationary)
+
+
+# --------------------------------------------------------------------------- field
+
+def test_field_std_closed_forms():
+    sz, sh = gr.field_std(30 * MGAL, 10e3, 0.0)
+    assert sz == pytest.approx(30 * MGAL, rel=1e-8)  # the exponential covariance at ground level
+    assert sh == pytest.approx(sz / math.sqrt(2), rel=1e-12)
+    hi, _ = gr.field_std(30 * MGAL, 10e3, 500.0)
+    assert hi < sz  # upward continuation smooths
+
+
+def test_synthetic_field_is_a_gradient_field_with_the_stated_variance():
+    f = gr.synthetic_field(300e3, 300e3, 500.0, sigma=30 * MGAL, correlation_length=3e3, altitude=500.0, seed=3)
+    # curl-free: d(dg_E)/dy = d(dg_N)/dx (spectral derivatives on the periodic grid, exact up to round-off)
+    ny, nx, _ = f.dg.shape
+    kx = 2 * np.pi * np.fft.fftfreq(nx, 500.0)
+    ky = 2 * np.pi * np.fft.fftfreq(ny, 500.0)
+    dEy = np.fft.ifft2(1j * ky[:, None] * np.fft.fft2(f.dg[..., 0])).real
+    dNx = np.fft.ifft2(1j * kx[None, :] * np.fft.fft2(f.dg[..., 1])).real
+    # the Nyquist rows/columns are not Hermitian-symmetric; compare away from them via the norm
+    assert np.linalg.norm(dEy - dNx) < 1e-3 * np.linalg.norm(dEy)
+    # 300 km / 3 km = 100 correlation lengths per side: the variance estimate is good to a few %;
+    # 10 % on the standard deviation is > 3 sigma
+    sz, sh = gr.field_std(30 * MGAL, 3e3, 500.0)
+    std = f.dg.std(axis=(0, 1))
+    np.testing.assert_allclose(std, [sh, sh, sz], rtol=0.10)
+
+
+def test_field_sampling_and_bounds():
+    f = gr.synthetic_field(40e3, 40e3, 500.0, seed=1)
+    node = f.sample(f.east[7], f.north[5])
+    np.testing.assert_allclose(node, f.dg[5, 7], rtol=1e-12)
+    with pytest.raises(ValueError, match="leaves the field"):
+        f.sample(-1.0, 0.0)
+
+
+def test_survey_lines_space_to_time():
+    tr = gr.survey_lines(4, 20e3, 500.0, 30.0, 1.0)
+    step = np.hypot(np.diff(tr["east"]), np.diff(tr["north"]))
+    # chord vs arc on the 250 m turns: 1 - theta^2/24 with theta = 30/250 rad -> < 1e-3 relative
+    np.testing.assert_allclose(step, 30.0, rtol=1e-3)
+    length = 4 * 20e3 + 3 * math.pi * 250.0
+    assert tr["t"][-1] == pytest.approx(length / 30.0, abs=1.0)
+    assert set(np.unique(tr["line"])) == {-1, 0, 1, 2, 3}
+    assert np.allclose(np.unique(tr["north"][tr["on_line"]]), [0, 500, 1000, 1500])
+
+
+# --------------------------------------------------------------------------- direct difference
+
+def _kinematics(n=50, seed=0):
+    rng = np.random.default_rng(seed)
+    lat = np.radians(40.0) + 1e-4 * rng.standard_normal(n)
+    h = 500.0 + rng.standard_normal(n)
+    v = np.array([30.0, 5.0, 0.5]) + rng.standard_normal((n, 3))
+    vdot = 0.3 * rng.standard_normal((n, 3))
+    dg = 30 * MGAL * rng.standard_normal((n, 3))
+    C = Rotation.from_euler("zyx", rng.uniform(-0.5, 0.5, (n, 3))).as_matrix()
+    w = 2 * earth.earth_rate_enu(lat) + earth.transport_rate_enu(lat, h, v)
+    f_n = vdot + np.cross(w, v) - earth.gravity_enu(lat, h) - dg  # eq. (3-2) with g = g_m + dg
+    f_b = np.einsum("nji,nj->ni", C, f_n)
+    return lat, h, v, vdot, dg, C, f_n, f_b
+
+
+def test_direct_difference_recovers_the_disturbance():
+    lat, h, v, vdot, dg, C, f_n, f_b = _kinematics()
+    np.testing.assert_allclose(gr.direct_difference(vdot, v, lat, h, f_n=f_n), dg, atol=1e-12)
+    np.testing.assert_allclose(gr.direct_difference(vdot, v, lat, h, C_bn=C, f_b=f_b), dg, atol=1e-12)
+    with pytest.raises(ValueError, match="f_n"):
+        gr.direct_difference(vdot, v, lat, h)
+
+
+def test_direct_difference_error_is_the_linearization():
+    lat, h, v, vdot, dg, C, f_n, f_b = _kinematics(n=5)
+    psi = np.array([2e-5, -3e-5, 1e-4])  # attitude error (rad) as in (3-4): C_hat = (I + [psi x]) C
+    Ch = Rotation.from_rotvec(psi).as_matrix() @ C
+    bias_n = np.einsum("nij,j->ni", C, np.array([50, -30, 20]) * MICRO_G)
+    fb_meas = f_b + np.array([50, -30, 20]) * MICRO_G
+    err = gr.direct_difference(vdot, v, lat, h, C_bn=Ch, f_b=fb_meas) - dg
+    lin = gr.direct_difference_error(psi, f_n, bias_n)
+    # second-order remainder ~ |psi|^2 g + |psi| |bias| ~ 1e-7 m/s^2 = 0.01 mGal
+    np.testing.assert_allclose(err, lin, atol=2e-7)
+
+
+def test_attitude_error_equivalent():
+    assert gr.attitude_error_equivalent(math.radians(0.005), g=9.8) / MGAL == pytest.approx(85.5, abs=0.1)
+
+
+def test_gnss_acceleration_exact_on_polynomials():
+    t = np.arange(0, 10, 0.1)
+    v = np.stack([3 * t**2, -t, 0 * t], -1)
+    a = gr.gnss_acceleration(v, 0.1)
+    np.testing.assert_allclose(a[1:-1], np.stack([6 * t, -np.ones_like(t), 0 * t], -1)[1:-1], atol=1e-9)
+    p = 0.5 * 2.0 * t**2
+    np.testing.assert_allclose(gr.gnss_acceleration(p, 0.1, source="position")[1:-1], 2.0, atol=1e-8)
+
+
+@pytest.mark.parametrize("source,sigma", [("velocity", 0.03), ("position", 0.1)])
+def test_differentiation_noise(source, sigma):
+    rng = np.random.default_rng(2)
+    x = sigma * rng.standard_normal(400_000)
+    a = gr.gnss_acceleration(x, 0.1, source=source)[1:-1]
+    # 4e5 samples with a two-sample correlation: the std estimate is good to < 0.5 %; allow 1.5 %
+    assert a.std() == pytest.approx(gr.differentiation_noise_std(sigma, 0.1, source=source), rel=0.015)
+    af = gr.lowpass(gr.gnss_acceleration(x, 0.1, source=source), 0.1, 100.0)[5000:-5000]
+    # after a 100 s filter only ~ 390 independent 100 s blocks remain: 1/sqrt(2*390) = 3.6 %; allow 15 %
+    assert af.std() == pytest.approx(gr.filtered_differentiation_noise_std(sigma, 0.1, 100.0, source=source), rel=0.15)
+
+
+# --------------------------------------------------------------------------- AR shaping filters
+
+def test_companion_form_reproduces_the_ar_recursion():
+    A = gr.ar_companion(PHI_E)
+    np.testing.assert_allclose(np.sort_complex(np.linalg.eigvals(A)), np.sort_complex(ts.ar_poles(PHI_E)), atol=1e-12)
+    w = np.random.default_rng(0).standard_normal(500)
+    y_ref = signal.lfilter([1.0], np.r_[1.0, -PHI_E], w)
+    x = np.zeros(3)
+    y = []
+    for wk in w:
+        x = A @ x
+        x[0] += wk
+        y.append(x[0])
+    np.testing.assert_allclose(y, y_ref, atol=1e-12)
+    sys = gr.ar_state_space(PHI_E, 1.0)
+    np.testing.assert_allclose(np.sort(np.abs(sys.poles())), np.sort(np.abs(ts.ar_poles(PHI_E))), atol=1e-12)
+    # the stationary covariance of the companion state reproduces the AR autocovariances
+    from scipy.linalg import solve_discrete_lyapunov
+
+    Q = np.zeros((3, 3))
+    Q[0, 0] = 2.0
+    P = solve_discrete_lyapunov(A, Q)
+    rho = ts.ar_autocorrelation(PHI_E, 2)
+    g0 = ts.ar_variance(PHI_E, 2.0)
+    np.testing.assert_allclose(P[0], g0 * rho, rtol=1e-10)
+
+
+def test_gravity_augmentation_blocks():
+    models = [(PHI_E, 1e-10), ([0.8], 2e-10), ([0.5, 0.2], 3e-10)]
+    aug = gr.gravity_augmentation(models, 1.0)
+    assert aug.A.shape == (6, 6) and aug.orders == (3, 1, 2)
+    np.testing.assert_array_equal(np.nonzero(aug.S)[1], [0, 3, 4])
+    assert np.diag(aug.Q)[[0, 3, 4]].tolist() == [1e-10, 2e-10, 3e-10]
+    Phi, Q = gr.augment_transition(np.eye(15), np.eye(15) * 1e-8, aug)
+    assert Phi.shape == (21, 21)
+    np.testing.assert_array_equal(Phi[3:6, 15:], aug.S)  # dt = 1 s
+    assert not Phi[15:, :15].any()
+    with pytest.raises(ValueError, match="not stationary.*sign convention"):
+        gr.gravity_augmentation([(-PHI_E, 1e-10)] * 3, 1.0)
+
+
+def test_specific_force_measurement_is_minus_the_disturbance():
+    lat, h, v, vdot, dg, C, f_n, f_b = _kinematics()
+    np.testing.assert_allclose(gr.specific_force_measurement(f_n, v, vdot, lat, h), -dg, atol=1e-12)
+
+
+def _kalman(Phi, Q, H, R, x0, P0, Z):
+    x, P, out = x0.copy(), P0.copy(), []
+    eye = np.eye(x.size)
+    for z in Z:
+        x, P = Phi @ x, Phi @ P @ Phi.T + Q
+        K = P @ H.T @ np.linalg.inv(H @ P @ H.T + R)
+        x = x + K @ (z - H @ x)
+        P = (eye - K @ H) @ P @ (eye - K @ H).T + K @ R @ K.T
+        out.append(x.copy())
+    return np.array(out)
+
+
+def test_augmented_filter_beats_normal_gravity_filter():
+    """One horizontal channel: velocity error driven by accelerometer bias + AR(3) disturbance.
+
+    Both filters see the same measurements: GNSS velocity (0.03 m/s) and the specific-force row
+    of (3-18) (10 mGal after filtering).  The normal-gravity filter models only the bias (a
+    slow random walk); the augmented filter adds the true AR(3) shaping filter.  Score: RMS of
+    the uncompensated acceleration error (bias + disturbance - estimate) over the second hour.
+    """
+    dt, n = 1.0, 3600
+    s2 = (20 * MGAL) ** 2 / ts.ar_variance(PHI_E, 1.0)  # 20 mGal disturbance
+    rng = np.random.default_rng(8)
+    dg = ts.simulate_ar(PHI_E, s2, n, 1, rng)[0]
+    bias, sv, sf = 50 * MICRO_G, 0.03, 10 * MGAL
+    dv = np.concatenate([[0.0], np.cumsum(dt * (bias + dg[:-1]))])
+    Z = np.c_[dv + sv * rng.standard_normal(n), -(bias + dg) + sf * rng.standard_normal(n)]
+    R = np.diag([sv**2, sf**2])
+    Phi = np.array([[1.0, dt], [0.0, 1.0]])
+    Q = np.diag([0.0, (1 * MICRO_G) ** 2 * dt])
+    P0 = np.diag([sv**2, (100 * MICRO_G) ** 2])
+    xn = _kalman(Phi, Q, np.array([[1.0, 0.0], [0.0, -1.0]]), R, np.zeros(2), P0, Z)
+    # augmented single-axis model: [dv, bias, d_t, d_t-1, d_t-2], coupling dv += dt d_t
+    from scipy.linalg import block_diag, solve_discrete_lyapunov
+
+    A = gr.ar_companion(PHI_E)
+    Qd = np.zeros((3, 3))
+    Qd[0, 0] = s2
+    Pa = block_diag(Phi, A)
+    Pa[0, 2] = dt
+    Qa = block_diag(Q, Qd)
+    Ha = np.array([[1.0, 0, 0, 0, 0], [0, -1.0, -1.0, 0, 0]])
+    P0a = block_diag(P0, solve_discrete_lyapunov(A, Qd))
+    xa = _kalman(Pa, Qa, Ha, R, np.zeros(5), P0a, Z)
+    h = slice(n // 2, None)
+    rms_normal = np.sqrt(np.mean((bias + dg - xn[:, 1])[h] ** 2))
+    rms_aug = np.sqrt(np.mean((bias + dg - xa[:, 1] - xa[:, 2])[h] ** 2))
+    assert rms_aug < 0.75 * rms_normal
