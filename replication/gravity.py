@@ -36,7 +36,7 @@ __all__ = [
     "specific_force_nav", "direct_difference", "direct_difference_error", "attitude_error_equivalent",
     "gnss_acceleration", "lowpass", "differentiation_noise_std", "filtered_differentiation_noise_std",
     "ar_companion", "ar_state_space", "GravityAugmentation", "gravity_augmentation",
-    "augment_transition", "specific_force_measurement",
+    "augment_transition", "specific_force_measurement", "gauss_markov", "analog_direct_difference",
 ]
 
 
@@ -309,10 +309,12 @@ def lowpass(x, dt: float, cutoff_period: float, *, order: int = 4) -> np.ndarray
 
     ``cutoff_period`` (s) is the period of the -6 dB point of the forward-backward filter's
     amplitude response (the half-power point of the single pass); airborne gravimetry uses
-    periods of the order of 100 s.
+    periods of the order of 100 s.  The ends are padded by even reflection (no step from a noisy end sample) over three cut-off
+    periods so that edge transients stay within the first and last few periods.
     """
     x = np.asarray(x, dtype=float)
-    return signal.sosfiltfilt(_butter(dt, cutoff_period, order), x, axis=0)
+    padlen = min(x.shape[0] - 1, int(3 * cutoff_period / dt))  # cover the impulse response, not scipy's default
+    return signal.sosfiltfilt(_butter(dt, cutoff_period, order), x, axis=0, padtype="even", padlen=padlen)
 
 
 def filtered_differentiation_noise_std(sigma: float, dt: float, cutoff_period: float, *,
@@ -459,3 +461,52 @@ def specific_force_measurement(f_n, v_gnss, a_gnss, lat, h) -> np.ndarray:
     if not (f_n.shape[-1] == v.shape[-1] == a.shape[-1] == 3):
         raise ValueError("f_n, v_gnss and a_gnss need a last axis of length 3 (E, N, U)")
     return f_n + earth.gravity_enu(lat, h) - _coriolis_transport(v, lat, h) - a
+
+
+# --------------------------------------------------------------------------- analog series
+
+def gauss_markov(n: int, dt: float, std: float, tau: float, rng: np.random.Generator, *, size: int = 1) -> np.ndarray:
+    """Stationary first-order Gauss-Markov sequences, shape (n, size): x_{k+1} = e^{-dt/tau} x_k + w_k."""
+    if not (n >= 1 and dt > 0 and std >= 0 and tau > 0):
+        raise ValueError("need n >= 1, dt > 0, std >= 0 and tau > 0")
+    a = math.exp(-dt / tau)
+    w = rng.standard_normal((n, size)) * std * math.sqrt(1 - a * a)
+    w[0] = rng.standard_normal(size) * std
+    return signal.lfilter([1.0], [1.0, -a], w, axis=0)
+
+
+def analog_direct_difference(field_: PlanarGravityField, *, n_lines: int, line_length: float, spacing: float,
+                             speed: float, seed: int, gnss_dt: float = 0.1, sigma_v: float = 0.03,
+                             cutoff_period: float = 100.0, level_error_std: float = 0.0,
+                             level_error_tau: float = 600.0, out_dt: float = 1.0, start=(0.0, 0.0)) -> dict:
+    """A simulated direct-difference disturbance series along survey lines (an analog, not flight data).
+
+    The true disturbance is sampled along :func:`survey_lines` every ``gnss_dt``; the direct
+    difference (3-7) adds the errors of (3-8) that dominate for a navigation-grade SINS:
+    the acceleration noise of differentiated GNSS velocity (white, ``sigma_v`` per sample) and
+    the level attitude error psi (first-order Gauss-Markov, ``level_error_std`` rad,
+    ``level_error_tau`` s) acting on f^n ~ [0, 0, g]; the sum is low-passed
+    (:func:`lowpass`, ``cutoff_period``), three cut-off periods are dropped at each end
+    (edge transients) and the rest is decimated to ``out_dt``.  Returns a dict with
+    ``t`` (s), ``true`` (low-passed true disturbance, (n, 3) m/s²), ``measured`` ((n, 3) m/s²),
+    ``east``/``north`` (m) and ``on_line``.
+    """
+    step = int(round(out_dt / gnss_dt))
+    if step < 1 or abs(step * gnss_dt - out_dt) > 1e-9:
+        raise ValueError("out_dt must be an integer multiple of gnss_dt")
+    tr = survey_lines(n_lines, line_length, spacing, speed, gnss_dt, start=start)
+    rng = np.random.default_rng(seed)
+    dg = field_.sample(tr["east"], tr["north"])
+    n = dg.shape[0]
+    acc_noise = gnss_acceleration(sigma_v * rng.standard_normal((n, 3)), gnss_dt)
+    psi = gauss_markov(n, gnss_dt, level_error_std, level_error_tau, rng, size=2)
+    g = float(earth.normal_gravity(np.radians(45.0), 0.0))
+    att = np.stack([-psi[:, 1] * g, psi[:, 0] * g, np.zeros(n)], axis=-1)  # -(psi x f), f = [0, 0, g]
+    meas = lowpass(dg + acc_noise + att, gnss_dt, cutoff_period)
+    true = lowpass(dg, gnss_dt, cutoff_period)
+    trim = int(math.ceil(3 * cutoff_period / gnss_dt))  # filter edge transients
+    if n <= 2 * trim + step:
+        raise ValueError("the survey is too short for the low-pass filter; lengthen the lines or shorten cutoff_period")
+    sl = slice(trim, n - trim, step)
+    return dict(t=tr["t"][sl], true=true[sl], measured=meas[sl], east=tr["east"][sl], north=tr["north"][sl],
+                on_line=tr["on_line"][sl])

@@ -31,7 +31,7 @@ import pandas as pd
 from scipy import linalg, signal, stats
 
 __all__ = [
-    "NonStationaryError", "InversionTest", "inversion_count", "inversion_moments", "inversion_test",
+    "NonStationaryError", "InversionTest", "inversion_count", "inversion_moments", "inversion_distribution", "inversion_test",
     "stationarity_report", "difference", "make_stationary", "acf_printed", "pacf_printed",
     "correlogram", "cutoff_lag", "Identification", "identify_model", "ar_design",
     "ar_least_squares", "fit_ar", "order_cap", "aic_by_order", "select_order",
@@ -85,6 +85,20 @@ def inversion_moments(m: int) -> tuple[float, float]:
     if int(m) != m or m < 2:
         raise ValueError(f"the number of segments m must be an integer >= 2, got {m}")
     return m * (m - 1) / 4.0, m * (2 * m**2 + 3 * m - 5) / 72.0
+
+
+def inversion_distribution(m: int) -> np.ndarray:
+    """Exact null distribution of the inversion count of m exchangeable values (Mahonian numbers).
+
+    P(A = a) for a = 0..m(m-1)/2 under a uniformly random order, from the generating function
+    prod_{k=1}^{m} (1 + x + ... + x^{k-1}) / m!.  An independent check of (E(A), D(A)).
+    """
+    if int(m) != m or m < 2:
+        raise ValueError(f"m must be an integer >= 2, got {m}")
+    c = np.array([1.0])
+    for k in range(1, int(m) + 1):
+        c = np.convolve(c, np.ones(k))
+    return c / c.sum()
 
 
 @dataclass(frozen=True)

@@ -216,3 +216,22 @@ def test_augmented_filter_beats_normal_gravity_filter():
     rms_normal = np.sqrt(np.mean((bias + dg - xn[:, 1])[h] ** 2))
     rms_aug = np.sqrt(np.mean((bias + dg - xa[:, 1] - xa[:, 2])[h] ** 2))
     assert rms_aug < 0.75 * rms_normal
+
+
+def test_gauss_markov_statistics():
+    x = gr.gauss_markov(200_000, 1.0, 2.0, 50.0, np.random.default_rng(1), size=2)
+    # 200000 / (2 x 50) = 2000 effective samples: std of the std estimate ~ 1.6 %; allow 6 %
+    np.testing.assert_allclose(x.std(axis=0), 2.0, rtol=0.06)
+    r1 = np.corrcoef(x[:-1, 0], x[1:, 0])[0, 1]
+    assert r1 == pytest.approx(math.exp(-1 / 50), abs=0.01)
+
+
+def test_analog_direct_difference_without_errors_is_the_filtered_field():
+    f = gr.synthetic_field(40e3, 20e3, 250.0, seed=4)
+    kw = dict(n_lines=2, line_length=20e3, spacing=500.0, speed=30.0, cutoff_period=10.0, start=(10e3, 5e3))
+    clean = gr.analog_direct_difference(f, seed=1, sigma_v=0.0, level_error_std=0.0, **kw)
+    np.testing.assert_allclose(clean["measured"], clean["true"], atol=1e-15)
+    noisy = gr.analog_direct_difference(f, seed=1, sigma_v=0.03, level_error_std=1e-4, **kw)
+    err = (noisy["measured"] - noisy["true"]).std(axis=0)
+    assert err[0] > 0.5 * 1e-4 * 9.8 and err[2] < err[0]  # the level error shows in the horizontals only
+    assert clean["t"][1] - clean["t"][0] == pytest.approx(1.0)

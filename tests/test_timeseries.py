@@ -30,6 +30,15 @@ def test_inversion_moments_equal_exact_permutation_moments(m):
     assert np.var(counts) == pytest.approx(da, abs=1e-12)
 
 
+@pytest.mark.parametrize("m", [4, 20, 50])
+def test_inversion_distribution_moments(m):
+    pmf = ts.inversion_distribution(m)
+    a = np.arange(pmf.size)
+    ea, da = ts.inversion_moments(m)
+    assert pmf @ a == pytest.approx(ea, rel=1e-12)
+    assert pmf @ (a - ea) ** 2 == pytest.approx(da, rel=1e-10)
+
+
 def test_inversion_count_counts_larger_later_values():
     assert ts.inversion_count([1, 2, 3, 4]) == 6
     assert ts.inversion_count([4, 3, 2, 1]) == 0
