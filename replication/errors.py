@@ -1,0 +1,433 @@
+"""Error-state models built from named blocks: the 15-state model and its extensions.
+
+State vector: the 9 navigation errors, always first,
+
+    [δL, δλ, δh | δv_E, δv_N, δv_U | φ_E, φ_N, φ_U]     (rad, rad, m | m/s | rad)
+
+followed by *augmented blocks*, each a named slice with its own linear dynamics and a coupling
+into the navigation equations.  Definitions (consistent with :mod:`replication.rotations`):
+
+* navigation errors are computed minus true: δL = L̂ - L, δv = v̂ - v, Ĉ_b^n = (I - φ×) C_b^n;
+* an augmented state is the true value of an error source minus the value currently compensated
+  (so that in closed loop the estimate is simply accumulated: p̂ ← p̂ + x̂).
+
+Continuous model (chen2019 eqs. (3-14)-(3-16), every first-order term kept — including the
+normal-gravity gradient ∂γ/∂h, ∂γ/∂L and dR_M/dL, dR_N/dL, which the printed F omits):
+
+    δṗ = F_pp δp + F_pv δv
+    δv̇ = f^n × φ - (2ω_ie^n + ω_en^n) × δv + v^n × (2δω_ie^n + δω_en^n) + δg_γ(δp)
+         + C_b^n δf^b - x_g
+    φ̇ = -ω_in^n × φ + δω_in^n - C_b^n δω_ib^b
+
+with the sensor errors of chen2019 eq. (2-10), δu = Σ_blocks B_kind(u) x_block:
+``identity`` (random constant ε_b/∇_b, first-order Markov ε_m/∇_m: B = I), ``scale``
+(δK: B = diag(u)) and ``misalignment`` (δG/δA of eq. (2-8): six angles).  x_g is a gravity-
+disturbance block (eq. (2-12) shaping filter).  The sign of the gyro term follows from the
+definitions above; chen2019 (3-16) prints +C_b^n ε (ε counted with the opposite sign) and
+(3-15) prints ψ × f^n where its own F23 block is (f^n ×) ψ = f^n × ψ, used here.
+
+Build models with :func:`model_15` or by composing blocks::
+
+    m15 = model_15(accel_bias_sd=..., gyro_bias_sd=..., accel_psd=..., gyro_psd=...)
+    m = m15.extend(accel_markov(...), gyro_markov(...), accel_scale(...), gyro_scale(...),
+                   accel_misalignment(...), gyro_misalignment(...), gravity_shaping(...),
+                   lever_arm(...))
+    m.slices["gyro_bias"], m.labels, m.F(point), m.numerical_jacobian(point)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from . import earth
+from . import _kernels as K
+from .rotations import euler_to_dcm, rotvec_to_dcm
+
+__all__ = ["StateBlock", "ErrorModel", "NavPoint", "nav_block_labels", "accel_bias", "gyro_bias",
+           "accel_markov", "gyro_markov", "accel_scale", "gyro_scale", "accel_misalignment",
+           "gyro_misalignment", "gravity_shaping", "lever_arm", "model_15", "NAV_LABELS"]
+
+NAV_LABELS = ("dL", "dlon", "dh", "dvE", "dvN", "dvU", "phiE", "phiN", "phiU")
+_TARGETS = {"accel": K.TARGET_ACCEL, "gyro": K.TARGET_GYRO, "gravity": K.TARGET_GRAVITY,
+            "lever_arm": K.TARGET_LEVER, "none": K.TARGET_NONE}
+_KINDS = {"identity": K.KIND_IDENTITY, "scale": K.KIND_SCALE, "misalignment": K.KIND_MISALIGN}
+_MIS_LABELS = ("xy", "yx", "xz", "zx", "yz", "zy")
+
+
+def nav_block_labels():
+    return list(NAV_LABELS)
+
+
+@dataclass(frozen=True)
+class StateBlock:
+    """One augmented block of the error state.
+
+    name      — unique key (``"accel_bias"``, ``"gyro_markov"``, ...);
+    labels    — one label per component;
+    target    — what it perturbs: ``"accel"`` (f^b), ``"gyro"`` (ω_ib^b), ``"gravity"`` (g^n),
+                ``"lever_arm"`` (GNSS antenna offset, measurement only) or ``"none"``;
+    kind      — coupling B(u) for accel/gyro targets: ``"identity"``, ``"scale"``,
+                ``"misalignment"`` (chen2019 eq. (2-8));
+    dynamics  — k×k matrix A of ẋ = A x + w (zeros: random constant);
+    noise_psd — k×k intensity of w;
+    output    — 3×k matrix mapping the block to δg^n (gravity blocks);
+    sd        — k initial standard deviations (for P0 and for drawing truth values);
+    fd_step   — finite-difference step for the numerical Jacobian.
+    """
+
+    name: str
+    labels: tuple
+    target: str
+    kind: str = "identity"
+    dynamics: np.ndarray | None = None
+    noise_psd: np.ndarray | None = None
+    output: np.ndarray | None = None
+    sd: np.ndarray | None = None
+    fd_step: float = 1e-6
+
+    def __post_init__(self):
+        k = len(self.labels)
+        if self.target not in _TARGETS:
+            raise ValueError(f"block {self.name!r}: target must be one of {sorted(_TARGETS)}, got {self.target!r}")
+        if self.kind not in _KINDS:
+            raise ValueError(f"block {self.name!r}: kind must be one of {sorted(_KINDS)}, got {self.kind!r}")
+        need = {"identity": 3, "scale": 3, "misalignment": 6}[self.kind]
+        if self.target in ("accel", "gyro") and k != need:
+            raise ValueError(f"block {self.name!r}: a {self.kind} block has {need} states, got {k} labels")
+        if self.target == "lever_arm" and k != 3:
+            raise ValueError(f"block {self.name!r}: a lever-arm block has 3 states")
+        for attr, shape in (("dynamics", (k, k)), ("noise_psd", (k, k)), ("sd", (k,))):
+            val = getattr(self, attr)
+            arr = np.zeros(shape) if val is None else np.asarray(val, float)
+            if arr.shape != shape:
+                raise ValueError(f"block {self.name!r}: {attr} must have shape {shape}, got {arr.shape}")
+            object.__setattr__(self, attr, arr)
+        if self.target == "gravity":
+            out = np.eye(3, k) if self.output is None else np.asarray(self.output, float)
+            if out.shape != (3, k):
+                raise ValueError(f"block {self.name!r}: output must be 3×{k}")
+            object.__setattr__(self, "output", out)
+
+    @property
+    def size(self):
+        return len(self.labels)
+
+
+@dataclass
+class NavPoint:
+    """A point of a trajectory at which F is evaluated: nav state and true sensor outputs."""
+
+    lat: float
+    lon: float
+    h: float
+    v_enu: np.ndarray
+    C_bn: np.ndarray
+    f_b: np.ndarray
+    w_ib_b: np.ndarray
+
+    @classmethod
+    def from_trajectory(cls, traj, k: int):
+        return cls(float(traj.lat[k]), float(traj.lon[k]), float(traj.h[k]), traj.v_enu[k].copy(),
+                   euler_to_dcm(*traj.hpr[k]),
+                   traj.f_b[k].copy(), traj.w_ib_b[k].copy())
+
+
+@dataclass
+class ErrorModel:
+    """The 9 navigation errors plus named augmented blocks (see the module docstring).
+
+    Also carries the white-noise intensities of the navigation equations: ``accel_psd`` and
+    ``gyro_psd`` (per axis, (m/s²)²·s and (rad/s)²·s: velocity/angle random walk squared), and
+    the initial navigation standard deviations ``nav_sd`` (9 values, state units).
+    """
+
+    blocks: tuple = ()
+    accel_psd: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    gyro_psd: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    nav_sd: np.ndarray = field(default_factory=lambda: np.zeros(9))
+
+    def __post_init__(self):
+        self.blocks = tuple(self.blocks)
+        names = [b.name for b in self.blocks]
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise ValueError(f"duplicated block names {sorted(dup)}: each block needs a unique name")
+        if sum(b.target == "lever_arm" for b in self.blocks) > 1:
+            raise ValueError("at most one lever-arm block")
+        self.accel_psd = np.broadcast_to(np.asarray(self.accel_psd, float), (3,)).copy()
+        self.gyro_psd = np.broadcast_to(np.asarray(self.gyro_psd, float), (3,)).copy()
+        self.nav_sd = np.asarray(self.nav_sd, float)
+        if self.nav_sd.shape != (9,):
+            raise ValueError("nav_sd needs 9 standard deviations (δL, δλ, δh, δv ENU, φ ENU)")
+
+    # -- layout
+    @property
+    def n(self) -> int:
+        return 9 + sum(b.size for b in self.blocks)
+
+    @property
+    def slices(self) -> dict:
+        """Named slices: ``position``, ``velocity``, ``attitude``, ``nav`` and one per block."""
+        s = {"position": slice(0, 3), "velocity": slice(3, 6), "attitude": slice(6, 9), "nav": slice(0, 9)}
+        k = 9
+        for b in self.blocks:
+            s[b.name] = slice(k, k + b.size)
+            k += b.size
+        return s
+
+    @property
+    def labels(self) -> list:
+        out = list(NAV_LABELS)
+        for b in self.blocks:
+            out += [f"{b.name}.{lab}" for lab in b.labels]
+        return out
+
+    def block(self, name) -> StateBlock:
+        for b in self.blocks:
+            if b.name == name:
+                return b
+        raise KeyError(f"no block {name!r}; blocks: {[b.name for b in self.blocks]}")
+
+    def extend(self, *blocks) -> "ErrorModel":
+        """A new model with ``blocks`` appended (the 15-state model extended to 36/45 states...)."""
+        return replace(self, blocks=self.blocks + tuple(blocks))
+
+    # -- constant parts and kernel encoding
+    def _encoding(self):
+        n = self.n
+        fconst = np.zeros((n, n))
+        qc = np.zeros((n, n))
+        tg, kd, st, sz = [], [], [], []
+        for b in self.blocks:
+            s = self.slices[b.name]
+            fconst[s, s] = b.dynamics
+            qc[s, s] = b.noise_psd
+            if b.target == "gravity":
+                fconst[3:6, s] = -b.output
+            tg.append(_TARGETS[b.target])
+            kd.append(_KINDS[b.kind])
+            st.append(s.start)
+            sz.append(b.size)
+        arr = lambda x: np.asarray(x, dtype=np.int64)
+        return fconst, qc, arr(tg), arr(kd), arr(st), arr(sz)
+
+    def P0(self) -> np.ndarray:
+        """Diagonal initial covariance from ``nav_sd`` and the blocks' ``sd``."""
+        sd = np.concatenate([self.nav_sd] + [b.sd for b in self.blocks])
+        return np.diag(sd**2)
+
+    # -- matrices
+    def F(self, point: NavPoint) -> np.ndarray:
+        """Continuous error-state matrix at ``point`` (chen2019 eqs. (3-14)-(3-16))."""
+        earth.check_latitude(point.lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
+        fconst, _, tg, kd, st, sz = self._encoding()
+        F = np.zeros((self.n, self.n))
+        v = np.asarray(point.v_enu, float)
+        K.build_F(float(point.lat), float(point.h), v[0], v[1], v[2], np.ascontiguousarray(point.C_bn, float),
+                  np.asarray(point.f_b, float), np.asarray(point.w_ib_b, float), fconst, tg, kd, st, sz, F)
+        return F
+
+    def G_Qc(self, C_bn) -> np.ndarray:
+        """Continuous process-noise intensity G Q Gᵀ (n×n) for attitude C_b^n."""
+        _, qc, *_ = self._encoding()
+        q = qc.copy()
+        C = np.asarray(C_bn, float)
+        q[3:6, 3:6] += C @ np.diag(self.accel_psd) @ C.T
+        q[6:9, 6:9] += C @ np.diag(self.gyro_psd) @ C.T
+        return q
+
+    def numerical_jacobian(self, point: NavPoint, *, steps=None) -> np.ndarray:
+        """Central finite-difference Jacobian of the continuous mechanization
+        (:func:`replication.strapdown.navigation_rates`) with respect to the error state.
+
+        Column j perturbs the state by ±ε_j: position/velocity additively, attitude by
+        Ĉ = exp(-ε e_j×) C, sensor blocks through their coupling B(u) on f^b or ω_ib^b, gravity
+        blocks through g^n.  Rows of the augmented blocks are their (constant) dynamics.
+        """
+        from .strapdown import navigation_rates
+
+        n = self.n
+        eps = np.array([1e-5, 1e-5, 100.0, 1.0, 1.0, 1.0, 1e-4, 1e-4, 1e-4]
+                       + [b.fd_step for b in self.blocks for _ in b.labels]) if steps is None else np.asarray(steps)
+        C = np.asarray(point.C_bn, float)
+        base = (float(point.lat), float(point.lon), float(point.h), np.asarray(point.v_enu, float), C)
+
+        def err_rate(x_lat, x_lon, x_h, x_v, x_C, f_b, w_b, g_extra):
+            r1 = navigation_rates(x_lat, x_lon, x_h, x_v, x_C, w_b, f_b, g_extra)
+            r0 = navigation_rates(*base, point.w_ib_b, point.f_b)
+            d = np.empty(9)
+            d[0], d[1], d[2] = r1[0] - r0[0], r1[1] - r0[1], r1[2] - r0[2]
+            d[3:6] = r1[3] - r0[3]
+            Edot = r1[4] @ C.T + x_C @ r0[4].T
+            d[6:9] = -0.5 * np.array([Edot[2, 1] - Edot[1, 2], Edot[0, 2] - Edot[2, 0], Edot[1, 0] - Edot[0, 1]])
+            return d
+
+        J = np.zeros((n, n))
+        fconst, *_ = self._encoding()
+        B = np.empty((3, 6))
+        slices = self.slices
+        for j in range(n):
+            cols = []
+            for sgn in (1.0, -1.0):
+                e = sgn * eps[j]
+                lat, lon, h, v, Cx = base[0], base[1], base[2], base[3].copy(), C
+                f_b, w_b, gx = np.asarray(point.f_b, float).copy(), np.asarray(point.w_ib_b, float).copy(), np.zeros(3)
+                if j < 3:
+                    lat, lon, h = (lat + e, lon, h) if j == 0 else ((lat, lon + e, h) if j == 1 else (lat, lon, h + e))
+                elif j < 6:
+                    v[j - 3] += e
+                elif j < 9:
+                    ax = np.zeros(3)
+                    ax[j - 6] = e
+                    Cx = rotvec_to_dcm(-ax) @ C
+                else:
+                    for b in self.blocks:
+                        s = slices[b.name]
+                        if s.start <= j < s.stop:
+                            x = np.zeros(b.size)
+                            x[j - s.start] = e
+                            if b.target in ("accel", "gyro"):
+                                u = f_b if b.target == "accel" else w_b
+                                K.coupling_matrix(_KINDS[b.kind], u, B)
+                                du = B[:, :b.size] @ x
+                                if b.target == "accel":
+                                    f_b = f_b + du
+                                else:
+                                    w_b = w_b + du
+                            elif b.target == "gravity":
+                                gx = -b.output @ x
+                cols.append(err_rate(lat, lon, h, v, Cx, f_b, w_b, gx))
+            J[:9, j] = (cols[0] - cols[1]) / (2 * eps[j])
+        J[9:, 9:] = fconst[9:, 9:]
+        return J
+
+    def propagate_linear(self, traj, x0, *, step: int = 10, order: int = 6):
+        """Propagate δx along a trajectory with the linear model: δx_{j+1} = Φ_j δx_j,
+        Φ_j = exp(F(t_mid) T) over ``step`` samples.  Returns (sample indices, δx (m, n))."""
+        x = np.asarray(x0, float).copy()
+        if x.shape != (self.n,):
+            raise ValueError(f"x0 must have {self.n} components ({self.labels})")
+        fconst, _, tg, kd, st, sz = self._encoding()
+        n = self.n
+        idx = np.arange(0, traj.n + 1, step)
+        out = np.empty((len(idx), n))
+        out[0] = x
+        F = np.zeros((n, n))
+        Phi, Qd, w1, w2 = (np.empty((n, n)) for _ in range(4))
+        Z = np.zeros((n, n))
+        C_all = euler_to_dcm(traj.hpr[:, 0], traj.hpr[:, 1], traj.hpr[:, 2])
+        for j in range(1, len(idx)):
+            k0, k1 = idx[j - 1], idx[j]
+            # average F over the interval (trapezoid of the sample values)
+            Fa = np.zeros((n, n))
+            for k in (k0, (k0 + k1) // 2, k1):
+                K.build_F(traj.lat[k], traj.h[k], traj.v_enu[k, 0], traj.v_enu[k, 1], traj.v_enu[k, 2],
+                          np.ascontiguousarray(C_all[k]), traj.f_b[k], traj.w_ib_b[k], fconst, tg, kd, st, sz, F)
+                Fa += F * (4.0 if k == (k0 + k1) // 2 else 1.0)
+            Fa /= 6.0
+            K.discretize_series(Fa, Z, traj.t[k1] - traj.t[k0], order, Phi, Qd, w1, w2)
+            x = Phi @ x
+            out[j] = x
+        return idx, out
+
+
+# ----------------------------------------------------------------------------- block factories
+
+def _diag3(x, name):
+    a = np.broadcast_to(np.asarray(x, float), (3,))
+    if np.any(a < 0):
+        raise ValueError(f"{name} cannot be negative")
+    return np.diag(a)
+
+
+def accel_bias(sd=0.0, *, name="accel_bias", random_walk_psd=0.0):
+    """Accelerometer random constant ∇_b (chen2019 eq. (2-5)), m/s²; optional random walk."""
+    return StateBlock(name, ("x", "y", "z"), "accel", "identity", noise_psd=_diag3(random_walk_psd, "psd"),
+                      sd=np.broadcast_to(np.asarray(sd, float), (3,)), fd_step=1e-2)
+
+
+def gyro_bias(sd=0.0, *, name="gyro_bias", random_walk_psd=0.0):
+    """Gyro random constant drift ε_b (chen2019 eq. (2-5)), rad/s; optional random walk."""
+    return StateBlock(name, ("x", "y", "z"), "gyro", "identity", noise_psd=_diag3(random_walk_psd, "psd"),
+                      sd=np.broadcast_to(np.asarray(sd, float), (3,)), fd_step=1e-3)
+
+
+def _markov(target, sigma, tau, name):
+    if not tau > 0:
+        raise ValueError("correlation time tau must be positive (seconds)")
+    s = np.broadcast_to(np.asarray(sigma, float), (3,))
+    return StateBlock(name, ("x", "y", "z"), target, "identity", dynamics=-np.eye(3) / tau,
+                      noise_psd=np.diag(2 * s**2 / tau), sd=s, fd_step=1e-2 if target == "accel" else 1e-5)
+
+
+def accel_markov(sigma, tau, *, name="accel_markov"):
+    """First-order Gauss-Markov accelerometer bias ∇_m (eq. (2-5)); stationary σ, correlation τ."""
+    return _markov("accel", sigma, tau, name)
+
+
+def gyro_markov(sigma, tau, *, name="gyro_markov"):
+    """First-order Gauss-Markov gyro drift ε_m (eq. (2-5)); stationary σ, correlation τ."""
+    return _markov("gyro", sigma, tau, name)
+
+
+def accel_scale(sd=0.0, *, name="accel_scale"):
+    """Accelerometer scale-factor errors δK_a (eq. (2-6)), dimensionless."""
+    return StateBlock(name, ("x", "y", "z"), "accel", "scale", sd=np.broadcast_to(np.asarray(sd, float), (3,)),
+                      fd_step=1e-3)
+
+
+def gyro_scale(sd=0.0, *, name="gyro_scale"):
+    """Gyro scale-factor errors δK_g (eq. (2-6)), dimensionless."""
+    return StateBlock(name, ("x", "y", "z"), "gyro", "scale", sd=np.broadcast_to(np.asarray(sd, float), (3,)),
+                      fd_step=1e-3)
+
+
+def accel_misalignment(sd=0.0, *, name="accel_misalignment"):
+    """Accelerometer non-orthogonality δA (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad."""
+    return StateBlock(name, _MIS_LABELS, "accel", "misalignment",
+                      sd=np.broadcast_to(np.asarray(sd, float), (6,)), fd_step=1e-3)
+
+
+def gyro_misalignment(sd=0.0, *, name="gyro_misalignment"):
+    """Gyro non-orthogonality δG (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad."""
+    return StateBlock(name, _MIS_LABELS, "gyro", "misalignment",
+                      sd=np.broadcast_to(np.asarray(sd, float), (6,)), fd_step=1e-3)
+
+
+def gravity_shaping(sigma, beta, *, name="gravity", dynamics=None, noise_psd=None, output=None, labels=None):
+    """Gravity-disturbance states: chen2019 eq. (2-12) δġ = -β δg + n per ENU axis (stationary σ),
+    or a general shaping filter (``dynamics``, ``noise_psd``, ``output``: e.g. the AR models of
+    chen2019 ch. 3 in state-space form)."""
+    if dynamics is None:
+        s = np.broadcast_to(np.asarray(sigma, float), (3,))
+        b = np.broadcast_to(np.asarray(beta, float), (3,))
+        if np.any(b <= 0):
+            raise ValueError("beta (inverse correlation time) must be positive")
+        return StateBlock(name, ("E", "N", "U"), "gravity", dynamics=-np.diag(b), noise_psd=np.diag(2 * b * s**2),
+                          sd=s, fd_step=1e-2)
+    A = np.asarray(dynamics, float)
+    k = A.shape[0]
+    return StateBlock(name, tuple(labels or [f"s{i}" for i in range(k)]), "gravity", dynamics=A,
+                      noise_psd=noise_psd, output=output, sd=np.broadcast_to(np.asarray(sigma, float), (k,)),
+                      fd_step=1e-2)
+
+
+def lever_arm(sd=0.0, *, name="lever_arm"):
+    """Lever-arm (spatial synchronisation) error l of the GNSS antenna, chen2019 eq. (2-13), m."""
+    return StateBlock(name, ("x", "y", "z"), "lever_arm", sd=np.broadcast_to(np.asarray(sd, float), (3,)))
+
+
+def model_15(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e-4, 1e-4, 1e-3),
+             accel_bias_sd=0.0, gyro_bias_sd=0.0, accel_psd=0.0, gyro_psd=0.0, lat=0.0, h=0.0) -> ErrorModel:
+    """The classic 15-state model (chen2019 eqs. (3-14)-(3-16)): 9 navigation errors, accelerometer
+    bias ∇_b, gyro drift ε_b.  ``position_sd`` in metres (E, N, U), converted to (δL, δλ, δh)
+    at (``lat``, ``h``); ``attitude_sd`` in rad (E, N, U)."""
+    ps = np.broadcast_to(np.asarray(position_sd, float), (3,))
+    rm, rn = earth.radii(lat)
+    nav_sd = np.concatenate([[ps[1] / (rm + h), ps[0] / ((rn + h) * np.cos(lat)), ps[2]],
+                             np.broadcast_to(np.asarray(velocity_sd, float), (3,)),
+                             np.broadcast_to(np.asarray(attitude_sd, float), (3,))])
+    return ErrorModel(blocks=(accel_bias(accel_bias_sd), gyro_bias(gyro_bias_sd)), accel_psd=accel_psd,
+                      gyro_psd=gyro_psd, nav_sd=nav_sd)

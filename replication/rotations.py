@@ -1,0 +1,268 @@
+"""Attitude representations: direction cosine matrices, Euler angles, quaternions, rotation vectors.
+
+Conventions (used by every navigation module of the package)
+--------------------------------------------------------------
+* Navigation frame n: local-level **East-North-Up** (ENU), as in chen2019 ch. 3.
+* Body frame b: **Right-Front-Up** (x to the right wing, y through the nose, z up), the IMU
+  axes chen2019 uses ("IMU 指向为东北天" with zero attitude).
+* ``C_bn`` is the DCM C_b^n that maps body-frame vectors into the n frame: v^n = C_b^n v^b.
+* Euler angles ``hpr = (heading, pitch, roll)`` in radians:
+  heading ψ (航向) clockwise from north ("北偏东" positive), pitch θ (俯仰) nose-up positive,
+  roll γ (横滚) right-wing-down positive.  The rotation from n to b is a turn about Up by -ψ,
+  then about the new x (Right) by θ, then about the new y (Front) by γ:
+
+      C_b^n = R_z(-ψ) R_x(θ) R_y(γ)
+
+  with R_i(a) the active (right-handed) rotation about axis i.  This is the gimbal order of a
+  three-axis turntable (outer = azimuth, middle = pitch, inner = roll).  Some Chinese texts use
+  a yaw counted *counter-clockwise* (north-west positive); that yaw is -ψ.
+* Quaternions are scalar-first ``[q0, q1, q2, q3]``; ``q_bn`` represents C_b^n
+  (v^n = q ⊗ v^b ⊗ q*).
+* Rotation vector φ: C = exp(φ×) (Rodrigues).
+* Attitude (misalignment) error φ^n of an estimate: Ĉ_b^n = (I - φ×) C_b^n, exactly
+  Ĉ C^T = exp(-φ×) (the ψ/φ-angle convention of chen2019 eq. (3-16)).
+
+All functions accept leading batch dimensions and return float arrays.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "skew", "vee", "euler_to_dcm", "dcm_to_euler", "rotvec_to_dcm", "dcm_to_rotvec",
+    "quat_to_dcm", "dcm_to_quat", "quat_multiply", "quat_conjugate", "quat_normalize",
+    "rotvec_to_quat", "quat_to_rotvec", "euler_to_quat", "quat_to_euler", "attitude_error",
+    "body_rate_from_euler_rates", "orthonormalize",
+]
+
+
+def _vec3(v, name):
+    v = np.asarray(v, dtype=float)
+    if v.shape[-1:] != (3,):
+        raise ValueError(f"{name} must have a last axis of length 3, got shape {v.shape}")
+    return v
+
+
+def _mat3(m, name):
+    m = np.asarray(m, dtype=float)
+    if m.shape[-2:] != (3, 3):
+        raise ValueError(f"{name} must have trailing shape (3, 3), got shape {m.shape}")
+    return m
+
+
+def _quat(q, name="q"):
+    q = np.asarray(q, dtype=float)
+    if q.shape[-1:] != (4,):
+        raise ValueError(f"{name} must have a last axis of length 4 (scalar first), got shape {q.shape}")
+    return q
+
+
+def skew(v):
+    """Skew-symmetric (cross-product) matrix (v×) such that (v×) u = v × u."""
+    v = _vec3(v, "v")
+    z = np.zeros(v.shape[:-1])
+    x, y, w = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([
+        np.stack([z, -w, y], -1),
+        np.stack([w, z, -x], -1),
+        np.stack([-y, x, z], -1),
+    ], -2)
+
+
+def vee(m):
+    """Inverse of :func:`skew` applied to the skew-symmetric part of ``m``."""
+    m = _mat3(m, "m")
+    return 0.5 * np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0],
+                           m[..., 1, 0] - m[..., 0, 1]], -1)
+
+
+def euler_to_dcm(heading, pitch, roll):
+    """C_b^n = R_z(-ψ) R_x(θ) R_y(γ) from heading ψ, pitch θ, roll γ (radians), ENU / R-F-U."""
+    h, p, r = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (heading, pitch, roll)))
+    if np.any(np.abs(p) > np.pi / 2 + 1e-12):
+        raise ValueError("pitch must lie within ±90° (radians expected; convert degrees with np.radians)")
+    sh, ch = np.sin(h), np.cos(h)
+    sp, cp = np.sin(p), np.cos(p)
+    sr, cr = np.sin(r), np.cos(r)
+    c = np.empty(h.shape + (3, 3))
+    c[..., 0, 0] = ch * cr + sh * sp * sr
+    c[..., 0, 1] = sh * cp
+    c[..., 0, 2] = ch * sr - sh * sp * cr
+    c[..., 1, 0] = -sh * cr + ch * sp * sr
+    c[..., 1, 1] = ch * cp
+    c[..., 1, 2] = -sh * sr - ch * sp * cr
+    c[..., 2, 0] = -cp * sr
+    c[..., 2, 1] = sp
+    c[..., 2, 2] = cp * cr
+    return c
+
+
+def dcm_to_euler(c):
+    """(heading, pitch, roll) from C_b^n; heading in [0, 2π), roll in (-π, π].
+
+    Near pitch = ±90° heading and roll are not separable (gimbal lock); the sum is kept.
+    """
+    c = _mat3(c, "C_bn")
+    pitch = np.arcsin(np.clip(c[..., 2, 1], -1.0, 1.0))
+    heading = np.mod(np.arctan2(c[..., 0, 1], c[..., 1, 1]), 2 * np.pi)
+    roll = np.arctan2(-c[..., 2, 0], c[..., 2, 2])
+    return heading, pitch, roll
+
+
+def rotvec_to_dcm(phi):
+    """exp(φ×) by Rodrigues' formula (exact, series-safe near zero)."""
+    phi = _vec3(phi, "phi")
+    a2 = np.sum(phi * phi, -1)
+    a = np.sqrt(a2)
+    small = a2 < 1e-8
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.where(small, 1 - a2 / 6 + a2**2 / 120, np.sin(a) / np.where(small, 1, a))
+        c1 = np.where(small, 0.5 - a2 / 24 + a2**2 / 720, (1 - np.cos(a)) / np.where(small, 1, a2))
+    k = skew(phi)
+    eye = np.broadcast_to(np.eye(3), k.shape)
+    return eye + s[..., None, None] * k + c1[..., None, None] * (k @ k)
+
+
+def dcm_to_rotvec(c):
+    """Rotation vector φ with exp(φ×) = C, |φ| ≤ π (via the quaternion for accuracy)."""
+    return quat_to_rotvec(dcm_to_quat(c))
+
+
+def quat_to_dcm(q):
+    """DCM of a unit scalar-first quaternion (normalised first)."""
+    q = quat_normalize(q)
+    a, b, c, d = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    m = np.empty(q.shape[:-1] + (3, 3))
+    m[..., 0, 0] = a * a + b * b - c * c - d * d
+    m[..., 0, 1] = 2 * (b * c - a * d)
+    m[..., 0, 2] = 2 * (b * d + a * c)
+    m[..., 1, 0] = 2 * (b * c + a * d)
+    m[..., 1, 1] = a * a - b * b + c * c - d * d
+    m[..., 1, 2] = 2 * (c * d - a * b)
+    m[..., 2, 0] = 2 * (b * d - a * c)
+    m[..., 2, 1] = 2 * (c * d + a * b)
+    m[..., 2, 2] = a * a - b * b - c * c + d * d
+    return m
+
+
+def dcm_to_quat(c):
+    """Scalar-first unit quaternion (q0 ≥ 0) of a DCM (Shepperd's method)."""
+    c = _mat3(c, "C")
+    tr = c[..., 0, 0] + c[..., 1, 1] + c[..., 2, 2]
+    cand = np.stack([tr, c[..., 0, 0], c[..., 1, 1], c[..., 2, 2]], -1)
+    i = np.argmax(cand, -1)
+    q = np.empty(c.shape[:-2] + (4,))
+    # case 0: trace largest
+    for case in range(4):
+        m = i == case
+        if not np.any(m):
+            continue
+        cc = c[m]
+        if case == 0:
+            s = 2 * np.sqrt(1 + cc[:, 0, 0] + cc[:, 1, 1] + cc[:, 2, 2])
+            qq = [0.25 * s, (cc[:, 2, 1] - cc[:, 1, 2]) / s, (cc[:, 0, 2] - cc[:, 2, 0]) / s,
+                  (cc[:, 1, 0] - cc[:, 0, 1]) / s]
+        elif case == 1:
+            s = 2 * np.sqrt(1 + cc[:, 0, 0] - cc[:, 1, 1] - cc[:, 2, 2])
+            qq = [(cc[:, 2, 1] - cc[:, 1, 2]) / s, 0.25 * s, (cc[:, 0, 1] + cc[:, 1, 0]) / s,
+                  (cc[:, 0, 2] + cc[:, 2, 0]) / s]
+        elif case == 2:
+            s = 2 * np.sqrt(1 - cc[:, 0, 0] + cc[:, 1, 1] - cc[:, 2, 2])
+            qq = [(cc[:, 0, 2] - cc[:, 2, 0]) / s, (cc[:, 0, 1] + cc[:, 1, 0]) / s, 0.25 * s,
+                  (cc[:, 1, 2] + cc[:, 2, 1]) / s]
+        else:
+            s = 2 * np.sqrt(1 - cc[:, 0, 0] - cc[:, 1, 1] + cc[:, 2, 2])
+            qq = [(cc[:, 1, 0] - cc[:, 0, 1]) / s, (cc[:, 0, 2] + cc[:, 2, 0]) / s,
+                  (cc[:, 1, 2] + cc[:, 2, 1]) / s, 0.25 * s]
+        q[m] = np.stack(qq, -1)
+    q = np.where(q[..., :1] < 0, -q, q)
+    return quat_normalize(q)
+
+
+def quat_multiply(p, q):
+    """Hamilton product p ⊗ q (scalar first)."""
+    p, q = _quat(p, "p"), _quat(q, "q")
+    a1, b1, c1, d1 = (p[..., i] for i in range(4))
+    a2, b2, c2, d2 = (q[..., i] for i in range(4))
+    return np.stack([
+        a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2,
+        a1 * b2 + b1 * a2 + c1 * d2 - d1 * c2,
+        a1 * c2 - b1 * d2 + c1 * a2 + d1 * b2,
+        a1 * d2 + b1 * c2 - c1 * b2 + d1 * a2,
+    ], -1)
+
+
+def quat_conjugate(q):
+    q = _quat(q)
+    return q * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def quat_normalize(q):
+    q = _quat(q)
+    n = np.linalg.norm(q, axis=-1, keepdims=True)
+    if np.any(n == 0):
+        raise ValueError("a zero quaternion cannot represent an attitude")
+    return q / n
+
+
+def rotvec_to_quat(phi):
+    """q = [cos(|φ|/2), sin(|φ|/2) φ/|φ|] (exact)."""
+    phi = _vec3(phi, "phi")
+    a = np.linalg.norm(phi, axis=-1)
+    half = 0.5 * a
+    small = a < 1e-6
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = np.where(small, 0.5 - a**2 / 48, np.sin(half) / np.where(small, 1, a))
+    return np.concatenate([np.cos(half)[..., None], k[..., None] * phi], -1)
+
+
+def quat_to_rotvec(q):
+    """Rotation vector of a unit quaternion, |φ| ≤ π."""
+    q = quat_normalize(q)
+    q = np.where(q[..., :1] < 0, -q, q)
+    s = np.linalg.norm(q[..., 1:], axis=-1)
+    ang = 2 * np.arctan2(s, q[..., 0])
+    small = s < 1e-12
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = np.where(small, 2.0 / np.where(q[..., 0] == 0, 1, q[..., 0]), ang / np.where(small, 1, s))
+    return k[..., None] * q[..., 1:]
+
+
+def euler_to_quat(heading, pitch, roll):
+    return dcm_to_quat(euler_to_dcm(heading, pitch, roll))
+
+
+def quat_to_euler(q):
+    return dcm_to_euler(quat_to_dcm(q))
+
+
+def attitude_error(c_est, c_true):
+    """Misalignment φ^n with Ĉ_b^n = exp(-φ×) C_b^n (≈ (I - φ×) C_b^n), chen2019 eq. (3-16) ψ^n."""
+    c_est, c_true = _mat3(c_est, "C_est"), _mat3(c_true, "C_true")
+    e = c_est @ np.swapaxes(c_true, -1, -2)
+    return -dcm_to_rotvec(e)
+
+
+def body_rate_from_euler_rates(heading, pitch, roll, heading_rate, pitch_rate, roll_rate):
+    """ω_nb^b (rad/s) of the Euler sequence C_b^n = R_z(-ψ) R_x(θ) R_y(γ).
+
+    ω_nb^b = R_y(γ)^T [θ̇ e_x + R_x(θ)^T (-ψ̇ e_z)] + γ̇ e_y.
+    """
+    p, r = np.broadcast_arrays(np.asarray(pitch, float), np.asarray(roll, float))
+    hd, pd, rd = np.broadcast_arrays(*(np.asarray(a, float) for a in (heading_rate, pitch_rate, roll_rate)))
+    sp, cp, sr, cr = np.sin(p), np.cos(p), np.sin(r), np.cos(r)
+    # u = θ̇ e_x + R_x(θ)^T(-ψ̇ e_z) = [θ̇, -ψ̇ sinθ, -ψ̇ cosθ]
+    ux, uy, uz = pd, -hd * sp, -hd * cp
+    # R_y(γ)^T u, R_y = [[c,0,s],[0,1,0],[-s,0,c]] -> R_y^T = [[c,0,-s],[0,1,0],[s,0,c]]
+    wx = cr * ux - sr * uz
+    wy = uy + rd
+    wz = sr * ux + cr * uz
+    return np.stack([wx, wy, wz], -1)
+
+
+def orthonormalize(c):
+    """Nearest rotation matrix (polar decomposition via SVD)."""
+    c = _mat3(c, "C")
+    u, _, vt = np.linalg.svd(c)
+    return u @ vt

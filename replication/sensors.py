@@ -1,0 +1,254 @@
+"""Sensor error models: IMU (chen2019 eqs. (2-3)-(2-10)), GNSS with lever arm (eq. (2-13)),
+barometric / air-data height.
+
+IMU model per triad (gyro or accelerometer), chen2019 eq. (2-10):
+
+    δu = x_b + x_m + w + (δK + δM) u
+
+* ``bias`` x_b — random constant (eq. (2-5): ẋ_b = 0), SI units (rad/s or m/s²);
+* ``markov_sigma``, ``markov_tau`` — first-order Gauss-Markov x_m (eq. (2-5):
+  ẋ_m = -x_m/τ + w_m); ``markov_sigma`` is the *stationary* standard deviation; the driving
+  white-noise intensity is q_m = 2σ²/τ (see :func:`markov_sigma_from_driving_psd` for the
+  papers' "驱动白噪声方差强度");
+* ``white_psd`` q — white noise w with E[w(t)w(t')] = q δ(t-t') (units (rad/s)²·s = rad²/s or
+  (m/s²)²·s); angle/velocity random walk √q;
+* ``scale`` δK — diagonal scale-factor errors (dimensionless, e.g. 10 ppm = 1e-5), eq. (2-6);
+* ``misalignment`` δM — six non-orthogonality angles [θ_xy, θ_yx, θ_xz, θ_zx, θ_yz, θ_zy] (rad) of
+  δC_m^s in eq. (2-8):  [[0, -θ_yz, θ_zy], [θ_xz, 0, -θ_zx], [-θ_xy, θ_yx, 0]].
+
+On increments over T: Δũ = (I + δK + δM) Δu + x_b T + x̄_m T + n,  n ~ N(0, q T); the Markov
+process is propagated exactly at the sample rate and held over each interval.
+
+Units as printed in the papers (°/h, μg, ppm, ″, (°/h)²) convert with :mod:`replication.units`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import earth
+from .rotations import euler_to_dcm
+from .units import DEG_PER_H, MICRO_G, PPM, ARCSEC, deg_per_h2
+
+__all__ = ["TriadErrors", "ImuErrors", "misalignment_matrix", "apply_imu_errors", "draw_imu_errors",
+           "markov_sigma_from_driving_psd", "GnssMeasurements", "gnss_measurements", "barometric_height",
+           "lever_arm_offset"]
+
+
+def _vec(x, name, n=3):
+    a = np.asarray(x, float)
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    if a.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or have {n} components, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite")
+    return a
+
+
+def misalignment_matrix(theta):
+    """δC_m^s of chen2019 eq. (2-8) from [θ_xy, θ_yx, θ_xz, θ_zx, θ_yz, θ_zy] (rad)."""
+    xy, yx, xz, zx, yz, zy = _vec(theta, "misalignment", 6)
+    return np.array([[0.0, -yz, zy], [xz, 0.0, -zx], [-xy, yx, 0.0]])
+
+
+def markov_sigma_from_driving_psd(q_drive, tau):
+    """Stationary σ of ẋ = -x/τ + w with driving intensity q: σ² = q τ / 2."""
+    if tau <= 0:
+        raise ValueError("the correlation time tau must be positive (seconds)")
+    return np.sqrt(np.asarray(q_drive, float) * tau / 2)
+
+
+@dataclass
+class TriadErrors:
+    """Error parameters of one sensor triad (SI units, see the module docstring)."""
+
+    bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    markov_sigma: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    markov_tau: float = np.inf
+    white_psd: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    scale: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    misalignment: np.ndarray = field(default_factory=lambda: np.zeros(6))
+
+    def __post_init__(self):
+        self.bias = _vec(self.bias, "bias")
+        self.markov_sigma = _vec(self.markov_sigma, "markov_sigma")
+        self.white_psd = _vec(self.white_psd, "white_psd")
+        if np.any(self.white_psd < 0) or np.any(self.markov_sigma < 0):
+            raise ValueError("white_psd and markov_sigma cannot be negative")
+        self.scale = _vec(self.scale, "scale")
+        self.misalignment = _vec(self.misalignment, "misalignment", 6)
+        if not self.markov_tau > 0:
+            raise ValueError("markov_tau must be positive (seconds; np.inf for none)")
+
+    @property
+    def matrix(self):
+        """I + δK + δM."""
+        return np.eye(3) + np.diag(self.scale) + misalignment_matrix(self.misalignment)
+
+
+@dataclass
+class ImuErrors:
+    """Gyro and accelerometer error parameters (chen2019 eq. (2-10))."""
+
+    gyro: TriadErrors = field(default_factory=TriadErrors)
+    accel: TriadErrors = field(default_factory=TriadErrors)
+
+    @classmethod
+    def from_printed_units(cls, *, gyro_bias_deg_h=0.0, gyro_white_deg2_h2=0.0, gyro_markov_deg_h=0.0,
+                           gyro_markov_tau_s=np.inf, accel_bias_ug=0.0, accel_white_ug2=0.0,
+                           accel_markov_ug=0.0, accel_markov_tau_s=np.inf, scale_ppm=0.0,
+                           misalignment_arcsec=0.0):
+        """Parameters in the units the papers print: °/h, (°/h)² per Hz (white-noise intensity),
+        μg, (μg)² per Hz, ppm, arc-seconds."""
+        g = TriadErrors(bias=np.asarray(gyro_bias_deg_h, float) * DEG_PER_H,
+                        white_psd=deg_per_h2(gyro_white_deg2_h2) if np.ndim(gyro_white_deg2_h2) == 0
+                        else np.asarray(gyro_white_deg2_h2, float) * DEG_PER_H**2,
+                        markov_sigma=np.asarray(gyro_markov_deg_h, float) * DEG_PER_H,
+                        markov_tau=gyro_markov_tau_s, scale=np.asarray(scale_ppm, float) * PPM,
+                        misalignment=np.asarray(misalignment_arcsec, float) * ARCSEC)
+        a = TriadErrors(bias=np.asarray(accel_bias_ug, float) * MICRO_G,
+                        white_psd=np.asarray(accel_white_ug2, float) * MICRO_G**2,
+                        markov_sigma=np.asarray(accel_markov_ug, float) * MICRO_G,
+                        markov_tau=accel_markov_tau_s, scale=np.asarray(scale_ppm, float) * PPM,
+                        misalignment=np.asarray(misalignment_arcsec, float) * ARCSEC)
+        return cls(gyro=g, accel=a)
+
+
+def _markov_path(n, T, sigma, tau, rng, x0=None):
+    """Exact discretisation of a first-order Gauss-Markov process at the sample rate."""
+    x = np.zeros((n, 3))
+    if not np.any(sigma > 0) or not np.isfinite(tau):
+        return x
+    a = np.exp(-T / tau)
+    s = sigma * np.sqrt(1 - a**2)
+    xk = sigma * rng.standard_normal(3) if x0 is None else np.asarray(x0, float)
+    w = rng.standard_normal((n, 3)) * s
+    # vectorised AR(1) recursion via scipy.signal.lfilter per axis
+    from scipy.signal import lfilter
+
+    for i in range(3):
+        x[:, i], _ = lfilter([1.0], [1.0, -a], w[:, i], zi=[a * xk[i]])
+    return x
+
+
+def apply_imu_errors(t, dtheta, dv, errors: ImuErrors, rng=None):
+    """Corrupt ideal increments with chen2019 eq. (2-10) errors.  Returns (dtheta, dv, info).
+
+    ``info`` holds the realised Markov paths (``gyro_markov``, ``accel_markov``, per interval).
+    """
+    from .strapdown import validate_increments, validate_time
+
+    dtheta, dv = validate_increments(dtheta, dv)
+    t = validate_time(t, len(dtheta))
+    T = np.diff(t)[:, None]
+    rng = np.random.default_rng(rng)
+    out = []
+    info = {}
+    for name, inc, e in (("gyro", dtheta, errors.gyro), ("accel", dv, errors.accel)):
+        y = inc @ e.matrix.T + e.bias * T
+        m = _markov_path(len(inc), float(np.median(T)), e.markov_sigma, e.markov_tau, rng)
+        y = y + m * T
+        if np.any(e.white_psd > 0):
+            y = y + rng.standard_normal(inc.shape) * np.sqrt(e.white_psd * T)
+        info[f"{name}_markov"] = m
+        out.append(y)
+    return out[0], out[1], info
+
+
+def draw_imu_errors(sd: ImuErrors, rng=None) -> ImuErrors:
+    """A realisation of the random-constant parameters: bias, scale and misalignment drawn
+    N(0, σ²) per component from ``sd`` (whose fields hold standard deviations); Markov and
+    white-noise parameters copied."""
+    rng = np.random.default_rng(rng)
+
+    def draw(s: TriadErrors):
+        return TriadErrors(bias=s.bias * rng.standard_normal(3), markov_sigma=s.markov_sigma,
+                           markov_tau=s.markov_tau, white_psd=s.white_psd,
+                           scale=s.scale * rng.standard_normal(3),
+                           misalignment=s.misalignment * rng.standard_normal(6))
+
+    return ImuErrors(gyro=draw(sd.gyro), accel=draw(sd.accel))
+
+
+# ----------------------------------------------------------------------------- GNSS
+
+@dataclass
+class GnssMeasurements:
+    """GNSS fixes: times, sample indices into the IMU record, antenna position and velocity."""
+
+    t: np.ndarray
+    index: np.ndarray
+    lat: np.ndarray
+    lon: np.ndarray
+    h: np.ndarray
+    v_enu: np.ndarray
+    sigma_pos: np.ndarray
+    sigma_vel: np.ndarray
+    lever_arm_b: np.ndarray
+
+    @property
+    def position(self):
+        return np.stack([self.lat, self.lon, self.h], -1)
+
+
+def lever_arm_offset(lat, h, C_bn, lever_arm_b, w_eb_b=None):
+    """Antenna minus IMU-centre offsets, chen2019 eq. (2-13).
+
+    Position: C_b^n l^b converted to (ΔL, Δλ, Δh); velocity: C_b^n (ω_eb^b × l^b) (the report
+    writes C_b^n ω_nb^n P^b; ω_eb^b = ω_ib^b - C_n^b ω_ie^n is the exact rate).
+    """
+    lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
+    l = _vec(lever_arm_b, "lever_arm_b")
+    d = np.einsum("...ij,j->...i", C_bn, l)
+    rm, rn = earth.radii(lat)
+    dpos = np.stack([d[..., 1] / (rm + h), d[..., 0] / ((rn + h) * np.cos(lat)), d[..., 2]], -1)
+    if w_eb_b is None:
+        return dpos, None
+    dvel = np.einsum("...ij,...j->...i", C_bn, np.cross(w_eb_b, l))
+    return dpos, dvel
+
+
+def gnss_measurements(traj, *, rate_hz: float = 10.0, sigma_pos=(0.03, 0.03, 0.1), sigma_vel=0.03,
+                      lever_arm_b=(0.0, 0.0, 0.0), rng=None) -> GnssMeasurements:
+    """GNSS antenna position/velocity fixes from a trajectory with white noise.
+
+    ``rate_hz`` must divide the IMU rate (fixes fall on IMU samples).  Noise: ``sigma_pos``
+    (E, N, U metres) and ``sigma_vel`` (m/s), independent white; ``lever_arm_b`` the antenna
+    position in the body frame (chen2019 eq. (2-13)).
+    """
+    dt = float(np.median(np.diff(traj.t)))
+    step = 1.0 / (rate_hz * dt)
+    if rate_hz <= 0 or abs(step - round(step)) > 1e-6:
+        raise ValueError(f"GNSS rate {rate_hz} Hz must divide the IMU rate {1 / dt:g} Hz")
+    step = int(round(step))
+    idx = np.arange(step, len(traj.t), step)
+    rng = np.random.default_rng(rng)
+    sp = _vec(sigma_pos, "sigma_pos")
+    sv = _vec(sigma_vel, "sigma_vel")
+    l = _vec(lever_arm_b, "lever_arm_b")
+    C = euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2])
+    w_ie = earth.earth_rate_enu(traj.lat[idx])
+    w_eb = traj.w_ib_b[idx] - np.einsum("kji,kj->ki", C, w_ie)
+    dpos, dvel = lever_arm_offset(traj.lat[idx], traj.h[idx], C, l, w_eb)
+    lat, lon, h = traj.lat[idx] + dpos[:, 0], traj.lon[idx] + dpos[:, 1], traj.h[idx] + dpos[:, 2]
+    rm, rn = earth.radii(lat)
+    n = rng.standard_normal((len(idx), 3)) * sp
+    lat = lat + n[:, 1] / (rm + h)
+    lon = lon + n[:, 0] / ((rn + h) * np.cos(lat))
+    h = h + n[:, 2]
+    v = traj.v_enu[idx] + dvel + rng.standard_normal((len(idx), 3)) * sv
+    return GnssMeasurements(traj.t[idx], idx, lat, lon, h, v, sp, sv, l)
+
+
+def barometric_height(traj, *, sigma: float = 1.0, bias: float = 0.0, markov_sigma: float = 0.0,
+                      markov_tau: float = 600.0, rng=None):
+    """Barometric / air-data height at every sample: h + bias + Gauss-Markov + white noise (m)."""
+    if sigma < 0 or markov_sigma < 0:
+        raise ValueError("sigma and markov_sigma cannot be negative")
+    rng = np.random.default_rng(rng)
+    n = len(traj.t)
+    m = _markov_path(n, float(np.median(np.diff(traj.t))), np.array([markov_sigma] * 3), markov_tau, rng)[:, 0]
+    return traj.h + bias + m + sigma * rng.standard_normal(n)

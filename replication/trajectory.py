@@ -1,0 +1,504 @@
+"""True motion and ideal IMU increments (ENU navigation frame, Right-Front-Up body, WGS-84).
+
+A trajectory is a list of segments (straight and level, climbs, speed changes, coordinated
+turns with bank, U-turns, S-turns, figure-8, turntable moves, ship rocking) evaluated in
+**closed form**: each segment gives heading/pitch/roll, their rates, the ENU velocity and the
+ENU acceleration as analytic functions of time.  Position follows from integrating
+L̇ = v_N/(R_M+h), λ̇ = v_E/((R_N+h) cos L), ḣ = v_U with an 8th-order Dormand-Prince solver
+(tolerance 1e-13, dense output), and the ideal sensor outputs are
+
+    ω_ib^b = ω_nb^b + C_n^b (ω_ie^n + ω_en^n),
+    f^b    = C_n^b (a^n + (2 ω_ie^n + ω_en^n) × v^n - g^n)            (chen2019 eq. (3-2))
+
+with g^n = earth.gravity_enu.  The increments Δθ_k = ∫ ω_ib^b dt and Δv_k = ∫ f^b dt over each
+sampling interval are computed by Gauss-Legendre quadrature of these continuous functions —
+independently of the strapdown algorithm's discrete scheme (nothing here inverts a
+mechanization).  Segment boundaries lie on the sampling grid, so each quadrature interval sees
+a smooth integrand.
+
+Conventions: see :mod:`replication.rotations` (heading clockwise from north, pitch nose-up,
+roll right-wing-down; C_b^n = R_z(-ψ) R_x(θ) R_y(γ)).  Coordinated turns bank by
+tan γ = V ψ̇ / g_0 with g_0 = 9.80665 m/s².
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from . import earth
+from .rotations import body_rate_from_euler_rates, euler_to_dcm, dcm_to_quat
+from .units import DEG, G0
+
+__all__ = [
+    "Segment", "Straight", "Turn", "UTurn", "STurn", "FigureEight", "Climb", "Accelerate",
+    "Rotate", "Dwell", "ShipRocking", "Trajectory", "generate", "chen2019_flight",
+    "turntable_chen2019", "rotation_rich_turntable", "fang2020_ship",
+]
+
+
+# ----------------------------------------------------------------------------- segments
+
+@dataclass
+class Segment:
+    """Base class: a piece of motion lasting ``duration`` seconds."""
+
+    duration: float
+
+    def pieces(self):
+        """Elementary segments this one expands into (composites override)."""
+        return [self]
+
+    # profile(tau, start) -> hpr, hpr_rate, v, a   (each (n, 3))
+    def profile(self, tau, start):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def label(self):
+        return type(self).__name__
+
+
+def _raised_cos(tau, T):
+    """∫-normalised raised cosine: r = (1 - cos 2πτ/T)/T; returns (R, r, r') with R = ∫r."""
+    w = 2 * np.pi / T
+    R = (tau - np.sin(w * tau) / w) / T
+    r = (1 - np.cos(w * tau)) / T
+    rd = w * np.sin(w * tau) / T
+    return R, r, rd
+
+
+class _Flight(Segment):
+    """Flight-dynamics segment: heading, horizontal speed and vertical speed profiles."""
+
+    def heading(self, tau):
+        z = np.zeros_like(tau)
+        return z, z, z
+
+    def speed(self, tau):
+        z = np.zeros_like(tau)
+        return z, z
+
+    def vertical(self, tau):
+        z = np.zeros_like(tau)
+        return z, z
+
+    def profile(self, tau, start):
+        hpr0, v0 = start
+        V0 = math.hypot(v0[0], v0[1])
+        w0 = v0[2]
+        dpsi, r, rd = self.heading(tau)
+        dV, Vd = self.speed(tau)
+        dw, wd = self.vertical(tau)
+        psi = hpr0[0] + dpsi
+        V = V0 + dV
+        w = w0 + dw
+        sp, cp = np.sin(psi), np.cos(psi)
+        v = np.stack([V * sp, V * cp, w], -1)
+        a = np.stack([Vd * sp + V * cp * r, Vd * cp - V * sp * r, wd], -1)
+        pitch = np.arctan2(w, V)
+        pitch_rate = (wd * V - w * Vd) / (V**2 + w**2)
+        u = V * r / G0
+        roll = np.arctan(u)
+        roll_rate = (Vd * r + V * rd) / G0 / (1 + u**2)
+        hpr = np.stack([psi, pitch, roll], -1)
+        rates = np.stack([r, pitch_rate, roll_rate], -1)
+        return hpr, rates, v, a
+
+    def check_start(self, start):
+        hpr0, v0 = start
+        V0 = math.hypot(v0[0], v0[1])
+        if V0 <= 0:
+            raise ValueError(f"{self.label()}: a flight segment needs a non-zero horizontal speed at its start")
+        trk = math.atan2(v0[0], v0[1])
+        if abs(math.remainder(trk - hpr0[0], 2 * math.pi)) > 1e-9:
+            raise ValueError(f"{self.label()}: heading {hpr0[0]:.6g} rad differs from the track {trk:.6g} rad "
+                             "at the segment start (flight segments fly without crab)")
+        if abs(hpr0[2]) > 1e-9 or abs(hpr0[1] - math.atan2(v0[2], V0)) > 1e-9:
+            raise ValueError(f"{self.label()}: a flight segment must start wings-level with pitch equal to "
+                             "the flight-path angle; end the previous segment in steady flight")
+
+
+@dataclass
+class Straight(_Flight):
+    """Straight (constant heading, speed and vertical speed) flight."""
+
+
+@dataclass
+class Turn(_Flight):
+    """Coordinated turn by ``angle`` rad (positive = clockwise, to the right) with bank.
+
+    Turn rate ψ̇ = angle (1 - cos 2πτ/T)/T: zero at both ends, so bank is continuous.
+    """
+
+    angle: float = 0.0
+
+    def heading(self, tau):
+        R, r, rd = _raised_cos(tau, self.duration)
+        return self.angle * R, self.angle * r, self.angle * rd
+
+
+def UTurn(duration: float, clockwise: bool = True) -> Turn:
+    """A 180° coordinated U-turn (chen2019 Table 4-42: "顺时针/逆时针 U 型转弯 180°")."""
+    return Turn(duration, np.pi if clockwise else -np.pi)
+
+
+@dataclass
+class STurn(_Flight):
+    """S-turn(s): ψ = ψ0 + swing (1 - cos 2πcτ/T)/2 — right by ``swing`` then back, ``cycles`` times."""
+
+    swing: float = 0.0
+    cycles: int = 1
+
+    def heading(self, tau):
+        T, c = self.duration, self.cycles
+        w = 2 * np.pi * c / T
+        return (self.swing * 0.5 * (1 - np.cos(w * tau)), self.swing * 0.5 * w * np.sin(w * tau),
+                self.swing * 0.5 * w**2 * np.cos(w * tau))
+
+
+@dataclass
+class FigureEight(Segment):
+    """Figure-8: a full clockwise turn followed by a full counter-clockwise one."""
+
+    def pieces(self):
+        return [Turn(self.duration / 2, 2 * np.pi), Turn(self.duration / 2, -2 * np.pi)]
+
+
+@dataclass
+class Climb(_Flight):
+    """Climb (or descent, negative) by ``height_change`` m with a raised-cosine vertical speed."""
+
+    height_change: float = 0.0
+
+    def vertical(self, tau):
+        _, r, rd = _raised_cos(tau, self.duration)
+        return self.height_change * r, self.height_change * rd
+
+
+@dataclass
+class Accelerate(_Flight):
+    """Change the horizontal speed by ``speed_change`` m/s (raised-cosine acceleration)."""
+
+    speed_change: float = 0.0
+
+    def speed(self, tau):
+        R, r, _ = _raised_cos(tau, self.duration)
+        return self.speed_change * R, self.speed_change * r
+
+
+@dataclass
+class Rotate(Segment):
+    """Turntable move: constant heading/pitch/roll rates (rad/s), ENU velocity held constant."""
+
+    rates: tuple = (0.0, 0.0, 0.0)
+
+    def profile(self, tau, start):
+        hpr0, v0 = start
+        rates = np.broadcast_to(np.asarray(self.rates, float), tau.shape + (3,))
+        hpr = hpr0 + tau[:, None] * rates
+        v = np.broadcast_to(v0, tau.shape + (3,))
+        return hpr, rates, v, np.zeros_like(v)
+
+
+def Dwell(duration: float) -> Rotate:
+    """Rest (turntable position / steady motion at constant velocity and attitude)."""
+    return Rotate(duration, (0.0, 0.0, 0.0))
+
+
+@dataclass
+class ShipRocking(Segment):
+    """Ship rocking, fang2020 eq. (28): pitch = P_m sin(2πt/T_p + φ_p), roll = R_m sin(...),
+    heading = heading0 + Y_m sin(...); constant ENU velocity ``speed`` along ``course``."""
+
+    amplitudes: tuple = (3 * DEG, 5 * DEG, 4 * DEG)    # pitch, roll, yaw
+    periods: tuple = (7.0, 9.0, 12.0)
+    phases: tuple = (0.0, 0.0, 0.0)
+    heading0: float = 90 * DEG
+    speed: float = 10.0
+    course: float | None = None
+
+    def _course(self):
+        return self.heading0 if self.course is None else self.course
+
+    def start_state(self):
+        hpr, _, v, _ = self.profile(np.zeros(1), None)
+        return hpr[0], v[0]
+
+    def profile(self, tau, start):
+        (Pm, Rm, Ym), (Tp, Tr, Ty), (pp, pr, py) = self.amplitudes, self.periods, self.phases
+        wp, wr, wy = 2 * np.pi / Tp, 2 * np.pi / Tr, 2 * np.pi / Ty
+        pitch = Pm * np.sin(wp * tau + pp)
+        roll = Rm * np.sin(wr * tau + pr)
+        head = self.heading0 + Ym * np.sin(wy * tau + py)
+        rates = np.stack([Ym * wy * np.cos(wy * tau + py), Pm * wp * np.cos(wp * tau + pp),
+                          Rm * wr * np.cos(wr * tau + pr)], -1)
+        crs = self._course()
+        v = np.broadcast_to(np.array([self.speed * math.sin(crs), self.speed * math.cos(crs), 0.0]),
+                            tau.shape + (3,))
+        return np.stack([head, pitch, roll], -1), rates, v, np.zeros_like(v)
+
+
+# ----------------------------------------------------------------------------- the trajectory
+
+@dataclass
+class Trajectory:
+    """True motion sampled every ``dt`` with the ideal increments between samples.
+
+    Arrays with N+1 rows (sample instants): ``t``, ``lat``, ``lon``, ``h``, ``v_enu``, ``hpr``
+    (heading, pitch, roll), ``w_ib_b`` (ω_ib^b), ``f_b`` (f^b).  Arrays with N rows (intervals
+    t_{k-1}..t_k): ``dtheta`` (Δθ), ``dv`` (Δv).  ``segments`` lists (label, t_start, t_end).
+    """
+
+    t: np.ndarray
+    lat: np.ndarray
+    lon: np.ndarray
+    h: np.ndarray
+    v_enu: np.ndarray
+    hpr: np.ndarray
+    w_ib_b: np.ndarray
+    f_b: np.ndarray
+    dtheta: np.ndarray
+    dv: np.ndarray
+    segments: list = field(default_factory=list)
+
+    @property
+    def n(self) -> int:
+        """Number of increments (intervals)."""
+        return len(self.dtheta)
+
+    @property
+    def dt(self) -> np.ndarray:
+        return np.diff(self.t)
+
+    @property
+    def C_bn(self) -> np.ndarray:
+        return euler_to_dcm(self.hpr[:, 0], self.hpr[:, 1], self.hpr[:, 2])
+
+    @property
+    def q_bn(self) -> np.ndarray:
+        return dcm_to_quat(self.C_bn)
+
+    @property
+    def f_n(self) -> np.ndarray:
+        return np.einsum("kij,kj->ki", self.C_bn, self.f_b)
+
+    @property
+    def position(self) -> np.ndarray:
+        """(N+1, 3) array of [lat, lon, h]."""
+        return np.stack([self.lat, self.lon, self.h], -1)
+
+    def initial_state(self, index: int = 0):
+        """The true navigation state at sample ``index`` (a :class:`replication.strapdown.NavState`)."""
+        from .strapdown import NavState
+
+        return NavState(lat=float(self.lat[index]), lon=float(self.lon[index]), h=float(self.h[index]),
+                        v_enu=self.v_enu[index].copy(), C_bn=euler_to_dcm(*self.hpr[index]))
+
+    def slice(self, k0: int, k1: int) -> "Trajectory":
+        """Samples k0..k1 (inclusive) with the increments between them."""
+        if not (0 <= k0 < k1 <= self.n):
+            raise ValueError(f"slice bounds must satisfy 0 <= k0 < k1 <= {self.n}, got {k0}, {k1}")
+        s = slice(k0, k1 + 1)
+        return Trajectory(self.t[s], self.lat[s], self.lon[s], self.h[s], self.v_enu[s], self.hpr[s],
+                          self.w_ib_b[s], self.f_b[s], self.dtheta[k0:k1], self.dv[k0:k1],
+                          [sg for sg in self.segments if sg[2] > self.t[k0] and sg[1] < self.t[k1]])
+
+
+_GL_CACHE: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _gauss(nq):
+    if nq not in _GL_CACHE:
+        _GL_CACHE[nq] = np.polynomial.legendre.leggauss(nq)
+    return _GL_CACHE[nq]
+
+
+def _sensor_outputs(seg, tau, start, sol, polar_limit_deg):
+    hpr, rates, v, a = seg.profile(tau, start)
+    y = sol(tau)
+    lat, lon, h = y[0], y[1], y[2]
+    earth.check_latitude(lat, polar_limit_deg=polar_limit_deg)
+    w_nb = body_rate_from_euler_rates(hpr[:, 0], hpr[:, 1], hpr[:, 2], rates[:, 0], rates[:, 1], rates[:, 2])
+    c = euler_to_dcm(hpr[:, 0], hpr[:, 1], hpr[:, 2])
+    w_ie = earth.earth_rate_enu(lat)
+    w_en = earth.transport_rate_enu(lat, h, v, polar_limit_deg=polar_limit_deg)
+    g = earth.gravity_enu(lat, h)
+    w_ib = w_nb + np.einsum("kji,kj->ki", c, w_ie + w_en)
+    f_n = a + np.cross(2 * w_ie + w_en, v) - g
+    f_b = np.einsum("kji,kj->ki", c, f_n)
+    return lat, lon, h, v, hpr, w_ib, f_b
+
+
+def generate(segments, lat0: float, lon0: float, h0: float, *, dt: float = 0.01, heading: float = 0.0,
+             speed: float = 0.0, v_enu=None, pitch: float | None = None, roll: float = 0.0,
+             quadrature_nodes: int = 3, polar_limit_deg: float = earth.POLAR_LIMIT_DEG,
+             chunk: int = 50_000) -> Trajectory:
+    """Generate a trajectory from ``segments`` starting at (lat0, lon0, h0) (radians, m).
+
+    The initial motion is ``speed`` m/s along ``heading`` (or an explicit ``v_enu``), with pitch
+    equal to the flight-path angle unless given and ``roll``.  A :class:`ShipRocking` first
+    segment sets its own initial attitude and velocity.  Every segment duration must be a
+    multiple of ``dt``.  Increments: Gauss-Legendre quadrature with ``quadrature_nodes`` nodes per
+    interval of the closed-form sensor outputs (see module docstring).
+    """
+    pieces = [p for s in segments for p in (s.pieces() if isinstance(s, Segment) else [s])]
+    if not pieces:
+        raise ValueError("generate needs at least one segment")
+    for p in pieces:
+        if not isinstance(p, Segment):
+            raise TypeError(f"segments must be Segment objects, got {type(p).__name__}")
+    if not (dt > 0 and np.isfinite(dt)):
+        raise ValueError(f"dt must be a positive number of seconds, got {dt}")
+    earth.check_latitude(lat0, polar_limit_deg=polar_limit_deg, name="lat0")
+    counts = []
+    for p in pieces:
+        m = p.duration / dt
+        if p.duration <= 0 or abs(m - round(m)) > 1e-6:
+            raise ValueError(f"{p.label()}: duration {p.duration} s must be a positive multiple of dt = {dt} s "
+                             "so that segment boundaries fall on samples")
+        counts.append(int(round(m)))
+    if isinstance(pieces[0], ShipRocking):
+        hpr0, vv = pieces[0].start_state()
+    else:
+        if v_enu is None:
+            vv = np.array([speed * math.sin(heading), speed * math.cos(heading), 0.0])
+        else:
+            vv = np.asarray(v_enu, float).copy()
+            if vv.shape != (3,):
+                raise ValueError(f"v_enu must have 3 components, got shape {vv.shape}")
+        p0 = math.atan2(vv[2], math.hypot(vv[0], vv[1])) if pitch is None else pitch
+        hpr0 = np.array([heading, p0, roll], float)
+    N = int(sum(counts))
+    xg, wg = _gauss(quadrature_nodes)
+    out = {k: np.empty((N + 1,) + s) for k, s in
+           dict(lat=(), lon=(), h=(), v=(3,), hpr=(3,), w=(3,), f=(3,)).items()}
+    dth = np.empty((N, 3))
+    dvv = np.empty((N, 3))
+    seginfo = []
+    start = (np.asarray(hpr0, float), np.asarray(vv, float))
+    pos = np.array([lat0, lon0, h0], float)
+    k0 = 0
+    t0 = 0.0
+    for p, m in zip(pieces, counts):
+        if isinstance(p, _Flight):
+            p.check_start(start)
+        T = m * dt
+        s_local = start
+
+        def rhs(tau, y, p=p, s_local=s_local):
+            _, _, v, _ = p.profile(np.atleast_1d(tau), s_local)
+            lat = y[0]
+            if abs(lat) >= math.radians(polar_limit_deg):
+                raise ValueError(f"the trajectory reaches latitude {math.degrees(lat):.4f}°, within the n-frame "
+                                 f"polar singularity (limit ±{polar_limit_deg}°)")
+            rm, rn = earth.radii(lat)
+            return [v[0, 1] / (rm + y[2]), v[0, 0] / ((rn + y[2]) * math.cos(lat)), v[0, 2]]
+
+        sol = solve_ivp(rhs, (0.0, T), pos, method="DOP853", rtol=1e-13, atol=[1e-15, 1e-15, 1e-9],
+                        dense_output=True).sol
+        # sample instants
+        taus = np.arange(m + 1) * dt
+        for c0 in range(0, m + 1, chunk):
+            tt = taus[c0:c0 + chunk]
+            lat, lon, h, v, hpr, w, f = _sensor_outputs(p, tt, s_local, sol, polar_limit_deg)
+            sl = slice(k0 + c0, k0 + c0 + len(tt))
+            out["lat"][sl], out["lon"][sl], out["h"][sl] = lat, lon, h
+            out["v"][sl], out["hpr"][sl], out["w"][sl], out["f"][sl] = v, hpr, w, f
+        # increments by Gauss-Legendre quadrature
+        for c0 in range(0, m, chunk):
+            ii = np.arange(c0, min(m, c0 + chunk))
+            nodes = ((ii[:, None] + 0.5) * dt + 0.5 * dt * xg[None, :]).ravel()
+            _, _, _, _, _, w, f = _sensor_outputs(p, nodes, s_local, sol, polar_limit_deg)
+            wts = 0.5 * dt * wg
+            dth[k0 + ii] = np.einsum("q,kqj->kj", wts, w.reshape(len(ii), len(xg), 3))
+            dvv[k0 + ii] = np.einsum("q,kqj->kj", wts, f.reshape(len(ii), len(xg), 3))
+        hpr_end, _, v_end, _ = p.profile(np.array([T]), s_local)
+        start = (hpr_end[0], v_end[0])
+        pos = sol(T)
+        seginfo.append((p.label(), t0, t0 + T))
+        k0 += m
+        t0 += T
+    t = np.arange(N + 1) * dt
+    hpr = out["hpr"].copy()
+    hpr[:, 0] = np.mod(hpr[:, 0], 2 * np.pi)
+    return Trajectory(t, out["lat"], out["lon"], out["h"], out["v"], hpr, out["w"], out["f"], dth, dvv, seginfo)
+
+
+# ----------------------------------------------------------------------------- scenarios
+
+def chen2019_flight(*, s_swing: float = np.pi, s_cycles: int = 2):
+    """Segments of chen2019 Table 4-42 (the 5100-s survey flight) and its initial state.
+
+    Table 4-42: 0-100 s straight; 100-1300 s S-maneuver; 1300-2300 s straight; 2300-2700 s
+    clockwise 180° U-turn; 2700-3700 s straight; 3700-4100 s counter-clockwise 180° U-turn;
+    4100-5100 s straight; constant speed and height, bank in the turns.  Initial state of
+    Table 4-41's text: 47°N, 115°E, 6000 m, heading 45° (north-east), 100 m/s.
+    The S-maneuver's amplitude is not printed: ``s_swing`` (default 180°) and ``s_cycles``
+    (default 2) are this package's choice.
+    Returns ``(segments, initial)`` with ``initial`` the keyword arguments of :func:`generate`.
+    """
+    segs = [Straight(100.0), STurn(1200.0, swing=s_swing, cycles=s_cycles), Straight(1000.0),
+            UTurn(400.0, clockwise=True), Straight(1000.0), UTurn(400.0, clockwise=False), Straight(1000.0)]
+    init = dict(lat0=47 * DEG, lon0=115 * DEG, h0=6000.0, heading=45 * DEG, speed=100.0)
+    return segs, init
+
+
+def turntable_chen2019(experiment: int = 2, *, dwell: float = 300.0, repeats: int = 3,
+                       outer_rate: float = 9 * DEG, middle_rate: float = 1 * DEG):
+    """Three-axis turntable sequences of chen2019 §4.1.3 (ch. 4, "SINS/GNSS 姿态仿真测试").
+
+    experiment 1: no roll — outer axis to -180° and back to 0° at 9°/s, dwelling ``dwell`` s;
+    experiment 2: coordinated-turn simulation — outer to -90° then -180° (9°/s), dwell, outer to
+    -90° with middle (roll) to 10° (1°/s) simultaneously, then both back to 0°, dwell;
+    experiment 3: as 2 with the IMU initially north-west-up ([90, 0, 0] in the report's
+    counter-clockwise yaw, i.e. heading -90°).  Steps repeated ``repeats`` times.
+    The outer angle α maps to heading ψ = -α, the middle (roll) axis to roll γ.
+    Returns ``(segments, initial_heading)``.
+    """
+    if experiment not in (1, 2, 3):
+        raise ValueError("experiment must be 1, 2 or 3 (chen2019 §4.1.3)")
+    segs = [Dwell(dwell)]
+    a = outer_rate
+    for _ in range(repeats):
+        if experiment == 1:
+            segs += [Rotate(np.pi / a, (a, 0, 0)), Dwell(dwell), Rotate(np.pi / a, (-a, 0, 0)), Dwell(dwell)]
+        else:
+            t90 = (np.pi / 2) / a
+            t10 = (10 * DEG) / middle_rate
+            if abs(t90 - t10) > 1e-9:
+                raise ValueError("the simultaneous outer/middle moves assume equal durations (90°/9°/s = 10°/1°/s)")
+            segs += [Rotate(t90, (a, 0, 0)), Rotate(t90, (a, 0, 0)), Dwell(dwell),
+                     Rotate(t90, (-a, 0, middle_rate)), Rotate(t90, (-a, 0, -middle_rate)), Dwell(dwell)]
+    return segs, (0.0 if experiment in (1, 2) else -90 * DEG)
+
+
+def rotation_rich_turntable(duration: float = 3600.0, *, dwell: float = 20.0):
+    """A rotation-rich turntable hour: chen2019 §4.1.3 experiment 2 moves with short dwells,
+    plus simultaneous three-axis moves (pitch and roll 10°/s with heading 9°/s), repeated to fill
+    ``duration`` seconds.  Returns ``(segments, initial_heading)``."""
+    a = 9 * DEG
+    block = [Rotate(10.0, (a, 0, 0)), Rotate(10.0, (a, 0, 0)), Dwell(dwell),
+             Rotate(10.0, (-a, 0, 1 * DEG)), Rotate(10.0, (-a, 0, -1 * DEG)), Dwell(dwell),
+             Rotate(3.0, (a, 10 * DEG, 10 * DEG)), Rotate(6.0, (-a, -10 * DEG, -10 * DEG)),
+             Rotate(3.0, (a, 10 * DEG, 10 * DEG)), Dwell(dwell)]
+    per = sum(s.duration for s in block)
+    segs = []
+    total = 0.0
+    while total + per <= duration + 1e-9:
+        segs += block
+        total += per
+    if duration - total > 1e-9:
+        segs.append(Dwell(round(duration - total, 6)))
+    return segs, 0.0
+
+
+def fang2020_ship(duration: float, rng=None, *, northward: bool = False):
+    """fang2020 §3 ship motion: eq. (28) rocking (3°, 5°, 4°; 7, 9, 12 s; random phases), 10 m/s
+    east along the parallel (heading 90°) or, with ``northward``, north along the meridian
+    (heading 0°).  ``rng`` draws the phases (uniform on [0, 2π)).  Returns a segment list."""
+    rng = np.random.default_rng(rng)
+    ph = tuple(rng.uniform(0, 2 * np.pi, 3))
+    head = 0.0 if northward else 90 * DEG
+    return [ShipRocking(duration, phases=ph, heading0=head, course=head)]
