@@ -1,0 +1,156 @@
+"""Tests of replication.airdata: duan2023 correction geometry, derivation checks, simulation."""
+
+import numpy as np
+import pytest
+
+from replication import airdata as ad
+from replication import reproduction as rp
+from replication.rotations import dcm_to_rotvec, rotvec_to_dcm
+
+# A 30-s interval at ~180 m/s climbing at ~3°: S ≈ 5.4 km, h ≈ 280 m.
+SX, SY, H = 2696.0, 4670.0, 283.0
+V_ENU = np.array([SX, SY, H]) / 30.0
+
+
+@pytest.fixture(scope="module")
+def eq22():
+    return rp.load_paper("duan2023-eq-22")
+
+
+# --------------------------------------------------------------------------- geometry
+
+def test_rotation_axis_raises_displacement():
+    u = ad.rotation_axis(SX, SY)
+    d = np.array([SX, SY, H])
+    assert np.isclose(np.linalg.norm(u), 1.0, atol=1e-15)
+    assert abs(u @ d) < 1e-9                      # horizontal and perpendicular to the track
+    assert np.cross(u, d)[2] > 0                  # a positive turn raises the displacement
+
+
+def test_rodrigues_and_log_map_match_core_rotations():
+    u = ad.rotation_axis(SX, SY)
+    for ang in (1e-9, 1e-4, 0.3, 2.5):
+        D = ad.rodrigues(u, ang)
+        np.testing.assert_allclose(D, rotvec_to_dcm(ang * u), atol=1e-14)
+        np.testing.assert_allclose(ad.rotation_vector_from_dcm(D), ang * u, rtol=1e-9, atol=1e-15)
+        np.testing.assert_allclose(ad.rotation_vector_from_dcm(D), dcm_to_rotvec(D), atol=1e-12)
+
+
+@pytest.mark.parametrize("dh", [0.1, 1.0, 10.0])
+def test_pitch_correction_small_angle_vs_exact(dh):
+    s = np.hypot(SX, SY)
+    printed = ad.pitch_correction(s, H, dh)
+    fixed = ad.pitch_correction(s, H, dh, form="fixed-S")
+    equal = ad.pitch_correction(s, H, dh, form="equal-length")
+    r2 = s**2 + H**2
+    # eq. (4) is the first-order term of the fixed-S angle: the remainder is the second-order
+    # term -S h dh²/r⁴ (plus O(dh³/S³))
+    second = -s * H * dh**2 / r2**2
+    assert abs(fixed - printed - second) <= 2 * (dh / s) ** 3
+    # under assumption 1 the first-order angle is dh/S: eq. (4) misses the factor S²/r²
+    lin_equal = ad.pitch_correction(s, H, dh, form="equal-length-linear")
+    assert abs(lin_equal - printed - dh * H**2 / (s * r2)) < 1e-15
+    assert abs(equal - lin_equal) <= 2 * (dh / s) ** 2
+
+
+def test_corrections_first_order_vs_exact_rotation():
+    """Every first-order correction (eqs. (6), (11), (13), (18), (19)) converges to the exact
+    finite rotation of Fig. 1 with an error O(dh²) (relative O(dh/S))."""
+    s = np.hypot(SX, SY)
+    speed = np.linalg.norm(V_ENU)
+    errs = []
+    for dh in (1.0, 0.1):
+        ex = ad.exact_correction(SX, SY, H, V_ENU, dh)
+        lin_phi = ad.misalignment_correction(SX, SY, H, dh, form="equal-length-linear")
+        lin_v = ad.velocity_correction(SX, SY, H, speed, dh, form="equal-length-linear")
+        lin_s = ad.displacement_correction(SX, SY, H, dh)
+        e = [np.max(np.abs(ex["phi"][:2] - lin_phi)) / (dh / s),
+             np.max(np.abs(ex["dv"] - lin_v)) / (speed * dh / s),
+             np.max(np.abs(ex["dSxy"] - lin_s)) / dh]
+        assert abs(ex["phi"][2]) < 1e-15                       # no up component
+        assert np.isclose(ex["d_new"][2], H + dh, atol=1e-9)   # the ADS height is met
+        errs.append(e)
+    errs = np.array(errs)
+    assert np.all(errs[0] < 2e-3)                 # relative error ~ dh/S ≈ 2e-4 (and h dh/S²)
+    assert np.all(errs[1] < errs[0] / 5)          # shrinks with dh: first order is right
+
+
+def test_velocity_correction_keeps_speed_to_first_order():
+    """Assumption 4 / eq. (10): V·δV = 0 for the corrections of eqs. (11) and (13)."""
+    dv = ad.velocity_correction(SX, SY, H, np.linalg.norm(V_ENU), 1.0)
+    assert abs(V_ENU @ dv) < 1e-12 * np.linalg.norm(V_ENU) * np.linalg.norm(dv)
+
+
+def test_printed_half_in_eq6_is_half_the_rotation_vector():
+    full = ad.misalignment_correction(SX, SY, H, 1.0)
+    half = ad.misalignment_correction(SX, SY, H, 1.0, printed_half=True)
+    np.testing.assert_allclose(half, 0.5 * full)
+    ex = ad.exact_correction(SX, SY, H, V_ENU, 1e-3)
+    # per unit dh the exact rotation vector equals eq. (6) without the 1/2, up to the factor
+    # S²/(S²+h²) of eq. (4) (relative h²/S² ≈ 3e-3 here)
+    np.testing.assert_allclose(full, ex["phi"][:2] / 1e-3, rtol=5e-3)
+
+
+def test_correction_vector_layout():
+    x = ad.correction_vector(SX, SY, H, 180.0, 2.0, np.radians(45), 3000.0)
+    assert x.shape == (9,) and x[2] == 0 and x[8] == 2.0
+    assert np.sign(x[6]) == -np.sign(H) * np.sign(SY)    # δS_y < 0 when climbing and dh > 0
+
+
+@pytest.mark.parametrize("call, msg", [
+    (lambda: ad.rotation_axis(0.0, 0.0), "horizontal displacement"),
+    (lambda: ad.pitch_correction(100.0, 0.0, 1.0, form="bogus"), "form must be"),
+    (lambda: ad.pitch_correction(-1.0, 0.0, 1.0), "positive"),
+    (lambda: ad.pitch_correction(10.0, 0.0, 50.0, form="equal-length"), "assumption 1"),
+    (lambda: ad.rodrigues([1.0, 1.0, 0.0], 0.1), "unit vector"),
+    (lambda: ad.velocity_correction(SX, SY, H, -1.0, 1.0), "non-negative"),
+    (lambda: ad.misalignment_correction(np.nan, SY, H, 1.0), "finite"),
+    (lambda: ad.position_correction(100.0, 0.0, 1.0, 1.0, 1.0), "radians"),
+    (lambda: ad.derived_coefficients("C"), "reading"),
+    (lambda: ad.reference_state("loop"), "kind"),
+])
+def test_bad_inputs(call, msg):
+    with pytest.raises(ValueError, match=msg):
+        call()
+
+
+# --------------------------------------------------------------------------- derivation checks
+
+def test_derived_coefficients_reproduce_printed_13_11_18(eq22):
+    df = ad.check_elements(eq22, "B").set_index("quantity")
+    for q in ("eq. (4) phi^c per dh^c", "eq. (13) dV_U^c per dh^c", "eq. (11) dV_E^c per dV_U^c",
+              "eq. (18) dS^c per dh^c", "eq. (7) [phi_E; dh]", "eq. (21) M_pv (1;3)"):
+        assert df.loc[q, "match"], q
+
+
+def test_erratum_eq6_half_and_eq12_cos(eq22):
+    df = ad.check_elements(eq22, "B").set_index("quantity")
+    r = df.loc["eq. (6) phi_E^c per dh^c"]
+    assert not r["match"] and np.isclose(r["derived"] / r["paper"], 2.0, rtol=1e-12)
+    r = df.loc["eq. (12) dV_U^c per phi^c"]
+    st = ad.reference_state("climb")
+    cos_theta = np.hypot(st["Sx"], st["Sy"]) / np.linalg.norm([st["Sx"], st["Sy"], st["h"]])
+    assert np.isclose(r["derived"] / r["paper"], cos_theta, rtol=1e-12)
+
+
+def test_reading_b_is_the_economical_one(eq22):
+    counts = ad.consistency_count(eq22)
+    assert counts["B"] < counts["A"]
+    df = ad.check_elements(eq22, "B")
+    bad = set(df.loc[df["comparable"] & ~df["match"], "quantity"])
+    assert "eq. (20) [dL; dV_U]" in bad and "eq. (21) M_pv (1;3)" not in bad   # R_Mh typo in (20) only
+
+
+def test_manifold_rows(eq22):
+    m = ad.manifold_residuals(eq22, states=("climb", "level"))
+    get = lambda eq, row, st, conv: float(m.query(
+        "equation == @eq and row == @row and state == @st and convention == @conv")["rel_residual"].iloc[0])
+    # eq. (7) is exactly the derivative of (6) without the 1/2, with d(dh)/dt = dV_U
+    assert get("7", "phi_E", "climb", "C1") < 1e-9 and get("7", "phi_N", "climb", "C1") < 1e-9
+    # eq. (14): right only with dh held constant, and then only in level flight
+    assert get("14", "dV_U", "level", "C2") < 1e-9
+    assert get("14", "dV_U", "climb", "C2") > 1e-4 and get("14", "dV_U", "level", "C1") > 0.5
+    # eq. (15) row 3 contradicts (14) (sign of the diagonal); (21) restates it
+    assert get("15", "dV_U", "level", "C1") > 0.5 and get("15", "dV_U", "level", "C2") > 0.5
+    # eq. (21) position rows are right under reading B
+    assert get("21", "dL", "climb", "C1") < 1e-9 and get("21", "dlambda", "climb", "C1") < 1e-9
