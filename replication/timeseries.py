@@ -306,34 +306,43 @@ class Identification:
     """p for AR, q for MA, None for ARMA (orders then come from AIC)."""
     acf_cutoff: int | None
     pacf_cutoff: int | None
+    acf_behaviour: str
+    """'cuts off' or 'tails off' (拖尾/截尾 of Table 3-1) for the ACF."""
+    pacf_behaviour: str
     note: str
 
 
 def identify_model(y, *, nlags: int | None = None, max_order: int = 10, alpha: float = 0.05) -> Identification:
     """Apply chen2019 Table 3-1 to the correlogram of ``y``.
 
-    ACF tails off and PACF cuts off after p -> AR(p); ACF cuts off after q and PACF tails off ->
-    MA(q); both tail off -> ARMA (orders by AIC).  When both cut off the shorter description is
-    taken (AR on a tie) and the note says so; both cutting off at 0 is white noise.  Cut-off as
-    defined in :func:`cutoff_lag` with ``max_lag = max_order``; ``nlags`` defaults to
-    min(4 max_order, n/4).
+    Each function's cut-off lag comes from :func:`cutoff_lag` (``max_lag = max_order``).  A
+    function *tails off* when it has no cut-off up to ``max_order``, or when both functions cut
+    off and its cut-off comes strictly later than the other's (a geometric decay that reaches
+    the noise level within ``max_order`` lags is a tail, judged against the abrupt end of the
+    other function).  Then: ACF tails off and PACF cuts off after p -> AR(p); ACF cuts off after
+    q and PACF tails off -> MA(q); both tail off -> ARMA (orders by AIC); both cut off at the
+    same lag -> white noise at lag 0, otherwise AR of that order (noted).  ``nlags`` defaults
+    to min(4 max_order, n/4).
     """
     y = _series(y, min_length=4 * max_order + 10)
     nlags = nlags or int(min(4 * max_order, y.size // 4))
     cg = correlogram(y, nlags, alpha=alpha)
     qa = cutoff_lag(cg["acf"], cg["acf_band"], max_lag=max_order, alpha=alpha)
     qp = cutoff_lag(cg["pacf"], cg["pacf_band"], max_lag=max_order, alpha=alpha)
-    if qa is None and qp is None:
-        return Identification("ARMA", None, None, None, "ACF and PACF both tail off")
-    if qa is None:
-        return Identification("AR", qp, None, qp, f"ACF tails off, PACF cuts off after lag {qp}")
-    if qp is None:
-        return Identification("MA", qa, qa, None, f"ACF cuts off after lag {qa}, PACF tails off")
-    if qa == 0 and qp == 0:
-        return Identification("white noise", 0, 0, 0, "no significant correlation")
-    if qp <= qa:
-        return Identification("AR", qp, qa, qp, f"both cut off (ACF after {qa}, PACF after {qp}); the shorter, AR({qp}), is taken")
-    return Identification("MA", qa, qa, qp, f"both cut off (ACF after {qa}, PACF after {qp}); the shorter, MA({qa}), is taken")
+    acf_cuts = qa is not None and (qp is None or qa <= qp)
+    pacf_cuts = qp is not None and (qa is None or qp <= qa)
+    ab = "cuts off" if acf_cuts else "tails off"
+    pb = "cuts off" if pacf_cuts else "tails off"
+    desc = f"ACF {ab}" + (f" after lag {qa}" if acf_cuts else "") + f", PACF {pb}" + (f" after lag {qp}" if pacf_cuts else "")
+    if acf_cuts and pacf_cuts:
+        if qa == 0:
+            return Identification("white noise", 0, qa, qp, ab, pb, "no significant correlation")
+        return Identification("AR", qp, qa, qp, ab, pb, desc + f"; ambiguous, AR({qp}) taken")
+    if pacf_cuts:
+        return Identification("AR", qp, qa, qp, ab, pb, desc)
+    if acf_cuts:
+        return Identification("MA", qa, qa, qp, ab, pb, desc)
+    return Identification("ARMA", None, qa, qp, ab, pb, desc)
 
 
 # --------------------------------------------------------------------------- estimation

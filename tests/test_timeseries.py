@@ -242,3 +242,12 @@ def test_order_recovery_of_a_clear_ar1():
     f = ts.order_recovery([0.7], 1.0, 2000, n_series=200, max_order=10, seed=1)
     assert f.sum() == pytest.approx(1.0)
     assert f[0] == 0 and f[1] > 0.5  # AIC never underfits here; overfitting keeps it below 1
+
+
+def test_identification_behaviours_follow_table_3_1():
+    rng = np.random.default_rng(12)
+    ar2 = ts.identify_model(ts.simulate_ar([1.2, -0.5], 1.0, 7200, 1, rng)[0])
+    assert (ar2.acf_behaviour, ar2.pacf_behaviour) == ("tails off", "cuts off")
+    e = rng.standard_normal(7201)
+    ma1 = ts.identify_model(e[1:] + 0.7 * e[:-1])
+    assert (ma1.acf_behaviour, ma1.pacf_behaviour) == ("cuts off", "tails off")
