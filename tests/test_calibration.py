@@ -467,3 +467,37 @@ def test_gauss_markov_is_stationary():
     y = cal.simulate_static_sensor(20000.0, 1.0, gm_sigma=2.0, gm_tau=20.0, rng=rng)
     # 20000 s / 20 s correlation: ~500 independent blocks → std known to ~5 %
     assert y.std() == pytest.approx(2.0, rel=0.15)
+
+
+# ------------------------------------------------------------------------------ stated conclusions
+
+def _self_check_deviations(first_table, kind):
+    q = "Earth-rate self-check" if kind == "earth" else "gravity self-check"
+    ref = "reference Earth rate Wie" if kind == "earth" else "reference gravity"
+    t = rp.load_paper(f"chen2019-table-4-{first_table}").numeric()
+    return np.array([t[f"{q} {p}"] for p in cal.POSITIONS]) - t[ref]
+
+
+def test_self_check_conclusions_are_not_supported_by_the_tables():
+    """§1.5 conclusions 1)/2): every Earth-rate check within 0.003 °/h, every g check within 10 μg."""
+    for n in (4, 12, 20, 28):
+        bound = rp.load_paper(f"chen2019-table-4-{n}").value("conclusion 1 Earth-rate self-check bound")
+        dev = np.abs(_self_check_deviations(n, "earth"))
+        assert dev.max() > bound + 5e-5                 # beyond the printed rounding (4 decimals)
+    for n in (8, 16, 24, 32):
+        bound_g = rp.load_paper(f"chen2019-table-4-{n}").value("conclusion 2 gravity self-check bound") * 1e-6
+        dev = np.abs(_self_check_deviations(n, "gravity"))
+        assert dev.max() > bound_g + 5e-8               # beyond the printed rounding (7 decimals)
+
+
+def test_table_4_40_repeats_the_scenario_tables_and_conclusion_units():
+    t40 = rp.load_paper("chen2019-table-4-40")
+    for e, n in enumerate((37, 38, 39), 1):
+        t = rp.load_paper(f"chen2019-table-4-{n}")
+        for q in t.quantities:
+            assert t40.data.set_index("quantity").loc[f"experiment {e} {q}", "value"] == \
+                t.data.set_index("quantity").loc[q, "value"]
+            assert t40.unit(f"experiment {e} {q}") == t.unit(q)
+    # the position bounds of conclusion (2) are printed in degrees; the rows they bound are in m
+    assert t40.unit("conclusion 2 latitude and longitude error bound").startswith("°")
+    assert {t40.unit(f"experiment {e} smoothed latitude error STD") for e in (1, 2, 3)} == {"m"}
