@@ -35,7 +35,7 @@ from .units import DEG, G0
 
 __all__ = [
     "Segment", "Straight", "Turn", "UTurn", "STurn", "FigureEight", "Climb", "Accelerate",
-    "Rotate", "Dwell", "ShipRocking", "Trajectory", "generate", "chen2019_flight",
+    "Rotate", "move", "Dwell", "ShipRocking", "Trajectory", "generate", "chen2019_flight",
     "turntable_chen2019", "rotation_rich_turntable", "fang2020_ship",
 ]
 
@@ -190,16 +190,58 @@ class Accelerate(_Flight):
 
 @dataclass
 class Rotate(Segment):
-    """Turntable move: constant heading/pitch/roll rates (rad/s), ENU velocity held constant."""
+    """Turntable move: heading/pitch/roll rates (rad/s), ENU velocity held constant.
+
+    With ``ramp`` = 0 the rates are constant over the segment (a rate step at each end).  With
+    ``ramp`` > 0 they rise from zero over ``ramp`` seconds, cruise at ``rates`` and fall back to
+    zero, with s(τ) = (1 - cos πτ/ramp)/2 on the ramps (continuous angular rate, as a real table's
+    servo gives), so the angles change by ``rates`` × (duration - ramp).
+    """
 
     rates: tuple = (0.0, 0.0, 0.0)
+    ramp: float = 0.0
+
+    def _shape(self, tau):
+        T, r = self.duration, self.ramp
+        if r <= 0:
+            return tau, np.ones_like(tau)
+        if 2 * r > T:
+            raise ValueError(f"Rotate: ramp {r} s is longer than half the move ({T} s)")
+        s = np.ones_like(tau)
+        S = tau - r / 2
+        a = tau < r
+        s[a] = 0.5 * (1 - np.cos(np.pi * tau[a] / r))
+        S[a] = 0.5 * (tau[a] - r / np.pi * np.sin(np.pi * tau[a] / r))
+        b = tau > T - r
+        u = T - tau[b]
+        s[b] = 0.5 * (1 - np.cos(np.pi * u / r))
+        S[b] = (T - r) - 0.5 * (u - r / np.pi * np.sin(np.pi * u / r))
+        return S, s
 
     def profile(self, tau, start):
         hpr0, v0 = start
-        rates = np.broadcast_to(np.asarray(self.rates, float), tau.shape + (3,))
-        hpr = hpr0 + tau[:, None] * rates
+        r = np.asarray(self.rates, float)
+        S, s = self._shape(np.asarray(tau, float))
+        hpr = hpr0 + S[:, None] * r
+        rates = s[:, None] * r
         v = np.broadcast_to(v0, tau.shape + (3,))
         return hpr, rates, v, np.zeros_like(v)
+
+
+def move(angles, rates, ramp: float = 1.0) -> Rotate:
+    """A turntable move by ``angles`` (heading, pitch, roll increments, rad) at cruise ``rates``
+    (rad/s; magnitudes, signs taken from ``angles``) with smooth ramps; all axes share the duration
+    max |angle|/|rate| + ramp, and the slower axes' cruise rates are scaled to arrive together."""
+    ang = np.asarray(angles, float)
+    rt = np.abs(np.broadcast_to(np.asarray(rates, float), (3,)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(ang != 0, np.abs(ang) / np.where(rt > 0, rt, np.nan), 0.0)
+    if np.any(np.isnan(t)):
+        raise ValueError("a non-zero move angle needs a non-zero rate")
+    cruise = float(t.max())
+    if cruise == 0:
+        raise ValueError("a move needs a non-zero angle; use Dwell for a rest")
+    return Rotate(round(cruise + ramp, 9), tuple(ang / cruise), ramp)
 
 
 def Dwell(duration: float) -> Rotate:
@@ -446,7 +488,7 @@ def chen2019_flight(*, s_swing: float = np.pi, s_cycles: int = 2):
 
 
 def turntable_chen2019(experiment: int = 2, *, dwell: float = 300.0, repeats: int = 3,
-                       outer_rate: float = 9 * DEG, middle_rate: float = 1 * DEG):
+                       outer_rate: float = 9 * DEG, middle_rate: float = 1 * DEG, ramp: float = 1.0):
     """Three-axis turntable sequences of chen2019 §4.1.3 (ch. 4, "SINS/GNSS 姿态仿真测试").
 
     experiment 1: no roll — outer axis to -180° and back to 0° at 9°/s, dwelling ``dwell`` s;
@@ -454,35 +496,41 @@ def turntable_chen2019(experiment: int = 2, *, dwell: float = 300.0, repeats: in
     -90° with middle (roll) to 10° (1°/s) simultaneously, then both back to 0°, dwell;
     experiment 3: as 2 with the IMU initially north-west-up ([90, 0, 0] in the report's
     counter-clockwise yaw, i.e. heading -90°).  Steps repeated ``repeats`` times.
-    The outer angle α maps to heading ψ = -α, the middle (roll) axis to roll γ.
+    The outer angle α maps to heading ψ = -α, the middle (roll) axis to roll γ.  Each move
+    accelerates and decelerates smoothly over ``ramp`` seconds (:func:`move`).
     Returns ``(segments, initial_heading)``.
     """
     if experiment not in (1, 2, 3):
         raise ValueError("experiment must be 1, 2 or 3 (chen2019 §4.1.3)")
     segs = [Dwell(dwell)]
-    a = outer_rate
+    a, m = outer_rate, middle_rate
     for _ in range(repeats):
         if experiment == 1:
-            segs += [Rotate(np.pi / a, (a, 0, 0)), Dwell(dwell), Rotate(np.pi / a, (-a, 0, 0)), Dwell(dwell)]
+            segs += [move((np.pi, 0, 0), a, ramp), Dwell(dwell), move((-np.pi, 0, 0), a, ramp), Dwell(dwell)]
         else:
-            t90 = (np.pi / 2) / a
-            t10 = (10 * DEG) / middle_rate
-            if abs(t90 - t10) > 1e-9:
-                raise ValueError("the simultaneous outer/middle moves assume equal durations (90°/9°/s = 10°/1°/s)")
-            segs += [Rotate(t90, (a, 0, 0)), Rotate(t90, (a, 0, 0)), Dwell(dwell),
-                     Rotate(t90, (-a, 0, middle_rate)), Rotate(t90, (-a, 0, -middle_rate)), Dwell(dwell)]
+            segs += [move((np.pi / 2, 0, 0), a, ramp), move((np.pi / 2, 0, 0), a, ramp), Dwell(dwell),
+                     move((-np.pi / 2, 0, 10 * DEG), (a, 0, m), ramp), move((-np.pi / 2, 0, -10 * DEG), (a, 0, m), ramp),
+                     Dwell(dwell)]
     return segs, (0.0 if experiment in (1, 2) else -90 * DEG)
 
 
-def rotation_rich_turntable(duration: float = 3600.0, *, dwell: float = 20.0):
-    """A rotation-rich turntable hour: chen2019 §4.1.3 experiment 2 moves with short dwells,
-    plus simultaneous three-axis moves (pitch and roll 10°/s with heading 9°/s), repeated to fill
-    ``duration`` seconds.  Returns ``(segments, initial_heading)``."""
-    a = 9 * DEG
-    block = [Rotate(10.0, (a, 0, 0)), Rotate(10.0, (a, 0, 0)), Dwell(dwell),
-             Rotate(10.0, (-a, 0, 1 * DEG)), Rotate(10.0, (-a, 0, -1 * DEG)), Dwell(dwell),
-             Rotate(3.0, (a, 10 * DEG, 10 * DEG)), Rotate(6.0, (-a, -10 * DEG, -10 * DEG)),
-             Rotate(3.0, (a, 10 * DEG, 10 * DEG)), Dwell(dwell)]
+def rotation_rich_turntable(duration: float = 3600.0, *, dwell: float = 20.0, tumble: bool = False):
+    """A rotation-rich turntable hour built from chen2019 §4.1.3 moves with short dwells:
+    outer axis ±90° steps at 9°/s, simultaneous outer 9°/s + roll 10° at 1°/s (experiments 2 and
+    3), and the same with pitch instead of roll, repeated to fill ``duration`` seconds.
+
+    ``tumble`` adds simultaneous three-axis moves (heading, pitch, roll together at 10°/s) — a
+    harsher motion than the report's table performs, used to show the two-sample coning
+    algorithm's O(dt³) error.  Returns ``(segments, initial_heading)``.
+    """
+    a, m = 9 * DEG, 1 * DEG
+    block = [move((np.pi / 2, 0, 0), a), move((np.pi / 2, 0, 0), a), Dwell(dwell),
+             move((-np.pi / 2, 0, 10 * DEG), (a, 0, m)), move((-np.pi / 2, 0, -10 * DEG), (a, 0, m)), Dwell(dwell),
+             move((np.pi / 2, 10 * DEG, 0), (a, m, 0)), move((np.pi / 2, -10 * DEG, 0), (a, m, 0)), Dwell(dwell),
+             move((-np.pi, 0, 0), a), Dwell(dwell)]
+    if tumble:
+        block += [move((30 * DEG, 30 * DEG, 30 * DEG), 10 * DEG), move((-60 * DEG, -60 * DEG, -60 * DEG), 10 * DEG),
+                  move((30 * DEG, 30 * DEG, 30 * DEG), 10 * DEG), Dwell(dwell)]
     per = sum(s.duration for s in block)
     segs = []
     total = 0.0
