@@ -1,0 +1,193 @@
+"""chen2019 45-/36-state models: state order, F against the numerical Jacobian, G w, H with the
+lever arm (eq. (2-13)), permutations, input validation."""
+
+import numpy as np
+import pytest
+
+from replication import errors as E
+from replication import models as M
+from replication import trajectory as tr
+from replication.units import DEG
+
+
+@pytest.fixture(scope="module")
+def maneuvering():
+    """A short maneuvering flight at the chen2019 flight conditions (47°N, 115°E, 6000 m,
+    heading 45°, 100 m/s): straight, 90° coordinated turn, S-turn, figure-8 piece."""
+    segs = [tr.Straight(10.0), tr.Turn(20.0, np.pi / 2), tr.STurn(20.0, swing=np.pi / 3), tr.FigureEight(40.0)]
+    return tr.generate(segs, 47 * DEG, 115 * DEG, 6000.0, heading=45 * DEG, speed=100.0, dt=0.1)
+
+
+@pytest.fixture(scope="module")
+def m45():
+    return M.model_45(accel_markov_sigma=5e-4, gyro_markov_sigma=5e-8, gravity_sigma=1e-4, lever_arm_sd=0.1)
+
+
+def test_45_state_order_matches_the_text(m45):
+    """The text's list: position (3, δλ restored), velocity, attitude; accelerometer b, m, K,
+    six A; gyro b, m, K, six G; gravity; lever arm = 45."""
+    assert m45.n == 45
+    sizes = [3, 3, 3] + [b.size for b in m45.blocks]
+    assert sizes == [3, 3, 3, 3, 3, 3, 6, 3, 3, 3, 6, 3, 3]
+    assert tuple(b.name for b in m45.blocks) == M.CHEN2019_45_ORDER
+    sym = M.state_symbols(m45)
+    assert sym[:9] == list(M.NAV_SYMBOLS)
+    assert sym[18:24] == ["δA_xy", "δA_yx", "δA_xz", "δA_zx", "δA_yz", "δA_zy"]
+    assert sym[33:39] == ["δG_xy", "δG_yx", "δG_xz", "δG_zx", "δG_yz", "δG_zy"]
+    assert sym[39:] == ["δg_E", "δg_N", "δg_U", "l_x", "l_y", "l_z"]
+    assert len(set(sym)) == 45
+
+
+def test_36_state_model_layout():
+    m = M.model_36(accel_random_walk_psd=1e-12, gyro_random_walk_psd=1e-18)
+    assert m.n == 36
+    assert [b.size for b in m.blocks] == [3] * 9
+    assert not any("misalignment" in b.name or b.name == "gravity" for b in m.blocks)
+    # random constant and random walk of one triad: identical F columns (only the sum is observable)
+    p = E.NavPoint(0.8, 2.0, 6000.0, np.array([70.0, 70.0, 0.0]), np.eye(3), np.array([0.1, 0.2, 9.8]),
+                   np.array([1e-4, 2e-4, 3e-4]))
+    F = m.F(p)
+    assert np.array_equal(F[:, m.slices["accel_bias"]], F[:, m.slices["accel_random_walk"]])
+    assert np.array_equal(F[:, m.slices["gyro_bias"]], F[:, m.slices["gyro_random_walk"]])
+
+
+def test_table_2_3_states_exist_in_the_45_state_model(m45):
+    st = M.table_2_3_states()
+    assert len(st) == 27 and len(set(st)) == 27
+    assert set(st) <= set(m45.labels)
+
+
+def test_F_matches_numerical_jacobian_along_maneuvers(maneuvering, m45):
+    """Every (row block × column block) of F agrees with the central-difference Jacobian of the
+    nonlinear mechanization to 1e-6 of the block's largest element.
+
+    Tolerance from the numerics, stated before comparing: the central-difference truncation error
+    is ε²/6 times the third derivative — for the attitude step ε = 1e-4 rad that is 1.7e-9
+    relative, for the position steps (1e-5 rad, 100 m) below 1e-7 of the block scale; rounding
+    (1e-16 |rate| / ε) stays below 1e-11.  1e-6 leaves a margin of ten over the largest."""
+    rows = {"position": slice(0, 3), "velocity": slice(3, 6), "attitude": slice(6, 9)}
+    ks = [5, 150, 260, 420, 560, 780]            # straight, turn, S-turn, figure-8 halves
+    checked = set()
+    for k in ks:
+        p = E.NavPoint.from_trajectory(maneuvering, k)
+        F, J = m45.F(p), m45.numerical_jacobian(p)
+        for cname, cs in m45.slices.items():
+            if cname == "nav":
+                continue
+            for rname, rs in rows.items():
+                a, b = F[rs, cs], J[rs, cs]
+                scale = max(np.abs(a).max(), np.abs(b).max())
+                if scale == 0:
+                    continue
+                assert np.abs(a - b).max() <= 1e-6 * scale, (k, rname, cname)
+                checked.add((rname, cname))
+        assert np.array_equal(F[9:], J[9:])      # augmented rows: their constant dynamics
+    # every coupling of eq. (2-15) was exercised
+    for need in [("velocity", "accel_misalignment"), ("attitude", "gyro_misalignment"), ("velocity", "gravity"),
+                 ("velocity", "accel_scale"), ("attitude", "gyro_scale"), ("attitude", "gyro_markov"),
+                 ("velocity", "accel_markov")]:
+        assert need in checked
+
+
+def test_augmented_dynamics(m45):
+    """Random constants: zero rows; Markov: -1/τ; gravity: -β (eq. (2-12)); lever arm: zero."""
+    m = M.model_45(accel_markov_tau=9000.0, gyro_markov_tau=300.0, gravity_beta=2e-3)
+    p = E.NavPoint(0.8, 2.0, 6000.0, np.array([70.0, 70.0, 0.0]), np.eye(3), np.array([0.0, 0.0, 9.8]), np.zeros(3))
+    F = m.F(p)
+    s = m.slices
+    assert np.allclose(F[s["accel_markov"], s["accel_markov"]], -np.eye(3) / 9000.0)
+    assert np.allclose(F[s["gyro_markov"], s["gyro_markov"]], -np.eye(3) / 300.0)
+    assert np.allclose(F[s["gravity"], s["gravity"]], -2e-3 * np.eye(3))
+    for nm in ("accel_bias", "accel_scale", "accel_misalignment", "gyro_bias", "gyro_scale", "gyro_misalignment",
+               "lever_arm"):
+        assert not np.any(F[s[nm], :])
+    assert not np.any(F[:, s["lever_arm"]])
+
+
+def test_noise_input_reproduces_G_Qc(maneuvering):
+    m = M.model_45(accel_markov_sigma=5e-4, accel_markov_tau=9000.0, gyro_markov_sigma=5e-8, gyro_markov_tau=300.0,
+                   gravity_sigma=1e-4, gravity_beta=1e-3, accel_psd=2.4e-7, gyro_psd=2.35e-11)
+    C = maneuvering.C_bn[300]
+    G, q, lab = M.noise_input(m, C)
+    assert G.shape == (45, 15) and len(q) == 15 and len(lab) == 15
+    assert lab[:6] == ["ω_ax", "ω_ay", "ω_az", "ω_gx", "ω_gy", "ω_gz"]
+    Q = m.G_Qc(C)
+    assert np.allclose(G @ np.diag(q) @ G.T, Q, rtol=1e-12, atol=1e-30)
+    assert np.allclose(q[6:9], 2 * 5e-4**2 / 9000.0)
+
+
+def test_measurement_matrix_matches_finite_differences(maneuvering, m45):
+    """H of the lever-arm-corrected 6-dim measurement equals the central-difference Jacobian
+    of the nonlinear measurement.  The model is first order in φ and δl: the neglected terms
+    are O(|φ|² |l|) and O(|φ| |δl|), so with steps 1e-6 rad / 1e-3 m and a 2 m lever arm the
+    relative difference must stay below 1e-5 (stated before comparing)."""
+    lever = np.array([0.4, 1.5, -2.0])
+    for k in (150, 560):
+        p = E.NavPoint.from_trajectory(maneuvering, k)
+        H = M.measurement_matrix(m45, p, lever)
+        steps = np.full(45, 1e-3)
+        steps[0:2] = 1e-7
+        steps[6:9] = 1e-6
+        J = np.zeros_like(H)
+        for j in range(45):
+            e = np.zeros(45)
+            e[j] = steps[j]
+            J[:, j] = (M.measurement_function(m45, p, lever, e) - M.measurement_function(m45, p, lever, -e)) / (2 * steps[j])
+        assert np.allclose(H, J, rtol=1e-5, atol=1e-5 * np.abs(H).max()), np.abs(H - J).max()
+        # the position rows carry R_M + h and (R_N + h) cos L as chen2019 Table 2-2's H (up to +h)
+        assert H[0, 0] > 6.3e6 and H[1, 1] > 4.3e6
+        assert np.allclose(H[:, 9:39], 0.0) and np.allclose(H[:, 39:42], 0.0)
+
+
+def test_lever_arm_correction_and_gnss_convention(maneuvering):
+    """(2-13): P_SINS = P_GNSS + C l with l the SINS centre seen from the antenna; sensors takes
+    the antenna seen from the SINS (−l).  The velocity term is the time derivative of C l."""
+    l = np.array([0.3, -1.2, 2.0])
+    k = 560
+    p = E.NavPoint.from_trajectory(maneuvering, k)
+    dp, dv = M.lever_arm_correction(p, l)
+    # d/dt (C_b^n l) in the n frame by the fourth-order central difference of the true attitude
+    # (dt = 0.1 s): truncation |ω|^5 dt^4 |l| / 30 ≲ 1e-6 m/s at the figure-8's peak rate 0.63 rad/s.
+    C = maneuvering.C_bn
+    num = (8 * (C[k + 1] - C[k - 1]) - (C[k + 2] - C[k - 2])) @ l / (12 * 0.1)
+    # C_b^n ω_eb^b × l differs from d(C l)/dt|_n by ω_en^n × (C l): |ω_en| ≈ 2e-5 rad/s, |l| = 2.4 m
+    # → 5e-5 m/s; 1e-4 m/s bounds the sum.
+    assert np.allclose(dv, num, atol=1e-4)
+    assert np.allclose(dp, C[k] @ l)
+
+
+def test_permutation_to_the_extend_order(maneuvering):
+    m = M.model_45(gravity_sigma=1e-4)
+    m2 = M.reorder(m, M.EXTEND_ORDER_45)
+    # the same blocks as errors.model_15().extend(...) builds
+    m15 = E.model_15().extend(E.accel_markov(1e-4, 100.0), E.gyro_markov(1e-8, 100.0), E.accel_scale(), E.gyro_scale(),
+                              E.accel_misalignment(), E.gyro_misalignment(), E.gravity_shaping(1e-4, 1e-3), E.lever_arm())
+    assert m2.labels == m15.labels
+    p = M.state_permutation(m, m2)
+    back = M.state_permutation(m2, m)
+    assert np.array_equal(np.arange(45)[p][back], np.arange(45))
+    pt = E.NavPoint.from_trajectory(maneuvering, 300)
+    assert np.allclose(m.F(pt)[np.ix_(p, p)], m2.F(pt), rtol=0, atol=1e-15)
+    assert [m.labels[i] for i in p] == m2.labels
+
+
+def test_bad_inputs():
+    with pytest.raises(ValueError, match="non-negative"):
+        M.model_45(gyro_bias_sd=-1.0)
+    with pytest.raises(ValueError, match="tau"):
+        M.model_45(gyro_markov_tau=0.0)
+    with pytest.raises(ValueError, match="6 components"):
+        M.model_45(accel_misalignment_sd=[1.0, 2.0])
+    with pytest.raises(ValueError, match="gravity_beta"):
+        M.model_45(gravity_beta=-1.0)
+    with pytest.raises(TypeError, match="ErrorModel"):
+        M.state_symbols("45")
+    with pytest.raises(ValueError, match="permutation"):
+        M.reorder(M.model_45(), ["accel_bias"])
+    with pytest.raises(ValueError, match="different states"):
+        M.state_permutation(M.model_45(), M.model_36())
+    p = E.NavPoint(0.8, 2.0, 6000.0, np.zeros(3), np.eye(3), np.zeros(3), np.zeros(3))
+    with pytest.raises(ValueError, match="lever_arm_b"):
+        M.measurement_matrix(M.model_45(), p, [1.0, 2.0])
+    with pytest.raises(ValueError, match="rotation"):
+        M.noise_input(M.model_45(), 2 * np.eye(3))
