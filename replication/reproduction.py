@@ -561,11 +561,16 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
     arts = load_artifacts()
     exported = {tid: json.loads((tables_dir() / f"{tid}.json").read_text(encoding="utf-8")) for tid in list_tables()}
     rows = []
+    covered: set[str] = set()
     for _, a in arts.iterrows():
-        rows.append(_status_row(a["id"], a["source"], a["artifact"], a["description"], exported.get(a["id"])))
-    for tid in sorted(set(exported) - set(arts["id"])):
+        ids = artifact_tables(a)
+        covered.update(ids)
+        present = [t for t in ids if t in exported]
+        rows.append(_status_row(a["id"], a["source"], a["artifact"], a["description"], present, exported))
+    for tid in sorted(set(exported) - covered):
         meta = exported[tid]
-        rows.append(_status_row(tid, meta.get("source", tid.split("-")[0]), "supplementary", meta.get("title", ""), meta))
+        rows.append(_status_row(tid, meta.get("source", tid.split("-")[0]), "supplementary", meta.get("title", ""),
+                                [tid], exported))
     status = pd.DataFrame(rows)
     errata_rows = []
     for tid in sorted(exported):
@@ -590,20 +595,36 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
     return status, errata
 
 
-def _status_row(tid: str, source: str, artifact: str, description: str, meta: dict | None) -> dict:
+def artifact_tables(artifact: Mapping[str, Any]) -> list[str]:
+    """The exported table ids that reproduce one artifact of ``data/artifacts.csv``.
+
+    By default the table with the artifact's own id; the optional ``tables`` column lists
+    other ids (space-separated) when a chapter covers the artifact with check tables.
+    """
+    extra = str(artifact.get("tables", "") or "").split()
+    for tid in extra:
+        validate_id(tid)
+    return extra or [artifact["id"]]
+
+
+def _status_row(tid: str, source: str, artifact: str, description: str, present: list[str],
+                exported: Mapping[str, dict]) -> dict:
     counts = {s: 0 for s in STATUSES}
-    notebook = ""
-    if meta is not None:
-        df = read_table(tid)
-        for s in df["status"]:
-            counts[s] += 1
-        overall = summarize_status(df["status"])
-        notebook = meta.get("notebook", "")
-    else:
-        overall = "pending"
+    statuses: list[str] = []
+    notebooks: list[str] = []
+    for t in present:
+        df = read_table(t)
+        statuses += list(df["status"])
+        nb = exported[t].get("notebook", "")
+        if nb and nb not in notebooks:
+            notebooks.append(nb)
+    for s in statuses:
+        counts[s] += 1
+    overall = summarize_status(statuses) if present else "pending"
     return {"id": tid, "source": source, "artifact": artifact, "description": description,
             "status": overall, "rows": sum(counts.values()),
-            **{s.replace("-", "_"): counts[s] for s in STATUSES}, "notebook": notebook}
+            **{s.replace("-", "_"): counts[s] for s in STATUSES}, "tables": " ".join(present),
+            "notebook": " ".join(notebooks)}
 
 
 def _write_if_changed(path: Path, content: str) -> None:

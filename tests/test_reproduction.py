@@ -198,3 +198,21 @@ def test_citation_cff_lists_the_four_documents():
     for doi_or_title in ("10.11918/201811112", "Influence of gravity disturbance", "Improved SINS/ADS",
                          "Error Estimation of Airborne Gravimeter"):
         assert doi_or_title in text
+
+
+def test_an_artifact_can_be_covered_by_check_tables(sandbox):
+    (sandbox / "data" / "artifacts.csv").write_text(
+        "id,source,artifact,description,tables\n"
+        "chen2019-eq-4-8,chen2019,Eq. (4-8),closed forms,chen2019-check-a chen2019-check-b\n",
+        encoding="utf-8",
+    )
+    rp.compare("chen2019-check-a", [dict(quantity="q", unit="", paper=1, reproduced=1, tolerance=0)],
+               title="A", notebook="book/a.ipynb")
+    status, _ = rp.build_index()
+    row = status.iloc[0]
+    assert row["id"] == "chen2019-eq-4-8" and row["status"] == "reproduced" and row["tables"] == "chen2019-check-a"
+    assert len(status) == 1  # the covering table is not listed again as supplementary
+    rp.compare("chen2019-check-b", [dict(quantity="q", unit="", paper=1, reproduced=2, tolerance=0)],
+               title="B", notebook="book/b.ipynb")
+    status, _ = rp.build_index()
+    assert status.iloc[0]["status"] == "not-reproduced" and status.iloc[0]["rows"] == 2
