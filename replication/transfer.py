@@ -1,0 +1,900 @@
+"""Transfer functions from the horizontal gravity disturbance to the horizontal attitude errors.
+
+The an2021 analysis in library form (python-control underneath, sympy for the closed forms):
+
+* the 7-state SINS error model (an2021 eqs. (1)-(2)): :func:`system_matrix`,
+  :func:`input_matrix`, :func:`output_matrix`, :func:`error_model`;
+* the transfer functions ϕ_E/g_dN and ϕ_N/g_dE (an2021 eq. (3)), numerically
+  (:func:`gravity_to_attitude`, :func:`transfer_function`) and symbolically
+  (:func:`symbolic_system_matrix`, :func:`symbolic_transfer_functions`), for north-south
+  motion (eqs. (4)-(5)) and east-west motion (eqs. (6)-(7));
+* zero/pole maps over speed and latitude (Figs. 2-3): :func:`pole_zero_grid`,
+  :func:`family_spread`;
+* the integrated (position-aided) mode (eqs. (8)-(10)) with a steady-state Kalman gain:
+  :func:`integrated_model`, :func:`noise_matrices`, :func:`steady_state_gain`,
+  :func:`integrated_gravity_to_attitude`;
+* frequency-response features (Figs. 5-6, eqs. (11)-(13), Table 1):
+  :func:`frequency_response`, :func:`proportional_band_edge`, :func:`cutoff_frequency`,
+  :func:`loglog_slope`, :func:`wavelength`.
+
+Conventions (those of an2021): ENU navigation frame, state
+``x = (ϕ_E, ϕ_N, ϕ_U, δV_E, δV_N, δL, δλ)``, error input
+``u = (ε_E, ε_N, ε_U, ∇_E - g_dE, ∇_N - g_dN)``, one Earth radius ``R`` and one gravity ``g``
+(the paper does not say which values; the defaults here are the Gaussian mean radius
+sqrt(R_M R_N) and WGS-84 normal gravity at the latitude, both overridable).  The gyro drift
+enters with the sign ``ϕ̇ = ... - ε`` (an2021 eq. (8): Ā_{1,8} = -1) and the gravity
+disturbance with ``δV̇ = ... - g_d`` (an2021 eq. (8): B_{4,1} = B_{5,2} = -1).
+SI units and radians throughout.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, replace
+
+import control as ct
+import numpy as np
+import pandas as pd
+import scipy.linalg as sla
+import sympy as sp
+from scipy.optimize import brentq
+
+from . import earth
+from .units import DEG, DEG_PER_H, DEG_PER_SQRT_H, HOUR, MICRO_G, UG_PER_SQRT_HZ
+
+STATES = ("phi_E", "phi_N", "phi_U", "dV_E", "dV_N", "dL", "dlambda")
+"""State names of the 7-state model, an2021 eq. (1)."""
+INPUTS = ("eps_E", "eps_N", "eps_U", "nabla_E-g_dE", "nabla_N-g_dN")
+"""Input names of the 7-state model, an2021 eq. (1)."""
+OUTPUTS = ("phi_E", "phi_N")
+"""Output names, an2021 eq. (2)."""
+STATES_12 = STATES + ("eps_E_c", "eps_N_c", "eps_U_c", "nabla_E_c", "nabla_N_c")
+"""State names of the 12-state integrated-navigation model, an2021 eq. (8)."""
+PAIRS = ("phiE/gdN", "phiN/gdE")
+"""The two transfer functions studied: ϕ_E/g_dN (eqs. (4), (6)) and ϕ_N/g_dE (eqs. (5), (7))."""
+MOTIONS = ("north-south", "east-west")
+
+_PAIR_INDEX = {"phiE/gdN": (0, 1), "phiN/gdE": (1, 0)}  # (output, input) of the (g_dE, g_dN) system
+
+
+# --------------------------------------------------------------------------- validation
+
+def _check_motion(lat, v_east, v_north):
+    lat = float(np.asarray(lat, dtype=float))
+    if not math.isfinite(lat):
+        raise ValueError("latitude must be a finite number (radians)")
+    if abs(lat) >= math.pi / 2:
+        raise ValueError(
+            f"latitude {math.degrees(lat):.6g}° is at or beyond ±90°: the an2021 model contains "
+            f"tan L and sec L, which diverge at the pole (latitudes are in radians; convert degrees "
+            f"with np.radians)"
+        )
+    v_east, v_north = float(v_east), float(v_north)
+    if not (math.isfinite(v_east) and math.isfinite(v_north)):
+        raise ValueError("velocities must be finite numbers (m/s)")
+    return lat, v_east, v_north
+
+
+def _check_pair(pair):
+    if pair not in PAIRS:
+        raise ValueError(f"pair must be one of {PAIRS}, not {pair!r}")
+    return pair
+
+
+def _check_motion_name(motion):
+    if motion not in MOTIONS:
+        raise ValueError(f"motion must be one of {MOTIONS}, not {motion!r}")
+    return motion
+
+
+def earth_parameters(lat, radius=None, gravity=None):
+    """The single Earth radius ``R`` (m) and gravity ``g`` (m/s²) of the an2021 model.
+
+    an2021 eq. (1) uses one radius R and one g without giving values.  Defaults: the Gaussian
+    mean radius of curvature sqrt(R_M R_N) and WGS-84 normal gravity at latitude ``lat``
+    (:mod:`replication.earth`).  Pass ``radius`` / ``gravity`` to override.
+    """
+    lat, _, _ = _check_motion(lat, 0.0, 0.0)
+    if radius is None:
+        rm, rn = earth.radii(lat)
+        radius = float(np.sqrt(rm * rn))
+    if gravity is None:
+        gravity = float(earth.normal_gravity(lat))
+    radius, gravity = float(radius), float(gravity)
+    if not (radius > 0 and gravity > 0 and math.isfinite(radius) and math.isfinite(gravity)):
+        raise ValueError(f"radius and gravity must be positive and finite, got R={radius}, g={gravity}")
+    return radius, gravity
+
+
+def schuler_frequency(lat=np.radians(30.0), radius=None, gravity=None):
+    """Schuler frequency ω_s = sqrt(g/R) (rad/s), an2021 §1.1 (below eq. (5))."""
+    r, g = earth_parameters(lat, radius, gravity)
+    return math.sqrt(g / r)
+
+
+# --------------------------------------------------------------------------- the 7-state model
+
+def system_matrix(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None):
+    """The 7×7 system matrix A of the SINS error model, an2021 eq. (1).
+
+    Every non-zero element as printed (ENU frame, states ϕ_E, ϕ_N, ϕ_U, δV_E, δV_N, δL, δλ;
+    latitude ``lat`` in radians, velocities in m/s).  Raises ``ValueError`` for |L| ≥ 90°.
+    """
+    lat, ve, vn = _check_motion(lat, v_east, v_north)
+    r, g = earth_parameters(lat, radius, gravity)
+    w = earth.OMEGA_IE
+    s, c, t = math.sin(lat), math.cos(lat), math.tan(lat)
+    sec = 1.0 / c
+    a = np.zeros((7, 7))
+    a[0, 1] = w * s + ve * t / r
+    a[0, 2] = -w * c - ve / r
+    a[0, 4] = -1.0 / r
+    a[1, 0] = -w * s - ve * t / r
+    a[1, 2] = -vn / r
+    a[1, 3] = 1.0 / r
+    a[1, 5] = -w * s
+    a[2, 0] = w * c + ve / r
+    a[2, 1] = vn / r
+    a[2, 3] = t / r
+    a[2, 5] = w * c + ve * sec**2 / r
+    a[3, 1] = -g
+    a[3, 3] = vn * t / r
+    a[3, 4] = 2 * w * s + ve * t / r
+    a[3, 5] = 2 * vn * w * c + ve * vn * sec**2 / r
+    a[4, 0] = g
+    a[4, 3] = -2 * w * s - 2 * ve * t / r
+    a[4, 5] = -2 * ve * w * c - ve**2 * sec**2 / r
+    a[5, 4] = 1.0 / r
+    a[6, 3] = sec / r
+    a[6, 5] = ve * t * sec / r
+    return a
+
+
+def input_matrix():
+    """The 7×5 input matrix B of an2021 eq. (1) for u = (ε_E, ε_N, ε_U, ∇_E-g_dE, ∇_N-g_dN).
+
+    Not printed in the paper; fixed by its eq. (8) (Ā_{1,8} = Ā_{2,9} = Ā_{3,10} = -1 for the
+    gyro drifts, Ā_{4,11} = Ā_{5,12} = 1 for the accelerometer biases):
+    B = [[-I_3, 0], [0, I_2], [0, 0]].
+    """
+    b = np.zeros((7, 5))
+    b[0, 0] = b[1, 1] = b[2, 2] = -1.0
+    b[3, 3] = b[4, 4] = 1.0
+    return b
+
+
+def output_matrix(n_states=7):
+    """The output matrix H selecting (ϕ_E, ϕ_N), an2021 eq. (2) (n_states=7) or eq. (9) (12)."""
+    if n_states not in (7, 12):
+        raise ValueError("n_states must be 7 (eq. (2)) or 12 (eq. (9))")
+    h = np.zeros((2, n_states))
+    h[0, 0] = h[1, 1] = 1.0
+    return h
+
+
+def error_model(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None):
+    """The 7-state SINS error model ẋ = Ax + Bu, Y = Hx as a python-control ``StateSpace``.
+
+    an2021 eqs. (1)-(2); inputs :data:`INPUTS`, outputs :data:`OUTPUTS`.
+    """
+    a = system_matrix(lat, v_east, v_north, radius=radius, gravity=gravity)
+    return ct.ss(a, input_matrix(), output_matrix(7), 0, states=list(STATES), inputs=list(INPUTS),
+                 outputs=list(OUTPUTS), name="an2021-eq1")
+
+
+def gravity_to_attitude(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None, drop_longitude=True):
+    """The state-space system from (g_dE, g_dN) to (ϕ_E, ϕ_N) in pure inertial mode.
+
+    an2021 eq. (3), H(Is - A)^{-1} B restricted to the gravity-disturbance inputs: since
+    u_4 = ∇_E - g_dE and u_5 = ∇_N - g_dN, the input columns are -B[:, 3:5].  The longitude
+    error δλ feeds nothing (column 7 of A is zero), so by default it is dropped: the 6-state
+    system has exactly the same transfer function and no spurious pole/zero pair at s = 0.
+    """
+    a = system_matrix(lat, v_east, v_north, radius=radius, gravity=gravity)
+    b = -input_matrix()[:, 3:5]
+    h = output_matrix(7)
+    states = list(STATES)
+    if drop_longitude:
+        a, b, h, states = a[:6, :6], b[:6], h[:, :6], states[:6]
+    return ct.ss(a, b, h, 0, states=states, inputs=["g_dE", "g_dN"], outputs=list(OUTPUTS),
+                 name="an2021-eq3")
+
+
+def _balanced(sys):
+    """A diagonally rescaled copy (same transfer function) with a well-conditioned A."""
+    a = np.asarray(sys.A)
+    _, (scale, _) = sla.matrix_balance(a, separate=True, permute=False)
+    t = np.diag(scale)
+    ti = np.diag(1.0 / scale)
+    return ct.ss(ti @ a @ t, ti @ np.asarray(sys.B), np.asarray(sys.C) @ t, np.asarray(sys.D))
+
+
+def siso(sys, pair):
+    """The SISO channel ``pair`` ('phiE/gdN' or 'phiN/gdE') of a (g_dE, g_dN) → (ϕ_E, ϕ_N) system."""
+    _check_pair(pair)
+    i, j = _PAIR_INDEX[pair]
+    return ct.ss(np.asarray(sys.A), np.asarray(sys.B)[:, [j]], np.asarray(sys.C)[[i], :], np.asarray(sys.D)[[i]][:, [j]])
+
+
+def common_factor_east_west(lat, v_east, *, radius=None):
+    """The exact common factor s² + (ω_ie + V_E sec L / R)² of east-west motion (monic, in s).
+
+    Numerator and denominator of both ϕ_E/g_dN and ϕ_N/g_dE share it for every V_E and L
+    (:func:`symbolic_transfer_functions`); cancelling it leaves the 4th-order eqs. (6)-(7).
+    Its roots ±j(ω_ie + V_E sec L / R) are the Earth-rate mode seen by the moving frame:
+    ω_ie + V_E/(R cos L) = ω_ie + λ̇ is the rotation rate of the navigation frame about the
+    polar axis.
+    """
+    lat, ve, _ = _check_motion(lat, v_east, 0.0)
+    r, _ = earth_parameters(lat, radius, None)
+    rate = earth.OMEGA_IE + ve / (r * math.cos(lat))
+    return np.array([1.0, 0.0, rate**2])
+
+
+def _divide_exactly(poly, factor, what):
+    q, rem = np.polydiv(poly, factor)
+    size = np.max(np.abs(poly))
+    if np.max(np.abs(rem)) > 1e-8 * size:
+        raise ArithmeticError(f"the {what} is not divisible by the east-west common factor "
+                              f"(remainder {np.max(np.abs(rem)):.3g} of {size:.3g})")
+    return q
+
+
+def transfer_function(lat, v_east=0.0, v_north=0.0, pair="phiE/gdN", *, radius=None, gravity=None,
+                      minimal=True):
+    """Numerical transfer function ϕ_E/g_dN or ϕ_N/g_dE (python-control ``TransferFunction``).
+
+    an2021 eq. (3) → eqs. (4)-(5) (north-south motion, v_east = 0) and (6)-(7) (east-west
+    motion, v_north = 0).  ``ss2tf`` is applied to the balanced 6-state system in the
+    dimensionless frequency s/ω_s (so that all polynomial coefficients are of order one), then
+    mapped back to s; the denominator is monic.  With ``minimal`` and v_north = 0, v_east ≠ 0 the
+    exact common factor :func:`common_factor_east_west` is divided out (4th-order eqs. (6)-(7));
+    otherwise the full 6th-order form is returned (the near-cancellation of north-south motion is
+    kept, as in eqs. (4)-(5)).
+    """
+    _check_pair(pair)
+    lat, v_east, v_north = _check_motion(lat, v_east, v_north)
+    r, g = earth_parameters(lat, radius, gravity)
+    w0 = math.sqrt(g / r)
+    sys = siso(_balanced(gravity_to_attitude(lat, v_east, v_north, radius=r, gravity=g)), pair)
+    scaled = ct.ss(np.asarray(sys.A) / w0, np.asarray(sys.B) / w0, np.asarray(sys.C), 0)
+    tfs = ct.ss2tf(scaled)
+    num = np.atleast_1d(np.squeeze(tfs.num[0][0])).astype(float)
+    den = np.atleast_1d(np.squeeze(tfs.den[0][0])).astype(float)
+    num, den = num / den[0], den / den[0]
+    n = len(den) - 1
+    # coefficients of s^k in the original variable: c'_k w0^(n-k); the monic scaling w0^n cancels
+    num = np.array([c * w0 ** (n - (len(num) - 1 - i)) for i, c in enumerate(num)])
+    den = np.array([c * w0**i for i, c in enumerate(den)])
+    # relative degree is 2 (H B = 0 exactly, H A B ≠ 0): drop the two rounding-level leading terms
+    num = num[-(n - 1):]
+    if minimal and v_north == 0.0 and v_east != 0.0:
+        f = common_factor_east_west(lat, v_east, radius=r)
+        num = _divide_exactly(num, f, "numerator")
+        den = _divide_exactly(den, f, "denominator")
+    return ct.tf(num, den)
+
+
+def polynomial_coefficients(tf):
+    """``(num, den)`` coefficient dicts {power: value} of a SISO tf, denominator made monic."""
+    num = np.atleast_1d(np.squeeze(tf.num[0][0])).astype(float)
+    den = np.atleast_1d(np.squeeze(tf.den[0][0])).astype(float)
+    lead = den[0]
+    num, den = num / lead, den / lead
+    return ({len(num) - 1 - k: v for k, v in enumerate(num)}, {len(den) - 1 - k: v for k, v in enumerate(den)})
+
+
+# --------------------------------------------------------------------------- symbolic
+
+SYMBOLS = {name: sp.Symbol(name, real=True) for name in ("s", "L", "V_E", "V_N")}
+SYMBOLS.update({name: sp.Symbol(name, positive=True) for name in ("R", "g", "omega_ie", "omega_s")})
+"""The sympy symbols of the closed forms: s, L, V_E, V_N, R, g, ω_ie (omega_ie), ω_s (omega_s)."""
+
+
+def symbolic_system_matrix(motion="general"):
+    """an2021 eq. (1) matrix A with sympy symbols (R, g, omega_ie, L, V_E, V_N).
+
+    ``motion``: 'general', 'north-south' (V_E = 0) or 'east-west' (V_N = 0).
+    """
+    if motion not in ("general",) + MOTIONS:
+        raise ValueError(f"motion must be 'general' or one of {MOTIONS}")
+    R, g, w, L = (SYMBOLS[k] for k in ("R", "g", "omega_ie", "L"))
+    ve = 0 if motion == "north-south" else SYMBOLS["V_E"]
+    vn = 0 if motion == "east-west" else SYMBOLS["V_N"]
+    t, sec = sp.tan(L), 1 / sp.cos(L)
+    a = sp.zeros(7, 7)
+    a[0, 1] = w * sp.sin(L) + ve * t / R
+    a[0, 2] = -w * sp.cos(L) - ve / R
+    a[0, 4] = -1 / R
+    a[1, 0] = -w * sp.sin(L) - ve * t / R
+    a[1, 2] = -vn / R
+    a[1, 3] = 1 / R
+    a[1, 5] = -w * sp.sin(L)
+    a[2, 0] = w * sp.cos(L) + ve / R
+    a[2, 1] = vn / R
+    a[2, 3] = t / R
+    a[2, 5] = w * sp.cos(L) + ve * sec**2 / R
+    a[3, 1] = -g
+    a[3, 3] = vn * t / R
+    a[3, 4] = 2 * w * sp.sin(L) + ve * t / R
+    a[3, 5] = 2 * vn * w * sp.cos(L) + ve * vn * sec**2 / R
+    a[4, 0] = g
+    a[4, 3] = -2 * w * sp.sin(L) - 2 * ve * t / R
+    a[4, 5] = -2 * ve * w * sp.cos(L) - ve**2 * sec**2 / R
+    a[5, 4] = 1 / R
+    a[6, 3] = sec / R
+    a[6, 5] = ve * t * sec / R
+    return a
+
+
+def symbolic_error_model_from_vectors():
+    """An independent derivation of the 7×7 A from the vector error equations (spherical Earth).
+
+    ϕ̇ = -ω_in^n × ϕ + δω_in^n - ε, δV̇ = f^n × ϕ - (2ω_ie^n + ω_en^n) × δV - (2δω_ie^n + δω_en^n) × V
+    + ∇ - g_d, δL̇ = δV_N/R, δλ̇ = δV_E sec L / R + V_E tan L sec L δL / R, with level
+    unaccelerated motion (f^n = (0, 0, g), V_U = 0, δV_U = 0, height fixed).  Used to check
+    every printed element of an2021 eq. (1).
+    """
+    R, g, w, L = (SYMBOLS[k] for k in ("R", "g", "omega_ie", "L"))
+    ve, vn = SYMBOLS["V_E"], SYMBOLS["V_N"]
+    phi = sp.Matrix(sp.symbols("phi_E phi_N phi_U"))
+    dve, dvn, dl, dlam = sp.symbols("dV_E dV_N dL dlambda")
+    x = list(phi) + [dve, dvn, dl, dlam]
+    lat = L + dl  # perturb the latitude, then linearize
+    wie = sp.Matrix([0, w * sp.cos(L), w * sp.sin(L)])
+    wen = sp.Matrix([-vn / R, ve / R, ve * sp.tan(L) / R])
+    wie_p = sp.Matrix([0, w * sp.cos(lat), w * sp.sin(lat)])
+    wen_p = sp.Matrix([-(vn + dvn) / R, (ve + dve) / R, (ve + dve) * sp.tan(lat) / R])
+    d_wie = (wie_p - wie)
+    d_wen = (wen_p - wen)
+    win = wie + wen
+    phidot = -win.cross(phi) + d_wie + d_wen
+    f = sp.Matrix([0, 0, g])
+    v = sp.Matrix([ve, vn, 0])
+    dv = sp.Matrix([dve, dvn, 0])
+    dvdot = f.cross(phi) - (2 * wie + wen).cross(dv) - (2 * d_wie + d_wen).cross(v)
+    dldot = dvn / R
+    dlamdot = (ve + dve) / (R * sp.cos(lat)) - ve / (R * sp.cos(L))
+    rhs = list(phidot) + [dvdot[0], dvdot[1], dldot, dlamdot]
+    zero = {xi: 0 for xi in x}
+    a = sp.zeros(7, 7)
+    for i, e in enumerate(rhs):
+        for j, xj in enumerate(x):
+            a[i, j] = sp.simplify(sp.diff(e, xj).subs(zero))
+    return a
+
+
+def _trig_to_cos(expr, c):
+    """Write a rational expression of sin L, cos L, tan L in c = cos L (valid for |L| < 90°)."""
+    L = SYMBOLS["L"]
+    e = sp.expand_trig(sp.sympify(expr).subs(sp.sec(L), 1 / sp.cos(L)))
+    e = e.subs(sp.tan(L), sp.sin(L) / sp.cos(L))
+    e = e.subs(sp.sin(L), sp.sqrt(1 - c**2)).subs(sp.cos(L), c)
+    return sp.together(sp.expand(e))
+
+
+@functools.lru_cache(maxsize=None)
+def symbolic_transfer_functions(motion):
+    """Closed-form ϕ_E/g_dN and ϕ_N/g_dE for ``motion`` (an2021 eqs. (4)-(5) or (6)-(7)).
+
+    Derived from H(Is - A)^{-1}(-B) with the symbolic A (δλ dropped: column 7 of A is zero) by
+    Cramer's rule (adjugate / determinant).  For east-west motion the exact common factor of
+    numerator and denominator, s² + (ω_ie + V_E sec L / R)², is cancelled; for north-south
+    motion numerator and denominator are coprime.  Returns ``{pair: (num, den, common)}`` with
+    ``num``, ``den`` sympy ``Poly`` in s (den monic, coefficients in R, g, omega_ie, L and the
+    speed) and ``common`` the cancelled factor (1 when none).
+    """
+    _check_motion_name(motion)
+    s, L = SYMBOLS["s"], SYMBOLS["L"]
+    a = symbolic_system_matrix(motion)[:6, :6]
+    m = s * sp.eye(6) - a
+    det = sp.expand(m.det(method="berkowitz"))
+    c = sp.Symbol("c", positive=True)
+    out = {}
+    for pair, (i, j) in (("phiE/gdN", (0, 4)), ("phiN/gdE", (1, 3))):
+        # adj(M)[i, j] = (-1)^(i+j) det(M without row j and column i); the g_d column is -e_j
+        num = sp.expand(-(-1) ** (i + j) * m.minor_submatrix(j, i).det(method="berkowitz"))
+        if motion == "north-south":
+            common = sp.Integer(1)
+            num_c, den_c = num, det
+        else:
+            ratio = sp.cancel(_trig_to_cos(num, c) / _trig_to_cos(det, c))
+            n_c, d_c = sp.fraction(ratio)
+            pn, pd = sp.Poly(n_c, s), sp.Poly(d_c, s)
+            lead = pd.LC()
+            num_c = (pn.as_expr() / lead).subs(c, sp.cos(L))
+            den_c = (pd.as_expr() / lead).subs(c, sp.cos(L))
+            common = sp.factor(sp.cancel(_trig_to_cos(det, c) / (d_c / lead))).subs(c, sp.cos(L))
+        pn = sp.Poly(sp.expand(num_c), s)
+        pd = sp.Poly(sp.expand(den_c), s)
+        pn = sp.Poly([sp.factor(sp.trigsimp(k)) for k in pn.all_coeffs()], s)
+        pd = sp.Poly([sp.factor(sp.trigsimp(k)) for k in pd.all_coeffs()], s)
+        out[pair] = (pn, pd, common)
+    return out
+
+
+def coefficient(poly, power):
+    """The coefficient of s**power of a sympy ``Poly`` (0 when absent)."""
+    return poly.coeff_monomial(SYMBOLS["s"] ** power)
+
+
+def printed_namespace():
+    """The names allowed in a transcribed closed-form expression (see :func:`parse_printed`)."""
+    ns = {k: v for k, v in SYMBOLS.items() if k != "s"}
+    ns.update({"w_ie": SYMBOLS["omega_ie"], "w_s": SYMBOLS["omega_s"], "sin": sp.sin, "cos": sp.cos,
+               "tan": sp.tan, "sec": sp.sec, "sqrt": sp.sqrt, "pi": sp.pi})
+    return ns
+
+
+def parse_printed(text):
+    """Parse a printed closed form transcribed in Python syntax (``w_ie``, ``w_s``, ``V_N``...).
+
+    ``w_s`` is the Schuler frequency and is replaced by sqrt(g/R) (an2021, below eq. (5)).
+    """
+    if not isinstance(text, str) or not text.strip():
+        raise ValueError("a printed expression must be a non-empty string")
+    expr = sp.sympify(text, locals=printed_namespace())
+    unknown = expr.free_symbols - set(SYMBOLS.values())
+    if unknown:
+        raise ValueError(f"unknown symbols {sorted(map(str, unknown))} in {text!r}")
+    return expr.subs(SYMBOLS["omega_s"], sp.sqrt(SYMBOLS["g"] / SYMBOLS["R"]))
+
+
+@functools.lru_cache(maxsize=4096)
+def _lambdified(expr):
+    names = [SYMBOLS[k] for k in ("L", "R", "g", "omega_ie", "omega_s", "V_N", "V_E")]
+    return sp.lambdify(names, expr, modules="mpmath")
+
+
+def evaluate(expr, lat, speed, motion, *, radius=None, gravity=None, digits=30):
+    """Evaluate a closed form at latitude ``lat`` (rad) and ``speed`` (m/s) with ``digits`` digits.
+
+    ``speed`` is V_N for north-south motion and V_E for east-west motion; evaluated with mpmath
+    so that the cancellations inside the printed forms do not lose precision.
+    """
+    import mpmath
+
+    _check_motion_name(motion)
+    lat, _, _ = _check_motion(lat, 0.0, 0.0)
+    r, g = earth_parameters(lat, radius, gravity)
+    f = _lambdified(sp.sympify(expr))
+    with mpmath.workdps(digits):
+        mp = mpmath.mpf
+        vn = mp(speed) if motion == "north-south" else mp(0)
+        ve = mp(speed) if motion == "east-west" else mp(0)
+        value = f(mp(lat), mp(r), mp(g), mp(earth.OMEGA_IE), mpmath.sqrt(mp(g) / mp(r)), vn, ve)
+        return float(value)
+
+
+def is_identity(expr_a, expr_b):
+    """True when two closed forms are algebraically identical (for |L| < 90°)."""
+    c = sp.Symbol("c", positive=True)
+    diff = _trig_to_cos(sp.sympify(expr_a) - sp.sympify(expr_b), c)
+    return sp.simplify(sp.expand(sp.numer(sp.together(diff)))) == 0
+
+
+def coefficient_location(name, motion):
+    """Where a printed coefficient lives: ``(pair, 'num'|'den', power)`` (an2021 eqs. (4)-(7)).
+
+    n_1k: numerator of ϕ_E/g_dN, n_2k: numerator of ϕ_N/g_dE, d_k: the shared denominator; k is
+    the power of s.
+    """
+    _check_motion_name(motion)
+    import re
+
+    m = re.fullmatch(r"([nd])_(\d+)", name)
+    if not m:
+        raise ValueError(f"coefficient names look like 'n_13' or 'd_4', not {name!r}")
+    if m.group(1) == "d":
+        return "phiE/gdN", "den", int(m.group(2))
+    digits = m.group(2)
+    if len(digits) != 2 or digits[0] not in "12":
+        raise ValueError(f"numerator coefficient names are n_1k or n_2k, not {name!r}")
+    return ("phiE/gdN" if digits[0] == "1" else "phiN/gdE"), "num", int(digits[1])
+
+
+def derived_coefficient(name, motion):
+    """The derived closed form of coefficient ``name`` in the paper's normalization.
+
+    North-south motion (eqs. (4)-(5)): monic denominator, exactly as printed.  East-west motion
+    (eqs. (6)-(7)): the printed polynomials share an arbitrary common scale (d_4 = 2R³cos²L), so
+    the derived closed form is returned monic, to be compared with the printed coefficient
+    divided by the printed d_4 (see :func:`printed_in_derived_normalization`).
+    """
+    pair, part, power = coefficient_location(name, motion)
+    num, den, _ = symbolic_transfer_functions(motion)[pair]
+    return coefficient(num if part == "num" else den, power)
+
+
+def printed_in_derived_normalization(name, printed, motion):
+    """A printed coefficient expression in the normalization of :func:`derived_coefficient`.
+
+    ``printed`` maps coefficient names to transcribed expressions (:func:`parse_printed`).  For
+    east-west motion every coefficient is divided by the printed d_4; for d_4 itself (d_4/d_4 = 1
+    would be vacuous) the printed leading ratio n_12/d_4 is returned, to be compared with the
+    derived monic n_12 = 1/R (the δV_N → ϕ_E path).
+    """
+    _check_motion_name(motion)
+    expr = parse_printed(printed[name])
+    if motion == "north-south":
+        return expr
+    d4 = parse_printed(printed["d_4"])
+    if name == "d_4":
+        return parse_printed(printed["n_12"]) / d4
+    return expr / d4
+
+
+def coefficient_checks(printed, motion, points, *, radius=None, gravity=None):
+    """Printed vs derived (sympy) vs numerical (python-control) value of every printed coefficient.
+
+    an2021 eqs. (4)-(5) (``motion='north-south'``) or (6)-(7) (``'east-west'``).  ``printed``
+    maps names (n_10 ... d_5) to transcribed expressions; ``points`` is a list of (lat, speed)
+    pairs (radians, m/s).  Returns a ``DataFrame`` with one row per coefficient: ``identical``
+    (the printed and derived closed forms are algebraically equal), the largest relative
+    printed-vs-derived and numerical-vs-derived differences over the points, and the values at
+    the first point.  For east-west motion the d_4 row compares n_12/d_4 (see
+    :func:`printed_in_derived_normalization`).
+    """
+    _check_motion_name(motion)
+    if not points:
+        raise ValueError("give at least one (lat, speed) point")
+    rows = []
+    tfs = {}
+    for lat, v in points:
+        ve, vn = (0.0, v) if motion == "north-south" else (v, 0.0)
+        for pair in PAIRS:
+            tfs[(lat, v, pair)] = polynomial_coefficients(
+                transfer_function(lat, ve, vn, pair, radius=radius, gravity=gravity))
+    for name in printed:
+        pair, part, power = coefficient_location(name, motion)
+        if motion == "east-west" and name == "d_4":
+            pair, part, power = "phiE/gdN", "num", 2
+        derived = derived_coefficient("n_12" if (motion == "east-west" and name == "d_4") else name, motion)
+        shown = printed_in_derived_normalization(name, printed, motion)
+        identical = is_identity(shown, derived)
+        rel_p, rel_n, first = 0.0, 0.0, None
+        for lat, v in points:
+            d = evaluate(derived, lat, v, motion, radius=radius, gravity=gravity)
+            p = evaluate(shown, lat, v, motion, radius=radius, gravity=gravity)
+            num, den = tfs[(lat, v, pair)]
+            x = (num if part == "num" else den).get(power, 0.0)
+            if d != 0:
+                rel_p = max(rel_p, abs(p - d) / abs(d))
+                rel_n = max(rel_n, abs(x - d) / abs(d))
+            if first is None:
+                first = (p, d, x)
+        rows.append(dict(coefficient=name, pair=pair, part=part, power=power, identical=bool(identical),
+                         printed_at_first=first[0], derived_at_first=first[1], numerical_at_first=first[2],
+                         max_rel_printed_vs_derived=rel_p, max_rel_numerical_vs_derived=rel_n))
+    return pd.DataFrame(rows)
+
+
+# --------------------------------------------------------------------------- zero/pole maps
+
+def pole_zero_grid(motion, lats_deg, speeds, *, radius=None, gravity=None):
+    """Poles and zeros of eqs. (4)-(5) or (6)-(7) over a grid of latitude and speed (Figs. 2-3).
+
+    Returns a long ``DataFrame`` with columns lat_deg, speed, pair, kind ('pole'/'zero'),
+    family (1 = largest |Im|; conjugates share a family), real, imag.  Families follow the
+    paper's numbering: p1,p2 / p3,p4 / p5,p6 and z11,z12 / z13,z14 by decreasing frequency.
+    """
+    _check_motion_name(motion)
+    rows = []
+    for lat_deg in np.atleast_1d(lats_deg):
+        for v in np.atleast_1d(speeds):
+            ve, vn = (0.0, float(v)) if motion == "north-south" else (float(v), 0.0)
+            for pair in PAIRS:
+                tf = transfer_function(np.radians(lat_deg), ve, vn, pair, radius=radius, gravity=gravity)
+                for kind, roots in (("pole", tf.poles()), ("zero", tf.zeros())):
+                    roots = sorted(roots, key=lambda z: (-round(abs(z.imag), 18), z.imag))
+                    for k, z in enumerate(roots):
+                        rows.append(dict(lat_deg=float(lat_deg), speed=float(v), pair=pair, kind=kind,
+                                         family=k // 2 + 1, real=float(z.real), imag=float(z.imag)))
+    return pd.DataFrame(rows)
+
+
+def family_spread(grid):
+    """Spread of each pole/zero family over the grid ("concentrated", an2021 §2).
+
+    For every (pair, kind, family): the median natural frequency |p|, its relative range
+    (max - min)/median, and the largest |Re p| relative to the median |p|.
+    """
+    g = grid[grid["imag"] >= 0].copy()
+    g["abs"] = np.hypot(g["real"], g["imag"])
+    out = g.groupby(["pair", "kind", "family"]).agg(
+        median_abs=("abs", "median"), min_abs=("abs", "min"), max_abs=("abs", "max"),
+        max_abs_real=("real", lambda x: float(np.max(np.abs(x)))))
+    out["relative_range"] = (out["max_abs"] - out["min_abs"]) / out["median_abs"]
+    out["real_over_abs"] = out["max_abs_real"] / out["median_abs"]
+    return out.reset_index()
+
+
+def cancellation_distance(lat, speed, motion, pair, *, radius=None, gravity=None):
+    """Relative distance |p - z| / |p| of the lowest-frequency pole and zero of ``pair``.
+
+    These are p5,p6 and z13,z14 (z23,z24) of an2021 §2, the Earth-rate mode: the pair the paper
+    calls cancellable.  Zero means exact cancellation (east-west motion, and north-south motion
+    at rest); for north-south motion it grows with |V_N|.
+    """
+    _check_motion_name(motion)
+    ve, vn = (0.0, speed) if motion == "north-south" else (speed, 0.0)
+    tf = transfer_function(lat, ve, vn, pair, radius=radius, gravity=gravity, minimal=False)
+    p = min((z for z in tf.poles() if z.imag >= 0), key=abs)
+    z = min((z for z in tf.zeros() if z.imag >= 0), key=abs)
+    return float(abs(p - z) / abs(p))
+
+
+# --------------------------------------------------------------------------- integrated mode
+
+@dataclass(frozen=True)
+class NoiseSettings:
+    """Noise of the integrated-navigation filter of an2021 eq. (8) (not printed in the paper).
+
+    gyro_arw (rad/√s), accel_vrw (m/s²/√Hz = m/s/√s): white noise on ϕ and δV;
+    gyro_bias_rw (rad/s/√s), accel_bias_rw (m/s²/√s): random walk of the constant-bias states;
+    position_sigma (m, per axis) at position_rate (Hz): the position fix.
+    """
+
+    gyro_arw: float
+    accel_vrw: float
+    gyro_bias_rw: float
+    accel_bias_rw: float
+    position_sigma: float
+    position_rate: float = 1.0
+
+    def __post_init__(self):
+        for name in ("gyro_arw", "accel_vrw", "gyro_bias_rw", "accel_bias_rw"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v >= 0):
+                raise ValueError(f"{name} must be finite and non-negative, got {v}")
+        for name in ("position_sigma", "position_rate"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be finite and positive, got {v}")
+
+    def scaled(self, **factors):
+        """A copy with some fields multiplied by factors, e.g. ``scaled(accel_vrw=10)``."""
+        return replace(self, **{k: getattr(self, k) * f for k, f in factors.items()})
+
+
+NAVIGATION_GRADE = NoiseSettings(
+    gyro_arw=0.001 * DEG_PER_SQRT_H,
+    accel_vrw=10.0 * UG_PER_SQRT_HZ,
+    gyro_bias_rw=0.001 * DEG_PER_H / math.sqrt(HOUR),
+    accel_bias_rw=1.0 * MICRO_G / math.sqrt(HOUR),
+    position_sigma=5.0,
+    position_rate=1.0,
+)
+"""The nominal setting of this package: a navigation-grade SINS (ARW 0.001 °/√h, VRW 10 μg/√Hz,
+bias random walks 0.001 °/h and 1 μg per √h) with a 1 Hz, 5 m (per axis) position fix."""
+
+
+def integrated_model(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None):
+    """Ā (12×12), B (12×2, inputs g_dE, g_dN), C (2×12, z = (δL, δλ)), H̄ (2×12), an2021 eqs. (8)-(9).
+
+    Ā_{1:7,1:7} = A, Ā_{1,8} = Ā_{2,9} = Ā_{3,10} = -1, Ā_{4,11} = Ā_{5,12} = 1;
+    B_{4,1} = B_{5,2} = -1; C_{1,6} = C_{2,7} = 1; H̄_{1,1} = H̄_{2,2} = 1.
+    """
+    a = np.zeros((12, 12))
+    a[:7, :7] = system_matrix(lat, v_east, v_north, radius=radius, gravity=gravity)
+    a[0, 7] = a[1, 8] = a[2, 9] = -1.0
+    a[3, 10] = a[4, 11] = 1.0
+    b = np.zeros((12, 2))
+    b[3, 0] = b[4, 1] = -1.0
+    c = np.zeros((2, 12))
+    c[0, 5] = c[1, 6] = 1.0
+    return a, b, c, output_matrix(12)
+
+
+def noise_matrices(lat, noise: NoiseSettings, *, radius=None, gravity=None):
+    """Continuous process-noise PSD Q (12×12) and measurement-noise PSD R_c (2×2) for eq. (8).
+
+    Q = diag(ARW² ×3, VRW² ×2, 0, 0, bias-RW² ×5); the position fix of σ metres at f Hz becomes
+    the continuous PSD R_c = (σ/R)²/f for δL and (σ/(R cos L))²/f for δλ (rad² s).
+    """
+    if not isinstance(noise, NoiseSettings):
+        raise TypeError("noise must be a NoiseSettings")
+    lat, _, _ = _check_motion(lat, 0.0, 0.0)
+    r, _ = earth_parameters(lat, radius, gravity)
+    q = np.zeros(12)
+    q[0:3] = noise.gyro_arw**2
+    q[3:5] = noise.accel_vrw**2
+    q[7:10] = noise.gyro_bias_rw**2
+    q[10:12] = noise.accel_bias_rw**2
+    rc = np.diag([(noise.position_sigma / r) ** 2, (noise.position_sigma / (r * math.cos(lat))) ** 2]) / noise.position_rate
+    return np.diag(q), rc
+
+
+_STATE_SCALE_12 = np.array([1e-5] * 3 + [0.1] * 2 + [1e-6] * 2 + [1e-8] * 3 + [1e-4] * 2)
+"""Typical magnitudes (rad, m/s, rad, rad/s, m/s²) used to balance the Riccati problem."""
+
+
+def observable_decomposition(a, c, *, time_scale=1e3, rtol=1e-9, min_gap=1e4):
+    """Orthonormal bases (V_o, V_u) of the observable subspace and unobservable subspace of (A, C).
+
+    From the SVD of the observability matrix of (A·time_scale, C).  Raises ``ValueError`` when
+    the singular values show no clear gap (``min_gap``) at the rank threshold ``rtol``.
+    """
+    a, c = np.asarray(a, float), np.asarray(c, float)
+    n = a.shape[0]
+    o = ct.obsv(a * time_scale, c)
+    _, sv, vt = np.linalg.svd(o)
+    r = int(np.sum(sv > rtol * sv[0]))
+    if r < n and r > 0 and sv[r - 1] / max(sv[r], 1e-300) < min_gap:
+        raise ValueError(f"observability rank is ambiguous: singular values {sv[r - 1]:.3g} and {sv[r]:.3g}")
+    return vt[:r].T, vt[r:].T
+
+
+def steady_state_gain(a, c, q, rc, *, state_scale=None):
+    """Steady-state Kalman gain K of ẋ = Ax + w, z = Cx + v (PSDs Q, R_c), an2021 eq. (10).
+
+    The position-aided 12-state model is not detectable (three combinations of attitude, gyro
+    drift and accelerometer bias are unobservable), so the algebraic Riccati equation on the full
+    state has no stabilizing solution.  The gain is the limit of the time-varying filter's gain:
+    in the Kalman observable decomposition (orthonormal, on states rescaled by ``state_scale``)
+    the observable block P_oo solves the continuous ARE (scipy ``solve_continuous_are``), the
+    cross-covariance P_uo solves the Sylvester equation
+    A_uu P_uo + P_uo (A_oo - K_o C_o)ᵀ = -(A_uo P_oo + Q_uo), and K = P Cᵀ R_c⁻¹ (P_uu does not
+    enter the gain).  When (A, C) is observable this is the usual ``control.lqe`` gain.
+    """
+    a, c, q, rc = (np.asarray(m, float) for m in (a, c, q, rc))
+    n = a.shape[0]
+    if a.shape != (n, n) or c.shape[1] != n or q.shape != (n, n) or rc.shape != (c.shape[0],) * 2:
+        raise ValueError("shapes must be A (n×n), C (m×n), Q (n×n), R_c (m×m)")
+    if np.any(np.linalg.eigvalsh(rc) <= 0):
+        raise ValueError("the measurement noise R_c must be positive definite")
+    scale = np.ones(n) if state_scale is None else np.asarray(state_scale, float)
+    meas_scale = np.sqrt(np.diag(rc))
+    s, si = np.diag(scale), np.diag(1.0 / scale)
+    di = np.diag(1.0 / meas_scale)
+    as_, cs = si @ a @ s, di @ c @ s
+    qs, rs = si @ q @ si, di @ rc @ di
+    vo, vu = observable_decomposition(as_, cs)
+    aoo, co, qoo = vo.T @ as_ @ vo, cs @ vo, vo.T @ qs @ vo
+    poo = sla.solve_continuous_are(aoo.T, co.T, qoo, rs)
+    rinv = np.linalg.inv(rs)
+    ko = poo @ co.T @ rinv
+    ks = vo @ ko
+    if vu.shape[1]:
+        auo, auu, quo = vu.T @ as_ @ vo, vu.T @ as_ @ vu, vu.T @ qs @ vo
+        puo = sla.solve_sylvester(auu, (aoo - ko @ co).T, -(auo @ poo + quo))
+        ks = ks + vu @ (puo @ co.T @ rinv)
+    return s @ ks @ di
+
+
+def kalman_gain_by_iteration(a, c, q, rc, *, dt, steps, p0):
+    """Gain of the discrete Kalman filter after ``steps`` predict/update cycles from P0.
+
+    The time-varying filter whose limit :func:`steady_state_gain` computes (discretized with the
+    matrix exponential and Van Loan's method); returns the continuous-equivalent gain K_d / dt.
+    Used in the tests to check the steady-state gain independently.
+    """
+    a, c, q, rc, p = (np.asarray(m, float) for m in (a, c, q, rc, p0))
+    n = a.shape[0]
+    m = np.zeros((2 * n, 2 * n))
+    m[:n, :n], m[:n, n:], m[n:, n:] = -a, q, a.T
+    e = sla.expm(m * dt)
+    phi = e[n:, n:].T
+    qd = phi @ e[:n, n:]
+    qd = 0.5 * (qd + qd.T)
+    rd = rc / dt
+    k = None
+    for _ in range(int(steps)):
+        p = phi @ p @ phi.T + qd
+        s_ = c @ p @ c.T + rd
+        k = np.linalg.solve(s_, c @ p).T
+        p = (np.eye(n) - k @ c) @ p
+        p = 0.5 * (p + p.T)
+    return k / dt
+
+
+def integrated_gravity_to_attitude(lat, v_east=0.0, v_north=0.0, noise: NoiseSettings = NAVIGATION_GRADE, *,
+                                   radius=None, gravity=None, gain=None):
+    """The closed loop H̄(Is - Ā + KC)^{-1}B from (g_dE, g_dN) to (ϕ_E, ϕ_N), an2021 eq. (10).
+
+    ``gain`` defaults to :func:`steady_state_gain` for ``noise``.  Returns a ``StateSpace``.
+    """
+    a, b, c, h = integrated_model(lat, v_east, v_north, radius=radius, gravity=gravity)
+    if gain is None:
+        q, rc = noise_matrices(lat, noise, radius=radius, gravity=gravity)
+        gain = steady_state_gain(a, c, q, rc, state_scale=_STATE_SCALE_12)
+    gain = np.asarray(gain, float)
+    if gain.shape != (12, 2):
+        raise ValueError(f"gain must be 12×2, got {gain.shape}")
+    return ct.ss(a - gain @ c, b, h, 0, states=list(STATES_12), inputs=["g_dE", "g_dN"],
+                 outputs=list(OUTPUTS), name="an2021-eq10")
+
+
+# --------------------------------------------------------------------------- frequency response
+
+def frequency_response(sys, omega, pair=None):
+    """Complex frequency response G(jω) of a SISO system, or of channel ``pair`` of a 2×2 one."""
+    omega = np.asarray(omega, dtype=float)
+    if np.any(omega <= 0) or not np.all(np.isfinite(omega)):
+        raise ValueError("frequencies must be positive and finite (rad/s)")
+    if pair is not None:
+        sys = siso(sys, pair)
+    resp = ct.frequency_response(sys, np.atleast_1d(omega))
+    return np.squeeze(np.asarray(resp.complex)).reshape(omega.shape)
+
+
+def dc_gain(sys, pair=None):
+    """Zero-frequency gain G(0) (an2021 eqs. (11)-(12)), from -H A⁻¹ B on the controllable part."""
+    if pair is not None:
+        sys = siso(sys, pair)
+    return float(np.real(frequency_response(sys, 1e-12)))
+
+
+def _db(sys, w):
+    return 20 * np.log10(np.abs(frequency_response(sys, w)))
+
+
+def proportional_band_edge(sys, pair=None, *, deviation_db=3.0, w_min=1e-7, w_max=10.0, n=4000):
+    """Upper edge of the band in which G(jω) stays a proportional element (an2021 §4, 7e-4 rad/s).
+
+    The lowest ω at which |G(jω)| departs from |G(0)| by ``deviation_db`` dB (either way),
+    located on a log grid and refined with Brent's method.
+    """
+    if pair is not None:
+        sys = siso(sys, pair)
+    g0 = 20 * np.log10(abs(dc_gain(sys)))
+    w = np.logspace(np.log10(w_min), np.log10(w_max), n)
+    dev = np.abs(_db(sys, w) - g0) - deviation_db
+    k = np.argmax(dev >= 0)
+    if dev[k] < 0:
+        raise ValueError("the response never departs from its DC value by the requested amount")
+    if k == 0:
+        return float(w[0])
+    f = lambda lw: abs(_db(sys, np.array([10**lw]))[0] - g0) - deviation_db
+    return float(10 ** brentq(f, np.log10(w[k - 1]), np.log10(w[k]), xtol=1e-12))
+
+
+def cutoff_frequency(sys, pair=None, *, drop_db=3.0, w_min=1e-7, w_max=10.0, n=4000):
+    """Cut-off frequency: the ω above which |G(jω)| stays ``drop_db`` dB below |G(0)|.
+
+    The highest crossing of |G(0)| - drop_db on a log grid, refined with Brent's method.
+    """
+    if pair is not None:
+        sys = siso(sys, pair)
+    g0 = 20 * np.log10(abs(dc_gain(sys)))
+    w = np.logspace(np.log10(w_min), np.log10(w_max), n)
+    above = _db(sys, w) - (g0 - drop_db)
+    idx = np.nonzero(above >= 0)[0]
+    if idx.size == 0 or idx[-1] == n - 1:
+        raise ValueError("no cut-off inside the frequency grid")
+    k = idx[-1]
+    f = lambda lw: _db(sys, np.array([10**lw]))[0] - (g0 - drop_db)
+    return float(10 ** brentq(f, np.log10(w[k]), np.log10(w[k + 1]), xtol=1e-12))
+
+
+def loglog_slope(sys, w_lo, w_hi, pair=None, n=200):
+    """Least-squares slope of 20 log10|G(jω)| against log10 ω on [w_lo, w_hi] (dB/decade)."""
+    if not (0 < w_lo < w_hi):
+        raise ValueError("need 0 < w_lo < w_hi")
+    if pair is not None:
+        sys = siso(sys, pair)
+    w = np.logspace(np.log10(w_lo), np.log10(w_hi), n)
+    return float(np.polyfit(np.log10(w), _db(sys, w), 1)[0])
+
+
+def wavelength(speed, omega):
+    """Spatial wavelength λ_g = 2π v / ω (m) of a disturbance met at time frequency ω, an2021 eq. (13)."""
+    speed, omega = np.asarray(speed, float), np.asarray(omega, float)
+    if np.any(omega <= 0):
+        raise ValueError("the time frequency ω must be positive (rad/s)")
+    return 2 * np.pi * np.abs(speed) / omega
+
+
+def attitude_error_per_disturbance(disturbance, lat=np.radians(30.0), *, gravity=None):
+    """Static horizontal attitude error ϕ = g_d / g (rad) for a horizontal disturbance (m/s²).
+
+    The DC gain of eqs. (4)-(7) and (11)-(12): |ϕ_E/g_dN| = |ϕ_N/g_dE| = 1/g.
+    """
+    _, g = earth_parameters(lat, None, gravity)
+    return np.asarray(disturbance, float) / g
+
+
+__all__ = [n for n in dir() if not n.startswith("_") and n not in (
+    "annotations", "functools", "math", "dataclass", "replace", "ct", "np", "pd", "sla", "sp", "brentq", "earth",
+    "DEG", "DEG_PER_H", "DEG_PER_SQRT_H", "HOUR", "MICRO_G", "UG_PER_SQRT_HZ")]

@@ -1,0 +1,305 @@
+"""Tests of replication.transfer (an2021: gravity disturbance → horizontal attitude error)."""
+
+from __future__ import annotations
+
+import math
+
+import control as ct
+import numpy as np
+import pytest
+import sympy as sp
+
+from replication import earth
+from replication import reproduction as rp
+from replication import transfer as tr
+from replication.units import ARCSEC, MGAL
+
+RNG_SEED = 2021
+
+
+def _random_motions(n, seed=RNG_SEED):
+    """Random (lat, v_east, v_north) for north-south and east-west motion, |L| ≤ 70°, |V| ≤ 100."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(n):
+        lat = np.radians(rng.uniform(-70, 70))
+        v = rng.uniform(-100, 100)
+        out.append((lat, 0.0, v) if k % 2 == 0 else (lat, v, 0.0))
+    return out
+
+
+def _printed(table_id):
+    t = rp.load_paper(table_id)
+    return {q: t.value(q) for q in t.quantities}
+
+
+# ------------------------------------------------------------------ the model, eqs. (1)-(3)
+
+def test_printed_A_matches_vector_error_equations():
+    """Every printed element of A (eq. (1)) equals the linearized vector error equations."""
+    derived = tr.symbolic_error_model_from_vectors()
+    coded = tr.symbolic_system_matrix("general")
+    printed = _printed("an2021-eq-3")
+    for i in range(7):
+        for j in range(7):
+            assert tr.is_identity(coded[i, j], derived[i, j]), (i + 1, j + 1)
+            name = f"A_{i + 1},{j + 1}"
+            if name in printed:
+                assert tr.is_identity(tr.parse_printed(printed[name]), derived[i, j]), name
+            else:
+                assert derived[i, j] == 0, f"{name} is non-zero but not printed"
+
+
+def test_numeric_A_equals_symbolic():
+    lat, ve, vn = np.radians(37.0), 12.0, -8.0
+    r, g = tr.earth_parameters(lat)
+    a_sym = tr.symbolic_system_matrix("general")
+    subs = {tr.SYMBOLS["L"]: lat, tr.SYMBOLS["R"]: r, tr.SYMBOLS["g"]: g,
+            tr.SYMBOLS["omega_ie"]: earth.OMEGA_IE, tr.SYMBOLS["V_E"]: ve, tr.SYMBOLS["V_N"]: vn}
+    a_num = np.array(a_sym.subs(subs).evalf(), dtype=float)
+    np.testing.assert_allclose(tr.system_matrix(lat, ve, vn), a_num, rtol=1e-13, atol=0)
+
+
+def test_transfer_function_equals_resolvent_at_random_frequencies():
+    """G(jω) of the (reduced, minimal) tf equals H(jωI - A)^{-1}(-B) of the 7-state model."""
+    rng = np.random.default_rng(RNG_SEED)
+    for lat, ve, vn in _random_motions(6):
+        a = tr.system_matrix(lat, ve, vn)
+        b = -tr.input_matrix()[:, 3:5]
+        h = tr.output_matrix()
+        for w in 10 ** rng.uniform(-5.5, 0, 4):
+            # stay away from the undamped resonances, where both sides are ill-conditioned
+            g_ref = h @ np.linalg.solve(1j * w * np.eye(7) - a, b)
+            for pair, (i, j) in (("phiE/gdN", (0, 1)), ("phiN/gdE", (1, 0))):
+                tf = tr.transfer_function(lat, ve, vn, pair)
+                got = complex(tf(1j * w))
+                # double precision on a balanced system: 1e-8 relative is generous
+                assert abs(got - g_ref[i, j]) <= 1e-8 * abs(g_ref[i, j]), (lat, ve, vn, w, pair)
+
+
+def test_dc_gain():
+    """s = 0: the closed forms n_0/d_0 of eqs. (4)-(7).  North-south motion: ϕ_E/g_dN = 1/g
+    exactly, ϕ_N/g_dE = -1/(g + 2V_N²/R); east-west motion: within 2|V|ω_ie/(g cos L) + 4V²/(gR)
+    (≲ 2e-3) of ±1/g."""
+    for lat, ve, vn in _random_motions(6):
+        _, g = tr.earth_parameters(lat)
+        sys = tr.gravity_to_attitude(lat, ve, vn)
+        motion = "north-south" if ve == 0 else "east-west"
+        sym = tr.symbolic_transfer_functions(motion)
+        for pair, sign in (("phiE/gdN", 1), ("phiN/gdE", -1)):
+            num, den, _ = sym[pair]
+            v = vn if motion == "north-south" else ve
+            exact = tr.evaluate(tr.coefficient(num, 0) / tr.coefficient(den, 0), lat, v, motion)
+            assert tr.dc_gain(sys, pair) == pytest.approx(exact, rel=1e-9)
+            r, _ = tr.earth_parameters(lat)
+            if motion == "north-south":
+                expected = 1 / g if pair == "phiE/gdN" else -1 / (g + 2 * v**2 / r)
+                assert exact == pytest.approx(expected, rel=1e-12)
+            else:
+                bound = 2 * abs(v) * earth.OMEGA_IE / (g * math.cos(lat)) + 4 * v**2 / (g * r)
+                assert abs(exact * g * sign - 1) <= bound
+
+
+def test_orders_and_exact_east_west_cancellation():
+    lat = np.radians(30.0)
+    for pair in tr.PAIRS:
+        ns = tr.transfer_function(lat, 0.0, 10.0, pair)
+        ew = tr.transfer_function(lat, 10.0, 0.0, pair)
+        assert len(ns.den[0][0]) - 1 == 6 and len(ns.num[0][0]) - 1 == 4
+        assert len(ew.den[0][0]) - 1 == 4 and len(ew.num[0][0]) - 1 == 2
+    sym = tr.symbolic_transfer_functions("east-west")
+    R, w, L, V, s = (tr.SYMBOLS[k] for k in ("R", "omega_ie", "L", "V_E", "s"))
+    expected = s**2 + (w + V / (R * sp.cos(L))) ** 2
+    for pair in tr.PAIRS:
+        assert sp.simplify(sym[pair][2] - expected) == 0
+
+
+def test_sum_of_poles_is_trace():
+    """North-south motion on a frozen latitude: the poles sum to V_N tan L / R (= -d_5)."""
+    lat, vn = np.radians(45.0), 50.0
+    r, _ = tr.earth_parameters(lat)
+    poles = tr.transfer_function(lat, 0.0, vn, "phiE/gdN").poles()
+    assert np.sum(poles).real == pytest.approx(vn * math.tan(lat) / r, rel=1e-6)
+
+
+# ------------------------------------------------------------------ symbolic vs numeric
+
+def test_symbolic_coefficients_equal_numeric_at_random_points():
+    rng = np.random.default_rng(RNG_SEED + 1)
+    for motion in tr.MOTIONS:
+        sym = tr.symbolic_transfer_functions(motion)
+        for _ in range(3):
+            lat, v = np.radians(rng.uniform(-70, 70)), rng.uniform(-100, 100)
+            ve, vn = (0.0, v) if motion == "north-south" else (v, 0.0)
+            for pair in tr.PAIRS:
+                num, den = tr.polynomial_coefficients(tr.transfer_function(lat, ve, vn, pair))
+                for poly, got in ((sym[pair][0], num), (sym[pair][1], den)):
+                    for k in range(poly.degree() + 1):
+                        exact = tr.evaluate(tr.coefficient(poly, k), lat, v, motion)
+                        if exact == 0:
+                            continue
+                        # frequency-scaled ss2tf: every coefficient to better than 1e-8 relative
+                        assert got.get(k, 0.0) == pytest.approx(exact, rel=1e-8), (motion, pair, k)
+
+
+def test_printed_north_south_coefficients_only_n13_differs():
+    """All 16 printed coefficients of eqs. (4)-(5) are identities except n_13 (erratum)."""
+    printed = _printed("an2021-eq-5")
+    pts = [(np.radians(30.0), 10.0), (np.radians(60.0), -100.0)]
+    df = tr.coefficient_checks(printed, "north-south", pts).set_index("coefficient")
+    assert set(df.index[~df["identical"]]) == {"n_13"}
+    assert (df.drop(index="n_13")["max_rel_printed_vs_derived"] < 1e-20).all()
+
+
+def test_printed_n13_is_dimensionally_wrong_and_off_by_V_N():
+    """n_13 printed -V_N² tan L / R² must be -V_N tan L / R²: the printed/derived ratio is V_N."""
+    printed = tr.parse_printed(_printed("an2021-eq-5")["n_13"])
+    derived = tr.derived_coefficient("n_13", "north-south")
+    ratio = sp.simplify(printed / derived)
+    assert ratio == tr.SYMBOLS["V_N"]
+
+
+def test_printed_east_west_coefficients_are_identities():
+    printed = _printed("an2021-eq-7")
+    df = tr.coefficient_checks(printed, "east-west", [(np.radians(30.0), 10.0)])
+    assert df["identical"].all()
+
+
+# ------------------------------------------------------------------ zero/pole maps
+
+def test_pole_zero_grid_families_and_cancellation():
+    grid = tr.pole_zero_grid("north-south", [0.0, 30.0, 70.0], [-100.0, 0.0, 100.0])
+    spread = tr.family_spread(grid)
+    poles = spread[(spread["kind"] == "pole") & (spread["pair"] == "phiE/gdN")].set_index("family")
+    ws = tr.schuler_frequency(np.radians(30.0))
+    # families 1-2: the Foucault-split Schuler pair near ω_s; family 3: the Earth-rate mode
+    assert poles.loc[1, "median_abs"] == pytest.approx(ws, rel=0.1)
+    assert poles.loc[3, "median_abs"] == pytest.approx(earth.OMEGA_IE, rel=0.05)
+    # at rest the Earth-rate pole and zero cancel exactly; moving north they separate
+    assert tr.cancellation_distance(np.radians(30.0), 0.0, "north-south", "phiE/gdN") < 1e-7
+    d10 = tr.cancellation_distance(np.radians(30.0), 10.0, "north-south", "phiN/gdE")
+    d100 = tr.cancellation_distance(np.radians(30.0), 100.0, "north-south", "phiN/gdE")
+    assert 1e-6 < d10 < d100
+
+
+# ------------------------------------------------------------------ integrated mode
+
+def test_integrated_model_structure():
+    a, b, c, h = tr.integrated_model(np.radians(30.0), 0.0, 10.0)
+    np.testing.assert_array_equal(a[:7, :7], tr.system_matrix(np.radians(30.0), 0.0, 10.0))
+    assert a[0, 7] == a[1, 8] == a[2, 9] == -1 and a[3, 10] == a[4, 11] == 1
+    assert b[3, 0] == b[4, 1] == -1 and np.count_nonzero(b) == 2
+    assert c[0, 5] == c[1, 6] == 1 and np.count_nonzero(c) == 2
+    assert h[0, 0] == h[1, 1] == 1 and np.count_nonzero(h) == 2
+
+
+def test_zero_gain_reduces_eq10_to_eq3():
+    lat = np.radians(30.0)
+    kf0 = tr.integrated_gravity_to_attitude(lat, 0.0, 10.0, gain=np.zeros((12, 2)))
+    pure = tr.gravity_to_attitude(lat, 0.0, 10.0)
+    w = np.array([3e-5, 2e-4, 5e-3, 0.1])
+    for pair in tr.PAIRS:
+        np.testing.assert_allclose(tr.frequency_response(kf0, w, pair), tr.frequency_response(pure, w, pair),
+                                   rtol=1e-9)
+
+
+def test_position_aided_model_has_three_unobservable_directions():
+    a, _, c, _ = tr.integrated_model(np.radians(30.0), 0.0, 10.0)
+    s = np.diag(tr._STATE_SCALE_12)
+    vo, vu = tr.observable_decomposition(np.linalg.solve(s, a @ s), c @ s / 1e-6)
+    assert vo.shape[1] == 9 and vu.shape[1] == 3
+
+
+def test_steady_state_gain_is_limit_of_stable_bias_models():
+    """The decomposition gain equals control.lqe's gain as the bias correlation time grows."""
+    lat = np.radians(30.0)
+    a, _, c, _ = tr.integrated_model(lat, 10.0, 0.0)
+    q, rc = tr.noise_matrices(lat, tr.NAVIGATION_GRADE)
+    k = tr.steady_state_gain(a, c, q, rc, state_scale=tr._STATE_SCALE_12)
+    s = np.diag(tr._STATE_SCALE_12)
+    d = np.diag(np.sqrt(np.diag(rc)))
+    ks = np.linalg.solve(s, k @ d)
+    errs = []
+    for tau in (1e8, 1e9):
+        a2 = a.copy()
+        a2[range(7, 12), range(7, 12)] = -1.0 / tau
+        kl, _, _ = ct.lqe(np.linalg.solve(s, a2 @ s), np.eye(12), np.linalg.solve(d, c @ s),
+                          np.linalg.solve(s, np.linalg.solve(s, q).T), np.linalg.solve(d, np.linalg.solve(d, rc).T))
+        errs.append(np.linalg.norm(kl - ks) / np.linalg.norm(ks))
+    # a first-order Gauss-Markov bias of correlation time τ perturbs the gain by
+    # O(1/(τ λ_slow)), λ_slow the slowest observable closed-loop rate (≈ 6.5e-5 rad/s here)
+    closed = np.linalg.eigvals(a - k @ c)
+    lam_slow = np.min(np.abs(closed.real[np.abs(closed.real) > 1e-12]))
+    assert errs[1] < 2.0 / (1e9 * lam_slow)
+    assert errs[1] < errs[0] / 5
+    assert np.max(closed.real) < 1e-12  # stable or (unobservable) neutral
+
+
+def test_integrated_dc_gain_and_high_frequency_asymptote():
+    lat = np.radians(30.0)
+    _, g = tr.earth_parameters(lat)
+    r, _ = tr.earth_parameters(lat)
+    sys = tr.integrated_gravity_to_attitude(lat, 0.0, 10.0)
+    # position aiding keeps the static tilt: 1/g to within 1 %
+    assert tr.dc_gain(sys, "phiE/gdN") == pytest.approx(1 / g, rel=0.01)
+    assert tr.dc_gain(sys, "phiN/gdE") == pytest.approx(-1 / g, rel=0.01)
+    # K C touches only the position columns: the relative degree stays 2, |G| → 1/(R ω²)
+    w = 1e3
+    assert abs(tr.frequency_response(sys, w, "phiE/gdN")) == pytest.approx(1 / (r * w**2), rel=1e-3)
+    assert tr.loglog_slope(sys, 1e2, 1e3, "phiE/gdN") == pytest.approx(-40.0, abs=0.5)
+
+
+# ------------------------------------------------------------------ frequency features
+
+def test_pure_proportional_edge_is_schuler_3db_point():
+    """|ω_s²/(ω_s² - ω²)| = √2 at ω = ω_s sqrt(1 - 1/√2); Foucault splitting shifts it < 1 %."""
+    lat = np.radians(30.0)
+    ws = tr.schuler_frequency(lat)
+    sys = tr.gravity_to_attitude(lat, 0.0, 10.0)
+    expected = ws * math.sqrt(1 - 1 / math.sqrt(2))
+    for pair in tr.PAIRS:
+        assert tr.proportional_band_edge(sys, pair) == pytest.approx(expected, rel=0.01)
+        # above resonance |G| ≈ (1/g) ω_s²/(ω² - ω_s²): falls below DC - 3 dB at ω_s sqrt(1 + √2)
+        assert tr.cutoff_frequency(sys, pair) == pytest.approx(ws * math.sqrt(1 + math.sqrt(2)), rel=0.01)
+
+
+def test_pure_slope_is_minus_40():
+    sys = tr.gravity_to_attitude(np.radians(30.0), 10.0, 0.0)
+    for pair in tr.PAIRS:
+        # relative degree 2, corrections (ω_s/ω)² < 1e-3 on [0.05, 0.5] rad/s
+        assert tr.loglog_slope(sys, 0.05, 0.5, pair) == pytest.approx(-40.0, abs=0.1)
+
+
+def test_wavelength_and_one_mgal():
+    assert tr.wavelength(10.0, 2 * np.pi) == pytest.approx(10.0)
+    assert tr.wavelength(-10.0, 0.05) == pytest.approx(40 * np.pi * 10.0)
+    phi = tr.attitude_error_per_disturbance(MGAL, np.radians(30.0))
+    assert phi / ARCSEC == pytest.approx(MGAL / earth.normal_gravity(np.radians(30.0)) / ARCSEC, rel=1e-12)
+    assert 0.20 < phi / ARCSEC < 0.22
+
+
+# ------------------------------------------------------------------ input validation
+
+@pytest.mark.parametrize("lat", [np.pi / 2, -np.pi / 2, 1.6, np.radians(90.0), float("nan")])
+def test_bad_latitude_fails_clearly(lat):
+    with pytest.raises(ValueError, match="latitude"):
+        tr.system_matrix(lat, 0.0, 10.0)
+    with pytest.raises(ValueError, match="latitude"):
+        tr.transfer_function(lat, 0.0, 10.0)
+    with pytest.raises(ValueError, match="latitude"):
+        tr.integrated_gravity_to_attitude(lat, 10.0, 0.0)
+
+
+def test_other_bad_inputs():
+    with pytest.raises(ValueError, match="velocities"):
+        tr.system_matrix(0.5, float("inf"), 0.0)
+    with pytest.raises(ValueError, match="pair"):
+        tr.transfer_function(0.5, 0.0, 1.0, "phiU/gdE")
+    with pytest.raises(ValueError, match="motion"):
+        tr.symbolic_transfer_functions("up-down")
+    with pytest.raises(ValueError, match="position_sigma"):
+        tr.NoiseSettings(1e-7, 1e-4, 0.0, 0.0, position_sigma=0.0)
+    with pytest.raises(ValueError, match="positive"):
+        tr.frequency_response(tr.gravity_to_attitude(0.5), [-1.0], "phiE/gdN")
+    with pytest.raises(ValueError, match="unknown symbols"):
+        tr.parse_printed("x + R")
