@@ -1,0 +1,790 @@
+"""Polar grid INS: frames, external horizontal damping, P and ψ equations, two-point calibration.
+
+Implements fang2020 (Fang, Huang & Wang 2020, *Comprehensive calibration method of shipborne
+grid inertial navigation system*):
+
+* frames of §2.1 — grid ``G`` (:func:`grid_frame`), OEPQ (:func:`oepq_frame`), computer ``c`` and
+  platform ``p`` with φ = θ + ψ (eq. (1));
+* the external horizontal damping network H_y(s) of eq. (1)/Fig. 1 (:func:`damping_network`,
+  :func:`damping_analysis`, :func:`discretize_damping`);
+* the P equation (2)-(17) (:func:`n_matrix`, :func:`m_matrix`, :func:`p_equation_numeric`);
+* the ψ equation (18)-(24) and its solution T, U of (25) (:func:`transition_t`,
+  :func:`input_u`, :func:`propagate_psi`);
+* the two-point comprehensive calibration (25)-(27) with the matrix B the paper leaves undefined
+  (:func:`b_matrix`, :func:`two_point_drift`);
+* the simulation of §3 (:func:`fang2020_scenario`, :func:`simulate`) on a grid-frame strapdown
+  INS that stays valid through the pole, and an ECEF-frame reference INS
+  (:func:`ecef_reference_comparison`).
+
+Sign conventions.  Small-angle frame errors carry the true grid frame G to another frame:
+θ: G → c (computer), φ: G → p (platform), ψ: c → p, with v^p = (I - [φ×]) v^G, so φ = θ + ψ.
+Position errors are computed minus true; heading errors are the indicated grid heading (clockwise
+from grid north) minus the true one, which equals φ_z.  Gyro drift ε_b is the gyro output minus
+the true rate (strapdown convention); fang2020's ψ equation (18)-(24) is written for the
+*platform drift rate*, which for a strapdown navigator is -C_b^G ε_b — see :func:`b_matrix`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from . import earth
+from . import units
+from . import _polar_kernels as _k
+
+OMEGA = earth.OMEGA_IE
+
+# H_y(s) of fang2020 eq. (1): zeros and poles (rad/s)
+DAMPING_ZEROS = (-8.5e-4, -9.412e-2)
+DAMPING_POLES = (-8.0e-3, -1.0e-2)
+
+
+# =============================================================================== validation
+
+def _vec3(r, name):
+    r = np.asarray(r, dtype=float)
+    if r.ndim == 0 or r.shape[-1] != 3:
+        raise ValueError(f"{name} must have a last axis of length 3 (x, y, z), got shape {r.shape}")
+    if not np.all(np.isfinite(r)):
+        raise ValueError(f"{name} must be finite")
+    return r
+
+
+def _angle(a, name, limit=None):
+    a = np.asarray(a, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite (radians)")
+    if limit is not None and np.any(np.abs(a) > limit + 1e-12):
+        raise ValueError(f"{name} exceeds {np.degrees(limit):.0f}° in magnitude: angles are radians "
+                         f"(convert degrees with np.radians)")
+    return a
+
+
+def _positive(x, name):
+    x = float(x)
+    if not np.isfinite(x) or x <= 0:
+        raise ValueError(f"{name} must be a positive finite number, got {x}")
+    return x
+
+
+# =============================================================================== frames (§2.1)
+
+def grid_frame(r):
+    """C_e^G: rows are the grid axes G_E, G_N, G_U in ECEF at the point ``r`` (fang2020 §2.1).
+
+    G_U is the normal of the WGS-84 ellipsoid (of the sphere when ``r`` lies on a sphere the
+    normal of which is r/|r| — pass :func:`sphere_point` output to :func:`grid_frame_sphere`);
+    G_N is the intersection of the local horizontal plane with the plane through the point
+    parallel to the prime-meridian plane, G_N ∝ G_U × e_y; G_E = G_N × G_U.  Regular at the poles;
+    undefined only where G_U = ±e_y (λ = ±90° on the equator).
+    """
+    r = _vec3(r, "r (ECEF position, m)")
+    q = r / np.array([earth.A**2, earth.A**2, earth.B**2])
+    return _frame_from_normal(q / np.linalg.norm(q, axis=-1, keepdims=True))
+
+
+def grid_frame_sphere(r):
+    """C_e^G of the spherical Earth used in fang2020 §2.2 (normal r/|r|)."""
+    r = _vec3(r, "r (position on the sphere, m)")
+    return _frame_from_normal(r / np.linalg.norm(r, axis=-1, keepdims=True))
+
+
+def _frame_from_normal(u):
+    w = np.stack([-u[..., 2], np.zeros_like(u[..., 0]), u[..., 0]], axis=-1)
+    wn = np.linalg.norm(w, axis=-1, keepdims=True)
+    if np.any(wn < 1e-9):
+        raise ValueError("the grid frame is undefined where the vertical is ±e_y (λ = ±90° on the "
+                         "equator): grid north has no direction there")
+    gn = w / wn
+    ge = np.cross(gn, u)
+    return np.stack([ge, gn, u], axis=-2)
+
+
+def grid_azimuth(lat, lon):
+    """Grid azimuth σ, the angle from geographic north to grid north (fang2020 eq. (8)).
+
+    sin σ = sin L sin λ / √(1 - cos²L sin²λ), cos σ = cos λ / √(1 - cos²L sin²λ).
+    """
+    lat = earth.check_latitude(lat)
+    lon = _angle(lon, "lon")
+    return np.arctan2(np.sin(lat) * np.sin(lon), np.cos(lon))
+
+
+def geographic_to_grid(sigma):
+    """C_g^G: geographic (E, N, U) to grid components, fang2020 eq. (2)."""
+    s = _angle(sigma, "sigma")
+    c, sn = np.cos(s), np.sin(s)
+    z, o = np.zeros_like(s), np.ones_like(s)
+    return np.stack([np.stack([c, -sn, z], -1), np.stack([sn, c, z], -1), np.stack([z, z, o], -1)], -2)
+
+
+def oepq_frame(lon):
+    """C_e^OEPQ: rows E (east, tangent to the parallel), P (parallel to the polar axis) and
+    Q = E × P in ECEF (fang2020 §2.1)."""
+    lon = _angle(lon, "lon")
+    s, c = np.sin(lon), np.cos(lon)
+    z, o = np.zeros_like(lon), np.ones_like(lon)
+    return np.stack([np.stack([-s, c, z], -1), np.stack([z, z, o], -1), np.stack([c, s, z], -1)], -2)
+
+
+def oepq_to_grid(lat, sigma):
+    """C_OEPQ^G = C_g^G(σ) R_x(L), fang2020 eq. (16)."""
+    lat = earth.check_latitude(lat)
+    sigma = _angle(sigma, "sigma")
+    c, s = np.cos(lat), np.sin(lat)
+    z, o = np.zeros_like(lat), np.ones_like(lat)
+    rx = np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2)
+    return geographic_to_grid(sigma) @ rx
+
+
+def computer_frame_angle(dlat, dlon, dsigma, lat, sigma):
+    """θ in grid components for position errors (δL, δλ) and grid-azimuth error δσ, eq. (2).
+
+    θ^g = [-δL, δλ cos L, δλ sin L - δσ], θ = C_g^G θ^g.
+    """
+    lat = earth.check_latitude(lat)
+    th_g = np.stack(np.broadcast_arrays(-np.asarray(dlat, float), np.asarray(dlon, float) * np.cos(lat),
+                                        np.asarray(dlon, float) * np.sin(lat) - np.asarray(dsigma, float)), -1)
+    return np.einsum("...ij,...j->...i", geographic_to_grid(sigma), th_g)
+
+
+def sphere_point(lat, lon, radius):
+    """(x, y, z) = R (cos L cos λ, cos L sin λ, sin L) — the spherical Earth of fang2020 eq. (6)."""
+    lat = earth.check_latitude(lat)
+    lon = _angle(lon, "lon")
+    radius = _positive(radius, "radius")
+    return radius * np.stack(np.broadcast_arrays(np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon),
+                                                 np.sin(lat)), -1)
+
+
+def gaussian_radius(lat):
+    """Gaussian mean radius √(R_M R_N) (m): the sphere osculating WGS-84 at latitude ``lat``."""
+    rm, rn = earth.radii(lat)
+    return np.sqrt(rm * rn)
+
+
+def grid_heading(c_b_g):
+    """Grid heading (rad, clockwise from grid north) of the body forward axis; C_b^G given."""
+    c = np.asarray(c_b_g, dtype=float)
+    if c.shape[-2:] != (3, 3):
+        raise ValueError(f"C_b^G must be (..., 3, 3), got {c.shape}")
+    return np.arctan2(c[..., 0, 1], c[..., 1, 1])
+
+
+def attitude_from_euler(heading, pitch, roll):
+    """C_b^G = R_z(-heading) R_x(pitch) R_y(roll) (body axes right, forward, up)."""
+    h, p, r = (np.asarray(x, dtype=float) for x in (heading, pitch, roll))
+    ch, sh, cp, sp, cr, sr = np.cos(h), np.sin(h), np.cos(p), np.sin(p), np.cos(r), np.sin(r)
+    m = np.array([[cr, 0 * cr, sr], [sp * sr, cp, -sp * cr], [-cp * sr, sp, cp * cr]])
+    rz = np.array([[ch, sh, 0 * ch], [-sh, ch, 0 * ch], [0 * ch, 0 * ch, 1 + 0 * ch]])
+    return np.einsum("ij...,jk...->...ik", rz, m)
+
+
+def euler_from_attitude(c_b_g):
+    """(heading, pitch, roll) of C_b^G = R_z(-heading) R_x(pitch) R_y(roll)."""
+    c = np.asarray(c_b_g, dtype=float)
+    return (np.arctan2(c[..., 0, 1], c[..., 1, 1]), np.arcsin(np.clip(c[..., 2, 1], -1, 1)),
+            np.arctan2(-c[..., 2, 0], c[..., 2, 2]))
+
+
+# =============================================================================== P equation (2)-(17)
+
+def n_matrix(r, radius=None, *, printed=False):
+    """N of fang2020 eq. (15): [δx, δy, φ_z]ᵀ = N [ψ_x, ψ_y, ψ_z]ᵀ (grid components of ψ).
+
+    ``r`` = (x, y, z) on the sphere of radius ``radius`` (default |r|).  The printed (2,2) entry
+    -Rz/√(x²+z²) contradicts the paper's own eq. (11) (δy = -√(x²+z²) ψ_y) and its eq. (17) for M;
+    ``printed=False`` (default) returns the corrected N with N₂₂ = -√(x²+z²), ``printed=True``
+    the matrix as printed.
+    """
+    r = _vec3(r, "r (sphere point, m)")
+    x, y, z = r[..., 0], r[..., 1], r[..., 2]
+    rad = np.linalg.norm(r, axis=-1) if radius is None else _positive(radius, "radius")
+    rxz = np.sqrt(x**2 + z**2)
+    if np.any(np.abs(z) < 1e-9 * np.maximum(rxz, 1.0)):
+        raise ValueError("N is singular on the equator (z = 0): the P equation needs z ≠ 0")
+    zero, one = np.zeros_like(x), np.ones_like(x)
+    n22 = -rad * z / rxz if printed else -rxz
+    return np.stack([np.stack([-rad * z / rxz, x * y / rxz, zero], -1),
+                     np.stack([zero, n22, zero], -1),
+                     np.stack([-y / rxz, zero, one], -1)], -2)
+
+
+def m_matrix(r, radius=None):
+    """M of fang2020 eq. (17), closed form as printed: P = [δx, δy, φ_z]ᵀ = M ψ_OEPQ.
+
+    ``r`` on the sphere of radius ``radius`` (default |r|).  Equals (corrected N) · C_OEPQ^G.
+    """
+    r = _vec3(r, "r (sphere point, m)")
+    x, y, z = r[..., 0], r[..., 1], r[..., 2]
+    rad = np.linalg.norm(r, axis=-1) if radius is None else _positive(radius, "radius")
+    rxy = np.sqrt(x**2 + y**2)
+    rxz2 = x**2 + z**2
+    if np.any(rxy < 1e-12 * rad):
+        raise ValueError("M needs the longitude: the point is exactly on the polar axis (x = y = 0)")
+    if np.any(np.abs(z) < 1e-9 * rad):
+        raise ValueError("M is singular on the equator (z = 0)")
+    return np.stack([np.stack([-x * z / rxy, y, -y * z / rxy], -1),
+                     np.stack([-y * z / rxy, -x, x * z / rxy], -1),
+                     np.stack([-rad * x * y / (rxy * rxz2), rad * z / rxz2, rad * x**2 / (rxy * rxz2)], -1)], -2)
+
+
+def p_equation_numeric(lat, lon, radius, step=0.05):
+    """N of eq. (15) and C_OEPQ^G of eq. (16) by numerical differentiation of the exact geometry.
+
+    On the sphere of ``radius``, the position is displaced by ±``step`` metres along x and along y
+    (z follows from |r| = R); the exact computer-frame rotation θ between the grid frames at the two
+    points is read from C_e^c C_G^e = I - [θ×] (no small-angle formula of the paper is used).  With
+    φ_x = φ_y = 0 (eq. (3)) ψ_x = -θ_x, ψ_y = -θ_y and φ_z = ψ_z + θ_z, so central differences give
+    ∂(ψ_x, ψ_y, θ_z)/∂(δx, δy), whose inverse is N.  C_OEPQ^G = C_e^G (C_e^OEPQ)ᵀ from the axis
+    definitions.  Returns (N, C).
+    """
+    lat = float(earth.check_latitude(lat))
+    lon = float(_angle(lon, "lon"))
+    radius = _positive(radius, "radius")
+    step = _positive(step, "step")
+    r0 = sphere_point(lat, lon, radius)
+    g0 = grid_frame_sphere(r0)
+
+    def theta(dx, dy):
+        x, y = r0[0] + dx, r0[1] + dy
+        z = np.sign(r0[2]) * np.sqrt(radius**2 - x**2 - y**2)
+        d = grid_frame_sphere(np.array([x, y, z])) @ g0.T      # C_G^c = I - [θ×]
+        return -0.5 * np.array([d[2, 1] - d[1, 2], d[0, 2] - d[2, 0], d[1, 0] - d[0, 1]])
+
+    jac = np.empty((3, 2))
+    for j, (dx, dy) in enumerate(((step, 0.0), (0.0, step))):
+        th = (theta(dx, dy) - theta(-dx, -dy)) / (2 * step)       # dθ/dδ
+        jac[:, j] = [-th[0], -th[1], th[2]]                         # (ψ_x, ψ_y, θ_z) = (-θ_x, -θ_y, θ_z)
+    n2 = np.linalg.inv(jac[:2, :])
+    n = np.zeros((3, 3))
+    n[:2, :2] = n2
+    n[2, :2] = jac[2, :] @ n2
+    n[2, 2] = 1.0
+    c = g0 @ oepq_frame(lon).T
+    return n, c
+
+
+def psi_from_p(p, r, radius=None):
+    """ψ_OEPQ = M⁻¹ P (fang2020 eq. (17) inverted)."""
+    p = _vec3(p, "P = (δx, δy, φ_z)")
+    m = m_matrix(r, radius)
+    return np.linalg.solve(m, p[..., None])[..., 0]
+
+
+# =============================================================================== ψ equation (18)-(24)
+
+def psi_system_matrix(omega=OMEGA):
+    """A of ψ̇ = A ψ + ε in OEPQ components (fang2020 eq. (24)): rows (0,0,-Ω), (0,0,0), (Ω,0,0)."""
+    omega = float(omega)
+    return np.array([[0.0, 0.0, -omega], [0.0, 0.0, 0.0], [omega, 0.0, 0.0]])
+
+
+def transition_t(a):
+    """T(t_{n+1}, t_n) of fang2020 eq. (25), a = Ω(t_{n+1} - t_n): the ψ-equation transition matrix."""
+    a = float(_angle(a, "a"))
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
+
+
+def input_u(a):
+    """U(t_{n+1}, t_n) of fang2020 eq. (25) = Ω ∫₀^τ T(s) ds, a = Ωτ."""
+    a = float(_angle(a, "a"))
+    if a <= 0:
+        raise ValueError("a = Ω(t_{n+1} - t_n) must be positive: the second fix must follow the first")
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[s, 0.0, c - 1.0], [0.0, a, 0.0], [1.0 - c, 0.0, s]])
+
+
+def propagate_psi(psi0, eps, tau, omega=OMEGA):
+    """Exact solution of eq. (24): ψ(τ) = T ψ(0) + U ε / Ω for a constant platform drift ε."""
+    psi0 = _vec3(psi0, "psi0")
+    eps = _vec3(eps, "eps")
+    tau = _positive(tau, "tau (s)")
+    a = omega * tau
+    return psi0 @ transition_t(a).T + eps @ input_u(a).T / omega
+
+
+# =============================================================================== calibration (25)-(27)
+
+DRIFT_CONVENTIONS = ("gyro-error", "platform-drift")
+
+
+def b_matrix(lat, sigma, convention="gyro-error"):
+    """The matrix B of fang2020 eq. (25), which the paper does not define.
+
+    Derivation.  The ψ equation (24) is linear with constant coefficients in OEPQ components:
+    ψ̇ = A ψ + ε_OEPQ.  Its solution over [t_n, t_{n+1}] is ψ(t_{n+1}) = T ψ(t_n) + (U/Ω) ε_OEPQ,
+    with T = exp(Aτ) and U/Ω = ∫₀^τ exp(As) ds exactly the printed T and U.  Hence
+    ε_OEPQ = Ω U⁻¹[ψ(t_{n+1}) - T ψ(t_n)].  The printed left factor C_G^b takes *grid* components
+    to body components, so B must take OEPQ components to grid components: B = C_OEPQ^G of
+    eq. (16) — times the sign that relates the paper's ε to the gyro error.  In (18) ε is the
+    platform drift rate (ω_ip = ω_ic + ψ×ω_ic + ε); a strapdown navigator integrating gyro outputs
+    ω + ε_b rotates its platform at ω_ic - C_b^p ε_b, so ε = -C_b^G ε_b and
+
+        ``convention="gyro-error"``: B = -C_OEPQ^G   (ε_b = gyro output minus true rate),
+        ``convention="platform-drift"``: B = +C_OEPQ^G (ε_b = platform drift rate, gimballed).
+    """
+    if convention not in DRIFT_CONVENTIONS:
+        raise ValueError(f"convention must be one of {DRIFT_CONVENTIONS}, got {convention!r}")
+    c = oepq_to_grid(lat, sigma)
+    return -c if convention == "gyro-error" else c
+
+
+def two_point_drift(p2, r2, c_b_g, tau, *, p1=None, r1=None, mean_c_b_e=None,
+                    convention="gyro-error", radius=None):
+    """Gyro constant drift in the body frame from two fixes, fang2020 eqs. (25)-(27).
+
+    ε_b = C_G^b B Ω U⁻¹ [M⁻¹(t_{n+1}) P(t_{n+1}) - T M⁻¹(t_n) P(t_n)]        (26)
+    with P(t_n⁺) = 0 after the first reset (``p1=None``) giving eq. (27).
+
+    ``p2`` (``p1``): P = (δx, δy in m, φ_z in rad) observed at the fix, computed minus reference;
+    ``r2`` (``r1``): ECEF position of the fix (m), mapped to the osculating sphere (Gaussian radius
+    unless ``radius`` is given) where M of eq. (17) is evaluated; ``c_b_g``: C_b^G at t_{n+1}
+    (its transpose is the printed C_G^b); ``tau`` = t_{n+1} - t_n (s); B from :func:`b_matrix`.
+
+    ``mean_c_b_e`` (optional): the interval mean of C_b^e over [t_n, t_{n+1}].  The ψ equation
+    integrates ε_OEPQ(t) = C_b^OEPQ(t) ε_b, so for a rocking ship the attitude that inverts it is the
+    mean ⟨C_b^OEPQ⟩ = C_e^OEPQ(λ_{n+1}) ⟨C_b^e⟩, not the attitude at one instant; when given,
+    ε_b = s ⟨C_b^OEPQ⟩⁻¹ Ω U⁻¹[...] (s = -1 for gyro errors), which equals eq. (27) for a ship
+    holding a constant attitude.  Works on batches (leading axes).  Returns ε_b (rad/s).
+    """
+    p2 = _vec3(p2, "p2")
+    r2 = _vec3(r2, "r2 (ECEF, m)")
+    tau = _positive(tau, "tau (s)")
+    if convention not in DRIFT_CONVENTIONS:
+        raise ValueError(f"convention must be one of {DRIFT_CONVENTIONS}, got {convention!r}")
+    if (p1 is None) != (r1 is None):
+        raise ValueError("give both p1 and r1 (eq. (26)) or neither (eq. (27), P(t_n+) = 0)")
+    lat2, lon2, _ = earth.ecef_to_geodetic(r2)
+    rad2 = gaussian_radius(lat2) if radius is None else np.broadcast_to(_positive(radius, "radius"), lat2.shape)
+    psi2 = _psi_at(p2, lat2, lon2, rad2)
+    a = OMEGA * tau
+    t_mat, u_mat = transition_t(a), input_u(a)
+    rhs = psi2
+    if p1 is not None:
+        p1 = _vec3(p1, "p1")
+        lat1, lon1, _ = earth.ecef_to_geodetic(_vec3(r1, "r1 (ECEF, m)"))
+        rad1 = gaussian_radius(lat1) if radius is None else np.broadcast_to(float(radius), lat1.shape)
+        # ψ(t_n) is expressed in OEPQ at the first fix; rotate it into OEPQ of the second (about P)
+        psi1 = _psi_at(p1, lat1, lon1, rad1)
+        rot = oepq_frame(lon2) @ np.swapaxes(oepq_frame(lon1), -1, -2)
+        rhs = rhs - np.einsum("ij,...jk,...k->...i", t_mat, rot, psi1)
+    return drift_from_psi(rhs, lat2, lon2, c_b_g, tau, mean_c_b_e=mean_c_b_e, convention=convention)
+
+
+def drift_from_psi(dpsi, lat, lon, c_b_g, tau, *, mean_c_b_e=None, convention="gyro-error"):
+    """ε_b = C_G^b B Ω U⁻¹ Δψ, fang2020 eq. (25), with Δψ = ψ(t_{n+1}) - T ψ(t_n) in OEPQ
+    components at (``lat``, ``lon``) of the second fix; see :func:`two_point_drift`."""
+    rhs = _vec3(dpsi, "dpsi")
+    tau = _positive(tau, "tau (s)")
+    if convention not in DRIFT_CONVENTIONS:
+        raise ValueError(f"convention must be one of {DRIFT_CONVENTIONS}, got {convention!r}")
+    lat2 = earth.check_latitude(lat)
+    lon2 = _angle(lon, "lon")
+    u_mat = input_u(OMEGA * tau)
+    eps_oepq = OMEGA * np.linalg.solve(u_mat, rhs[..., None])[..., 0]
+    sign = -1.0 if convention == "gyro-error" else 1.0
+    if mean_c_b_e is None:
+        c_b_g = np.asarray(c_b_g, dtype=float)
+        if c_b_g.shape[-2:] != (3, 3):
+            raise ValueError(f"c_b_g must be (..., 3, 3), got {c_b_g.shape}")
+        sigma = grid_azimuth(lat2, lon2)
+        bm = b_matrix(lat2, sigma, convention)
+        return np.einsum("...ji,...jk,...k->...i", c_b_g, bm, eps_oepq)
+    mc = np.asarray(mean_c_b_e, dtype=float)
+    if mc.shape[-2:] != (3, 3):
+        raise ValueError(f"mean_c_b_e must be (..., 3, 3), got {mc.shape}")
+    c_b_oepq = oepq_frame(lon2) @ mc
+    return sign * np.linalg.solve(c_b_oepq, eps_oepq[..., None])[..., 0]
+
+
+def _psi_at(p, lat, lon, rad):
+    pts = np.stack([rad * np.cos(lat) * np.cos(lon), rad * np.cos(lat) * np.sin(lon), rad * np.sin(lat)], -1)
+    m = m_matrix(pts, None)
+    return np.linalg.solve(m, p[..., None])[..., 0]
+
+
+# =============================================================================== damping (eq. (1))
+
+def damping_network():
+    """H_y(s) = (s + 8.5e-4)(s + 9.412e-2) / ((s + 8.0e-3)(s + 1.0e-2)), fang2020 eq. (1)."""
+    import control as ct
+
+    return ct.tf(np.poly(DAMPING_ZEROS), np.poly(DAMPING_POLES))
+
+
+def schuler_loop(damped=True, *, radius=None, gravity=None):
+    """Grid-horizontal tilt loop as a transfer function from accelerometer bias to tilt.
+
+    δV̇_N = g φ_E + ∇_N,  φ̇_E = -H_y(s) δV_N / R  (δV_N through the damping network when
+    ``damped``, H = 1 otherwise): φ_E/∇_N = -H/R / (s² + ω_s² H), ω_s² = g/R.  The characteristic
+    polynomial s² + ω_s² H_y(s) is the same for the east channel.  Defaults: R = a, g = γ(85°).
+    """
+    import control as ct
+
+    radius = earth.A if radius is None else _positive(radius, "radius")
+    gravity = float(earth.normal_gravity(np.radians(85.0))) if gravity is None else _positive(gravity, "gravity")
+    s = ct.tf("s")
+    h = damping_network() if damped else ct.tf([1.0], [1.0])
+    ws2 = gravity / radius
+    return ct.minreal(-(h / radius) / (s * s + ws2 * h), verbose=False)
+
+
+def damping_analysis(*, radius=None, gravity=None):
+    """Poles/zeros of H_y and of the Schuler loop with and without damping (python-control).
+
+    Returns a dict with the network's zeros, poles and DC gain, and for the undamped and damped
+    loops the closed-loop poles, their natural frequencies and damping ratios (``control.damp``),
+    the Schuler period, and the 2 % settling time of the tilt's step response to an accelerometer
+    bias (``control.step_info``; infinite for the undamped loop, whose poles are on the axis).
+    """
+    import control as ct
+
+    h = damping_network()
+    out = {"zeros": np.sort(np.real(ct.zeros(h))), "poles": np.sort(np.real(ct.poles(h))),
+           "dc_gain": float(np.real(ct.dcgain(h)))}
+    for name, damped in (("undamped", False), ("damped", True)):
+        sys = schuler_loop(damped, radius=radius, gravity=gravity)
+        poles = ct.poles(sys)
+        wn, zeta, _ = ct.damp(sys, doprint=False)
+        if np.max(np.real(poles)) < -1e-12:
+            info = ct.step_info(sys, SettlingTimeThreshold=0.02)
+            settling = float(info["SettlingTime"])
+        else:
+            settling = float("inf")
+        out[name] = {"poles": poles, "wn": wn, "zeta": zeta, "settling_time": settling}
+    radius = earth.A if radius is None else radius
+    gravity = float(earth.normal_gravity(np.radians(85.0))) if gravity is None else gravity
+    out["schuler_period"] = 2 * np.pi * np.sqrt(radius / gravity)
+    return out
+
+
+def discretize_damping(dt):
+    """Tustin (bilinear) discretization of H_y at step ``dt`` (s): (b0, b1, b2, a1, a2), a0 = 1."""
+    import control as ct
+
+    dt = _positive(dt, "dt (s)")
+    hd = ct.sample_system(damping_network(), dt, method="tustin")
+    num = np.atleast_1d(np.squeeze(hd.num[0][0]))
+    den = np.atleast_1d(np.squeeze(hd.den[0][0]))
+    num, den = num / den[0], den / den[0]
+    return np.array([num[0], num[1], num[2], den[1], den[2]])
+
+
+# =============================================================================== simulation (§3)
+
+@dataclass(frozen=True)
+class Scenario:
+    """One simulation case of fang2020 §3 (SI units inside; printed units in the constructor)."""
+
+    track: str                      # "parallel-east" or "meridian-north"
+    lat0: float                     # rad
+    lon0: float                     # rad
+    speed: float = 10.0             # m/s
+    heading_offset: float = 0.0     # rad, mean heading relative to the track direction
+    duration: float = 10 * units.HOUR
+    rate_hz: float = 100.0
+    fix_times: tuple = (2 * units.HOUR, 3.5 * units.HOUR)
+    fix_position_error: tuple = (5.0, 5.0, 5.0)          # ECEF, m (constant, as printed)
+    fix_heading_error: float = 6 * units.ARCSEC
+    gyro_drift: tuple = (0.01 * units.DEG_PER_H,) * 3    # rad/s, body axes
+    accel_bias: tuple = (1e-4 * units.G0,) * 3           # m/s², body axes
+    gyro_white: float = 0.001 * units.DEG_PER_H          # rad/s, 1σ per sample (choice)
+    accel_white: float = 1e-5 * units.G0                 # m/s², 1σ per sample (choice)
+    initial_attitude_error: tuple = (6 * units.ARCSEC, 6 * units.ARCSEC, 6 * units.ARCMIN)  # roll, pitch, heading
+    rocking_amplitude: tuple = (3 * units.DEG, 5 * units.DEG, 4 * units.DEG)  # pitch, roll, yaw
+    rocking_period: tuple = (7.0, 9.0, 12.0)            # s
+    damping: bool = True
+
+    def __post_init__(self):
+        if self.track not in ("parallel-east", "meridian-north"):
+            raise ValueError("track must be 'parallel-east' or 'meridian-north'")
+        earth.check_latitude(self.lat0, polar_limit_deg=None)
+        if not (self.rate_hz > 0 and self.duration > 0 and self.speed >= 0):
+            raise ValueError("rate_hz and duration must be positive and speed non-negative")
+        if len(self.fix_times) != 2 or not (0 < self.fix_times[0] < self.fix_times[1] <= self.duration):
+            raise ValueError("fix_times must be two increasing times inside (0, duration]")
+        for name in ("fix_position_error", "gyro_drift", "accel_bias", "initial_attitude_error",
+                     "rocking_amplitude", "rocking_period"):
+            if len(getattr(self, name)) != 3:
+                raise ValueError(f"{name} needs three values")
+        if min(self.rocking_period) <= 0:
+            raise ValueError("rocking periods must be positive (s)")
+        if self.gyro_white < 0 or self.accel_white < 0:
+            raise ValueError("white-noise levels cannot be negative")
+        if self.track == "parallel-east" and abs(self.lat0) > np.radians(89.9):
+            raise ValueError("a track along a parallel needs |lat0| < 89.9° (the parallel shrinks to the pole)")
+
+    @property
+    def dt(self):
+        return 1.0 / self.rate_hz
+
+    def steps(self, t):
+        k = t * self.rate_hz
+        if abs(k - round(k)) > 1e-6:
+            raise ValueError(f"time {t} s is not a multiple of the step 1/{self.rate_hz} s")
+        return int(round(k))
+
+    def trajectory_rate(self):
+        """λ̇ (parallel track) or L̇ (meridian track) in rad/s."""
+        if self.track == "parallel-east":
+            _, rn = earth.radii(self.lat0)
+            return self.speed / (float(rn) * np.cos(self.lat0))
+        rm_pole, _ = earth.radii(np.pi / 2)
+        return self.speed / float(rm_pole)
+
+
+def fang2020_scenario(case, **changes):
+    """Case 1 (85°N 18°E, east 10 m/s along the parallel, heading 90° ± 4° yaw rocking) or
+    case 2 (88.868°N 168°E, north 10 m/s along the meridian across the pole, heading 0°, pitch
+    and roll rocking only) of fang2020 §3.  ``changes`` override fields (e.g. noise levels)."""
+    if case == 1:
+        sc = Scenario("parallel-east", np.radians(85.0), np.radians(18.0))
+    elif case == 2:
+        sc = Scenario("meridian-north", np.radians(88.868), np.radians(168.0),
+                      rocking_amplitude=(3 * units.DEG, 5 * units.DEG, 0.0))
+    else:
+        raise ValueError("fang2020 has two simulation cases: 1 (85°N) and 2 (across the pole)")
+    return replace(sc, **changes)
+
+
+def _traj_params(sc, phases):
+    n = phases.shape[0]
+    p = np.zeros((n, _k.N_TRAJ))
+    p[:, 0] = 0.0 if sc.track == "parallel-east" else 1.0
+    p[:, 1], p[:, 2], p[:, 3], p[:, 4] = sc.lat0, sc.lon0, sc.trajectory_rate(), sc.heading_offset
+    p[:, 5:8] = sc.rocking_amplitude
+    p[:, 8:11] = sc.rocking_period
+    p[:, 11:14] = phases
+    return p
+
+
+def true_state(sc, t, phases):
+    """True C_b^e, r^e, ṙ^e of runs with rocking ``phases`` (n×3) at time ``t`` (s)."""
+    traj = _traj_params(sc, np.atleast_2d(phases))
+    n = traj.shape[0]
+    cbe, re, rde = np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3))
+    for i in range(n):
+        _k.truth(float(t), traj[i], cbe[i], re[i], rde[i])
+    return cbe, re, rde
+
+
+@dataclass
+class SimulationResult:
+    """Output of :func:`simulate` (errors: computed minus true; SI units)."""
+
+    scenario: Scenario
+    t: np.ndarray                   # record times (s)
+    errors: np.ndarray              # runs × records × 8 (REC_FIELDS), calibrated (drift compensated)
+    errors_reset_only: np.ndarray   # runs_reset_only × records × 8 (reset without compensation)
+    estimates: dict                 # estimator name -> runs × 3 drift estimates (rad/s)
+    p2: np.ndarray                  # runs × 3 observation at the second fix
+    phases: np.ndarray              # runs × 3 rocking phases (pitch, roll, yaw)
+    fields: tuple = _k.REC_FIELDS
+    extra: dict = field(default_factory=dict)
+
+
+ESTIMATORS = ("printed", "mean-attitude")
+
+
+def _initial_state(sc, phases):
+    n = phases.shape[0]
+    cbe, re, rde = true_state(sc, 0.0, phases)
+    ceg = grid_frame(re)
+    cbg = ceg @ cbe
+    h, pch, rol = euler_from_attitude(cbg)
+    d_roll, d_pitch, d_head = sc.initial_attitude_error
+    cbp = np.ascontiguousarray(attitude_from_euler(h + d_head, pch + d_pitch, rol + d_roll).reshape(n, 3, 3))
+    vg = np.einsum("nij,nj->ni", ceg, rde)
+    vg[:, 2] = 0.0
+    return cbp, np.ascontiguousarray(vg), np.ascontiguousarray(re.copy())
+
+
+HEADING_OBSERVATIONS = ("misalignment", "euler")
+
+
+def _fix(sc, t, phases, cbp, r, err_pos, err_head, heading_observation="misalignment"):
+    """Observation P at a fix and the reset of position and heading (in place).
+
+    P = (x - x_ref, y - y_ref, heading error - reference heading error).  The heading error is
+    the platform's azimuth misalignment φ_z about the true grid vertical (``"misalignment"``, the
+    quantity of the P equation) or the difference of grid-heading Euler angles (``"euler"``),
+    which for a pitched and rolled ship also contains tilt errors times the tangent of the tilt.
+    The reset rotates the platform about its vertical by P_3 and sets the position to the fix.
+    """
+    cbe, re, _ = true_state(sc, t, phases)
+    c_b_g_true = grid_frame(re) @ cbe
+    r_ref = re + np.asarray(err_pos)
+    if heading_observation == "euler":
+        dh = np.angle(np.exp(1j * (grid_heading(cbp) - grid_heading(c_b_g_true) - err_head)))
+    else:
+        d = cbp @ np.swapaxes(c_b_g_true, -1, -2)         # I - [φ×]
+        dh = 0.5 * (d[:, 0, 1] - d[:, 1, 0]) - err_head
+    p = np.stack([r[:, 0] - r_ref[:, 0], r[:, 1] - r_ref[:, 1], dh], -1)
+    c_b_g_before = cbp.copy()
+    ca, sa = np.cos(dh), np.sin(dh)
+    rz = np.zeros((len(dh), 3, 3))
+    rz[:, 0, 0], rz[:, 0, 1], rz[:, 1, 0], rz[:, 1, 1], rz[:, 2, 2] = ca, -sa, sa, ca, 1.0
+    cbp[:] = rz @ cbp
+    lat, lon, _ = earth.ecef_to_geodetic(r_ref)
+    r[:] = earth.geodetic_to_ecef(lat, lon, np.zeros_like(lat))
+    return p, r_ref, c_b_g_before
+
+
+def true_psi(sc, t, phases, cbp, r):
+    """ψ = φ - θ of the navigator state (``cbp``, ``r``) against the truth, in OEPQ at the truth.
+
+    φ from C_b^p (C_b^G)ᵀ = I - [φ×], θ from C_e^G(r) C_G^e(r_true) = I - [θ×] (exact small
+    angles, no P-equation approximation); returned in OEPQ components at the true longitude.
+    """
+    cbe, re, _ = true_state(sc, t, phases)
+    g_true = grid_frame(re)
+    d = cbp @ np.swapaxes(g_true @ cbe, -1, -2)
+    phi = 0.5 * np.stack([d[:, 1, 2] - d[:, 2, 1], d[:, 2, 0] - d[:, 0, 2], d[:, 0, 1] - d[:, 1, 0]], -1)
+    c = grid_frame(r) @ np.swapaxes(g_true, -1, -2)
+    theta = 0.5 * np.stack([c[:, 1, 2] - c[:, 2, 1], c[:, 2, 0] - c[:, 0, 2], c[:, 0, 1] - c[:, 1, 0]], -1)
+    _, lon, _ = earth.ecef_to_geodetic(re)
+    c_g_oepq = oepq_frame(lon) @ np.swapaxes(g_true, -1, -2)
+    return np.einsum("nij,nj->ni", c_g_oepq, phi - theta), re
+
+
+def run_segment(sc, k0, k1, traj, sens, state, *, record_every_steps=None):
+    """Advance the grid INS ``state`` (dict from :func:`initial_state`) from step k0 to k1."""
+    rec = np.zeros((traj.shape[0], 0, _k.N_REC))
+    _k.run_grid(k0, k1, sc.dt, traj, sens, state["cbp"], state["vg"], state["r"], state["damp"],
+                state["comp"], state["rng"], state["acc_e"], state["acc_i"], discretize_damping(sc.dt),
+                1 if sc.damping else 0, rec, record_every_steps or max(k1 - k0, 1), 10)
+    return state
+
+
+def initial_state(sc, n_runs, seed):
+    """Trajectory/sensor parameters and the initial navigator state of ``n_runs`` runs."""
+    rng = np.random.default_rng(seed)
+    phases = rng.uniform(0, 2 * np.pi, (n_runs, 3))
+    seeds = rng.integers(1, 2**63 - 1, size=n_runs, dtype=np.int64).astype(np.uint64)
+    traj = np.ascontiguousarray(_traj_params(sc, phases))
+    sens = np.zeros((n_runs, _k.N_SENS))
+    sens[:, 0:3], sens[:, 3:6] = sc.gyro_drift, sc.accel_bias
+    sens[:, 6], sens[:, 7] = sc.gyro_white, sc.accel_white
+    cbp, vg, r = _initial_state(sc, phases)
+    state = {"cbp": cbp, "vg": vg, "r": r, "damp": np.zeros((n_runs, 2, 2)), "comp": np.zeros((n_runs, 3)),
+             "rng": seeds, "acc_e": np.zeros((n_runs, 3, 3)), "acc_i": np.zeros((n_runs, 3, 3))}
+    return phases, traj, sens, state
+
+
+def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimator="mean-attitude",
+             heading_observation="misalignment"):
+    """Run fang2020 §3: damped grid INS, fixes at ``sc.fix_times``, two-point calibration.
+
+    ``n_runs`` Monte Carlo runs (random rocking phases, white noise, ``seed``); the first fix resets
+    position and heading, the second observes P(t_{n+1}), estimates the drift with every estimator
+    of :data:`ESTIMATORS` (``"printed"``: eq. (27) with the instantaneous C_G^b; ``"mean-attitude"``:
+    the interval-mean attitude, see :func:`two_point_drift`), resets, and the runs continue with
+    the ``estimator`` estimate subtracted from the gyro outputs.  The first ``reset_only_runs``
+    runs are continued a second time without compensation (the paper's dashed curves).
+    ``heading_observation``: see :func:`_fix` (:data:`HEADING_OBSERVATIONS`).
+    """
+    if heading_observation not in HEADING_OBSERVATIONS:
+        raise ValueError(f"heading_observation must be one of {HEADING_OBSERVATIONS}")
+    if not isinstance(n_runs, (int, np.integer)) or n_runs < 1:
+        raise ValueError("n_runs must be a positive integer")
+    if estimator not in ESTIMATORS:
+        raise ValueError(f"estimator must be one of {ESTIMATORS}")
+    if not 0 <= reset_only_runs <= n_runs:
+        raise ValueError("reset_only_runs must lie in [0, n_runs]")
+    dt = sc.dt
+    rec_every_k = sc.steps(_positive(record_every, "record_every (s)"))
+    k_end = sc.steps(sc.duration)
+    k1, k2 = sc.steps(sc.fix_times[0]), sc.steps(sc.fix_times[1])
+    if k1 % rec_every_k or k2 % rec_every_k:
+        raise ValueError("fix times must be multiples of record_every")
+    phases, traj, sens, st = initial_state(sc, n_runs, seed)
+    cbp, vg, r, damp, comp, seeds = st["cbp"], st["vg"], st["r"], st["damp"], st["comp"], st["rng"]
+    coef = discretize_damping(dt)
+    n_rec = k_end // rec_every_k + 1
+    rec = np.full((n_runs, n_rec, _k.N_REC), np.nan)
+    acc_e = np.zeros((n_runs, 3, 3))
+    acc_i = np.zeros((n_runs, 3, 3))
+    flag = 1 if sc.damping else 0
+    acc_every = 10
+
+    def seg(ka, kb, cbp_, vg_, r_, damp_, comp_, rng_, acc_e_, acc_i_, traj_, sens_, rec_):
+        j0 = ka // rec_every_k
+        sub = np.zeros((traj_.shape[0], (kb - ka) // rec_every_k + 1, _k.N_REC))
+        _k.run_grid(ka, kb, dt, traj_, sens_, cbp_, vg_, r_, damp_, comp_, rng_, acc_e_, acc_i_,
+                    coef, flag, sub, rec_every_k, acc_every)
+        rec_[:, j0:j0 + sub.shape[1]] = sub
+
+    seg(0, k1, cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens, rec)
+    e1 = np.array(sc.fix_position_error, float)
+    _fix(sc, sc.fix_times[0], phases, cbp, r, e1, sc.fix_heading_error, heading_observation)
+    acc_e[:] = 0.0
+    acc_i[:] = 0.0
+    seg(k1, k2, cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens, rec)
+    p2, r_ref2, cbg2 = _fix(sc, sc.fix_times[1], phases, cbp, r, e1, sc.fix_heading_error, heading_observation)
+    tau = sc.fix_times[1] - sc.fix_times[0]
+    est = {"printed": two_point_drift(p2, r_ref2, cbg2, tau),
+           "mean-attitude": two_point_drift(p2, r_ref2, None, tau, mean_c_b_e=acc_e / tau)}
+    m = reset_only_runs
+    st = [x[:m].copy() for x in (cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens)]
+    rec_reset = rec[:m].copy()
+    comp[:] = est[estimator]
+    seg(k2, k_end, cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens, rec)
+    if m:
+        seg(k2, k_end, *st, rec_reset)
+    t = np.arange(n_rec) * rec_every_k * dt
+    return SimulationResult(sc, t, rec, rec_reset, est, p2, phases)
+
+
+# =============================================================================== ECEF reference
+
+def ecef_reference_comparison(sc, duration, *, seed=0, record_every=60.0):
+    """Run the grid-frame INS (damping off) and an ECEF-frame INS on identical IMU data.
+
+    Both start from the same state (true position and velocity, ``sc``'s initial attitude errors)
+    and integrate the same sensor model (drift, bias, white noise with the same random stream).
+    Returns a dict of time (s), ECEF positions of both (runs × records × 3), ECEF velocities and
+    the angle between their attitudes (rad), plus the true positions.
+    """
+    duration = _positive(duration, "duration (s)")
+    sc = replace(sc, damping=False)
+    dt = sc.dt
+    k_end = sc.steps(duration)
+    rec_k = sc.steps(_positive(record_every, "record_every (s)"))
+    rng = np.random.default_rng(seed)
+    phases = rng.uniform(0, 2 * np.pi, (1, 3))
+    seeds = rng.integers(1, 2**63 - 1, size=1, dtype=np.int64).astype(np.uint64)
+    traj = np.ascontiguousarray(_traj_params(sc, phases))
+    sens = np.zeros((1, _k.N_SENS))
+    sens[:, 0:3], sens[:, 3:6], sens[:, 6], sens[:, 7] = sc.gyro_drift, sc.accel_bias, sc.gyro_white, sc.accel_white
+    cbp, vg, r = _initial_state(sc, phases)
+    ceg = grid_frame(r)
+    cbe_nav = np.ascontiguousarray(np.swapaxes(ceg, -1, -2) @ cbp)
+    ve = np.ascontiguousarray(np.einsum("nji,nj->ni", ceg, vg))
+    r_e = r.copy()
+    n_rec = k_end // rec_k + 1
+    rp_, rv_, ra_ = np.zeros((1, n_rec, 3)), np.zeros((1, n_rec, 3)), np.zeros((1, n_rec, 9))
+    _k.run_ecef(0, k_end, dt, traj, sens, cbe_nav, ve, r_e, seeds.copy(), rp_, rv_, ra_, rec_k)
+    # grid run in segments, reading its absolute state at every record time
+    coef = discretize_damping(dt)
+    pos_grid, vel_grid, cbe_grid = [r[0].copy()], [ceg[0].T @ vg[0]], [ceg[0].T @ cbp[0]]
+    rng_g = seeds.copy()
+    empty = np.zeros((1, 0, _k.N_REC))
+    for j in range(1, n_rec):
+        _k.run_grid((j - 1) * rec_k, j * rec_k, dt, traj, sens, cbp, vg, r, np.zeros((1, 2, 2)),
+                    np.zeros((1, 3)), rng_g, np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), coef, 0, empty, rec_k, 10)
+        c = grid_frame(r[0])
+        pos_grid.append(r[0].copy())
+        vel_grid.append(c.T @ vg[0])
+        cbe_grid.append(c.T @ cbp[0])
+    t = np.arange(n_rec) * rec_k * dt
+    re_t = np.concatenate([true_state(sc, tt, phases)[1] for tt in t])
+    d = np.array(cbe_grid) @ np.swapaxes(ra_[0].reshape(-1, 3, 3), -1, -2)
+    # small-angle rotation vector from the antisymmetric part (insensitive to 1e-12 scale drift)
+    w = 0.5 * np.stack([d[:, 2, 1] - d[:, 1, 2], d[:, 0, 2] - d[:, 2, 0], d[:, 1, 0] - d[:, 0, 1]], -1)
+    ang = np.arcsin(np.clip(np.linalg.norm(w, axis=-1), 0, 1))
+    return {"t": t, "pos_grid": np.array(pos_grid), "pos_ecef": rp_[0], "vel_grid": np.array(vel_grid),
+            "vel_ecef": rv_[0], "attitude_angle": ang, "pos_true": re_t}
