@@ -235,3 +235,71 @@ def test_analog_direct_difference_without_errors_is_the_filtered_field():
     err = (noisy["measured"] - noisy["true"]).std(axis=0)
     assert err[0] > 0.5 * 1e-4 * 9.8 and err[2] < err[0]  # the level error shows in the horizontals only
     assert clean["t"][1] - clean["t"][0] == pytest.approx(1.0)
+
+
+# --------------------------------------------------------------------------- flight experiment pieces
+
+@pytest.fixture(scope="module")
+def short_flight():
+    return gr.survey_flight(n_lines=2, duration=200.0, turn_duration=20.0, speed=30.0, lat0=math.radians(30.0),
+                            lon0=math.radians(110.0), h0=500.0, dt=0.05)
+
+
+def test_survey_flight_pattern(short_flight):
+    tr = short_flight
+    assert tr.t[-1] == pytest.approx(200.0)
+    assert np.degrees(tr.hpr[0, 0]) == pytest.approx(90.0)
+    assert np.degrees(tr.hpr[-1, 0]) == pytest.approx(270.0, abs=1e-6)
+    e, n = gr.local_east_north(tr.lat, tr.lon, tr.lat[0], tr.lon[0], 500.0)
+    # the left U-turn steps northwards; the lines are parallel (constant north on each)
+    assert n[-1] > 100.0
+    on = tr.t <= 90.0
+    assert np.ptp(n[on]) < 0.05 and np.ptp(n[tr.t >= 110.0]) < 0.05
+    k = gr.photo_epochs(tr, 10, margin=5.0)
+    assert k.size == 10 and np.all(np.isin(np.round(np.degrees(tr.hpr[k, 0])), [90.0, 270.0]))
+
+
+def test_disturbed_and_compensated_increments_are_inverse(short_flight):
+    tr = short_flight
+    dg = np.tile([20e-5, -10e-5, 30e-5], (tr.n + 1, 1))
+    dvd = gr.disturbed_increments(tr, dg)
+    # heading east, level: body x = east... the change is -C_n^b dg dt whatever the attitude
+    np.testing.assert_allclose(np.einsum("kij,kj->ki", tr.C_bn[:-1], dvd - tr.dv), -dg[1:] * 0.05, atol=1e-15)
+    np.testing.assert_allclose(gr.compensated_increments(dvd, tr.C_bn, dg, tr.t), tr.dv, atol=1e-15)
+
+
+def test_errors_of_the_truth_are_zero(short_flight):
+    from replication.strapdown import NavSolution
+
+    tr = short_flight
+    sol = NavSolution(tr.t, tr.lat, tr.lon, tr.h, tr.v_enu, tr.q_bn)
+    errs = gr.attitude_position_errors(sol, tr, np.arange(0, tr.n, 100))
+    for v in errs.values():
+        np.testing.assert_allclose(v, 0.0, atol=1e-9)
+
+
+def test_direct_difference_from_filter_obeys_eq_3_8():
+    """Error-free IMU and GNSS, constant disturbance: the direct difference returns dg + C nabla-hat
+    (the part of the disturbance the 15-state filter has taken for accelerometer bias), eq. (3-8)."""
+    from replication import errors as er
+    from replication import kalman as kf
+    from replication import sensors as se
+
+    tr = gr.survey_flight(n_lines=1, duration=600.0, speed=30.0, lat0=math.radians(30.0), lon0=math.radians(110.0),
+                          h0=500.0, dt=0.01)
+    dg = np.array([20e-5, -10e-5, 30e-5])
+    dv = gr.disturbed_increments(tr, np.tile(dg, (tr.n + 1, 1)))
+    gnss = se.gnss_measurements(tr, rate_hz=10, sigma_pos=1e-4, sigma_vel=1e-6, rng=0)
+    m = er.model_15(accel_bias_sd=50 * MICRO_G, gyro_bias_sd=1e-9, position_sd=1e-4, velocity_sd=1e-6,
+                    attitude_sd=(1e-6, 1e-6, 1e-6), lat=math.radians(30.0), h=500.0)
+    r = kf.closed_loop(tr.t, tr.dtheta, dv, tr.initial_state(), gnss, m)
+    dd = gr.direct_difference_from_filter(r, dv, tr.t, gnss, cutoff_period=5.0)
+    C = r.solution.C_bn[gnss.index]
+    phi = r.solution.errors_against(tr)["phi"][gnss.index]  # C-hat = exp(-phi x) C, i.e. psi = -phi in (3-4)
+    expect = dg + np.einsum("kij,kj->ki", C, r.estimate("accel_bias")) + np.cross(phi, tr.f_n[gnss.index])
+    mid = slice(len(dd) // 4, 3 * len(dd) // 4)
+    # in straight level flight the 15-state filter takes the constant disturbance for accelerometer bias
+    assert np.all(np.abs(np.einsum("kij,kj->ki", C, r.estimate("accel_bias")) + dg)[mid] < 0.5 * MGAL)
+    # residual: 1e-6 m/s GNSS velocity noise differentiated and 5 s filtered (~0.013 mGal) plus
+    # second-order terms; 0.2 mGal is > 10 sigma of the noise part
+    np.testing.assert_allclose(dd[mid], expect[mid], atol=0.2 * MGAL)
