@@ -1,0 +1,387 @@
+"""Observability of time-varying linear error models: the SVD-based piece-wise constant system
+(PWCS) observability degree used by chen2019 (ch. 2 §4.2, Table 2-3, Fig. 2-4; refs. [66-67]),
+and a covariance-based cross-check.
+
+PWCS analysis (Goshen-Meskin & Bar-Itzhack 1992)
+-----------------------------------------------
+The time-varying error model ẋ = F(t) x, z = H(t) x along a trajectory is approximated by r
+segments j = 1..r on which F_j and H_j are constant (:func:`piecewise_systems`: F, H evaluated
+at the segment midpoint, or averaged over the segment).  Segment j has the observability matrix
+
+    Q_j = [H_j; H_j F_j; H_j F_j²; ...; H_j F_j^(k-1)]      (k = n by default)
+
+(:func:`observability_matrix`).  The total observability matrix (TOM) of the first r segments
+stacks Q_j e^{F_{j-1}Δ_{j-1}} ... e^{F_1 Δ_1}; when null(Q_j) ⊂ null(F_j) for every j
+(:func:`som_condition`) its rank equals that of the *stripped* observability matrix (SOM)
+
+    Q_s(r) = [Q_1; Q_2; ...; Q_r]                                  (:func:`stripped_observability_matrix`)
+
+which needs no transition matrices.  The observability degree of a state then comes from the
+singular value decomposition Q_s = U S Vᵀ (:func:`observability_degrees`): the noise-free output
+y = Q_s x_0 gives x_0 = Σ_i (u_iᵀ y / σ_i) v_i, so the initial-state direction v_i is recovered
+with gain σ_i — a large σ_i means the direction is well observed.  Each state k is assigned a
+singular value:
+
+* ``assignment="state"`` (default) — σ_{i*} with i* = argmax_i |V[k, i]|: the singular value of
+  the right singular vector in which state k has its largest component;
+* ``assignment="singular"`` — each σ_i goes to the state argmax_k |V[k, i]| that dominates v_i; a
+  state dominating several vectors keeps the largest, a state dominating none gets 0.
+
+Unspecified by chen2019 and therefore parameters here (sweep them): the number and length of
+the segments, the number of powers k, where F/H are evaluated in a segment, the time span
+(which flight legs are stacked), the measurement scaling (position in metres as the report's
+H, or radians), the state subset, and the normalization:
+
+* ``normalize=None`` — raw singular values (their size depends on units and on r: stacking r
+  identical segments multiplies every σ by √r);
+* ``"max"`` — σ / σ_max;
+* ``"scale"`` — SVD of Q_s D with D = diag(``state_scale``), i.e. each state measured in units
+  of a chosen scale (e.g. its prior standard deviation): unit-free degrees.
+
+A singular value below the numerical-rank tolerance σ_max · max(m, n) · ε_machine (numpy's
+``matrix_rank`` rule) is numerically zero (:attr:`ObservabilityDegrees.rank_tol`).
+
+Covariance cross-check
+----------------------
+:func:`covariance_observability` runs the Kalman covariance recursion (Φ, Q_d by Van Loan,
+Joseph update) along the same trajectory and returns √(P0_kk / P_kk(t_end)) per state: 1 when the
+measurements taught nothing about the state, large when its uncertainty collapsed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import errors as E
+from .kalman import update, van_loan
+
+__all__ = ["observability_matrix", "stripped_observability_matrix", "total_observability_matrix", "som_condition",
+           "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
+           "covariance_observability", "segment_bounds", "spearman"]
+
+
+# ----------------------------------------------------------------------------- validation
+
+def _FH(F, H):
+    F = np.asarray(F, float)
+    H = np.atleast_2d(np.asarray(H, float))
+    if F.ndim != 2 or F.shape[0] != F.shape[1]:
+        raise ValueError(f"F must be a square n×n matrix, got shape {F.shape}")
+    if H.ndim != 2 or H.shape[1] != F.shape[0]:
+        raise ValueError(f"H must be m×n with n = {F.shape[0]} columns (one per state), got shape {H.shape}")
+    if not (np.all(np.isfinite(F)) and np.all(np.isfinite(H))):
+        raise ValueError("F and H must be finite")
+    return F, H
+
+
+def _powers(n_powers, n):
+    if n_powers is None:
+        return n
+    if int(n_powers) != n_powers or n_powers < 1:
+        raise ValueError(f"n_powers must be a positive integer (the default is the state dimension {n}), got {n_powers}")
+    return int(n_powers)
+
+
+def _systems(systems):
+    systems = list(systems)
+    if not systems:
+        raise ValueError("give at least one (F, H) segment")
+    out = [_FH(F, H) for F, H in systems]
+    n = out[0][0].shape[0]
+    if any(F.shape[0] != n for F, _ in out):
+        raise ValueError("all segments must have the same state dimension")
+    return out
+
+
+# ----------------------------------------------------------------------------- matrices
+
+def observability_matrix(F, H, n_powers=None) -> np.ndarray:
+    """Q = [H; H F; ...; H F^(k-1)] of a constant segment (k = ``n_powers``, default n)."""
+    F, H = _FH(F, H)
+    k = _powers(n_powers, F.shape[0])
+    blocks = [H]
+    for _ in range(k - 1):
+        blocks.append(blocks[-1] @ F)
+    return np.vstack(blocks)
+
+
+def stripped_observability_matrix(systems, n_powers=None) -> np.ndarray:
+    """The SOM Q_s(r) = [Q_1; ...; Q_r] of the segments ``systems`` = [(F_1, H_1), ...]
+    (Goshen-Meskin & Bar-Itzhack 1992; the matrix chen2019 ch. 2 §4.2 decomposes)."""
+    return np.vstack([observability_matrix(F, H, n_powers) for F, H in _systems(systems)])
+
+
+def total_observability_matrix(systems, durations, n_powers=None) -> np.ndarray:
+    """The TOM [Q_1; Q_2 Φ_1; Q_3 Φ_2 Φ_1; ...] with Φ_j = exp(F_j Δ_j) (``durations`` Δ_j, s)."""
+    import scipy.linalg
+
+    sy = _systems(systems)
+    d = np.asarray(durations, float)
+    if d.shape != (len(sy),) or np.any(d <= 0):
+        raise ValueError(f"durations must hold one positive duration per segment ({len(sy)})")
+    out, Phi = [], np.eye(sy[0][0].shape[0])
+    for (F, H), dj in zip(sy, d):
+        out.append(observability_matrix(F, H, n_powers) @ Phi)
+        Phi = scipy.linalg.expm(F * dj) @ Phi
+    return np.vstack(out)
+
+
+def som_condition(F, H, n_powers=None, rtol: float = 1e-9) -> bool:
+    """True when null(Q_j) ⊂ null(F_j): every unobservable direction of the segment is also
+    a direction F_j does not move, the condition under which rank SOM = rank TOM.
+    Null space by SVD with the relative tolerance ``rtol``."""
+    F, H = _FH(F, H)
+    Q = observability_matrix(F, H, n_powers)
+    _, s, Vt = np.linalg.svd(Q)
+    tol = rtol * (s[0] if s.size and s[0] > 0 else 1.0)
+    rank = int(np.sum(s > tol))
+    N = Vt[rank:].T
+    if N.size == 0:
+        return True
+    scale = max(np.abs(F).max(), 1e-300)
+    return bool(np.abs(F @ N).max() <= rtol * scale * max(1, F.shape[0]))
+
+
+# ----------------------------------------------------------------------------- degrees
+
+@dataclass
+class ObservabilityDegrees:
+    """SVD of a (stripped) observability matrix and the degree assigned to every state.
+
+    ``singular_values`` σ (descending), ``V`` right singular vectors (columns), ``degree`` the
+    value assigned to each state (normalized as requested), ``index`` the singular vector each
+    state was assigned (-1 for none), ``rank_tol`` the numerical-rank tolerance in the same
+    units as ``degree``, ``labels`` the state names."""
+
+    singular_values: np.ndarray
+    V: np.ndarray
+    degree: np.ndarray
+    index: np.ndarray
+    rank_tol: float
+    labels: list
+    normalize: str | None
+    assignment: str
+
+    @property
+    def rank(self) -> int:
+        return int(np.sum(self.singular_values > self._raw_tol))
+
+    @property
+    def _raw_tol(self):
+        s = self.singular_values
+        return float(s[0] * max(self.V.shape[0], 1) * np.finfo(float).eps * 10) if s.size else 0.0
+
+    def observable(self, threshold=None) -> np.ndarray:
+        """Boolean per state: degree above ``threshold`` (default: the numerical-rank tolerance)."""
+        t = self.rank_tol if threshold is None else float(threshold)
+        return self.degree > t
+
+    def as_dict(self) -> dict:
+        return dict(zip(self.labels, self.degree))
+
+
+def observability_degrees(Q, *, assignment: str = "state", normalize: str | None = None, state_scale=None,
+                          labels=None) -> ObservabilityDegrees:
+    """Observability degree of every state from the SVD of ``Q`` (see the module docstring).
+
+    ``assignment``: ``"state"`` or ``"singular"``; ``normalize``: ``None``, ``"max"`` or
+    ``"scale"`` (then ``state_scale``, one positive number per state, multiplies the columns of
+    Q before the SVD).  The numerical-rank tolerance is σ_max · max(m, n) · ε (numpy's rule).
+    """
+    Q = np.atleast_2d(np.asarray(Q, float))
+    if Q.ndim != 2 or not np.all(np.isfinite(Q)):
+        raise ValueError("Q must be a finite 2-D matrix (rows: outputs and their derivatives, columns: states)")
+    m, n = Q.shape
+    if assignment not in ("state", "singular"):
+        raise ValueError(f"assignment must be 'state' or 'singular', got {assignment!r}")
+    if normalize not in (None, "max", "scale"):
+        raise ValueError(f"normalize must be None, 'max' or 'scale', got {normalize!r}")
+    labels = list(labels) if labels is not None else [f"x{k}" for k in range(n)]
+    if len(labels) != n:
+        raise ValueError(f"labels must name the {n} states (columns of Q)")
+    if normalize == "scale":
+        if state_scale is None:
+            raise ValueError("normalize='scale' needs state_scale (one positive scale per state, e.g. prior sd)")
+        d = np.asarray(state_scale, float)
+        if d.shape != (n,) or np.any(~(d > 0)) or not np.all(np.isfinite(d)):
+            raise ValueError(f"state_scale must hold {n} positive finite numbers")
+        Q = Q * d
+    elif state_scale is not None:
+        raise ValueError("state_scale is only used with normalize='scale'")
+    _, s, Vt = np.linalg.svd(Q, full_matrices=True)
+    V = Vt.T                                   # n × n; columns beyond len(s) span the exact null space
+    sig = np.zeros(n)
+    sig[:len(s)] = s
+    tol = float(sig[0] * max(m, n) * np.finfo(float).eps) if n else 0.0
+    A = np.abs(V)
+    if assignment == "state":
+        idx = np.argmax(A, axis=1)
+        deg = sig[idx]
+    else:
+        idx = np.full(n, -1)
+        deg = np.zeros(n)
+        for i in range(n):
+            k = int(np.argmax(A[:, i]))
+            if idx[k] < 0 or sig[i] > deg[k]:
+                idx[k], deg[k] = i, sig[i]
+    if normalize == "max" and sig[0] > 0:
+        deg = deg / sig[0]
+        tol = tol / sig[0]
+    return ObservabilityDegrees(sig, V, deg, idx, tol, labels, normalize, assignment)
+
+
+# ----------------------------------------------------------------------------- along a trajectory
+
+def segment_bounds(t0: float, t1: float, n_segments: int) -> list:
+    """Equal segments [(a, b), ...] covering [t0, t1]."""
+    if int(n_segments) != n_segments or n_segments < 1:
+        raise ValueError(f"n_segments must be a positive integer, got {n_segments}")
+    if not t1 > t0:
+        raise ValueError(f"the time span needs t1 > t0, got {t0}, {t1}")
+    e = np.linspace(t0, t1, int(n_segments) + 1)
+    return list(zip(e[:-1], e[1:]))
+
+
+def _state_index(model, states):
+    if states is None:
+        return np.arange(model.n)
+    pos = {lab: i for i, lab in enumerate(model.labels)}
+    bad = [s for s in states if s not in pos]
+    if bad:
+        raise ValueError(f"unknown states {bad[:5]}; the model's labels are {model.labels[:12]}...")
+    return np.array([pos[s] for s in states], dtype=int)
+
+
+def _sample(traj, t):
+    if not (traj.t[0] - 1e-9 <= t <= traj.t[-1] + 1e-9):
+        raise ValueError(f"time {t} s lies outside the trajectory [{traj.t[0]}, {traj.t[-1]}] s")
+    return int(np.argmin(np.abs(traj.t - t)))
+
+
+def piecewise_systems(model, traj, spans, *, evaluate: str = "mid", lever_arm_b=(0.0, 0.0, 0.0), states=None,
+                      position_units: str = "m"):
+    """The constant (F_j, H_j) of each segment ``spans`` = [(t_a, t_b), ...] of ``traj``.
+
+    F_j = ``model.F`` (chen2019 eq. (2-15)) and H_j = :func:`replication.models.measurement_matrix`
+    (6-dim position/velocity measurement, Table 2-2, with the lever arm of eq. (2-13)) at the
+    sample nearest the segment midpoint (``evaluate="mid"``) or averaged over the samples of the
+    segment (``"mean"``).  ``position_units``: ``"m"`` (rows scaled by R_M+h, (R_N+h) cos L as the
+    report's H) or ``"rad"`` (H = I on δL, δλ).  ``states`` (labels) restricts F and H to a
+    subset (the others are dropped, i.e. assumed absent from the model).
+    """
+    from .models import measurement_matrix
+
+    if not isinstance(model, E.ErrorModel):
+        raise TypeError("model must be a replication.errors.ErrorModel (e.g. models.model_45())")
+    if evaluate not in ("mid", "mean"):
+        raise ValueError(f"evaluate must be 'mid' or 'mean', got {evaluate!r}")
+    if position_units not in ("m", "rad"):
+        raise ValueError(f"position_units must be 'm' or 'rad', got {position_units!r}")
+    idx = _state_index(model, states)
+    out = []
+    for a, b in spans:
+        ka, kb = _sample(traj, a), _sample(traj, b)
+        ks = [_sample(traj, 0.5 * (a + b))] if evaluate == "mid" else list(range(ka, max(kb, ka + 1)))
+        Fs, Hs = 0.0, 0.0
+        for k in ks:
+            p = E.NavPoint.from_trajectory(traj, k)
+            H = measurement_matrix(model, p, lever_arm_b)
+            if position_units == "rad":       # metres north/east back to δL, δλ
+                H[0] /= H[0, 0]
+                H[1] /= H[1, 1]
+            Fs = Fs + model.F(p)
+            Hs = Hs + H
+        Fs, Hs = Fs / len(ks), Hs / len(ks)
+        out.append((Fs[np.ix_(idx, idx)], Hs[:, idx]))
+    return out
+
+
+def pwcs_observability(model, traj, spans, *, n_powers=None, evaluate: str = "mid", assignment: str = "state",
+                       normalize: str | None = None, state_scale=None, states=None, lever_arm_b=(0.0, 0.0, 0.0),
+                       position_units: str = "m") -> ObservabilityDegrees:
+    """PWCS/SVD observability degrees (chen2019 Table 2-3 method) of ``model`` along ``traj``:
+    SOM of the segments ``spans`` (:func:`piecewise_systems`), then
+    :func:`observability_degrees`.  ``state_scale`` for ``normalize="scale"`` is given for the
+    states kept (``states`` order)."""
+    systems = piecewise_systems(model, traj, spans, evaluate=evaluate, lever_arm_b=lever_arm_b, states=states,
+                                position_units=position_units)
+    Q = stripped_observability_matrix(systems, n_powers)
+    labels = list(states) if states is not None else model.labels
+    return observability_degrees(Q, assignment=assignment, normalize=normalize, state_scale=state_scale,
+                                 labels=labels)
+
+
+def covariance_observability(model, traj, t0: float, t1: float, *, update_interval: float = 1.0, R=None, P0=None,
+                             states=None, lever_arm_b=(0.0, 0.0, 0.0), return_history: bool = False):
+    """Covariance-based observability √(P0_kk / P_kk(t1)) of every state over [t0, t1].
+
+    Kalman covariance recursion of ``model`` along the *true* trajectory (the error-state
+    linearization point): every ``update_interval`` seconds Φ, Q_d by Van Loan
+    (:func:`replication.kalman.van_loan`) with F and G Q Gᵀ at the interval midpoint, then a
+    Joseph-form update with the 6-dim measurement of :func:`replication.models.measurement_matrix`
+    (position in metres) and noise covariance ``R`` (6×6, m² and (m/s)²).  ``P0`` defaults to
+    ``model.P0()``; states with zero prior variance are reported as NaN.  ``states`` restricts
+    the model as in :func:`piecewise_systems`.  Returns the ratios (and, with
+    ``return_history``, the epoch times and √diag P history).
+    """
+    from .models import measurement_matrix
+
+    if not isinstance(model, E.ErrorModel):
+        raise TypeError("model must be a replication.errors.ErrorModel (e.g. models.model_45())")
+    if not update_interval > 0:
+        raise ValueError("update_interval must be a positive number of seconds")
+    idx = _state_index(model, states)
+    n = len(idx)
+    P = (model.P0() if P0 is None else np.asarray(P0, float))
+    if P.shape == (model.n, model.n) and n != model.n:
+        P = P[np.ix_(idx, idx)]
+    if P.shape != (n, n):
+        raise ValueError(f"P0 must be {n}×{n} (states kept) or {model.n}×{model.n}")
+    R = np.asarray(R, float) if R is not None else None
+    if R is None or R.shape != (6, 6):
+        raise ValueError("R must be the 6×6 measurement noise covariance (position m², velocity (m/s)²)")
+    _sample(traj, t0), _sample(traj, t1)
+    if not t1 > t0:
+        raise ValueError("t1 must be later than t0")
+    n_ep = int(math.floor((t1 - t0) / update_interval + 1e-9))
+    if n_ep < 1:
+        raise ValueError("the span is shorter than one update interval")
+    P0d = np.diag(P).copy()
+    x = np.zeros(n)
+    hist_t, hist_s = [t0], [np.sqrt(P0d)]
+    for j in range(n_ep):
+        ta, tb = t0 + j * update_interval, t0 + (j + 1) * update_interval
+        p = E.NavPoint.from_trajectory(traj, _sample(traj, 0.5 * (ta + tb)))
+        F = model.F(p)[np.ix_(idx, idx)]
+        Qc = model.G_Qc(p.C_bn)[np.ix_(idx, idx)]
+        Phi, Qd = van_loan(F, Qc, update_interval)
+        P = Phi @ P @ Phi.T + Qd
+        pe = E.NavPoint.from_trajectory(traj, _sample(traj, tb))
+        H = measurement_matrix(model, pe, lever_arm_b)[:, idx]
+        x, P, _, _ = update(x, P, np.zeros(6), H, R)
+        if return_history:
+            hist_t.append(tb)
+            hist_s.append(np.sqrt(np.diag(P)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(P0d > 0, np.sqrt(P0d / np.diag(P)), np.nan)
+    if return_history:
+        return ratio, np.array(hist_t), np.array(hist_s)
+    return ratio
+
+
+# ----------------------------------------------------------------------------- comparison helper
+
+def spearman(a, b) -> float:
+    """Spearman rank correlation of two equal-length sequences (average ranks for ties;
+    scipy.stats.spearmanr)."""
+    from scipy import stats
+
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    if a.shape != b.shape or a.ndim != 1 or len(a) < 3:
+        raise ValueError("spearman needs two 1-D sequences of equal length ≥ 3")
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        raise ValueError("spearman needs finite values")
+    return float(stats.spearmanr(a, b).statistic)

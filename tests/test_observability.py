@@ -1,0 +1,150 @@
+"""PWCS / SVD observability degree on systems with known answers; covariance cross-check."""
+
+import numpy as np
+import pytest
+
+from replication import models as M
+from replication import observability as O
+from replication import trajectory as tr
+from replication.units import DEG
+
+G, R = 9.8, 6.4e6
+
+
+def switching_bias(s):
+    """x' = b1 + s b2, b1' = b2' = 0, y = x: the sign s of the second input switches between
+    segments (a textbook piece-wise constant system)."""
+    F = np.array([[0.0, 1.0, s], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    H = np.array([[1.0, 0.0, 0.0]])
+    return F, H
+
+
+def test_decoupled_system_degrees_are_the_output_gains():
+    """F = 0, H = diag(a): Q = [diag(a); 0; 0], σ_k = |a_k| assigned to state k."""
+    a = np.array([3.0, -0.5, 2e-3, 40.0])
+    d = O.observability_degrees(O.observability_matrix(np.zeros((4, 4)), np.diag(a)))
+    assert np.allclose(d.degree, np.abs(a), rtol=1e-14)
+    assert list(d.index) == [1, 2, 3, 0]            # σ sorted: 40, 3, 0.5, 2e-3
+    assert d.rank == 4
+
+
+def test_switching_bias_one_segment_is_unobservable_two_are_not():
+    """One segment: rank 2, null direction (0, 1, -1)/√2 (b1 and b2 indistinguishable).
+    Two segments s = +1, -1: SOM columns are orthogonal with norm √2 → every σ = √2;
+    the Goshen-Meskin condition holds, so rank TOM = rank SOM = 3."""
+    F1, H1 = switching_bias(1.0)
+    F2, H2 = switching_bias(-1.0)
+    Q1 = O.observability_matrix(F1, H1)
+    d1 = O.observability_degrees(Q1)
+    assert d1.rank == 2
+    null = d1.V[:, 2]
+    assert np.allclose(np.abs(null), [0, 1 / np.sqrt(2), 1 / np.sqrt(2)], atol=1e-12)
+    assert O.som_condition(F1, H1)
+    Qs = O.stripped_observability_matrix([(F1, H1), (F2, H2)])
+    d2 = O.observability_degrees(Qs)
+    assert np.allclose(d2.singular_values, np.sqrt(2), rtol=1e-14)
+    assert np.allclose(d2.degree, np.sqrt(2), rtol=1e-14)
+    Qt = O.total_observability_matrix([(F1, H1), (F2, H2)], [1.0, 2.0])
+    assert np.linalg.matrix_rank(Qt) == np.linalg.matrix_rank(Qs) == 3
+
+
+def test_stationary_single_axis_ins():
+    """One horizontal channel of a stationary INS (Goshen-Meskin & Bar-Itzhack 1992):
+    δv' = -g φ + ∇, φ' = δv/R + ε, y = δv.  Rank 3 of 4; the unobservable direction is
+    (0, 1, g, 0) (a tilt balancing the accelerometer bias), so the bias — the larger component
+    of that null vector — gets the zero singular value; the gyro drift is observable."""
+    F = np.array([[0.0, -G, 1.0, 0.0], [1 / R, 0.0, 0.0, 1.0], [0.0] * 4, [0.0] * 4])
+    H = np.array([[1.0, 0.0, 0.0, 0.0]])
+    d = O.observability_degrees(O.observability_matrix(F, H), labels=["dv", "phi", "bias", "drift"])
+    assert d.rank == 3
+    null = d.V[:, 3] * np.sign(d.V[1, 3])
+    assert np.allclose(null, np.array([0, 1, G, 0]) / np.hypot(1, G), atol=1e-9)
+    assert d.degree[2] == 0.0
+    assert d.observable().tolist() == [True, True, False, True]
+    # the drift's degree: its column H F² e_ε = -g is orthogonal to the others at leading order
+    assert abs(d.degree[3] - G) / G < 1e-3
+
+
+def test_normalizations_and_sign_invariance():
+    rng = np.random.default_rng(7)
+    Q = rng.standard_normal((30, 5)) * np.array([1.0, 10.0, 0.1, 3.0, 1e-3])
+    d = O.observability_degrees(Q)
+    dm = O.observability_degrees(Q, normalize="max")
+    assert dm.degree.max() <= 1.0 and np.allclose(dm.degree, d.degree / d.singular_values[0])
+    s = np.array([2.0, 0.5, 1.0, 4.0, 100.0])
+    ds = O.observability_degrees(Q, normalize="scale", state_scale=s)
+    assert np.allclose(ds.degree, O.observability_degrees(Q * s).degree)
+    # flipping the sign of a state (e.g. the gyro-error convention) changes no degree
+    flip = np.array([1, -1, 1, -1, 1])
+    assert np.allclose(O.observability_degrees(Q * flip).degree, d.degree, rtol=1e-12)
+    dsg = O.observability_degrees(Q, assignment="singular")
+    assert set(dsg.degree[dsg.index >= 0]) <= set(dsg.singular_values)
+
+
+def test_spearman():
+    assert O.spearman([1, 2, 3, 4], [10, 20, 30, 40]) == pytest.approx(1.0)
+    assert O.spearman([1, 2, 3, 4], [4, 3, 2, 1]) == pytest.approx(-1.0)
+
+
+@pytest.fixture(scope="module")
+def flight():
+    _, init = tr.chen2019_flight()
+    return tr.generate([tr.Straight(60.0), tr.Turn(120.0, np.pi)], dt=0.5, **init)
+
+
+def test_pwcs_on_the_45_state_model_straight_flight(flight):
+    """Straight level flight (one constant segment): the gyro x/y drifts are seen through the
+    tilt they build (column H F² e_ε, H F³ e_ε of norm √2 g with the position in metres), the
+    sum ∇_z + g δK_az only through δK_az, the accelerometer x/y scale factors not at all (f_x = f_y
+    ≈ 0 up to the Coriolis residual)."""
+    m = M.model_45()
+    keep = m.labels[:9] + M.table_2_3_states()[3:]
+    d = O.pwcs_observability(m, flight, [(0.0, 60.0)], states=keep)
+    deg = d.as_dict()
+    g = 9.79
+    for s in ("gyro_bias.x", "gyro_bias.y"):
+        assert abs(deg[s] / (np.sqrt(2) * g) - 1) < 5e-3
+    assert deg["accel_scale.z"] > 10 and deg["accel_bias.z"] <= d.rank_tol * 10
+    assert deg["accel_scale.y"] <= d.rank_tol * 10
+    # the turn adds segments: observability of heading (φ_U) appears
+    d2 = O.pwcs_observability(m, flight, [(0.0, 60.0)] + O.segment_bounds(60.0, 180.0, 6), states=keep)
+    assert d2.as_dict()["phiU"] > 1.0 > 1e3 * deg["phiU"]
+
+
+def test_covariance_observability(flight):
+    """√(P0/P): the unexcited accelerometer y scale factor (f_y = 0 at constant speed) keeps
+    its prior to 1e-3; velocity errors, measured directly with σ = 0.03 m/s against a prior
+    of 1 m/s, shrink by far more than 10."""
+    m = M.model_45(velocity_sd=1.0, accel_bias_sd=5e-4, gyro_bias_sd=5e-8, accel_scale_sd=1e-5,
+                   gyro_scale_sd=1e-5, accel_misalignment_sd=1e-5, gyro_misalignment_sd=1e-5)
+    keep = m.labels[:9] + M.table_2_3_states()[3:]
+    Rm = np.diag([0.03**2, 0.03**2, 0.1**2, 0.03**2, 0.03**2, 0.03**2])
+    r = O.covariance_observability(m, flight, 0.0, 180.0, update_interval=2.0, R=Rm, states=keep)
+    rr = dict(zip(keep, r))
+    assert abs(rr["accel_scale.y"] - 1) < 1e-3
+    assert min(rr["dvE"], rr["dvN"], rr["dvU"]) > 10
+
+
+def test_bad_inputs():
+    with pytest.raises(ValueError, match="square"):
+        O.observability_matrix(np.zeros((2, 3)), np.zeros((1, 3)))
+    with pytest.raises(ValueError, match="columns"):
+        O.observability_matrix(np.zeros((3, 3)), np.zeros((1, 2)))
+    with pytest.raises(ValueError, match="n_powers"):
+        O.observability_matrix(np.zeros((3, 3)), np.zeros((1, 3)), n_powers=0)
+    with pytest.raises(ValueError, match="finite"):
+        O.observability_degrees(np.array([[np.nan, 1.0]]))
+    with pytest.raises(ValueError, match="assignment"):
+        O.observability_degrees(np.eye(2), assignment="max")
+    with pytest.raises(ValueError, match="state_scale"):
+        O.observability_degrees(np.eye(2), normalize="scale")
+    with pytest.raises(ValueError, match="n_segments"):
+        O.segment_bounds(0.0, 1.0, 0)
+    with pytest.raises(ValueError, match="durations"):
+        O.total_observability_matrix([(np.zeros((2, 2)), np.eye(2))], [0.0])
+    with pytest.raises(ValueError, match="at least one"):
+        O.stripped_observability_matrix([])
+    with pytest.raises(TypeError, match="ErrorModel"):
+        O.piecewise_systems("model", None, [(0, 1)])
+    with pytest.raises(ValueError, match="spearman"):
+        O.spearman([1, 2], [2, 1])
