@@ -447,24 +447,31 @@ def _lambdified(expr):
     return sp.lambdify(names, expr, modules="mpmath")
 
 
-def evaluate(expr, lat, speed, motion, *, radius=None, gravity=None, digits=30):
-    """Evaluate a closed form at latitude ``lat`` (rad) and ``speed`` (m/s) with ``digits`` digits.
+def evaluate_at(expr, lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None, digits=30):
+    """Evaluate a closed form at latitude ``lat`` (rad) and velocity (v_east, v_north) (m/s).
 
-    ``speed`` is V_N for north-south motion and V_E for east-west motion; evaluated with mpmath
-    so that the cancellations inside the printed forms do not lose precision.
+    mpmath with ``digits`` digits, so that the cancellations inside the printed forms do not lose
+    precision; R and g from :func:`earth_parameters`.
     """
     import mpmath
 
-    _check_motion_name(motion)
-    lat, _, _ = _check_motion(lat, 0.0, 0.0)
+    lat, v_east, v_north = _check_motion(lat, v_east, v_north)
     r, g = earth_parameters(lat, radius, gravity)
     f = _lambdified(sp.sympify(expr))
     with mpmath.workdps(digits):
         mp = mpmath.mpf
-        vn = mp(speed) if motion == "north-south" else mp(0)
-        ve = mp(speed) if motion == "east-west" else mp(0)
-        value = f(mp(lat), mp(r), mp(g), mp(earth.OMEGA_IE), mpmath.sqrt(mp(g) / mp(r)), vn, ve)
+        value = f(mp(lat), mp(r), mp(g), mp(earth.OMEGA_IE), mpmath.sqrt(mp(g) / mp(r)), mp(v_north), mp(v_east))
         return float(value)
+
+
+def evaluate(expr, lat, speed, motion, *, radius=None, gravity=None, digits=30):
+    """Evaluate a closed form for ``motion`` at latitude ``lat`` (rad) and ``speed`` (m/s).
+
+    ``speed`` is V_N for north-south motion and V_E for east-west motion (:func:`evaluate_at`).
+    """
+    _check_motion_name(motion)
+    ve, vn = (0.0, speed) if motion == "north-south" else (speed, 0.0)
+    return evaluate_at(expr, lat, ve, vn, radius=radius, gravity=gravity, digits=digits)
 
 
 def is_identity(expr_a, expr_b):
@@ -876,6 +883,41 @@ def loglog_slope(sys, w_lo, w_hi, pair=None, n=200):
         sys = siso(sys, pair)
     w = np.logspace(np.log10(w_lo), np.log10(w_hi), n)
     return float(np.polyfit(np.log10(w), _db(sys, w), 1)[0])
+
+
+def noise_sensitivity(lat, v_east, v_north, base: NoiseSettings, factors, pair="phiE/gdN", *,
+                      slope_band=(0.05, 0.5), n=1000, radius=None, gravity=None):
+    """Cut-off frequency and high-band slope of eq. (10) when one noise setting is scaled.
+
+    ``factors`` maps a :class:`NoiseSettings` field to the multipliers to try, e.g.
+    ``{"gyro_arw": [0.1, 1, 10]}``; every other field stays at ``base``.  Returns a
+    ``DataFrame`` (setting, factor, value, cutoff, slope) for ``pair``; ``slope`` is the
+    :func:`loglog_slope` over ``slope_band``.  an2021 does not print its filter noise: this is
+    the sensitivity of Figs. 5-6 and Table 1 to that unstated choice.
+    """
+    rows = []
+    for field_name, mults in factors.items():
+        if not hasattr(base, field_name):
+            raise ValueError(f"unknown noise setting {field_name!r}")
+        for f in mults:
+            noise = base.scaled(**{field_name: f})
+            sys = siso(integrated_gravity_to_attitude(lat, v_east, v_north, noise, radius=radius, gravity=gravity), pair)
+            rows.append(dict(setting=field_name, factor=float(f), value=getattr(noise, field_name),
+                             cutoff=cutoff_frequency(sys, n=n), slope=loglog_slope(sys, *slope_band)))
+    return pd.DataFrame(rows)
+
+
+def cutoff_grid(lat, v_east, v_north, base: NoiseSettings, field_a, factors_a, field_b, factors_b,
+                pair="phiE/gdN", *, n=1000, radius=None, gravity=None):
+    """Cut-off frequency of eq. (10) on a grid of two scaled noise settings (rows: ``field_a``)."""
+    out = np.empty((len(factors_a), len(factors_b)))
+    for i, fa in enumerate(factors_a):
+        for j, fb in enumerate(factors_b):
+            noise = base.scaled(**{field_a: fa, field_b: fb})
+            sys = siso(integrated_gravity_to_attitude(lat, v_east, v_north, noise, radius=radius, gravity=gravity), pair)
+            out[i, j] = cutoff_frequency(sys, n=n)
+    return pd.DataFrame(out, index=pd.Index(list(factors_a), name=field_a),
+                        columns=pd.Index(list(factors_b), name=field_b))
 
 
 def wavelength(speed, omega):

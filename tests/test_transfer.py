@@ -303,3 +303,18 @@ def test_other_bad_inputs():
         tr.frequency_response(tr.gravity_to_attitude(0.5), [-1.0], "phiE/gdN")
     with pytest.raises(ValueError, match="unknown symbols"):
         tr.parse_printed("x + R")
+
+
+def test_noise_sensitivity_directions():
+    """More gyro noise → the filter levels harder → higher cut-off; more accelerometer noise → lower."""
+    lat = np.radians(30.0)
+    df = tr.noise_sensitivity(lat, 0.0, 10.0, tr.NAVIGATION_GRADE,
+                              {"gyro_arw": [0.3, 1.0, 3.0], "accel_vrw": [1.0, 30.0]})
+    arw = df[df["setting"] == "gyro_arw"]["cutoff"].to_numpy()
+    assert arw[0] < arw[1] < arw[2]
+    vrw = df[df["setting"] == "accel_vrw"]["cutoff"].to_numpy()
+    assert vrw[1] < vrw[0]
+    nominal = tr.cutoff_frequency(tr.integrated_gravity_to_attitude(lat, 0.0, 10.0), "phiE/gdN")
+    assert arw[1] == pytest.approx(nominal, rel=1e-6)
+    grid = tr.cutoff_grid(lat, 0.0, 10.0, tr.NAVIGATION_GRADE, "gyro_arw", [1.0], "position_sigma", [1.0, 0.1])
+    assert grid.iloc[0, 0] == pytest.approx(nominal, rel=1e-6) and grid.iloc[0, 1] > grid.iloc[0, 0]
