@@ -23,6 +23,7 @@ _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 # block targets / couplings (see replication.errors)
 TARGET_ACCEL, TARGET_GYRO, TARGET_GRAVITY, TARGET_LEVER, TARGET_NONE = 0, 1, 2, 3, 4
 KIND_IDENTITY, KIND_SCALE, KIND_MISALIGN = 0, 1, 2
+_TWELFTH = 1.0 / 12.0
 
 
 # ----------------------------------------------------------------------------- Earth (scalar)
@@ -100,12 +101,15 @@ def _qmul(p, q, out):
 
 @njit(**_NJ)
 def _rv2q(x, y, z, out):
+    """q = [cos(a/2), sin(a/2)/a · φ], a = |φ|; Taylor series below a = 0.02 (truncation
+    error < (a/2)^10/10! ≈ 3e-24), closed form above."""
     a2 = x * x + y * y + z * z
-    a = math.sqrt(a2)
-    if a < 1e-6:
-        k = 0.5 - a2 / 48.0
-        out[0] = 1.0 - a2 / 8.0 + a2 * a2 / 384.0
+    if a2 < 4e-4:
+        u = 0.25 * a2                       # (a/2)²
+        out[0] = 1.0 - u / 2.0 * (1.0 - u / 12.0 * (1.0 - u / 30.0 * (1.0 - u / 56.0)))
+        k = 0.5 * (1.0 - u / 6.0 * (1.0 - u / 20.0 * (1.0 - u / 42.0 * (1.0 - u / 72.0))))
     else:
+        a = math.sqrt(a2)
         k = math.sin(0.5 * a) / a
         out[0] = math.cos(0.5 * a)
     out[1] = k * x
@@ -131,7 +135,7 @@ def _q2c(q, c):
 
 @njit(**_NJ)
 def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en, tmp3a, tmp3b,
-            vmode, h_ref, vu_ref, gains, dampint, g_extra):
+            vmode, h_ref, vu_ref, gains, dampint, g_extra, trig):
     """One ENU strapdown update (chen2019 eq. (3-2)), in place.
 
     st = [L, λ, h, vE, vN, vU] at k-1 (updated to k); st_prev = state at k-2 (for extrapolation);
@@ -139,6 +143,7 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
     exact rotation-vector attitude update, Earth and transport rates, normal gravity.
     vmode: 0 free, 1 hold (h, vU set to h_ref, vu_ref after the step), 2 damped (third-order loop).
     g_extra: additional n-frame gravity (disturbance compensation), added to g^n.
+    trig: [L, sin L, cos L] of the previous step's mid latitude (updated).
     Returns the damping-loop integrator state.
     """
     L0, lam0, h0, ve0, vn0, vu0 = st[0], st[1], st[2], st[3], st[4], st[5]
@@ -148,20 +153,34 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
     vem = 1.5 * ve0 - 0.5 * st_prev[3]
     vnm = 1.5 * vn0 - 0.5 * st_prev[4]
     vum = 1.5 * vu0 - 0.5 * st_prev[5]
-    sL = math.sin(Lm)
-    cL = math.cos(Lm)
+    # sin/cos of the mid latitude, advanced from the previous step by the angle-sum formulas
+    # (the latitude moves by ~1e-7 rad per step; series truncation < d⁴/24), exact otherwise
+    d = Lm - trig[0]
+    if abs(d) < 1e-5:
+        cd = 1.0 - 0.5 * d * d
+        sd = d * (1.0 - d * d / 6.0)
+        sL = trig[1] * cd + trig[2] * sd
+        cL = trig[2] * cd - trig[1] * sd
+    else:
+        sL = math.sin(Lm)
+        cL = math.cos(Lm)
+    trig[0] = Lm
+    trig[1] = sL
+    trig[2] = cL
     s2 = sL * sL
     w2 = 1.0 - E2 * s2
-    wq = math.sqrt(w2)
-    rm = A * (1.0 - E2) / (w2 * wq)
-    rn = A / wq
+    iw = 1.0 / math.sqrt(w2)
+    rn = A * iw
+    rm = rn * (1.0 - E2) / w2
+    irmh = 1.0 / (rm + hm)
+    irnh = 1.0 / (rn + hm)
     w_ie[0] = 0.0
     w_ie[1] = OMEGA_IE * cL
     w_ie[2] = OMEGA_IE * sL
-    w_en[0] = -vnm / (rm + hm)
-    w_en[1] = vem / (rn + hm)
-    w_en[2] = vem * sL / cL / (rn + hm)
-    gam = (GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / wq) * (
+    w_en[0] = -vnm * irmh
+    w_en[1] = vem * irnh
+    w_en[2] = vem * (sL / cL) * irnh
+    gam = (GAMMA_E * (1.0 + K_SOMIGLIANA * s2) * iw) * (
         1.0 - 2.0 / A * (1.0 + FLAT + M_RATIO - 2.0 * FLAT * s2) * hm + 3.0 * hm * hm / (A * A))
     # velocity: sculling + rotation compensation in b, then (I - ζ×/2) C_{k-1}
     _q2c(q, c)
@@ -171,9 +190,9 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
     sz = dvv[2] + 0.5 * tmp3a[2]
     _cross(dth_prev, dvv, tmp3a)
     _cross(dv_prev, dth, tmp3b)
-    sx += (tmp3a[0] + tmp3b[0]) / 12.0
-    sy += (tmp3a[1] + tmp3b[1]) / 12.0
-    sz += (tmp3a[2] + tmp3b[2]) / 12.0
+    sx += (tmp3a[0] + tmp3b[0]) * _TWELFTH
+    sy += (tmp3a[1] + tmp3b[1]) * _TWELFTH
+    sz += (tmp3a[2] + tmp3b[2]) * _TWELFTH
     ux = c[0, 0] * sx + c[0, 1] * sy + c[0, 2] * sz
     uy = c[1, 0] * sx + c[1, 1] * sy + c[1, 2] * sz
     uz = c[2, 0] * sx + c[2, 1] * sy + c[2, 2] * sz
@@ -209,7 +228,7 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
         vu1 = vu_ref
     # attitude: q_k = q(-ζ) ⊗ q_{k-1} ⊗ q(φ), ζ = ω_in^n T at mid-interval
     _cross(dth_prev, dth, tmp3a)
-    _rv2q(dth[0] + tmp3a[0] / 12.0, dth[1] + tmp3a[1] / 12.0, dth[2] + tmp3a[2] / 12.0, qtmp)
+    _rv2q(dth[0] + tmp3a[0] * _TWELFTH, dth[1] + tmp3a[1] * _TWELFTH, dth[2] + tmp3a[2] * _TWELFTH, qtmp)
     q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
     a1, b1, c1, d1 = qtmp[0], qtmp[1], qtmp[2], qtmp[3]
     # r = q ⊗ qφ
@@ -223,8 +242,8 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
     n1 = a1 * r1 + b1 * r0 + c1 * r3 - d1 * r2
     n2 = a1 * r2 - b1 * r3 + c1 * r0 + d1 * r1
     n3 = a1 * r3 + b1 * r2 - c1 * r1 + d1 * r0
-    nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
-    q[0], q[1], q[2], q[3] = n0 / nn, n1 / nn, n2 / nn, n3 / nn
+    nn = 1.0 / math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
+    q[0], q[1], q[2], q[3] = n0 * nn, n1 * nn, n2 * nn, n3 * nn
     for i in range(6):
         st_prev[i] = st[i]
     st[0], st[1], st[2], st[3], st[4], st[5] = L1, lam1, h1, ve1, vn1, vu1
@@ -245,16 +264,21 @@ def strapdown_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains, out_s
     ta = np.empty(3)
     tb = np.empty(3)
     gx = np.zeros(3)
-    out_st[0, :] = st
-    out_q[0, :] = q
+    trig = np.array([st0[0], math.sin(st0[0]), math.cos(st0[0])])
+    for i in range(6):
+        out_st[0, i] = st[i]
+    for i in range(4):
+        out_q[0, i] = q[i]
     dampint = 0.0
     for k in range(n):
         kp = k - 1 if k > 0 else 0
         dampint = sd_step(dt[k], dtheta[k], dv[k], dtheta[kp], dv[kp], st, st_prev, q, qtmp, c,
                           w_ie, w_en, ta, tb, vmode, h_ref[k + 1] if vmode == 1 else h_ref[k],
-                          vu_ref[k + 1], gains, dampint, gx)
-        out_st[k + 1, :] = st
-        out_q[k + 1, :] = q
+                          vu_ref[k + 1], gains, dampint, gx, trig)
+        for i in range(6):
+            out_st[k + 1, i] = st[i]
+        for i in range(4):
+            out_q[k + 1, i] = q[i]
     return out_st, out_q
 
 
@@ -603,6 +627,7 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
     ta = np.empty(3)
     tb = np.empty(3)
     g_extra = np.zeros(3)
+    trig = np.array([st0[0], math.sin(st0[0]), math.cos(st0[0])])
     P = P0.copy()
     p_hat = np.zeros(n_aug)
     lever = lever0.copy()
@@ -659,7 +684,7 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
         tsum += T
         dampint = sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, qtmp, c, w_ie, w_en, ta, tb,
                           vmode, h_ref[k + 1] if vmode == 1 else h_ref[k], vu_ref[k + 1], gains,
-                          dampint, g_extra)
+                          dampint, g_extra, trig)
         dth_cp[:] = dth_c
         dv_cp[:] = dv_c
         if j < n_ep and gnss_idx[j] == k + 1:

@@ -197,7 +197,7 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
         raise ValueError(f"the solution reaches latitude {np.degrees(lat[bad]):.4f}° at t = {t[bad]:.3f} s, "
                          f"within the n-frame polar singularity (limit ±{polar_limit_deg}°); "
                          "use a grid-frame mechanization near the pole")
-    return NavSolution(t, lat.copy(), out_st[:, 1].copy(), out_st[:, 2].copy(), out_st[:, 3:6].copy(), out_q)
+    return NavSolution(t, lat, out_st[:, 1], out_st[:, 2], out_st[:, 3:6], out_q)
 
 
 def navigation_rates(lat, lon, h, v_enu, C_bn, w_ib_b, f_b, g_extra=None):
