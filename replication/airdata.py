@@ -520,3 +520,654 @@ def consistency_count(paper, state: str = "climb"):
     economical explanation of the print)."""
     return {rd: int((~check_elements(paper, rd, state)["match"] & check_elements(paper, rd, state)["comparable"]).sum())
             for rd in READINGS}
+
+
+# =========================================================================== 1b. eq. (1)
+
+def sins_error_matrix(point):
+    """The SINS error matrix of duan2023 eq. (1) in the paper's state order [φ, δv, δp].
+
+    duan2023 cites the standard ENU model of Yan & Weng (2019) (their ref. [21]) without
+    printing it.  It is built here from the navigation core's 15-state model
+    (:func:`replication.errors.model_15`, states [δp, δv, φ]) by permuting into the paper's
+    order φ = [φ_E, φ_N, φ_U], δv = [δv_E, δv_N, δv_U], δp = [δL, δλ, δh]:
+
+        M_φφ = -(ω_in^n ×),  M_φv = ∂ω_in^n/∂v,  M_φp = ∂ω_in^n/∂p,
+        M_vφ = (f^n ×),  M_vv = (v^n ×) M_φv' - ((2ω_ie^n + ω_en^n) ×),
+        M_vp = (v^n ×)(2 ∂ω_ie/∂p + ∂ω_en/∂p) + ∂g^n/∂p,  M_pφ = 0,
+        M_pv = [[0, 1/R_Mh, 0], [sec L/R_Nh, 0, 0], [0, 0, 1]],  M_pp = ∂ṗ/∂p,
+
+    with the forcing -C_b^n δω_ib^b (attitude) and +C_b^n δf^b (velocity).  Returns a dict with
+    ``F`` (9×9), ``G_gyro`` and ``G_accel`` (9×3 forcing of a body-frame gyro / accelerometer
+    error) and the nine blocks ``M_phiphi`` ... ``M_pp``.  ``point`` is an
+    :class:`replication.errors.NavPoint`.
+    """
+    from .errors import NavPoint, model_15
+
+    if not isinstance(point, NavPoint):
+        raise TypeError("point must be a replication.errors.NavPoint (e.g. NavPoint.from_trajectory(traj, k))")
+    F15 = model_15().F(point)
+    perm = np.r_[6:9, 3:6, 0:3]
+    F = F15[np.ix_(perm, perm)]
+    G_accel = F15[np.ix_(perm, np.arange(9, 12))]
+    G_gyro = F15[np.ix_(perm, np.arange(12, 15))]
+    names = ("phi", "v", "p")
+    out = {"F": F, "G_gyro": G_gyro, "G_accel": G_accel}
+    for i, a in enumerate(names):
+        for j, b in enumerate(names):
+            key = f"M_{a}{b}" if a != b else f"M_{a}{a}"
+            out[key.replace("M_phiphi", "M_phiphi")] = F[3 * i:3 * i + 3, 3 * j:3 * j + 3]
+    return out
+
+
+# =========================================================================== 3. air data
+
+@dataclass
+class AirData:
+    """Air-data measurements at the sample instants: barometric height (m) and true airspeed (m/s)."""
+
+    height: np.ndarray
+    airspeed: np.ndarray
+    sigma_height: float
+    sigma_airspeed: float
+
+
+def ads_measurements(traj, *, sigma_height: float = 1.0, sigma_airspeed: float = 0.5, height_bias: float = 0.0,
+                     wind_enu=(0.0, 0.0, 0.0), rng=None) -> AirData:
+    """ADS height and true airspeed along a trajectory (duan2023 §3: "ADS 测量误差为 1 m").
+
+    height = h + bias + n_h, n_h ~ N(0, σ_h²) white (duan2023 gives 1 m, type unstated);
+    airspeed = |v^n - wind| + n_V, n_V ~ N(0, σ_V²) white (not given by duan2023: this
+    package's choice, stated in the chapter).  The default wind is zero (the paper mentions the
+    steady-airflow, low-frequency-wind condition of refs. [15-17]).
+    """
+    if sigma_height < 0 or sigma_airspeed < 0:
+        raise ValueError("sigma_height and sigma_airspeed cannot be negative")
+    rng = np.random.default_rng(rng)
+    n = len(traj.t)
+    w = np.broadcast_to(np.asarray(wind_enu, float), (3,))
+    tas = np.linalg.norm(traj.v_enu - w, axis=1)
+    return AirData(traj.h + height_bias + sigma_height * rng.standard_normal(n),
+                   tas + sigma_airspeed * rng.standard_normal(n), float(sigma_height), float(sigma_airspeed))
+
+
+# =========================================================================== 4. simulation
+
+def duan2023_flight(*, dt: float = 0.02, start_speed: float = 10.0, height0: float = 500.0,
+                    climb: float = 3000.0):
+    """The analog of duan2023 Fig. 2: 45°N, 1.05 h (3780 s), 729 km along track.
+
+    The figure is not published; this package's flight (stated, not fitted): take-off run
+    accelerating from ``start_speed`` to the cruise speed over 120 s heading north, a 300-s climb
+    of ``climb`` m, 500 s straight, a 90° right turn (120 s), 900 s straight, a 90° left turn
+    (120 s), 1300 s straight, a 300-s descent of ``climb`` m and a 120-s deceleration back to
+    ``start_speed`` ("起飞加速阶段与降落减速阶段").  The cruise speed
+    V_c = (729 km - 120 s · start_speed) / 3660 s makes the along-track range exactly 729 km
+    (≈ 198.9 m/s with the defaults).  Returns a :class:`replication.trajectory.Trajectory`.
+    """
+    from . import trajectory as tr
+    from .units import DEG
+
+    if not (0 < start_speed < 100):
+        raise ValueError("start_speed must lie in (0, 100) m/s (flight segments need forward speed)")
+    vc = (729_000.0 - 120.0 * start_speed) / 3660.0
+    segs = [tr.Accelerate(120.0, speed_change=vc - start_speed), tr.Climb(300.0, height_change=climb),
+            tr.Straight(500.0), tr.Turn(120.0, angle=np.pi / 2), tr.Straight(900.0),
+            tr.Turn(120.0, angle=-np.pi / 2), tr.Straight(1300.0), tr.Climb(300.0, height_change=-climb),
+            tr.Accelerate(120.0, speed_change=start_speed - vc)]
+    return tr.generate(segs, 45 * DEG, 110 * DEG, height0, dt=dt, heading=0.0, speed=start_speed)
+
+
+@dataclass
+class SimulationSetup:
+    """duan2023 §3 simulation parameters (SI) and this package's stated choices.
+
+    Printed: correction interval 30 s; gyro constant drift and random drift 0.01 °/h;
+    accelerometer bias and random drift 100 μg; ADS error 1 m; initial velocity error 0.1 m/s
+    and position error 10 m on each axis.  Choices (not printed): the constant terms are
+    +value on every axis (the convention of the PSINS toolbox of ref. [21]); "random drift" is
+    white noise whose 1-s average has the printed 1σ (PSD = σ² · 1 s); initial attitude error 0;
+    airspeed noise 0.5 m/s; the Kalman filter of refs. [15-17] updates at 1 Hz.
+    """
+
+    correction_interval: float = 30.0
+    gyro_bias: float = 0.01 * np.pi / 180 / 3600
+    gyro_random: float = 0.01 * np.pi / 180 / 3600
+    accel_bias: float = 100e-6 * 9.80665
+    accel_random: float = 100e-6 * 9.80665
+    sigma_height: float = 1.0
+    sigma_airspeed: float = 0.5
+    initial_velocity_error: float = 0.1
+    initial_position_error: float = 10.0
+    filter_interval: float = 1.0
+    markov_tau: float = 300.0
+    threshold: float = 1.5 / 30.0
+    gate: str = "skip"
+    attitude_sign: float = -1.0
+    printed_half: bool = False
+
+    @classmethod
+    def from_paper(cls, paper_setup, **overrides):
+        """Printed values from ``duan2023-claim-simulation-setup`` (units converted), plus overrides."""
+        from .units import DEG_PER_H, MICRO_G
+
+        v = paper_setup.value
+        kw = dict(correction_interval=v("correction interval"), gyro_bias=v("gyro constant drift") * DEG_PER_H,
+                  gyro_random=v("gyro random drift") * DEG_PER_H, accel_bias=v("accelerometer bias") * MICRO_G,
+                  accel_random=v("accelerometer random drift") * MICRO_G, sigma_height=v("ADS measurement error"),
+                  initial_velocity_error=v("initial velocity error E/N/U"),
+                  initial_position_error=v("initial position error E/N/U"))
+        kw["threshold"] = 1.5 / kw["correction_interval"]
+        kw.update(overrides)
+        return cls(**kw)
+
+    def __post_init__(self):
+        if self.correction_interval <= 0 or self.filter_interval <= 0:
+            raise ValueError("correction_interval and filter_interval must be positive (seconds)")
+        if self.gate not in ("skip", "height-only", "none"):
+            raise ValueError("gate must be 'skip' (no correction when Sdot/S exceeds the threshold), "
+                             "'height-only' (the paper's remedy) or 'none' (never gate)")
+        if not self.threshold > 0:
+            raise ValueError("threshold (on Sdot/S, 1/s) must be positive")
+        if self.attitude_sign not in (1.0, -1.0, 0.0):
+            raise ValueError("attitude_sign must be +1 (attitude turned with the vectors), -1 (opposite) "
+                             "or 0 (misalignment correction not applied)")
+
+
+def _initial_state(traj, setup):
+    from .strapdown import NavState
+
+    st = traj.initial_state()
+    rm, rn = earth.radii(st.lat)
+    dp = setup.initial_position_error
+    return NavState(st.lat + dp / (rm + st.h), st.lon + dp / ((rn + st.h) * np.cos(st.lat)), st.h + dp,
+                    st.v_enu + setup.initial_velocity_error, st.C_bn)
+
+
+def _corrupt(traj, setup, rng):
+    T = np.diff(traj.t)[:, None]
+    qg, qa = setup.gyro_random**2 * 1.0, setup.accel_random**2 * 1.0
+    dth = traj.dtheta + setup.gyro_bias * T + rng.standard_normal(traj.dtheta.shape) * np.sqrt(qg * T)
+    dv = traj.dv + setup.accel_bias * T + rng.standard_normal(traj.dv.shape) * np.sqrt(qa * T)
+    return dth, dv
+
+
+def _epochs(traj, interval):
+    step = int(round(interval / float(np.median(np.diff(traj.t)))))
+    if step < 1 or abs(step * np.median(np.diff(traj.t)) - interval) > 1e-9:
+        raise ValueError(f"interval {interval} s must be a multiple of the sampling interval")
+    ep = np.arange(0, traj.n + 1, step)
+    return ep if ep[-1] == traj.n else np.append(ep, traj.n)   # a last, shorter interval
+
+
+class _Recorder:
+    """Navigation states on a coarse grid (every ``every`` samples)."""
+
+    def __init__(self, traj, every):
+        self.idx = np.arange(0, traj.n + 1, every)
+        self.st = np.full((len(self.idx), 6), np.nan)
+        self.C = np.full((len(self.idx), 3, 3), np.nan)
+
+    def put(self, k_samples, sol_st, sol_C):
+        pos = np.searchsorted(self.idx, k_samples)
+        ok = (pos < len(self.idx)) & (self.idx[np.minimum(pos, len(self.idx) - 1)] == k_samples)
+        self.st[pos[ok]] = sol_st[ok]
+        self.C[pos[ok]] = sol_C[ok]
+
+
+def _segment(t, dth, dv, k0, k1, state, every):
+    from .strapdown import mechanize
+
+    sol = mechanize(t[k0:k1 + 1], dth[k0:k1], dv[k0:k1], state)
+    ks = np.arange(k0, k1 + 1)
+    sel = (ks % every) == 0
+    st = np.column_stack([sol.lat, sol.lon, sol.h, sol.v_enu])
+    return sol, ks[sel], st[sel], sol.C_bn[sel] if np.any(sel) else np.zeros((0, 3, 3))
+
+
+def _end_state(sol):
+    from .strapdown import NavState
+    from .rotations import orthonormalize, quat_to_dcm
+
+    return NavState(float(sol.lat[-1]), float(sol.lon[-1]), float(sol.h[-1]), sol.v_enu[-1].copy(),
+                    orthonormalize(quat_to_dcm(sol.q_bn[-1])))
+
+
+def run_pure_sins(traj, dth, dv, setup, *, every: int = 50):
+    """Pure SINS: strapdown with a free vertical channel from the perturbed initial state."""
+    rec = _Recorder(traj, every)
+    sol, ks, st, C = _segment(traj.t, dth, dv, 0, traj.n, _initial_state(traj, setup), every)
+    rec.put(ks, st, C)
+    return rec
+
+
+def error_correction_step(origin, state, h_ads, setup):
+    """One correction of the proposed method (duan2023 eqs. (4)-(22)) applied to a SINS state.
+
+    ``origin`` is the SINS position (lat, lon, h) at the start of the interval (point o of
+    Fig. 1), ``state`` the SINS :class:`~replication.strapdown.NavState` at its end, ``h_ads``
+    the ADS height then.  Returns (corrected state, info dict with S, Ṡ/S, δh^c, gated, X^C).
+    Gate (duan2023 §3): when Ṡ/S > ``setup.threshold`` the interval is either not corrected
+    (``gate="skip"``: the step-like height error of Fig. 5) or only its height is reset
+    (``"height-only"``: the remedy the paper proposes).
+    """
+    from .strapdown import NavState
+    from .rotations import rotvec_to_dcm
+
+    lat0, lon0, h0 = origin
+    rm, rn = earth.radii(state.lat)
+    sx = (state.lon - lon0) * (rn + state.h) * np.cos(state.lat)
+    sy = (state.lat - lat0) * (rm + state.h)
+    h = state.h - h0
+    s = float(np.hypot(sx, sy))
+    v = state.v_enu
+    sdot = float((sx * v[0] + sy * v[1]) / s) if s > 0 else np.inf
+    ratio = sdot / s if s > 0 else np.inf
+    dh = float(h_ads - state.h)
+    gated = (setup.gate != "none") and not (ratio <= setup.threshold)
+    info = dict(S=s, ratio=ratio, dh=dh, gated=gated, X=np.zeros(9))
+    if gated:
+        if setup.gate == "skip":
+            return state, info
+        return NavState(state.lat, state.lon, state.h + dh, v.copy(), state.C_bn), info
+    x = correction_vector(sx, sy, h, float(np.linalg.norm(v)), dh, state.lat, state.h,
+                          printed_half=setup.printed_half)
+    info["X"] = x
+    phi = np.array([x[0], x[1], 0.0]) * setup.attitude_sign
+    # the SINS vectors are turned by D = exp(φ^c u ×) (eq. (5)); the attitude is turned with them
+    C = rotvec_to_dcm(phi) @ state.C_bn
+    return NavState(state.lat + x[6], state.lon + x[7], state.h + x[8], v + x[3:6], C), info
+
+
+def run_error_correction(traj, dth, dv, ads, setup, *, every: int = 50):
+    """The proposed SINS/ADS: strapdown, corrected every ``setup.correction_interval`` seconds
+    by :func:`error_correction_step` (duan2023 §2, eq. (22) applied as a feedback reset)."""
+    rec = _Recorder(traj, every)
+    ep = _epochs(traj, setup.correction_interval)
+    state = _initial_state(traj, setup)
+    infos = []
+    for k0, k1 in zip(ep[:-1], ep[1:]):
+        origin = (state.lat, state.lon, state.h)
+        sol, ks, st, C = _segment(traj.t, dth, dv, k0, k1, state, every)
+        end = _end_state(sol)
+        state, info = error_correction_step(origin, end, ads.height[k1], setup)
+        info["t"] = float(traj.t[k1])
+        infos.append(info)
+        st[-1] = [state.lat, state.lon, state.h, *state.v_enu] if ks[-1] == k1 else st[-1]
+        if ks[-1] == k1:
+            C[-1] = state.C_bn
+        rec.put(ks, st, C)
+    rec.infos = infos
+    return rec
+
+
+def literature_filter_model(setup):
+    """Error model of the SINS/ADS Kalman filter standing in for duan2023 refs. [15-17].
+
+    15 states (core :func:`replication.errors.model_15`: δp, δv, φ, ∇_b, ε_b) plus two
+    first-order Markov states for the air data (height error and airspeed error, σ =
+    ``sigma_height`` / ``sigma_airspeed``, τ = ``markov_tau``) — "建立一阶马尔可夫过程".
+    """
+    from .errors import StateBlock, model_15
+
+    rm, rn = earth.radii(np.radians(45.0))
+    m = model_15(position_sd=setup.initial_position_error, velocity_sd=setup.initial_velocity_error,
+                 attitude_sd=(1e-4, 1e-4, 1e-3), accel_bias_sd=2 * setup.accel_bias,
+                 gyro_bias_sd=2 * setup.gyro_bias, accel_psd=setup.accel_random**2,
+                 gyro_psd=setup.gyro_random**2, lat=np.radians(45.0))
+    tau = setup.markov_tau
+    sig = np.array([setup.sigma_height, setup.sigma_airspeed])
+    ads = StateBlock("ads_markov", ("h", "V"), "none", dynamics=-np.eye(2) / tau,
+                     noise_psd=np.diag(2 * sig**2 / tau), sd=sig)
+    return m.extend(ads)
+
+
+def literature_gains(traj, setup):
+    """Kalman gains of the literature SINS/ADS along the true trajectory (shared by all runs).
+
+    Measurements every ``setup.filter_interval`` s: z = [ĥ - h_ADS, |v̂| - V_TAS] =
+    H x + n, H = [[e_h, -1 (height Markov)], [v/|v| on δv, -1 (airspeed Markov)]], white noise
+    R = diag(σ_h², σ_V²) on top of the Markov states (a filter of the kind of refs. [15-17]).
+    The covariance is propagated along the truth (F from :class:`replication.errors.ErrorModel`,
+    Φ and Q_d by Van Loan) and does not depend on the measured values, so the gains are computed
+    once.  Returns (epoch indices, gains (m × n × 2), H (m × 2 × n), Φ_ads (2×2), model).
+    """
+    from .errors import NavPoint
+    from .kalman import update, van_loan
+
+    model = literature_filter_model(setup)
+    n = model.n
+    ep = _epochs(traj, setup.filter_interval)
+    sl = model.slices["ads_markov"]
+    P = model.P0()
+    R = np.diag([setup.sigma_height**2, setup.sigma_airspeed**2])
+    gains = np.empty((len(ep) - 1, n, 2))
+    Hs = np.empty((len(ep) - 1, 2, n))
+    Phi = Qd = None
+    for j, (k0, k1) in enumerate(zip(ep[:-1], ep[1:])):
+        km = (k0 + k1) // 2
+        pt = NavPoint.from_trajectory(traj, km)
+        if Phi is None or j % 10 == 0:          # F changes slowly: re-discretise every 10 epochs
+            Phi, Qd = van_loan(model.F(pt), model.G_Qc(pt.C_bn), traj.t[k1] - traj.t[k0])
+        P = Phi @ P @ Phi.T + Qd
+        v = traj.v_enu[k1]
+        H = np.zeros((2, n))
+        H[0, 2] = 1.0
+        H[0, sl.start] = -1.0
+        H[1, 3:6] = v / np.linalg.norm(v)
+        H[1, sl.start + 1] = -1.0
+        S = H @ P @ H.T + R
+        K = np.linalg.solve(S, H @ P).T
+        A = np.eye(n) - K @ H
+        P = A @ P @ A.T + K @ R @ K.T
+        P = 0.5 * (P + P.T)
+        gains[j], Hs[j] = K, H
+    phi_ads = np.exp(-setup.filter_interval / setup.markov_tau) * np.eye(2)
+    return ep, gains, Hs, phi_ads, model
+
+
+def run_literature(traj, dth, dv, ads, setup, gains_pack, *, every: int = 50):
+    """The literature SINS/ADS (refs. [15-17] as read by this package): closed-loop error-state
+    Kalman filter with ADS height and airspeed, feedback of δp, δv, φ, accumulated ∇̂, ε̂."""
+    from .rotations import rotvec_to_dcm
+    from .strapdown import NavState
+
+    ep, gains, Hs, phi_ads, model = gains_pack
+    sl = model.slices
+    rec = _Recorder(traj, every)
+    state = _initial_state(traj, setup)
+    ba, bg = np.zeros(3), np.zeros(3)
+    xads = np.zeros(2)
+    T = np.diff(traj.t)[:, None]
+    for j, (k0, k1) in enumerate(zip(ep[:-1], ep[1:])):
+        d1 = dth[k0:k1] - bg * T[k0:k1]
+        d2 = dv[k0:k1] - ba * T[k0:k1]
+        from .strapdown import mechanize
+
+        sol = mechanize(traj.t[k0:k1 + 1], d1, d2, state)
+        end = _end_state(sol)
+        xads = phi_ads @ xads
+        z = np.array([end.h - ads.height[k1], np.linalg.norm(end.v_enu) - ads.airspeed[k1]])
+        xm = np.zeros(model.n)
+        xm[sl["ads_markov"]] = xads
+        x = xm + gains[j] @ (z - Hs[j] @ xm)
+        C = rotvec_to_dcm(x[6:9]) @ end.C_bn
+        state = NavState(end.lat - x[0], end.lon - x[1], end.h - x[2], end.v_enu - x[3:6], C)
+        ba = ba + x[sl["accel_bias"]]
+        bg = bg + x[sl["gyro_bias"]]
+        xads = x[sl["ads_markov"]]
+        ks = np.arange(k0, k1 + 1)
+        sel = (ks % every) == 0
+        st = np.column_stack([sol.lat, sol.lon, sol.h, sol.v_enu])[sel]
+        Cs = sol.C_bn[sel]
+        if ks[sel].size and ks[sel][-1] == k1:
+            st[-1] = [state.lat, state.lon, state.h, *state.v_enu]
+            Cs[-1] = state.C_bn
+        rec.put(ks[sel], st, Cs)
+    return rec
+
+
+def navigation_errors(traj, rec):
+    """Errors of recorded states against the truth: dict with ``t``, ``enu`` (m), ``v`` (m/s),
+    ``phi`` (rad, Ĉ = exp(-φ×) C) on the recorder's grid."""
+    from .rotations import attitude_error, euler_to_dcm
+
+    i = rec.idx
+    rm, rn = earth.radii(traj.lat[i])
+    st = rec.st
+    enu = np.column_stack([(st[:, 1] - traj.lon[i]) * (rn + traj.h[i]) * np.cos(traj.lat[i]),
+                           (st[:, 0] - traj.lat[i]) * (rm + traj.h[i]), st[:, 2] - traj.h[i]])
+    Ct = euler_to_dcm(traj.hpr[i, 0], traj.hpr[i, 1], traj.hpr[i, 2])
+    return {"t": traj.t[i], "enu": enu, "v": st[:, 3:6] - traj.v_enu[i], "phi": attitude_error(rec.C, Ct)}
+
+
+SYSTEMS = ("SINS", "literature SINS/ADS", "proposed SINS/ADS")
+"""The three systems of duan2023 §3, in the order of Table 1."""
+
+
+@dataclass
+class MonteCarlo:
+    """Error histories of the three systems: arrays runs × grid × 3 per system and quantity."""
+
+    t: np.ndarray
+    errors: dict
+    infos: list
+    setup: SimulationSetup
+    seed: int
+
+    def summary(self, statistic: str = "max"):
+        """Per run and system: misalignment (°), velocity error (m/s), position error (km) — the
+        3-axis norm, reduced over the flight by ``statistic`` ("max", "final" or "rms")."""
+        import pandas as pd
+
+        if statistic not in ("max", "final", "rms"):
+            raise ValueError("statistic must be 'max', 'final' or 'rms'")
+        red = {"max": lambda a: np.nanmax(a, axis=1), "final": lambda a: a[:, -1],
+               "rms": lambda a: np.sqrt(np.nanmean(a**2, axis=1))}[statistic]
+        rows = []
+        for sys_ in [x for x in SYSTEMS if x in self.errors]:
+            e = self.errors[sys_]
+            vals = {"misalignment": red(np.degrees(np.linalg.norm(e["phi"], axis=2))),
+                    "velocity error": red(np.linalg.norm(e["v"], axis=2)),
+                    "position error": red(np.linalg.norm(e["enu"], axis=2)) / 1e3}
+            for r in range(len(vals["misalignment"])):
+                rows.append({"system": sys_, "run": r, **{k: float(v[r]) for k, v in vals.items()}})
+        return pd.DataFrame(rows)
+
+
+def simulate(traj, setup: SimulationSetup, *, n_runs: int = 10, seed: int = 2023, every: int = 50,
+             systems=SYSTEMS, gains_pack=None) -> MonteCarlo:
+    """Monte Carlo of the three systems of duan2023 §3 on one trajectory.
+
+    Each run draws IMU white noise, ADS height and airspeed noise from its own generator
+    (``SeedSequence(seed).spawn(n_runs)``); the three systems of a run share the same draws
+    (common random numbers).  The literature filter's gains are computed once along the truth.
+    """
+    if n_runs < 1:
+        raise ValueError("n_runs must be at least 1")
+    unknown = set(systems) - set(SYSTEMS)
+    if unknown:
+        raise ValueError(f"unknown systems {sorted(unknown)}; choose from {SYSTEMS}")
+    if "literature SINS/ADS" in systems and gains_pack is None:
+        gains_pack = literature_gains(traj, setup)
+    out = {s: {"enu": [], "v": [], "phi": []} for s in systems}
+    infos = []
+    t = None
+    for ss in np.random.SeedSequence(seed).spawn(n_runs):
+        rng = np.random.default_rng(ss)
+        dth, dv = _corrupt(traj, setup, rng)
+        ads = ads_measurements(traj, sigma_height=setup.sigma_height, sigma_airspeed=setup.sigma_airspeed, rng=rng)
+        for s in systems:
+            if s == "SINS":
+                rec = run_pure_sins(traj, dth, dv, setup, every=every)
+            elif s == "literature SINS/ADS":
+                rec = run_literature(traj, dth, dv, ads, setup, gains_pack, every=every)
+            else:
+                rec = run_error_correction(traj, dth, dv, ads, setup, every=every)
+                infos.append(rec.infos)
+            e = navigation_errors(traj, rec)
+            t = e["t"]
+            for q in ("enu", "v", "phi"):
+                out[s][q].append(e[q])
+    errs = {s: {q: np.stack(v) for q, v in d.items()} for s, d in out.items()}
+    return MonteCarlo(t, errs, infos, setup, seed)
+
+
+# =========================================================================== 5. chapter helpers
+
+def table1_rows(mc: MonteCarlo, paper, statistic: str = "max"):
+    """Rows of duan2023 Table 1 (paper vs the Monte-Carlo mean ± std of ``statistic``)."""
+    s = mc.summary(statistic)
+    rows = []
+    units = {"misalignment": "deg", "velocity error": "m/s", "position error": "km"}
+    for sys_ in SYSTEMS:
+        sub = s[s["system"] == sys_]
+        for q, u in units.items():
+            rows.append({"system": sys_, "quantity": q, "unit": u,
+                         "paper": paper.value(f"{sys_} / {q}"), "mean": float(sub[q].mean()),
+                         "std": float(sub[q].std(ddof=1)) if len(sub) > 1 else 0.0})
+    return rows
+
+
+def claim_checks(mc: MonteCarlo):
+    """The qualitative statements of duan2023 §3 evaluated on a Monte Carlo (dict of numbers/bools).
+
+    * ordering — per quantity, is proposed < literature < SINS (run means of the flight maxima)?
+    * literature E/N velocity vs position — literature's max horizontal velocity error below the
+      proposed method's while its max horizontal position error is above it?
+    * start-up overshoot — the largest |φ^c| applied in the first 300 s over the median |φ^c| of
+      the cruise corrections (a ratio ≫ 1 is an overshoot);
+    * step — the largest |δh^c| met at a correction epoch over the median one (gated intervals let
+      the height error grow, then it is removed in one step);
+    * spatial — final 3-D position error of proposed vs literature.
+    """
+    s = mc.summary("max").groupby("system").mean(numeric_only=True)
+    out = {}
+    for q in ("misalignment", "velocity error", "position error"):
+        out[f"ordering {q}"] = bool(s.loc["proposed SINS/ADS", q] < s.loc["literature SINS/ADS", q]
+                                    < s.loc["SINS", q])
+    hor = lambda sys_, key: float(np.mean(np.nanmax(np.linalg.norm(mc.errors[sys_][key][:, :, :2], axis=2), axis=1)))
+    out["literature horizontal velocity error (m/s)"] = hor("literature SINS/ADS", "v")
+    out["proposed horizontal velocity error (m/s)"] = hor("proposed SINS/ADS", "v")
+    out["literature horizontal position error (km)"] = hor("literature SINS/ADS", "enu") / 1e3
+    out["proposed horizontal position error (km)"] = hor("proposed SINS/ADS", "enu") / 1e3
+    ratios, steps, gated = [], [], []
+    for infos in mc.infos:
+        t = np.array([i["t"] for i in infos])
+        phi = np.array([np.hypot(*i["X"][:2]) for i in infos])
+        dh = np.abs(np.array([i["dh"] for i in infos]))
+        g = np.array([i["gated"] for i in infos])
+        cruise = (t > 600) & (t < t[-1] - 600) & ~g
+        ratios.append(np.max(phi[t <= 300]) / np.median(phi[cruise]))
+        steps.append(np.max(dh) / np.median(dh[cruise]))
+        gated.append(int(g.sum()))
+    out["start-up |phi^c| / cruise median"] = float(np.median(ratios))
+    out["max |dh^c| / cruise median"] = float(np.median(steps))
+    out["gated corrections per run"] = float(np.mean(gated))
+    fin = lambda sys_: float(np.mean(np.linalg.norm(mc.errors[sys_]["enu"][:, -1], axis=1))) / 1e3
+    out["final 3-D position error literature (km)"] = fin("literature SINS/ADS")
+    out["final 3-D position error proposed (km)"] = fin("proposed SINS/ADS")
+    return out
+
+
+def plot_error_histories(mc: MonteCarlo, quantity: str, *, scale=1.0, unit="", axes_labels=("E", "N", "U")):
+    """Figs. 3-5 analog: per axis, the run-mean of each system with a ±1σ band (one panel per axis)."""
+    import matplotlib.pyplot as plt
+
+    if quantity not in ("phi", "v", "enu"):
+        raise ValueError("quantity must be 'phi', 'v' or 'enu'")
+    fig, axs = plt.subplots(3, 1, figsize=(7, 6.5), sharex=True)
+    for ax, i, lab in zip(axs, range(3), axes_labels):
+        for sys_, c in zip(SYSTEMS, ("C0", "C1", "C2")):
+            a = mc.errors[sys_][quantity][:, :, i] * scale
+            m, sd = np.nanmean(a, 0), np.nanstd(a, 0)
+            ax.plot(mc.t / 60, m, color=c, lw=1, label=sys_)
+            ax.fill_between(mc.t / 60, m - sd, m + sd, color=c, alpha=0.2, lw=0)
+        ax.set_ylabel(f"{lab} ({unit})")
+        ax.set_yscale("symlog", linthresh=abs(np.nanmedian(np.abs(mc.errors['proposed SINS/ADS'][quantity][:, :, i] * scale))) + 1e-12)
+    axs[0].legend(fontsize=7, loc="upper left")
+    axs[-1].set_xlabel("time (min)")
+    fig.tight_layout()
+    return fig
+
+
+def sweep(traj, setup: SimulationSetup, changes, *, n_runs: int = 3, seed: int = 7):
+    """Sensitivity of the proposed method: one Monte Carlo per dict of ``changes`` to ``setup``.
+
+    Returns a DataFrame with the changed values and the run-mean of the flight maxima and the
+    final values (misalignment °, velocity m/s, position km) and the gated corrections per run.
+    """
+    import pandas as pd
+
+    rows = []
+    for ch in changes:
+        s2 = SimulationSetup(**{**setup.__dict__, **ch})
+        mc = simulate(traj, s2, n_runs=n_runs, seed=seed, systems=("proposed SINS/ADS",))
+        mx = mc.summary("max").query("system == 'proposed SINS/ADS'")
+        fi = mc.summary("final").query("system == 'proposed SINS/ADS'")
+        rows.append({**ch, "max misalignment (deg)": mx["misalignment"].mean(),
+                     "max velocity error (m/s)": mx["velocity error"].mean(),
+                     "max position error (km)": mx["position error"].mean(),
+                     "final position error (km)": fi["position error"].mean(),
+                     "gated per run": float(np.mean([sum(i["gated"] for i in r) for r in mc.infos]))})
+    return pd.DataFrame(rows)
+
+
+_EVID = "book/duan2023/01_sins_ads_error_correction.ipynb; tests/test_airdata.py::"
+_ERRATA = {
+    "eq. (6) phi_E^c per dh^c": ("factor 1/2 too many: the rotation-vector formula (5) applied to D gives exactly phi^c u, "
+                                 "and the paper's own eq. (7) differentiates the expression without 1/2",
+                                 "test_erratum_eq6_half_and_eq12_cos", "S_y/(S^2+h^2)"),
+    "eq. (6) phi_N^c per dh^c": ("factor 1/2 too many (as for phi_E^c)", "test_erratum_eq6_half_and_eq12_cos",
+                                 "-S_x/(S^2+h^2)"),
+    "eq. (12) dV_U^c per phi^c": ("turning V by phi^c changes its up component by phi^c V cos(theta_2); eq. (13) contains "
+                                  "the cos(theta_2) = S/sqrt(S^2+h^2) that eq. (12) omits (relative O(h^2/S^2))",
+                                  "test_erratum_eq6_half_and_eq12_cos", "phi^c V S/sqrt(S^2+h^2)"),
+    "eq. (16) dS_x^c per dS^c": ("with beta the heading from north (reading B, under which eq. (21) is right) the east "
+                                 "component is sin(beta): cos and sin exchanged", "test_reading_b_is_the_economical_one",
+                                 "sin(beta)"),
+    "eq. (16) dS_y^c per dS^c": ("cos and sin exchanged (reading B)", "test_reading_b_is_the_economical_one", "cos(beta)"),
+    "eq. (19) dS_x^c per dh^c": ("cos and sin exchanged (reading B)", "test_reading_b_is_the_economical_one",
+                                 "-sin(beta) h/S"),
+    "eq. (19) dS_y^c per dh^c": ("cos and sin exchanged (reading B)", "test_reading_b_is_the_economical_one",
+                                 "-cos(beta) h/S"),
+    "text below (19) dL-dot^c per dV_N^c": ("metric factors exchanged: the latitude rate is dV_N/R_Mh",
+                                            "test_reading_b_is_the_economical_one", "1/R_Mh"),
+    "text below (19) dlambda-dot^c per dV_E^c": ("metric factors exchanged: the longitude rate is dV_E/(R_Nh cos L)",
+                                                 "test_reading_b_is_the_economical_one", "1/(R_Nh cos L)"),
+    "eq. (20) [dL; dV_U]": ("R_Mh printed where R_Nh is needed (eq. (21) prints R_Nh for the same element)",
+                            "test_reading_b_is_the_economical_one", "-h sin(beta)/(S R_Nh cos L)"),
+}
+
+
+def eq22_rows(paper, reading: str = "B", state: str = "climb"):
+    """Comparison rows for ``duan2023-eq-22``: every comparable printed element (value at the
+    reference state vs the re-derivation, relative tolerance 1e-9 — the two are symbolic
+    expressions, so only round-off may separate them) and the rows of eqs. (14)-(15), whose
+    split over the states is not unique, checked on the correction manifold (convention C1,
+    δḣ^c = δV_U^c, the one eqs. (7) and (20) use)."""
+    df = check_elements(paper, reading, state)
+    rows = []
+    for _, r in df[df["comparable"]].iterrows():
+        row = {"quantity": r["quantity"], "unit": r["unit"], "paper": r["paper"], "reproduced": r["derived"],
+               "tolerance": 1e-9, "tolerance_kind": "rel"}
+        if not r["match"] and r["quantity"] in _ERRATA:
+            note, test, corr = _ERRATA[r["quantity"]]
+            row.update(status="erratum", note=note, evidence=_EVID + test, corrected=corr)
+        rows.append(row)
+    m = manifold_residuals(paper, reading, states=(state,), conventions=("C1",))
+    notes = {"14": "right only if dh^c is held constant over the interval and the flight is level; with "
+                   "d(dh^c)/dt = dV_U^c (eqs. (7), (20)) the term a_U dV_U^c is missing",
+             "15": "not the time derivative of eqs. (11)/(13) under either convention; row 3 contradicts eq. (14) "
+                   "(sign of the diagonal, different dh^c term)"}
+    for _, r in m[m["equation"].isin(["14", "15"])].iterrows():
+        rows.append({"quantity": f"eq. ({r['equation']}) row d{r['row']}/dt on the correction manifold (per unit dh^c)",
+                     "unit": "1/s^2" if r["row"] == "dV_U" else "1/s^2", "paper": r["printed"],
+                     "reproduced": r["derived"], "tolerance": 1e-9, "tolerance_kind": "rel",
+                     "status": "erratum", "note": notes[r["equation"]], "evidence": _EVID + "test_manifold_rows",
+                     "corrected": "d/dt of the coefficient of eq. (13)/(11) plus a dV_U^c term (derived_coefficients)"})
+    return rows
+
+
+def eq1_checks(point):
+    """Structure of duan2023 eq. (1) from the navigation core: largest |M_pφ|, the scalar k with
+    G_gyro = k C_b^n (attitude rows), G_accel = k C_b^n (velocity rows), largest position forcing,
+    and the largest difference between the analytic F and the numerical Jacobian of the
+    mechanization (relative to the largest element of each column)."""
+    from .errors import model_15
+
+    m = sins_error_matrix(point)
+    C = np.asarray(point.C_bn, float)
+    kg = float(np.trace(C.T @ m["G_gyro"][0:3]) / 3)
+    ka = float(np.trace(C.T @ m["G_accel"][3:6]) / 3)
+    mod = model_15()
+    Fa, Fn = mod.F(point)[:9, :9], mod.numerical_jacobian(point)[:9, :9]
+    col = np.maximum(np.max(np.abs(Fa), axis=0), 1e-30)
+    return {"block (p; phi) largest element": float(np.max(np.abs(m["M_pphi"]))),
+            "gyro forcing coefficient of C_b^n": kg,
+            "gyro forcing residual": float(np.max(np.abs(m["G_gyro"][0:3] - kg * C))),
+            "accelerometer forcing coefficient of C_b^n": ka,
+            "accelerometer forcing residual": float(np.max(np.abs(m["G_accel"][3:6] - ka * C))),
+            "position forcing largest element": float(max(np.max(np.abs(m["G_gyro"][6:9])),
+                                                          np.max(np.abs(m["G_accel"][6:9])))),
+            "F vs numerical Jacobian (max column-relative difference)": float(np.max(np.abs(Fa - Fn) / col))}

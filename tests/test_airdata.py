@@ -154,3 +154,87 @@ def test_manifold_rows(eq22):
     assert get("15", "dV_U", "level", "C1") > 0.5 and get("15", "dV_U", "level", "C2") > 0.5
     # eq. (21) position rows are right under reading B
     assert get("21", "dL", "climb", "C1") < 1e-9 and get("21", "dlambda", "climb", "C1") < 1e-9
+
+
+# --------------------------------------------------------------------------- eq. (1), ADS, simulation
+
+@pytest.fixture(scope="module")
+def short_flight():
+    from replication import trajectory as tr
+    from replication.units import DEG
+
+    segs = [tr.Straight(60.0), tr.Climb(60.0, height_change=300.0), tr.Straight(60.0)]
+    return tr.generate(segs, 45 * DEG, 110 * DEG, 1000.0, dt=0.1, heading=0.3, speed=180.0)
+
+
+def test_eq1_structure_from_core(short_flight):
+    from replication.errors import NavPoint
+
+    c = ad.eq1_checks(NavPoint.from_trajectory(short_flight, 900))
+    assert c["block (p; phi) largest element"] == 0.0
+    assert c["gyro forcing coefficient of C_b^n"] == pytest.approx(-1.0, abs=1e-12)
+    assert c["accelerometer forcing coefficient of C_b^n"] == pytest.approx(1.0, abs=1e-12)
+    assert c["gyro forcing residual"] < 1e-12 and c["accelerometer forcing residual"] < 1e-12
+    # analytic F against central differences of the mechanization: truncation ~ eps² terms
+    assert c["F vs numerical Jacobian (max column-relative difference)"] < 1e-6
+    with pytest.raises(TypeError, match="NavPoint"):
+        ad.sins_error_matrix(None)
+
+
+def test_ads_measurements_statistics(short_flight):
+    a = ad.ads_measurements(short_flight, sigma_height=1.0, sigma_airspeed=0.5, rng=3)
+    n = len(short_flight.t)
+    e = a.height - short_flight.h
+    # sample std of n draws: 5σ band of its own standard error 1/√(2n)
+    assert abs(np.std(e) - 1.0) < 5 / np.sqrt(2 * n)
+    assert abs(np.mean(a.airspeed - np.linalg.norm(short_flight.v_enu, axis=1))) < 5 * 0.5 / np.sqrt(n)
+    with pytest.raises(ValueError, match="negative"):
+        ad.ads_measurements(short_flight, sigma_height=-1.0)
+
+
+def test_setup_from_paper_and_validation():
+    s = ad.SimulationSetup.from_paper(rp.load_paper("duan2023-claim-simulation-setup"))
+    assert s.correction_interval == 30.0 and s.sigma_height == 1.0
+    assert s.gyro_bias == pytest.approx(0.01 * np.pi / 180 / 3600)
+    assert s.accel_bias == pytest.approx(100e-6 * 9.80665)
+    for bad, msg in ((dict(gate="never"), "gate"), (dict(threshold=0.0), "threshold"),
+                     (dict(attitude_sign=2.0), "attitude_sign"), (dict(correction_interval=-1.0), "positive")):
+        with pytest.raises(ValueError, match=msg):
+            ad.SimulationSetup(**bad)
+
+
+def test_error_correction_step_meets_ads_height(short_flight):
+    from replication.strapdown import NavState
+
+    tr_ = short_flight
+    k0, k1 = 0, 300                       # straight flight: V parallel to the displacement (eq. (8))
+    s0 = tr_.initial_state(k0)
+    end = tr_.initial_state(k1)
+    end = NavState(end.lat, end.lon, end.h + 3.0, end.v_enu + [0, 0, 0.05], end.C_bn)
+    setup = ad.SimulationSetup(gate="none")
+    new, info = ad.error_correction_step((s0.lat, s0.lon, s0.h), end, tr_.h[k1], setup)
+    assert new.h == pytest.approx(tr_.h[k1], abs=1e-9)           # height reset to the ADS
+    assert info["dh"] == pytest.approx(-3.0, abs=1e-9)
+    assert np.linalg.norm(new.v_enu) == pytest.approx(np.linalg.norm(end.v_enu), rel=1e-6)  # assumption 4 (2nd order)
+    assert abs(info["ratio"] - 1 / 30) < 2e-3                     # uniform motion: Sdot/S = 1/T
+    gated, ginfo = ad.error_correction_step((s0.lat, s0.lon, s0.h), end, tr_.h[k1],
+                                            ad.SimulationSetup(threshold=0.01, gate="skip"))
+    assert ginfo["gated"] and gated.h == end.h
+    ho, _ = ad.error_correction_step((s0.lat, s0.lon, s0.h), end, tr_.h[k1],
+                                     ad.SimulationSetup(threshold=0.01, gate="height-only"))
+    assert ho.h == pytest.approx(tr_.h[k1]) and np.all(ho.v_enu == end.v_enu)
+
+
+def test_three_systems_short_run(short_flight):
+    """3 min: the ADS-aided systems bound the vertical error that the free SINS lets grow."""
+    setup = ad.SimulationSetup(correction_interval=30.0, threshold=1.0)
+    mc = ad.simulate(short_flight, setup, n_runs=2, seed=1, every=10)
+    s = mc.summary("final").groupby("system").mean(numeric_only=True)
+    up = {k: float(np.mean(np.abs(v["enu"][:, -1, 2]))) for k, v in mc.errors.items()}
+    assert up["literature SINS/ADS"] < up["SINS"] and up["proposed SINS/ADS"] < up["SINS"]
+    assert s.loc["literature SINS/ADS", "position error"] < 0.1        # km, 3 minutes
+    a, b = ad.simulate(short_flight, setup, n_runs=1, seed=5, every=10), ad.simulate(
+        short_flight, setup, n_runs=1, seed=5, every=10)
+    np.testing.assert_array_equal(a.errors["proposed SINS/ADS"]["enu"], b.errors["proposed SINS/ADS"]["enu"])
+    with pytest.raises(ValueError, match="unknown systems"):
+        ad.simulate(short_flight, setup, systems=("INS",))
