@@ -31,6 +31,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import earth
+from . import rotations
 from . import units
 from . import _polar_kernels as _k
 
@@ -174,19 +175,15 @@ def grid_heading(c_b_g):
 
 
 def attitude_from_euler(heading, pitch, roll):
-    """C_b^G = R_z(-heading) R_x(pitch) R_y(roll) (body axes right, forward, up)."""
-    h, p, r = (np.asarray(x, dtype=float) for x in (heading, pitch, roll))
-    ch, sh, cp, sp, cr, sr = np.cos(h), np.sin(h), np.cos(p), np.sin(p), np.cos(r), np.sin(r)
-    m = np.array([[cr, 0 * cr, sr], [sp * sr, cp, -sp * cr], [-cp * sr, sp, cp * cr]])
-    rz = np.array([[ch, sh, 0 * ch], [-sh, ch, 0 * ch], [0 * ch, 0 * ch, 1 + 0 * ch]])
-    return np.einsum("ij...,jk...->...ik", rz, m)
+    """C_b^G = R_z(-heading) R_x(pitch) R_y(roll) (body axes right, forward, up), the convention of
+    :func:`replication.rotations.euler_to_dcm` applied to grid angles."""
+    return rotations.euler_to_dcm(heading, pitch, roll)
 
 
 def euler_from_attitude(c_b_g):
-    """(heading, pitch, roll) of C_b^G = R_z(-heading) R_x(pitch) R_y(roll)."""
-    c = np.asarray(c_b_g, dtype=float)
-    return (np.arctan2(c[..., 0, 1], c[..., 1, 1]), np.arcsin(np.clip(c[..., 2, 1], -1, 1)),
-            np.arctan2(-c[..., 2, 0], c[..., 2, 2]))
+    """(heading, pitch, roll) of C_b^G, heading wrapped to (-π, π] (grid angles)."""
+    h, p, r = rotations.dcm_to_euler(c_b_g)
+    return np.angle(np.exp(1j * h)), p, r
 
 
 # =============================================================================== P equation (2)-(17)
@@ -788,3 +785,87 @@ def ecef_reference_comparison(sc, duration, *, seed=0, record_every=60.0):
     ang = np.arcsin(np.clip(np.linalg.norm(w, axis=-1), 0, 1))
     return {"t": t, "pos_grid": np.array(pos_grid), "pos_ecef": rp_[0], "vel_grid": np.array(vel_grid),
             "vel_ecef": rv_[0], "attitude_angle": ang, "pos_true": re_t}
+
+
+# =============================================================================== fang2020 §3 runs
+
+FANG2020_SEEDS = {1: 2020_04_58, 2: 2020_04_65}
+"""Seeds of the two 20-run Monte Carlos (case → seed)."""
+
+
+def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, **changes):
+    """The 20-run Monte Carlo of fang2020 §3 for case 1 (Table 1) or case 2 (Table 2).
+
+    Full fidelity: 10 h at 100 Hz, fixes at 2 h and 3.5 h; ``changes`` override scenario fields
+    (for sensitivity checks).  Returns a :class:`SimulationResult`.
+    """
+    sc = fang2020_scenario(case, **changes)
+    return simulate(sc, n_runs, FANG2020_SEEDS[case] if seed is None else seed,
+                    reset_only_runs=reset_only_runs)
+
+
+def drift_summary(result, estimator="mean-attitude"):
+    """Mean and sample standard deviation (ddof = 1) of the drift estimates per body axis, °/h."""
+    if estimator not in result.estimates:
+        raise ValueError(f"unknown estimator {estimator!r}; have {sorted(result.estimates)}")
+    est = result.estimates[estimator] / units.DEG_PER_H
+    ddof = 1 if est.shape[0] > 1 else 0
+    return {axis: (float(est[:, j].mean()), float(est[:, j].std(ddof=ddof))) for j, axis in enumerate("XYZ")}
+
+
+# =============================================================================== figures
+
+_PANELS = {
+    "attitude": ((0, 1, 2), ("grid east φ_E", "grid north φ_N", "grid azimuth φ_U"), units.ARCSEC, "″"),
+    "velocity": ((3, 4), ("grid east δV_E", "grid north δV_N"), 1.0, "m/s"),
+    "position": ((5, 6, 7), ("ECEF δx", "ECEF δy", "ECEF δz"), 1000.0, "km"),
+}
+
+
+def plot_error_histories(result, kind, *, run=0, title=None):
+    """Figs. 4-6 / 8-10 equivalents: error histories of one run, calibrated (solid) and reset
+    only (dashed), with the fix times marked.  ``kind``: "attitude", "velocity" or "position"."""
+    import matplotlib.pyplot as plt
+
+    if kind not in _PANELS:
+        raise ValueError(f"kind must be one of {sorted(_PANELS)}")
+    if result.errors_reset_only.shape[0] <= run:
+        raise ValueError(f"run {run} has no reset-only continuation; simulate with reset_only_runs > {run}")
+    cols, labels, scale, unit = _PANELS[kind]
+    fig, axes = plt.subplots(len(cols), 1, figsize=(7.5, 1.9 * len(cols) + 0.6), sharex=True)
+    th = result.t / units.HOUR
+    for ax, c, lab in zip(axes, cols, labels):
+        ax.plot(th, result.errors_reset_only[run, :, c] / scale, "C0--", lw=1.0, label="reset only")
+        ax.plot(th, result.errors[run, :, c] / scale, "C3-", lw=1.0, label="two-point calibration")
+        for tf in result.scenario.fix_times:
+            ax.axvline(tf / units.HOUR, color="0.6", lw=0.8, ls=":")
+        ax.set_ylabel(f"{lab} ({unit})")
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="best", fontsize=8)
+    axes[-1].set_xlabel("time (h)")
+    if title:
+        axes[0].set_title(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_drift_estimates(result, *, axis="X", paper_mean=None, estimators=ESTIMATORS):
+    """Fig. 7 equivalent: the per-run drift estimates of one body axis (°/h), with the true drift
+    and, if given, the paper's mean."""
+    import matplotlib.pyplot as plt
+
+    j = "XYZ".index(axis)
+    fig, ax = plt.subplots(figsize=(7.0, 3.2))
+    n = result.estimates[estimators[0]].shape[0]
+    for k, name in enumerate(estimators):
+        ax.plot(np.arange(1, n + 1), result.estimates[name][:, j] / units.DEG_PER_H, "os^"[k % 3],
+                ms=4, label=f"estimate ({name})")
+    ax.axhline(result.scenario.gyro_drift[j] / units.DEG_PER_H, color="k", lw=1, label="true drift")
+    if paper_mean is not None:
+        ax.axhline(paper_mean, color="C2", ls="--", lw=1, label="paper mean")
+    ax.set_xlabel("run")
+    ax.set_ylabel(f"{axis}-axis drift estimate (°/h)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig

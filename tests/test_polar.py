@@ -247,6 +247,24 @@ def test_kernel_gravity_and_truth_kinematics():
                 assert abs(np.angle(np.exp(1j * head))) < 1e-6 or abs(abs(head) - np.pi) < 1e-6
 
 
+def test_truth_rocking_matches_trajectory_ship_rocking():
+    """Our in-kernel eq. (28) (needed per step inside numba) against the navigation core's
+    ShipRocking segment at 85°N, where the ENU angles of both are defined."""
+    from replication import trajectory as tr
+
+    sc = polar.fang2020_scenario(1)
+    ph = np.array([0.4, 2.2, 5.1])
+    seg = tr.ShipRocking(600.0, phases=tuple(ph), heading0=np.pi / 2, course=np.pi / 2)
+    tau = np.array([0.0, 3.3, 47.25, 599.0])
+    hpr, _, v, _ = seg.profile(tau, None)
+    for j, t in enumerate(tau):
+        cbe, re, rde = polar.true_state(sc, t, ph[None])
+        lat, lon, _ = earth.ecef_to_geodetic(re[0])
+        head, pitch, roll = polar.euler_from_attitude(enu_frame(lat, lon) @ cbe[0])
+        assert np.allclose([head, pitch, roll], hpr[j], atol=1e-9)
+        assert np.allclose(enu_frame(lat, lon) @ rde[0], v[j], atol=1e-9)
+
+
 def test_attitude_convention_matches_scipy():
     h, p, r = 0.7, -0.05, 0.08
     c = polar.attitude_from_euler(h, p, r)
