@@ -9,6 +9,9 @@ chen2019 eq. (3-1).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from functools import lru_cache
+
 import numpy as np
 
 # --- defining and derived WGS-84 constants (NIMA TR8350.2 tables 3.1, 3.3) ---------------
@@ -123,55 +126,292 @@ def normal_gravity(lat, h=0.0):
     return g0 * (1.0 - 2.0 / A * (1.0 + F + M_RATIO - 2.0 * F * s2) * h + 3.0 * h**2 / A**2)
 
 
-def normal_gravity_series(lat, h=0.0):
-    """The standard series form of WGS-84 normal gravity with height terms (m/s^2).
+E_LINEAR = float(np.sqrt(A**2 - B**2))
+"""Linear eccentricity E = sqrt(a² - b²) (m)."""
 
-    γ = 9.7803253359 (1 + 0.0053024 sin²L - 0.0000058 sin²2L)
-        - (3.0877e-6 - 4.4e-9 sin²L) h + 7.2e-14 h²
-    (the form chen2019 eq. (3-1) intends; e.g. Groves 2013 and common navigation texts).
+
+def _q(u):
+    """Legendre function of the second kind q(u) = ½[(1 + 3u²/E²) arctan(E/u) - 3u/E]."""
+    return 0.5 * ((1.0 + 3.0 * u**2 / E_LINEAR**2) * np.arctan(E_LINEAR / u) - 3.0 * u / E_LINEAR)
+
+
+def _q_prime(u):
+    """q'(u) = 3(1 + u²/E²)(1 - (u/E) arctan(E/u)) - 1."""
+    return 3.0 * (1.0 + u**2 / E_LINEAR**2) * (1.0 - u / E_LINEAR * np.arctan(E_LINEAR / u)) - 1.0
+
+
+def normal_gravity_closed_form(lat, h=0.0):
+    """Normal gravity magnitude of the WGS-84 ellipsoid at any height, in closed form (m/s^2).
+
+    The exact normal field of the level ellipsoid (a, f, GM, ω) in ellipsoidal coordinates
+    (u, β): NIMA TR8350.2 §4 (normal gravity above the ellipsoid), Heiskanen & Moritz (1967)
+    ch. 2 (ellipsoidal harmonics):
+
+        γ_u = -[GM/(u²+E²) + ω²a²E q'(u)/((u²+E²) q(b)) (½ sin²β - 1/6)]/w + ω² u cos²β / w
+        γ_β = [-ω²a² q(u)/(√(u²+E²) q(b)) + ω² √(u²+E²)] sinβ cosβ / w,
+        w = √((u² + E² sin²β)/(u² + E²)),   γ = √(γ_u² + γ_β²).
+
+    No series truncation: this is the reference for every series form (chen2019 eq. (3-1)).
+    On the ellipsoid it equals Somigliana's formula :func:`normal_gravity_ellipsoid`.
     """
     lat = check_latitude(lat)
+    h = _check_height(h)
+    _, rn = radii(lat)
+    p = (rn + h) * np.cos(lat)
+    z = (rn * (1.0 - E2) + h) * np.sin(lat)
+    e2l = E_LINEAR**2
+    r2 = p**2 + z**2
+    u2 = 0.5 * (r2 - e2l) * (1.0 + np.sqrt(1.0 + 4.0 * e2l * z**2 / (r2 - e2l) ** 2))
+    u = np.sqrt(u2)
+    beta = np.arctan2(z * np.sqrt(u2 + e2l), u * np.abs(p))
+    sb, cb = np.sin(beta), np.cos(beta)
+    w = np.sqrt((u2 + e2l * sb**2) / (u2 + e2l))
+    q0 = _q(B)
+    gu = (-(GM / (u2 + e2l) + OMEGA_IE**2 * A**2 * E_LINEAR * _q_prime(u) / ((u2 + e2l) * q0)
+            * (0.5 * sb**2 - 1.0 / 6.0)) + OMEGA_IE**2 * u * cb**2) / w
+    gb = (-OMEGA_IE**2 * A**2 * _q(u) / (np.sqrt(u2 + e2l) * q0) + OMEGA_IE**2 * np.sqrt(u2 + e2l)) * sb * cb / w
+    return np.hypot(gu, gb)
+
+
+def _check_height(h, name: str = "height"):
     h = np.asarray(h, dtype=float)
+    if not np.all(np.isfinite(h)):
+        raise ValueError(f"{name} must be finite (metres above the ellipsoid)")
+    if np.any(h <= -B + 1000.0):
+        raise ValueError(f"{name} {float(np.min(h)):.6g} m lies deep inside the Earth; heights are metres")
+    return h
+
+
+# --------------------------------------------------------------------------- series forms
+
+SERIES_TERMS = ("gamma_e", "k1", "k2", "h1", "h1s", "h2")
+"""Coefficients of the series form γ = γ_e(1 + k1 sin²L - k2 sin²2L) - (h1 - h1s sin²L) h + h2 h²."""
+
+
+@dataclass(frozen=True)
+class SeriesCoefficients:
+    """Coefficients of the normal-gravity series, symbolic (sympy) and numeric (SI).
+
+    ``symbolic[name]`` is the sympy expression it was derived from, ``numeric[name]`` its WGS-84
+    value; ``extra`` holds by-products of the derivation (e.g. the h² coefficient at the pole).
+    """
+
+    numeric: dict
+    symbolic: dict
+    height_model: str
+    extra: dict
+    symbolic_extra: dict = None
+
+    def __getitem__(self, name):
+        return self.numeric[name]
+
+
+def _wgs84_symbols():
+    import sympy as sp
+
+    a, f, gm, om = sp.symbols("a f GM omega", positive=True)
+    b = a * (1 - f)
+    values = {a: sp.Float(A, 30), f: 1 / sp.Float(298.257223563, 30), gm: sp.Float(GM, 30),
+              om: sp.Float(OMEGA_IE, 30)}
+    return sp, a, f, gm, om, b, values
+
+
+@lru_cache(maxsize=None)
+def normal_gravity_series_coefficients(height_model: str = "closed-form") -> SeriesCoefficients:
+    """Series coefficients of WGS-84 normal gravity, derived symbolically with sympy.
+
+    The form is that of chen2019 eq. (3-1) once repaired:
+    ``γ = γ_e(1 + k1 sin²L - k2 sin²2L) - (h1 - h1s sin²L) h + h2 h²``.
+
+    Latitude terms, from Somigliana's closed form γ_0 = γ_e(1 + k sin²L)/√(1 - e² sin²L)
+    (NIMA TR8350.2 eq. 4-1): with s = sin²L, γ_0/γ_e = 1 + c1 s + c2 s² + O(e⁶ s³) and
+    s² = s - ¼ sin²2L, so k2 = c2/4; k1 is fixed so that the series is exact at the poles,
+    k1 = γ_p/γ_e - 1 = (1+k)/√(1-e²) - 1 (the gravity flattening f*), which folds the O(e⁶)
+    remainder into k1 as the GRS80/WGS-84 series does.
+
+    Height terms, ``height_model``:
+
+    * ``"closed-form"`` (default): Taylor coefficients in h of the exact closed form
+      (:func:`normal_gravity_closed_form`, which at the equator and at the pole reduces to a
+      function of u alone): h1 = -∂γ/∂h at the equator, h1s = ∂γ/∂h(pole) - ∂γ/∂h(equator),
+      h2 = ½ ∂²γ/∂h² at the equator;
+    * ``"tr8350"``: the expansion γ_h = γ_0[1 - 2h/a(1 + f + m - 2f sin²L) + 3h²/a²]
+      (NIMA TR8350.2 eq. 4-3, Heiskanen & Moritz 1967 eq. 2-215) multiplied out with the
+      latitude series, keeping terms linear in s in the h term and the constant in h².
+    """
+    if height_model not in ("closed-form", "tr8350"):
+        raise ValueError("height_model must be 'closed-form' or 'tr8350'")
+    sp, a, f, gm, om, b, values = _wgs84_symbols()
+    s, h = sp.symbols("s h", real=True)
+    e2 = f * (2 - f)
+    el = sp.sqrt(a**2 - b**2)
+
+    # exact closed form on the axis (pole, u = b + h) and in the equatorial plane (u² = (a+h)² - E²)
+    def q(u):
+        return sp.Rational(1, 2) * ((1 + 3 * u**2 / el**2) * sp.atan(el / u) - 3 * u / el)
+
+    def qp(u):
+        return 3 * (1 + u**2 / el**2) * (1 - u / el * sp.atan(el / u)) - 1
+
+    u_eq = sp.sqrt((a + h) ** 2 - el**2)
+    w_eq = u_eq / sp.sqrt(u_eq**2 + el**2)
+    gamma_eq = (gm / (u_eq**2 + el**2) - om**2 * a**2 * el * qp(u_eq) / (6 * (u_eq**2 + el**2) * q(b))
+                - om**2 * u_eq) / w_eq
+    u_p = b + h
+    gamma_pole = gm / (u_p**2 + el**2) + om**2 * a**2 * el * qp(u_p) / (3 * (u_p**2 + el**2) * q(b))
+    ge, gp = gamma_eq.subs(h, 0), gamma_pole.subs(h, 0)
+    k = b * gp / (a * ge) - 1
+
+    ks, e2s = sp.symbols("k e2", positive=True)
+    ser = sp.series((1 + ks * s) / sp.sqrt(1 - e2s * s), s, 0, 3).removeO()
+    ser = ser.subs({ks: k, e2s: e2})
+    c2 = ser.coeff(s, 2)
+    sym = {"gamma_e": ge, "k1": gp / ge - 1, "k2": c2 / 4}
+    extra_sym = {"gamma_p": gp, "c1": ser.coeff(s, 1), "c2": c2}
+    if height_model == "closed-form":
+        d1e, d1p = sp.diff(gamma_eq, h).subs(h, 0), sp.diff(gamma_pole, h).subs(h, 0)
+        sym["h1"] = -d1e
+        sym["h1s"] = d1p - d1e
+        sym["h2"] = sp.diff(gamma_eq, h, 2).subs(h, 0) / 2
+        extra_sym["h2_pole"] = sp.diff(gamma_pole, h, 2).subs(h, 0) / 2
+    else:
+        # multiply out with plain symbols (γ_e, k1 stand for their closed forms above)
+        g_e, k_1, m_s = sp.symbols("gamma_e k1 m", positive=True)
+        lin = sp.expand(-g_e * (1 + k_1 * s) * 2 / a * (1 + f + m_s - 2 * f * s))
+        back = {g_e: ge, k_1: sym["k1"], m_s: om**2 * a**2 * b / gm}
+        sym["h1"] = (-lin.coeff(s, 0)).subs(back)
+        sym["h1s"] = lin.coeff(s, 1).subs(back)
+        sym["h2"] = 3 * ge / a**2
+        extra_sym["h1s_s2"] = lin.coeff(s, 2).subs(back)
+        extra_sym["h1_expr"] = -lin.coeff(s, 0)
+        extra_sym["h1s_expr"] = lin.coeff(s, 1)
+    num = {kk: float(sp.N(v.subs(values), 25)) for kk, v in sym.items()}
+    extra = {kk: float(sp.N(v.subs(values), 25)) for kk, v in extra_sym.items() if not kk.endswith("_expr")}
+    extra_sym = {kk: v for kk, v in extra_sym.items() if kk.endswith("_expr")}
+    return SeriesCoefficients(numeric=num, symbolic=sym, height_model=height_model, extra=extra,
+                              symbolic_extra=extra_sym)
+
+
+def gravity_series_form(lat, h, coefficients, *, third_term: str = "sin2_2L", trailing_L: bool = False):
+    """Evaluate the series form of chen2019 eq. (3-1) with given coefficients (m/s^2).
+
+    γ = γ_e(1 + k1 sin²L - k2 X)·[L] - (h1 - h1s sin²L) h + h2 h²,
+    X = sin²2L (``third_term="sin2_2L"``, the standard form) or sin²L (``"sin2L"``, as printed);
+    ``trailing_L=True`` multiplies the bracket by L in radians, as printed.  ``coefficients`` is
+    a mapping with the keys of :data:`SERIES_TERMS` in SI units.
+    """
+    lat = check_latitude(lat)
+    h = _check_height(h)
+    missing = [t for t in SERIES_TERMS if t not in coefficients]
+    if missing:
+        raise ValueError(f"coefficients lack {missing}; need {SERIES_TERMS}")
+    if third_term not in ("sin2_2L", "sin2L"):
+        raise ValueError("third_term must be 'sin2_2L' or 'sin2L'")
+    c = {t: float(coefficients[t]) for t in SERIES_TERMS}
     s2 = np.sin(lat) ** 2
-    return (
-        GAMMA_E * (1.0 + 0.0053024 * s2 - 0.0000058 * np.sin(2.0 * lat) ** 2)
-        - (3.0877e-6 - 4.4e-9 * s2) * h
-        + 7.2e-14 * h**2
-    )
+    x = np.sin(2.0 * lat) ** 2 if third_term == "sin2_2L" else s2
+    bracket = c["gamma_e"] * (1.0 + c["k1"] * s2 - c["k2"] * x)
+    if trailing_L:
+        bracket = bracket * lat
+    return bracket - (c["h1"] - c["h1s"] * s2) * h + c["h2"] * h**2
 
 
-def normal_gravity_chen2019_printed(lat, h=0.0):
+def normal_gravity_series(lat, h=0.0, coefficients=None):
+    """Normal gravity from the series form with sympy-derived coefficients (m/s^2).
+
+    γ = γ_e(1 + k1 sin²L - k2 sin²2L) - (h1 - h1s sin²L) h + h2 h², the form chen2019
+    eq. (3-1) intends, with the coefficients of :func:`normal_gravity_series_coefficients`
+    (closed-form height terms) unless ``coefficients`` is given.
+    """
+    if coefficients is None:
+        coefficients = normal_gravity_series_coefficients().numeric
+    return gravity_series_form(lat, h, coefficients)
+
+
+EQ_3_1_QUANTITIES = {
+    "gamma_e": "leading factor (gamma_e)",
+    "k1": "coefficient of sin^2 L",
+    "k2": "coefficient of the third bracket term",
+    "h1": "height coefficient",
+    "h1s": "height-latitude coefficient (sin^2 L h)",
+    "h2": "height-squared coefficient",
+}
+"""Quantity names of the printed coefficients in ``data/paper/chen2019/chen2019-eq-3-1.csv``."""
+
+
+def eq_3_1_coefficients(paper) -> dict:
+    """The printed coefficients of chen2019 eq. (3-1) in SI from its paper-value table.
+
+    ``paper`` is the :class:`~replication.reproduction.PaperTable` of ``chen2019-eq-3-1``
+    (printed mantissa × ``si_factor``).
+    """
+    data = paper.data.set_index("quantity")
+    out = {}
+    for term, q in EQ_3_1_QUANTITIES.items():
+        if q not in data.index:
+            raise ValueError(f"paper table {paper.table_id} has no quantity {q!r}")
+        out[term] = float(data.loc[q, "value"]) * float(data.loc[q, "si_factor"])
+    return out
+
+
+def normal_gravity_chen2019_printed(lat, h, coefficients):
     """chen2019 eq. (3-1) evaluated literally as printed (m/s^2).
 
     γ = 9.7803253 × (1 + 0.0053022 sin²L - 0.0000058 sin²L) L - (3.0877 - 0.0044 sin²L)e-6 h
-        + 0.072e-12 h².
-    The trailing factor L (latitude in radians) and the sin²L in place of sin²2L are kept
-    exactly as printed so that the defect can be quantified; see the normal-gravity chapter.
+        + 0.072e-12 h², with the printed coefficients passed in ``coefficients`` (see
+    :func:`eq_3_1_coefficients`).  The trailing factor L (radians) and sin²L in the third
+    term are kept exactly as printed so that each defect can be quantified.
     """
-    lat = check_latitude(lat)
-    h = np.asarray(h, dtype=float)
-    s2 = np.sin(lat) ** 2
-    return (
-        9.7803253 * (1.0 + 0.0053022 * s2 - 0.0000058 * s2) * lat
-        - (3.0877 - 0.0044 * s2) * 1e-6 * h
-        + 0.072e-12 * h**2
-    )
+    return gravity_series_form(lat, h, coefficients, third_term="sin2L", trailing_L=True)
 
 
-def normal_gravity_chen2019_corrected(lat, h=0.0):
-    """chen2019 eq. (3-1) with the extraction defects repaired (m/s^2).
+def normal_gravity_chen2019_repaired(lat, h, coefficients):
+    """chen2019 eq. (3-1) with its typographic defects repaired (m/s^2).
 
-    The trailing ``L`` dropped and sin²L in the third term restored to sin²2L; the printed
-    coefficients 9.7803253 and 0.0053022 are kept as printed.
+    The trailing L is dropped and sin²L in the third term restored to sin²2L; the coefficients
+    are those passed in (the printed ones, or corrected ones).
     """
-    lat = check_latitude(lat)
-    h = np.asarray(h, dtype=float)
-    s2 = np.sin(lat) ** 2
-    return (
-        9.7803253 * (1.0 + 0.0053022 * s2 - 0.0000058 * np.sin(2.0 * lat) ** 2)
-        - (3.0877 - 0.0044 * s2) * 1e-6 * h
-        + 0.072e-12 * h**2
-    )
+    return gravity_series_form(lat, h, coefficients, third_term="sin2_2L", trailing_L=False)
+
+
+EQ_3_1_DEFECTS = ("trailing_L", "third_term_sin2L", "k1", "h2")
+"""The defects of the printed chen2019 eq. (3-1) that :func:`eq_3_1_defect_effects` isolates."""
+
+
+def eq_3_1_variant(lat, h, printed, corrected, defects=()):
+    """chen2019 eq. (3-1) with only the named ``defects`` (of :data:`EQ_3_1_DEFECTS`) present.
+
+    ``printed`` and ``corrected`` are coefficient mappings; the coefficient defects ``k1`` and
+    ``h2`` take the printed value when present and the corrected one otherwise; all other
+    coefficients are the printed ones.
+    """
+    unknown = set(defects) - set(EQ_3_1_DEFECTS)
+    if unknown:
+        raise ValueError(f"unknown defects {sorted(unknown)}; known: {EQ_3_1_DEFECTS}")
+    c = dict(printed)
+    for term in ("k1", "h2"):
+        if term not in defects:
+            c[term] = corrected[term]
+    return gravity_series_form(lat, h, c, third_term="sin2L" if "third_term_sin2L" in defects else "sin2_2L",
+                               trailing_L="trailing_L" in defects)
+
+
+def eq_3_1_defect_effects(lat, h, printed, corrected, reference=None):
+    """Size of each defect of chen2019 eq. (3-1) on a grid, in mGal.
+
+    For each defect d: max |γ(only d present) - γ(no defect)| over the grid (``lat`` radians,
+    ``h`` metres, broadcast together).  Also the whole print and the fully corrected form
+    against ``reference`` (default: the closed form).  Returns a dict name → mGal.
+    """
+    lat, h = np.broadcast_arrays(np.asarray(lat, float), np.asarray(h, float))
+    ref = normal_gravity_closed_form(lat, h) if reference is None else reference
+    clean = eq_3_1_variant(lat, h, printed, corrected)
+    out = {d: float(np.max(np.abs(eq_3_1_variant(lat, h, printed, corrected, (d,)) - clean))) / MGAL
+           for d in EQ_3_1_DEFECTS}
+    out["all defects (literal print) vs closed form"] = float(
+        np.max(np.abs(eq_3_1_variant(lat, h, printed, corrected, EQ_3_1_DEFECTS) - ref))) / MGAL
+    out["corrected form vs closed form"] = float(np.max(np.abs(clean - ref))) / MGAL
+    return out
 
 
 def gravity_enu(lat, h=0.0):
@@ -202,6 +442,11 @@ def ecef_to_geodetic(r):
     lon = np.arctan2(y, x)
     p = np.hypot(x, y)
     lat = np.arctan2(z, p * (1.0 - E2))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return _bowring(p, z, lat, lon)
+
+
+def _bowring(p, z, lat, lon):
     for _ in range(6):
         _, rn = radii(lat)
         h = np.where(np.abs(lat) < np.radians(80), p / np.maximum(np.cos(lat), 1e-300) - rn,
