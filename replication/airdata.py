@@ -555,8 +555,7 @@ def sins_error_matrix(point):
     out = {"F": F, "G_gyro": G_gyro, "G_accel": G_accel}
     for i, a in enumerate(names):
         for j, b in enumerate(names):
-            key = f"M_{a}{b}" if a != b else f"M_{a}{a}"
-            out[key.replace("M_phiphi", "M_phiphi")] = F[3 * i:3 * i + 3, 3 * j:3 * j + 3]
+            out[f"M_{a}{b}"] = F[3 * i:3 * i + 3, 3 * j:3 * j + 3]
     return out
 
 
