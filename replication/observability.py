@@ -56,11 +56,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import errors as E
-from .kalman import update, van_loan
+from .kalman import discretize_series, update
 
 __all__ = ["observability_matrix", "stripped_observability_matrix", "total_observability_matrix", "som_condition",
            "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
-           "covariance_observability", "segment_bounds", "spearman"]
+           "covariance_observability", "segment_bounds", "spearman", "CHEN2019_MANEUVERS", "Maneuver",
+           "chen2019_maneuvers", "degrees_table", "covariance_table", "rank_metrics", "best_scenario_counts"]
 
 
 # ----------------------------------------------------------------------------- validation
@@ -135,7 +136,7 @@ def som_condition(F, H, n_powers=None, rtol: float = 1e-9) -> bool:
     Null space by SVD with the relative tolerance ``rtol``."""
     F, H = _FH(F, H)
     Q = observability_matrix(F, H, n_powers)
-    _, s, Vt = np.linalg.svd(Q)
+    _, s, Vt = np.linalg.svd(Q, full_matrices=Q.shape[0] < Q.shape[1])
     tol = rtol * (s[0] if s.size and s[0] > 0 else 1.0)
     rank = int(np.sum(s > tol))
     N = Vt[rank:].T
@@ -211,8 +212,8 @@ def observability_degrees(Q, *, assignment: str = "state", normalize: str | None
         Q = Q * d
     elif state_scale is not None:
         raise ValueError("state_scale is only used with normalize='scale'")
-    _, s, Vt = np.linalg.svd(Q, full_matrices=True)
-    V = Vt.T                                   # n × n; columns beyond len(s) span the exact null space
+    _, s, Vt = np.linalg.svd(Q, full_matrices=m < n)   # Vt is n × n either way (U is never needed)
+    V = Vt.T                                   # columns beyond len(s) span the exact null space
     sig = np.zeros(n)
     sig[:len(s)] = s
     tol = float(sig[0] * max(m, n) * np.finfo(float).eps) if n else 0.0
@@ -315,12 +316,16 @@ def pwcs_observability(model, traj, spans, *, n_powers=None, evaluate: str = "mi
 
 
 def covariance_observability(model, traj, t0: float, t1: float, *, update_interval: float = 1.0, R=None, P0=None,
-                             states=None, lever_arm_b=(0.0, 0.0, 0.0), return_history: bool = False):
+                             states=None, lever_arm_b=(0.0, 0.0, 0.0), return_history: bool = False,
+                             series_order: int = 8):
     """Covariance-based observability √(P0_kk / P_kk(t1)) of every state over [t0, t1].
 
     Kalman covariance recursion of ``model`` along the *true* trajectory (the error-state
     linearization point): every ``update_interval`` seconds Φ, Q_d by Van Loan
-    (:func:`replication.kalman.van_loan`) with F and G Q Gᵀ at the interval midpoint, then a
+    series (:func:`replication.kalman.discretize_series`, order ``series_order``; the products of
+    F decay through the 1/R couplings, so order 8 is exact to rounding for intervals of a few
+    seconds — tests/test_observability.py compares with scipy's expm) with F and G Q Gᵀ at the
+    interval midpoint, then a
     Joseph-form update with the 6-dim measurement of :func:`replication.models.measurement_matrix`
     (position in metres) and noise covariance ``R`` (6×6, m² and (m/s)²).  ``P0`` defaults to
     ``model.P0()``; states with zero prior variance are reported as NaN.  ``states`` restricts
@@ -357,7 +362,7 @@ def covariance_observability(model, traj, t0: float, t1: float, *, update_interv
         p = E.NavPoint.from_trajectory(traj, _sample(traj, 0.5 * (ta + tb)))
         F = model.F(p)[np.ix_(idx, idx)]
         Qc = model.G_Qc(p.C_bn)[np.ix_(idx, idx)]
-        Phi, Qd = van_loan(F, Qc, update_interval)
+        Phi, Qd = discretize_series(F, Qc, update_interval, series_order)
         P = Phi @ P @ Phi.T + Qd
         pe = E.NavPoint.from_trajectory(traj, _sample(traj, tb))
         H = measurement_matrix(model, pe, lever_arm_b)[:, idx]
@@ -385,3 +390,122 @@ def spearman(a, b) -> float:
     if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
         raise ValueError("spearman needs finite values")
     return float(stats.spearmanr(a, b).statistic)
+
+
+# ----------------------------------------------------------------------------- chen2019 Fig. 2-3 scenarios
+
+CHEN2019_MANEUVERS = ("before maneuver", "U-turn", "figure-8", "S-turn")
+"""Columns of chen2019 Table 2-3 (机动前, U 型机动, 8 字型机动, S 型机动)."""
+
+
+@dataclass
+class Maneuver:
+    """A Fig. 2-3 scenario: the trajectory, the end of the straight "before maneuver" leg
+    ``t_start`` and the end of the maneuver ``t_end`` (the trajectory may continue straight)."""
+
+    name: str
+    traj: object
+    t_start: float
+    t_end: float
+
+    def spans(self, n_segments: int = 16, before_segments: int = 1) -> list:
+        """PWCS segments: ``before_segments`` equal segments over the straight leg [0, t_start]
+        followed by ``n_segments`` over the maneuver [t_start, t_end] (none for the straight
+        scenario)."""
+        out = segment_bounds(0.0, self.t_start, before_segments)
+        if self.t_end > self.t_start:
+            out += segment_bounds(self.t_start, self.t_end, n_segments)
+        return out
+
+
+def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure_eight: float = 1600.0,
+                       s_turn: float = 1200.0, s_swing: float = math.pi, s_cycles: int = 2, total: float | None = None,
+                       dt: float = 1.0) -> dict:
+    """The maneuvers of chen2019 Fig. 2-3 at the flight conditions of Table 4-41/4-42 (47°N,
+    115°E, 6000 m, heading 45°, 100 m/s, constant speed and height, coordinated turns):
+
+    * ``before maneuver`` — straight and level flight;
+    * ``U-turn`` — straight leg, clockwise 180° turn in ``u_turn`` s (Table 4-42: 400 s);
+    * ``figure-8`` — straight leg, a full right then a full left turn in ``figure_eight`` s (not
+      in Table 4-42; the default 1600 s keeps the U-turn's mean turn rate, 0.45°/s);
+    * ``S-turn`` — straight leg, S-maneuver of ``s_turn`` s (Table 4-42: 1200 s) swinging
+      ``s_swing`` rad ``s_cycles`` times (not printed; :func:`replication.trajectory.chen2019_flight`'s choice).
+
+    Every scenario starts with ``straight`` s (Table 4-42's first leg: 100 s).  With ``total``
+    every trajectory is continued straight (the straight scenario extended) to ``total`` s, so
+    that time-dependent measures (:func:`covariance_observability`) compare equal durations.
+    Returns ``{name: Maneuver}`` in the order of :data:`CHEN2019_MANEUVERS`.
+    """
+    from . import trajectory as tr
+
+    for nm, v in (("straight", straight), ("u_turn", u_turn), ("figure_eight", figure_eight), ("s_turn", s_turn)):
+        if not (v > 0 and math.isfinite(v)):
+            raise ValueError(f"{nm} must be a positive duration in seconds, got {v}")
+    _, init = tr.chen2019_flight()
+    man = {"before maneuver": [], "U-turn": [tr.UTurn(u_turn)], "figure-8": [tr.FigureEight(figure_eight)],
+           "S-turn": [tr.STurn(s_turn, swing=s_swing, cycles=int(s_cycles))]}
+    longest = straight + max(u_turn, figure_eight, s_turn)
+    if total is not None and total < longest:
+        raise ValueError(f"total ({total} s) must cover the longest scenario ({longest} s)")
+    out = {}
+    for name, segs in man.items():
+        dur = straight + sum(s.duration for s in segs)
+        extra = [] if total is None or total - dur <= 0 else [tr.Straight(total - dur)]
+        traj = tr.generate([tr.Straight(straight)] + segs + extra, dt=dt, **init)
+        out[name] = Maneuver(name, traj, straight, dur)
+    return out
+
+
+def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, before_segments: int = 1, **kw):
+    """PWCS observability degrees of ``states`` for every scenario of ``maneuvers`` (from
+    :func:`chen2019_maneuvers`) as a DataFrame (rows: states, columns: scenarios).  The
+    straight scenario uses its straight leg only; ``kw`` goes to :func:`pwcs_observability`.
+    Also returns, in ``df.attrs["rank_tol"]``, each scenario's numerical-rank tolerance."""
+    import pandas as pd
+
+    cols, tols = {}, {}
+    for name, mv in maneuvers.items():
+        d = pwcs_observability(model, mv.traj, mv.spans(n_segments, before_segments), states=states, **kw)
+        cols[name] = d.degree
+        tols[name] = d.rank_tol
+    df = pd.DataFrame(cols, index=list(states))
+    df.attrs["rank_tol"] = tols
+    return df
+
+
+def covariance_table(model, maneuvers: dict, R, *, states, update_interval: float = 2.0, P0=None):
+    """√(P0/P) (:func:`covariance_observability`) over each scenario's whole trajectory, as a
+    DataFrame (rows: states, columns: scenarios)."""
+    import pandas as pd
+
+    cols = {}
+    for name, mv in maneuvers.items():
+        cols[name] = covariance_observability(model, mv.traj, 0.0, float(mv.traj.t[-1]), update_interval=update_interval,
+                                              R=R, P0=P0, states=states)
+    return pd.DataFrame(cols, index=list(states))
+
+
+def rank_metrics(reference, reproduced, *, reference_threshold: float, reproduced_threshold):
+    """Agreement of two observability tables (rows: states, columns: scenarios): per column the
+    Spearman rank correlation, the number of states whose verdict (observable: degree above the
+    column's threshold) agrees, and the counts of unobservable states.  ``reproduced_threshold``
+    is a number or a {column: threshold} mapping.  Returns a DataFrame indexed by column."""
+    import pandas as pd
+
+    if list(reference.columns) != list(reproduced.columns) or list(reference.index) != list(reproduced.index):
+        raise ValueError("the two tables must have the same states (rows) and scenarios (columns) in the same order")
+    rows = []
+    for c in reference.columns:
+        thr = reproduced_threshold[c] if isinstance(reproduced_threshold, dict) else float(reproduced_threshold)
+        a, b = reference[c].to_numpy(float), reproduced[c].to_numpy(float)
+        va, vb = a > reference_threshold, b > thr
+        rows.append(dict(scenario=c, spearman=spearman(a, b), verdicts_agree=int(np.sum(va == vb)),
+                         unobservable_reference=int(np.sum(~va)), unobservable_reproduced=int(np.sum(~vb))))
+    return pd.DataFrame(rows).set_index("scenario")
+
+
+def best_scenario_counts(table, exclude=("before maneuver",)):
+    """For every state, the scenario with the largest degree (``exclude``d columns ignored);
+    returns the number of states won by each scenario (a Series)."""
+    t = table.drop(columns=[c for c in exclude if c in table.columns])
+    return t.idxmax(axis=1).value_counts().reindex(t.columns, fill_value=0)

@@ -148,3 +148,42 @@ def test_bad_inputs():
         O.piecewise_systems("model", None, [(0, 1)])
     with pytest.raises(ValueError, match="spearman"):
         O.spearman([1, 2], [2, 1])
+
+
+def test_series_discretization_matches_expm(flight):
+    """The covariance recursion's order-8 series (Φ, Q_d) equals Van Loan's expm to 1e-9 of
+    the largest element over a 2 s interval in a turn (F's products decay through the 1/R
+    couplings: the truncated terms are below (ω_s T)^8 / 8!)."""
+    from replication import errors as E
+    from replication.kalman import discretize_series, van_loan
+    m = M.model_45(accel_markov_sigma=1e-4, gyro_markov_sigma=1e-8, gravity_sigma=1e-4, accel_psd=1e-8, gyro_psd=1e-14)
+    p = E.NavPoint.from_trajectory(flight, 200)
+    F, Qc = m.F(p), m.G_Qc(p.C_bn)
+    P1, Q1 = discretize_series(F, Qc, 2.0, 8)
+    P2, Q2 = van_loan(F, Qc, 2.0)
+    assert np.abs(P1 - P2).max() <= 1e-9 * np.abs(P2).max()
+    assert np.abs(Q1 - Q2).max() <= 1e-9 * np.abs(Q2).max()
+
+
+def test_chen2019_maneuvers_and_tables():
+    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
+    assert list(mv) == list(O.CHEN2019_MANEUVERS)
+    assert all(abs(m.traj.t[-1] - 260.0) < 1e-9 for m in mv.values())
+    # headings: the U-turn reverses the course, the figure-8 and the S-turn return to it
+    h = {k: np.degrees(m.traj.hpr[int(m.t_end), 0]) % 360 for k, m in mv.items()}
+    assert h["U-turn"] == pytest.approx(225.0, abs=1e-6)
+    assert h["figure-8"] == pytest.approx(45.0, abs=1e-6) and h["S-turn"] == pytest.approx(45.0, abs=1e-6)
+    assert mv["before maneuver"].spans(8) == [(0.0, 20.0)]
+    assert len(mv["U-turn"].spans(8, 2)) == 10
+    m = M.model_45()
+    st = m.labels[:9] + M.table_2_3_states()[3:]
+    df = O.degrees_table(m, mv, states=st, n_segments=4)
+    assert df.shape == (33, 4) and set(df.attrs["rank_tol"]) == set(O.CHEN2019_MANEUVERS)
+    met = O.rank_metrics(df, df, reference_threshold=1e-5, reproduced_threshold=1e-5)
+    assert np.allclose(met["spearman"], 1.0) and (met["verdicts_agree"] == 33).all()
+    best = O.best_scenario_counts(df)
+    assert best.sum() == 33 and list(best.index) == ["U-turn", "figure-8", "S-turn"]
+    with pytest.raises(ValueError, match="total"):
+        O.chen2019_maneuvers(total=10.0)
+    with pytest.raises(ValueError, match="same states"):
+        O.rank_metrics(df, df.iloc[:5], reference_threshold=1e-5, reproduced_threshold=1e-5)
