@@ -78,7 +78,7 @@ __all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "EXTEND_ORDER_45", "NAV_SYM
            "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
            "measurement_function", "lever_arm_correction", "table_2_3_states", "frozen_earth_jacobian",
            "TABLE_2_2_BLOCKS", "table_2_2_printed", "table_2_2_corrected", "table_2_2_verified",
-           "table_2_2_differences", "TABLE_2_2_CORRECTED_TEXT"]
+           "table_2_2_differences", "TABLE_2_2_CORRECTED_TEXT", "table_2_2_reference_point"]
 
 CHEN2019_45_ORDER = ("accel_bias", "accel_markov", "accel_scale", "accel_misalignment", "gyro_bias",
                      "gyro_markov", "gyro_scale", "gyro_misalignment", "gravity", "lever_arm")
@@ -505,6 +505,15 @@ def _nav_quantities(point):
 TABLE_2_2_BLOCKS = ("F11", "F12", "F21", "F22", "F23", "F31", "F32", "F33", "F41", "F42", "F43", "F51", "F52",
                     "F53", "F6", "F7")
 """The printed sub-blocks of chen2019 Table 2-2's F (F33/F41 are printed twice, identically)."""
+
+
+def table_2_2_reference_point():
+    """A generic evaluation point for the Table 2-2 comparison: the chen2019 flight conditions
+    (47°N, 115°E, 6000 m, heading ≈ 45°) with a climb (v_U = 5 m/s), bank, and non-zero
+    components of f^b and ω_ib^b, so that no printed element vanishes by accident."""
+    from .rotations import euler_to_dcm
+    return E.NavPoint(math.radians(47.0), math.radians(115.0), 6000.0, np.array([70.7, 68.0, 5.0]),
+                      euler_to_dcm(0.7, 0.05, 0.17), np.array([0.3, -0.4, 9.7]), np.array([0.01, -0.02, 0.03]))
 
 
 def table_2_2_printed(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.0) -> dict:

@@ -61,7 +61,7 @@ from .kalman import discretize_series, update
 __all__ = ["observability_matrix", "stripped_observability_matrix", "total_observability_matrix", "som_condition",
            "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
            "covariance_observability", "segment_bounds", "spearman", "CHEN2019_MANEUVERS", "Maneuver",
-           "chen2019_maneuvers", "degrees_table", "covariance_table", "rank_metrics", "best_scenario_counts"]
+           "chen2019_maneuvers", "degrees_table", "covariance_table", "rank_metrics", "best_scenario_counts", "unbanked", "sweep"]
 
 
 # ----------------------------------------------------------------------------- validation
@@ -456,6 +456,34 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
     return out
 
 
+def unbanked(traj):
+    """The same track flown *without bank* (flat, skidding turns): roll set to zero, the
+    specific force f^n = C_b^n f^b kept, so the centripetal acceleration V ψ̇ appears on the
+    body x (right) axis; f^b = C'ᵀ f^n and ω_ib^b = ω_nb'^b + C'ᵀ (ω_ie^n + ω_en^n) recomputed
+    with C' = C(ψ, θ, 0) and the heading/pitch rates by central differences of the samples.
+    A kinematic variant for the sensitivity study of the observability degrees (chen2019 does
+    not say how its Fig. 2-3 maneuvers were flown); the increments ``dtheta``/``dv`` are the
+    trapezoid of the new rates (not meant for strapdown accuracy tests)."""
+    from . import earth
+    from .rotations import body_rate_from_euler_rates, euler_to_dcm
+    from .trajectory import Trajectory
+
+    t = np.asarray(traj.t, float)
+    hpr = np.array(traj.hpr, float)
+    f_n = np.einsum("kij,kj->ki", traj.C_bn, traj.f_b)
+    psi = np.unwrap(hpr[:, 0])
+    psi_rate, pitch_rate = np.gradient(psi, t), np.gradient(hpr[:, 1], t)
+    hpr[:, 2] = 0.0
+    C = euler_to_dcm(hpr[:, 0], hpr[:, 1], hpr[:, 2])
+    w_nb = body_rate_from_euler_rates(hpr[:, 0], hpr[:, 1], hpr[:, 2], psi_rate, pitch_rate, np.zeros_like(t))
+    w_in = earth.earth_rate_enu(traj.lat) + earth.transport_rate_enu(traj.lat, traj.h, traj.v_enu)
+    w_ib = w_nb + np.einsum("kji,kj->ki", C, w_in)
+    f_b = np.einsum("kji,kj->ki", C, f_n)
+    dt = np.diff(t)[:, None]
+    return Trajectory(t, traj.lat, traj.lon, traj.h, traj.v_enu, hpr, w_ib, f_b, 0.5 * (w_ib[1:] + w_ib[:-1]) * dt,
+                      0.5 * (f_b[1:] + f_b[:-1]) * dt, list(traj.segments))
+
+
 def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, before_segments: int = 1, **kw):
     """PWCS observability degrees of ``states`` for every scenario of ``maneuvers`` (from
     :func:`chen2019_maneuvers`) as a DataFrame (rows: states, columns: scenarios).  The
@@ -509,3 +537,27 @@ def best_scenario_counts(table, exclude=("before maneuver",)):
     returns the number of states won by each scenario (a Series)."""
     t = table.drop(columns=[c for c in exclude if c in table.columns])
     return t.idxmax(axis=1).value_counts().reindex(t.columns, fill_value=0)
+
+
+def sweep(model, maneuvers: dict, reference, variants: dict, *, states, reference_threshold: float = 1e-5):
+    """Sensitivity of the comparison with ``reference`` (rows: states, columns: scenarios) to
+    the unspecified choices.  ``variants`` maps a name to keyword arguments of
+    :func:`degrees_table` plus optional ``model``, ``maneuvers`` and ``states`` overrides.
+    Returns one row per variant: Spearman ρ per scenario, total verdict agreement (of
+    states × scenarios) and the scenario winning most states."""
+    import pandas as pd
+
+    rows = []
+    for name, spec in variants.items():
+        spec = dict(spec)
+        mdl, mvs, sts = spec.pop("model", model), spec.pop("maneuvers", maneuvers), spec.pop("states", states)
+        table = degrees_table(mdl, mvs, states=sts, **spec)
+        tol = table.attrs["rank_tol"]
+        table = table.loc[list(reference.index)]
+        met = rank_metrics(reference, table, reference_threshold=reference_threshold, reproduced_threshold=tol)
+        row = {"variant": name}
+        row.update({f"ρ {c}": met.loc[c, "spearman"] for c in reference.columns})
+        row["verdicts agree"] = int(met["verdicts_agree"].sum())
+        row["best maneuver"] = best_scenario_counts(table).idxmax()
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("variant")

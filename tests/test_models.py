@@ -198,10 +198,8 @@ def test_bad_inputs():
 def _points(traj):
     """Maneuvering points plus a generic one (climbing, all velocity/force/rate components
     non-zero) so that no element vanishes by accident."""
-    from replication.rotations import euler_to_dcm
     pts = [E.NavPoint.from_trajectory(traj, k) for k in (150, 420, 780)]
-    pts.append(E.NavPoint(47 * DEG, 115 * DEG, 6000.0, np.array([70.7, 68.0, 5.0]), euler_to_dcm(0.7, 0.05, 0.17),
-                          np.array([0.3, -0.4, 9.7]), np.array([0.01, -0.02, 0.03])))
+    pts.append(M.table_2_2_reference_point())
     return pts
 
 
