@@ -638,19 +638,23 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
       back into the increments (:func:`compensated_increments`) and the 15-state filter re-run;
     * ``state`` — steps 2-3: AR(3) fitted (:func:`replication.timeseries.fit_ar`) to the
       direct-difference series sampled every ``ar_interval`` s (default: half the cut-off
-      period, the filter's Nyquist interval), each axis represented in the continuous-time
+      period, the filter's Nyquist interval).  The inversion test (m = 10) is recorded, not
+      enforced: on a series this strongly correlated the segment means are not independent and
+      the test over-rejects; a fit whose poles leave the unit circle is refused.  Each axis is
+      represented in the continuous-time
       filter by the first-order Gauss-Markov block (:func:`replication.errors.gravity_shaping`)
       with the AR model's variance and dominant correlation time; position/velocity updates;
     * ``true-model`` (if ``true_model`` = (sigma_ENU, beta_ENU)) — the same block with the field's
       own statistics.
 
-    Returns {method: {component: error array at ``photos``}} plus ``ar`` (fitted models) and
+    Returns {method: {component: error array at ``photos``}} plus ``ar`` (per axis: phi, sigma2,
+    the model checks and the inversion test) and
     ``dd`` (direct difference and true disturbance at the GNSS epochs).
     """
     from . import errors as er
     from . import kalman as kf
     from . import sensors as se
-    from .timeseries import check_ar_model, fit_ar
+    from .timeseries import check_ar_model, fit_ar, inversion_test
 
     rng = np.random.default_rng(seed)
     lat0, lon0, h0 = origin
@@ -675,10 +679,15 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
     step = int(round(ar_dt / float(np.median(np.diff(gnss.t)))))
     ar = []
     for i in range(3):
-        fit = fit_ar(dd[::step, i], 3, segments=10)
-        ar.append((fit.params, fit.sigma2, check_ar_model(fit.params, fit.sigma2, dt=ar_dt)))
-    sig = np.array([c["std"] for _, _, c in ar])
-    beta = np.array([1.0 / c["correlation_time"] for _, _, c in ar])
+        y = dd[::step, i]
+        inv = inversion_test(y - y.mean(), 10)
+        fit = fit_ar(y, 3, check=False)
+        chk = check_ar_model(fit.params, fit.sigma2, dt=ar_dt)
+        if not chk["stationary"]:
+            raise ValueError(f"axis {'ENU'[i]}: the AR(3) fit is not stationary; lengthen ar_interval or the cut-off")
+        ar.append((fit.params, fit.sigma2, chk, inv))
+    sig = np.array([a[2]["std"] for a in ar])
+    beta = np.array([1.0 / a[2]["correlation_time"] for a in ar])
     r3 = kf.closed_loop(traj.t, dth, dvm, init, gnss, m15.extend(er.gravity_shaping(sig, beta)))
     out["state"] = attitude_position_errors(r3.solution, traj, photos)
     if true_model is not None:
