@@ -263,6 +263,10 @@ def transfer_function(lat, v_east=0.0, v_north=0.0, pair="phiE/gdN", *, radius=N
     num = np.atleast_1d(np.squeeze(tfs.num[0][0])).astype(float)
     den = np.atleast_1d(np.squeeze(tfs.den[0][0])).astype(float)
     num, den = num / den[0], den / den[0]
+    # in the scaled variable every coefficient is O(1); rounding-level ones are structural zeros
+    # (the odd powers of east-west motion)
+    num[np.abs(num) < 1e-11 * np.max(np.abs(num))] = 0.0
+    den[np.abs(den) < 1e-11] = 0.0
     n = len(den) - 1
     # coefficients of s^k in the original variable: c'_k w0^(n-k); the monic scaling w0^n cancels
     num = np.array([c * w0 ** (n - (len(num) - 1 - i)) for i, c in enumerate(num)])
@@ -857,14 +861,19 @@ def proportional_band_edge(sys, pair=None, *, deviation_db=3.0, w_min=1e-7, w_ma
     return float(10 ** brentq(f, np.log10(w[k - 1]), np.log10(w[k]), xtol=1e-12))
 
 
-def cutoff_frequency(sys, pair=None, *, drop_db=3.0, w_min=1e-7, w_max=10.0, n=4000):
-    """Cut-off frequency: the ω above which |G(jω)| stays ``drop_db`` dB below |G(0)|.
+def cutoff_frequency(sys, pair=None, *, reference=None, drop_db=3.0, w_min=1e-7, w_max=10.0, n=4000):
+    """Cut-off frequency: the ω above which |G(jω)| stays ``drop_db`` dB below a reference gain.
 
-    The highest crossing of |G(0)| - drop_db on a log grid, refined with Brent's method.
+    The reference is |G(0)| by default; pass ``reference=1/g`` (the static tilt gain of
+    eqs. (11)-(12)) for the integrated mode, whose very-low-frequency gain depends on the
+    gyro-bias process noise.  The highest crossing on a log grid, refined with Brent's method.
     """
     if pair is not None:
         sys = siso(sys, pair)
-    g0 = 20 * np.log10(abs(dc_gain(sys)))
+    ref = abs(dc_gain(sys)) if reference is None else abs(float(reference))
+    if not ref > 0:
+        raise ValueError("the reference gain must be positive")
+    g0 = 20 * np.log10(ref)
     w = np.logspace(np.log10(w_min), np.log10(w_max), n)
     above = _db(sys, w) - (g0 - drop_db)
     idx = np.nonzero(above >= 0)[0]
@@ -891,10 +900,12 @@ def noise_sensitivity(lat, v_east, v_north, base: NoiseSettings, factors, pair="
 
     ``factors`` maps a :class:`NoiseSettings` field to the multipliers to try, e.g.
     ``{"gyro_arw": [0.1, 1, 10]}``; every other field stays at ``base``.  Returns a
-    ``DataFrame`` (setting, factor, value, cutoff, slope) for ``pair``; ``slope`` is the
-    :func:`loglog_slope` over ``slope_band``.  an2021 does not print its filter noise: this is
+    ``DataFrame`` (setting, factor, value, cutoff, slope, dc) for ``pair``; ``cutoff`` is
+    relative to the static tilt gain 1/g, ``slope`` the :func:`loglog_slope` over ``slope_band``
+    and ``dc`` the zero-frequency gain times g (1 when the filter keeps the static tilt).  an2021 does not print its filter noise: this is
     the sensitivity of Figs. 5-6 and Table 1 to that unstated choice.
     """
+    _, g = earth_parameters(lat, radius, gravity)
     rows = []
     for field_name, mults in factors.items():
         if not hasattr(base, field_name):
@@ -903,19 +914,21 @@ def noise_sensitivity(lat, v_east, v_north, base: NoiseSettings, factors, pair="
             noise = base.scaled(**{field_name: f})
             sys = siso(integrated_gravity_to_attitude(lat, v_east, v_north, noise, radius=radius, gravity=gravity), pair)
             rows.append(dict(setting=field_name, factor=float(f), value=getattr(noise, field_name),
-                             cutoff=cutoff_frequency(sys, n=n), slope=loglog_slope(sys, *slope_band)))
+                             cutoff=cutoff_frequency(sys, reference=1 / g, n=n), slope=loglog_slope(sys, *slope_band),
+                             dc=abs(dc_gain(sys)) * g))
     return pd.DataFrame(rows)
 
 
 def cutoff_grid(lat, v_east, v_north, base: NoiseSettings, field_a, factors_a, field_b, factors_b,
                 pair="phiE/gdN", *, n=1000, radius=None, gravity=None):
-    """Cut-off frequency of eq. (10) on a grid of two scaled noise settings (rows: ``field_a``)."""
+    """Cut-off frequency (relative to 1/g) of eq. (10) on a grid of two scaled noise settings."""
+    _, g = earth_parameters(lat, radius, gravity)
     out = np.empty((len(factors_a), len(factors_b)))
     for i, fa in enumerate(factors_a):
         for j, fb in enumerate(factors_b):
             noise = base.scaled(**{field_a: fa, field_b: fb})
             sys = siso(integrated_gravity_to_attitude(lat, v_east, v_north, noise, radius=radius, gravity=gravity), pair)
-            out[i, j] = cutoff_frequency(sys, n=n)
+            out[i, j] = cutoff_frequency(sys, reference=1 / g, n=n)
     return pd.DataFrame(out, index=pd.Index(list(factors_a), name=field_a),
                         columns=pd.Index(list(factors_b), name=field_b))
 
