@@ -1,0 +1,1241 @@
+"""chen2019 ch. 4 §2: the simulated SINS/GNSS flight, its sensor errors (Table 4-41), and a
+batched closed-loop Kalman filter with a Rauch-Tung-Striebel smoother pass for the 15-, 36- and
+45-state models.
+
+What this module adds to the navigation core (:mod:`replication.kalman` runs one closed-loop
+filter per call and keeps neither the per-epoch transition matrices nor the prior covariances):
+
+* :func:`table_4_41_setup` — the sensor errors of chen2019 Table 4-41 in SI units, with the two
+  readings the print leaves open made explicit: the unit of the misalignment angle "1.5"
+  (``misalignment_unit``) and the meaning of the Markov "驱动白噪声方差强度" (``markov_reading``);
+  the parameters the report does not print (initial navigation errors, gravity disturbance,
+  lever arm) are this package's stated choices;
+* :func:`simulated_flight` — the Table 4-42 flight from :func:`replication.trajectory.chen2019_flight`;
+* :func:`filter_model` — the 15-state (:func:`replication.errors.model_15`), 36-state
+  (:func:`replication.models.model_36`) and 45-state (:func:`replication.models.model_45`) models
+  built from one setup;
+* :func:`run_batch` — a Monte Carlo of the closed-loop (feedback) filter *batched across runs*:
+  every run has its own truth (sensor errors, Markov paths, gravity disturbance, lever arm, GNSS
+  noise, initial errors), its own strapdown, innovations and feedback; the covariance recursion
+  (Φ, Q_d, P, gain K) is computed once per epoch along the first run's solution and shared —
+  to first order the gain of an error-state filter depends on the trajectory, not on the
+  realisation (the first run is an exact extended filter; the others use its gains, see
+  ``tests/test_simulation.py``).  Optionally the covariance propagated *without* measurements
+  (for the observable subspace of the NEES) and an RTS smoother pass, run backwards chunk by
+  chunk from checkpoints so that memory stays bounded (the forward chunk is replayed with the
+  smoother's inputs Φ_k, P_k⁻, P_k⁺ and the applied corrections stored);
+* diagnostics: NEES of the full state and of the observable subspace (:func:`observable_nees`),
+  χ² bands, attitude RMS with Monte-Carlo confidence intervals, the improvement percentages.
+
+Closed-loop smoothing (derivation used by :func:`_rts_chunk`): let e_k⁺ be the error of the
+solution after feedback at epoch k (navigation: computed − true; sensor states: true −
+compensated, the convention of :mod:`replication.errors`) and x_k the correction applied at
+epoch k (so e_k⁻ = e_k⁺ + x_k).  The filtered estimate of e_k⁺ is 0 with covariance P_k⁺, the
+prediction of e_{k+1}⁻ is 0 with covariance P_{k+1}⁻ = Φ_k P_k⁺ Φ_kᵀ + Q_k.  The RTS recursion
+(Rauch, Tung & Striebel 1965) then reads
+
+    C_k = P_k⁺ Φ_kᵀ (P_{k+1}⁻)⁻¹,   ê_k^s = C_k (ê_{k+1}^s + x_{k+1}),
+    P_k^s = P_k⁺ + C_k (P_{k+1}^s − P_{k+1}⁻) C_kᵀ,
+
+and the smoothed solution's error is e_k⁺ − ê_k^s.  This is :func:`replication.kalman.rts_smoother`
+with x_f = 0 and x_p[k+1] = −x_{k+1}; the test suite checks the two against each other.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
+
+import numpy as np
+from numba import njit
+from scipy import stats
+from scipy.signal import lfilter
+
+from . import earth
+from . import errors as E
+from . import models as M
+from . import _kernels as K
+from .rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
+from .sensors import lever_arm_offset, misalignment_matrix
+from .units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MGAL, MICRO_G
+
+__all__ = ["SimulationSetup", "table_4_41_setup", "MISALIGNMENT_UNITS", "MARKOV_READINGS",
+           "simulated_flight", "segment_summary", "filter_model", "BatchResult", "run_batch",
+           "truth_parameters", "observable_nees", "fraction_in_band", "attitude_errors",
+           "segment_mask", "survey_line_mask", "rms_with_ci", "improvement_percent",
+           "improvement_with_ci", "printed_improvements", "total_bias_estimates"]
+
+MISALIGNMENT_UNITS = {"arcsec": ARCSEC, "arcmin": ARCMIN, "mrad": 1e-3}
+"""Candidate units of Table 4-41's misalignment angle "1.5" (printed without a unit)."""
+
+MARKOV_READINGS = ("stationary", "driving-psd")
+"""Readings of Table 4-41's "一阶马尔科夫过程 ... 驱动白噪声方差强度 (σ)²": ``stationary`` — σ² is
+the variance of the Markov process itself; ``driving-psd`` — σ² is the intensity q (per Hz) of
+the driving noise, whose stationary variance is q τ / 2."""
+
+
+# ----------------------------------------------------------------------------- the setup
+
+@dataclass(frozen=True)
+class SimulationSetup:
+    """Truth and filter parameters of the chen2019 §4.2 simulation, SI units.
+
+    Sensor errors (chen2019 eq. (2-10), Table 4-41), one value per axis:
+    ``*_bias_sd`` random constant (σ of the draw), ``*_markov_sigma``/``*_markov_tau`` first-order
+    Gauss-Markov (stationary σ, correlation time), ``*_white_psd`` white-noise intensity
+    ((rad/s)²·s, (m/s²)²·s), ``scale_sd`` and ``misalignment_sd`` (σ of the draws, both triads).
+    GNSS: ``gnss_rate_hz``, ``sigma_pos`` (E, N, U m), ``sigma_vel`` (m/s).  Not printed by the
+    report (this package's choices): ``position_sd``/``velocity_sd``/``attitude_sd`` (initial
+    navigation errors, E/N/U), ``gravity_sigma``/``gravity_tau`` (eq. (2-12) disturbance per
+    ENU axis), ``lever_arm_b`` (nominal antenna position in the body frame, seen from the IMU)
+    and ``lever_arm_sd`` (σ of its error).  ``random_walk_fraction`` sets the 36-state model's
+    random-walk intensity (see :func:`filter_model`).
+    """
+
+    imu_rate_hz: float
+    gnss_rate_hz: float
+    gyro_bias_sd: float
+    gyro_markov_sigma: float
+    gyro_markov_tau: float
+    gyro_white_psd: float
+    accel_bias_sd: float
+    accel_markov_sigma: float
+    accel_markov_tau: float
+    accel_white_psd: float
+    scale_sd: float
+    misalignment_sd: float
+    sigma_pos: tuple
+    sigma_vel: float
+    position_sd: tuple = (0.03, 0.03, 0.1)
+    velocity_sd: float = 0.03
+    attitude_sd: tuple = (20 * ARCSEC, 20 * ARCSEC, 3 * ARCMIN)
+    gravity_sigma: float = 10 * MGAL
+    gravity_tau: float = 300.0
+    lever_arm_b: tuple = (0.3, 0.8, 1.5)
+    lever_arm_sd: float = 0.05
+    random_walk_fraction: float = 1.0
+    flight_duration: float = 5100.0
+    misalignment_unit: str = "arcsec"
+    markov_reading: str = "stationary"
+
+    def __post_init__(self):
+        for name in ("imu_rate_hz", "gnss_rate_hz", "gyro_markov_tau", "accel_markov_tau", "gravity_tau",
+                     "flight_duration"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be a positive number, got {v!r}")
+        for name in ("gyro_bias_sd", "gyro_markov_sigma", "gyro_white_psd", "accel_bias_sd", "accel_markov_sigma",
+                     "accel_white_psd", "scale_sd", "misalignment_sd", "sigma_vel", "velocity_sd", "gravity_sigma",
+                     "lever_arm_sd", "random_walk_fraction"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v >= 0):
+                raise ValueError(f"{name} must be finite and non-negative (SI units), got {v!r}")
+        step = self.imu_rate_hz / self.gnss_rate_hz
+        if abs(step - round(step)) > 1e-9:
+            raise ValueError(f"the GNSS rate {self.gnss_rate_hz} Hz must divide the IMU rate {self.imu_rate_hz} Hz")
+        for name, n in (("sigma_pos", 3), ("position_sd", 3), ("attitude_sd", 3), ("lever_arm_b", 3)):
+            a = np.asarray(getattr(self, name), float)
+            if a.shape != (n,) or not np.all(np.isfinite(a)):
+                raise ValueError(f"{name} must have {n} finite components, got {getattr(self, name)!r}")
+
+    @property
+    def gnss_step(self) -> int:
+        """IMU samples per GNSS epoch."""
+        return int(round(self.imu_rate_hz / self.gnss_rate_hz))
+
+
+def _printed_base(paper, quantity, unit):
+    v = paper.value(quantity)
+    if not isinstance(v, float) or not math.isfinite(v):
+        raise ValueError(f"Table 4-41 value {quantity!r} is not numeric: {v!r}")
+    got = paper.unit(quantity)
+    if got != unit:
+        raise ValueError(f"Table 4-41 {quantity!r}: expected unit {unit!r}, the file says {got!r}")
+    return v
+
+
+def table_4_41_setup(paper, *, misalignment_unit: str = "arcsec", markov_reading: str = "stationary",
+                     **choices) -> SimulationSetup:
+    """The sensor-error setup of chen2019 Table 4-41 (``paper`` = ``rp.load_paper("chen2019-table-4-41")``).
+
+    Conversions (stated; the print gives squares without a per-Hz unit):
+
+    * random constants: the printed value is the σ of the draw (0.01 °/h, 50 μg);
+    * white noise "方差强度 (σ)²": intensity q = σ² per Hz, e.g. (0.01 °/h)²/Hz → angle random
+      walk 0.01 °/h/√Hz (chen2019 eq. (2-5) white term);
+    * Markov "驱动白噪声方差强度 (σ)²": ``markov_reading="stationary"`` (default) takes σ as the
+      stationary standard deviation of the process; ``"driving-psd"`` takes σ² as the driving
+      intensity q (per Hz), stationary σ_m = σ √(τ/2)
+      (:func:`replication.sensors.markov_sigma_from_driving_psd`);
+    * scale factor 0.00001 (both triads);
+    * misalignment "1.5" in ``misalignment_unit`` (``"arcsec"`` default; ``"arcmin"``,
+      ``"mrad"`` as alternatives, :data:`MISALIGNMENT_UNITS`);
+    * GNSS (0.03 m)², (0.1 m)², (0.03 m/s)² are variances of white errors at each fix.
+
+    ``choices`` override the parameters the report does not print (see :class:`SimulationSetup`).
+    """
+    if misalignment_unit not in MISALIGNMENT_UNITS:
+        raise ValueError(f"misalignment_unit must be one of {sorted(MISALIGNMENT_UNITS)}, got {misalignment_unit!r}")
+    if markov_reading not in MARKOV_READINGS:
+        raise ValueError(f"markov_reading must be one of {MARKOV_READINGS}, got {markov_reading!r}")
+    for q in ("gyro_markov_sigma", "accel_markov_sigma"):
+        if q in choices:
+            raise ValueError(f"{q} comes from Table 4-41 (use markov_reading), not from a keyword")
+    p = paper
+    g_tau = _printed_base(p, "gyro Markov correlation time", "s")
+    a_tau = _printed_base(p, "accelerometer Markov correlation time", "h") * HOUR
+    g_m = _printed_base(p, "gyro Markov driving white-noise variance intensity", "°/h") * DEG_PER_H
+    a_m = _printed_base(p, "accelerometer Markov driving white-noise variance intensity", "μg") * MICRO_G
+    if markov_reading == "driving-psd":
+        g_m, a_m = g_m * math.sqrt(g_tau / 2), a_m * math.sqrt(a_tau / 2)
+    hor = _printed_base(p, "GNSS horizontal position white-noise variance intensity", "m")
+    vert = _printed_base(p, "GNSS height white-noise variance intensity", "m")
+    base = dict(
+        imu_rate_hz=_printed_base(p, "IMU rate", "Hz"),
+        gnss_rate_hz=_printed_base(p, "GNSS rate", "Hz"),
+        gyro_bias_sd=_printed_base(p, "gyro random constant drift", "°/h") * DEG_PER_H,
+        gyro_markov_sigma=g_m, gyro_markov_tau=g_tau,
+        gyro_white_psd=(_printed_base(p, "gyro white-noise variance intensity", "°/h") * DEG_PER_H) ** 2,
+        accel_bias_sd=_printed_base(p, "accelerometer random constant bias", "μg") * MICRO_G,
+        accel_markov_sigma=a_m, accel_markov_tau=a_tau,
+        accel_white_psd=(_printed_base(p, "accelerometer white-noise variance intensity", "μg") * MICRO_G) ** 2,
+        scale_sd=_printed_base(p, "gyro (accelerometer) scale-factor error", "1"),
+        misalignment_sd=_printed_base(p, "gyro (accelerometer) misalignment angle", "")
+        * MISALIGNMENT_UNITS[misalignment_unit],
+        sigma_pos=(hor, hor, vert),
+        sigma_vel=_printed_base(p, "GNSS velocity white-noise variance intensity", "m/s"),
+        misalignment_unit=misalignment_unit, markov_reading=markov_reading,
+    )
+    base.update(choices)
+    return SimulationSetup(**base)
+
+
+# ----------------------------------------------------------------------------- the flight
+
+@lru_cache(maxsize=4)
+def _flight_cached(dt, s_swing, s_cycles, lat0, lon0, h0, heading, speed):
+    from .trajectory import chen2019_flight, generate
+
+    segs, init = chen2019_flight(s_swing=s_swing, s_cycles=s_cycles)
+    init = dict(init, lat0=lat0, lon0=lon0, h0=h0, heading=heading, speed=speed)
+    return generate(segs, **init, dt=dt)
+
+
+def simulated_flight(paper=None, *, imu_rate_hz: float = 100.0, s_swing: float = np.pi, s_cycles: int = 2):
+    """The chen2019 Table 4-42 flight (5100 s) sampled at ``imu_rate_hz``.
+
+    Initial state from ``paper`` (``rp.load_paper("chen2019-table-4-41")``: 47°N, 115°E, 6000 m,
+    heading 45°, 100 m/s) or, without it, the same numbers built into
+    :func:`replication.trajectory.chen2019_flight`.  The S-maneuver amplitude (``s_swing``) and its
+    number of cycles are not printed (this package's choice).  Cached: repeated calls return the
+    same :class:`replication.trajectory.Trajectory` object — do not modify it.
+    """
+    if not imu_rate_hz > 0:
+        raise ValueError("imu_rate_hz must be positive")
+    if paper is not None:
+        vals = [paper.value(q) for q in ("initial latitude", "initial longitude", "initial height",
+                                         "initial heading", "initial speed")]
+        lat0, lon0, h0, hd, sp = vals[0] * DEG, vals[1] * DEG, vals[2], vals[3] * DEG, vals[4]
+    else:
+        lat0, lon0, h0, hd, sp = 47 * DEG, 115 * DEG, 6000.0, 45 * DEG, 100.0
+    return _flight_cached(1.0 / imu_rate_hz, float(s_swing), int(s_cycles), lat0, lon0, h0, hd, sp)
+
+
+def segment_summary(traj):
+    """Per segment of ``traj``: label, start, end (s), heading change (°, clockwise positive,
+    unwrapped), largest |roll| (°), speed and height change (m/s, m) — the quantities of Table 4-42."""
+    import pandas as pd
+
+    rows = []
+    t = traj.t
+    head = np.unwrap(traj.hpr[:, 0])
+    speed = np.hypot(traj.v_enu[:, 0], traj.v_enu[:, 1])
+    for label, t0, t1 in traj.segments:
+        i0, i1 = int(np.searchsorted(t, t0 - 1e-9)), int(np.searchsorted(t, t1 - 1e-9))
+        i1 = min(i1, len(t) - 1)
+        sl = slice(i0, i1 + 1)
+        rows.append(dict(segment=label, start_s=t0, end_s=t1, heading_change_deg=(head[i1] - head[i0]) / DEG,
+                         max_abs_roll_deg=float(np.max(np.abs(traj.hpr[sl, 2]))) / DEG,
+                         speed_change=float(speed[i1] - speed[i0]), height_change=float(traj.h[i1] - traj.h[i0])))
+    return pd.DataFrame(rows)
+
+
+# ----------------------------------------------------------------------------- the models
+
+def filter_model(kind: str, setup: SimulationSetup, lat: float, h: float) -> E.ErrorModel:
+    """The filter model ``kind`` (``"15"``, ``"36"`` or ``"45"``) for ``setup`` at (``lat``, ``h``).
+
+    Each model receives the truth's parameters for the error sources it has; sources it lacks
+    stay unmodelled (no noise inflation — the comparison is of the models, not of tunings):
+
+    * 15 — chen2019 eqs. (3-14)-(3-16): random-constant bias/drift with σ the RSS of the truth's
+      constant and Markov parts (the only bias it has);
+    * 36 — chen2019 ref. [35] as the report describes it (:func:`replication.models.model_36`):
+      constant + random walk + Markov bias/drift, scale factors, lever arm; the random walk is
+      not in the truth and its intensity is not printed: q_rw = (f σ_b)² / T_flight with
+      f = ``setup.random_walk_fraction`` (the walk reaches f times the random-constant σ over
+      the flight);
+    * 45 — chen2019 eqs. (2-14), (2-15), Table 2-2 (:func:`replication.models.model_45`), every
+      source of the truth.
+    """
+    if kind not in ("15", "36", "45"):
+        raise ValueError(f"kind must be '15', '36' or '45', got {kind!r}")
+    s = setup
+    nav = dict(position_sd=s.position_sd, velocity_sd=s.velocity_sd, attitude_sd=s.attitude_sd, lat=lat, h=h,
+               accel_psd=s.accel_white_psd, gyro_psd=s.gyro_white_psd)
+    if kind == "15":
+        return E.model_15(accel_bias_sd=math.hypot(s.accel_bias_sd, s.accel_markov_sigma),
+                          gyro_bias_sd=math.hypot(s.gyro_bias_sd, s.gyro_markov_sigma), **nav)
+    if kind == "36":
+        f2 = s.random_walk_fraction ** 2 / s.flight_duration
+        return M.model_36(accel_bias_sd=s.accel_bias_sd, accel_random_walk_psd=f2 * s.accel_bias_sd ** 2,
+                          accel_markov_sigma=s.accel_markov_sigma, accel_markov_tau=s.accel_markov_tau,
+                          accel_scale_sd=s.scale_sd, gyro_bias_sd=s.gyro_bias_sd,
+                          gyro_random_walk_psd=f2 * s.gyro_bias_sd ** 2, gyro_markov_sigma=s.gyro_markov_sigma,
+                          gyro_markov_tau=s.gyro_markov_tau, gyro_scale_sd=s.scale_sd,
+                          lever_arm_sd=s.lever_arm_sd, **nav)
+    return M.model_45(accel_bias_sd=s.accel_bias_sd, accel_markov_sigma=s.accel_markov_sigma,
+                      accel_markov_tau=s.accel_markov_tau, accel_scale_sd=s.scale_sd,
+                      accel_misalignment_sd=s.misalignment_sd, gyro_bias_sd=s.gyro_bias_sd,
+                      gyro_markov_sigma=s.gyro_markov_sigma, gyro_markov_tau=s.gyro_markov_tau,
+                      gyro_scale_sd=s.scale_sd, gyro_misalignment_sd=s.misalignment_sd,
+                      gravity_sigma=s.gravity_sigma, gravity_beta=1.0 / s.gravity_tau,
+                      lever_arm_sd=s.lever_arm_sd, **nav)
+
+
+# ----------------------------------------------------------------------------- compiled kernels
+
+_NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+
+
+@njit(**_NJ)
+def _propagate_sparse(Phi, P, Qd, W, nzc, nzv, cnt):
+    """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (Φ of an INS error model is sparse)."""
+    n = P.shape[0]
+    for i in range(n):
+        c = 0
+        for k in range(n):
+            v = Phi[i, k]
+            if v != 0.0:
+                nzc[i, c] = k
+                nzv[i, c] = v
+                c += 1
+        cnt[i] = c
+    for i in range(n):
+        for j in range(n):
+            W[i, j] = 0.0
+        for t in range(cnt[i]):
+            k = nzc[i, t]
+            v = nzv[i, t]
+            for j in range(n):
+                W[i, j] += v * P[k, j]
+    for i in range(n):
+        for j in range(i, n):
+            acc = 0.0
+            for t in range(cnt[j]):
+                acc += W[i, nzc[j, t]] * nzv[j, t]
+            v = acc + 0.5 * (Qd[i, j] + Qd[j, i])
+            P[i, j] = v
+            P[j, i] = v
+
+
+@njit(**_NJ)
+def _forward_chunk(dt, dth, dvv, ep_step, gpos, gvel, R_pos, R_vel, lever0,
+                   st, st_prev, q, p_hat, lever, g_extra, dth_cp, dv_cp, trig, flags, P, Pbar, use_pbar,
+                   fconst, qc_const, q_accel, q_gyro, tg, kd, bs, bz, order, dyn_rows,
+                   truth_st, truth_q,
+                   out_err, out_phat, out_pdiag, out_nis, out_flag, out_P, out_Pbar,
+                   record, rec_Pf, rec_Pp, rec_Phi, rec_x):
+    """Closed-loop filter over one chunk of IMU steps for R runs sharing one covariance.
+
+    Per IMU step and run: sensor-error corrections (accumulated estimates), strapdown
+    (:func:`replication._kernels.sd_step`, chen2019 eq. (3-2)).  Per GNSS epoch (after step
+    ``ep_step[j]``): F at the interval means of run 0 (chen2019 eq. (2-15) via
+    :func:`replication._kernels.build_F`), (Φ, Q_d) by the Van Loan series, P⁻ = Φ P Φᵀ + Q_d,
+    gain from run 0's H (antenna position and velocity with the lever arm of eq. (2-13)),
+    Joseph update written as P − K(HP) − (HP)ᵀKᵀ + K S Kᵀ, then per run: innovation, correction,
+    NIS and feedback.  Records navigation errors against ``truth_st``/``truth_q``.
+    """
+    R = st.shape[0]
+    n_steps = dth.shape[1]
+    n = P.shape[0]
+    n_aug = n - 9
+    n_ep = ep_step.shape[0]
+    qtmp = np.empty(4)
+    c = np.empty((3, 3))
+    c0 = np.empty((3, 3))
+    w_ie = np.empty(3)
+    w_en = np.empty(3)
+    ta = np.empty(3)
+    tb = np.empty(3)
+    gains = np.zeros(3)
+    B = np.empty((3, 6))
+    dth_c = np.empty(3)
+    dv_c = np.empty(3)
+    fb = np.empty(3)
+    wb = np.empty(3)
+    F = np.zeros((n, n))
+    Phi = np.empty((n, n))
+    Qd = np.empty((n, n))
+    Qc = np.empty((n, n))
+    w1 = np.empty((n, n))
+    w2 = np.empty((n, n))
+    nzc = np.empty((n, n), np.int64)
+    nzv = np.empty((n, n))
+    cnt = np.empty(n, np.int64)
+    m = 6
+    H = np.zeros((m, n))
+    Rm = np.zeros((m, m))
+    for i in range(3):
+        for jj in range(3):
+            Rm[i, jj] = R_pos[i, jj]
+            Rm[3 + i, 3 + jj] = R_vel[i, jj]
+    z = np.empty(m)
+    xk = np.empty(n)
+    tmp = np.empty(n_aug)
+    # interval accumulators of run 0: lat, h, vE, vN, vU, C (9), Σdv (3), Σdθ (3), T, count
+    acc = np.zeros(23)
+    j = 0
+    for k in range(n_steps):
+        T = dt[k]
+        for r in range(R):
+            K._apply_corrections(dth[r, k], T, p_hat[r], tg, kd, bs, bz, 1, dth_c, B)
+            K._apply_corrections(dvv[r, k], T, p_hat[r], tg, kd, bs, bz, 0, dv_c, B)
+            if flags[0] == 1:
+                for i in range(3):
+                    dth_cp[r, i] = dth_c[i]
+                    dv_cp[r, i] = dv_c[i]
+            if r == 0:
+                K._q2c(q[0], c0)
+                acc[0] += st[0, 0]
+                acc[1] += st[0, 2]
+                acc[2] += st[0, 3]
+                acc[3] += st[0, 4]
+                acc[4] += st[0, 5]
+                for i in range(3):
+                    for jj in range(3):
+                        acc[5 + 3 * i + jj] += c0[i, jj]
+                    acc[14 + i] += dv_c[i]
+                    acc[17 + i] += dth_c[i]
+                acc[20] += T
+                acc[21] += 1.0
+            K.sd_step(T, dth_c, dv_c, dth_cp[r], dv_cp[r], st[r], st_prev[r], q[r], qtmp, c, w_ie, w_en, ta, tb,
+                      0, 0.0, 0.0, gains, 0.0, g_extra[r], trig[r])
+            for i in range(3):
+                dth_cp[r, i] = dth_c[i]
+                dv_cp[r, i] = dv_c[i]
+        flags[0] = 0
+        if j < n_ep and ep_step[j] == k:
+            # ---------------- time update (run 0's interval means)
+            na = acc[21]
+            tsum = acc[20]
+            for i in range(3):
+                for jj in range(3):
+                    c0[i, jj] = acc[5 + 3 * i + jj] / na
+                fb[i] = acc[14 + i] / tsum
+                wb[i] = acc[17 + i] / tsum
+            K.build_F(acc[0] / na, acc[1] / na, acc[2] / na, acc[3] / na, acc[4] / na, c0, fb, wb, fconst,
+                      tg, kd, bs, bz, F)
+            for i in range(n):
+                for jj in range(n):
+                    Qc[i, jj] = qc_const[i, jj]
+            for i in range(3):
+                for jj in range(3):
+                    sa = 0.0
+                    sg = 0.0
+                    for mm in range(3):
+                        sa += c0[i, mm] * q_accel[mm] * c0[jj, mm]
+                        sg += c0[i, mm] * q_gyro[mm] * c0[jj, mm]
+                    Qc[3 + i, 3 + jj] += sa
+                    Qc[6 + i, 6 + jj] += sg
+            K.discretize_series(F, Qc, tsum, order, Phi, Qd, w1, w2)
+            _propagate_sparse(Phi, P, Qd, w1, nzc, nzv, cnt)
+            if use_pbar:
+                _propagate_sparse(Phi, Pbar, Qd, w1, nzc, nzv, cnt)
+            if record:
+                for i in range(n):
+                    for jj in range(n):
+                        rec_Phi[j, i, jj] = Phi[i, jj]
+                        rec_Pp[j, i, jj] = P[i, jj]
+            # sensor-error estimates with dynamics (Markov, gravity) follow Φ
+            for r in range(R):
+                for t in range(dyn_rows.shape[0]):
+                    i = dyn_rows[t]
+                    s_ = 0.0
+                    for jj in range(n_aug):
+                        s_ += Phi[9 + i, 9 + jj] * p_hat[r, jj]
+                    tmp[t] = s_
+                for t in range(dyn_rows.shape[0]):
+                    p_hat[r, dyn_rows[t]] = tmp[t]
+            # ---------------- measurement matrix from run 0
+            K._q2c(q[0], c0)
+            L, h = st[0, 0], st[0, 2]
+            rm, rn = K.radii_s(L)
+            cl = math.cos(L)
+            for i in range(m):
+                for jj in range(n):
+                    H[i, jj] = 0.0
+            la0 = c0[0, 0] * lever[0, 0] + c0[0, 1] * lever[0, 1] + c0[0, 2] * lever[0, 2]
+            la1 = c0[1, 0] * lever[0, 0] + c0[1, 1] * lever[0, 1] + c0[1, 2] * lever[0, 2]
+            la2 = c0[2, 0] * lever[0, 0] + c0[2, 1] * lever[0, 1] + c0[2, 2] * lever[0, 2]
+            H[0, 1] = (rn + h) * cl
+            H[1, 0] = rm + h
+            H[2, 2] = 1.0
+            H[0, 7] = -la2
+            H[0, 8] = la1
+            H[1, 6] = la2
+            H[1, 8] = -la0
+            H[2, 6] = -la1
+            H[2, 7] = la0
+            K.rates_s(L, h, st[0, 3], st[0, 4], w_ie, w_en)
+            wx = dth_cp[0, 0] / T - (c0[0, 0] * w_ie[0] + c0[1, 0] * w_ie[1] + c0[2, 0] * w_ie[2])
+            wy = dth_cp[0, 1] / T - (c0[0, 1] * w_ie[0] + c0[1, 1] * w_ie[1] + c0[2, 1] * w_ie[2])
+            wz = dth_cp[0, 2] / T - (c0[0, 2] * w_ie[0] + c0[1, 2] * w_ie[1] + c0[2, 2] * w_ie[2])
+            cx = wy * lever[0, 2] - wz * lever[0, 1]
+            cy = wz * lever[0, 0] - wx * lever[0, 2]
+            cz = wx * lever[0, 1] - wy * lever[0, 0]
+            u0 = c0[0, 0] * cx + c0[0, 1] * cy + c0[0, 2] * cz
+            u1 = c0[1, 0] * cx + c0[1, 1] * cy + c0[1, 2] * cz
+            u2 = c0[2, 0] * cx + c0[2, 1] * cy + c0[2, 2] * cz
+            H[3, 3] = 1.0
+            H[4, 4] = 1.0
+            H[5, 5] = 1.0
+            H[3, 7] = -u2
+            H[3, 8] = u1
+            H[4, 6] = u2
+            H[4, 8] = -u0
+            H[5, 6] = -u1
+            H[5, 7] = u0
+            for b in range(tg.shape[0]):
+                if tg[b] == K.TARGET_LEVER:
+                    k0 = bs[b]
+                    for i in range(3):
+                        for jj in range(3):
+                            H[i, k0 + jj] = -c0[i, jj]
+                    # velocity rows: -C (ω_eb^b ×)
+                    for i in range(3):
+                        s0 = c0[i, 1] * wz - c0[i, 2] * wy      # (C skew(ω))[i, 0]
+                        s1 = -c0[i, 0] * wz + c0[i, 2] * wx     # (C skew(ω))[i, 1]
+                        s2 = c0[i, 0] * wy - c0[i, 1] * wx      # (C skew(ω))[i, 2]
+                        H[3 + i, k0] = -s0
+                        H[3 + i, k0 + 1] = -s1
+                        H[3 + i, k0 + 2] = -s2
+            # ---------------- gain and covariance (shared)
+            PHt = np.empty((n, m))
+            for i in range(n):
+                for a in range(m):
+                    s_ = 0.0
+                    for kk in range(n):
+                        hv = H[a, kk]
+                        if hv != 0.0:
+                            s_ += P[i, kk] * hv
+                    PHt[i, a] = s_
+            S = Rm.copy()
+            for a in range(m):
+                for b2 in range(m):
+                    s_ = 0.0
+                    for kk in range(n):
+                        hv = H[a, kk]
+                        if hv != 0.0:
+                            s_ += hv * PHt[kk, b2]
+                    S[a, b2] += s_
+            for a in range(m):
+                for b2 in range(a + 1, m):
+                    v = 0.5 * (S[a, b2] + S[b2, a])
+                    S[a, b2] = v
+                    S[b2, a] = v
+            Sinv = np.linalg.inv(S)
+            Kg = PHt @ Sinv
+            KS = Kg @ S
+            for i in range(n):
+                for jj in range(i, n):
+                    s_ = P[i, jj]
+                    for a in range(m):
+                        s_ += -Kg[i, a] * PHt[jj, a] - PHt[i, a] * Kg[jj, a] + KS[i, a] * Kg[jj, a]
+                    P[i, jj] = s_
+                    P[jj, i] = s_
+            # ---------------- per run: innovation, correction, feedback
+            for r in range(R):
+                K._q2c(q[r], c)
+                Lr, hr = st[r, 0], st[r, 2]
+                rmr, rnr = K.radii_s(Lr)
+                la0 = c[0, 0] * lever[r, 0] + c[0, 1] * lever[r, 1] + c[0, 2] * lever[r, 2]
+                la1 = c[1, 0] * lever[r, 0] + c[1, 1] * lever[r, 1] + c[1, 2] * lever[r, 2]
+                la2 = c[2, 0] * lever[r, 0] + c[2, 1] * lever[r, 1] + c[2, 2] * lever[r, 2]
+                z[0] = (st[r, 1] - gpos[r, j, 1]) * (rnr + hr) * math.cos(Lr) + la0
+                z[1] = (st[r, 0] - gpos[r, j, 0]) * (rmr + hr) + la1
+                z[2] = (st[r, 2] - gpos[r, j, 2]) + la2
+                K.rates_s(Lr, hr, st[r, 3], st[r, 4], w_ie, w_en)
+                wx = dth_cp[r, 0] / T - (c[0, 0] * w_ie[0] + c[1, 0] * w_ie[1] + c[2, 0] * w_ie[2])
+                wy = dth_cp[r, 1] / T - (c[0, 1] * w_ie[0] + c[1, 1] * w_ie[1] + c[2, 1] * w_ie[2])
+                wz = dth_cp[r, 2] / T - (c[0, 2] * w_ie[0] + c[1, 2] * w_ie[1] + c[2, 2] * w_ie[2])
+                cx = wy * lever[r, 2] - wz * lever[r, 1]
+                cy = wz * lever[r, 0] - wx * lever[r, 2]
+                cz = wx * lever[r, 1] - wy * lever[r, 0]
+                for i in range(3):
+                    z[3 + i] = st[r, 3 + i] + c[i, 0] * cx + c[i, 1] * cy + c[i, 2] * cz - gvel[r, j, i]
+                nis = 0.0
+                for a in range(m):
+                    for b2 in range(m):
+                        nis += z[a] * Sinv[a, b2] * z[b2]
+                out_nis[r, j] = nis
+                for i in range(n):
+                    s_ = 0.0
+                    for a in range(m):
+                        s_ += Kg[i, a] * z[a]
+                    xk[i] = s_
+                if record:
+                    for i in range(n):
+                        rec_x[r, j, i] = xk[i]
+                for i in range(6):
+                    st[r, i] -= xk[i]
+                    st_prev[r, i] -= xk[i]
+                K._rv2q(xk[6], xk[7], xk[8], qtmp)
+                a1, b1, c1, d1 = qtmp[0], qtmp[1], qtmp[2], qtmp[3]
+                q0_, q1_, q2_, q3_ = q[r, 0], q[r, 1], q[r, 2], q[r, 3]
+                n0 = a1 * q0_ - b1 * q1_ - c1 * q2_ - d1 * q3_
+                n1 = a1 * q1_ + b1 * q0_ + c1 * q3_ - d1 * q2_
+                n2 = a1 * q2_ - b1 * q3_ + c1 * q0_ + d1 * q1_
+                n3 = a1 * q3_ + b1 * q2_ - c1 * q1_ + d1 * q0_
+                nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
+                q[r, 0], q[r, 1], q[r, 2], q[r, 3] = n0 / nn, n1 / nn, n2 / nn, n3 / nn
+                for i in range(n_aug):
+                    p_hat[r, i] += xk[9 + i]
+                for b in range(tg.shape[0]):
+                    k0, kk_ = bs[b], bz[b]
+                    if tg[b] == K.TARGET_LEVER:
+                        for i in range(3):
+                            lever[r, i] = lever0[i] + p_hat[r, k0 - 9 + i]
+                    elif tg[b] == K.TARGET_GRAVITY:
+                        for i in range(3):
+                            s_ = 0.0
+                            for jj in range(kk_):
+                                s_ -= fconst[3 + i, k0 + jj] * p_hat[r, k0 - 9 + jj]
+                            g_extra[r, i] = s_
+                # ---------------- records
+                for i in range(3):
+                    out_err[r, j, i] = st[r, i] - truth_st[j, i]
+                    out_err[r, j, 3 + i] = st[r, 3 + i] - truth_st[j, 3 + i]
+                t0, t1, t2, t3 = truth_q[j, 0], -truth_q[j, 1], -truth_q[j, 2], -truth_q[j, 3]
+                a1, b1, c1, d1 = q[r, 0], q[r, 1], q[r, 2], q[r, 3]
+                r0 = a1 * t0 - b1 * t1 - c1 * t2 - d1 * t3
+                r1 = a1 * t1 + b1 * t0 + c1 * t3 - d1 * t2
+                r2 = a1 * t2 - b1 * t3 + c1 * t0 + d1 * t1
+                r3 = a1 * t3 + b1 * t2 - c1 * t1 + d1 * t0
+                sg = 1.0 if r0 >= 0 else -1.0
+                out_err[r, j, 6] = -2.0 * sg * r1
+                out_err[r, j, 7] = -2.0 * sg * r2
+                out_err[r, j, 8] = -2.0 * sg * r3
+                for i in range(n_aug):
+                    out_phat[r, j, i] = p_hat[r, i]
+            for i in range(n):
+                out_pdiag[j, i] = P[i, i]
+            if record:
+                for i in range(n):
+                    for jj in range(n):
+                        rec_Pf[j, i, jj] = P[i, jj]
+            f = out_flag[j]
+            if f >= 0:
+                for i in range(n):
+                    for jj in range(n):
+                        out_P[f, i, jj] = P[i, jj]
+                        if use_pbar:
+                            out_Pbar[f, i, jj] = Pbar[i, jj]
+            for i in range(23):
+                acc[i] = 0.0
+            j += 1
+    return j
+
+
+@njit(**_NJ)
+def _rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, out_ds, out_Ps, out_psdiag, with_cov):
+    """Backward RTS pass over one chunk (see the module docstring); ``ds`` (R×n) and ``Ps`` hold
+    the smoothed error estimate and covariance at the epoch after the chunk on entry (when
+    ``has_next``) and at the chunk's first epoch on return.  Without ``with_cov`` only the
+    state recursion runs (C_k needs P_k⁺, P_{k+1}⁻ and Φ_k, not P^s)."""
+    E_ = Pf.shape[0]
+    R = ds.shape[0]
+    n = Pf.shape[1]
+    d = np.empty(n)
+    Rc = np.empty((n, n))
+    rhs = np.empty((n, n))
+    tmp = np.empty(n)
+    for jj in range(E_ - 1, -1, -1):
+        if jj == E_ - 1 and not has_next:
+            for r in range(R):
+                for i in range(n):
+                    ds[r, i] = 0.0
+            for i in range(n):
+                for k in range(n):
+                    Ps[i, k] = Pf[jj, i, k]
+        else:
+            if jj == E_ - 1:
+                Pp1 = Pp_n
+                Ph1 = Phi_n
+                x1 = x_n
+            else:
+                Pp1 = Pp[jj + 1]
+                Ph1 = Phi[jj + 1]
+                x1 = xrec[:, jj + 1, :]
+            for i in range(n):
+                # a state with zero prior variance (no prior, no noise) decouples: unit scale,
+                # its row of Φ P⁺ is zero, so its column of C_k is zero
+                d[i] = math.sqrt(Pp1[i, i]) if Pp1[i, i] > 0.0 else 1.0
+            for i in range(n):
+                for k in range(n):
+                    Rc[i, k] = Pp1[i, k] / (d[i] * d[k])
+                if Pp1[i, i] <= 0.0:
+                    Rc[i, i] = 1.0
+            A = Ph1 @ Pf[jj]
+            for i in range(n):
+                for k in range(n):
+                    rhs[i, k] = A[i, k] / d[i]
+            Y = np.linalg.solve(Rc, rhs)
+            Cm = np.empty((n, n))
+            for i in range(n):
+                for k in range(n):
+                    Cm[k, i] = Y[i, k] / d[i]
+            for r in range(R):
+                for i in range(n):
+                    tmp[i] = ds[r, i] + x1[r, i]
+                for i in range(n):
+                    s_ = 0.0
+                    for k in range(n):
+                        s_ += Cm[i, k] * tmp[k]
+                    ds[r, i] = s_
+            if with_cov:
+                D = Ps - Pp1
+                G = Cm @ D @ Cm.T
+                for i in range(n):
+                    for k in range(i, n):
+                        v = Pf[jj, i, k] + 0.5 * (G[i, k] + G[k, i])
+                        Ps[i, k] = v
+                        Ps[k, i] = v
+        for i in range(n):
+            out_psdiag[jj, i] = Ps[i, i]
+        f = out_flag[jj]
+        if f >= 0:
+            for r in range(R):
+                for i in range(n):
+                    out_ds[r, f, i] = ds[r, i]
+            if with_cov:
+                for i in range(n):
+                    for k in range(n):
+                        out_Ps[f, i, k] = Ps[i, k]
+
+
+# ----------------------------------------------------------------------------- truth generation
+
+_NAMES_CONST = ("gyro_bias", "accel_bias", "gyro_scale", "accel_scale", "gyro_misalignment",
+                "accel_misalignment", "lever_arm_error", "gyro_markov0", "accel_markov0", "gravity0", "nav0")
+
+
+class _Truth:
+    """Per-run truth of the batch: random constants drawn once, AR(1) processes carried across
+    chunks, all noise drawn from generators seeded by (seed, run, chunk) so that a run's
+    realisation does not depend on the number of runs nor on replaying a chunk (it does depend
+    on the chunk length)."""
+
+    def __init__(self, setup: SimulationSetup, traj, n_runs: int, seed: int, nav_sd, first_run: int = 0):
+        s = setup
+        self.setup, self.traj, self.R, self.seed, self.r0 = s, traj, n_runs, int(seed), int(first_run)
+        R = n_runs
+        self.const = {k: np.empty((R, n)) for k, n in (("gyro_bias", 3), ("accel_bias", 3), ("gyro_scale", 3),
+                                                       ("accel_scale", 3), ("gyro_misalignment", 6),
+                                                       ("accel_misalignment", 6), ("lever_arm_error", 3),
+                                                       ("nav0", 9))}
+        self.x0 = {k: np.empty((R, 3)) for k in ("gyro_markov", "accel_markov", "gravity")}
+        for r in range(R):
+            g = np.random.default_rng([self.seed, self.r0 + r, 0])
+            self.const["gyro_bias"][r] = s.gyro_bias_sd * g.standard_normal(3)
+            self.const["accel_bias"][r] = s.accel_bias_sd * g.standard_normal(3)
+            self.const["gyro_scale"][r] = s.scale_sd * g.standard_normal(3)
+            self.const["accel_scale"][r] = s.scale_sd * g.standard_normal(3)
+            self.const["gyro_misalignment"][r] = s.misalignment_sd * g.standard_normal(6)
+            self.const["accel_misalignment"][r] = s.misalignment_sd * g.standard_normal(6)
+            self.const["lever_arm_error"][r] = s.lever_arm_sd * g.standard_normal(3)
+            self.x0["gyro_markov"][r] = s.gyro_markov_sigma * g.standard_normal(3)
+            self.x0["accel_markov"][r] = s.accel_markov_sigma * g.standard_normal(3)
+            self.x0["gravity"][r] = s.gravity_sigma * g.standard_normal(3)
+            self.const["nav0"][r] = np.asarray(nav_sd) * g.standard_normal(9)
+        self.Mg = np.eye(3) + np.stack([np.diag(self.const["gyro_scale"][r]) + misalignment_matrix(
+            self.const["gyro_misalignment"][r]) for r in range(R)])
+        self.Ma = np.eye(3) + np.stack([np.diag(self.const["accel_scale"][r]) + misalignment_matrix(
+            self.const["accel_misalignment"][r]) for r in range(R)])
+        self.lever_true = np.asarray(s.lever_arm_b, float) + self.const["lever_arm_error"]
+
+    def initial_states(self):
+        """Perturbed initial navigation states (st, q) of every run (kalman.perturb_state's rule)."""
+        tr = self.traj
+        C = euler_to_dcm(*tr.hpr[0])
+        st = np.empty((self.R, 6))
+        q = np.empty((self.R, 4))
+        for r in range(self.R):
+            d = self.const["nav0"][r]
+            st[r] = [tr.lat[0] + d[0], tr.lon[0] + d[1], tr.h[0] + d[2], *(tr.v_enu[0] + d[3:6])]
+            q[r] = dcm_to_quat(rotvec_to_dcm(-d[6:9]) @ C)
+        return st, q
+
+    def chunk(self, c: int, k0: int, k1: int, ep_samples, state):
+        """Corrupted increments (R, k1-k0, 3) of steps k0..k1-1 and GNSS fixes at ``ep_samples``;
+        ``state`` carries the AR(1) values (updated in place).  Returns also the process values at
+        the epochs (value of the interval ending at the epoch)."""
+        s, tr, R = self.setup, self.traj, self.R
+        Kn = k1 - k0
+        T = tr.t[k0 + 1:k1 + 1] - tr.t[k0:k1]
+        Tm = float(np.median(T))
+        dth = np.empty((R, Kn, 3))
+        dvv = np.empty((R, Kn, 3))
+        C = euler_to_dcm(tr.hpr[k0:k1, 0], tr.hpr[k0:k1, 1], tr.hpr[k0:k1, 2])
+        E_ = len(ep_samples)
+        eidx = np.asarray(ep_samples) - 1 - k0          # interval index ending at each epoch
+        procs = {k: np.empty((R, E_, 3)) for k in ("gyro_markov", "accel_markov", "gravity")}
+        gpos = np.empty((R, E_, 3))
+        gvel = np.empty((R, E_, 3))
+        idx = np.asarray(ep_samples)
+        Ce = euler_to_dcm(tr.hpr[idx, 0], tr.hpr[idx, 1], tr.hpr[idx, 2])
+        w_ie = earth.earth_rate_enu(tr.lat[idx])
+        w_eb = tr.w_ib_b[idx] - np.einsum("kji,kj->ki", Ce, w_ie)
+        rm, rn = earth.radii(tr.lat[idx])
+        taus = {"gyro_markov": s.gyro_markov_tau, "accel_markov": s.accel_markov_tau, "gravity": s.gravity_tau}
+        sigmas = {"gyro_markov": s.gyro_markov_sigma, "accel_markov": s.accel_markov_sigma, "gravity": s.gravity_sigma}
+        for r in range(R):
+            g = np.random.default_rng([self.seed, self.r0 + r, c + 1])
+            paths = {}
+            for name in ("gyro_markov", "accel_markov", "gravity"):
+                a = math.exp(-Tm / taus[name])
+                w = g.standard_normal((Kn, 3)) * (sigmas[name] * math.sqrt(1 - a * a))
+                x, _ = lfilter([1.0], [1.0, -a], w, axis=0, zi=(a * state[name][r])[None, :])
+                state[name][r] = x[-1]
+                paths[name] = x
+                procs[name][r] = x[eidx]
+            wg = g.standard_normal((Kn, 3)) * np.sqrt(s.gyro_white_psd * T)[:, None]
+            wa = g.standard_normal((Kn, 3)) * np.sqrt(s.accel_white_psd * T)[:, None]
+            dg_b = np.einsum("kji,kj->ki", C, paths["gravity"]) * T[:, None]
+            dth[r] = tr.dtheta[k0:k1] @ self.Mg[r].T + (self.const["gyro_bias"][r] + paths["gyro_markov"]) * T[:, None] + wg
+            dvv[r] = (tr.dv[k0:k1] - dg_b) @ self.Ma[r].T + (self.const["accel_bias"][r]
+                                                             + paths["accel_markov"]) * T[:, None] + wa
+            if E_:
+                dpos, dvel = lever_arm_offset(tr.lat[idx], tr.h[idx], Ce, self.lever_true[r], w_eb)
+                npos = g.standard_normal((E_, 3)) * np.asarray(s.sigma_pos)
+                nvel = g.standard_normal((E_, 3)) * s.sigma_vel
+                lat = tr.lat[idx] + dpos[:, 0]
+                h = tr.h[idx] + dpos[:, 2]
+                gpos[r, :, 0] = lat + npos[:, 1] / (rm + h)
+                gpos[r, :, 1] = tr.lon[idx] + dpos[:, 1] + npos[:, 0] / ((rn + h) * np.cos(lat))
+                gpos[r, :, 2] = h + npos[:, 2]
+                gvel[r] = tr.v_enu[idx] + dvel + nvel
+        return dth, dvv, gpos, gvel, procs
+
+
+def truth_parameters(model: E.ErrorModel, const: dict, procs: dict) -> np.ndarray:
+    """True values of ``model``'s augmented states (runs × epochs × (n − 9)) in its layout, from
+    the batch truth: random constants ``const`` (runs × k) and processes ``procs`` (runs ×
+    epochs × 3).  A 15-state bias holds constant + Markov (the total bias it stands for); a
+    random-walk block of the 36-state model is zero (the truth has no random walk); the lever-arm
+    state is the error of the nominal lever arm (true − used)."""
+    R, E_ = procs["gravity"].shape[:2]
+    out = np.zeros((R, E_, model.n - 9))
+    has = {b.name for b in model.blocks}
+    for b in model.blocks:
+        s = model.slices[b.name]
+        sl = slice(s.start - 9, s.stop - 9)
+        name = b.name
+        if name in ("accel_bias", "gyro_bias"):
+            v = const[name][:, None, :]
+            kind = name.split("_")[0]
+            if f"{kind}_markov" not in has:
+                v = v + procs[f"{kind}_markov"]
+            out[:, :, sl] = v
+        elif name in ("accel_markov", "gyro_markov", "gravity"):
+            out[:, :, sl] = procs[name]
+        elif name in ("accel_scale", "gyro_scale", "accel_misalignment", "gyro_misalignment"):
+            out[:, :, sl] = const[name][:, None, :]
+        elif name == "lever_arm":
+            out[:, :, sl] = const["lever_arm_error"][:, None, :]
+        elif name in ("accel_random_walk", "gyro_random_walk"):
+            pass
+        else:
+            raise ValueError(f"no truth for block {name!r}")
+    return out
+
+
+# ----------------------------------------------------------------------------- the batch driver
+
+@dataclass
+class BatchResult:
+    """Output of :func:`run_batch` at the recorded epochs (every ``record_every`` GNSS epochs).
+
+    ``nav_err`` runs × epochs × 9 (δL, δλ rad, δh m, δv m/s, φ rad), ``p_hat`` and ``p_true``
+    runs × epochs × (n − 9); ``P`` epochs × n × n (filter, after the update), ``P_bar`` the same
+    model's covariance propagated without measurements (or ``None``); ``nis`` runs × epochs;
+    ``P_diag_all`` the filter variances at every GNSS epoch (epochs × n); with the smoother:
+    ``ds`` runs × epochs × n (smoothed error estimate) and ``P_s`` epochs × n × n.
+    """
+
+    model: E.ErrorModel
+    setup: SimulationSetup
+    t: np.ndarray
+    epoch_index: np.ndarray
+    nav_err: np.ndarray
+    p_hat: np.ndarray
+    p_true: np.ndarray
+    P: np.ndarray
+    P_bar: np.ndarray | None
+    nis: np.ndarray
+    t_all: np.ndarray
+    P_diag_all: np.ndarray
+    ds: np.ndarray | None = None
+    P_s: np.ndarray | None = None
+    seed: int = 0
+    const: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def n_runs(self) -> int:
+        return self.nav_err.shape[0]
+
+    def errors(self, smoothed: bool = False) -> np.ndarray:
+        """Full error vector e (runs × epochs × n) in the filter's convention: navigation errors
+        computed − true, augmented states true − estimated; ``smoothed`` subtracts the RTS
+        estimate ê^s."""
+        e = np.concatenate([self.nav_err, self.p_true - self.p_hat], axis=-1)
+        if smoothed:
+            if self.ds is None:
+                raise ValueError("run_batch(..., smoother=True) to get smoothed errors")
+            e = e - self.ds
+        return e
+
+    def estimates(self, smoothed: bool = False) -> np.ndarray:
+        """Estimated augmented states (runs × epochs × (n − 9)), filtered or smoothed."""
+        if not smoothed:
+            return self.p_hat
+        if self.ds is None:
+            raise ValueError("run_batch(..., smoother=True) to get smoothed estimates")
+        return self.p_hat + self.ds[..., 9:]
+
+    def sigma(self, smoothed: bool = False) -> np.ndarray:
+        """Standard deviations (epochs × n) of the filter (or smoother)."""
+        P = self.P_s if smoothed else self.P
+        if P is None:
+            raise ValueError("no smoothed covariance: run_batch(..., smoother=True)")
+        return np.sqrt(np.diagonal(P, axis1=1, axis2=2))
+
+
+def _check_traj(traj, setup):
+    dt = np.diff(traj.t)
+    if not np.allclose(dt, 1.0 / setup.imu_rate_hz, rtol=0, atol=1e-9):
+        raise ValueError(f"the trajectory must be sampled at the setup's IMU rate {setup.imu_rate_hz} Hz")
+
+
+def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int = 20, seed: int = 0,
+              chunk_epochs: int = 1000, record_every: int = 20, smoother: bool = False,
+              smoother_covariance: bool = True, prior_covariance: bool = False, first_run: int = 0,
+              series_order: int = 4) -> BatchResult:
+    """Monte Carlo of the closed-loop INS/GNSS filter of ``model`` on ``traj`` with the truth of
+    ``setup`` (chen2019 eq. (2-10) sensor errors, eq. (2-12) gravity disturbance, eq. (2-13)
+    lever arm, Table 4-41 noise), batched across ``n_runs`` runs (see the module docstring).
+
+    ``record_every`` GNSS epochs are recorded (20 → 1 Hz at 20-Hz GNSS); ``smoother`` adds the
+    RTS pass (replaying the forward pass chunk by chunk, ``chunk_epochs`` epochs each);
+    ``smoother_covariance=False`` skips the smoothed covariance (P^s) and keeps only the smoothed
+    states (about a third faster); ``prior_covariance`` propagates the covariance without
+    measurements as well (for :func:`observable_nees`).  Runs are numbered ``first_run`` ..
+    ``first_run + n_runs - 1``; run r's truth depends only on (``seed``, r), so run r processed
+    alone (``first_run=r, n_runs=1``) is an exact extended filter of the same truth.
+    Deterministic for a given ``seed``.
+    """
+    if not isinstance(model, E.ErrorModel):
+        raise TypeError("model must be a replication.errors.ErrorModel (see filter_model)")
+    if not isinstance(setup, SimulationSetup):
+        raise TypeError("setup must be a SimulationSetup (see table_4_41_setup)")
+    if int(n_runs) < 1 or int(chunk_epochs) < 2 or int(record_every) < 1:
+        raise ValueError("n_runs ≥ 1, chunk_epochs ≥ 2 and record_every ≥ 1 are required")
+    _check_traj(traj, setup)
+    n_runs, chunk_epochs, record_every = int(n_runs), int(chunk_epochs), int(record_every)
+    step = setup.gnss_step
+    N = traj.n
+    ep_samples = np.arange(step, N + 1, step)
+    n_ep = len(ep_samples)
+    if n_ep < 2:
+        raise ValueError("the trajectory is shorter than two GNSS epochs")
+    if int(first_run) < 0:
+        raise ValueError("first_run must be non-negative")
+    truth = _Truth(setup, traj, n_runs, seed, model.nav_sd, first_run=int(first_run))
+    fconst, qc, tg, kd, bs, bz = model._encoding()
+    n = model.n
+    n_aug = n - 9
+    dyn_rows = np.array([i - 9 for i in range(9, n) if np.any(fconst[i, 9:] != 0)], dtype=np.int64)
+    R_pos = np.diag(np.asarray(setup.sigma_pos, float) ** 2)
+    R_vel = np.diag(np.full(3, setup.sigma_vel ** 2))
+    lever0 = np.asarray(setup.lever_arm_b, float)
+    st, q = truth.initial_states()
+    state = dict(st=st, st_prev=st.copy(), q=q, p_hat=np.zeros((n_runs, n_aug)),
+                 lever=np.tile(lever0, (n_runs, 1)), g_extra=np.zeros((n_runs, 3)),
+                 dth_cp=np.zeros((n_runs, 3)), dv_cp=np.zeros((n_runs, 3)), flags=np.array([1], np.int64),
+                 trig=np.column_stack([st[:, 0], np.sin(st[:, 0]), np.cos(st[:, 0])]),
+                 P=model.P0(), Pbar=model.P0())
+    ar = {k: v.copy() for k, v in truth.x0.items()}
+    rec_mask = (np.arange(n_ep) + 1) % record_every == 0
+    rec_ep = np.nonzero(rec_mask)[0]
+    m_rec = len(rec_ep)
+    rec_pos = np.full(n_ep, -1, np.int64)
+    rec_pos[rec_ep] = np.arange(m_rec)
+    nav_err = np.empty((n_runs, m_rec, 9))
+    p_hat_rec = np.empty((n_runs, m_rec, n_aug))
+    procs_rec = {k: np.empty((n_runs, m_rec, 3)) for k in ("gyro_markov", "accel_markov", "gravity")}
+    P_rec = np.empty((m_rec, n, n))
+    Pbar_rec = np.empty((m_rec, n, n)) if prior_covariance else np.empty((0, n, n))
+    nis_rec = np.empty((n_runs, m_rec))
+    pdiag_all = np.empty((n_ep, n))
+    idx = ep_samples
+    truth_st = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
+    truth_q = dcm_to_quat(euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2]))
+    dtv = np.diff(traj.t)
+    chunks = [(j0, min(j0 + chunk_epochs, n_ep)) for j0 in range(0, n_ep, chunk_epochs)]
+    checkpoints = []
+    empty3 = np.empty((0, n, n))
+    emptyx = np.empty((n_runs, 0, n))
+
+    def run_chunk(ci, st_, ar_, record):
+        j0, j1 = chunks[ci]
+        k0 = 0 if ci == 0 else ep_samples[j0 - 1]
+        k1 = N if ci == len(chunks) - 1 else ep_samples[j1 - 1]
+        eps = ep_samples[j0:j1]
+        dth, dvv, gpos, gvel, procs = truth.chunk(ci, k0, k1, eps, ar_)
+        E_ = j1 - j0
+        ep_step = (eps - 1 - k0).astype(np.int64)
+        out_err = np.empty((n_runs, E_, 9))
+        out_phat = np.empty((n_runs, E_, n_aug))
+        out_nis = np.empty((n_runs, E_))
+        out_pd = np.empty((E_, n))
+        flag = rec_pos[j0:j1] - (rec_pos[j0:j1][rec_pos[j0:j1] >= 0].min() if np.any(rec_pos[j0:j1] >= 0) else 0)
+        flag = np.where(rec_pos[j0:j1] >= 0, flag, -1).astype(np.int64)
+        n_f = int(np.sum(flag >= 0))
+        oP = np.empty((n_f, n, n))
+        oPb = np.empty((n_f, n, n)) if prior_covariance else empty3
+        if record:
+            rPf, rPp, rPhi = (np.empty((E_, n, n)) for _ in range(3))
+            rx = np.empty((n_runs, E_, n))
+        else:
+            rPf = rPp = rPhi = empty3
+            rx = emptyx
+        _forward_chunk(dtv[k0:k1], dth, dvv, ep_step, gpos, gvel, R_pos, R_vel, lever0,
+                       st_["st"], st_["st_prev"], st_["q"], st_["p_hat"], st_["lever"], st_["g_extra"],
+                       st_["dth_cp"], st_["dv_cp"], st_["trig"], st_["flags"], st_["P"], st_["Pbar"], prior_covariance,
+                       fconst, qc, model.accel_psd, model.gyro_psd, tg, kd, bs, bz, int(series_order), dyn_rows,
+                       np.ascontiguousarray(truth_st[j0:j1]), np.ascontiguousarray(truth_q[j0:j1]),
+                       out_err, out_phat, out_pd, out_nis, flag, oP, oPb, record, rPf, rPp, rPhi, rx)
+        return dict(j0=j0, j1=j1, err=out_err, phat=out_phat, nis=out_nis, pd=out_pd, flag=flag, P=oP, Pb=oPb,
+                    procs=procs, rec=(rPf, rPp, rPhi, rx))
+
+    for ci in range(len(chunks)):
+        if smoother:
+            checkpoints.append(({k: v.copy() for k, v in state.items()}, {k: v.copy() for k, v in ar.items()}))
+        out = run_chunk(ci, state, ar, False)
+        j0, j1 = out["j0"], out["j1"]
+        sel = out["flag"] >= 0
+        pos = rec_pos[j0:j1][sel]
+        nav_err[:, pos] = out["err"][:, sel]
+        p_hat_rec[:, pos] = out["phat"][:, sel]
+        nis_rec[:, pos] = out["nis"][:, sel]
+        for k in procs_rec:
+            procs_rec[k][:, pos] = out["procs"][k][:, sel]
+        P_rec[pos] = out["P"]
+        if prior_covariance:
+            Pbar_rec[pos] = out["Pb"]
+        pdiag_all[j0:j1] = out["pd"]
+    ds_rec = Ps_rec = None
+    if smoother:
+        ds_rec = np.empty((n_runs, m_rec, n))
+        Ps_rec = np.empty((m_rec, n, n)) if smoother_covariance else None
+        ds = np.zeros((n_runs, n))
+        Ps = np.zeros((n, n))
+        nxt = None
+        for ci in range(len(chunks) - 1, -1, -1):
+            st_c, ar_c = checkpoints[ci]
+            out = run_chunk(ci, st_c, ar_c, True)
+            rPf, rPp, rPhi, rx = out["rec"]
+            j0, j1 = out["j0"], out["j1"]
+            E_ = j1 - j0
+            flag = out["flag"]
+            n_f = int(np.sum(flag >= 0))
+            o_ds = np.empty((n_runs, n_f, n))
+            o_Ps = np.empty((n_f if smoother_covariance else 0, n, n))
+            o_pd = np.empty((E_, n))
+            if nxt is None:
+                    _rts_chunk(rPf, rPp, rPhi, rx, False, rPp[0], rPhi[0], np.ascontiguousarray(rx[:, 0, :]), ds, Ps,
+                           flag, o_ds, o_Ps, o_pd, smoother_covariance)
+            else:
+                _rts_chunk(rPf, rPp, rPhi, rx, True, nxt[0], nxt[1], nxt[2], ds, Ps, flag, o_ds, o_Ps, o_pd,
+                           smoother_covariance)
+            nxt = (rPp[0].copy(), rPhi[0].copy(), np.ascontiguousarray(rx[:, 0, :]))
+            pos = rec_pos[j0:j1][flag >= 0]
+            ds_rec[:, pos] = o_ds
+            if smoother_covariance:
+                Ps_rec[pos] = o_Ps
+            checkpoints[ci] = None
+    p_true = truth_parameters(model, truth.const, procs_rec)
+    return BatchResult(model=model, setup=setup, t=traj.t[ep_samples[rec_ep]], epoch_index=ep_samples[rec_ep],
+                       nav_err=nav_err, p_hat=p_hat_rec, p_true=p_true, P=P_rec,
+                       P_bar=Pbar_rec if prior_covariance else None, nis=nis_rec, t_all=traj.t[ep_samples],
+                       P_diag_all=pdiag_all, ds=ds_rec, P_s=Ps_rec, seed=int(seed), const=truth.const)
+
+
+# ----------------------------------------------------------------------------- diagnostics
+
+def observable_nees(e, P, P_bar, threshold: float = 0.1):
+    """NEES in the observable subspace at each epoch.
+
+    The generalised eigenproblem P v = λ P̄ v (P the filter covariance, P̄ the same model's
+    covariance propagated without measurements) gives directions v_i, P̄-orthonormal, with
+    variance ratio λ_i = v_iᵀ P v_i / v_iᵀ P̄ v_i.  Directions with λ_i ≤ ``threshold`` are the
+    subspace the measurements have informed (variance reduced at least 1/threshold times);
+    NEES_obs = Σ_{λ_i ≤ thr} (v_iᵀ e)² / λ_i, χ² with d = #{λ_i ≤ thr} degrees of freedom.
+
+    ``e`` runs × epochs × n, ``P``/``P_bar`` epochs × n × n.  Returns (nees runs × epochs, d per
+    epoch).  The problem is solved on the correlation scale of P̄ for conditioning.
+    """
+    e = np.asarray(e, float)
+    P = np.asarray(P, float)
+    Pb = np.asarray(P_bar, float)
+    if e.ndim != 3 or P.shape != Pb.shape or P.shape[0] != e.shape[1] or P.shape[1] != e.shape[2]:
+        raise ValueError("e must be runs × epochs × n and P, P_bar epochs × n × n")
+    if not 0 < threshold < 1:
+        raise ValueError("threshold must lie in (0, 1)")
+    R_, m, n = e.shape
+    out = np.empty((R_, m))
+    dof = np.empty(m, dtype=int)
+    for k in range(m):
+        d = np.sqrt(np.diag(Pb[k]))
+        A = P[k] / np.outer(d, d)
+        Bm = Pb[k] / np.outer(d, d)
+        Lb = np.linalg.cholesky(Bm)
+        Li = np.linalg.inv(Lb)
+        Cw = Li @ A @ Li.T
+        lam, U = np.linalg.eigh(0.5 * (Cw + Cw.T))
+        V = Li.T @ U                    # columns: P̄-orthonormal generalised eigenvectors (scaled)
+        sel = lam <= threshold
+        dof[k] = int(sel.sum())
+        y = (e[:, k, :] / d) @ V[:, sel]
+        out[:, k] = np.sum(y ** 2 / lam[sel], axis=1)
+    return out, dof
+
+
+def fraction_in_band(nees, dof, prob: float = 0.95, mask=None):
+    """Fraction of epochs whose run-averaged NEES lies in its two-sided ``prob`` χ² band
+    (χ²(R d) quantiles / R, :func:`replication.kalman.chi2_band`), with the band per epoch when
+    ``dof`` varies.  Returns (fraction, mean NEES per epoch, lower, upper)."""
+    nees = np.asarray(nees, float)
+    R_ = nees.shape[0]
+    dof = np.broadcast_to(np.asarray(dof), nees.shape[1:]).astype(int)
+    if np.any(dof < 1):
+        raise ValueError("every epoch needs at least one degree of freedom")
+    a = (1 - prob) / 2
+    lo = stats.chi2.ppf(a, R_ * dof) / R_
+    hi = stats.chi2.ppf(1 - a, R_ * dof) / R_
+    mean = nees.mean(0)
+    inside = (mean >= lo) & (mean <= hi)
+    if mask is not None:
+        inside = inside[np.asarray(mask, bool)]
+    return float(inside.mean()), mean, lo, hi
+
+
+def attitude_errors(result: BatchResult, traj, smoothed: bool = False) -> np.ndarray:
+    """Heading, pitch and roll errors (runs × epochs × 3, rad; estimated − true, heading wrapped
+    to ±π) of the filtered or smoothed solution: Ĉ = exp(−φ×) C with φ the attitude error."""
+    phi = result.errors(smoothed)[..., 6:9]
+    idx = result.epoch_index
+    C = euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2])
+    Ch = rotvec_to_dcm(-phi) @ C[None]
+    h, p, r = dcm_to_euler(Ch)
+    out = np.stack([h - traj.hpr[idx, 0], p - traj.hpr[idx, 1], r - traj.hpr[idx, 2]], -1)
+    return np.mod(out + np.pi, 2 * np.pi) - np.pi
+
+
+def segment_mask(t, traj, labels=("Straight",), after: float = 0.0):
+    """Epochs ``t`` lying in segments of ``traj`` whose label is in ``labels`` and that start at
+    or after ``after`` seconds."""
+    t = np.asarray(t)
+    m = np.zeros(t.shape, bool)
+    for lab, t0, t1 in traj.segments:
+        if lab in labels and t0 >= after:
+            m |= (t > t0) & (t <= t1)
+    return m
+
+
+def survey_line_mask(t, traj):
+    """The survey lines of the Table 4-42 flight: the straight segments after the S-maneuver
+    (1300-2300, 2700-3700, 4100-5100 s) — the analog of the photo epochs of Table 4-44."""
+    sturn = [t0 for lab, t0, _ in traj.segments if lab == "STurn"]
+    return segment_mask(t, traj, ("Straight",), after=sturn[0] if sturn else 0.0)
+
+
+def rms_with_ci(err, mask, prob: float = 0.95):
+    """Per-run RMS over ``mask`` epochs (runs × components), their mean and the two-sided
+    ``prob`` Student-t confidence interval of the mean.  Returns (per_run, mean, lo, hi)."""
+    err = np.asarray(err, float)
+    mask = np.asarray(mask, bool)
+    if not mask.any():
+        raise ValueError("the mask selects no epoch")
+    per = np.sqrt(np.mean(err[:, mask] ** 2, axis=1))
+    R_ = per.shape[0]
+    mean = per.mean(0)
+    if R_ < 2:
+        return per, mean, mean * np.nan, mean * np.nan
+    half = stats.t.ppf(0.5 + prob / 2, R_ - 1) * per.std(0, ddof=1) / math.sqrt(R_)
+    return per, mean, mean - half, mean + half
+
+
+def improvement_percent(other, new):
+    """Improvement of ``new`` over ``other``, 100 (other − new) / other (%) — the reading of the
+    percentages chen2019 prints after Table 4-44."""
+    other = np.asarray(other, float)
+    new = np.asarray(new, float)
+    if np.any(other <= 0):
+        raise ValueError("accuracies must be positive")
+    return 100.0 * (other - new) / other
+
+
+def improvement_with_ci(per_other, per_new, prob: float = 0.95, n_boot: int = 2000, seed: int = 0):
+    """Improvement of the run-mean RMS (``per_*`` runs × components, same truths) with a paired
+    bootstrap ``prob`` interval over runs.  Returns (value, lo, hi) per component."""
+    a = np.asarray(per_other, float)
+    b = np.asarray(per_new, float)
+    if a.shape != b.shape:
+        raise ValueError("per_other and per_new need the same runs × components shape (paired runs)")
+    val = improvement_percent(a.mean(0), b.mean(0))
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, a.shape[0], size=(n_boot, a.shape[0]))
+    boot = improvement_percent(a[idx].mean(1), b[idx].mean(1))
+    lo, hi = np.quantile(boot, [(1 - prob) / 2, (1 + prob) / 2], axis=0)
+    return val, lo, hi
+
+
+def printed_improvements(table):
+    """The improvement percentages recomputed from chen2019 Table 4-44 itself
+    (``rp.load_paper("chen2019-table-4-44")``): 45-state vs 15-state and vs 36-state, for
+    heading, pitch, roll.  Returns {quantity of chen2019-claim-table-4-44-improvements: value}."""
+    out = {}
+    for ref in ("15", "36"):
+        for ang in ("heading", "pitch", "roll"):
+            other = table.value(f"{ang} {ref}-state")
+            new = table.value(f"{ang} 45-state")
+            out[f"{ang} improvement vs {ref}-state"] = float(improvement_percent(other, new))
+    return out
+
+
+def total_bias_estimates(result: BatchResult, smoothed: bool = False):
+    """The filter's estimate of the *total* gyro drift and accelerometer bias (constant + Markov,
+    chen2019's "总体漂移/总体偏置" of Fig. 4-14): runs × epochs × 3 each (rad/s, m/s²)."""
+    m = result.model
+    est = result.estimates(smoothed)
+
+    def blk(name):
+        s = m.slices[name]
+        return est[..., s.start - 9:s.stop - 9]
+
+    names = {b.name for b in m.blocks}
+    g = blk("gyro_bias") + (blk("gyro_markov") if "gyro_markov" in names else 0.0)
+    a = blk("accel_bias") + (blk("accel_markov") if "accel_markov" in names else 0.0)
+    return g, a
