@@ -78,7 +78,8 @@ __all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "EXTEND_ORDER_45", "NAV_SYM
            "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
            "measurement_function", "lever_arm_correction", "table_2_3_states", "frozen_earth_jacobian",
            "TABLE_2_2_BLOCKS", "table_2_2_printed", "table_2_2_corrected", "table_2_2_verified",
-           "table_2_2_differences", "TABLE_2_2_CORRECTED_TEXT", "table_2_2_reference_point"]
+           "table_2_2_differences", "TABLE_2_2_CORRECTED_TEXT", "table_2_2_reference_point",
+           "jacobian_agreement"]
 
 CHEN2019_45_ORDER = ("accel_bias", "accel_markov", "accel_scale", "accel_misalignment", "gyro_bias",
                      "gyro_markov", "gyro_scale", "gyro_misalignment", "gravity", "lever_arm")
@@ -652,3 +653,27 @@ def table_2_2_differences(model, point, *, rtol=1e-6, floor=1e-8) -> list:
                 out.append(dict(block=name, row=i + 1, col=j + 1, printed=float(p[i, j]), verified=float(v[i, j]),
                                 differs=bool(d > rtol * abs(v[i, j]) + floor * scale)))
     return out
+
+
+def jacobian_agreement(model, traj, indices) -> "pandas.DataFrame":
+    """Largest relative difference, over the samples ``indices`` of ``traj``, between
+    ``model.F`` and ``model.numerical_jacobian`` for every non-zero (row block × column block)
+    of the navigation rows (relative to the block's largest element).  Columns ``row_block``,
+    ``column_block``, ``max_rel_diff``."""
+    import pandas as pd
+
+    _check_model(model)
+    rows = {"position": slice(0, 3), "velocity": slice(3, 6), "attitude": slice(6, 9)}
+    worst = {}
+    for k in indices:
+        p = E.NavPoint.from_trajectory(traj, int(k))
+        F, J = model.F(p), model.numerical_jacobian(p)
+        for cname, cs in model.slices.items():
+            if cname == "nav":
+                continue
+            for rname, rs in rows.items():
+                scale = np.abs(F[rs, cs]).max()
+                if scale > 0:
+                    d = float(np.abs(F[rs, cs] - J[rs, cs]).max() / scale)
+                    worst[(rname, cname)] = max(worst.get((rname, cname), 0.0), d)
+    return pd.DataFrame([dict(row_block=r, column_block=c, max_rel_diff=v) for (r, c), v in worst.items()])

@@ -133,17 +133,20 @@ def total_observability_matrix(systems, durations, n_powers=None) -> np.ndarray:
 def som_condition(F, H, n_powers=None, rtol: float = 1e-9) -> bool:
     """True when null(Q_j) ⊂ null(F_j): every unobservable direction of the segment is also
     a direction F_j does not move, the condition under which rank SOM = rank TOM.
-    Null space by SVD with the relative tolerance ``rtol``."""
+
+    null(Q_j) is spanned by the right singular vectors below the numerical-rank tolerance
+    σ_max · max(m, n) · ε (as :func:`observability_degrees`); the condition holds when
+    max |F_j N| ≤ ``rtol`` · max |F_j| (rounding leaves ~1e-13 here)."""
     F, H = _FH(F, H)
     Q = observability_matrix(F, H, n_powers)
     _, s, Vt = np.linalg.svd(Q, full_matrices=Q.shape[0] < Q.shape[1])
-    tol = rtol * (s[0] if s.size and s[0] > 0 else 1.0)
+    tol = (s[0] if s.size else 0.0) * max(Q.shape) * np.finfo(float).eps
     rank = int(np.sum(s > tol))
     N = Vt[rank:].T
     if N.size == 0:
         return True
     scale = max(np.abs(F).max(), 1e-300)
-    return bool(np.abs(F @ N).max() <= rtol * scale * max(1, F.shape[0]))
+    return bool(np.abs(F @ N).max() <= rtol * scale)
 
 
 # ----------------------------------------------------------------------------- degrees

@@ -187,3 +187,17 @@ def test_chen2019_maneuvers_and_tables():
         O.chen2019_maneuvers(total=10.0)
     with pytest.raises(ValueError, match="same states"):
         O.rank_metrics(df, df.iloc[:5], reference_threshold=1e-5, reproduced_threshold=1e-5)
+
+
+def test_goshen_meskin_condition_on_the_45_state_segments():
+    """Along a U-turn every segment's unobservable directions are not moved by F (|F N| at
+    rounding level), so the SOM has the rank of the TOM; a system violating it is detected."""
+    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
+    m = M.model_45()
+    st = m.labels[:9] + M.table_2_3_states()[3:]
+    sy = O.piecewise_systems(m, mv["U-turn"].traj, mv["U-turn"].spans(4), states=st)
+    assert all(O.som_condition(F, H) for F, H in sy)
+    # counter-example: nothing is measured (H = 0), yet F moves x1 with the unobservable x2
+    F = np.array([[0.0, 1.0], [0.0, 0.0]])
+    H = np.array([[0.0, 0.0]])
+    assert O.som_condition(F, H) is False
