@@ -869,3 +869,52 @@ def plot_drift_estimates(result, *, axis="X", paper_mean=None, estimators=ESTIMA
     ax.legend(fontsize=8)
     fig.tight_layout()
     return fig
+
+
+# =============================================================================== checks for the book
+
+def p_equation_check(lats, lons, radius):
+    """Per point: N (corrected) and the printed N, M of (17) against numerical differentiation.
+
+    Columns: latitude (°), longitude (°), max relative error of the corrected N and of the printed
+    N (row-scaled), relative error of the printed N₂₂, max relative error of the printed M against
+    N_num · C_num, and of C_OEPQ^G (16) against the axis definitions.
+    """
+    import pandas as pd
+
+    rows = []
+    for lat, lon in zip(np.atleast_1d(lats), np.atleast_1d(lons)):
+        n_num, c_num = p_equation_numeric(lat, lon, radius)
+        r = sphere_point(lat, lon, radius)
+        scale = np.max(np.abs(n_num), axis=1, keepdims=True)
+        m = m_matrix(r)
+        m_num = n_num @ c_num
+        rows.append({"lat_deg": float(np.degrees(lat)), "lon_deg": float(np.degrees(lon)),
+                     "N corrected": float(np.max(np.abs(n_matrix(r) - n_num) / scale)),
+                     "N printed": float(np.max(np.abs(n_matrix(r, printed=True) - n_num) / scale)),
+                     "N22 printed": float(abs(n_matrix(r, printed=True)[1, 1] / n_num[1, 1] - 1)),
+                     "M printed": float(np.max(np.abs(m - m_num)) / np.max(np.abs(m_num))),
+                     "C (16)": float(np.max(np.abs(oepq_to_grid(lat, grid_azimuth(lat, lon)) - c_num)))})
+    return pd.DataFrame(rows)
+
+
+def sensitivity(case, variants, *, n_runs=4, seed=None):
+    """Drift-estimate summaries (°/h) of short runs (to the second fix) for scenario ``variants``
+    (name → dict of scenario overrides, plus optionally ``heading_observation``); one row per
+    variant and estimator."""
+    import pandas as pd
+
+    rows = []
+    for name, changes in variants.items():
+        changes = dict(changes)
+        heading_observation = changes.pop("heading_observation", "misalignment")
+        sc = fang2020_scenario(case, **changes)
+        sc = replace(sc, duration=sc.fix_times[1])
+        res = simulate(sc, n_runs, FANG2020_SEEDS[case] if seed is None else seed, reset_only_runs=0,
+                       heading_observation=heading_observation,
+                       record_every=float(np.gcd(int(sc.fix_times[0]), int(sc.fix_times[1]))))
+        for est in ESTIMATORS:
+            s = drift_summary(res, est)
+            rows.append({"variant": name, "estimator": est,
+                         **{f"{a} mean": s[a][0] for a in "XYZ"}, **{f"{a} std": s[a][1] for a in "XYZ"}})
+    return pd.DataFrame(rows)
