@@ -39,6 +39,7 @@ __all__ = [
     "augment_transition", "specific_force_measurement", "gauss_markov", "analog_direct_difference",
     "survey_flight", "local_east_north", "disturbed_increments", "direct_difference_from_filter",
     "compensated_increments", "attitude_position_errors", "photo_epochs", "compensation_run",
+    "consistent_kinematics",
 ]
 
 
@@ -696,3 +697,27 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
     out["ar"] = ar
     out["dd"] = dict(t=gnss.t, measured=dd, true=dg[gnss.index])
     return out
+
+
+def consistent_kinematics(n: int, rng: np.random.Generator, *, lat=math.radians(40.0), h=500.0, speed=30.0,
+                          dg_std: float = 30 * MGAL) -> dict:
+    """Random but exactly consistent kinematics for checking (3-7)/(3-8) and (3-18).
+
+    Positions near ``lat``/``h``, velocities around ``speed`` eastwards, accelerations, attitudes
+    and a disturbance (``dg_std`` per axis) drawn from ``rng``; the specific force follows from
+    the specific-force equation (3-2) with g^n = g_m^n + dg^n (3-6):
+    f^n = dV/dt + (2 w_ie + w_en) x V - g_m^n - dg^n, f^b = C_n^b f^n.
+    Returns a dict with ``lat``, ``h``, ``v``, ``v_dot``, ``dg``, ``C_bn``, ``f_n``, ``f_b``.
+    """
+    from scipy.spatial.transform import Rotation
+
+    if not isinstance(rng, np.random.Generator):
+        raise TypeError("pass a seeded numpy Generator")
+    lat = lat + 1e-4 * rng.standard_normal(n)
+    h = h + rng.standard_normal(n)
+    v = np.array([speed, 0.0, 0.0]) + rng.standard_normal((n, 3))
+    vdot = 0.3 * rng.standard_normal((n, 3))
+    dg = dg_std * rng.standard_normal((n, 3))
+    C = Rotation.from_euler("zyx", rng.uniform(-0.5, 0.5, (n, 3))).as_matrix()
+    f_n = vdot + _coriolis_transport(v, lat, h) - earth.gravity_enu(lat, h) - dg
+    return dict(lat=lat, h=h, v=v, v_dot=vdot, dg=dg, C_bn=C, f_n=f_n, f_b=np.einsum("nji,nj->ni", C, f_n))

@@ -64,17 +64,8 @@ def test_survey_lines_space_to_time():
 # --------------------------------------------------------------------------- direct difference
 
 def _kinematics(n=50, seed=0):
-    rng = np.random.default_rng(seed)
-    lat = np.radians(40.0) + 1e-4 * rng.standard_normal(n)
-    h = 500.0 + rng.standard_normal(n)
-    v = np.array([30.0, 5.0, 0.5]) + rng.standard_normal((n, 3))
-    vdot = 0.3 * rng.standard_normal((n, 3))
-    dg = 30 * MGAL * rng.standard_normal((n, 3))
-    C = Rotation.from_euler("zyx", rng.uniform(-0.5, 0.5, (n, 3))).as_matrix()
-    w = 2 * earth.earth_rate_enu(lat) + earth.transport_rate_enu(lat, h, v)
-    f_n = vdot + np.cross(w, v) - earth.gravity_enu(lat, h) - dg  # eq. (3-2) with g = g_m + dg
-    f_b = np.einsum("nji,nj->ni", C, f_n)
-    return lat, h, v, vdot, dg, C, f_n, f_b
+    k = gr.consistent_kinematics(n, np.random.default_rng(seed))
+    return k["lat"], k["h"], k["v"], k["v_dot"], k["dg"], k["C_bn"], k["f_n"], k["f_b"]
 
 
 def test_direct_difference_recovers_the_disturbance():
