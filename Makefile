@@ -5,6 +5,10 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 export PYTHONHASHSEED := 0
+# one BLAS thread: bit-reproducible linear algebra and no oversubscription on 2 cores
+export OPENBLAS_NUM_THREADS := 1
+export OMP_NUM_THREADS := 1
+export MKL_NUM_THREADS := 1
 export MPLBACKEND := module://matplotlib_inline.backend_inline
 export REPLICATION_ROOT := $(CURDIR)
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
