@@ -6,25 +6,22 @@ input G w of eq. (2-14) and the 6-dimensional position/velocity measurement with
 correction of eq. (2-13).
 
 45-state model, chen2019 eq. (2-14)/(2-15) and ch. 2 §4.1, state order exactly as listed in the
-text ("系统状态向量 X 包括了 ..."):
+text ("系统状态向量 X 包括了 ...")::
 
-====  =======================  ====================================  ==================
- idx   block (``model.slices``)  chen2019 symbols                     units
-====  =======================  ====================================  ==================
- 0-2   position                δL, δλ, δh                            rad, rad, m
- 3-5   velocity                δV_E, δV_N, δV_U                      m/s
- 6-8   attitude                φ_E, φ_N, φ_U                         rad
- 9-11  accel_bias              b_x, b_y, b_z (∇_b)                   m/s²
-12-14  accel_markov            m_x, m_y, m_z (∇_m)                   m/s²
-15-17  accel_scale             K_ax, K_ay, K_az (δK_a)               1
-18-23  accel_misalignment      A_xy, A_yx, A_xz, A_zx, A_yz, A_zy    rad
-24-26  gyro_bias               b_x, b_y, b_z (ε_b)                   rad/s
-27-29  gyro_markov             m_x, m_y, m_z (ε_m)                   rad/s
-30-32  gyro_scale              K_gx, K_gy, K_gz (δK_g)               1
-33-38  gyro_misalignment       G_xy, G_yx, G_xz, G_zx, G_yz, G_zy    rad
-39-41  gravity                 g_x, g_y, g_z (δg, n-frame E, N, U)   m/s²
-42-44  lever_arm               l_x, l_y, l_z (P_SINS^b error)        m
-====  =======================  ====================================  ==================
+     idx   block (``model.slices``)  chen2019 symbols                     units
+     0-2   position                δL, δλ, δh                            rad, rad, m
+     3-5   velocity                δV_E, δV_N, δV_U                      m/s
+     6-8   attitude                φ_E, φ_N, φ_U                         rad
+     9-11  accel_bias              b_x, b_y, b_z (∇_b)                   m/s²
+    12-14  accel_markov            m_x, m_y, m_z (∇_m)                   m/s²
+    15-17  accel_scale             K_ax, K_ay, K_az (δK_a)               1
+    18-23  accel_misalignment      A_xy, A_yx, A_xz, A_zx, A_yz, A_zy    rad
+    24-26  gyro_bias               b_x, b_y, b_z (ε_b)                   rad/s
+    27-29  gyro_markov             m_x, m_y, m_z (ε_m)                   rad/s
+    30-32  gyro_scale              K_gx, K_gy, K_gz (δK_g)               1
+    33-38  gyro_misalignment       G_xy, G_yx, G_xz, G_zx, G_yz, G_zy    rad
+    39-41  gravity                 g_x, g_y, g_z (δg, n-frame E, N, U)   m/s²
+    42-44  lever_arm               l_x, l_y, l_z (P_SINS^b error)        m
 
 The text lists "位置误差 L、h" — only two position errors; with them the list counts 44 states.
 The 45 of the text (and the three position rows of Table 2-2's F1) need δλ: the longitude error
@@ -157,7 +154,7 @@ def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
     """The 45-state SINS/GNSS error model of chen2019 eqs. (2-14), (2-15) and Table 2-2, in the
     text's state order (see the module docstring; ``model.labels`` / :func:`state_symbols`).
 
-    Dynamics: eq. (2-15) with every first-order term (:meth:`errors.ErrorModel.F`); random
+    Dynamics: eq. (2-15) with every first-order term (:meth:`replication.errors.ErrorModel.F`); random
     constants (eq. (2-5), (2-6), (2-9)): ẋ = 0; first-order Gauss-Markov biases (eq. (2-5)):
     ẋ = -x/τ + w with stationary σ (``*_markov_sigma``; driving intensity 2σ²/τ — convert the
     report's "驱动白噪声方差强度" with :func:`replication.sensors.markov_sigma_from_driving_psd`);
@@ -382,7 +379,7 @@ def measurement_matrix(model, point, lever_arm_b=(0.0, 0.0, 0.0)) -> np.ndarray:
         z_p = D δp + φ × (C l) + C δl,      z_v = δv + φ × u + C (ω_eb^b ×) δl,   u = C (ω_eb^b × l)
 
     with D δp = [(R_M+h) δL, (R_N+h) cos L δλ, δh] and the ENU vectors reordered to (N, E, U)
-    in the position rows.  Gyro-error terms of ω̂_eb (|δω| |l| ≲ 1e-7 m/s) are neglected.
+    in the position rows.  Gyro-error terms of ω̂_eb (size δω · l ≲ 1e-7 m/s) are neglected.
     The lever-arm columns are filled only when ``model`` has a ``lever_arm`` block.
     """
     _check_model(model)
@@ -453,9 +450,9 @@ def _frozen_rates(lat, h, v, C, w_b, f_b, rm0, rn0, g0):
 
 def frozen_earth_jacobian(point, *, steps=(1e-4, 1e-4, 1000.0, 1.0, 1.0, 1.0, 1e-4, 1e-4, 1e-4)) -> np.ndarray:
     """9×9 navigation block of F at the approximation level of chen2019 eq. (2-15) and Table 2-2:
-    central finite differences of the mechanization :func:`_frozen_rates` in which R_M, R_N and
+    central finite differences of the mechanization ``_frozen_rates`` in which R_M, R_N and
     the normal gravity γ are held at their values at ``point`` (so dR/dL, ∂γ/∂L, ∂γ/∂h — which
-    the report's F omits — are absent).  Perturbations as :meth:`errors.ErrorModel.numerical_jacobian`:
+    the report's F omits — are absent).  Perturbations as :meth:`replication.errors.ErrorModel.numerical_jacobian`:
     δL, δλ, δh, δv additive, Ĉ = exp(-φ×) C.  The difference to the full
     ``ErrorModel.F`` is confined to the δL column and the (δv_U, δh) element
     (tests/test_models.py).
@@ -563,13 +560,13 @@ def table_2_2_corrected(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.
     """The Table 2-2 sub-blocks re-derived (same conventions and the same approximation level
     as the report: Earth radii and gravity frozen, gyro errors with +C_b^n), evaluated at
     ``point``.  Verified against :func:`frozen_earth_jacobian` and ``ErrorModel.F`` in
-    tests/test_models.py; :data:`TABLE_2_2_CORRECTED_TEXT` gives the expressions.
+    tests/test_models.py; :data:`TABLE_2_2_CORRECTED_TEXT` gives the expressions::
 
-    F21(·,3) = [V_E(V_U - V_N tan L)/(R_N+h)², V_E² tan L/(R_N+h)² + V_N V_U/(R_M+h)²,
-                -V_E²/(R_N+h)² - V_N²/(R_M+h)²];  F22(1,1) = (V_N tan L - V_U)/(R_N+h),
-    F22(3,·) = [2ω_ie cos L + 2V_E/(R_N+h), 2V_N/(R_M+h), 0];  F23 = (f^n ×);
-    F32/F33 = C_b^n ∂(δA f^b)/∂(A_xy, A_yx, A_xz, A_zx, A_yz, A_zy) (eq. (2-8));
-    F43(2,1) = -ω_ie sin L - V_E tan L/(R_N+h);  the others as printed.
+        F21(·,3) = [V_E(V_U - V_N tan L)/(R_N+h)², V_E² tan L/(R_N+h)² + V_N V_U/(R_M+h)²,
+                    -V_E²/(R_N+h)² - V_N²/(R_M+h)²];  F22(1,1) = (V_N tan L - V_U)/(R_N+h),
+        F22(3,·) = [2ω_ie cos L + 2V_E/(R_N+h), 2V_N/(R_M+h), 0];  F23 = (f^n ×);
+        F32/F33 = C_b^n ∂(δA f^b)/∂(A_xy, A_yx, A_xz, A_zx, A_yz, A_zy) (eq. (2-8));
+        F43(2,1) = -ω_ie sin L - V_E tan L/(R_N+h);  the others as printed.
     """
     B = table_2_2_printed(point, accel_markov_tau=accel_markov_tau, gyro_markov_tau=gyro_markov_tau)
     q = _nav_quantities(point)
@@ -631,7 +628,7 @@ def table_2_2_verified(model, point) -> dict:
 def table_2_2_differences(model, point, *, rtol=1e-6, floor=1e-8) -> list:
     """Element-wise comparison of the printed Table 2-2 blocks with the verified ones at
     ``point``: a list of dicts (block, row, col (1-based), printed, verified, differs) where
-    ``differs`` means |printed - verified| > rtol |verified| + floor · max|verified block|.
+    ``differs`` means abs(printed - verified) > rtol · abs(verified) + floor · max abs(verified block).
     Defaults from the accuracy of the verified blocks: the finite differences of
     :func:`frozen_earth_jacobian` agree with the re-derived expressions
     (:func:`table_2_2_corrected`) to 3e-8 of each element plus 1e-8 of the block scale (the

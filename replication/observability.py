@@ -2,8 +2,7 @@
 (PWCS) observability degree used by chen2019 (ch. 2 §4.2, Table 2-3, Fig. 2-4; refs. [66-67]),
 and a covariance-based cross-check.
 
-PWCS analysis (Goshen-Meskin & Bar-Itzhack 1992)
------------------------------------------------
+**PWCS analysis** (Goshen-Meskin & Bar-Itzhack 1992).
 The time-varying error model ẋ = F(t) x, z = H(t) x along a trajectory is approximated by r
 segments j = 1..r on which F_j and H_j are constant (:func:`piecewise_systems`: F, H evaluated
 at the segment midpoint, or averaged over the segment).  Segment j has the observability matrix
@@ -22,9 +21,9 @@ y = Q_s x_0 gives x_0 = Σ_i (u_iᵀ y / σ_i) v_i, so the initial-state directi
 with gain σ_i — a large σ_i means the direction is well observed.  Each state k is assigned a
 singular value:
 
-* ``assignment="state"`` (default) — σ_{i*} with i* = argmax_i |V[k, i]|: the singular value of
+* ``assignment="state"`` (default) — σ_{i*} with i* = argmax_i abs(V[k, i]): the singular value of
   the right singular vector in which state k has its largest component;
-* ``assignment="singular"`` — each σ_i goes to the state argmax_k |V[k, i]| that dominates v_i; a
+* ``assignment="singular"`` — each σ_i goes to the state argmax_k abs(V[k, i]) that dominates v_i; a
   state dominating several vectors keeps the largest, a state dominating none gets 0.
 
 Unspecified by chen2019 and therefore parameters here (sweep them): the number and length of
@@ -39,10 +38,9 @@ H, or radians), the state subset, and the normalization:
   of a chosen scale (e.g. its prior standard deviation): unit-free degrees.
 
 A singular value below the numerical-rank tolerance σ_max · max(m, n) · ε_machine (numpy's
-``matrix_rank`` rule) is numerically zero (:attr:`ObservabilityDegrees.rank_tol`).
+``matrix_rank`` rule) is numerically zero (``ObservabilityDegrees.rank_tol``).
 
-Covariance cross-check
-----------------------
+**Covariance cross-check.**
 :func:`covariance_observability` runs the Kalman covariance recursion (Φ, Q_d by Van Loan,
 Joseph update) along the same trajectory and returns √(P0_kk / P_kk(t_end)) per state: 1 when the
 measurements taught nothing about the state, large when its uncertainty collapsed.
@@ -136,7 +134,7 @@ def som_condition(F, H, n_powers=None, rtol: float = 1e-9) -> bool:
 
     null(Q_j) is spanned by the right singular vectors below the numerical-rank tolerance
     σ_max · max(m, n) · ε (as :func:`observability_degrees`); the condition holds when
-    max |F_j N| ≤ ``rtol`` · max |F_j| (rounding leaves ~1e-13 here)."""
+    max abs(F_j N) ≤ ``rtol`` · max abs(F_j) (rounding leaves ~1e-13 here)."""
     F, H = _FH(F, H)
     Q = observability_matrix(F, H, n_powers)
     _, s, Vt = np.linalg.svd(Q, full_matrices=Q.shape[0] < Q.shape[1])
@@ -487,17 +485,20 @@ def unbanked(traj):
                       0.5 * (f_b[1:] + f_b[:-1]) * dt, list(traj.segments))
 
 
-def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, before_segments: int = 1, **kw):
+def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, before_segments: int = 1,
+                  clip_null: bool = True, **kw):
     """PWCS observability degrees of ``states`` for every scenario of ``maneuvers`` (from
     :func:`chen2019_maneuvers`) as a DataFrame (rows: states, columns: scenarios).  The
     straight scenario uses its straight leg only; ``kw`` goes to :func:`pwcs_observability`.
-    Also returns, in ``df.attrs["rank_tol"]``, each scenario's numerical-rank tolerance."""
+    With ``clip_null`` degrees at or below the numerical-rank tolerance — numerically zero, their
+    digits are rounding noise — are reported as 0.  ``df.attrs["rank_tol"]`` holds each
+    scenario's tolerance."""
     import pandas as pd
 
     cols, tols = {}, {}
     for name, mv in maneuvers.items():
         d = pwcs_observability(model, mv.traj, mv.spans(n_segments, before_segments), states=states, **kw)
-        cols[name] = d.degree
+        cols[name] = np.where(d.degree > d.rank_tol, d.degree, 0.0) if clip_null else d.degree
         tols[name] = d.rank_tol
     df = pd.DataFrame(cols, index=list(states))
     df.attrs["rank_tol"] = tols
@@ -536,10 +537,15 @@ def rank_metrics(reference, reproduced, *, reference_threshold: float, reproduce
 
 
 def best_scenario_counts(table, exclude=("before maneuver",)):
-    """For every state, the scenario with the largest degree (``exclude``d columns ignored);
+    """For every state, the scenario with the strictly largest degree (columns in ``exclude``
+    ignored; states whose largest degree is shared, e.g. zero everywhere, count for none);
     returns the number of states won by each scenario (a Series)."""
     t = table.drop(columns=[c for c in exclude if c in table.columns])
-    return t.idxmax(axis=1).value_counts().reindex(t.columns, fill_value=0)
+    v = t.to_numpy(float)
+    top = v.max(axis=1, keepdims=True)
+    unique = (v == top).sum(axis=1) == 1
+    winners = t.columns[v.argmax(axis=1)][unique]
+    return winners.value_counts().reindex(t.columns, fill_value=0)
 
 
 def sweep(model, maneuvers: dict, reference, variants: dict, *, states, reference_threshold: float = 1e-5):
