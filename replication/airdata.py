@@ -800,6 +800,129 @@ def run_error_correction(traj, dth, dv, ads, setup, *, every: int = 50):
     return rec
 
 
+EXPERIMENT_KINDS = ("cruise", "accelerate", "decelerate")
+"""The flight states of :func:`correction_experiment_flight`."""
+
+
+def correction_experiment_flight(kind: str = "cruise", *, dt: float = 0.02):
+    """A 60-s straight, level flight at 45°N, 3000 m, heading 0.5 rad, for the controlled experiment.
+
+    ``"cruise"``: 200 m/s; ``"accelerate"``: 100 → 160 m/s; ``"decelerate"``: 160 → 100 m/s
+    (raised-cosine speed change over the 60 s: mean along-track acceleration ±1 m/s² over the
+    first 30 s).  Returns a :class:`replication.trajectory.Trajectory`.
+    """
+    from . import trajectory as tr
+    from .units import DEG
+
+    if kind not in EXPERIMENT_KINDS:
+        raise ValueError(f"kind must be one of {EXPERIMENT_KINDS}, got {kind!r}")
+    speed, change = {"cruise": (200.0, 0.0), "accelerate": (100.0, 60.0), "decelerate": (160.0, -60.0)}[kind]
+    seg = tr.Straight(60.0) if change == 0 else tr.Accelerate(60.0, speed_change=change)
+    return tr.generate([seg], 45 * DEG, 110 * DEG, 3000.0, dt=dt, heading=0.5, speed=speed)
+
+
+def correction_experiment(traj, *, tilt: float = 0.0, dh0: float = 0.0, dvu0: float = 0.0,
+                          interval: float = 30.0, attitude_sign: float = -1.0, k0: int = 0):
+    """One correction of the proposed method (duan2023 eqs. (4)-(22)) on a controlled SINS error.
+
+    The SINS starts from the true state at sample ``k0`` with known errors — a pitch tilt
+    ``tilt`` (rad) about the cross-track axis u = e_S × e_U of eq. (5) (misalignment φ = tilt·u in
+    the convention of eq. (1), Ĉ = exp(-φ×) C; tilt > 0 turns the computed frame nose-down), a
+    height error ``dh0`` (m) and an up-velocity error ``dvu0`` (m/s) — and integrates the exact
+    (error-free) IMU increments of ``traj`` for ``interval`` s.  The ADS height is the true one
+    (no noise), the gate is off, and :func:`error_correction_step` is applied once with
+    ``attitude_sign`` (-1: eq. (22) as printed, φ + φ^c; +1: the attitude turned with the vectors as
+    eq. (5) states, φ - φ^c; 0: no attitude term).
+
+    Returns a dict of errors at the end of the interval, ``_before`` and ``_after`` the correction:
+    ``tilt`` (component of φ along u, rad), ``dh`` (m), ``dvu`` (m/s), ``dvs`` (along-track
+    velocity, m/s); plus ``dhc`` (δh^c, m), ``S`` (m), ``phic`` (φ^c·u, rad) and ``dhc_over_S``.
+    """
+    from .rotations import attitude_error, euler_to_dcm, rotvec_to_dcm
+    from .strapdown import NavState, mechanize
+
+    if attitude_sign not in (1.0, -1.0, 0.0):
+        raise ValueError("attitude_sign must be +1, -1 or 0")
+    for name, x in (("tilt", tilt), ("dh0", dh0), ("dvu0", dvu0)):
+        if not np.isfinite(x):
+            raise ValueError(f"{name} must be finite (SI units: rad, m, m/s)")
+    step = int(round(interval / float(np.median(np.diff(traj.t)))))
+    k1 = k0 + step
+    if step < 1 or k1 > traj.n:
+        raise ValueError(f"interval {interval} s from sample {k0} does not fit in the trajectory ({traj.t[-1]:.0f} s)")
+
+    def axes(k):
+        v = traj.v_enu[k]
+        es = np.array([v[0], v[1], 0.0]) / np.hypot(v[0], v[1])
+        return es, np.cross(es, [0.0, 0.0, 1.0])
+
+    s0 = traj.initial_state(k0)
+    _, u0 = axes(k0)
+    start = NavState(s0.lat, s0.lon, s0.h + dh0, s0.v_enu + np.array([0.0, 0.0, dvu0]),
+                     rotvec_to_dcm(-tilt * u0) @ s0.C_bn)
+    end = _end_state(mechanize(traj.t[k0:k1 + 1], traj.dtheta[k0:k1], traj.dv[k0:k1], start))
+    setup = SimulationSetup(correction_interval=interval, gate="none", attitude_sign=attitude_sign)
+    new, info = error_correction_step((start.lat, start.lon, start.h), end, traj.h[k1], setup)
+    es, u = axes(k1)
+    ct = euler_to_dcm(*traj.hpr[k1])
+    out = {}
+    for tag, st in (("before", end), ("after", new)):
+        dv = st.v_enu - traj.v_enu[k1]
+        out[f"tilt_{tag}"] = float(attitude_error(st.C_bn, ct) @ u)
+        out[f"dh_{tag}"] = float(st.h - traj.h[k1])
+        out[f"dvu_{tag}"] = float(dv[2])
+        out[f"dvs_{tag}"] = float(dv @ es)
+    out.update(dhc=info["dh"], S=info["S"], phic=float(info["X"][:2] @ u[:2]), dhc_over_S=info["dh"] / info["S"])
+    return out
+
+
+EXPERIMENT_CASES = (("cruise", "tilt", 1e-3), ("cruise", "dh0", 10.0), ("cruise", "dvu0", 0.1),
+                    ("accelerate", "tilt", 1e-3), ("decelerate", "tilt", 1e-3))
+"""The controlled cases of :func:`correction_experiment_table`: (flight, injected error, value)."""
+
+
+def correction_experiment_table(cases=EXPERIMENT_CASES, signs=(-1.0, 1.0)):
+    """:func:`correction_experiment` for each (flight, injected error, value) and attitude sign.
+
+    Returns a DataFrame: flight, injected, value, sign, dh^c (m), φ^c·u (mrad), tilt before/after
+    (mrad), up-velocity error before/after (m/s), along-track velocity error (m/s).
+    """
+    import pandas as pd
+
+    flights = {}
+    rows = []
+    for kind, what, val in cases:
+        if what not in ("tilt", "dh0", "dvu0"):
+            raise ValueError(f"injected error must be 'tilt', 'dh0' or 'dvu0', got {what!r}")
+        tr_ = flights.setdefault(kind, correction_experiment_flight(kind))
+        for sg in signs:
+            r = correction_experiment(tr_, attitude_sign=sg, **{what: val})
+            rows.append({"flight": kind, "injected": what, "value": val, "sign": sg, "dh^c (m)": r["dhc"],
+                         "phi^c.u (mrad)": 1e3 * r["phic"], "tilt before (mrad)": 1e3 * r["tilt_before"],
+                         "tilt after (mrad)": 1e3 * r["tilt_after"], "dV_U before (m/s)": r["dvu_before"],
+                         "dV_U after (m/s)": r["dvu_after"], "dV_S (m/s)": r["dvs_after"]})
+    return pd.DataFrame(rows)
+
+
+def schuler_response(tilt, lat=np.radians(45.0), height: float = 0.0):
+    """Horizontal errors driven by a horizontal tilt φ_0 left in the attitude (duan2023 eq. (1)).
+
+    With M_vφ = (f^n ×), f^n ≈ g e_U, and M_φv ≈ 1/R, a tilt φ_0 at t = 0 (no other error)
+    gives the undamped Schuler oscillation φ = φ_0 cos ω_s t, |δv| = √(gR) φ_0 |sin ω_s t|,
+    |δp| = R φ_0 (1 - cos ω_s t), ω_s = √(g/R), R = √(R_M R_N) + h.  Returns a dict with
+    ``velocity_amplitude`` (m/s), ``position_peak`` (m, 2Rφ_0), ``period`` (s) and
+    ``velocity_rate`` g φ_0 (m/s², the initial slope of |δv|).
+    """
+    tilt = _arr(tilt, "tilt")
+    lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
+    rm, rn = earth.radii(lat)
+    r = np.sqrt(rm * rn) + height
+    g = earth.normal_gravity(lat, height)
+    ws = np.sqrt(g / r)
+    return {"velocity_amplitude": np.sqrt(g * r) * np.abs(tilt), "position_peak": 2 * r * np.abs(tilt),
+            "period": 2 * np.pi / ws, "velocity_rate": g * np.abs(tilt)}
+
+
 def literature_filter_model(setup):
     """Error model of the SINS/ADS Kalman filter standing in for duan2023 refs. [15-17].
 
@@ -868,41 +991,39 @@ def literature_gains(traj, setup):
 def run_literature(traj, dth, dv, ads, setup, gains_pack, *, every: int = 50):
     """The literature SINS/ADS (refs. [15-17] as read by this package): closed-loop error-state
     Kalman filter with ADS height and airspeed, feedback of δp, δv, φ, accumulated ∇̂, ε̂."""
-    from .rotations import rotvec_to_dcm
-    from .strapdown import NavState
+    from .rotations import quat_to_dcm, rotvec_to_dcm
+    from .strapdown import NavState, mechanize
 
     ep, gains, Hs, phi_ads, model = gains_pack
     sl = model.slices
+    sa, sg, sm = sl["accel_bias"], sl["gyro_bias"], sl["ads_markov"]
     rec = _Recorder(traj, every)
     state = _initial_state(traj, setup)
     ba, bg = np.zeros(3), np.zeros(3)
     xads = np.zeros(2)
     T = np.diff(traj.t)[:, None]
+    xm = np.zeros(model.n)
     for j, (k0, k1) in enumerate(zip(ep[:-1], ep[1:])):
-        d1 = dth[k0:k1] - bg * T[k0:k1]
-        d2 = dv[k0:k1] - ba * T[k0:k1]
-        from .strapdown import mechanize
-
-        sol = mechanize(traj.t[k0:k1 + 1], d1, d2, state)
-        end = _end_state(sol)
+        sol = mechanize(traj.t[k0:k1 + 1], dth[k0:k1] - bg * T[k0:k1], dv[k0:k1] - ba * T[k0:k1], state)
+        v_end = sol.v_enu[-1]
         xads = phi_ads @ xads
-        z = np.array([end.h - ads.height[k1], np.linalg.norm(end.v_enu) - ads.airspeed[k1]])
-        xm = np.zeros(model.n)
-        xm[sl["ads_markov"]] = xads
+        z = np.array([sol.h[-1] - ads.height[k1], np.sqrt(v_end @ v_end) - ads.airspeed[k1]])
+        xm[sm] = xads
         x = xm + gains[j] @ (z - Hs[j] @ xm)
-        C = rotvec_to_dcm(x[6:9]) @ end.C_bn
-        state = NavState(end.lat - x[0], end.lon - x[1], end.h - x[2], end.v_enu - x[3:6], C)
-        ba = ba + x[sl["accel_bias"]]
-        bg = bg + x[sl["gyro_bias"]]
-        xads = x[sl["ads_markov"]]
+        C = rotvec_to_dcm(x[6:9]) @ quat_to_dcm(sol.q_bn[-1])
+        state = NavState(sol.lat[-1] - x[0], sol.lon[-1] - x[1], sol.h[-1] - x[2], v_end - x[3:6], C)
+        ba = ba + x[sa]
+        bg = bg + x[sg]
+        xads = x[sm]
         ks = np.arange(k0, k1 + 1)
-        sel = (ks % every) == 0
-        st = np.column_stack([sol.lat, sol.lon, sol.h, sol.v_enu])[sel]
-        Cs = sol.C_bn[sel]
-        if ks[sel].size and ks[sel][-1] == k1:
-            st[-1] = [state.lat, state.lon, state.h, *state.v_enu]
-            Cs[-1] = state.C_bn
-        rec.put(ks[sel], st, Cs)
+        sel = np.flatnonzero((ks % every) == 0)
+        if sel.size:
+            st = np.column_stack([sol.lat[sel], sol.lon[sel], sol.h[sel], sol.v_enu[sel]])
+            Cs = quat_to_dcm(sol.q_bn[sel])
+            if ks[sel[-1]] == k1:
+                st[-1] = [state.lat, state.lon, state.h, *state.v_enu]
+                Cs[-1] = state.C_bn
+            rec.put(ks[sel], st, Cs)
     return rec
 
 

@@ -238,3 +238,95 @@ def test_three_systems_short_run(short_flight):
     np.testing.assert_array_equal(a.errors["proposed SINS/ADS"]["enu"], b.errors["proposed SINS/ADS"]["enu"])
     with pytest.raises(ValueError, match="unknown systems"):
         ad.simulate(short_flight, setup, systems=("INS",))
+
+
+# --------------------------------------------------------------------------- controlled experiment
+
+@pytest.fixture(scope="module")
+def experiment_flights():
+    return {k: ad.correction_experiment_flight(k) for k in ad.EXPERIMENT_KINDS}
+
+
+def test_controlled_height_and_velocity_channel_signs(experiment_flights):
+    """Known height / up-velocity errors, no tilt: the height is reset to the ADS and an up-velocity
+    error is removed (eq. (13): dV_U^c = dh^c V/S = dh^c/T in level flight) — the signs of the
+    height and velocity corrections are right."""
+    cr = experiment_flights["cruise"]
+    r = ad.correction_experiment(cr, dvu0=0.1)
+    assert r["dh_before"] == pytest.approx(3.0, rel=1e-2)                 # 0.1 m/s x 30 s
+    assert abs(r["dh_after"]) < 1e-9
+    assert abs(r["dvu_after"]) < 0.01 * abs(r["dvu_before"])              # removed to 1 %
+    # a pure height error (present at the start of the interval) is read as a flight-path error:
+    # the correction creates an up-velocity error dh^c/T that was not there
+    r = ad.correction_experiment(cr, dh0=10.0)
+    assert abs(r["dvu_before"]) < 2e-3 and abs(r["dh_after"]) < 1e-9
+    assert r["dvu_after"] == pytest.approx(-10.0 / 30.0, rel=2e-3)
+
+
+@pytest.mark.parametrize("sign", [-1.0, 1.0])
+def test_controlled_attitude_correction_is_blind_in_cruise(experiment_flights, sign):
+    """A 1-mrad pitch tilt in level cruise leaves a height error of millimetres over 30 s (a tilt
+    drives the along-track, not the vertical, velocity): phi^c is 1e-3 of the tilt, whatever its sign.
+    Conversely a height error with no tilt produces phi^c = dh^c/S, i.e. a tilt is injected."""
+    cr = experiment_flights["cruise"]
+    r = ad.correction_experiment(cr, tilt=1e-3, attitude_sign=sign)
+    assert r["dvs_before"] == pytest.approx(9.8 * 1e-3 * 30, rel=0.02)  # g * tilt * T along track
+    assert abs(r["dhc"]) < 0.01 and abs(r["phic"]) < 1e-3 * 1e-3
+    assert abs(r["tilt_after"] - r["tilt_before"]) < 1e-3 * 1e-3
+    r = ad.correction_experiment(cr, dh0=10.0, attitude_sign=sign)
+    assert abs(r["tilt_before"]) < 1e-8
+    # phi^c from eq. (4)/(6) = S dh^c/(S^2+h^2) = dh^c/S (level); sign -1 adds it, +1 subtracts it
+    assert r["phic"] == pytest.approx(r["dhc_over_S"], rel=1e-6)
+    assert r["tilt_after"] == pytest.approx(-sign * r["phic"], rel=1e-3)
+    assert abs(r["tilt_after"]) > 1.5e-3                                 # 10 m / 6 km
+
+
+@pytest.mark.parametrize("kind, sign_that_reduces", [("accelerate", 1.0), ("decelerate", -1.0)])
+def test_controlled_tilt_seen_only_through_acceleration(experiment_flights, kind, sign_that_reduces):
+    """Along-track acceleration a makes a pitch tilt visible in the height (f-error -a*tilt up):
+    dh^c ≈ tilt a T²/2, phi^c ≈ tilt aT/(2V), a few per cent of the tilt per interval.  The sign
+    that reduces the tilt flips between acceleration and deceleration: neither convention of eq.
+    (22) removes a tilt in general."""
+    tr_ = experiment_flights[kind]
+    red = ad.correction_experiment(tr_, tilt=1e-3, attitude_sign=sign_that_reduces)
+    inc = ad.correction_experiment(tr_, tilt=1e-3, attitude_sign=-sign_that_reduces)
+    assert red["tilt_before"] == pytest.approx(1e-3, rel=2e-3)
+    assert 0.02 < 1 - red["tilt_after"] / red["tilt_before"] < 0.15
+    assert 0.02 < inc["tilt_after"] / inc["tilt_before"] - 1 < 0.15
+    assert np.sign(red["dhc"]) == (1 if kind == "accelerate" else -1)
+
+
+def test_schuler_response_matches_core():
+    """The tilt-to-horizontal-error amplitudes used in the chapter against a strapdown run: a
+    0.1-mrad tilt, height held, one Schuler period; Earth-rate coupling and the Coriolis term
+    allow ~10 % (stated before the comparison)."""
+    from replication import trajectory as tr
+    from replication.rotations import rotvec_to_dcm
+    from replication.strapdown import NavState, mechanize
+    from replication.units import DEG
+
+    traj = tr.generate([tr.Straight(5100.0)], 45 * DEG, 110 * DEG, 3000.0, dt=0.2, heading=0.5, speed=200.0)
+    s0 = traj.initial_state()
+    u = np.cross(np.array([np.sin(0.5), np.cos(0.5), 0.0]), [0.0, 0.0, 1.0])
+    tilt = 1e-4
+    st = NavState(s0.lat, s0.lon, s0.h, s0.v_enu, rotvec_to_dcm(-tilt * u) @ s0.C_bn)
+    sol = mechanize(traj.t, traj.dtheta, traj.dv, st, vertical="hold", h_ref=traj.h)
+    dv = np.linalg.norm((sol.v_enu - traj.v_enu)[:, :2], axis=1)
+    pred = ad.schuler_response(tilt, np.radians(45.0), 3000.0)
+    assert pred["period"] == pytest.approx(5067, rel=0.01)
+    assert np.max(dv) == pytest.approx(pred["velocity_amplitude"], rel=0.1)
+    k = int(np.searchsorted(traj.t, 60.0))
+    assert dv[k] / 60.0 == pytest.approx(pred["velocity_rate"], rel=0.02)
+    with pytest.raises(ValueError, match="kind"):
+        ad.correction_experiment_flight("hover")
+    with pytest.raises(ValueError, match="does not fit"):
+        ad.correction_experiment(traj.slice(0, 100), interval=30.0)
+
+
+def test_correction_experiment_table():
+    df = ad.correction_experiment_table(cases=(("cruise", "dh0", 10.0),), signs=(-1.0, 0.0))
+    assert list(df["sign"]) == [-1.0, 0.0]
+    assert abs(df["tilt after (mrad)"].iloc[1]) < 1e-5       # no attitude term (1e-8 rad: transport rate over 30 s)
+    assert df["tilt after (mrad)"].iloc[0] == pytest.approx(df["phi^c.u (mrad)"].iloc[0], rel=1e-3)
+    with pytest.raises(ValueError, match="injected"):
+        ad.correction_experiment_table(cases=(("cruise", "roll", 1.0),))
