@@ -39,7 +39,9 @@ OMEGA = earth.OMEGA_IE
 
 # H_y(s) of fang2020 eq. (1): zeros and poles (rad/s)
 DAMPING_ZEROS = (-8.5e-4, -9.412e-2)
+"""Zeros of H_y(s), fang2020 eq. (1) (rad/s)."""
 DAMPING_POLES = (-8.0e-3, -1.0e-2)
+"""Poles of H_y(s), fang2020 eq. (1) (rad/s)."""
 
 
 # =============================================================================== validation
@@ -76,7 +78,7 @@ def grid_frame(r):
     """C_e^G: rows are the grid axes G_E, G_N, G_U in ECEF at the point ``r`` (fang2020 §2.1).
 
     G_U is the normal of the WGS-84 ellipsoid (of the sphere when ``r`` lies on a sphere the
-    normal of which is r/|r| — pass :func:`sphere_point` output to :func:`grid_frame_sphere`);
+    normal of which is r/‖r‖ — pass :func:`sphere_point` output to :func:`grid_frame_sphere`);
     G_N is the intersection of the local horizontal plane with the plane through the point
     parallel to the prime-meridian plane, G_N ∝ G_U × e_y; G_E = G_N × G_U.  Regular at the poles;
     undefined only where G_U = ±e_y (λ = ±90° on the equator).
@@ -87,7 +89,7 @@ def grid_frame(r):
 
 
 def grid_frame_sphere(r):
-    """C_e^G of the spherical Earth used in fang2020 §2.2 (normal r/|r|)."""
+    """C_e^G of the spherical Earth used in fang2020 §2.2 (normal r/‖r‖)."""
     r = _vec3(r, "r (position on the sphere, m)")
     return _frame_from_normal(r / np.linalg.norm(r, axis=-1, keepdims=True))
 
@@ -191,7 +193,7 @@ def euler_from_attitude(c_b_g):
 def n_matrix(r, radius=None, *, printed=False):
     """N of fang2020 eq. (15): [δx, δy, φ_z]ᵀ = N [ψ_x, ψ_y, ψ_z]ᵀ (grid components of ψ).
 
-    ``r`` = (x, y, z) on the sphere of radius ``radius`` (default |r|).  The printed (2,2) entry
+    ``r`` = (x, y, z) on the sphere of radius ``radius`` (default ‖r‖).  The printed (2,2) entry
     -Rz/√(x²+z²) contradicts the paper's own eq. (11) (δy = -√(x²+z²) ψ_y) and its eq. (17) for M;
     ``printed=False`` (default) returns the corrected N with N₂₂ = -√(x²+z²), ``printed=True``
     the matrix as printed.
@@ -212,7 +214,7 @@ def n_matrix(r, radius=None, *, printed=False):
 def m_matrix(r, radius=None):
     """M of fang2020 eq. (17), closed form as printed: P = [δx, δy, φ_z]ᵀ = M ψ_OEPQ.
 
-    ``r`` on the sphere of radius ``radius`` (default |r|).  Equals (corrected N) · C_OEPQ^G.
+    ``r`` on the sphere of radius ``radius`` (default ‖r‖).  Equals (corrected N) · C_OEPQ^G.
     """
     r = _vec3(r, "r (sphere point, m)")
     x, y, z = r[..., 0], r[..., 1], r[..., 2]
@@ -232,7 +234,7 @@ def p_equation_numeric(lat, lon, radius, step=0.05):
     """N of eq. (15) and C_OEPQ^G of eq. (16) by numerical differentiation of the exact geometry.
 
     On the sphere of ``radius``, the position is displaced by ±``step`` metres along x and along y
-    (z follows from |r| = R); the exact computer-frame rotation θ between the grid frames at the two
+    (z follows from ‖r‖ = R); the exact computer-frame rotation θ between the grid frames at the two
     points is read from C_e^c C_G^e = I - [θ×] (no small-angle formula of the paper is used).  With
     φ_x = φ_y = 0 (eq. (3)) ψ_x = -θ_x, ψ_y = -θ_y and φ_z = ψ_z + θ_z, so central differences give
     ∂(ψ_x, ψ_y, θ_z)/∂(δx, δy), whose inverse is N.  C_OEPQ^G = C_e^G (C_e^OEPQ)ᵀ from the axis
@@ -307,6 +309,7 @@ def propagate_psi(psi0, eps, tau, omega=OMEGA):
 # =============================================================================== calibration (25)-(27)
 
 DRIFT_CONVENTIONS = ("gyro-error", "platform-drift")
+"""Meaning of ε: gyro output minus true rate (strapdown), or platform drift rate (fang2020 eq. (18))."""
 
 
 def b_matrix(lat, sigma, convention="gyro-error"):
@@ -585,6 +588,8 @@ class SimulationResult:
 
 
 ESTIMATORS = ("printed", "mean-attitude")
+"""Drift estimators of :func:`simulate`: eq. (27) with the attitude at the second fix, or with the
+interval-mean attitude (see :func:`two_point_drift`)."""
 
 
 def _initial_state(sc, phases):
@@ -601,6 +606,7 @@ def _initial_state(sc, phases):
 
 
 HEADING_OBSERVATIONS = ("misalignment", "euler")
+"""Heading observation models at a fix: azimuth misalignment φ_z, or Euler grid-heading difference."""
 
 
 def _fix(sc, t, phases, cbp, r, err_pos, err_head, heading_observation="misalignment"):
@@ -682,7 +688,8 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     the interval-mean attitude, see :func:`two_point_drift`), resets, and the runs continue with
     the ``estimator`` estimate subtracted from the gyro outputs.  The first ``reset_only_runs``
     runs are continued a second time without compensation (the paper's dashed curves).
-    ``heading_observation``: see :func:`_fix` (:data:`HEADING_OBSERVATIONS`).
+    ``heading_observation``: ``"misalignment"`` observes the platform azimuth misalignment φ_z of
+    the P equation, ``"euler"`` the difference of grid-heading Euler angles (:data:`HEADING_OBSERVATIONS`).
     """
     if heading_observation not in HEADING_OBSERVATIONS:
         raise ValueError(f"heading_observation must be one of {HEADING_OBSERVATIONS}")
