@@ -518,8 +518,11 @@ def consistency_count(paper, state: str = "climb"):
 
     The reading with fewer disagreements is the one the chapter adopts (it is the more
     economical explanation of the print)."""
-    return {rd: int((~check_elements(paper, rd, state)["match"] & check_elements(paper, rd, state)["comparable"]).sum())
-            for rd in READINGS}
+    out = {}
+    for rd in READINGS:
+        df = check_elements(paper, rd, state)
+        out[rd] = int((~df["match"] & df["comparable"]).sum())
+    return out
 
 
 # =========================================================================== 1b. eq. (1)
@@ -627,6 +630,12 @@ class SimulationSetup:
     +value on every axis (the convention of the PSINS toolbox of ref. [21]); "random drift" is
     white noise whose 1-s average has the printed 1σ (PSD = σ² · 1 s); initial attitude error 0;
     airspeed noise 0.5 m/s; the Kalman filter of refs. [15-17] updates at 1 Hz.
+
+    ``attitude_sign`` reads the misalignment term of eq. (22) in the convention that the forcing
+    -C_b^n δω_ib^b of eq. (1) fixes (ref. [21]: Ĉ = exp(-φ×) C): -1 (default) is eq. (22) as printed,
+    φ_S/A = φ + φ^c u, i.e. the attitude turned by -φ^c u; +1 turns the attitude with the vectors as
+    eq. (5) turns the displacement and the velocity (φ_S/A = φ - φ^c u); 0 leaves it out.
+    ``threshold`` (1/s) gates Ṡ/S, ``gate`` says what a gated interval does.
     """
 
     correction_interval: float = 30.0
@@ -773,7 +782,8 @@ def error_correction_step(origin, state, h_ads, setup):
                           printed_half=setup.printed_half)
     info["X"] = x
     phi = np.array([x[0], x[1], 0.0]) * setup.attitude_sign
-    # the SINS vectors are turned by D = exp(φ^c u ×) (eq. (5)); the attitude is turned with them
+    # misalignment convention of eq. (1) / ref. [21]: Ĉ = exp(-φ×) C.  attitude_sign = -1 adds φ^c to φ
+    # (eq. (22) as printed: Ĉ turned by -φ^c u); +1 turns Ĉ by +φ^c u, with the vectors (eq. (5))
     C = rotvec_to_dcm(phi) @ state.C_bn
     return NavState(state.lat + x[6], state.lon + x[7], state.h + x[8], v + x[3:6], C), info
 
@@ -874,6 +884,46 @@ def correction_experiment(traj, *, tilt: float = 0.0, dh0: float = 0.0, dvu0: fl
         out[f"dvs_{tag}"] = float(dv @ es)
     out.update(dhc=info["dh"], S=info["S"], phic=float(info["X"][:2] @ u[:2]), dhc_over_S=info["dh"] / info["S"])
     return out
+
+
+def bias_experiment(accel_bias_up: float, *, n_intervals: int = 10, interval: float = 30.0,
+                    attitude_sign: float = -1.0, speed: float = 200.0, dt: float = 0.05):
+    """Repeated corrections (duan2023 eq. (22)) of a SINS whose only error is an up accelerometer bias.
+
+    Level cruise at ``speed`` (45°N, 3000 m), exact ADS height, gate off, ``n_intervals``
+    corrections.  With the height reset and δV_U^c = δh^c/T (level flight) the up-velocity error
+    after a correction settles at bT/2 and every later interval ends with δh^c = -bT² (b the bias):
+    a height discrepancy of constant sign, which eq. (6) turns into a tilt increment of size bT/V
+    per interval — a tilt that grows linearly, about b/V rad/s.  Returns a dict of arrays over the
+    corrections: ``dhc`` (m), ``tilt`` (rad, along u after each correction) and the predictions
+    ``dhc_steady`` = -bT² and ``tilt_step`` = -attitude_sign · dhc_steady/(V T) (the tilt change
+    per interval, signed as the correction applies it).
+    """
+    from . import trajectory as tr
+    from .rotations import attitude_error, euler_to_dcm
+    from .units import DEG
+
+    if n_intervals < 2:
+        raise ValueError("n_intervals must be at least 2 (the first interval is the transient)")
+    traj = tr.generate([tr.Straight(n_intervals * interval + 1.0)], 45 * DEG, 110 * DEG, 3000.0, dt=dt,
+                       heading=0.5, speed=speed)
+    dv = traj.dv.copy()
+    dv[:, 2] += accel_bias_up * np.diff(traj.t)        # body up = nav up in level, wings-level flight
+    setup = SimulationSetup(correction_interval=interval, gate="none", attitude_sign=attitude_sign)
+    step = int(round(interval / dt))
+    state = traj.initial_state()
+    u = np.cross(np.array([np.sin(0.5), np.cos(0.5), 0.0]), [0.0, 0.0, 1.0])
+    dhc, tilt = [], []
+    for j in range(n_intervals):
+        k0, k1 = j * step, (j + 1) * step
+        origin = (state.lat, state.lon, state.h)
+        end = _end_state(_segment(traj.t, traj.dtheta, dv, k0, k1, state, step)[0])
+        state, info = error_correction_step(origin, end, traj.h[k1], setup)
+        dhc.append(info["dh"])
+        tilt.append(float(attitude_error(state.C_bn, euler_to_dcm(*traj.hpr[k1])) @ u))
+    b = accel_bias_up
+    return {"dhc": np.array(dhc), "tilt": np.array(tilt), "dhc_steady": -b * interval**2,
+            "tilt_step": -attitude_sign * (-b * interval**2) / (speed * interval)}
 
 
 EXPERIMENT_CASES = (("cruise", "tilt", 1e-3), ("cruise", "dh0", 10.0), ("cruise", "dvu0", 0.1),

@@ -330,3 +330,19 @@ def test_correction_experiment_table():
     assert df["tilt after (mrad)"].iloc[0] == pytest.approx(df["phi^c.u (mrad)"].iloc[0], rel=1e-3)
     with pytest.raises(ValueError, match="injected"):
         ad.correction_experiment_table(cases=(("cruise", "roll", 1.0),))
+
+
+@pytest.mark.parametrize("sign", [-1.0, 1.0])
+def test_bias_experiment_tilt_grows_linearly(sign):
+    """A 100-ug up accelerometer bias alone: after the first interval every correction meets
+    dh^c = -bT² (0.88 m) and adds a tilt step bT/V (0.15 mrad at 200 m/s) of one sign — the tilt
+    grows ~1 deg/h, whichever sign eq. (22) is read with.  Tolerances: the Coriolis coupling of the
+    growing along-track velocity changes dh^c by ~1 % per interval (3 % over the first three)."""
+    b = 100e-6 * 9.80665
+    r = ad.bias_experiment(b, n_intervals=5, attitude_sign=sign)
+    assert r["dhc"][0] == pytest.approx(r["dhc_steady"] / 2, rel=0.02)     # transient: bT²/2
+    np.testing.assert_allclose(r["dhc"][1:4], r["dhc_steady"], rtol=0.03)
+    np.testing.assert_allclose(np.diff(r["tilt"])[:3], r["tilt_step"], rtol=0.03)
+    assert abs(r["tilt_step"]) == pytest.approx(b * 30.0 / 200.0, rel=1e-12)
+    with pytest.raises(ValueError, match="n_intervals"):
+        ad.bias_experiment(b, n_intervals=1)
