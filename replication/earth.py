@@ -355,10 +355,12 @@ def eq_3_1_coefficients(paper) -> dict:
 
 
 def normal_gravity_chen2019_printed(lat, h, coefficients):
-    """chen2019 eq. (3-1) evaluated literally as printed (m/s^2).
+    """chen2019 eq. (3-1) evaluated literally as printed (m/s^2)::
 
-    γ = 9.7803253 × (1 + 0.0053022 sin²L - 0.0000058 sin²L) L - (3.0877 - 0.0044 sin²L)e-6 h
-        + 0.072e-12 h², with the printed coefficients passed in ``coefficients`` (see
+        γ = 9.7803253 × (1 + 0.0053022 sin²L - 0.0000058 sin²L) L
+            - (3.0877 - 0.0044 sin²L)e-6 h + 0.072e-12 h²
+
+    with the printed coefficients passed in ``coefficients`` (see
     :func:`eq_3_1_coefficients`).  The trailing factor L (radians) and sin²L in the third
     term are kept exactly as printed so that each defect can be quantified.
     """

@@ -50,3 +50,19 @@ def test_runner_strips_volatile_metadata(tmp_path):
     assert "widgets" not in nb.metadata and "kernelspec" in nb.metadata
     assert "execution" not in nb.cells[0].metadata
     assert json.loads(nbformat.writes(nb))["cells"][0]["metadata"] == {}
+
+
+def test_book_glue_makes_numpy_scalars_plain():
+    import numpy as np
+    import pytest
+
+    from replication.book import plain
+
+    assert repr(plain(np.float64(0.1))) == "0.1"
+    assert type(plain(np.int64(3))) is int and type(plain(np.bool_(True))) is bool
+    assert type(plain(np.array(2.5))) is float
+    assert plain("text") == "text"
+    from replication.book import glue
+
+    with pytest.raises(ValueError, match="not finite"):
+        glue("x", float("nan"), display=False)

@@ -1,0 +1,41 @@
+"""Helpers for the book's notebooks.
+
+:func:`glue` wraps ``myst_nb.glue`` so that numbers glued into prose render with a format
+spec (``{glue:text}`name:.3f```): numpy scalars are converted to Python numbers first, because
+their ``repr`` (``np.float64(0.1)``) is not a number the book can format.  Floats are
+stored with 10 significant digits, the precision of the exported tables, so that a stored
+output does not depend on the last bits of a long computation.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+
+def plain(value):
+    """``value`` with numpy scalars (and 0-d arrays) converted to Python ``int``/``float``/``bool``."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    return value
+
+
+def glue(name: str, value, display: bool = True):
+    """``myst_nb.glue(name, value, display)`` with numpy scalars made plain (see :func:`plain`)."""
+    from myst_nb import glue as _glue
+
+    if not isinstance(name, str) or not name:
+        raise ValueError("glue needs a non-empty string name")
+    value = plain(value)
+    if isinstance(value, numbers.Number) and not isinstance(value, bool) and not np.isfinite(value):
+        raise ValueError(f"glue {name!r}: value {value!r} is not finite")
+    if isinstance(value, float):
+        value = float(format(value, ".10g"))  # the precision of the exported tables
+    return _glue(name, value, display=display)
