@@ -28,7 +28,7 @@ The module has four parts.
    :func:`derived_coefficients`, :func:`printed_elements`, :func:`check_elements`,
    :func:`manifold_residuals`.
 
-3. **The air-data measurement model** (:func:`ads_measurements`).
+3. **The air-data measurement model** (``ads_measurements``).
 
 4. **The simulation of the three systems** (pure SINS, a SINS/ADS Kalman filter of the kind of
    duan2023 refs. [15-17], the error-correction method) built on the navigation core
@@ -88,7 +88,7 @@ def pitch_correction(s, h, dh, *, form: str = "printed"):
     * ``"printed"``: eq. (4), φ^c ≈ S δh^c / (S² + h²) — the first-order expansion of
       tan(θ_1 - θ_2) with S^c = S;
     * ``"fixed-S"``: the exact angle with S^c = S, atan((h+δh)/S) - atan(h/S);
-    * ``"equal-length"``: the exact angle under assumption 1 (|d^c| = |d|, so S^c from eq. (17)),
+    * ``"equal-length"``: the exact angle under assumption 1 (d^c as long as d, so S^c from eq. (17)),
       asin((h+δh)/r) - asin(h/r), r = √(S² + h²);
     * ``"equal-length-linear"``: its first-order form δh/S.
 
@@ -178,7 +178,7 @@ def velocity_correction(sx, sy, h, speed, dh, *, form: str = "printed"):
     """Velocity correction [δV_E^c, δV_N^c, δV_U^c] (m/s), duan2023 eqs. (11)-(13).
 
     δV_U^c = φ^c V cos θ_2 = S² V δh^c/(S² + h²)^{3/2} (eq. (13), with φ^c of eq. (4)) and
-    [δV_E^c, δV_N^c] = -[S_x, S_y] h/S² δV_U^c (eq. (11)).  ``speed`` is |V| (assumption 4:
+    [δV_E^c, δV_N^c] = -[S_x, S_y] h/S² δV_U^c (eq. (11)).  ``speed`` is the norm of V (assumption 4:
     unchanged by the correction).  Eq. (12) prints δV_U^c = φ^c V, without the cos θ_2 that
     eq. (13) contains; this function follows eq. (13), the first-order geometry.
     """
@@ -451,8 +451,8 @@ def check_elements(paper, reading: str = "B", state: str = "climb", rel_tol: flo
     """Every printed element of ``duan2023-eq-22`` against its re-derivation at a reference state.
 
     Returns a pandas DataFrame (quantity, unit, equation, row, col, printed, paper (printed value
-    at the state), derived (re-derived value), derived_expr, match (|Δ| ≤ rel_tol·max(|paper|,
-    |derived|, tiny)), comparable (False for elements of eqs. (14)-(15), whose split over the
+    at the state), derived (re-derived value), derived_expr, match (abs(paper - derived) ≤
+    rel_tol·max(abs(paper), abs(derived), tiny)), comparable (False for elements of eqs. (14)-(15), whose split over the
     states is not unique — checked row-wise by :func:`manifold_residuals`)).
     """
     import pandas as pd
