@@ -636,12 +636,11 @@ def _status_markdown(status: pd.DataFrame) -> str:
     tally = status["status"].value_counts()
     head = ", ".join(f"{s}: {int(tally.get(s, 0))}" for s in STATUSES)
     lines = [f"Artifacts: {len(status)} ({head}).", "",
-             "| id | source | artifact | status | rows | reproduced | erratum | qualitative | analog | not-reproduced | description |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| id | artifact | status | rows | description |", "|---|---|---|---|---|"]
     for _, r in status.iterrows():
+        split = ", ".join(f"{int(r[s.replace('-', '_')])} {s}" for s in STATUSES if int(r[s.replace('-', '_')]))
         lines.append(
-            f"| {r['id']} | {r['source']} | {r['artifact']} | {r['status']} | {r['rows']} | {r['reproduced']} | "
-            f"{r['erratum']} | {r['qualitative']} | {r['analog']} | {r['not_reproduced']} | "
+            f"| `{r['id']}` | {r['artifact']} | **{r['status']}** | {split or '-'} | "
             f"{str(r['description']).replace('|', '/')} |"
         )
     return "\n".join(lines) + "\n"
