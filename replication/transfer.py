@@ -779,7 +779,8 @@ def kalman_gain_by_iteration(a, c, q, rc, *, dt, steps, p0):
 
     The time-varying filter whose limit :func:`steady_state_gain` computes (discretized with the
     matrix exponential and Van Loan's method); returns the continuous-equivalent gain K_d / dt.
-    Used in the tests to check the steady-state gain independently.
+    Used in the tests to check the steady-state gain independently
+    (``test_steady_state_gain_is_limit_of_the_time_varying_discrete_filter``).
     """
     a, c, q, rc, p = (np.asarray(m, float) for m in (a, c, q, rc, p0))
     n = a.shape[0]
