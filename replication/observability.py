@@ -169,12 +169,16 @@ class ObservabilityDegrees:
 
     @property
     def rank(self) -> int:
+        """Numerical rank: the singular values above the same tolerance as :meth:`observable`."""
         return int(np.sum(self.singular_values > self._raw_tol))
 
     @property
     def _raw_tol(self):
+        # rank_tol is stored in the units of ``degree``; undo the "max" normalization
         s = self.singular_values
-        return float(s[0] * max(self.V.shape[0], 1) * np.finfo(float).eps * 10) if s.size else 0.0
+        if not s.size:
+            return 0.0
+        return float(self.rank_tol * s[0]) if self.normalize == "max" and s[0] > 0 else float(self.rank_tol)
 
     def observable(self, threshold=None) -> np.ndarray:
         """Boolean per state: degree above ``threshold`` (default: the numerical-rank tolerance)."""

@@ -204,3 +204,18 @@ def test_goshen_meskin_condition_on_the_45_state_segments():
     F = np.array([[0.0, 1.0], [0.0, 0.0]])
     H = np.array([[0.0, 0.0]])
     assert O.som_condition(F, H) is False
+
+
+def test_rank_uses_the_documented_tolerance():
+    """rank and observable() share one rule, σ_max · max(m, n) · ε.  A tall Q (m = 1000, n = 2)
+    whose second singular value is 5e-14 σ_max lies between 10 n ε (4.4e-15) and m ε (2.2e-13):
+    numerically zero under the documented rule, so the rank is 1 for every normalization."""
+    rng = np.random.default_rng(7)
+    u, _ = np.linalg.qr(rng.standard_normal((1000, 2)))
+    Q = u @ np.diag([1.0, 5e-14])
+    for norm in (None, "max"):
+        d = O.observability_degrees(Q, normalize=norm)
+        assert d.rank == 1
+        assert list(d.observable()) == [True, False]
+    d = O.observability_degrees(Q, normalize="scale", state_scale=[2.0, 3.0])
+    assert d.rank == 1
