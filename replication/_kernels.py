@@ -313,6 +313,33 @@ def build_F(lat, h, ve, vn, vu, c, f_b, w_b, fconst, blk_target, blk_kind, blk_s
     State order: [δL, δλ, δh, δvE, δvN, δvU, φE, φN, φU, augmented blocks...].
     ``fconst`` holds the constant part (block dynamics, gravity-state output couplings).
     """
+    fn0 = c[0, 0] * f_b[0] + c[0, 1] * f_b[1] + c[0, 2] * f_b[2]
+    fn1 = c[1, 0] * f_b[0] + c[1, 1] * f_b[1] + c[1, 2] * f_b[2]
+    fn2 = c[2, 0] * f_b[0] + c[2, 1] * f_b[1] + c[2, 2] * f_b[2]
+    build_F_core(lat, h, ve, vn, vu, fn0, fn1, fn2, fconst, F)
+    B = np.empty((3, 6))
+    for b in range(blk_target.shape[0]):
+        tg = blk_target[b]
+        if tg != TARGET_ACCEL and tg != TARGET_GYRO:
+            continue
+        k0, kk = blk_start[b], blk_size[b]
+        if tg == TARGET_ACCEL:
+            coupling_matrix(blk_kind[b], f_b, B)
+            row, sgn = 3, 1.0
+        else:
+            coupling_matrix(blk_kind[b], w_b, B)
+            row, sgn = 6, -1.0
+        for i in range(3):
+            for j in range(kk):
+                acc = 0.0
+                for m in range(3):
+                    acc += c[i, m] * B[m, j]
+                F[row + i, k0 + j] += sgn * acc
+
+
+@njit(**_NJ)
+def build_F_core(lat, h, ve, vn, vu, fn0, fn1, fn2, fconst, F):
+    """F without the sensor-block couplings: fconst + the navigation-error rows (f^n given)."""
     n = F.shape[0]
     for i in range(n):
         for j in range(n):
@@ -340,23 +367,18 @@ def build_F(lat, h, ve, vn, vu, c, f_b, w_b, fconst, blk_target, blk_kind, blk_s
     Om1 = win1 + w * co
     Om2 = win2 + w * s
     # ∂ω_in/∂(L, h, vE, vN) ; ∂Ω/∂ = same plus ω_ie terms
-    dwin_dL = np.empty(3)
-    dwin_dh = np.empty(3)
-    dwin_dL[0] = vn * drm / (rmh * rmh)
-    dwin_dL[1] = -w * s - ve * drn / (rnh * rnh)
-    dwin_dL[2] = w * co + ve * sec2 / rnh - ve * t * drn / (rnh * rnh)
-    dwin_dh[0] = vn / (rmh * rmh)
-    dwin_dh[1] = -ve / (rnh * rnh)
-    dwin_dh[2] = -ve * t / (rnh * rnh)
-    dOm_dL0 = dwin_dL[0]
-    dOm_dL1 = dwin_dL[1] - w * s
-    dOm_dL2 = dwin_dL[2] + w * co
+    dwL0 = vn * drm / (rmh * rmh)
+    dwL1 = -w * s - ve * drn / (rnh * rnh)
+    dwL2 = w * co + ve * sec2 / rnh - ve * t * drn / (rnh * rnh)
+    dwh0 = vn / (rmh * rmh)
+    dwh1 = -ve / (rnh * rnh)
+    dwh2 = -ve * t / (rnh * rnh)
+    dOm_dL0 = dwL0
+    dOm_dL1 = dwL1 - w * s
+    dOm_dL2 = dwL2 + w * co
     # ∂ω_in/∂v: columns vE, vN, vU
     # E: -1/rmh on vN ; N: 1/rnh on vE ; U: t/rnh on vE
     # velocity rows: -Ω×δv + v×δΩ + f×φ + δg
-    fn0 = c[0, 0] * f_b[0] + c[0, 1] * f_b[1] + c[0, 2] * f_b[2]
-    fn1 = c[1, 0] * f_b[0] + c[1, 1] * f_b[1] + c[1, 2] * f_b[2]
-    fn2 = c[2, 0] * f_b[0] + c[2, 1] * f_b[1] + c[2, 2] * f_b[2]
     # -Ω× : [[0, Om2, -Om1], [-Om2, 0, Om0], [Om1, -Om0, 0]]
     F[3, 4] += Om2
     F[3, 5] += -Om1
@@ -378,9 +400,9 @@ def build_F(lat, h, ve, vn, vu, c, f_b, w_b, fconst, blk_target, blk_kind, blk_s
     F[3, 0] += -vu * dOm_dL1 + vn * dOm_dL2
     F[4, 0] += vu * dOm_dL0 - ve * dOm_dL2
     F[5, 0] += -vn * dOm_dL0 + ve * dOm_dL1
-    F[3, 2] += -vu * dwin_dh[1] + vn * dwin_dh[2]
-    F[4, 2] += vu * dwin_dh[0] - ve * dwin_dh[2]
-    F[5, 2] += -vn * dwin_dh[0] + ve * dwin_dh[1]
+    F[3, 2] += -vu * dwh1 + vn * dwh2
+    F[4, 2] += vu * dwh0 - ve * dwh2
+    F[5, 2] += -vn * dwh0 + ve * dwh1
     dgl, dgh = gamma_grad_s(lat, h)
     F[5, 0] += -dgl
     F[5, 2] += -dgh
@@ -401,31 +423,12 @@ def build_F(lat, h, ve, vn, vu, c, f_b, w_b, fconst, blk_target, blk_kind, blk_s
     F[6, 4] += b0
     F[7, 3] += a1
     F[8, 3] += a2
-    F[6, 0] += dwin_dL[0]
-    F[7, 0] += dwin_dL[1]
-    F[8, 0] += dwin_dL[2]
-    F[6, 2] += dwin_dh[0]
-    F[7, 2] += dwin_dh[1]
-    F[8, 2] += dwin_dh[2]
-    # sensor-error blocks
-    B = np.empty((3, 6))
-    for b in range(blk_target.shape[0]):
-        tg = blk_target[b]
-        if tg != TARGET_ACCEL and tg != TARGET_GYRO:
-            continue
-        k0, kk = blk_start[b], blk_size[b]
-        if tg == TARGET_ACCEL:
-            coupling_matrix(blk_kind[b], f_b, B)
-            row, sgn = 3, 1.0
-        else:
-            coupling_matrix(blk_kind[b], w_b, B)
-            row, sgn = 6, -1.0
-        for i in range(3):
-            for j in range(kk):
-                acc = 0.0
-                for m in range(3):
-                    acc += c[i, m] * B[m, j]
-                F[row + i, k0 + j] += sgn * acc
+    F[6, 0] += dwL0
+    F[7, 0] += dwL1
+    F[8, 0] += dwL2
+    F[6, 2] += dwh0
+    F[7, 2] += dwh1
+    F[8, 2] += dwh2
 
 
 # ----------------------------------------------------------------------------- dense helpers
@@ -524,57 +527,43 @@ def _chol_solve_scaled(P, e):
 
 @njit(**_NJ)
 def joseph_update(P, H, R, z, x, w1, w2):
-    """x = K z (prior error estimate zero), P = (I-KH)P(I-KH)ᵀ + K R Kᵀ. Returns NIS."""
+    """Joseph-form update with a diagonal R, applied one measurement at a time.
+
+    For each row h, r of (H, R): ν = z_i - h x, b = P h, s = hᵀb + r, K = b/s, x += K ν and
+    P ← (I - K hᵀ) P (I - K hᵀ)ᵀ + r K Kᵀ = P - K bᵀ - b Kᵀ + s K Kᵀ (the Joseph form expanded,
+    valid for any gain).  x starts from zero (closed loop).  Returns the NIS νᵀS⁻¹ν of the whole
+    vector, which the sequential innovations give exactly as Σ ν_i²/s_i.
+    """
     n = P.shape[0]
     m = H.shape[0]
-    PHt = np.empty((n, m))
+    bvec = w1[0]
+    kvec = w1[1]
     for i in range(n):
-        for j in range(m):
-            acc = 0.0
-            for k in range(n):
-                acc += P[i, k] * H[j, k]
-            PHt[i, j] = acc
-    S = np.empty((m, m))
-    for i in range(m):
-        for j in range(m):
-            acc = R[i, j]
-            for k in range(n):
-                acc += H[i, k] * PHt[k, j]
-            S[i, j] = acc
-    for i in range(m):
-        for j in range(i + 1, m):
-            v = 0.5 * (S[i, j] + S[j, i])
-            S[i, j] = v
-            S[j, i] = v
-    Sinv = np.linalg.inv(S)
-    K = PHt @ Sinv
+        x[i] = 0.0
     nis = 0.0
-    for i in range(m):
-        for j in range(m):
-            nis += z[i] * Sinv[i, j] * z[j]
-    for i in range(n):
-        acc = 0.0
-        for j in range(m):
-            acc += K[i, j] * z[j]
-        x[i] = acc
-    # A = I - K H
-    for i in range(n):
-        for j in range(n):
-            acc = 1.0 if i == j else 0.0
-            for k in range(m):
-                acc -= K[i, k] * H[k, j]
-            w1[i, j] = acc
-    _matmul_sp(w1, P, w2)
-    KR = K @ R
-    for i in range(n):
-        for j in range(i, n):
+    for r in range(m):
+        nu = z[r]
+        for k in range(n):
+            nu -= H[r, k] * x[k]
+        for i in range(n):
             acc = 0.0
             for k in range(n):
-                acc += w2[i, k] * w1[j, k]
-            for k in range(m):
-                acc += KR[i, k] * K[j, k]
-            P[i, j] = acc
-            P[j, i] = acc
+                hk = H[r, k]
+                if hk != 0.0:
+                    acc += P[i, k] * hk
+            bvec[i] = acc
+        sv = R[r, r]
+        for k in range(n):
+            sv += H[r, k] * bvec[k]
+        for i in range(n):
+            kvec[i] = bvec[i] / sv
+            x[i] += kvec[i] * nu
+        for i in range(n):
+            for j in range(i, n):
+                v = P[i, j] - kvec[i] * bvec[j] - bvec[i] * kvec[j] + sv * kvec[i] * kvec[j]
+                P[i, j] = v
+                P[j, i] = v
+        nis += nu * nu / sv
     return nis
 
 
@@ -631,9 +620,11 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
     P = P0.copy()
     p_hat = np.zeros(n_aug)
     lever = lever0.copy()
-    Fk = np.zeros((n, n))
     Fsum = np.zeros((n, n))
     Csum = np.zeros((3, 3))
+    Cpl = np.zeros((6, n))
+    fsum = np.zeros(3)
+    navsum = np.zeros(5)
     Phi = np.empty((n, n))
     Qd = np.empty((n, n))
     Qc = np.empty((n, n))
@@ -667,19 +658,34 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
         if k == 0:
             dth_cp[:] = dth_c
             dv_cp[:] = dv_c
-        # F at the start of the step (nav state k, corrected IMU of the step)
+        # inputs of F at the start of the step (nav state k, corrected IMU of the step), summed
+        # over the GNSS interval: F is affine in f^n and in the couplings C_b^n B(u), and the
+        # navigation state barely moves in an interval, so F(averages) = average of F to O(T²)
         _q2c(q, c)
         for i in range(3):
             fb[i] = dv_c[i] / T
             wb[i] = dth_c[i] / T
-        build_F(st[0], st[2], st[3], st[4], st[5], c, fb, wb, fconst, blk_target, blk_kind,
-                blk_start, blk_size, Fk)
-        for i in range(n):
-            for jj in range(n):
-                Fsum[i, jj] += Fk[i, jj]
         for i in range(3):
+            fsum[i] += c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2]
             for jj in range(3):
                 Csum[i, jj] += c[i, jj]
+        for i in range(5):
+            navsum[i] += st[0] if i == 0 else st[i + 1]
+        for b in range(blk_target.shape[0]):
+            tg = blk_target[b]
+            if tg != TARGET_ACCEL and tg != TARGET_GYRO:
+                continue
+            r0 = 0 if tg == TARGET_ACCEL else 3
+            k0, kk = blk_start[b], blk_size[b]
+            if blk_kind[b] == KIND_IDENTITY:
+                for i in range(3):
+                    for jj in range(3):
+                        Cpl[r0 + i, k0 + jj] += c[i, jj]
+            else:
+                coupling_matrix(blk_kind[b], fb if tg == TARGET_ACCEL else wb, B)
+                for i in range(3):
+                    for jj in range(kk):
+                        Cpl[r0 + i, k0 + jj] += c[i, 0] * B[0, jj] + c[i, 1] * B[1, jj] + c[i, 2] * B[2, jj]
         nsum += 1
         tsum += T
         dampint = sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, qtmp, c, w_ie, w_en, ta, tb,
@@ -689,13 +695,19 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
         dv_cp[:] = dv_c
         if j < n_ep and gnss_idx[j] == k + 1:
             # ---- time update over the interval
+            inv = 1.0 / nsum
+            build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
+                         fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, fconst, Fsum)
+            for i in range(3):
+                for jj in range(9, n):
+                    Fsum[3 + i, jj] += Cpl[i, jj] * inv
+                    Fsum[6 + i, jj] -= Cpl[3 + i, jj] * inv
             for i in range(n):
                 for jj in range(n):
-                    Fsum[i, jj] /= nsum
                     Qc[i, jj] = qc_const[i, jj]
             for i in range(3):
                 for jj in range(3):
-                    Csum[i, jj] /= nsum
+                    Csum[i, jj] *= inv
             # nav white noise: G = [0; C; -C] with accel/gyro PSDs
             for i in range(3):
                 for jj in range(3):
@@ -853,12 +865,15 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
                     e[9 + i] = truth_p[j, i] - p_hat[i]
                 ep_nees[j] = _chol_solve_scaled(P, e)
             j += 1
-            for i in range(n):
+            for i in range(6):
                 for jj in range(n):
-                    Fsum[i, jj] = 0.0
+                    Cpl[i, jj] = 0.0
             for i in range(3):
+                fsum[i] = 0.0
                 for jj in range(3):
                     Csum[i, jj] = 0.0
+            for i in range(5):
+                navsum[i] = 0.0
             nsum = 0
             tsum = 0.0
         if store_nav:
