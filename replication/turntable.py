@@ -1,0 +1,198 @@
+"""chen2019 ch. 4 §1 三 (§4.1.3, "SINS/GNSS 姿态仿真测试"): a simulated analog of the three
+turntable attitude experiments of Tables 4-37, 4-38 and 4-39.
+
+The report mounts the SINS/GNSS system on a three-axis turntable, runs the rotation sequences
+printed in the text (:func:`replication.trajectory.turntable_chen2019`) and prints the standard
+deviation of the post-processed (smoothed) attitude, position and velocity errors
+(后处理平滑 STD).  The raw data are unpublished; this module builds the analog on the batched
+closed-loop filter and RTS smoother of :mod:`replication.simulation`:
+
+* :func:`tested_imu_setup` — the sensor errors of the unit tested in §4.1 (Tables 4-33 and
+  4-34: bias repeatability and in-run bias stability), completed with the Table 4-41 values for
+  what §4.1 does not print, and the stationary-table aiding measurement;
+* :func:`scenario` — the rotation sequence of experiment 1, 2 or 3 sampled at the IMU rate;
+* :func:`run_scenario` — Monte Carlo of the forward filter (15-state model, chen2019
+  eqs. (3-14)-(3-16)) with the RTS smoother pass;
+* :func:`error_std` — the statistic the tables print: per run, the standard deviation over time
+  of the smoothed pitch, roll, heading (°), latitude, longitude, height (m) and east, north, up
+  velocity (m/s) errors; :func:`summary` — Monte-Carlo mean, spread, extremes;
+* :func:`ordering_rows` — the comparisons between experiments that the printed tables show.
+
+The aiding measurement (the print does not say what the filter used on the table): the table
+stands still at a surveyed point, so the filter receives, at ``reference_rate_hz`` (default
+1 Hz), the known position of the IMU (lever arm zero: the IMU sits at the table's rotation
+centre) with white error σ = ``sigma_pos`` per ENU axis (default 1 cm) and zero velocity with
+white error σ = ``sigma_vel`` (default 1 mm/s).  These are the measurement-noise values the
+filter assumes and the truth draws.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+
+from . import earth
+from . import simulation as S
+from .trajectory import generate, turntable_chen2019
+from .units import DEG, DEG_PER_H, G0
+
+__all__ = ["QUANTITIES", "UNITS", "SITE", "tested_imu_setup", "scenario", "run_scenario", "error_std",
+           "summary", "ordering_rows"]
+
+QUANTITIES = ("smoothed pitch error STD", "smoothed roll error STD", "smoothed heading error STD",
+              "smoothed latitude error STD", "smoothed longitude error STD", "smoothed height error STD",
+              "smoothed east velocity error STD", "smoothed north velocity error STD",
+              "smoothed up velocity error STD")
+"""The nine rows of Tables 4-37 ... 4-39, in printed order (the names of the paper files)."""
+
+UNITS = ("°", "°", "°", "m", "m", "m", "m/s", "m/s", "m/s")
+"""Units of :data:`QUANTITIES` as printed in the row labels."""
+
+SITE = dict(lat0=40.0 * DEG, lon0=116.0 * DEG, h0=50.0)
+"""Turntable site (not printed in §4.1.3; this package's choice: 40°N, 116°E, 50 m)."""
+
+
+def _axes_max(table, stem, unit):
+    vals = []
+    for ax in "xyz":
+        q = f"{stem} {ax}"
+        v = table.value(q)
+        if table.unit(q) != unit:
+            raise ValueError(f"{q!r}: expected unit {unit!r}, the file says {table.unit(q)!r}")
+        if not isinstance(v, float) or not math.isfinite(v) or v < 0:
+            raise ValueError(f"{q!r} is not a non-negative number: {v!r}")
+        vals.append(v)
+    return max(vals)
+
+
+def tested_imu_setup(t433, t434, t441, *, imu_rate_hz: float = 100.0, reference_rate_hz: float = 1.0,
+                     sigma_pos: float = 0.01, sigma_vel: float = 0.001, duration: float = 2226.0,
+                     **choices) -> S.SimulationSetup:
+    """Sensor errors of the unit tested in chen2019 §4.1 and the stationary-table aiding.
+
+    Arguments are the loaded paper files (``rp.load_paper``) of Table 4-33 (gyro static test),
+    Table 4-34 (accelerometer static test) and Table 4-41 (the flight simulation's IMU).
+
+    Readings (stated; the largest axis is taken so that one σ serves the three axes):
+
+    * random constant (turn-on to turn-on) = the printed repeatability 重复性 of the output
+      means: gyro in °/h (Table 4-33), accelerometer in g (Table 4-34, g = 9.80665 m/s²);
+    * in-run bias instability = the mean of the printed bias stability 零偏稳定性, modelled as a
+      first-order Gauss-Markov process with that stationary σ; its correlation time is not
+      printed in §4.1 and is taken from Table 4-41 (300 s gyro, 2.5 h accelerometer);
+    * white noise, scale-factor and misalignment residuals after calibration are not printed in
+      §4.1: Table 4-41's values (:func:`replication.simulation.table_4_41_setup`);
+    * no gravity disturbance (a fixed site: a constant disturbance is part of the accelerometer
+      bias), no lever arm (the IMU at the rotation centre);
+    * aiding: position and zero velocity at ``reference_rate_hz`` with white errors
+      ``sigma_pos`` (m, each ENU axis) and ``sigma_vel`` (m/s).
+
+    ``duration`` (s) is the scenario length (used only by the 36-state model's random walk);
+    ``choices`` override other :class:`replication.simulation.SimulationSetup` fields.
+    """
+    for name, v in (("imu_rate_hz", imu_rate_hz), ("reference_rate_hz", reference_rate_hz),
+                    ("sigma_pos", sigma_pos), ("sigma_vel", sigma_vel), ("duration", duration)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise ValueError(f"{name} must be a positive number, got {v!r}")
+    base = S.table_4_41_setup(t441, gnss_rate_hz=reference_rate_hz)
+    params = dict(
+        imu_rate_hz=float(imu_rate_hz),
+        gyro_bias_sd=_axes_max(t433, "repeatability gyro output mean", "°/h") * DEG_PER_H,
+        gyro_markov_sigma=_axes_max(t433, "mean gyro bias stability", "°/h") * DEG_PER_H,
+        accel_bias_sd=_axes_max(t434, "repeatability accelerometer output mean", "g") * G0,
+        accel_markov_sigma=_axes_max(t434, "mean accelerometer bias stability", "g") * G0,
+        sigma_pos=(float(sigma_pos),) * 3, sigma_vel=float(sigma_vel),
+        gravity_sigma=0.0, lever_arm_b=(0.0, 0.0, 0.0), lever_arm_sd=0.0, flight_duration=float(duration),
+    )
+    params.update(choices)
+    fields = {f: getattr(base, f) for f in base.__dataclass_fields__}
+    fields.update(params)
+    return S.SimulationSetup(**fields)
+
+
+@lru_cache(maxsize=3)
+def _scenario_cached(experiment, dt, dwell, repeats):
+    segs, heading = turntable_chen2019(experiment, dwell=dwell, repeats=repeats)
+    return generate(segs, SITE["lat0"], SITE["lon0"], SITE["h0"], dt=dt, heading=heading)
+
+
+def scenario(experiment: int, *, imu_rate_hz: float = 100.0, dwell: float = 300.0, repeats: int = 3):
+    """Experiment ``experiment`` (1, 2 or 3) of chen2019 §4.1.3 at :data:`SITE`, sampled at
+    ``imu_rate_hz``: 5-min dwells (采集 5 分钟) and the printed rotations (outer axis 9°/s, middle
+    axis 1°/s), steps repeated 3 times.  Cached: do not modify the returned trajectory."""
+    if experiment not in (1, 2, 3):
+        raise ValueError("experiment must be 1, 2 or 3 (chen2019 §4.1.3)")
+    if not (imu_rate_hz > 0 and dwell > 0 and int(repeats) >= 1):
+        raise ValueError("imu_rate_hz and dwell must be positive and repeats ≥ 1")
+    return _scenario_cached(int(experiment), 1.0 / float(imu_rate_hz), float(dwell), int(repeats))
+
+
+def run_scenario(traj, setup: S.SimulationSetup, *, n_runs: int = 12, seed: int = 0, model: str = "15"):
+    """Forward closed-loop filter plus RTS smoother (:func:`replication.simulation.run_batch`) over
+    ``n_runs`` Monte Carlo runs on ``traj``, recording every aiding epoch.  ``model`` is the
+    filter model kind of :func:`replication.simulation.filter_model` (default the 15-state model
+    of chen2019 eqs. (3-14)-(3-16); the report does not say which model the turntable test used)."""
+    if not isinstance(setup, S.SimulationSetup):
+        raise TypeError("setup must be a SimulationSetup (see tested_imu_setup)")
+    m = S.filter_model(model, setup, float(traj.lat[0]), float(traj.h[0]))
+    return S.run_batch(traj, setup, m, n_runs=n_runs, seed=seed, record_every=1, smoother=True,
+                       smoother_covariance=False, chunk_epochs=500)
+
+
+def error_std(result, traj, smoothed: bool = True) -> np.ndarray:
+    """Per run, the standard deviation over time (population, all recorded epochs) of the
+    errors printed in chen2019 Tables 4-37 ... 4-39, in :data:`QUANTITIES` order and
+    :data:`UNITS`: pitch, roll, heading (°, from the attitude error), latitude and longitude
+    (m: δL (R_M + h), δλ (R_N + h) cos L), height (m), east, north, up velocity (m/s).
+    Returns runs × 9."""
+    if smoothed and result.ds is None:
+        raise ValueError("the result has no smoother pass (run_scenario always adds one)")
+    e = result.errors(smoothed)
+    att = S.attitude_errors(result, traj, smoothed)            # heading, pitch, roll (rad)
+    lat = traj.lat[result.epoch_index]
+    h = traj.h[result.epoch_index]
+    rm, rn = earth.radii(lat)
+    pos = np.stack([e[..., 0] * (rm + h), e[..., 1] * (rn + h) * np.cos(lat), e[..., 2]], -1)
+    series = np.concatenate([att[..., [1, 2, 0]] / DEG, pos, e[..., 3:6]], -1)
+    return series.std(axis=1)
+
+
+def summary(per_run) -> dict:
+    """Monte-Carlo statistics of ``per_run`` (runs × k): mean, sample standard deviation
+    (the spread of one run), min and max across runs, each a length-k array."""
+    a = np.asarray(per_run, float)
+    if a.ndim != 2 or a.shape[0] < 2:
+        raise ValueError("per_run must be runs × quantities with at least two runs")
+    return dict(mean=a.mean(0), sd=a.std(0, ddof=1), min=a.min(0), max=a.max(0))
+
+
+def ordering_rows(paper_exp, paper_ref, sim_exp, sim_ref, *, label: str, indices=(1, 2, 5, 8)):
+    """Comparison rows for the orderings between two experiments the printed tables show.
+
+    For each index i of :data:`QUANTITIES`: the printed ratio paper_exp[i] / paper_ref[i] and the
+    simulated ratio of the Monte-Carlo means; status ``qualitative`` when both ratios lie on the
+    same side of 1 (the ordering is reproduced), ``not-reproduced`` otherwise (and when the
+    printed values are equal, so there is no ordering to reproduce).  ``label`` names the
+    reference experiment in the quantity, e.g. ``"experiment 1"``.
+    """
+    pe, pr, se, sr = (np.asarray(x, float) for x in (paper_exp, paper_ref, sim_exp, sim_ref))
+    if not (pe.shape == pr.shape == se.shape == sr.shape == (len(QUANTITIES),)):
+        raise ValueError(f"each argument needs {len(QUANTITIES)} values in QUANTITIES order")
+    if np.any(pr <= 0) or np.any(sr <= 0):
+        raise ValueError("reference values must be positive")
+    rows = []
+    for i in indices:
+        if not 0 <= int(i) < len(QUANTITIES):
+            raise ValueError(f"index {i} outside 0..{len(QUANTITIES) - 1}")
+        p, s = pe[i] / pr[i], se[i] / sr[i]
+        name = QUANTITIES[i].replace("smoothed ", "").replace(" STD", "")
+        same = (p - 1) * (s - 1) > 0
+        note = ("ordering reproduced (magnitudes of an analog, not comparable)" if same else
+                "ordering differs: " + ("the printed values are equal" if p == 1 else
+                                        f"printed ratio {'>' if p > 1 else '<'} 1, simulated {'>' if s > 1 else '≤'} 1"))
+        rows.append(dict(quantity=f"{name} STD ratio to {label}", unit="1", paper=round(float(p), 3),
+                         reproduced=round(float(s), 3), status="qualitative" if same else "not-reproduced",
+                         note=note))
+    return rows
