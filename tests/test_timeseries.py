@@ -14,10 +14,19 @@ from replication import timeseries as ts
 # statistical tolerances below are stated from the sampling distributions before comparing
 
 
+def _printed_phi(axis):
+    paper = rp.load_paper("chen2019-eq-4-13")
+    return np.array([paper.value(f"phi{i} dg_{axis}") for i in (1, 2, 3)])
+
+
+PHI_E_REVERSED = -_printed_phi("E")
+"""The sign-reversed chen2019 east model of eq. (4-13): a stationary AR(3) used as a test model."""
+
+
 @pytest.fixture(scope="module")
 def ar3():
     """A stationary AR(3) series of 2 h at 1 Hz (the sign-reversed chen2019 east model)."""
-    return ts.simulate_ar([0.9168, -0.0758, 0.0991], 1.0, 7200, 1, np.random.default_rng(2019))[0]
+    return ts.simulate_ar(PHI_E_REVERSED, 1.0, 7200, 1, np.random.default_rng(2019))[0]
 
 
 # --------------------------------------------------------------------------- inversion test
@@ -168,7 +177,7 @@ def test_fit_ar_refuses_non_stationary_input():
 def test_fit_ar_estimates_true_coefficients(ar3):
     # 2 h at 1 Hz: standard errors ~ 1/sqrt(7200) = 0.012; 4 sigma = 0.05
     fit = ts.fit_ar(ar3, 3)
-    np.testing.assert_allclose(fit.params, [0.9168, -0.0758, 0.0991], atol=0.05)
+    np.testing.assert_allclose(fit.params, PHI_E_REVERSED, atol=0.05)
 
 
 # --------------------------------------------------------------------------- AIC
@@ -205,7 +214,8 @@ def test_printed_table_4_49_increments_need_very_short_series():
     paper = rp.load_paper("chen2019-table-4-49")
     east = [paper.value(f"AIC AR({p}) dg_E") for p in range(1, 11)]
     b = ts.aic_increment_bound(east)
-    assert b["at_order"] == 8 and b["max_increment"] == pytest.approx(0.1711, abs=1e-9)
+    assert b["at_order"] == 8 and b["max_increment"] == pytest.approx(east[8] - east[7], abs=1e-12)
+    assert b["max_increment"] == pytest.approx(max(np.diff(east)), abs=1e-12)
     assert b["max_length_per_obs"] < 12  # far below the 100 samples the sqrt(n) cap needs for AR(10)
 
 
@@ -231,8 +241,31 @@ def test_printed_east_model_is_not_stationary():
         ts.ar_variance(phi, 1.0)
 
 
+def test_both_repairs_of_the_east_model_are_mirror_images():
+    """Eq. (4-13) east: reversing all signs or only phi2 both give a stationary model.
+
+    With x_t = (-1)^t y_t an AR model (phi1, phi2, phi3) becomes (-phi1, phi2, -phi3): its poles
+    are mirrored (z -> -z) and keep their moduli.  The full reversal is the mirror image of the
+    phi2-only reversal, so the text cannot tell the two repairs apart by stability.
+    """
+    phi = _printed_phi("E")
+    full, only2 = -phi, phi * np.array([1.0, -1.0, 1.0])
+    assert not ts.is_stationary(phi)
+    assert ts.is_stationary(full) and ts.is_stationary(only2)
+    np.testing.assert_allclose(np.sort_complex(ts.ar_poles(full)), np.sort_complex(-ts.ar_poles(only2)), atol=1e-12)
+    # the phi2-only repair keeps every coefficient negative, like the printed north model
+    assert all(c < 0 for c in only2) and all(c < 0 for c in _printed_phi("N"))
+    # an AR(3) fit is invariant under the alternating-sign transform: same residual variance
+    y = ts.simulate_ar(full, 1.0, 4000, 1, np.random.default_rng(3))[0]
+    alt = y * (-1.0) ** np.arange(y.size)
+    p1, s1 = ts.ar_least_squares(y, 3)
+    p2, s2 = ts.ar_least_squares(alt, 3)
+    np.testing.assert_allclose(p2, p1 * np.array([-1.0, 1.0, -1.0]), atol=1e-12)
+    assert s2 == pytest.approx(s1, rel=1e-12)
+
+
 def test_simulated_variance_matches_theory():
-    phi = [0.9168, -0.0758, 0.0991]
+    phi = PHI_E_REVERSED
     Y = ts.simulate_ar(phi, 1.0, 20000, 20, np.random.default_rng(4))
     # 20 x 20000 samples with a correlation length of ~18 samples: ~2e4 effective samples, 5 % is > 5 sigma
     assert Y.var() == pytest.approx(ts.ar_variance(phi, 1.0), rel=0.05)
