@@ -320,3 +320,27 @@ def test_defect_effects_are_separated(printed, derived, first_order):
     assert eff["k1"] == pytest.approx((derived["k1"] - printed["k1"]) * earth.GAMMA_E / earth.MGAL, rel=1e-7)
     with pytest.raises(ValueError, match="unknown defects"):
         earth.eq_3_1_variant(0.1, 0.0, printed, corrected, ("typo",))
+
+
+# --------------------------------------------------------------------------- chen2019 Tables 1-1…1-4
+
+def test_table_1_3_third_imu_is_class_5_not_nus6():
+    """Table 1-3: the prose names the third IPAS20 IMU NUS6, the table header NUS5.
+
+    The name's last digit tracks the accuracy class in the table itself: with the header's NUS5
+    the attitude accuracy is a function of the digit (class 4 > class 5 > class 6, the two
+    class-5 columns identical); with the prose's NUS6 two "class-6" IMUs would differ by a
+    factor 2 in roll/pitch while the third column would equal the class-5 DUS5.
+    """
+    t = rp.load_paper("chen2019-table-1-3").data
+    assert t.set_index("quantity").loc["prose: IMU name / column 3", "value"] == "NUS6"
+    assert t.set_index("quantity").loc["IMU name / column 3 / table header", "value"] == "NUS5"
+    acc = t[(t["kind"] == "table") & t["parameter"].isin(["roll and pitch", "heading"])].astype({"hi": float})
+    acc = acc.pivot_table(index="imu", columns="parameter", values="hi")
+    by_digit = acc.groupby([int(n[-1]) for n in acc.index]).nunique()
+    assert (by_digit == 1).all().all()                  # header names: one accuracy per class digit
+    grades = acc.groupby([int(n[-1]) for n in acc.index]).first()
+    assert (grades.diff().dropna() < 0).all().all()     # and a higher digit is strictly better
+    prose_names = {"NUS4": "NUS4", "DUS5": "DUS5", "NUS5": "NUS6", "CUS6": "CUS6"}
+    by_prose = acc.groupby([int(prose_names[n][-1]) for n in acc.index]).nunique()
+    assert (by_prose.loc[6] > 1).any()                  # prose names: class 6 would be ambiguous
