@@ -168,31 +168,45 @@ def summary(per_run) -> dict:
     return dict(mean=a.mean(0), sd=a.std(0, ddof=1), min=a.min(0), max=a.max(0))
 
 
-def ordering_rows(paper_exp, paper_ref, sim_exp, sim_ref, *, label: str, indices=(1, 2, 5, 8)):
+def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indices=(1, 2, 5, 8)):
     """Comparison rows for the orderings between two experiments the printed tables show.
 
-    For each index i of :data:`QUANTITIES`: the printed ratio paper_exp[i] / paper_ref[i] and the
-    simulated ratio of the Monte-Carlo means; status ``qualitative`` when both ratios lie on the
-    same side of 1 (the ordering is reproduced), ``not-reproduced`` otherwise (and when the
-    printed values are equal, so there is no ordering to reproduce).  ``label`` names the
+    ``paper_exp``, ``paper_ref``: the nine printed values (:data:`QUANTITIES` order) of the
+    experiment and of the reference experiment; ``runs_exp``, ``runs_ref``: the simulated per-run
+    values (runs × 9, :func:`error_std`, independent runs).  For each index i: the printed ratio
+    paper_exp[i] / paper_ref[i] and the ratio of the Monte-Carlo means.  Status ``qualitative``
+    when the simulated means differ in the printed direction by more than two standard errors of
+    their difference (the ordering is reproduced); ``not-reproduced`` otherwise (opposite
+    direction, no significant difference, or equal printed values).  ``label`` names the
     reference experiment in the quantity, e.g. ``"experiment 1"``.
     """
-    pe, pr, se, sr = (np.asarray(x, float) for x in (paper_exp, paper_ref, sim_exp, sim_ref))
-    if not (pe.shape == pr.shape == se.shape == sr.shape == (len(QUANTITIES),)):
-        raise ValueError(f"each argument needs {len(QUANTITIES)} values in QUANTITIES order")
-    if np.any(pr <= 0) or np.any(sr <= 0):
+    pe, pr = (np.asarray(x, float) for x in (paper_exp, paper_ref))
+    re_, rr = (np.asarray(x, float) for x in (runs_exp, runs_ref))
+    k = len(QUANTITIES)
+    if pe.shape != (k,) or pr.shape != (k,):
+        raise ValueError(f"paper_exp and paper_ref need {k} values in QUANTITIES order")
+    if re_.ndim != 2 or rr.ndim != 2 or re_.shape[1] != k or rr.shape[1] != k or min(len(re_), len(rr)) < 2:
+        raise ValueError(f"runs_exp and runs_ref must be runs × {k} with at least two runs each")
+    if np.any(pr <= 0) or np.any(rr <= 0):
         raise ValueError("reference values must be positive")
+    me, mr = re_.mean(0), rr.mean(0)
+    se = np.sqrt(re_.var(0, ddof=1) / len(re_) + rr.var(0, ddof=1) / len(rr))
     rows = []
     for i in indices:
-        if not 0 <= int(i) < len(QUANTITIES):
-            raise ValueError(f"index {i} outside 0..{len(QUANTITIES) - 1}")
-        p, s = pe[i] / pr[i], se[i] / sr[i]
+        if not 0 <= int(i) < k:
+            raise ValueError(f"index {i} outside 0..{k - 1}")
+        p, s, d = pe[i] / pr[i], me[i] / mr[i], me[i] - mr[i]
         name = QUANTITIES[i].replace("smoothed ", "").replace(" STD", "")
-        same = (p - 1) * (s - 1) > 0
-        note = ("ordering reproduced (magnitudes of an analog, not comparable)" if same else
-                "ordering differs: " + ("the printed values are equal" if p == 1 else
-                                        f"printed ratio {'>' if p > 1 else '<'} 1, simulated {'>' if s > 1 else '≤'} 1"))
+        ok = p != 1 and d * (p - 1) > 0 and abs(d) > 2 * se[i]
+        if ok:
+            note = "ordering reproduced (difference > 2 standard errors; magnitudes of an analog)"
+        elif p == 1:
+            note = "the printed values are equal: no ordering to reproduce"
+        elif abs(d) <= 2 * se[i]:
+            note = f"no significant simulated difference ({d:.2g} within 2 standard errors {2 * se[i]:.2g})"
+        else:
+            note = "simulated ordering opposite to the printed one"
         rows.append(dict(quantity=f"{name} STD ratio to {label}", unit="1", paper=round(float(p), 3),
-                         reproduced=round(float(s), 3), status="qualitative" if same else "not-reproduced",
+                         reproduced=round(float(s), 3), status="qualitative" if ok else "not-reproduced",
                          note=note))
     return rows

@@ -80,10 +80,18 @@ def test_summary_and_ordering_rows():
     with pytest.raises(ValueError, match="two runs"):
         tt.summary([[1.0, 2.0]])
     ref = np.ones(9)
-    rows = tt.ordering_rows(np.full(9, 2.0), ref, np.r_[np.full(8, 1.5), 0.5], ref, label="experiment 1")
-    st = {r["quantity"]: r["status"] for r in rows}
-    assert st["heading error STD ratio to experiment 1"] == "qualitative"
-    assert st["up velocity error STD ratio to experiment 1"] == "not-reproduced"
-    assert len(rows) == 4 and all(r["note"] for r in rows)
+    rng = np.random.default_rng(0)
+    runs_ref = 1.0 + 0.01 * rng.standard_normal((8, 9))
+    runs_exp = runs_ref * np.r_[np.full(8, 1.5), 0.5]                 # up velocity: opposite direction
+    runs_exp[:, 5] = 1.0 + 0.01 * rng.standard_normal(8)               # height: no real difference
+    rows = tt.ordering_rows(np.full(9, 2.0), ref, runs_exp, runs_ref, label="experiment 1")
+    st = {r["quantity"]: r for r in rows}
+    assert st["heading error STD ratio to experiment 1"]["status"] == "qualitative"
+    assert st["up velocity error STD ratio to experiment 1"]["status"] == "not-reproduced"
+    assert "opposite" in st["up velocity error STD ratio to experiment 1"]["note"]
+    assert "no significant" in st["height error STD ratio to experiment 1"]["note"]
+    assert len(rows) == 4
     with pytest.raises(ValueError, match="positive"):
-        tt.ordering_rows(ref, np.zeros(9), ref, ref, label="x")
+        tt.ordering_rows(ref, np.zeros(9), runs_ref, runs_ref, label="x")
+    with pytest.raises(ValueError, match="two runs"):
+        tt.ordering_rows(ref, ref, runs_ref[:1], runs_ref, label="x")
