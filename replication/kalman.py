@@ -233,9 +233,11 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     """Closed-loop INS/GNSS integration with the error-state Kalman filter of ``model``.
 
     Strapdown (chen2019 eq. (3-2)) at the IMU rate on increments corrected by the accumulated
-    sensor-error estimates; at each GNSS epoch: F averaged over the interval, Van Loan (Φ, Q_d)
-    by series, Joseph update with antenna position (ENU metres, lever arm of chen2019 eq. (2-13))
-    and/or velocity, feedback of δp, δv, φ and accumulation p̂ += x̂ of the augmented states.
+    sensor-error estimates; at each GNSS epoch: F from the interval averages of its inputs, Van
+    Loan (Φ, Q_d) by series (order ``series_order``), Joseph-form update — one measurement at a
+    time, the GNSS noise being independent per axis (``gnss.sigma_pos``, ``gnss.sigma_vel``) —
+    with antenna position (ENU metres, lever arm of chen2019 eq. (2-13)) and/or velocity, feedback
+    of δp, δv, φ and accumulation p̂ += x̂ of the augmented states.
 
     ``truth`` (a Trajectory on the same samples) with ``true_params`` (augmented-state truth,
     see :func:`true_parameter_vector`) enables the NEES at every epoch.
