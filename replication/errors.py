@@ -15,8 +15,7 @@ Continuous model (chen2019 eqs. (3-14)-(3-16), every first-order term kept — i
 normal-gravity gradient ∂γ/∂h, ∂γ/∂L and dR_M/dL, dR_N/dL, which the printed F omits):
 
     δṗ = F_pp δp + F_pv δv
-    δv̇ = f^n × φ - (2ω_ie^n + ω_en^n) × δv + v^n × (2δω_ie^n + δω_en^n) + δg_γ(δp)
-         + C_b^n δf^b - x_g
+    δv̇ = f^n × φ - (2ω_ie^n + ω_en^n) × δv + v^n × (2δω_ie^n + δω_en^n) + δg_γ(δp) + C_b^n δf^b - x_g
     φ̇ = -ω_in^n × φ + δω_in^n - C_b^n δω_ib^b
 
 with the sensor errors of chen2019 eq. (2-10), δu = Σ_blocks B_kind(u) x_block:
@@ -64,17 +63,17 @@ def nav_block_labels():
 class StateBlock:
     """One augmented block of the error state.
 
-    name      — unique key (``"accel_bias"``, ``"gyro_markov"``, ...);
-    labels    — one label per component;
-    target    — what it perturbs: ``"accel"`` (f^b), ``"gyro"`` (ω_ib^b), ``"gravity"`` (g^n),
-                ``"lever_arm"`` (GNSS antenna offset, measurement only) or ``"none"``;
-    kind      — coupling B(u) for accel/gyro targets: ``"identity"``, ``"scale"``,
-                ``"misalignment"`` (chen2019 eq. (2-8));
-    dynamics  — k×k matrix A of ẋ = A x + w (zeros: random constant);
-    noise_psd — k×k intensity of w;
-    output    — 3×k matrix mapping the block to δg^n (gravity blocks);
-    sd        — k initial standard deviations (for P0 and for drawing truth values);
-    fd_step   — finite-difference step for the numerical Jacobian.
+    * ``name`` — unique key (``"accel_bias"``, ``"gyro_markov"``, ...);
+    * ``labels`` — one label per component;
+    * ``target`` — what it perturbs: ``"accel"`` (f^b), ``"gyro"`` (ω_ib^b), ``"gravity"``
+      (g^n), ``"lever_arm"`` (GNSS antenna offset, measurement only) or ``"none"``;
+    * ``kind`` — coupling B(u) for accel/gyro targets: ``"identity"``, ``"scale"``,
+      ``"misalignment"`` (chen2019 eq. (2-8));
+    * ``dynamics`` — k×k matrix A of ẋ = A x + w (zeros: random constant);
+    * ``noise_psd`` — k×k intensity of w;
+    * ``output`` — 3×k matrix mapping the block to δg^n (gravity blocks);
+    * ``sd`` — k initial standard deviations (for P0 and for drawing truth values);
+    * ``fd_step`` — finite-difference step for the numerical Jacobian.
     """
 
     name: str

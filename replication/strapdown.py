@@ -14,7 +14,7 @@ Discrete algorithm (one update per IMU interval T, increments Δθ_k, Δv_k):
 
 Earth quantities are those of :mod:`replication.earth` (WGS-84 radii, Somigliana normal gravity
 with height, Earth and transport rates), evaluated inside a compiled loop
-(:mod:`replication._kernels`).  Frames and angles: :mod:`replication.rotations`.
+(``replication._kernels``).  Frames and angles: :mod:`replication.rotations`.
 """
 
 from __future__ import annotations
@@ -156,15 +156,12 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
               damping_tau: float = 100.0, polar_limit_deg: float = earth.POLAR_LIMIT_DEG) -> NavSolution:
     """Integrate IMU increments with the ENU strapdown algorithm (chen2019 eq. (3-2)).
 
-    Parameters
-    ----------
-    t : (N+1,) sample times (s), strictly increasing.
-    dtheta, dv : (N, 3) gyro and accelerometer increments Δθ (rad), Δv (m/s) in the body frame
-        (Right-Front-Up), increment k covering t[k]..t[k+1].
-    initial : navigation state at t[0].
-    vertical : "free", "hold" (needs ``h_ref`` and optionally ``vu_ref`` of length N+1: the
-        papers' height channel held to the true height) or "damped" (third-order loop on
-        ``h_ref``, e.g. a barometric height, poles at -1/``damping_tau``).
+    ``t`` holds the N+1 sample times (s, strictly increasing); ``dtheta`` and ``dv`` the (N, 3)
+    gyro and accelerometer increments Δθ (rad), Δv (m/s) in the body frame (Right-Front-Up),
+    increment k covering t[k]..t[k+1]; ``initial`` the navigation state at t[0].
+    ``vertical`` is "free", "hold" (needs ``h_ref`` and optionally ``vu_ref``, N+1 values each:
+    the papers' height channel held to the true height) or "damped" (third-order loop on
+    ``h_ref``, e.g. a barometric height, with poles at -1/``damping_tau``).
     """
     dtheta, dv = validate_increments(dtheta, dv)
     n = len(dtheta)
