@@ -27,7 +27,7 @@ filter per call and keeps neither the per-epoch transition matrices nor the prio
 * diagnostics: NEES of the full state and of the observable subspace (:func:`observable_nees`),
   χ² bands, attitude RMS with Monte-Carlo confidence intervals, the improvement percentages.
 
-Closed-loop smoothing (derivation used by :func:`_rts_chunk`): let e_k⁺ be the error of the
+Closed-loop smoothing (the derivation behind the chunked smoother kernel ``_rts_chunk``): let e_k⁺ be the error of the
 solution after feedback at epoch k (navigation: computed − true; sensor states: true −
 compensated, the convention of :mod:`replication.errors`) and x_k the correction applied at
 epoch k (so e_k⁻ = e_k⁺ + x_k).  The filtered estimate of e_k⁺ is 0 with covariance P_k⁺, the
