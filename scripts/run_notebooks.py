@@ -39,11 +39,28 @@ def clean(nb: nbformat.NotebookNode) -> None:
         cell.metadata.pop("ExecuteTime", None)
         cell.metadata.pop("collapsed", None)
         cell.metadata.pop("scrolled", None)
-        if "id" in cell:  # stable, content-independent cell ids
-            pass
         if cell.cell_type == "code":
-            for out in cell.get("outputs", []):
+            cell.outputs = coalesce_streams(cell.get("outputs", []))
+            for out in cell.outputs:
                 out.get("metadata", {}).pop("execution", None)
+
+
+def coalesce_streams(outputs: list) -> list:
+    """Merge consecutive stream outputs of the same stream.
+
+    How a kernel splits printed text into stream messages depends on timing; merging them
+    makes the stored notebook independent of it (strict nbval merges them the same way)."""
+    merged: list = []
+    for out in outputs:
+        if (out.get("output_type") == "stream" and merged and merged[-1].get("output_type") == "stream"
+                and merged[-1].get("name") == out.get("name")):
+            prev = merged[-1]
+            text = (prev["text"] if isinstance(prev["text"], str) else "".join(prev["text"]))
+            text += out["text"] if isinstance(out["text"], str) else "".join(out["text"])
+            prev["text"] = text
+        else:
+            merged.append(out)
+    return merged
 
 
 def execute(path: Path, timeout: int) -> float:

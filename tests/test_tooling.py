@@ -66,3 +66,11 @@ def test_book_glue_makes_numpy_scalars_plain():
 
     with pytest.raises(ValueError, match="not finite"):
         glue("x", float("nan"), display=False)
+
+
+def test_runner_merges_split_stream_outputs():
+    a = nbformat.v4.new_output("stream", name="stdout", text="within 1e-6:")
+    b = nbformat.v4.new_output("stream", name="stdout", text=" True\n")
+    c = nbformat.v4.new_output("stream", name="stderr", text="x\n")
+    merged = run_notebooks.coalesce_streams([a, b, c])
+    assert len(merged) == 2 and merged[0]["text"] == "within 1e-6: True\n" and merged[1]["name"] == "stderr"
