@@ -25,9 +25,11 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 from scipy import integrate, interpolate, signal
 
 from . import earth
+from . import _kernels as K
 from .timeseries import _phi, ar_poles, is_stationary
 from .units import MGAL
 
@@ -39,7 +41,7 @@ __all__ = [
     "augment_transition", "specific_force_measurement", "gauss_markov", "analog_direct_difference",
     "survey_flight", "local_east_north", "disturbed_increments", "direct_difference_from_filter",
     "compensated_increments", "attitude_position_errors", "photo_epochs", "compensation_run",
-    "consistent_kinematics",
+    "consistent_kinematics", "ar_continuous", "ar_gravity_block", "slope_weights", "augmented_filter",
 ]
 
 
@@ -626,7 +628,8 @@ def photo_epochs(traj, n_photos: int, *, margin: float = 60.0) -> np.ndarray:
 
 def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, offset, photos, imu: dict, gnss_kw: dict,
                      model_kw: dict, cutoff_period: float = 100.0, ar_interval: float | None = None,
-                     true_model: tuple | None = None) -> dict:
+                     true_model: tuple | None = None, specific_force: bool = True,
+                     gauss_markov_reference: bool = False, methods=("normal", "direct", "state")) -> dict:
     """One Monte-Carlo run of the three compensation methods of chen2019 §4.3 (Table 4-50 analog).
 
     The truth flies through ``field_`` (sampled at the planar offsets of the track from
@@ -641,12 +644,20 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
       direct-difference series sampled every ``ar_interval`` s (default: half the cut-off
       period, the filter's Nyquist interval).  The inversion test (m = 10) is recorded, not
       enforced: on a series this strongly correlated the segment means are not independent and
-      the test over-rejects; a fit whose poles leave the unit circle is refused.  Each axis is
-      represented in the continuous-time
-      filter by the first-order Gauss-Markov block (:func:`replication.errors.gravity_shaping`)
-      with the AR model's variance and dominant correlation time; position/velocity updates;
-    * ``true-model`` (if ``true_model`` = (sigma_ENU, beta_ENU)) — the same block with the field's
-      own statistics.
+      the test over-rejects; a fit whose poles leave the unit circle is refused.  The three AR(3)
+      models enter in companion form (:func:`gravity_augmentation`), run as discrete models at
+      ``ar_interval`` inside :func:`augmented_filter`, with the 9-dimensional measurement (3-18)
+      (position, velocity and, every ``ar_interval``, specific force against GNSS acceleration;
+      ``specific_force=False`` drops the last rows);
+    * ``state-gm`` (if ``gauss_markov_reference``) — the former stand-in: each AR model as the
+      first-order Gauss-Markov block of the same variance and dominant correlation time
+      (:func:`replication.errors.gravity_shaping`), position/velocity updates only;
+    * ``true-model`` (if ``true_model`` = (sigma_ENU, beta_ENU)) — the Gauss-Markov block with
+      the field's own statistics in :func:`augmented_filter` (with the specific-force rows when
+      ``specific_force``).
+
+    ``methods`` selects which of ``normal``/``direct`` are returned (``normal`` is always run:
+    step 1 needs it).
 
     Returns {method: {component: error array at ``photos``}} plus ``ar`` (per axis: phi, sigma2,
     the model checks and the inversion test) and
@@ -671,11 +682,13 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
     init = kf.perturb_state(traj.initial_state(), m15, rng)
     out = {}
     r1 = kf.closed_loop(traj.t, dth, dvm, init, gnss, m15)
-    out["normal"] = attitude_position_errors(r1.solution, traj, photos)
+    if "normal" in methods:
+        out["normal"] = attitude_position_errors(r1.solution, traj, photos)
     dd = direct_difference_from_filter(r1, dvm, traj.t, gnss, cutoff_period=cutoff_period)
     g_s = np.stack([np.interp(traj.t, gnss.t, dd[:, i]) for i in range(3)], axis=-1)
-    r2 = kf.closed_loop(traj.t, dth, compensated_increments(dvm, r1.solution.C_bn, g_s, traj.t), init, gnss, m15)
-    out["direct"] = attitude_position_errors(r2.solution, traj, photos)
+    if "direct" in methods:
+        r2 = kf.closed_loop(traj.t, dth, compensated_increments(dvm, r1.solution.C_bn, g_s, traj.t), init, gnss, m15)
+        out["direct"] = attitude_position_errors(r2.solution, traj, photos)
     ar_dt = cutoff_period / 2 if ar_interval is None else ar_interval
     step = int(round(ar_dt / float(np.median(np.diff(gnss.t)))))
     ar = []
@@ -687,13 +700,26 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
         if not chk["stationary"]:
             raise ValueError(f"axis {'ENU'[i]}: the AR(3) fit is not stationary; lengthen ar_interval or the cut-off")
         ar.append((fit.params, fit.sigma2, chk, inv))
-    sig = np.array([a[2]["std"] for a in ar])
-    beta = np.array([1.0 / a[2]["correlation_time"] for a in ar])
-    r3 = kf.closed_loop(traj.t, dth, dvm, init, gnss, m15.extend(er.gravity_shaping(sig, beta)))
-    out["state"] = attitude_position_errors(r3.solution, traj, photos)
+    aug = gravity_augmentation([(a[0], a[1]) for a in ar], ar_dt)
+    from scipy.linalg import solve_discrete_lyapunov
+
+    Pg = solve_discrete_lyapunov(aug.A, aug.Q)
+    zero = np.zeros_like(aug.A)
+    m3 = m15.extend(er.gravity_shaping(np.sqrt(np.diag(Pg)), None, dynamics=zero, noise_psd=zero, output=aug.S))
+    P0 = m3.P0()
+    P0[15:, 15:] = Pg
+    kw = dict(P0=P0, sf_interval=ar_dt, discrete=(aug.A, aug.Q))
+    sol3 = augmented_filter(traj.t, dth, dvm, init, gnss, m3, use_specific_force=specific_force, **kw)
+    out["state"] = attitude_position_errors(sol3, traj, photos)
+    if gauss_markov_reference:
+        sig = np.array([a[2]["std"] for a in ar])
+        beta = np.array([1.0 / a[2]["correlation_time"] for a in ar])
+        r3 = kf.closed_loop(traj.t, dth, dvm, init, gnss, m15.extend(er.gravity_shaping(sig, beta)))
+        out["state-gm"] = attitude_position_errors(r3.solution, traj, photos)
     if true_model is not None:
-        r4 = kf.closed_loop(traj.t, dth, dvm, init, gnss, m15.extend(er.gravity_shaping(*true_model)))
-        out["true-model"] = attitude_position_errors(r4.solution, traj, photos)
+        sol4 = augmented_filter(traj.t, dth, dvm, init, gnss, m15.extend(er.gravity_shaping(*true_model)),
+                                sf_interval=ar_dt if specific_force else None)
+        out["true-model"] = attitude_position_errors(sol4, traj, photos)
     out["ar"] = ar
     out["dd"] = dict(t=gnss.t, measured=dd, true=dg[gnss.index])
     return out
@@ -721,3 +747,423 @@ def consistent_kinematics(n: int, rng: np.random.Generator, *, lat=math.radians(
     C = Rotation.from_euler("zyx", rng.uniform(-0.5, 0.5, (n, 3))).as_matrix()
     f_n = vdot + _coriolis_transport(v, lat, h) - earth.gravity_enu(lat, h) - dg
     return dict(lat=lat, h=h, v=v, v_dot=vdot, dg=dg, C_bn=C, f_n=f_n, f_b=np.einsum("nji,nj->ni", C, f_n))
+
+
+# --------------------------------------------------------------------------- step 3: the augmented filter
+
+def ar_continuous(phi, sigma2: float, dt: float):
+    """Continuous-time shaping filter whose samples every ``dt`` are exactly the AR process.
+
+    With A the companion matrix (:func:`ar_companion`) and P the stationary covariance of the
+    discrete state (P = A P A^T + sigma² e_1 e_1^T), the continuous system::
+
+        A_c = logm(A) / dt,      Q_c = -(A_c P + P A_c^T)
+
+    has the transition exp(A_c dt) = A and the stationary covariance P, so its samples every
+    ``dt`` have the discrete process noise P - A P A^T = sigma² e_1 e_1^T: the same
+    second-order statistics as the AR model at the sampling instants (chen2019 eq. (3-17)).
+    Returns ``(A_c, Q_c, P, embeddable)``.  A real logarithm needs no pole on the negative real
+    axis (refused with a message); Q_c must be positive semi-definite for a continuous process
+    with white driving noise to exist — when it is not (``embeddable`` False) its negative
+    eigenvalues are set to zero, which keeps the transition and raises the variance slightly.
+    """
+    from scipy.linalg import logm, solve_continuous_lyapunov, solve_discrete_lyapunov
+
+    phi = _phi(phi)
+    if not (sigma2 > 0 and dt > 0):
+        raise ValueError("sigma2 ((m/s²)²) and dt (s) must be positive")
+    if not is_stationary(phi):
+        raise ValueError("the AR model is not stationary: it has no continuous-time shaping filter")
+    A = ar_companion(phi)
+    poles = np.linalg.eigvals(A)
+    if np.any((np.abs(poles.imag) < 1e-12) & (poles.real <= 0)):
+        raise ValueError(f"AR poles {np.round(poles, 4)} include one on the negative real axis: no real "
+                         f"continuous-time equivalent exists at dt = {dt} s; sample the series more densely")
+    Ac = logm(A)
+    if np.max(np.abs(np.imag(Ac))) > 1e-9 * max(1.0, np.max(np.abs(Ac))):
+        raise ValueError("the matrix logarithm of the companion matrix is not real")
+    Ac = np.real(Ac) / dt
+    Qd = np.zeros_like(A)
+    Qd[0, 0] = sigma2
+    P = solve_discrete_lyapunov(A, Qd)
+    Qc = -(Ac @ P + P @ Ac.T)
+    Qc = 0.5 * (Qc + Qc.T)
+    w, V = np.linalg.eigh(Qc)
+    embeddable = bool(w.min() >= -1e-9 * w.max())
+    if not embeddable:
+        Qc = (V * np.clip(w, 0.0, None)) @ V.T
+        P = solve_continuous_lyapunov(Ac, -Qc)
+    return Ac, Qc, P, embeddable
+
+
+def ar_gravity_block(models, dt: float, *, name: str = "gravity"):
+    """Gravity-disturbance block of three AR shaping filters in companion form (chen2019 eq. 3-17).
+
+    ``models``: three (phi, sigma2) pairs (E, N, U) identified at the interval ``dt``; each is
+    converted by :func:`ar_continuous` and the three are stacked block-diagonally into a
+    :func:`replication.errors.gravity_shaping` block whose output selects the first state of
+    each companion block.  Returns ``(block, P0, embeddable)`` with the stationary covariance
+    ``P0`` of the block (the filter's initial covariance of these states).
+    """
+    from scipy.linalg import block_diag
+
+    from . import errors as er
+
+    models = list(models)
+    if len(models) != 3:
+        raise ValueError("give three (phi, sigma2) models, for the east, north and up components")
+    parts = [ar_continuous(phi, s2, dt) for phi, s2 in models]
+    Ac = block_diag(*[p[0] for p in parts])
+    Qc = block_diag(*[p[1] for p in parts])
+    P0 = block_diag(*[p[2] for p in parts])
+    orders = [p[0].shape[0] for p in parts]
+    S = np.zeros((3, Ac.shape[0]))
+    S[[0, 1, 2], np.cumsum([0] + orders[:-1])] = 1.0
+    labels = [f"{ax}{i}" for ax, p in zip("ENU", orders) for i in range(p)]
+    blk = er.gravity_shaping(np.sqrt(np.diag(P0)), None, name=name, dynamics=Ac, noise_psd=Qc, output=S, labels=labels)
+    return blk, P0, all(p[3] for p in parts)
+
+
+def slope_weights(t_gnss, t_imu) -> np.ndarray:
+    """Weights w_k (summing to one) of the IMU steps such that the least-squares slope of GNSS
+    velocity samples at ``t_gnss`` equals sum_k w_k a_k for the step-mean accelerations a_k.
+
+    The slope sum_i c_i v_i (c_i = (t_i - t_mean) / sum (t_i - t_mean)²) rewritten with
+    v_{i+1} - v_i = sum_k a_k Delta t_k gives w_k = -(c_0 + ... + c_i) Delta t_k for the steps of
+    GNSS interval i: a parabolic window.  ``t_imu`` are the IMU sample times from ``t_gnss[0]``
+    to ``t_gnss[-1]`` (both included).  This is the GNSS-acceleration low-pass of
+    :func:`augmented_filter`: the INS side is averaged with the same weights.
+    """
+    tg = np.asarray(t_gnss, float)
+    ti = np.asarray(t_imu, float)
+    if tg.size < 3:
+        raise ValueError("the window needs at least three GNSS epochs")
+    d = tg - tg.mean()
+    c = d / np.sum(d * d)
+    C = -np.cumsum(c)[:-1]
+    seg = np.searchsorted(tg, 0.5 * (ti[1:] + ti[:-1])) - 1
+    return C[seg] * np.diff(ti)
+
+
+@njit(cache=True, nogil=True)
+def _augmented_kernel(dt, dtheta, dv, st0, q0, gnss_idx, gnss_pos, gnss_vel, R_pos, R_vel, P0, fconst, qc_const,
+                      q_accel, q_gyro, tg, kd, bst, bsz, order, wgt, win, win_end, a_gnss, R_sf, Hg, gS, gstart,
+                      ar_tick, Tg, Qg, out_st, out_q):
+    n_imu = dtheta.shape[0]
+    n = P0.shape[0]
+    n_aug = n - 9
+    st = st0.copy()
+    st_prev = st0.copy()
+    q = q0.copy()
+    qtmp = np.empty(4)
+    c = np.empty((3, 3))
+    w_ie = np.empty(3)
+    w_en = np.empty(3)
+    ta = np.empty(3)
+    tb = np.empty(3)
+    g_extra = np.zeros(3)
+    trig = np.array([st0[0], math.sin(st0[0]), math.cos(st0[0])])
+    gains = np.zeros(3)
+    Ta = np.ascontiguousarray(Tg[9:, 9:])
+    P = P0.copy()
+    p_hat = np.zeros(n_aug)
+    Fsum = np.zeros((n, n))
+    Csum = np.zeros((3, 3))
+    Cpl = np.zeros((6, n))
+    fsum = np.zeros(3)
+    navsum = np.zeros(5)
+    Phi = np.empty((n, n))
+    Qd = np.empty((n, n))
+    Qc = np.empty((n, n))
+    w1 = np.empty((n, n))
+    w2 = np.empty((n, n))
+    B = np.empty((3, 6))
+    dth_c = np.empty(3)
+    dv_c = np.empty(3)
+    dth_cp = np.zeros(3)
+    dv_cp = np.zeros(3)
+    fb = np.empty(3)
+    xk = np.empty(n)
+    H6 = np.zeros((6, n))
+    R6 = np.zeros((6, 6))
+    z6 = np.zeros(6)
+    H9 = np.zeros((9, n))
+    R9 = np.zeros((9, 9))
+    z9 = np.zeros(9)
+    vacc = np.zeros(3)   # weighted mean INS acceleration of the current window
+    facc = np.zeros(3)   # weighted mean f^n
+    Cw = np.zeros((3, 3))  # weighted mean C_b^n
+    n_sf = 0
+    nsum = 0
+    tsum = 0.0
+    j = 0
+    n_ep = gnss_idx.shape[0]
+    out_st[0, :] = st
+    out_q[0, :] = q
+    for k in range(n_imu):
+        T = dt[k]
+        K._apply_corrections(dtheta[k], T, p_hat, tg, kd, bst, bsz, 1, dth_c, B)
+        K._apply_corrections(dv[k], T, p_hat, tg, kd, bst, bsz, 0, dv_c, B)
+        if k == 0:
+            dth_cp[:] = dth_c
+            dv_cp[:] = dv_c
+        K._q2c(q, c)
+        for i in range(3):
+            fb[i] = dv_c[i] / T
+        for i in range(3):
+            fn = c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2]
+            fsum[i] += fn
+            if win[k] >= 0:
+                facc[i] += wgt[k] * fn
+            for jj in range(3):
+                Csum[i, jj] += c[i, jj]
+                if win[k] >= 0:
+                    Cw[i, jj] += wgt[k] * c[i, jj]
+        for i in range(5):
+            navsum[i] += st[0] if i == 0 else st[i + 1]
+        for b in range(tg.shape[0]):
+            if tg[b] == K.TARGET_ACCEL or tg[b] == K.TARGET_GYRO:
+                r0 = 0 if tg[b] == K.TARGET_ACCEL else 3
+                for i in range(3):
+                    for jj in range(3):
+                        Cpl[r0 + i, bst[b] + jj] += c[i, jj]
+        nsum += 1
+        tsum += T
+        v0, v1, v2 = st[3], st[4], st[5]
+        K.sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, qtmp, c, w_ie, w_en, ta, tb,
+                  0, 0.0, 0.0, gains, 0.0, g_extra, trig)
+        if win[k] >= 0:
+            vacc[0] += wgt[k] * (st[3] - v0) / T
+            vacc[1] += wgt[k] * (st[4] - v1) / T
+            vacc[2] += wgt[k] * (st[5] - v2) / T
+        dth_cp[:] = dth_c
+        dv_cp[:] = dv_c
+        if j < n_ep and gnss_idx[j] == k + 1:
+            inv = 1.0 / nsum
+            K.build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
+                           fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, fconst, Fsum)
+            for i in range(3):
+                for jj in range(9, n):
+                    Fsum[3 + i, jj] += Cpl[i, jj] * inv
+                    Fsum[6 + i, jj] -= Cpl[3 + i, jj] * inv
+            for i in range(n):
+                for jj in range(n):
+                    Qc[i, jj] = qc_const[i, jj]
+            for i in range(3):
+                for jj in range(3):
+                    Csum[i, jj] *= inv
+            for i in range(3):
+                for jj in range(3):
+                    sa = 0.0
+                    sg = 0.0
+                    for m in range(3):
+                        sa += Csum[i, m] * q_accel[m] * Csum[jj, m]
+                        sg += Csum[i, m] * q_gyro[m] * Csum[jj, m]
+                    Qc[3 + i, 3 + jj] += sa
+                    Qc[6 + i, 6 + jj] += sg
+            K.discretize_series(Fsum, Qc, tsum, order, Phi, Qd, w1, w2)
+            K._propagate_P(Phi, P, Qd, w1)
+            for i in range(n_aug):
+                acc = 0.0
+                for jj in range(n_aug):
+                    acc += Phi[9 + i, 9 + jj] * p_hat[jj]
+                xk[i] = acc
+            for i in range(n_aug):
+                p_hat[i] = xk[i]
+            if ar_tick[j]:
+                # discrete AR step of the gravity states (held between steps): P <- T P T' + Q
+                P[:, :] = Tg @ P @ Tg.T + Qg
+                xk[9:] = Ta @ p_hat
+                p_hat[:] = xk[9:]
+            # ---- position / velocity rows of (3-18)
+            L, h = st[0], st[2]
+            rm, rn = K.radii_s(L)
+            sf = win_end[j]
+            H = H9 if sf >= 0 else H6
+            Rm = R9 if sf >= 0 else R6
+            z = z9 if sf >= 0 else z6
+            for i in range(H.shape[0]):
+                for jj in range(n):
+                    H[i, jj] = 0.0
+            z[0] = (st[1] - gnss_pos[j, 1]) * (rn + h) * math.cos(L)
+            z[1] = (st[0] - gnss_pos[j, 0]) * (rm + h)
+            z[2] = st[2] - gnss_pos[j, 2]
+            H[0, 1] = (rn + h) * math.cos(L)
+            H[1, 0] = rm + h
+            H[2, 2] = 1.0
+            for i in range(3):
+                z[3 + i] = st[3 + i] - gnss_vel[j, i]
+                H[3 + i, 3 + i] = 1.0
+                for jj in range(3):
+                    Rm[i, jj] = R_pos[i, jj]
+                    Rm[3 + i, 3 + jj] = R_vel[i, jj]
+            # ---- specific-force rows of (3-18): INS acceleration minus GNSS acceleration, same window
+            if sf >= 0:
+                for i in range(3):
+                    z[6 + i] = vacc[i] - a_gnss[sf, i]
+                    Rm[6 + i, 6 + i] = R_sf[sf, i]
+                    for jj in range(n_aug):
+                        H[6 + i, 9 + jj] = Hg[i, jj]
+                # f^n x phi
+                H[6, 7] = -facc[2]
+                H[6, 8] = facc[1]
+                H[7, 6] = facc[2]
+                H[7, 8] = -facc[0]
+                H[8, 6] = -facc[1]
+                H[8, 7] = facc[0]
+                for b in range(tg.shape[0]):
+                    if tg[b] == K.TARGET_ACCEL:
+                        for i in range(3):
+                            for jj in range(3):
+                                H[6 + i, bst[b] + jj] += Cw[i, jj]
+                n_sf += 1
+            K.joseph_update(P, H, Rm, z, xk, w1, w2)
+            if sf >= 0:
+                for i in range(3):
+                    vacc[i] = 0.0
+                    facc[i] = 0.0
+                    for jj in range(3):
+                        Cw[i, jj] = 0.0
+            for i in range(6):
+                st[i] -= xk[i]
+                st_prev[i] -= xk[i]
+            K._rv2q(xk[6], xk[7], xk[8], qtmp)
+            a1, b1, c1, d1 = qtmp[0], qtmp[1], qtmp[2], qtmp[3]
+            q0_, q1_, q2_, q3_ = q[0], q[1], q[2], q[3]
+            n0 = a1 * q0_ - b1 * q1_ - c1 * q2_ - d1 * q3_
+            n1 = a1 * q1_ + b1 * q0_ + c1 * q3_ - d1 * q2_
+            n2 = a1 * q2_ - b1 * q3_ + c1 * q0_ + d1 * q1_
+            n3 = a1 * q3_ + b1 * q2_ - c1 * q1_ + d1 * q0_
+            nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
+            q[0], q[1], q[2], q[3] = n0 / nn, n1 / nn, n2 / nn, n3 / nn
+            for i in range(n_aug):
+                p_hat[i] += xk[9 + i]
+            for i in range(3):
+                acc = 0.0
+                for jj in range(gS.shape[1]):
+                    acc += gS[i, jj] * p_hat[gstart - 9 + jj]
+                g_extra[i] = acc
+            j += 1
+            for i in range(6):
+                for jj in range(n):
+                    Cpl[i, jj] = 0.0
+            for i in range(3):
+                fsum[i] = 0.0
+                for jj in range(3):
+                    Csum[i, jj] = 0.0
+            for i in range(5):
+                navsum[i] = 0.0
+            nsum = 0
+            tsum = 0.0
+        out_st[k + 1, :] = st
+        out_q[k + 1, :] = q
+    return n_sf
+
+
+def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float | None = None, P0=None,
+                     discrete=None, use_specific_force: bool = True, series_order: int = 4):
+    """Closed-loop INS/GNSS filter with the 9-dimensional measurement of chen2019 eq. (3-18).
+
+    The error-state filter of :func:`replication.kalman.closed_loop` (same strapdown, Van Loan
+    series, Joseph update, feedback; free vertical channel, no lever arm) with ``model``'s
+    gravity block (e.g. :func:`ar_gravity_block`) compensated in the mechanization, and, every
+    ``sf_interval`` seconds, the specific-force rows of (3-18) stacked under the GNSS position and
+    velocity rows::
+
+        z_f = mean_w(C_b^n f^b + g_m^n + g-hat^n - (2 omega_ie + omega_en) x V) - a_GNSS
+            = f^n x phi + C_b^n nabla - delta g^n(t - lag) + noise
+
+    The GNSS acceleration a_GNSS is the least-squares slope of the GNSS velocity over the
+    window's epochs (the low-pass of this implementation) and the INS side is averaged with the
+    same weights (:func:`slope_weights`), so both sides see the same band.  The windows are
+    disjoint (their noises independent); R_f is the slope's variance from ``gnss.sigma_vel``
+    plus the averaged accelerometer white noise.  The disturbance enters H through the output
+    of the gravity block taken back by the window's centroid lag (exp(-A_c lag)); the attitude
+    and bias columns use the window means.  ``sf_interval=None``: position/velocity only.
+
+    ``discrete`` = (A_d, Q_d): the gravity block is instead the discrete AR model itself, run at
+    the interval ``sf_interval`` (e.g. the ``A`` and ``Q`` of :class:`GravityAugmentation`): the block's
+    continuous dynamics must be zero, its states are held between AR steps and at the start of
+    each window the transition x <- A_d x + w (covariance Q_d) is applied to the estimate and
+    the covariance.  This needs no continuous-time equivalent (which does not exist when an
+    AR pole lies on the negative real axis, see :func:`ar_continuous`); the disturbance is then
+    piecewise constant over each window, so the window lag is zero.  ``use_specific_force=False``
+    keeps the windows (and the AR steps) but drops the specific-force rows.
+    Returns a :class:`replication.strapdown.NavSolution`.
+    """
+    from scipy.linalg import expm
+
+    from .rotations import dcm_to_quat
+    from .strapdown import NavSolution, validate_increments, validate_time
+
+    dtheta, dv = validate_increments(dtheta, dv)
+    n = len(dtheta)
+    t = validate_time(t, n)
+    idx = np.asarray(gnss.index, np.int64)
+    if np.any(np.asarray(gnss.lever_arm_b) != 0):
+        raise ValueError("augmented_filter has no lever-arm correction; use GNSS at the IMU (lever_arm_b = 0)")
+    names = [b.name for b in model.blocks if b.target == "gravity"]
+    if len(names) != 1:
+        raise ValueError("the model needs exactly one gravity block (errors.gravity_shaping or ar_gravity_block)")
+    gblk = model.block(names[0])
+    gs = model.slices[names[0]]
+    fconst, qc, tg, kd, bst, bsz = model._encoding()
+    P0 = model.P0() if P0 is None else np.asarray(P0, float)
+    if P0.shape != (model.n, model.n):
+        raise ValueError(f"P0 must be {model.n}x{model.n}")
+    n_aug = model.n - 9
+    wgt = np.zeros(n)
+    win = np.full(n, -1, np.int64)
+    win_end = np.full(len(idx), -1, np.int64)
+    Hg = np.zeros((3, n_aug))
+    a_g, R_sf = np.zeros((1, 3)), np.zeros((1, 3))
+    if sf_interval is not None:
+        dtg = float(np.median(np.diff(gnss.t)))
+        m = int(round(sf_interval / dtg))
+        if m < 3 or abs(m * dtg - sf_interval) > 1e-6:
+            raise ValueError(f"sf_interval must be a multiple (>= 3) of the GNSS interval {dtg} s")
+        nw = len(idx) // m
+        a_g, R_sf = np.zeros((nw, 3)), np.zeros((nw, 3))
+        sv2 = np.broadcast_to(np.asarray(gnss.sigma_vel, float) ** 2, (3,))
+        lag = 0.0
+        for w in range(nw):
+            e = np.arange(w * m, (w + 1) * m)
+            te = gnss.t[e]
+            d = te - te.mean()
+            a_g[w] = (d / np.sum(d * d)) @ gnss.v_enu[e]
+            k0, k1 = idx[e[0]], idx[e[-1]]
+            ww = slope_weights(te, t[k0:k1 + 1])
+            wgt[k0:k1] = ww
+            win[k0:k1] = w
+            win_end[e[-1]] = w
+            T = np.diff(t[k0:k1 + 1])
+            R_sf[w] = sv2 / np.sum(d * d) + model.accel_psd * np.sum(ww**2 / T)
+            lag = te[-1] - np.sum(ww * 0.5 * (t[k0:k1] + t[k0 + 1:k1 + 1]))
+        Hg[:, gs.start - 9:gs.stop - 9] = -np.asarray(gblk.output, float) @ expm(
+            -np.asarray(gblk.dynamics) * (0.0 if discrete is not None else lag))
+    ar_tick = np.zeros(len(idx), np.int64)
+    Tg = np.eye(model.n)
+    Qg = np.zeros((model.n, model.n))
+    if discrete is not None:
+        if sf_interval is None:
+            raise ValueError("a discrete gravity model needs sf_interval (its sampling interval)")
+        Ad, Qd = (np.asarray(x, float) for x in discrete)
+        if Ad.shape != (gblk.size, gblk.size) or Qd.shape != Ad.shape:
+            raise ValueError(f"discrete = (A_d, Q_d) must be {gblk.size}x{gblk.size} for block {gblk.name!r}")
+        if np.any(gblk.dynamics != 0) or np.any(gblk.noise_psd != 0):
+            raise ValueError("with a discrete gravity model the block's continuous dynamics and noise must be zero")
+        Tg[gs, gs] = Ad
+        Qg[gs, gs] = Qd
+        ar_tick[np.arange(m, len(idx), m)] = 1
+    if not use_specific_force:
+        win_end[:] = -1
+    out_st = np.empty((n + 1, 6))
+    out_q = np.empty((n + 1, 4))
+    R_pos = np.diag(np.broadcast_to(np.asarray(gnss.sigma_pos, float), (3,)) ** 2)
+    R_vel = np.diag(np.broadcast_to(np.asarray(gnss.sigma_vel, float), (3,)) ** 2)
+    _augmented_kernel(np.diff(t), dtheta, dv, initial.vector(), dcm_to_quat(initial.C_bn), idx,
+                      np.ascontiguousarray(gnss.position), np.ascontiguousarray(gnss.v_enu, float), R_pos, R_vel,
+                      np.ascontiguousarray(P0), fconst, qc, model.accel_psd, model.gyro_psd, tg, kd, bst, bsz,
+                      int(series_order), wgt, win, win_end, a_g, R_sf, Hg, np.ascontiguousarray(gblk.output, float),
+                      int(gs.start), ar_tick, Tg, Qg, out_st, out_q)
+    return NavSolution(t, out_st[:, 0], out_st[:, 1], out_st[:, 2], out_st[:, 3:6], out_q)

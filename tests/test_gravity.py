@@ -294,3 +294,100 @@ def test_direct_difference_from_filter_obeys_eq_3_8():
     # residual: 1e-6 m/s GNSS velocity noise differentiated and 5 s filtered (~0.013 mGal) plus
     # second-order terms; 0.2 mGal is > 10 sigma of the noise part
     np.testing.assert_allclose(dd[mid], expect[mid], atol=0.2 * MGAL)
+
+
+# --------------------------------------------------------------------------- step 3: the augmented filter
+
+def test_ar_continuous_is_exact_at_the_samples():
+    from scipy.linalg import expm
+
+    s2, dt = 1e-10, 50.0
+    Ac, Qc, P, emb = gr.ar_continuous(PHI_E, s2, dt)
+    A = gr.ar_companion(PHI_E)
+    np.testing.assert_allclose(expm(Ac * dt), A, atol=1e-10)
+    if emb:  # the discrete noise of the sampled process is the AR model's e_1 sigma² e_1^T
+        Qd = np.zeros((3, 3))
+        Qd[0, 0] = s2
+        np.testing.assert_allclose(P - A @ P @ A.T, Qd, atol=1e-9 * s2)
+        assert P[0, 0] == pytest.approx(ts.ar_variance(PHI_E, s2), rel=1e-9)
+    assert np.all(np.linalg.eigvalsh(Qc) >= -1e-12 * np.abs(Qc).max())
+    with pytest.raises(ValueError, match="negative real axis"):
+        gr.ar_continuous([-0.5, 0.1, 0.02], s2, dt)
+    blk, P0, _ = gr.ar_gravity_block([(PHI_E, s2)] * 3, dt)
+    assert blk.output.shape == (3, 9) and np.all(blk.output.sum(axis=1) == 1.0)
+    assert P0.shape == (9, 9)
+
+
+def test_slope_weights_reproduce_the_least_squares_slope():
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 5.0 + 1e-9, 0.01)
+    a = rng.standard_normal(t.size - 1)
+    v = np.concatenate([[0.0], np.cumsum(a * np.diff(t))])
+    k = np.arange(0, t.size, 10)  # 10 Hz GNSS on 100 Hz IMU samples
+    w = gr.slope_weights(t[k], t)
+    slope = np.polyfit(t[k], v[k], 1)[0]
+    assert w.sum() == pytest.approx(1.0, abs=1e-12)
+    assert np.all(w >= 0)
+    assert w @ a == pytest.approx(slope, abs=1e-10)
+
+
+@pytest.fixture(scope="module")
+def noisy_line():
+    from replication import errors as er
+    from replication import kalman as kf
+    from replication import sensors as se
+
+    tr = gr.survey_flight(n_lines=1, duration=600.0, speed=30.0, lat0=math.radians(30.0), lon0=math.radians(110.0),
+                          h0=500.0, dt=0.01)
+    rng = np.random.default_rng(11)
+    dg = np.tile([20e-5, -10e-5, 30e-5], (tr.n + 1, 1))
+    errs = se.ImuErrors(gyro=se.TriadErrors(bias=1e-8 * rng.standard_normal(3), white_psd=1e-14),
+                        accel=se.TriadErrors(bias=5e-4 * rng.standard_normal(3), white_psd=1e-8))
+    dth, dv, _ = se.apply_imu_errors(tr.t, tr.dtheta, gr.disturbed_increments(tr, dg), errs, rng)
+    gnss = se.gnss_measurements(tr, rate_hz=10, sigma_pos=0.1, sigma_vel=0.03, rng=rng)
+    m = er.model_15(accel_bias_sd=5e-4, gyro_bias_sd=1e-8, accel_psd=1e-8, gyro_psd=1e-14, position_sd=0.1,
+                    velocity_sd=0.03, attitude_sd=(1e-4, 1e-4, 5e-4), lat=math.radians(30.0), h=500.0)
+    init = kf.perturb_state(tr.initial_state(), m, rng)
+    return tr, dth, dv, gnss, m, init
+
+
+def test_augmented_filter_without_specific_force_is_the_core_filter(noisy_line):
+    from replication import errors as er
+    from replication import kalman as kf
+
+    tr, dth, dv, gnss, m, init = noisy_line
+    mg = m.extend(er.gravity_shaping([13e-5, 13e-5, 26e-5], 1 / 300.0))
+    ref = kf.closed_loop(tr.t, dth, dv, init, gnss, mg).solution
+    sol = gr.augmented_filter(tr.t, dth, dv, init, gnss, mg)
+    # same strapdown, discretization, update and feedback: equal to rounding
+    np.testing.assert_allclose(sol.lat, ref.lat, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(sol.v_enu, ref.v_enu, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(sol.q_bn, ref.q_bn, rtol=0, atol=1e-11)
+
+
+def test_augmented_filter_with_the_9_dimensional_measurement(noisy_line):
+    from scipy.linalg import solve_discrete_lyapunov
+
+    from replication import errors as er
+
+    tr, dth, dv, gnss, m, init = noisy_line
+    aug = gr.gravity_augmentation([(PHI_E, 1e-9)] * 3, 20.0)
+    Pg = solve_discrete_lyapunov(aug.A, aug.Q)
+    z = np.zeros_like(aug.A)
+    ma = m.extend(er.gravity_shaping(np.sqrt(np.diag(Pg)), None, dynamics=z, noise_psd=z, output=aug.S))
+    kw = dict(sf_interval=20.0, discrete=(aug.A, aug.Q))
+    with pytest.raises(ValueError, match="continuous dynamics"):
+        moving = er.gravity_shaping(np.sqrt(np.diag(Pg)), None, dynamics=-0.01 * np.eye(9), noise_psd=z, output=aug.S)
+        gr.augmented_filter(tr.t, dth, dv, init, gnss, m.extend(moving), **kw)
+    with pytest.raises(ValueError, match="multiple"):
+        gr.augmented_filter(tr.t, dth, dv, init, gnss, ma, sf_interval=0.15)
+    k = np.arange(2000, tr.n, 100)
+    out = {}
+    for use in (False, True):
+        sol = gr.augmented_filter(tr.t, dth, dv, init, gnss, ma, use_specific_force=use, **kw)
+        e = gr.attitude_position_errors(sol, tr, k)
+        out[use] = {c: float(np.sqrt(np.mean(v**2))) for c, v in e.items()}
+    # GNSS-held position (0.1 m noise) with and without the extra rows; the rows change the run
+    for use in (False, True):
+        assert max(out[use]["latitude"], out[use]["longitude"], out[use]["height"]) < 0.3
+    assert out[True] != out[False]
