@@ -23,7 +23,7 @@ help:
 	@echo "make test   - unit tests, strict nbval over every notebook, tables unchanged, strict book build, browser check"
 	@echo "make notebook NB=book/part/file.ipynb - execute one notebook in place"
 	@echo "make lock   - recompile requirements.lock from requirements.in (needs network to PyPI)"
-	@echo "make bench  - run the benchmark scripts (optional pyins comparison from requirements-bench.lock)"
+	@echo "make bench  - run the benchmark scripts, writing benchmarks/*.json (optional pyins comparison from requirements-bench.lock)"
 
 # ---------------------------------------------------------------- environment
 env: $(STAMP)
@@ -82,6 +82,8 @@ browser: env
 
 bench: env
 	$(PY) scripts/benchmark_navigation.py
+	$(PY) scripts/benchmark_polar.py
+	$(PY) scripts/benchmark_chen2019_simulation.py
 
 clean:
 	rm -rf book/_build .pytest_cache
