@@ -74,3 +74,15 @@ def test_runner_merges_split_stream_outputs():
     c = nbformat.v4.new_output("stream", name="stderr", text="x\n")
     merged = run_notebooks.coalesce_streams([a, b, c])
     assert len(merged) == 2 and merged[0]["text"] == "within 1e-6: True\n" and merged[1]["name"] == "stderr"
+
+
+def test_docstring_bars_are_escaped_outside_literal_blocks():
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "book" / "_ext"))
+    from plain_bars import escape_bars
+
+    lines = ["The gain |G(0)| is 1/g::", "", "    |x| stays", "", "Back to |text|.", "| a | b |"]
+    out = escape_bars(lines)
+    assert out[0] == r"The gain \|G(0)\| is 1/g::"
+    assert out[2] == "    |x| stays"
+    assert out[4] == r"Back to \|text\|."
+    assert out[5] == "| a | b |"
