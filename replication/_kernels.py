@@ -588,6 +588,143 @@ def _apply_corrections(u, T, p_hat, blk_target, blk_kind, blk_start, blk_size, t
             out[i] -= fac * acc
 
 
+# ----------------------------------------------------------------------------- closed-loop steps
+# Shared by closed_loop_kernel, the batched filter of replication.simulation and the augmented
+# filter of replication.gravity: one GNSS interval's time update, the feedback, the resets.
+
+@njit(**_NJ)
+def _accumulate_interval(c, fb, st, fsum, Csum, navsum):
+    """Interval sums of the inputs of F at the start of an IMU step: f^n = C f^b, C_b^n and the
+    navigation state (lat, h, vE, vN, vU)."""
+    for i in range(3):
+        fsum[i] += c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2]
+        for jj in range(3):
+            Csum[i, jj] += c[i, jj]
+    for i in range(5):
+        navsum[i] += st[0] if i == 0 else st[i + 1]
+
+
+@njit(**_NJ)
+def _reset_interval(Cpl, fsum, Csum, navsum):
+    """Zero the interval sums of ``_accumulate_interval`` and the block couplings."""
+    for i in range(6):
+        for jj in range(Cpl.shape[1]):
+            Cpl[i, jj] = 0.0
+    for i in range(3):
+        fsum[i] = 0.0
+        for jj in range(3):
+            Csum[i, jj] = 0.0
+    for i in range(5):
+        navsum[i] = 0.0
+
+
+@njit(**_NJ)
+def _interval_discretize(F, qc_const, Cm, q_accel, q_gyro, T, order, Qc, Phi, Qd, w1, w2):
+    """(Φ, Q_d) of one GNSS interval of length ``T``: Qc = ``qc_const`` plus the navigation white
+    noise G diag(q) Gᵀ with G = [0; C; -C] (``Cm`` the interval-mean C_b^n, accelerometer and gyro
+    PSDs ``q_accel``, ``q_gyro``), then the Van Loan series of ``discretize_series``."""
+    n = Qc.shape[0]
+    for i in range(n):
+        for jj in range(n):
+            Qc[i, jj] = qc_const[i, jj]
+    for i in range(3):
+        for jj in range(3):
+            sa = 0.0
+            sg = 0.0
+            for m in range(3):
+                sa += Cm[i, m] * q_accel[m] * Cm[jj, m]
+                sg += Cm[i, m] * q_gyro[m] * Cm[jj, m]
+            Qc[3 + i, 3 + jj] += sa
+            Qc[6 + i, 6 + jj] += sg
+    discretize_series(F, Qc, T, order, Phi, Qd, w1, w2)
+
+
+@njit(**_NJ)
+def _interval_time_update(navsum, fsum, Csum, Cpl, nsum, tsum, fconst, qc_const, q_accel, q_gyro, order,
+                          F, Qc, Phi, Qd, w1, w2, P):
+    """Time update over one GNSS interval from the sums of ``_accumulate_interval`` over ``nsum``
+    IMU steps of total length ``tsum``: F of the averaged inputs (``build_F_core``) plus the
+    averaged block couplings ``Cpl`` (rows 0-2 accelerometer into δv, rows 3-5 gyro into φ with
+    sign -), Qc with the navigation white noise at the mean C_b^n (``Csum`` is averaged in place),
+    (Φ, Q_d) and P = Φ P Φᵀ + Q_d."""
+    n = F.shape[0]
+    inv = 1.0 / nsum
+    build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
+                 fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, fconst, F)
+    for i in range(3):
+        for jj in range(9, n):
+            F[3 + i, jj] += Cpl[i, jj] * inv
+            F[6 + i, jj] -= Cpl[3 + i, jj] * inv
+    for i in range(3):
+        for jj in range(3):
+            Csum[i, jj] *= inv
+    _interval_discretize(F, qc_const, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2)
+    _propagate_P(Phi, P, Qd, w1)
+
+
+@njit(**_NJ)
+def _propagate_estimates(Phi, p_hat, tmp):
+    """Sensor-error estimates follow their own dynamics: p̂ = Φ[9:, 9:] p̂ (``tmp`` scratch)."""
+    n_aug = p_hat.shape[0]
+    for i in range(n_aug):
+        acc = 0.0
+        for jj in range(n_aug):
+            acc += Phi[9 + i, 9 + jj] * p_hat[jj]
+        tmp[i] = acc
+    for i in range(n_aug):
+        p_hat[i] = tmp[i]
+
+
+@njit(**_NJ)
+def _skew_rows(H, r, u0, u1, u2):
+    """Rows r..r+2 of H, columns 6-8 (φ): the cross-product matrix (u×)."""
+    H[r + 0, 7] = -u2
+    H[r + 0, 8] = u1
+    H[r + 1, 6] = u2
+    H[r + 1, 8] = -u0
+    H[r + 2, 6] = -u1
+    H[r + 2, 7] = u0
+
+
+@njit(**_NJ)
+def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp):
+    """Feedback of the estimate ``xk``: δp, δv subtracted from ``st`` and ``st_prev``, the attitude
+    corrected by q ← q(φ) ⊗ q (normalized), and p̂ += x̂[9:]."""
+    n_aug = xk.shape[0] - 9
+    for i in range(6):
+        st[i] -= xk[i]
+        st_prev[i] -= xk[i]
+    _rv2q(xk[6], xk[7], xk[8], qtmp)
+    a1, b1, c1, d1 = qtmp[0], qtmp[1], qtmp[2], qtmp[3]
+    q0_, q1_, q2_, q3_ = q[0], q[1], q[2], q[3]
+    n0 = a1 * q0_ - b1 * q1_ - c1 * q2_ - d1 * q3_
+    n1 = a1 * q1_ + b1 * q0_ + c1 * q3_ - d1 * q2_
+    n2 = a1 * q2_ - b1 * q3_ + c1 * q0_ + d1 * q1_
+    n3 = a1 * q3_ + b1 * q2_ - c1 * q1_ + d1 * q0_
+    nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
+    q[0], q[1], q[2], q[3] = n0 / nn, n1 / nn, n2 / nn, n3 / nn
+    for i in range(n_aug):
+        p_hat[i] += xk[9 + i]
+
+
+@njit(**_NJ)
+def _feedback_blocks(p_hat, blk_target, blk_start, blk_size, fconst, lever0, lever, g_extra):
+    """Apply the accumulated estimates p̂ of the lever-arm block (lever = lever0 + δl) and of the
+    gravity block (ĝ^n = output rows of ``fconst``, velocity rows with sign -, into ``g_extra``)."""
+    for b in range(blk_target.shape[0]):
+        tg = blk_target[b]
+        k0, kk = blk_start[b], blk_size[b]
+        if tg == TARGET_LEVER:
+            for i in range(3):
+                lever[i] = lever0[i] + p_hat[k0 - 9 + i]
+        elif tg == TARGET_GRAVITY:
+            for i in range(3):
+                acc = 0.0
+                for jj in range(kk):
+                    acc -= fconst[3 + i, k0 + jj] * p_hat[k0 - 9 + jj]
+                g_extra[i] = acc
+
+
 @njit(**_NJ)
 def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
                        gnss_idx, gnss_pos, gnss_vel, use_pos, use_vel, R_pos, R_vel, lever0,
@@ -665,12 +802,7 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
         for i in range(3):
             fb[i] = dv_c[i] / T
             wb[i] = dth_c[i] / T
-        for i in range(3):
-            fsum[i] += c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2]
-            for jj in range(3):
-                Csum[i, jj] += c[i, jj]
-        for i in range(5):
-            navsum[i] += st[0] if i == 0 else st[i + 1]
+        _accumulate_interval(c, fb, st, fsum, Csum, navsum)
         for b in range(blk_target.shape[0]):
             tg = blk_target[b]
             if tg != TARGET_ACCEL and tg != TARGET_GYRO:
@@ -694,41 +826,11 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
         dth_cp[:] = dth_c
         dv_cp[:] = dv_c
         if j < n_ep and gnss_idx[j] == k + 1:
-            # ---- time update over the interval
-            inv = 1.0 / nsum
-            build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
-                         fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, fconst, Fsum)
-            for i in range(3):
-                for jj in range(9, n):
-                    Fsum[3 + i, jj] += Cpl[i, jj] * inv
-                    Fsum[6 + i, jj] -= Cpl[3 + i, jj] * inv
-            for i in range(n):
-                for jj in range(n):
-                    Qc[i, jj] = qc_const[i, jj]
-            for i in range(3):
-                for jj in range(3):
-                    Csum[i, jj] *= inv
-            # nav white noise: G = [0; C; -C] with accel/gyro PSDs
-            for i in range(3):
-                for jj in range(3):
-                    sa = 0.0
-                    sg = 0.0
-                    for m in range(3):
-                        sa += Csum[i, m] * q_accel[m] * Csum[jj, m]
-                        sg += Csum[i, m] * q_gyro[m] * Csum[jj, m]
-                    Qc[3 + i, 3 + jj] += sa
-                    Qc[6 + i, 6 + jj] += sg
-            discretize_series(Fsum, Qc, tsum, order, Phi, Qd, w1, w2)
-            _propagate_P(Phi, P, Qd, w1)
+            # ---- time update over the interval (nav white noise: G = [0; C; -C])
+            _interval_time_update(navsum, fsum, Csum, Cpl, nsum, tsum, fconst, qc_const, q_accel, q_gyro, order,
+                                  Fsum, Qc, Phi, Qd, w1, w2, P)
             # sensor-error estimates follow their own dynamics (Markov decay)
-            if n_aug > 0:
-                for i in range(n_aug):
-                    acc = 0.0
-                    for jj in range(n_aug):
-                        acc += Phi[9 + i, 9 + jj] * p_hat[jj]
-                    xk[i] = acc
-                for i in range(n_aug):
-                    p_hat[i] = xk[i]
+            _propagate_estimates(Phi, p_hat, xk)
             # ---- measurement
             _q2c(q, c)
             L, h = st[0], st[2]
@@ -749,12 +851,7 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
                 H[1, 0] = rm + h
                 H[2, 2] = 1.0
                 # (C l)× φ
-                H[0, 7] = -la2
-                H[0, 8] = la1
-                H[1, 6] = la2
-                H[1, 8] = -la0
-                H[2, 6] = -la1
-                H[2, 7] = la0
+                _skew_rows(H, 0, la0, la1, la2)
                 for i in range(3):
                     for jj in range(3):
                         Rm[i, jj] = R_pos[i, jj]
@@ -780,12 +877,7 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
                 H[r + 0, 3] = 1.0
                 H[r + 1, 4] = 1.0
                 H[r + 2, 5] = 1.0
-                H[r + 0, 7] = -u2
-                H[r + 0, 8] = u1
-                H[r + 1, 6] = u2
-                H[r + 1, 8] = -u0
-                H[r + 2, 6] = -u1
-                H[r + 2, 7] = u0
+                _skew_rows(H, r, u0, u1, u2)
                 for i in range(3):
                     for jj in range(3):
                         Rm[r + i, r + jj] = R_vel[i, jj]
@@ -798,39 +890,9 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
                             for jj in range(3):
                                 H[i, k0 + jj] = -c[i, jj]
             nis = joseph_update(P, H, Rm, z, xk, w1, w2)
-            # ---- feedback
-            st[0] -= xk[0]
-            st[1] -= xk[1]
-            st[2] -= xk[2]
-            st[3] -= xk[3]
-            st[4] -= xk[4]
-            st[5] -= xk[5]
-            for i in range(6):
-                st_prev[i] -= xk[i]
-            _rv2q(xk[6], xk[7], xk[8], qtmp)
-            a1, b1, c1, d1 = qtmp[0], qtmp[1], qtmp[2], qtmp[3]
-            q0_, q1_, q2_, q3_ = q[0], q[1], q[2], q[3]
-            n0 = a1 * q0_ - b1 * q1_ - c1 * q2_ - d1 * q3_
-            n1 = a1 * q1_ + b1 * q0_ + c1 * q3_ - d1 * q2_
-            n2 = a1 * q2_ - b1 * q3_ + c1 * q0_ + d1 * q1_
-            n3 = a1 * q3_ + b1 * q2_ - c1 * q1_ + d1 * q0_
-            nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
-            q[0], q[1], q[2], q[3] = n0 / nn, n1 / nn, n2 / nn, n3 / nn
-            for i in range(n_aug):
-                p_hat[i] += xk[9 + i]
-            for b in range(blk_target.shape[0]):
-                tg = blk_target[b]
-                k0, kk = blk_start[b], blk_size[b]
-                if tg == TARGET_LEVER:
-                    for i in range(3):
-                        lever[i] = lever0[i] + p_hat[k0 - 9 + i]
-                elif tg == TARGET_GRAVITY:
-                    # gravity compensation: ĝ^n = output rows of fconst (velocity rows, sign -)
-                    for i in range(3):
-                        acc = 0.0
-                        for jj in range(kk):
-                            acc -= fconst[3 + i, k0 + jj] * p_hat[k0 - 9 + jj]
-                        g_extra[i] = acc
+            # ---- feedback (gravity compensation: ĝ^n = output rows of fconst, velocity rows, sign -)
+            _feedback_nav(xk, st, st_prev, q, p_hat, qtmp)
+            _feedback_blocks(p_hat, blk_target, blk_start, blk_size, fconst, lever0, lever, g_extra)
             # ---- records
             ep_st[j, :] = st
             ep_q[j, :] = q
@@ -865,15 +927,7 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
                     e[9 + i] = truth_p[j, i] - p_hat[i]
                 ep_nees[j] = _chol_solve_scaled(P, e)
             j += 1
-            for i in range(6):
-                for jj in range(n):
-                    Cpl[i, jj] = 0.0
-            for i in range(3):
-                fsum[i] = 0.0
-                for jj in range(3):
-                    Csum[i, jj] = 0.0
-            for i in range(5):
-                navsum[i] = 0.0
+            _reset_interval(Cpl, fsum, Csum, navsum)
             nsum = 0
             tsum = 0.0
         if store_nav:

@@ -910,17 +910,12 @@ def _augmented_kernel(dt, dtheta, dv, st0, q0, gnss_idx, gnss_pos, gnss_vel, R_p
         K._q2c(q, c)
         for i in range(3):
             fb[i] = dv_c[i] / T
-        for i in range(3):
-            fn = c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2]
-            fsum[i] += fn
-            if win[k] >= 0:
-                facc[i] += wgt[k] * fn
-            for jj in range(3):
-                Csum[i, jj] += c[i, jj]
-                if win[k] >= 0:
+        K._accumulate_interval(c, fb, st, fsum, Csum, navsum)
+        if win[k] >= 0:
+            for i in range(3):
+                facc[i] += wgt[k] * (c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2])
+                for jj in range(3):
                     Cw[i, jj] += wgt[k] * c[i, jj]
-        for i in range(5):
-            navsum[i] += st[0] if i == 0 else st[i + 1]
         for b in range(tg.shape[0]):
             if tg[b] == K.TARGET_ACCEL or tg[b] == K.TARGET_GYRO:
                 r0 = 0 if tg[b] == K.TARGET_ACCEL else 3
@@ -939,37 +934,9 @@ def _augmented_kernel(dt, dtheta, dv, st0, q0, gnss_idx, gnss_pos, gnss_vel, R_p
         dth_cp[:] = dth_c
         dv_cp[:] = dv_c
         if j < n_ep and gnss_idx[j] == k + 1:
-            inv = 1.0 / nsum
-            K.build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
-                           fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, fconst, Fsum)
-            for i in range(3):
-                for jj in range(9, n):
-                    Fsum[3 + i, jj] += Cpl[i, jj] * inv
-                    Fsum[6 + i, jj] -= Cpl[3 + i, jj] * inv
-            for i in range(n):
-                for jj in range(n):
-                    Qc[i, jj] = qc_const[i, jj]
-            for i in range(3):
-                for jj in range(3):
-                    Csum[i, jj] *= inv
-            for i in range(3):
-                for jj in range(3):
-                    sa = 0.0
-                    sg = 0.0
-                    for m in range(3):
-                        sa += Csum[i, m] * q_accel[m] * Csum[jj, m]
-                        sg += Csum[i, m] * q_gyro[m] * Csum[jj, m]
-                    Qc[3 + i, 3 + jj] += sa
-                    Qc[6 + i, 6 + jj] += sg
-            K.discretize_series(Fsum, Qc, tsum, order, Phi, Qd, w1, w2)
-            K._propagate_P(Phi, P, Qd, w1)
-            for i in range(n_aug):
-                acc = 0.0
-                for jj in range(n_aug):
-                    acc += Phi[9 + i, 9 + jj] * p_hat[jj]
-                xk[i] = acc
-            for i in range(n_aug):
-                p_hat[i] = xk[i]
+            K._interval_time_update(navsum, fsum, Csum, Cpl, nsum, tsum, fconst, qc_const, q_accel, q_gyro, order,
+                                    Fsum, Qc, Phi, Qd, w1, w2, P)
+            K._propagate_estimates(Phi, p_hat, xk)
             if ar_tick[j]:
                 # discrete AR step of the gravity states (held between steps): P <- T P T' + Q
                 P[:, :] = Tg @ P @ Tg.T + Qg
@@ -1024,35 +991,14 @@ def _augmented_kernel(dt, dtheta, dv, st0, q0, gnss_idx, gnss_pos, gnss_vel, R_p
                     facc[i] = 0.0
                     for jj in range(3):
                         Cw[i, jj] = 0.0
-            for i in range(6):
-                st[i] -= xk[i]
-                st_prev[i] -= xk[i]
-            K._rv2q(xk[6], xk[7], xk[8], qtmp)
-            a1, b1, c1, d1 = qtmp[0], qtmp[1], qtmp[2], qtmp[3]
-            q0_, q1_, q2_, q3_ = q[0], q[1], q[2], q[3]
-            n0 = a1 * q0_ - b1 * q1_ - c1 * q2_ - d1 * q3_
-            n1 = a1 * q1_ + b1 * q0_ + c1 * q3_ - d1 * q2_
-            n2 = a1 * q2_ - b1 * q3_ + c1 * q0_ + d1 * q1_
-            n3 = a1 * q3_ + b1 * q2_ - c1 * q1_ + d1 * q0_
-            nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
-            q[0], q[1], q[2], q[3] = n0 / nn, n1 / nn, n2 / nn, n3 / nn
-            for i in range(n_aug):
-                p_hat[i] += xk[9 + i]
+            K._feedback_nav(xk, st, st_prev, q, p_hat, qtmp)
             for i in range(3):
                 acc = 0.0
                 for jj in range(gS.shape[1]):
                     acc += gS[i, jj] * p_hat[gstart - 9 + jj]
                 g_extra[i] = acc
             j += 1
-            for i in range(6):
-                for jj in range(n):
-                    Cpl[i, jj] = 0.0
-            for i in range(3):
-                fsum[i] = 0.0
-                for jj in range(3):
-                    Csum[i, jj] = 0.0
-            for i in range(5):
-                navsum[i] = 0.0
+            K._reset_interval(Cpl, fsum, Csum, navsum)
             nsum = 0
             tsum = 0.0
         out_st[k + 1, :] = st

@@ -438,19 +438,7 @@ def _forward_chunk(dt, dth, dvv, ep_step, gpos, gvel, R_pos, R_vel, lever0,
                 wb[i] = acc[17 + i] / tsum
             K.build_F(acc[0] / na, acc[1] / na, acc[2] / na, acc[3] / na, acc[4] / na, c0, fb, wb, fconst,
                       tg, kd, bs, bz, F)
-            for i in range(n):
-                for jj in range(n):
-                    Qc[i, jj] = qc_const[i, jj]
-            for i in range(3):
-                for jj in range(3):
-                    sa = 0.0
-                    sg = 0.0
-                    for mm in range(3):
-                        sa += c0[i, mm] * q_accel[mm] * c0[jj, mm]
-                        sg += c0[i, mm] * q_gyro[mm] * c0[jj, mm]
-                    Qc[3 + i, 3 + jj] += sa
-                    Qc[6 + i, 6 + jj] += sg
-            K.discretize_series(F, Qc, tsum, order, Phi, Qd, w1, w2)
+            K._interval_discretize(F, qc_const, c0, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2)
             _propagate_sparse(Phi, P, Qd, w1, nzc, nzv, cnt)
             if use_pbar:
                 _propagate_sparse(Phi, Pbar, Qd, w1, nzc, nzv, cnt)
@@ -483,12 +471,7 @@ def _forward_chunk(dt, dth, dvv, ep_step, gpos, gvel, R_pos, R_vel, lever0,
             H[0, 1] = (rn + h) * cl
             H[1, 0] = rm + h
             H[2, 2] = 1.0
-            H[0, 7] = -la2
-            H[0, 8] = la1
-            H[1, 6] = la2
-            H[1, 8] = -la0
-            H[2, 6] = -la1
-            H[2, 7] = la0
+            K._skew_rows(H, 0, la0, la1, la2)
             K.rates_s(L, h, st[0, 3], st[0, 4], w_ie, w_en)
             wx = dth_cp[0, 0] / T - (c0[0, 0] * w_ie[0] + c0[1, 0] * w_ie[1] + c0[2, 0] * w_ie[2])
             wy = dth_cp[0, 1] / T - (c0[0, 1] * w_ie[0] + c0[1, 1] * w_ie[1] + c0[2, 1] * w_ie[2])
@@ -502,12 +485,7 @@ def _forward_chunk(dt, dth, dvv, ep_step, gpos, gvel, R_pos, R_vel, lever0,
             H[3, 3] = 1.0
             H[4, 4] = 1.0
             H[5, 5] = 1.0
-            H[3, 7] = -u2
-            H[3, 8] = u1
-            H[4, 6] = u2
-            H[4, 8] = -u0
-            H[5, 6] = -u1
-            H[5, 7] = u0
+            K._skew_rows(H, 3, u0, u1, u2)
             for b in range(tg.shape[0]):
                 if tg[b] == K.TARGET_LEVER:
                     k0 = bs[b]
@@ -589,31 +567,8 @@ def _forward_chunk(dt, dth, dvv, ep_step, gpos, gvel, R_pos, R_vel, lever0,
                 if record:
                     for i in range(n):
                         rec_x[r, j, i] = xk[i]
-                for i in range(6):
-                    st[r, i] -= xk[i]
-                    st_prev[r, i] -= xk[i]
-                K._rv2q(xk[6], xk[7], xk[8], qtmp)
-                a1, b1, c1, d1 = qtmp[0], qtmp[1], qtmp[2], qtmp[3]
-                q0_, q1_, q2_, q3_ = q[r, 0], q[r, 1], q[r, 2], q[r, 3]
-                n0 = a1 * q0_ - b1 * q1_ - c1 * q2_ - d1 * q3_
-                n1 = a1 * q1_ + b1 * q0_ + c1 * q3_ - d1 * q2_
-                n2 = a1 * q2_ - b1 * q3_ + c1 * q0_ + d1 * q1_
-                n3 = a1 * q3_ + b1 * q2_ - c1 * q1_ + d1 * q0_
-                nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
-                q[r, 0], q[r, 1], q[r, 2], q[r, 3] = n0 / nn, n1 / nn, n2 / nn, n3 / nn
-                for i in range(n_aug):
-                    p_hat[r, i] += xk[9 + i]
-                for b in range(tg.shape[0]):
-                    k0, kk_ = bs[b], bz[b]
-                    if tg[b] == K.TARGET_LEVER:
-                        for i in range(3):
-                            lever[r, i] = lever0[i] + p_hat[r, k0 - 9 + i]
-                    elif tg[b] == K.TARGET_GRAVITY:
-                        for i in range(3):
-                            s_ = 0.0
-                            for jj in range(kk_):
-                                s_ -= fconst[3 + i, k0 + jj] * p_hat[r, k0 - 9 + jj]
-                            g_extra[r, i] = s_
+                K._feedback_nav(xk, st[r], st_prev[r], q[r], p_hat[r], qtmp)
+                K._feedback_blocks(p_hat[r], tg, bs, bz, fconst, lever0, lever[r], g_extra[r])
                 # ---------------- records
                 for i in range(3):
                     out_err[r, j, i] = st[r, i] - truth_st[j, i]
