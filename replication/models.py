@@ -70,6 +70,7 @@ import numpy as np
 from . import earth
 from . import errors as E
 from .rotations import rotvec_to_dcm, skew
+from .sensors import _vec
 
 __all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "EXTEND_ORDER_45", "NAV_SYMBOLS", "model_45", "model_36",
            "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
@@ -113,12 +114,8 @@ _BLOCK_SYMBOLS = {
 # ----------------------------------------------------------------------------- helpers
 
 def _nonneg(x, name, n=3):
-    a = np.asarray(x, float)
-    if a.ndim == 0:
-        a = np.full(n, float(a))
-    if a.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have {n} components, got shape {a.shape}")
-    if not np.all(np.isfinite(a)) or np.any(a < 0):
+    a = _vec(x, name, n)
+    if np.any(a < 0):
         raise ValueError(f"{name} must be finite and non-negative (SI units), got {a}")
     return a
 
