@@ -15,12 +15,15 @@ export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
 NOTEBOOKS := $(shell find book -name '*.ipynb' -not -path '*/_build/*' -not -path '*/.ipynb_checkpoints/*' | sort)
 
-.PHONY: help env lock book notebooks notebook tables html test unit nbval check-notebooks \
-        check-tables html-strict browser bench clean
+.PHONY: help env lock book notebooks notebook tables html test unit unit-portable portability nbval \
+        check-notebooks check-tables html-strict browser bench clean
 
 help:
 	@echo "make book   - create the environment if missing, re-execute every notebook, regenerate tables/, build book/_build/html"
-	@echo "make test   - unit tests, strict nbval over every notebook, tables unchanged, strict book build, browser check"
+	@echo "make test   - unit tests (native and on a perturbed numerical code path), strict nbval of every notebook"
+	@echo "              re-executed under two perturbed numerical configurations, tables unchanged, strict book build,"
+	@echo "              browser check"
+	@echo "make nbval  - strict nbval of every notebook on this machine's native code path"
 	@echo "make notebook NB=book/part/file.ipynb - execute one notebook in place"
 	@echo "make lock   - recompile requirements.lock from requirements.in (needs network to PyPI)"
 	@echo "make bench  - run the benchmark scripts, writing benchmarks/*.json (optional pyins comparison from requirements-bench.lock)"
@@ -56,10 +59,19 @@ html: env
 	$(VENV)/bin/jupyter-book build book --path-output book --quiet
 
 # ---------------------------------------------------------------- tests
-test: env unit nbval check-notebooks tables check-tables html-strict browser
+test: env unit unit-portable portability check-notebooks tables check-tables html-strict browser
 
 unit: env
 	$(PY) -m pytest -q tests -m "not browser"
+
+# the unit tests once more on a perturbed numerical code path (scripts/portability.py says why)
+unit-portable: env
+	$(PY) scripts/portability.py unit tests -m "not browser and not slow"
+
+# every notebook re-executed under two perturbed numerical configurations: strict nbval against
+# the stored outputs, and tables/ unchanged
+portability: env
+	$(PY) scripts/portability.py nbval $(NOTEBOOKS)
 
 nbval: env
 	@test -n "$(NOTEBOOKS)" || { echo "no notebooks under book/"; exit 1; }

@@ -3,8 +3,9 @@
 :func:`glue` wraps ``myst_nb.glue`` so that numbers glued into prose render with a format
 spec (``{glue:text}`name:.3f```): numpy scalars are converted to Python numbers first, because
 their ``repr`` (``np.float64(0.1)``) is not a number the book can format.  Floats are
-stored with 10 significant digits, the precision of the exported tables, so that a stored
-output does not depend on the last bits of a long computation.
+stored with ``digits`` significant digits (6 by default, fewer where a chapter knows its
+computation determines fewer), so that a stored output does not depend on the last bits of a
+long computation (the precision policy of CONTRIBUTING.md).
 """
 
 from __future__ import annotations
@@ -27,8 +28,15 @@ def plain(value):
     return value
 
 
-def glue(name: str, value, display: bool = True):
-    """``myst_nb.glue(name, value, display)`` with numpy scalars made plain (see :func:`plain`)."""
+GLUE_DIGITS = 6
+"""Significant digits a glued float keeps unless the chapter says otherwise."""
+
+
+def glue(name: str, value, display: bool = True, digits: int = GLUE_DIGITS):
+    """``myst_nb.glue(name, value, display)`` with numpy scalars made plain (see :func:`plain`).
+
+    A float is rounded to ``digits`` significant digits before it is stored.
+    """
     from myst_nb import glue as _glue
 
     if not isinstance(name, str) or not name:
@@ -37,5 +45,7 @@ def glue(name: str, value, display: bool = True):
     if isinstance(value, numbers.Number) and not isinstance(value, bool) and not np.isfinite(value):
         raise ValueError(f"glue {name!r}: value {value!r} is not finite")
     if isinstance(value, float):
-        value = float(format(value, ".10g"))  # the precision of the exported tables
+        if not isinstance(digits, int) or isinstance(digits, bool) or digits < 1:
+            raise ValueError(f"glue {name!r}: digits must be a positive integer, not {digits!r}")
+        value = float(format(value, f".{digits}g"))
     return _glue(name, value, display=display)

@@ -40,7 +40,9 @@ import pandas as pd
 
 from . import __version__
 
-STATUSES = ("reproduced", "erratum", "qualitative", "analog", "not-reproduced", "pending")
+STATUSES = (
+    "reproduced", "erratum", "inconsistent", "qualitative", "analog", "unverifiable", "not-reproduced", "pending",
+)
 """The status vocabulary, in the order used for summaries (best first)."""
 
 SOURCE_KEYS = ("chen2019", "fang2020", "duan2023", "an2021")
@@ -50,10 +52,21 @@ REQUIRED_PROVENANCE = ("document", "location", "section", "notes")
 """Provenance fields every paper-value file must carry."""
 
 TABLE_COLUMNS = (
-    "quantity", "unit", "paper", "reproduced", "abs_error", "rel_error",
-    "tolerance", "status", "note", "evidence", "corrected",
+    "quantity", "unit", "paper", "paper_text", "reproduced", "reproduced_text", "abs_error", "rel_error",
+    "tolerance", "tolerance_kind", "status", "note", "evidence", "corrected",
 )
-"""Columns of every exported comparison table, in order."""
+"""Columns of every exported comparison table, in order.  ``paper``, ``reproduced``,
+``abs_error``, ``rel_error`` and ``tolerance`` hold numbers only (or nothing); the printed form
+of a non-numeric paper value is in ``paper_text``, a non-numeric result in ``reproduced_text``."""
+
+NUMERIC_COLUMNS = ("paper", "reproduced", "abs_error", "rel_error", "tolerance")
+"""The numeric columns of :data:`TABLE_COLUMNS`."""
+
+ROW_KEYS = (
+    "quantity", "unit", "paper", "paper_text", "reproduced", "tolerance", "tolerance_kind", "status",
+    "note", "evidence", "corrected", "digits",
+)
+"""Keys a comparison row may carry (see :func:`comparison_frame`)."""
 
 TRACKED_PACKAGES = (
     "numpy", "scipy", "pandas", "statsmodels", "control", "matplotlib", "sympy", "numba",
@@ -221,9 +234,55 @@ def load_paper(table_id: str) -> PaperTable:
 
 
 # --------------------------------------------------------------------------- comparisons
+#
+# Precision policy (CONTRIBUTING.md, "Precision"): a stored number carries only the digits the
+# computation determines on every IEEE-754 platform and code path.  Tolerances are stored with
+# three significant digits.  A reproduced value of a row with a tolerance is stored on the
+# decimal grid one decade below the tolerance (10**(floor(log10(tol)) - 1)): fine enough to
+# read the comparison to a tenth of the tolerance, coarse enough that round-off, a BLAS kernel or
+# a SIMD width cannot move it.  A row without a tolerance is stored with six significant digits.
+# A row's ``digits`` (significant digits) overrides both where the chapter knows better (a long
+# nonlinear run, a Monte-Carlo mean).  Errors are computed from the stored values, so a reader
+# of the CSV recomputes them exactly.
 
-def _fmt(v: Any) -> str:
-    """Deterministic text for a table cell: 10 significant digits for floats."""
+DEFAULT_DIGITS = 6
+"""Significant digits of a computed value without a tolerance or an explicit ``digits``."""
+
+TOLERANCE_DIGITS = 3
+"""Significant digits of a stored tolerance."""
+
+ERROR_DIGITS = 2
+"""Significant digits of a stored relative error."""
+
+
+def round_sig(x: float, digits: int) -> float:
+    """``x`` rounded to ``digits`` significant digits (0, NaN and inf unchanged)."""
+    if not isinstance(digits, (int, np.integer)) or isinstance(digits, bool) or digits < 1:
+        raise RegistryError(f"significant digits must be a positive integer, not {digits!r}")
+    x = float(x)
+    if x == 0 or not math.isfinite(x):
+        return x
+    return float(format(x, f".{int(digits) - 1}e"))
+
+
+def round_to_grid(x: float, step: float) -> float:
+    """``x`` rounded to a multiple of the power of ten ``step`` (the text of that grid)."""
+    x = float(x)
+    if not math.isfinite(x) or step <= 0:
+        return x
+    e = int(round(math.log10(step)))
+    return float(format(round(x, -e), f".{max(0, -e)}f")) if e <= 0 else float(round(x / 10**e) * 10**e)
+
+
+def tolerance_grid(tol_abs: float) -> float:
+    """The storage grid of a row with absolute tolerance ``tol_abs``: one decade below it."""
+    if not (tol_abs > 0 and math.isfinite(tol_abs)):
+        return 0.0
+    return 10.0 ** (math.floor(math.log10(tol_abs)) - 1)
+
+
+def format_number(v: Any, digits: int | None = None) -> str:
+    """Deterministic text of a number: shortest round-trip form, optionally ``digits`` significant."""
     if v is None:
         return ""
     if isinstance(v, (bool, np.bool_)):
@@ -231,12 +290,48 @@ def _fmt(v: Any) -> str:
     if isinstance(v, (int, np.integer)):
         return str(int(v))
     if isinstance(v, (float, np.floating)):
+        v = float(v)
         if math.isnan(v):
             return ""
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
         if v == 0:
             return "0"
-        return format(float(v), ".10g")
+        if digits is not None:
+            v = round_sig(v, digits)
+        text = repr(v)
+        return text.replace("e-0", "e-").replace("e+0", "e+")
     return str(v)
+
+
+def _fmt(v: Any) -> str:
+    """Text of a non-numeric or already-rounded table cell."""
+    return format_number(v)
+
+
+def _significant(text: str) -> int:
+    digits = re.sub(r"[eE].*$", "", text).replace("-", "").replace(".", "").lstrip("0")
+    return len(digits)
+
+
+def _store(v: Any, grid: float, digits: int | None) -> float:
+    """A computed value rounded for storage (see the precision policy above)."""
+    f = _as_float_or_nan(v)
+    if not math.isfinite(f):
+        return f
+    if digits is not None:
+        return round_sig(f, digits)
+    if grid > 0:
+        return round_to_grid(f, grid)
+    return round_sig(f, DEFAULT_DIGITS)
+
+
+def _store_paper(v: Any, grid: float, digits: int | None) -> float:
+    """A paper value: as transcribed when it is a short literal, else rounded like a computed one."""
+    f = _as_float_or_nan(v)
+    if not math.isfinite(f) or _significant(repr(f)) <= 10:
+        return f
+    return _store(f, grid, digits)
 
 
 def _row_errors(paper: Any, reproduced: Any) -> tuple[float, float]:
@@ -244,7 +339,7 @@ def _row_errors(paper: Any, reproduced: Any) -> tuple[float, float]:
     if math.isnan(p) or math.isnan(r):
         return float("nan"), float("nan")
     ae = abs(r - p)
-    re_ = ae / abs(p) if p != 0 else (0.0 if ae == 0 else float("inf"))
+    re_ = ae / abs(p) if p != 0 else float("nan")
     return ae, re_
 
 
@@ -257,7 +352,7 @@ def _decide(row: Mapping[str, Any], ae: float, re_: float) -> str:
     if explicit not in (None, ""):
         if explicit not in STATUSES:
             raise RegistryError(f"row {row.get('quantity')!r}: unknown status {explicit!r}; use one of {STATUSES}")
-        if explicit in ("erratum", "qualitative", "analog", "not-reproduced") and not str(row.get("note", "")).strip():
+        if explicit != "reproduced" and explicit != "pending" and not str(row.get("note", "")).strip():
             raise RegistryError(f"row {row.get('quantity')!r}: status {explicit!r} needs a note saying why")
         if explicit == "erratum" and not str(row.get("evidence", "")).strip():
             raise RegistryError(f"row {row.get('quantity')!r}: an erratum needs evidence (notebook and test)")
@@ -286,14 +381,31 @@ def _decide(row: Mapping[str, Any], ae: float, re_: float) -> str:
     return "reproduced" if err <= float(tol) else "not-reproduced"
 
 
+def _text_or_number(v: Any) -> tuple[float, str]:
+    """Split a cell into its numeric value (NaN if none) and its text (empty if numeric)."""
+    if v is None or (isinstance(v, str) and not v.strip()):
+        return float("nan"), ""
+    if isinstance(v, (bool, np.bool_)):
+        return float("nan"), str(bool(v))
+    f = _as_float_or_nan(v)
+    if math.isnan(f) and not _is_nan_text(v) and not (isinstance(v, (float, np.floating))):
+        return f, str(v)
+    return f, ""
+
+
 def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
     """Build the long-format comparison table from row mappings.
 
     Each row gives ``quantity``, ``unit``, ``paper``, ``reproduced`` and either ``tolerance``
     (with ``tolerance_kind`` ``'abs'`` — the default — or ``'rel'``) or an explicit ``status``;
-    optional ``note``, ``evidence`` and ``corrected`` (the corrected text for an erratum whose
-    correction is not a single number).  The status is computed, never typed: a numeric row is
-    ``reproduced`` when its error is within the tolerance and ``not-reproduced`` otherwise.
+    optional ``note``, ``evidence``, ``corrected`` (the corrected text for an erratum whose
+    correction is not a single number), ``paper_text`` (the printed form where the paper printed
+    a formula or a range) and ``digits`` (significant digits the computation determines, for a
+    long nonlinear run or a Monte-Carlo mean).  The status is computed, never typed: a numeric
+    row is ``reproduced`` when its error is within the tolerance and ``not-reproduced``
+    otherwise.  Numbers are stored by the precision policy of this module (see
+    :data:`DEFAULT_DIGITS`); the status is decided on the stored values, so the CSV is
+    self-consistent.  Errors are shown only for rows compared against a tolerance.
     """
     out = []
     seen = set()
@@ -305,27 +417,89 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
         if q in seen:
             raise RegistryError(f"quantity {q!r} appears twice")
         seen.add(q)
-        ae, re_ = _row_errors(row.get("paper"), row.get("reproduced"))
-        status = _decide(row, ae, re_)
-        tol = row.get("tolerance")
+        unknown = set(row) - set(ROW_KEYS)
+        if unknown:
+            raise RegistryError(f"row {q!r}: unknown keys {sorted(unknown)}; allowed: {', '.join(ROW_KEYS)}")
+        digits = row.get("digits")
+        if digits is not None:
+            round_sig(1.0, digits)  # validates
         kind = row.get("tolerance_kind", "abs")
-        tol_txt = "" if tol is None else (f"{_fmt(tol)} (rel)" if kind == "rel" else _fmt(tol))
+        p_num, p_text = _text_or_number(row.get("paper"))
+        r_num, r_text = _text_or_number(row.get("reproduced"))
+        tol = row.get("tolerance")
+        if tol is not None:
+            tol_f = _as_float_or_nan(tol)
+            if not (tol_f >= 0 and math.isfinite(tol_f)):
+                raise RegistryError(f"row {q!r}: tolerance must be a finite number >= 0, not {tol!r}")
+            tol = round_sig(tol_f, TOLERANCE_DIGITS)
+            row["tolerance"] = tol
+        tol_abs = (tol * abs(p_num) if kind == "rel" and math.isfinite(p_num) else tol) if tol is not None else None
+        grid = tolerance_grid(tol_abs) if tol_abs is not None and math.isfinite(tol_abs) else 0.0
+        p_num = _store_paper(p_num, grid, digits)
+        r_num = _store(r_num, grid, digits)
+        ae, re_dec = _row_errors(p_num, r_num)
+        if not math.isnan(ae):
+            ae = _store(ae, grid, None if grid > 0 else (digits or DEFAULT_DIGITS))
+            if math.isfinite(p_num) and p_num == 0:
+                re_dec = 0.0 if ae == 0 else float("inf")
+        status = _decide(row, ae, re_dec)
+        if tol is None:
+            # no comparison was made (an explicit status without a tolerance): no error is shown
+            ae = float("nan")
+        re_store = ae / abs(p_num) if math.isfinite(ae) and math.isfinite(p_num) and p_num != 0 else float("nan")
+        paper_text = str(row.get("paper_text") or p_text)
+        corrected = row.get("corrected")
+        if corrected in (None, "") and status == "erratum":
+            corrected = r_text or format_number(r_num)
         out.append({
             "quantity": str(q),
             "unit": _fmt(row.get("unit", "")),
-            "paper": _fmt(row.get("paper")),
-            "reproduced": _fmt(row.get("reproduced")),
-            "abs_error": _fmt(ae),
-            "rel_error": _fmt(re_),
-            "tolerance": tol_txt,
+            "paper": format_number(p_num),
+            "paper_text": paper_text,
+            "reproduced": format_number(r_num),
+            "reproduced_text": r_text,
+            "abs_error": format_number(ae),
+            "rel_error": format_number(re_store, ERROR_DIGITS),
+            "tolerance": "" if tol is None else format_number(tol),
+            "tolerance_kind": "" if tol is None else kind,
             "status": status,
             "note": _fmt(row.get("note", "")),
             "evidence": _fmt(row.get("evidence", "")),
-            "corrected": _fmt(row.get("corrected", row.get("reproduced") if status == "erratum" else "")),
+            "corrected": _fmt(corrected if corrected is not None else ""),
         })
     if not out:
         raise RegistryError("a comparison needs at least one row")
     return pd.DataFrame(out, columns=list(TABLE_COLUMNS))
+
+
+def display_cell(row: Mapping[str, Any], column: str) -> str:
+    """The reader's text of one cell of a comparison table.
+
+    ``paper`` shows the printed form (``paper_text``) when the paper printed one, ``reproduced``
+    a non-numeric result, ``tolerance`` its kind when relative.
+    """
+    def get(c: str) -> str:
+        v = row.get(c, "")
+        if isinstance(v, (float, np.floating, int, np.integer, bool, np.bool_)) or v is None:
+            return format_number(v, DEFAULT_DIGITS if isinstance(v, (float, np.floating)) else None)
+        return str(v)
+
+    if column == "paper":
+        return get("paper_text") or get("paper")
+    if column == "reproduced":
+        return get("reproduced_text") or get("reproduced")
+    if column == "tolerance":
+        t = get("tolerance")
+        return f"{t} (rel)" if t and get("tolerance_kind") == "rel" else t
+    return get(column)
+
+
+SIDECAR_IDENTITY = (
+    "id", "title", "description", "source", "notebook", "notebook_digest", "paper_source", "paper_digest",
+    "table_digest", "seeds", "status_counts", "generated_by",
+)
+"""Sidecar fields that identify a table and its inputs; when all are unchanged on a rerun the
+stored sidecar (commit, versions) is kept."""
 
 
 def _package_versions() -> dict[str, str]:
@@ -371,10 +545,9 @@ def _notebook_digest(root: Path, notebook: str | None) -> str | None:
 
 def _markdown(df: pd.DataFrame, title: str) -> str:
     cols = ["quantity", "unit", "paper", "reproduced", "abs_error", "rel_error", "tolerance", "status", "note"]
-    sub = df[cols]
     lines = [f"**{title}**", "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    for _, r in sub.iterrows():
-        cells = [str(r[c]).replace("|", "\\|").replace("\n", " ") for c in cols]
+    for _, r in df.iterrows():
+        cells = [display_cell(r, c).replace("|", "\\|").replace("\n", " ") for c in cols]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
@@ -395,7 +568,7 @@ def _latex(df: pd.DataFrame, title: str, table_id: str) -> str:
         " & ".join(_tex_escape(c) for c in cols) + r" \\", r"\hline",
     ]
     for _, r in df.iterrows():
-        lines.append(" & ".join(_tex_escape(str(r[c])) for c in cols) + r" \\")
+        lines.append(" & ".join(_tex_escape(display_cell(r, c)) for c in cols) + r" \\")
     lines += [r"\hline", r"\end{tabular}", r"\end{table}"]
     return "\n".join(lines) + "\n"
 
@@ -464,8 +637,12 @@ def compare(
             old = json.loads(json_path.read_text(encoding="utf-8"))
         except ValueError:
             old = None
-    if old is not None and {k: v for k, v in old.items() if k != "git_commit"} == sidecar and (out_dir / f"{table_id}.csv").exists():
-        sidecar["git_commit"] = old.get("git_commit")
+    same = (old is not None and (out_dir / f"{table_id}.csv").exists()
+            and all(old.get(k) == sidecar[k] for k in SIDECAR_IDENTITY))
+    if same:
+        # the same table from the same inputs: its provenance (the commit, library and package
+        # versions that first produced it) stands, so a rerun on another machine changes nothing
+        sidecar = old
     else:
         sidecar["git_commit"] = _git_head(root)
     files = {
@@ -512,8 +689,8 @@ def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterabl
     if not re.match(r"^[a-z0-9][a-z0-9-]*$", name):
         raise RegistryError(f"display_table: name {name!r} must be lower-case letters, digits and '-'")
     lines = [f"```{{table}} {caption}", f":name: {name}", "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    for _, r in df[cols].iterrows():
-        lines.append("| " + " | ".join(_fmt(r[c]).replace("|", "\\|").replace("\n", " ") for c in cols) + " |")
+    for _, r in df.iterrows():
+        lines.append("| " + " | ".join(display_cell(r, c).replace("|", "\\|").replace("\n", " ") for c in cols) + " |")
     lines.append("```")
     return Markdown("\n".join(lines))
 
@@ -579,8 +756,8 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
             errata_rows.append({
                 "source": tid.split("-")[0],
                 "location": f"{tid}: {r['quantity']}",
-                "printed": r["paper"],
-                "corrected": r["corrected"] or r["reproduced"],
+                "printed": display_cell(r, "paper"),
+                "corrected": r["corrected"] or display_cell(r, "reproduced"),
                 "evidence": r["evidence"] or exported[tid].get("notebook", ""),
                 "note": r["note"],
             })

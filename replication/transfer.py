@@ -583,12 +583,22 @@ def coefficient_checks(printed, motion, points, *, radius=None, gravity=None):
 
 # --------------------------------------------------------------------------- zero/pole maps
 
+ROOT_REAL_TOL = 1e-6
+"""Relative size below which a computed real part of a pole or zero is round-off (see
+:func:`pole_zero_grid`)."""
+
+
 def pole_zero_grid(motion, lats_deg, speeds, *, radius=None, gravity=None):
     """Poles and zeros of eqs. (4)-(5) or (6)-(7) over a grid of latitude and speed (Figs. 2-3).
 
     Returns a long ``DataFrame`` with columns lat_deg, speed, pair, kind ('pole'/'zero'),
     family (1 = largest |Im|; conjugates share a family), real, imag.  Families follow the
     paper's numbering: p1,p2 / p3,p4 / p5,p6 and z11,z12 / z13,z14 by decreasing frequency.
+
+    The undamped INS has its poles on the imaginary axis, several of them nearly double, where a
+    polynomial root finder is accurate to about sqrt(eps)|z| ~ 1.5e-8 |z|: real parts smaller
+    than ``ROOT_REAL_TOL`` |z| are that round-off and are returned as 0 (otherwise they change
+    from one BLAS/SIMD code path to another).
     """
     _check_motion_name(motion)
     rows = []
@@ -600,8 +610,9 @@ def pole_zero_grid(motion, lats_deg, speeds, *, radius=None, gravity=None):
                 for kind, roots in (("pole", tf.poles()), ("zero", tf.zeros())):
                     roots = sorted(roots, key=lambda z: (-round(abs(z.imag), 18), z.imag))
                     for k, z in enumerate(roots):
+                        re_ = 0.0 if abs(z.real) < ROOT_REAL_TOL * abs(z) else float(z.real)
                         rows.append(dict(lat_deg=float(lat_deg), speed=float(v), pair=pair, kind=kind,
-                                         family=k // 2 + 1, real=float(z.real), imag=float(z.imag)))
+                                         family=k // 2 + 1, real=re_, imag=float(z.imag)))
     return pd.DataFrame(rows)
 
 

@@ -171,7 +171,9 @@ def test_eq1_structure_from_core(short_flight):
     from replication.errors import NavPoint
 
     c = ad.eq1_checks(NavPoint.from_trajectory(short_flight, 900))
-    assert c["block (p; phi) largest element"] == 0.0
+    # a structurally zero block: entries of the neighbouring blocks are O(1e-3..1), so anything
+    # above round-off would be a real coupling
+    assert abs(c["block (p; phi) largest element"]) <= 1e-15
     assert c["gyro forcing coefficient of C_b^n"] == pytest.approx(-1.0, abs=1e-12)
     assert c["accelerometer forcing coefficient of C_b^n"] == pytest.approx(1.0, abs=1e-12)
     assert c["gyro forcing residual"] < 1e-12 and c["accelerometer forcing residual"] < 1e-12

@@ -76,7 +76,7 @@ def test_imu_error_eq_2_10():
     dw, df = cal.imu_error(w, f, gyro_bias=np.full(3, 1e-6), accel_bias=np.zeros(3),
                            gyro_scale_error=[1e-5, 0, 0], gyro_misalignment=dg)
     assert np.allclose(dw, 1e-6 + np.array([1e-5 * 0.1 - 1e-4 * -0.2, 0, 0]), atol=1e-18)
-    assert np.all(df == 0)
+    assert np.allclose(df, 0.0, rtol=0.0, atol=1e-18)  # no accelerometer error was given
     with pytest.raises(ValueError, match="zero diagonal"):
         cal.imu_error(w, f, gyro_bias=0, accel_bias=0, gyro_misalignment=np.eye(3))
 

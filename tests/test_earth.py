@@ -294,6 +294,7 @@ def test_printed_third_term_must_be_sin2_2L(printed, derived):
 
 def test_printed_trailing_L_is_spurious(printed):
     # as printed, γ vanishes at the equator and exceeds 15 m/s^2 at the pole
+    # the trailing factor L multiplies the whole series: exactly 0 at L = 0 by construction
     assert earth.normal_gravity_chen2019_printed(0.0, 0.0, printed) == 0.0
     assert earth.normal_gravity_chen2019_printed(np.pi / 2, 0.0, printed) > 15.0
     repaired = earth.normal_gravity_chen2019_repaired(0.0, 0.0, printed)

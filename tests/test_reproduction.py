@@ -85,8 +85,51 @@ def test_status_is_computed_from_the_tolerance():
         dict(quantity="rel", unit="m", paper=100.0, reproduced=101.0, tolerance=0.02, tolerance_kind="rel"),
     ])
     assert list(df["status"]) == ["reproduced", "not-reproduced", "reproduced"]
-    assert df.loc[1, "abs_error"] == format(0.01, ".10g") or float(df.loc[1, "abs_error"]) == pytest.approx(0.01)
-    assert df.loc[2, "tolerance"] == "0.02 (rel)"
+    assert float(df.loc[1, "abs_error"]) == pytest.approx(0.01, rel=1e-12)
+    assert df.loc[2, "tolerance"] == "0.02" and df.loc[2, "tolerance_kind"] == "rel"
+    assert rp.display_cell(df.loc[2], "tolerance") == "0.02 (rel)"
+    assert df.loc[0, "tolerance_kind"] == "abs"
+
+
+def test_numeric_columns_hold_only_numbers():
+    df = rp.comparison_frame([
+        dict(quantity="range", unit="m", paper="4.0~6.0", reproduced=5.0, status="qualitative", note="inside"),
+        dict(quantity="word", unit="", paper=1.0, reproduced="decreasing", status="qualitative", note="shape"),
+        dict(quantity="num", unit="m", paper=2.0, reproduced=2.0, tolerance=0.1),
+    ])
+    for col in rp.NUMERIC_COLUMNS:
+        for v in df[col]:
+            assert v == "" or math.isfinite(float(v)), (col, v)
+    assert df.loc[0, "paper"] == "" and df.loc[0, "paper_text"] == "4.0~6.0"
+    assert df.loc[1, "reproduced"] == "" and df.loc[1, "reproduced_text"] == "decreasing"
+    assert rp.display_cell(df.loc[0], "paper") == "4.0~6.0"
+
+
+def test_precision_policy_stores_only_determined_digits():
+    # round-off-level differences (relative 1e-5 of an ideal-flight error, a few 1e-15 of a
+    # numerical Jacobian) must not change the stored text; the tolerance sets the grid
+    a = rp.comparison_frame([dict(quantity="e", unit="m", paper=0.0, reproduced=1.457058959e-4, tolerance=0.05),
+                             dict(quantity="j", unit="SI", paper=0.0, reproduced=3.25e-15, tolerance=7.349899533e-13)])
+    b = rp.comparison_frame([dict(quantity="e", unit="m", paper=0.0, reproduced=1.457070961e-4, tolerance=0.05),
+                             dict(quantity="j", unit="SI", paper=0.0, reproduced=4.34e-15, tolerance=7.349899501e-13)])
+    assert a.equals(b)
+    assert a.loc[0, "reproduced"] == "0" and a.loc[1, "reproduced"] == "0"  # grids 1e-3 m and 1e-14
+    assert a.loc[1, "tolerance"] == "7.35e-13"
+    # a row without a tolerance keeps DEFAULT_DIGITS significant digits, ``digits`` overrides
+    c = rp.comparison_frame([dict(quantity="x", unit="", paper=1.0, reproduced=1.23456789, status="analog", note="n"),
+                             dict(quantity="y", unit="", paper=1.0, reproduced=1.23456789, status="analog", note="n",
+                                  digits=3)])
+    assert c.loc[0, "reproduced"] == "1.23457" and c.loc[1, "reproduced"] == "1.23"
+    # a tight tolerance keeps the digits it needs: the comparison is read to a tenth of it
+    d = rp.comparison_frame([dict(quantity="g", unit="m/s^2", paper=9.7803267714, reproduced=9.78032677141234,
+                                  tolerance=1e-9)])
+    assert d.loc[0, "reproduced"] == "9.7803267714" and d.loc[0, "status"] == "reproduced"
+    # errors are recomputed exactly from the stored values
+    assert float(d.loc[0, "abs_error"]) == 0.0
+    with pytest.raises(rp.RegistryError, match="positive integer"):
+        rp.comparison_frame([dict(quantity="z", unit="", paper=1, reproduced=1, tolerance=1, digits=0)])
+    with pytest.raises(rp.RegistryError, match="unknown keys"):
+        rp.comparison_frame([dict(quantity="z", unit="", paper=1, reproduced=1, tolerence=1)])
 
 
 def test_explicit_statuses_are_checked():
@@ -153,7 +196,7 @@ def test_cli_show_cite_and_unknown_id(sandbox, capsys):
     rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=1.5, tolerance=0)],
                title="Test table", notebook="book/x.ipynb")
     assert cli(["show", "chen2019-table-9-9", "--format", "csv"]) == 0
-    assert "alpha,m,1.5,1.5" in capsys.readouterr().out
+    assert "alpha,m,1.5,,1.5,,0,0,0,abs,reproduced" in capsys.readouterr().out
     assert cli(["show", "chen2019-table-9-9", "--format", "tex"]) == 0
     assert r"\begin{tabular}" in capsys.readouterr().out
     assert cli(["cite", "chen2019-table-9-9"]) == 0

@@ -20,7 +20,7 @@ def test_rates():
     # 15.041 °/h is the Earth rate (sidereal): 7.2921e-5 rad/s
     assert 15.041067 * u.DEG_PER_H == pytest.approx(7.292115e-5, rel=1e-6)
     assert u.DEG_PER_S == pytest.approx(math.pi / 180, rel=1e-15)
-    assert 0.01 * u.DEG_PER_H / u.DEG_PER_H == pytest.approx(0.01, rel=1e-15)
+    assert u.DEG_PER_H == pytest.approx(math.pi / 180 / 3600, rel=1e-15)  # 1 °/h from its definition
     # 1 °/√h = (π/180)/60 rad/√s
     assert u.DEG_PER_SQRT_H == pytest.approx(math.pi / 180 / 60, rel=1e-15)
 

@@ -1,0 +1,138 @@
+"""Re-execute the book under perturbed numerical code paths and require the stored results back.
+
+    python scripts/portability.py nbval [NOTEBOOK ...]   # strict nbval under every configuration
+    python scripts/portability.py unit [PYTEST ARGS ...] # the unit tests under the first one
+    python scripts/portability.py show                  # the configurations, as shell exports
+
+A stored number must carry only the digits that every IEEE-754 machine computes (CONTRIBUTING.md,
+"Precision").  What differs between real x86-64 machines, and how each configuration reaches it
+on this one:
+
+* SIMD width and instruction set of compiled loops: numba compiles for the host CPU unless
+  ``NUMBA_CPU_NAME`` says otherwise; numpy dispatches its loops (sums, transcendental functions,
+  sorting) to AVX512/AVX2/SSE variants at import, restricted by ``NPY_DISABLE_CPU_FEATURES``.
+* FMA contraction: present with AVX2/FMA3 targets (numba host, OpenBLAS Haswell/Zen kernels),
+  absent on the generic and Sandy Bridge targets used below.
+* BLAS kernels: OpenBLAS picks a kernel family per CPU (different blocking, so a different
+  summation order in every product and factorization); ``OPENBLAS_CORETYPE`` forces one.
+* Transcendental functions: numpy's own SIMD implementations per dispatch level, and glibc's
+  ifunc variants (FMA/AVX2 versions of exp, log, sin, pow ...), disabled by ``GLIBC_TUNABLES``.
+
+``baseline`` is an x86-64 machine without AVX (SSE2-era code everywhere); ``avx`` is an AVX
+machine without FMA/AVX2 for numba and BLAS while numpy keeps its AVX2 loops.  Together with the
+native path used by ``make book`` these are three different code paths for every kind of
+arithmetic the package does; AVX512 code cannot run on every machine, but the mechanism by which
+it would differ (another accumulation order, another transcendental implementation) is the one
+exercised here.  Notebooks run in parallel (one shard per core); nbval compares every text
+output exactly (book/conftest.py lists what it skips), and ``tables/`` must be unchanged.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+from run_notebooks import _order, book_notebooks  # noqa: E402
+
+CONFIGS: dict[str, dict[str, str]] = {
+    "baseline": {
+        "NUMBA_CPU_NAME": "generic",
+        "NPY_DISABLE_CPU_FEATURES": "X86_V3",
+        "OPENBLAS_CORETYPE": "Nehalem",
+        "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA",
+    },
+    "avx": {
+        "NUMBA_CPU_NAME": "sandybridge",
+        "OPENBLAS_CORETYPE": "Sandybridge",
+    },
+}
+COMMON = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "PYTHONHASHSEED": "0",
+          "MPLBACKEND": "module://matplotlib_inline.backend_inline"}
+
+
+def environment(name: str) -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items() if k not in {"NUMBA_CPU_NAME", "NPY_DISABLE_CPU_FEATURES",
+                                                            "OPENBLAS_CORETYPE", "GLIBC_TUNABLES"}}
+    env.update(COMMON)
+    env.update(CONFIGS[name])
+    env.setdefault("REPLICATION_ROOT", str(ROOT))
+    return env
+
+
+def _git_state() -> str:
+    out = subprocess.run(["git", "status", "--porcelain", "--untracked-files=all", "--", "tables", "book"],
+                         cwd=ROOT, capture_output=True, text=True, check=True)
+    diff = subprocess.run(["git", "diff", "--", "tables", "book"], cwd=ROOT, capture_output=True, text=True,
+                          check=True)
+    return out.stdout + diff.stdout
+
+
+def _shards(paths: list[Path], n: int) -> list[list[Path]]:
+    shards: list[list[Path]] = [[] for _ in range(n)]
+    for i, p in enumerate(_order(paths)):  # slowest first, dealt round-robin
+        shards[i % n].append(p)
+    return [s for s in shards if s]
+
+
+def nbval(paths: list[Path], jobs: int, configs: list[str]) -> int:
+    before = _git_state()
+    for name in configs:
+        env = environment(name)
+        cmds = [[sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--nbval", "--nbval-current-env",
+                 *map(str, shard), "--nbval-sanitize-with", str(ROOT / "book" / "sanitize.cfg"),
+                 "--nbval-cell-timeout=900", "-o", "testpaths=", "-o", "addopts="]
+                for shard in _shards(paths, jobs)]
+        print(f"== nbval under '{name}': " + " ".join(f"{k}={v}" for k, v in CONFIGS[name].items()), flush=True)
+        with ThreadPoolExecutor(len(cmds)) as pool:
+            results = list(pool.map(lambda c: subprocess.run(c, cwd=ROOT, env=env, capture_output=True, text=True),
+                                    cmds))
+        failed = False
+        for r in results:
+            sys.stdout.write(r.stdout[-6000:])
+            sys.stderr.write(r.stderr[-3000:])
+            failed |= r.returncode != 0
+        if failed:
+            print(f"strict nbval failed under '{name}'", file=sys.stderr)
+            return 1
+        if _git_state() != before:
+            subprocess.run(["git", "status", "--short", "--", "tables", "book"], cwd=ROOT)
+            print(f"re-executing under '{name}' changed tables/ or book/", file=sys.stderr)
+            return 1
+    return 0
+
+
+def unit(args: list[str]) -> int:
+    name = next(iter(CONFIGS))
+    print(f"== unit tests under '{name}'", flush=True)
+    return subprocess.run([sys.executable, "-m", "pytest", "-q", *args], cwd=ROOT, env=environment(name)).returncode
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    p = sub.add_parser("nbval")
+    p.add_argument("notebooks", nargs="*", type=Path)
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    p.add_argument("--config", action="append", choices=list(CONFIGS), help="default: every configuration")
+    p = sub.add_parser("unit")
+    p.add_argument("pytest_args", nargs=argparse.REMAINDER)
+    sub.add_parser("show")
+    args = ap.parse_args(argv)
+    if args.cmd == "show":
+        for name, cfg in CONFIGS.items():
+            print(f"# {name}\n" + "\n".join(f"export {k}='{v}'" for k, v in cfg.items()))
+        return 0
+    if args.cmd == "unit":
+        return unit(args.pytest_args or ["tests", "-m", "not browser"])
+    paths = [p.resolve() for p in args.notebooks] or book_notebooks()
+    return nbval(paths, max(1, args.jobs), args.config or list(CONFIGS))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
