@@ -49,3 +49,43 @@ def glue(name: str, value, display: bool = True, digits: int = GLUE_DIGITS):
             raise ValueError(f"glue {name!r}: digits must be a positive integer, not {digits!r}")
         value = float(format(value, f".{digits}g"))
     return _glue(name, value, display=display)
+
+
+def sig(value, digits: int = 3):
+    """``value`` (a number, array or DataFrame) rounded to ``digits`` significant digits.
+
+    For printed output of results whose last digits depend on the code path (long nonlinear
+    runs, Monte-Carlo statistics): see the precision policy of CONTRIBUTING.md.
+    """
+    import pandas as pd
+
+    if not isinstance(digits, int) or isinstance(digits, bool) or digits < 1:
+        raise ValueError(f"digits must be a positive integer, not {digits!r}")
+
+    def one(v):
+        v = plain(v)
+        if isinstance(v, float) and np.isfinite(v) and v != 0:
+            return float(format(v, f".{digits - 1}e"))
+        return v
+
+    if isinstance(value, pd.DataFrame):
+        return value.map(one)
+    if isinstance(value, pd.Series):
+        return value.map(one)
+    if isinstance(value, np.ndarray):
+        return np.vectorize(one, otypes=[float])(value) if value.size else value
+    return one(value)
+
+
+def order_bound(value) -> float:
+    """The smallest power of ten not below ``|value|``: how a round-off-level result is reported.
+
+    An ideal-sensor error of 1.46e-4 m, or a relative difference of 1.3e-14 between two exact
+    implementations, is round-off: its digits change with the code path, its order does not.
+    """
+    v = abs(float(plain(value)))
+    if not np.isfinite(v):
+        raise ValueError(f"order_bound: {value!r} is not finite")
+    if v == 0:
+        return 0.0
+    return float(10.0 ** np.ceil(np.log10(v)))

@@ -94,8 +94,8 @@ def nbval(paths: list[Path], jobs: int, configs: list[str]) -> int:
                                     cmds))
         failed = False
         for r in results:
-            sys.stdout.write(r.stdout[-6000:])
-            sys.stderr.write(r.stderr[-3000:])
+            sys.stdout.write(r.stdout)
+            sys.stderr.write(r.stderr)
             failed |= r.returncode != 0
         if failed:
             print(f"strict nbval failed under '{name}'", file=sys.stderr)
