@@ -477,6 +477,32 @@ def select_order(y, max_order: int | None = None, *, demean: bool = True) -> int
     return int(max(sel.ar_lags)) if sel.ar_lags else 0
 
 
+def select_order_checked(y, max_order: int | None = None, *, demean: bool = True) -> tuple[int, bool]:
+    """The AIC order of :func:`select_order` and whether the AIC column it rests on is sound.
+
+    Nested least-squares fits on one sample never lose likelihood with the order, so each AIC
+    increment is at most the penalty per order, 2 (chen2019 eq. (3-13)).  A larger increment
+    means the normal equations have lost their digits (a series sampled far faster than its
+    bandwidth): the AIC values, and so the selected order, are round-off and change with the
+    code path.  Returns ``(order, sound)``; report the order only when ``sound`` is true.
+    """
+    from statsmodels.tsa.ar_model import ar_select_order
+
+    y = _series(y, min_length=8)
+    if demean:
+        y = y - y.mean()
+    cap = order_cap(y.size)
+    m = cap if max_order is None else min(int(max_order), cap)
+    sel = ar_select_order(y, m, ic="aic", trend="n")
+    aic = {(max(k) if isinstance(k, tuple) and k else 0): float(np.ravel(v)[0]) for k, v in sel.aic.items()}
+    orders = sorted(aic)
+    inc = np.diff([aic[p] for p in orders])
+    # 2 per order plus a relative allowance for the round-off of values of size |AIC|
+    sound = bool(np.all(inc <= 2.0 + 1e-9 * max(1.0, max(abs(v) for v in aic.values()))))
+    order = int(max(sel.ar_lags)) if sel.ar_lags else 0
+    return order, sound
+
+
 def aic_increment_bound(aic_values, *, penalty_per_order: float = 2.0) -> dict:
     """What the order-to-order increments of an AIC column imply about its normalization.
 

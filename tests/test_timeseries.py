@@ -284,3 +284,18 @@ def test_identification_behaviours_follow_table_3_1():
     e = rng.standard_normal(7201)
     ma1 = ts.identify_model(e[1:] + 0.7 * e[:-1])
     assert (ma1.acf_behaviour, ma1.pacf_behaviour) == ("cuts off", "tails off")
+
+
+def test_select_order_checked_flags_a_round_off_aic_column():
+    rng = np.random.default_rng(3)
+    # a well-conditioned AR(2) series: a sound AIC column and the order of select_order
+    y = np.zeros(3000)
+    e = rng.standard_normal(3000)
+    for k in range(2, 3000):
+        y[k] = 0.5 * y[k - 1] - 0.3 * y[k - 2] + e[k]
+    order, sound = ts.select_order_checked(y, 10)
+    assert sound and order == ts.select_order(y, 10)
+    # a series sampled far faster than its bandwidth (a 1000-sample moving average of a smooth
+    # random walk): the normal equations lose their digits and the AIC column jumps upwards
+    smooth = np.convolve(np.cumsum(np.cumsum(rng.standard_normal(6000))), np.ones(1000) / 1000, "valid")
+    assert not ts.select_order_checked(smooth, 10)[1]
