@@ -89,3 +89,19 @@ def order_bound(value) -> float:
     if v == 0:
         return 0.0
     return float(10.0 ** np.ceil(np.log10(v)))
+
+
+def below(value, bound: float, digits: int = 2):
+    """``"< bound"`` when ``|value| < bound``, else ``value`` to ``digits`` significant digits.
+
+    For a residual that is only known to lie under a stated accuracy (a numerical derivative, a
+    round-off difference): its digits below the bound are noise; whether it exceeds the bound is
+    the finding.  ``bound`` must be positive.
+    """
+    b = float(plain(bound))
+    if not np.isfinite(b) or b <= 0:
+        raise ValueError(f"below: the bound must be a positive number, not {bound!r}")
+    v = float(plain(value))
+    if not np.isfinite(v):
+        raise ValueError(f"below: {value!r} is not finite")
+    return f"< {b:.0e}" if abs(v) < b else sig(v, digits)

@@ -58,7 +58,7 @@ from .kalman import discretize_series, update
 
 __all__ = ["observability_matrix", "stripped_observability_matrix", "total_observability_matrix", "som_condition",
            "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
-           "covariance_observability", "segment_bounds", "spearman", "CHEN2019_MANEUVERS", "Maneuver",
+           "covariance_observability", "segment_bounds", "AMBIGUOUS", "spearman", "CHEN2019_MANEUVERS", "Maneuver",
            "chen2019_maneuvers", "degrees_table", "covariance_table", "rank_metrics", "best_scenario_counts", "unbanked", "sweep"]
 
 
@@ -156,7 +156,9 @@ class ObservabilityDegrees:
     ``singular_values`` σ (descending), ``V`` right singular vectors (columns), ``degree`` the
     value assigned to each state (normalized as requested), ``index`` the singular vector each
     state was assigned (-1 for none), ``rank_tol`` the numerical-rank tolerance in the same
-    units as ``degree``, ``labels`` the state names."""
+    units as ``degree``, ``labels`` the state names, ``ambiguity`` per state the ratio of its
+    second-largest to its largest projection on a singular subspace (near 1: the state lies almost
+    equally in two directions and its assignment hangs on that small difference)."""
 
     singular_values: np.ndarray
     V: np.ndarray
@@ -166,6 +168,7 @@ class ObservabilityDegrees:
     labels: list
     normalize: str | None
     assignment: str
+    ambiguity: np.ndarray | None = None
 
     @property
     def rank(self) -> int:
@@ -189,6 +192,28 @@ class ObservabilityDegrees:
         return dict(zip(self.labels, self.degree))
 
 
+TIE_TOL = 1e-6
+"""Relative difference below which two |singular-vector| components of a state count as equal."""
+
+AMBIGUOUS = 0.95
+"""A state whose second-largest projection on a singular subspace is above this fraction of its
+largest lies almost equally in two directions: its assignment (observable or not) hangs on a
+few per cent of its components and is no verdict (``ObservabilityDegrees.ambiguity``)."""
+
+
+def _clusters(sig, tol):
+    """Indices of the singular values (descending) grouped where consecutive ones differ by no
+    more than ``tol``; all values at or below ``tol`` form one (null-space) group."""
+    groups = []
+    for i, v in enumerate(sig):
+        prev = groups[-1][-1] if groups else None
+        if prev is not None and (sig[prev] - v <= tol or v <= tol and sig[prev] <= tol):
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    return groups
+
+
 def observability_degrees(Q, *, assignment: str = "state", normalize: str | None = None, state_scale=None,
                           labels=None) -> ObservabilityDegrees:
     """Observability degree of every state from the SVD of ``Q`` (see the module docstring).
@@ -196,6 +221,10 @@ def observability_degrees(Q, *, assignment: str = "state", normalize: str | None
     ``assignment``: ``"state"`` or ``"singular"``; ``normalize``: ``None``, ``"max"`` or
     ``"scale"`` (then ``state_scale``, one positive number per state, multiplies the columns of
     Q before the SVD).  The numerical-rank tolerance is σ_max · max(m, n) · ε (numpy's rule).
+    Singular values within the rank tolerance of each other count as one repeated value and a
+    state's component on it is the norm of its projection onto their subspace; a state whose
+    largest component is shared (within ``TIE_TOL``) gets the larger singular value.  Both make
+    the assignment independent of round-off.
     """
     Q = np.atleast_2d(np.asarray(Q, float))
     if Q.ndim != 2 or not np.all(np.isfinite(Q)):
@@ -222,21 +251,34 @@ def observability_degrees(Q, *, assignment: str = "state", normalize: str | None
     sig = np.zeros(n)
     sig[:len(s)] = s
     tol = float(sig[0] * max(m, n) * np.finfo(float).eps) if n else 0.0
-    A = np.abs(V)
+    # singular values closer than the rank tolerance are numerically one repeated value, whose
+    # singular vectors are any basis of their subspace: a state's component there is the norm of
+    # its projection onto the whole subspace (basis-invariant), not one arbitrary vector's entry
+    groups = _clusters(sig, tol)
+    A = np.column_stack([np.sqrt(np.sum(V[:, g] ** 2, axis=1)) for g in groups]) if n else np.zeros((0, 0))
+    gsig = np.array([sig[g[0]] for g in groups])
+    # equal components (within TIE_TOL) are a tie that round-off would otherwise break: it goes to
+    # the larger singular value, the degree of the combination the state belongs to
+    tied = A >= (1 - TIE_TOL) * A.max(axis=1, keepdims=True)
+    srt = np.sort(A, axis=1)
+    ambiguity = srt[:, -2] / srt[:, -1] if A.shape[1] > 1 else np.zeros(n)
     if assignment == "state":
-        idx = np.argmax(A, axis=1)
-        deg = sig[idx]
+        gi = np.argmax(np.where(tied, gsig[None, :], -1.0), axis=1)
+        idx = np.array([groups[g][0] for g in gi], dtype=int)
+        deg = gsig[gi]
     else:
         idx = np.full(n, -1)
         deg = np.zeros(n)
-        for i in range(n):
-            k = int(np.argmax(A[:, i]))
-            if idx[k] < 0 or sig[i] > deg[k]:
-                idx[k], deg[k] = i, sig[i]
+        for c, g in enumerate(groups):              # a p-fold σ goes to the p states dominating it
+            col = A[:, c]
+            top = np.sort(col)[::-1][len(g) - 1]
+            for k in np.flatnonzero(col >= (1 - TIE_TOL) * top):
+                if idx[k] < 0 or gsig[c] > deg[k]:
+                    idx[k], deg[k] = g[0], gsig[c]
     if normalize == "max" and sig[0] > 0:
         deg = deg / sig[0]
         tol = tol / sig[0]
-    return ObservabilityDegrees(sig, V, deg, idx, tol, labels, normalize, assignment)
+    return ObservabilityDegrees(sig, V, deg, idx, tol, labels, normalize, assignment, ambiguity)
 
 
 # ----------------------------------------------------------------------------- along a trajectory
@@ -496,16 +538,19 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
     straight scenario uses its straight leg only; ``kw`` goes to :func:`pwcs_observability`.
     With ``clip_null`` degrees at or below the numerical-rank tolerance — numerically zero, their
     digits are rounding noise — are reported as 0.  ``df.attrs["rank_tol"]`` holds each
-    scenario's tolerance."""
+    scenario's tolerance, ``df.attrs["ambiguity"]`` (scenario → state → ratio) each
+    state's :attr:`ObservabilityDegrees.ambiguity`."""
     import pandas as pd
 
-    cols, tols = {}, {}
+    cols, tols, amb = {}, {}, {}
     for name, mv in maneuvers.items():
         d = pwcs_observability(model, mv.traj, mv.spans(n_segments, before_segments), states=states, **kw)
         cols[name] = np.where(d.degree > d.rank_tol, d.degree, 0.0) if clip_null else d.degree
         tols[name] = d.rank_tol
+        amb[name] = dict(zip(states, map(float, d.ambiguity)))
     df = pd.DataFrame(cols, index=list(states))
     df.attrs["rank_tol"] = tols
+    df.attrs["ambiguity"] = amb
     return df
 
 

@@ -68,6 +68,25 @@ def test_book_glue_makes_numpy_scalars_plain():
         glue("x", float("nan"), display=False)
 
 
+def test_book_precision_helpers_round_to_what_is_determined():
+    import numpy as np
+    import pytest
+
+    from replication.book import below, order_bound, sig
+
+    assert sig(10.74049, 3) == pytest.approx(10.7, abs=1e-12)
+    assert sig(np.array([1.23456e-7, -987.65]), 2).tolist() == pytest.approx([1.2e-7, -990.0])
+    with pytest.raises(ValueError, match="positive integer"):
+        sig(1.0, 0)
+    # a round-off result is reported by its order: both sides of a code-path change agree
+    assert order_bound(1.457058959e-4) == order_bound(1.457070961e-4) == pytest.approx(1e-3)
+    assert order_bound(0.0) == 0.0
+    assert below(2.7e-11, 1e-7) == below(9.9e-12, 1e-7) == "< 1e-07"
+    assert below(0.82, 1e-7) == pytest.approx(0.82)
+    with pytest.raises(ValueError, match="positive"):
+        below(1.0, 0.0)
+
+
 def test_runner_merges_split_stream_outputs():
     a = nbformat.v4.new_output("stream", name="stdout", text="within 1e-6:")
     b = nbformat.v4.new_output("stream", name="stdout", text=" True\n")
