@@ -223,15 +223,16 @@ def test_frozen_earth_jacobian_differs_from_F_only_by_the_omitted_earth_terms(ma
 
 def test_table_2_2_corrected_blocks_match_the_verified_blocks(maneuvering):
     """Re-derived Table 2-2 (same conventions and approximation level as the report) equals the
-    verified blocks (finite differences / Jacobian-checked F) element by element: within 1e-9 of
-    the block scale (Richardson-extrapolated central differences leave ≲ 6e-10)."""
+    verified blocks (finite differences / Jacobian-checked F) element by element: within 3e-9 of
+    the block scale (Richardson-extrapolated central differences leave ≲ 1e-9, mostly round-off of
+    the attitude rows; measured natively and under the perturbed configurations)."""
     m = M.model_45(accel_markov_tau=9000.0, gyro_markov_tau=300.0)
     for p in _points(maneuvering):
         Cb = M.table_2_2_corrected(p, accel_markov_tau=9000.0, gyro_markov_tau=300.0)
         Vb = M.table_2_2_verified(m, p)
         for name in M.TABLE_2_2_BLOCKS:
             c, v = Cb[name], Vb[name]
-            assert np.all(np.abs(c - v) <= 1e-9 * np.abs(v).max()), name
+            assert np.all(np.abs(c - v) <= 3e-9 * np.abs(v).max()), name
 
 
 ERRATA_ELEMENTS = (
