@@ -310,7 +310,7 @@ def ideal_increments(c0, c1, v0, v1, g0, g1, dt, dth, dvel):
 
 @njit(cache=True, parallel=True)
 def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
-             coef, damping, rec, rec_every, acc_every):
+             coef, damping, pos_damped, rec, rec_every, acc_every):
     """Integrate the damped grid-frame strapdown INS of every run from step k0 to k1.
 
     State per run (updated in place): platform attitude ``cbp`` = C_b^p (3×3), grid velocity
@@ -323,6 +323,8 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
     V_c = V_r + H_y(z)(V - V_r) in each grid-horizontal channel (V_r: true grid velocity, the
     reference); v̇^G = C_b^p f^b - (2ω_ie^G + ω_eG^G(V)) × v^G + g^G; ṙ^e = C_G^e v^G.
     ``damping`` = 0 switches the network off (V_c = V, a pure Schuler-tuned grid INS).
+    ``pos_damped`` = 1 integrates the position with the damped velocity V_c (the velocity that
+    also commands the platform, as fang2020 eq. (18) presupposes), 0 with the undamped V.
     ``coef`` = (b0, b1, b2, a1, a2) of the discretized H_y (direct form II transposed).
     ``acc_e``/``acc_i`` accumulate Σ C_b^e Δt and Σ C_b^i Δt of the navigator's attitude every
     ``acc_every`` steps (for the interval-mean attitude of the calibration).
@@ -426,6 +428,11 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
                 vn_new = v[1] + f1 - cor1 * dt
                 vme = 0.5 * (v[0] + ve_new)
                 vmn = 0.5 * (v[1] + vn_new)
+                if damping != 0 and pos_damped != 0:
+                    # damped velocity at mid-step: V_c plus the half-step increment, which the
+                    # network passes at unit gain (H_y → 1 at high frequency)
+                    vme = vce + 0.5 * (ve_new - v[0])
+                    vmn = vcn + 0.5 * (vn_new - v[1])
                 v[0] = ve_new
                 v[1] = vn_new
                 v[2] = 0.0

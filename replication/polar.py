@@ -492,9 +492,21 @@ def discretize_damping(dt):
 
 # =============================================================================== simulation (§3)
 
+POSITION_VELOCITIES = ("damped", "undamped")
+"""Which velocity the grid INS integrates into position (:class:`Scenario`)."""
+
+
 @dataclass(frozen=True)
 class Scenario:
-    """One simulation case of fang2020 §3 (SI units inside; printed units in the constructor)."""
+    """One simulation case of fang2020 §3 (SI units inside; printed units in the constructor).
+
+    ``position_velocity``: ``"damped"`` integrates the position with the damped velocity V_c that
+    also commands the platform (eq. (18) presupposes it), ``"undamped"`` with the free-inertial V
+    (then an (H_y - 1)δV/R term enters the P equation); see :data:`POSITION_VELOCITIES`.
+    ``rocking_phase``: ``None`` draws the pitch/roll/yaw rocking phases at random for every
+    Monte-Carlo run; three numbers fix them for all runs (then only the sensor noise varies; with
+    zero phases the rocking angles vanish at every multiple of 252 s, e.g. at both fixes' 3.5 h).
+    """
 
     track: str                      # "parallel-east" or "meridian-north"
     lat0: float                     # rad
@@ -514,8 +526,15 @@ class Scenario:
     rocking_amplitude: tuple = (3 * units.DEG, 5 * units.DEG, 4 * units.DEG)  # pitch, roll, yaw
     rocking_period: tuple = (7.0, 9.0, 12.0)            # s
     damping: bool = True
+    position_velocity: str = "damped"                     # velocity integrated into position
+    rocking_phase: tuple | None = None                    # pitch, roll, yaw phases (rad); None: random per run
 
     def __post_init__(self):
+        if self.position_velocity not in POSITION_VELOCITIES:
+            raise ValueError(f"position_velocity must be one of {POSITION_VELOCITIES}")
+        if self.rocking_phase is not None and (len(self.rocking_phase) != 3
+                                               or not np.all(np.isfinite(self.rocking_phase))):
+            raise ValueError("rocking_phase must be None (random per run) or three finite phases (rad)")
         if self.track not in ("parallel-east", "meridian-north"):
             raise ValueError("track must be 'parallel-east' or 'meridian-north'")
         earth.check_latitude(self.lat0, polar_limit_deg=None)
@@ -565,6 +584,10 @@ def fang2020_scenario(case, **changes):
     else:
         raise ValueError("fang2020 has two simulation cases: 1 (85°N) and 2 (across the pole)")
     return replace(sc, **changes)
+
+
+def _pos_flag(sc):
+    return 1 if sc.position_velocity == "damped" else 0
 
 
 def _traj_params(sc, phases):
@@ -675,7 +698,7 @@ def run_segment(sc, k0, k1, traj, sens, state, *, record_every_steps=None):
     rec = np.zeros((traj.shape[0], 0, _k.N_REC))
     _k.run_grid(k0, k1, sc.dt, traj, sens, state["cbp"], state["vg"], state["r"], state["damp"],
                 state["comp"], state["rng"], state["acc_e"], state["acc_i"], discretize_damping(sc.dt),
-                1 if sc.damping else 0, rec, record_every_steps or max(k1 - k0, 1), 10)
+                1 if sc.damping else 0, _pos_flag(sc), rec, record_every_steps or max(k1 - k0, 1), 10)
     return state
 
 
@@ -683,6 +706,8 @@ def initial_state(sc, n_runs, seed):
     """Trajectory/sensor parameters and the initial navigator state of ``n_runs`` runs."""
     rng = np.random.default_rng(seed)
     phases = rng.uniform(0, 2 * np.pi, (n_runs, 3))
+    if sc.rocking_phase is not None:
+        phases[:] = np.asarray(sc.rocking_phase, float)
     seeds = rng.integers(1, 2**63 - 1, size=n_runs, dtype=np.int64).astype(np.uint64)
     traj = np.ascontiguousarray(_traj_params(sc, phases))
     sens = np.zeros((n_runs, _k.N_SENS))
@@ -694,7 +719,7 @@ def initial_state(sc, n_runs, seed):
     return phases, traj, sens, state
 
 
-def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimator="mean-attitude",
+def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimator="printed",
              heading_observation="misalignment"):
     """Run fang2020 §3: damped grid INS, fixes at ``sc.fix_times``, two-point calibration.
 
@@ -735,7 +760,7 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
         j0 = ka // rec_every_k
         sub = np.zeros((traj_.shape[0], (kb - ka) // rec_every_k + 1, _k.N_REC))
         _k.run_grid(ka, kb, dt, traj_, sens_, cbp_, vg_, r_, damp_, comp_, rng_, acc_e_, acc_i_,
-                    coef, flag, sub, rec_every_k, acc_every)
+                    coef, flag, _pos_flag(sc), sub, rec_every_k, acc_every)
         rec_[:, j0:j0 + sub.shape[1]] = sub
 
     seg(0, k1, cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens, rec)
@@ -795,7 +820,7 @@ def ecef_reference_comparison(sc, duration, *, seed=0, record_every=60.0):
     empty = np.zeros((1, 0, _k.N_REC))
     for j in range(1, n_rec):
         _k.run_grid((j - 1) * rec_k, j * rec_k, dt, traj, sens, cbp, vg, r, np.zeros((1, 2, 2)),
-                    np.zeros((1, 3)), rng_g, np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), coef, 0, empty, rec_k, 10)
+                    np.zeros((1, 3)), rng_g, np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), coef, 0, 0, empty, rec_k, 10)
         c = grid_frame(r[0])
         pos_grid.append(r[0].copy())
         vel_grid.append(c.T @ vg[0])
@@ -816,18 +841,26 @@ FANG2020_SEEDS = {1: 2020_04_58, 2: 2020_04_65}
 """Seeds of the two 20-run Monte Carlos (case → seed)."""
 
 
+FANG2020_READING = dict(position_velocity="damped", rocking_phase=(0.0, 0.0, 0.0))
+"""The reading of the open choices under which the chapter's main runs are made (the one that
+reaches the printed Tables 1-2, see :func:`readings_ledger`): position integrated from the
+damped velocity, one rocking-phase set shared by all runs that leaves the ship level at the
+fixes; eq. (27) with the attitude at the second fix (``estimator="printed"``)."""
+
+
 def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, **changes):
     """The 20-run Monte Carlo of fang2020 §3 for case 1 (Table 1) or case 2 (Table 2).
 
-    Full fidelity: 10 h at 100 Hz, fixes at 2 h and 3.5 h; ``changes`` override scenario fields
-    (for sensitivity checks).  Returns a :class:`SimulationResult`.
+    Full fidelity: 10 h at 100 Hz, fixes at 2 h and 3.5 h, under :data:`FANG2020_READING`;
+    ``changes`` override scenario fields (for sensitivity checks).  Returns a
+    :class:`SimulationResult`.
     """
-    sc = fang2020_scenario(case, **changes)
+    sc = fang2020_scenario(case, **{**FANG2020_READING, **changes})
     return simulate(sc, n_runs, FANG2020_SEEDS[case] if seed is None else seed,
                     reset_only_runs=reset_only_runs)
 
 
-def drift_summary(result, estimator="mean-attitude"):
+def drift_summary(result, estimator="printed"):
     """Mean and sample standard deviation (ddof = 1) of the drift estimates per body axis, °/h."""
     if estimator not in result.estimates:
         raise ValueError(f"unknown estimator {estimator!r}; have {sorted(result.estimates)}")
@@ -938,6 +971,39 @@ def sensitivity(case, variants, *, n_runs=4, seed=None):
                        record_every=float(np.gcd(int(sc.fix_times[0]), int(sc.fix_times[1]))))
         for est in ESTIMATORS:
             s = drift_summary(res, est)
-            rows.append({"variant": name, "estimator": est,
+            rows.append({"variant": name, "estimator": est, "runs": n_runs,
                          **{f"{a} mean": s[a][0] for a in "XYZ"}, **{f"{a} std": s[a][1] for a in "XYZ"}})
     return pd.DataFrame(rows)
+
+
+READINGS = {
+    "damped position, ship level at the fixes": dict(position_velocity="damped", rocking_phase=(0.0, 0.0, 0.0)),
+    "damped position, random phases per run": dict(position_velocity="damped"),
+    "undamped position, ship level at the fixes": dict(position_velocity="undamped", rocking_phase=(0.0, 0.0, 0.0)),
+    "undamped position, random phases per run": dict(position_velocity="undamped"),
+}
+"""The readings of fang2020 §3 that the text leaves open, crossed with :data:`ESTIMATORS` in
+:func:`readings_ledger`: which velocity the grid INS integrates into position (eq. (18) presupposes
+the damped one) and the rocking phases of eq. (28) ("set to random values": per run, or one draw
+shared by the 20 runs; zero phases, for which every rocking angle vanishes at both fixes, is the
+draw that leaves the ship level at the fixes)."""
+
+
+def readings_ledger(case, *, n_runs=8, shared_draws=3, seed=None):
+    """Drift-estimate summaries of every reading of :data:`READINGS`, of ``shared_draws`` random
+    rocking-phase sets shared by all runs (damped position) and of the three other sign patterns
+    of the horizontal accelerometer biases (not printed) under :data:`FANG2020_READING`, for both
+    estimators: short runs to the second fix (:func:`sensitivity`).  Columns as
+    :func:`sensitivity`, with ``reading`` for ``variant``."""
+    if not isinstance(shared_draws, (int, np.integer)) or shared_draws < 0:
+        raise ValueError("shared_draws must be a non-negative integer")
+    variants = dict(READINGS)
+    rng = np.random.default_rng(FANG2020_SEEDS[case] + 1 if seed is None else seed + 1)
+    for k in range(shared_draws):
+        ph = tuple(float(x) for x in rng.uniform(0, 2 * np.pi, 3))
+        variants[f"damped position, one random phase set shared by all runs (draw {k + 1})"] = dict(
+            position_velocity="damped", rocking_phase=ph)
+    g = 1e-4 * units.G0
+    for signs, bias in (("+,-,+", (g, -g, g)), ("-,+,+", (-g, g, g)), ("-,-,+", (-g, -g, g))):
+        variants[f"as the first, accelerometer biases ({signs})"] = dict(**FANG2020_READING, accel_bias=bias)
+    return sensitivity(case, variants, n_runs=n_runs, seed=seed).rename(columns={"variant": "reading"})
