@@ -32,6 +32,7 @@ from __future__ import annotations
 import argparse
 import os
 import subprocess
+import time
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -80,6 +81,22 @@ def _shards(paths: list[Path], n: int) -> list[list[Path]]:
     return [s for s in shards if s]
 
 
+KERNEL_START_FAILURE = "Kernel died before replying to kernel_info"
+
+
+def _run_shard(cmd: list[str], env: dict[str, str], delay: float) -> subprocess.CompletedProcess:
+    """Run one nbval shard.  Shards start a few seconds apart: kernels launched at the same
+    instant by two processes can race for the same TCP ports, and the loser dies before replying.
+    A shard whose kernel did not start is run once more (a start-up failure says nothing about
+    the stored outputs); any other failure stands."""
+    time.sleep(delay)
+    r = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True)
+    if r.returncode != 0 and KERNEL_START_FAILURE in r.stdout:
+        print("a kernel did not start; running that shard once more", flush=True)
+        r = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True)
+    return r
+
+
 def nbval(paths: list[Path], jobs: int, configs: list[str]) -> int:
     before = _git_state()
     for name in configs:
@@ -90,8 +107,7 @@ def nbval(paths: list[Path], jobs: int, configs: list[str]) -> int:
                 for shard in _shards(paths, jobs)]
         print(f"== nbval under '{name}': " + " ".join(f"{k}={v}" for k, v in CONFIGS[name].items()), flush=True)
         with ThreadPoolExecutor(len(cmds)) as pool:
-            results = list(pool.map(lambda c: subprocess.run(c, cwd=ROOT, env=env, capture_output=True, text=True),
-                                    cmds))
+            results = list(pool.map(lambda kc: _run_shard(kc[1], env, delay=3.0 * kc[0]), enumerate(cmds)))
         failed = False
         for r in results:
             sys.stdout.write(r.stdout)
