@@ -718,7 +718,7 @@ def summarize_status(statuses: Iterable[str]) -> str:
     The order is ``reproduced`` < ``erratum`` < ``analog`` < ``qualitative`` <
     ``not-reproduced`` < ``pending``: an artifact is only as reproduced as its worst row.
     """
-    order = ["reproduced", "erratum", "analog", "qualitative", "not-reproduced", "pending"]
+    order = ["reproduced", "erratum", "inconsistent", "analog", "qualitative", "unverifiable", "not-reproduced", "pending"]
     present = [s for s in statuses]
     if not present:
         return "pending"

@@ -842,11 +842,29 @@ def frequency_response(sys, omega, pair=None):
     return np.squeeze(np.asarray(resp.complex)).reshape(omega.shape)
 
 
-def dc_gain(sys, pair=None):
-    """Zero-frequency gain G(0) (an2021 eqs. (11)-(12)), from -H A⁻¹ B on the controllable part."""
+DC_FREQUENCIES = (1e-12, 10**-11.5, 1e-11)
+"""Frequencies (rad/s) at which :func:`dc_gain` evaluates Re G(jω); they must agree."""
+
+
+def dc_gain(sys, pair=None, *, rtol=1e-6):
+    """Zero-frequency gain G(0) (an2021 eqs. (11)-(12)): Re G(jω) at the :data:`DC_FREQUENCIES`.
+
+    Re G(jω) = G(0) + O(ω²) below the slowest pole, so the three values agree to ``rtol`` when the
+    DC gain is determined.  A neutral mode that should cancel (unobservable or uncontrollable, with
+    an eigenvalue at round-off distance from zero, e.g. an2021's filter with no bias random walk)
+    leaves an error ~ε/ω that grows towards ω → 0; the values then disagree and a ``ValueError``
+    says so instead of returning a wrong gain.
+    """
     if pair is not None:
         sys = siso(sys, pair)
-    return float(np.real(frequency_response(sys, 1e-12)))
+    vals = np.real(frequency_response(sys, np.array(DC_FREQUENCIES)))
+    g0 = float(vals[-1])
+    if np.max(np.abs(vals - g0)) > rtol * max(abs(g0), 1e-300):
+        raise ValueError("the DC gain is not determined numerically: Re G(jω) at "
+                         + ", ".join(f"{w:.1e}" for w in DC_FREQUENCIES) + " rad/s gives "
+                         + ", ".join(f"{v:.6g}" for v in vals)
+                         + " (a near-zero mode that should cancel); evaluate G(jω) at the frequency of interest")
+    return g0
 
 
 def _db(sys, w):

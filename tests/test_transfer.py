@@ -235,6 +235,23 @@ def test_steady_state_gain_is_limit_of_stable_bias_models():
     assert np.max(closed.real) < 1e-12  # stable or (unobservable) neutral
 
 
+def test_dc_gain_refuses_an_undetermined_value():
+    """With (almost) no bias random walk the filter has a mode at round-off distance from zero
+    that should cancel; at ω → 0 its error ~ε/ω swamps G(0).  dc_gain must say so, not return a
+    value orders off 1/g; with the nominal noise it returns the proportional gain ≈ 1/g."""
+    import dataclasses
+
+    lat = np.radians(30.0)
+    _, g = tr.earth_parameters(lat)
+    nominal = tr.siso(tr.integrated_gravity_to_attitude(lat, 0.0, 10.0), "phiE/gdN")
+    assert tr.dc_gain(nominal) * g == pytest.approx(1.0, rel=1e-3)
+    f = 1e-18 / tr.NAVIGATION_GRADE.gyro_bias_rw
+    tiny = dataclasses.replace(tr.NAVIGATION_GRADE, gyro_bias_rw=1e-18, accel_bias_rw=tr.NAVIGATION_GRADE.accel_bias_rw * f)
+    sys = tr.siso(tr.integrated_gravity_to_attitude(lat, 0.0, 10.0, tiny), "phiE/gdN")
+    with pytest.raises(ValueError, match="not determined"):
+        tr.dc_gain(sys)
+
+
 def test_integrated_dc_gain_and_high_frequency_asymptote():
     lat = np.radians(30.0)
     _, g = tr.earth_parameters(lat)
