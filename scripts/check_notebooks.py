@@ -10,8 +10,22 @@ metadata that would make ``make book`` leave ``git status`` dirty.
 from __future__ import annotations
 
 import json
+import re
 import sys
 from pathlib import Path
+
+
+def math_line_problems(text: str) -> list[str]:
+    """Lines of an inline formula that Markdown would read as something else: a formula broken
+    across lines so that a line starts with ``- `` / ``+ `` / ``* `` (a list item) or ``#``."""
+    out, inside = [], False
+    for line in text.split("\n"):
+        if inside and re.match(r"\s*([-+*]\s|#)", line):
+            out.append(f"a line inside $...$ starts with {line.strip()[:2]!r} (rendered as Markdown): {line.strip()[:60]}")
+        # an odd number of unescaped single $ (not $$) toggles the inline-math state
+        singles = len(re.findall(r"(?<![\\$])\$(?!\$)", line))
+        inside ^= singles % 2 == 1
+    return out
 
 
 def problems(path: Path) -> list[str]:
@@ -38,6 +52,9 @@ def problems(path: Path) -> list[str]:
                     out.append(f"code cell {i}: a warning was printed (fix its cause): {text.strip()[:120]}")
     if not code:
         out.append("no code cells")
+    for i, c in enumerate(nb.get("cells", []), 1):
+        if c.get("cell_type") == "markdown":
+            out += [f"markdown cell {i}: {m}" for m in math_line_problems("".join(c.get("source", "")))]
     return out
 
 

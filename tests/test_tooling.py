@@ -105,3 +105,11 @@ def test_docstring_bars_are_escaped_outside_literal_blocks():
     assert out[2] == "    |x| stays"
     assert out[4] == r"Back to \|text\|."
     assert out[5] == "| a | b |"
+
+
+def test_a_formula_line_read_as_a_list_item_is_caught():
+    broken = "the error $\\delta\\dot V = f\\times\\phi\n- (2\\delta\\omega)\\times V$ follows"
+    fixed = "the error $\\delta\\dot V = f\\times\\phi -\n(2\\delta\\omega)\\times V$ follows\n- a real list item"
+    assert len(check_notebooks.math_line_problems(broken)) == 1
+    assert check_notebooks.math_line_problems(fixed) == []
+    assert check_notebooks.math_line_problems("$$\nx\n- y\n$$") == []     # display maths is not inline
