@@ -77,6 +77,7 @@ def test_inversion_test_rejects_bad_segments():
         ts.inversion_test(np.zeros(10), 8)
 
 
+@pytest.mark.slow
 def test_stationarity_report_on_white_noise_and_random_walks():
     rng = np.random.default_rng(7)
     rep = ts.stationarity_report(rng.standard_normal(3000), 20).set_index("test")["stationary"]
