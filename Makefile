@@ -15,7 +15,7 @@ export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
 NOTEBOOKS := $(shell find book -name '*.ipynb' -not -path '*/_build/*' -not -path '*/.ipynb_checkpoints/*' | sort)
 
-.PHONY: help env lock book notebooks notebook tables html test unit unit-portable portability nbval \
+.PHONY: help env lock book notebooks notebook tables html test unit units unit-portable portability nbval \
         check-notebooks check-tables html-strict browser bench clean
 
 help:
@@ -59,10 +59,14 @@ html: env
 	$(VENV)/bin/jupyter-book build book --path-output book --quiet
 
 # ---------------------------------------------------------------- tests
-test: env unit unit-portable portability check-notebooks tables check-tables html-strict browser
+test: env units portability check-notebooks tables check-tables html-strict browser
 
 unit: env
 	$(PY) -m pytest -q tests -m "not browser"
+
+# the unit tests natively and under a perturbed configuration, side by side on the two cores
+units: env
+	$(PY) scripts/portability.py units
 
 # the unit tests once more on a perturbed numerical code path (scripts/portability.py says why)
 unit-portable: env

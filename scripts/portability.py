@@ -2,6 +2,7 @@
 
     python scripts/portability.py nbval [NOTEBOOK ...]   # strict nbval under every configuration
     python scripts/portability.py unit [PYTEST ARGS ...] # the unit tests under the first one
+    python scripts/portability.py units                 # natively and under the first one, side by side
     python scripts/portability.py show                  # the configurations, as shell exports
 
 A stored number must carry only the digits that every IEEE-754 machine computes (CONTRIBUTING.md,
@@ -129,6 +130,26 @@ def unit(args: list[str]) -> int:
     return subprocess.run([sys.executable, "-m", "pytest", "-q", *args], cwd=ROOT, env=environment(name)).returncode
 
 
+def units() -> int:
+    """The unit tests natively (all but the browser test) and, at the same time on the other core,
+    under the first perturbed configuration (without the slow ones); both logs printed whole."""
+    name = next(iter(CONFIGS))
+    runs = {"natively": ([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests", "-m", "not browser"], None),
+            f"under '{name}'": ([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests", "-m",
+                                 "not browser and not slow"], environment(name))}
+    with ThreadPoolExecutor(len(runs)) as pool:
+        futures = {k: pool.submit(subprocess.run, cmd, cwd=ROOT, env=env, capture_output=True, text=True)
+                   for k, (cmd, env) in runs.items()}
+    rc = 0
+    for k, f in futures.items():
+        r = f.result()
+        print(f"== unit tests {k}", flush=True)
+        sys.stdout.write(r.stdout)
+        sys.stderr.write(r.stderr)
+        rc |= r.returncode
+    return rc
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -138,8 +159,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--config", action="append", choices=list(CONFIGS), help="default: every configuration")
     p = sub.add_parser("unit")
     p.add_argument("pytest_args", nargs=argparse.REMAINDER)
+    sub.add_parser("units")
     sub.add_parser("show")
     args = ap.parse_args(argv)
+    if args.cmd == "units":
+        return units()
     if args.cmd == "show":
         for name, cfg in CONFIGS.items():
             print(f"# {name}\n" + "\n".join(f"export {k}='{v}'" for k, v in cfg.items()))
