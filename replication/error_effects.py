@@ -31,7 +31,7 @@ from .sensors import ImuErrors, TriadErrors, apply_imu_errors
 from .strapdown import mechanize
 from .units import DEG
 
-__all__ = ["consequence_flight", "single_errors", "error_features", "error_effects", "classify"]
+__all__ = ["consequence_flight", "single_errors", "error_features", "error_effects", "classify", "CONSEQUENCE_RULES"]
 
 
 def consequence_flight(*, dt: float = 0.05, lat0: float = 47 * DEG, lon0: float = 115 * DEG, h0: float = 6000.0):

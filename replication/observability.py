@@ -539,7 +539,7 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
     With ``clip_null`` degrees at or below the numerical-rank tolerance — numerically zero, their
     digits are rounding noise — are reported as 0.  ``df.attrs["rank_tol"]`` holds each
     scenario's tolerance, ``df.attrs["ambiguity"]`` (scenario → state → ratio) each
-    state's :attr:`ObservabilityDegrees.ambiguity`."""
+    state's ``ambiguity`` (:class:`ObservabilityDegrees`)."""
     import pandas as pd
 
     cols, tols, amb = {}, {}, {}

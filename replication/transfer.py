@@ -980,11 +980,6 @@ def attitude_error_per_disturbance(disturbance, lat=np.radians(30.0), *, gravity
     return np.asarray(disturbance, float) / g
 
 
-__all__ = [n for n in dir() if not n.startswith("_") and n not in (
-    "annotations", "functools", "math", "dataclass", "replace", "ct", "np", "pd", "sla", "sp", "brentq", "earth",
-    "DEG", "DEG_PER_H", "DEG_PER_SQRT_H", "HOUR", "MICRO_G", "UG_PER_SQRT_HZ")]
-
-
 # --------------------------------------------------------------------------- time-domain cross-check
 
 def time_domain_response(lat, v_east, v_north, noise: NoiseSettings, omegas, *, pair="phiE/gdN", settle=60000.0,
@@ -1043,3 +1038,8 @@ def time_domain_response(lat, v_east, v_north, noise: NoiseSettings, omegas, *, 
         (s_, c_), *_ = np.linalg.lstsq(X, y[tail, 0], rcond=None)
         rows.append({"omega": float(w), "gain": float(np.hypot(s_, c_)), "phase_deg": float(np.degrees(np.arctan2(c_, s_)))})
     return pd.DataFrame(rows)
+
+
+__all__ = [n for n in dir() if not n.startswith("_") and n not in (
+    "annotations", "functools", "math", "dataclass", "replace", "ct", "np", "pd", "sla", "sp", "brentq", "earth",
+    "DEG", "DEG_PER_H", "DEG_PER_SQRT_H", "HOUR", "MICRO_G", "UG_PER_SQRT_HZ")]
