@@ -655,6 +655,7 @@ def compare(
         p = out_dir / f"{table_id}{ext}"
         if not p.exists() or p.read_text(encoding="utf-8") != content:
             p.write_text(content, encoding="utf-8")
+    df.attrs.update(table_id=table_id, notebook=notebook)
     return df
 
 
@@ -674,24 +675,48 @@ def list_tables() -> list[str]:
     return sorted(p.stem for p in d.glob("*.json") if _ID_RE.match(p.stem)) if d.exists() else []
 
 
+COMPACT_COLUMNS = ("quantity", "paper", "reproduced", "status", "note")
+"""What a reader sees of every comparison table: the printed and the reproduced value, the status
+and its reason (the ``note``); the long format is one click away (:func:`display_table`)."""
+
+_HEADINGS = {"note": "reason", "abs_error": "|error|", "rel_error": "rel. error"}
+
+
+def _md_rows(df: pd.DataFrame, cols: list[str]) -> list[str]:
+    head = "| " + " | ".join(_HEADINGS.get(c, c) for c in cols) + " |"
+    lines = [head, "|" + "---|" * len(cols)]
+    for _, r in df.iterrows():
+        lines.append("| " + " | ".join(display_cell(r, c).replace("|", "\\|").replace("\n", " ") for c in cols) + " |")
+    return lines
+
+
 def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterable[str] | None = None):
     """A numbered, cross-referenceable MyST table of a comparison (for notebook output).
 
-    Returns an IPython ``Markdown`` object whose text is a ``{table}`` directive; the book
-    renders it as a numbered table labelled ``name`` (reference it with ``{numref}``).
+    The table shows ``columns`` (default :data:`COMPACT_COLUMNS`); the status and its reason (the
+    ``note``, headed "reason") are always shown.  For a table returned by :func:`compare`, a
+    download link to its CSV and a collapsed copy of the full long format follow.  Returns an
+    IPython ``Markdown`` object whose text is a ``{table}`` directive; the book renders it as a
+    numbered table labelled ``name`` (reference it with ``{numref}``).
     """
     from IPython.display import Markdown
 
-    cols = list(columns or ["quantity", "unit", "paper", "reproduced", "abs_error", "tolerance", "status"])
+    cols = list(columns or COMPACT_COLUMNS)
+    cols += [c for c in ("status", "note") if c not in cols and c in df.columns]
     missing = [c for c in cols if c not in df.columns]
     if missing:
         raise RegistryError(f"display_table: columns {missing} not in the table")
     if not re.match(r"^[a-z0-9][a-z0-9-]*$", name):
         raise RegistryError(f"display_table: name {name!r} must be lower-case letters, digits and '-'")
-    lines = [f"```{{table}} {caption}", f":name: {name}", "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    for _, r in df.iterrows():
-        lines.append("| " + " | ".join(display_cell(r, c).replace("|", "\\|").replace("\n", " ") for c in cols) + " |")
-    lines.append("```")
+    lines = [f"```{{table}} {caption}", f":name: {name}", "", *_md_rows(df, cols), "```"]
+    table_id, notebook = df.attrs.get("table_id"), df.attrs.get("notebook")
+    if table_id and notebook:
+        up = "../" * (len(Path(notebook).parts) - 1)
+        full = [c for c in TABLE_COLUMNS if c in df.columns and c not in ("paper_text", "reproduced_text", "tolerance_kind")
+                and (df[c].astype(str) != "").any()]
+        lines += ["", f"Download: {{download}}`{table_id}.csv <{up}tables/{table_id}.csv>` (long format, with "
+                  f"provenance in {{download}}`{table_id}.json <{up}tables/{table_id}.json>`)", "",
+                  f":::{{dropdown}} All columns of {table_id}", *_md_rows(df, full), ":::"]
     return Markdown("\n".join(lines))
 
 
