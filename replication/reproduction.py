@@ -794,7 +794,72 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
         _write_if_changed(d / "errata.csv", errata.to_csv(index=False, lineterminator="\n"))
         _write_if_changed(d / "status.md", _status_markdown(status))
         _write_if_changed(d / "errata.md", _errata_markdown(errata))
+        write_datapackage()
     return status, errata
+
+
+DATAPACKAGE = "datapackage.json"
+"""The Frictionless data-package descriptor of ``tables/`` (written by :func:`build_index`)."""
+
+
+def _field_type(name: str, values: pd.Series) -> str:
+    if name in NUMERIC_COLUMNS:
+        return "number"
+    v = values[values != ""]
+    if len(v) and v.str.fullmatch(r"-?\d+").all():
+        return "integer"
+    return "string"
+
+
+def datapackage() -> dict:
+    """A Frictionless *tabular data package* describing every CSV of ``tables/``: one resource per
+    file, with its title, the notebook that wrote it, its commit and a schema (field names in file
+    order; ``number`` for the numeric columns of a comparison, empty cells missing values)."""
+    d = tables_dir()
+    resources = []
+    for path in sorted(d.glob("*.csv")):
+        df = pd.read_csv(path, dtype=str, keep_default_na=False)
+        side = d / f"{path.stem}.json"
+        meta = json.loads(side.read_text(encoding="utf-8")) if side.exists() else {}
+        res = {"name": path.stem, "path": path.name, "profile": "tabular-data-resource", "format": "csv",
+               "mediatype": "text/csv", "encoding": "utf-8",
+               "title": meta.get("title", {"status": "Reproduction status of every artifact",
+                                           "errata": "Errata register"}.get(path.stem, path.stem)),
+               "schema": {"fields": [{"name": c, "type": _field_type(c, df[c])} for c in df.columns],
+                          "missingValues": [""]}}
+        if meta:
+            res["sources"] = [{"title": meta.get("notebook", ""), "path": meta.get("notebook", "")}]
+            res["git_commit"] = meta.get("git_commit", "")
+        resources.append(res)
+    return {"profile": "tabular-data-package", "name": "sins-gnss-reproduction-tables",
+            "title": "Reproduced tables of four SINS/GNSS publications", "version": __version__,
+            "licenses": [{"name": "CC-BY-4.0", "title": "Creative Commons Attribution 4.0"}],
+            "resources": resources}
+
+
+def write_datapackage() -> Path:
+    """Write :func:`datapackage` to ``tables/datapackage.json`` (only when it changed)."""
+    path = tables_dir() / DATAPACKAGE
+    _write_if_changed(path, json.dumps(datapackage(), indent=1, sort_keys=True, ensure_ascii=False) + "\n")
+    return path
+
+
+def load_table(table_id: str) -> pd.DataFrame:
+    """An exported comparison table with typed columns and its provenance.
+
+    Numeric columns (``paper``, ``reproduced``, ``abs_error``, ``rel_error``, ``tolerance``) are
+    floats (NaN where the cell holds text or nothing: the printed form is in ``paper_text``,
+    ``reproduced_text``); ``df.attrs`` holds the sidecar (title, notebook, commit, seeds, package
+    versions).  ``table_id`` as printed by ``python -m replication status``.
+    """
+    df = read_table(table_id)
+    for c in NUMERIC_COLUMNS:
+        if c in df.columns:
+            df[c] = pd.to_numeric(df[c].replace("", np.nan), errors="coerce")
+    side = tables_dir() / f"{table_id}.json"
+    if side.exists():
+        df.attrs.update(json.loads(side.read_text(encoding="utf-8")))
+    return df
 
 
 def artifact_tables(artifact: Mapping[str, Any]) -> list[str]:
