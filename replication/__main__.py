@@ -13,22 +13,28 @@ def _cmd_status(args) -> int:
     if args.source:
         status = status[status["source"] == args.source]
     width = max(len(i) for i in status["id"]) if len(status) else 10
-    print(f"{'id':<{width}}  {'status':<15} rows  description")
-    for _, r in status.iterrows():
-        print(f"{r['id']:<{width}}  {r['status']:<15} {r['rows']:>4}  {str(r['description'])[:70]}")
-    tally = status["status"].value_counts()
-    print()
-    print(f"{len(status)} artifacts: " + ", ".join(f"{s} {int(tally.get(s, 0))}" for s in rp.STATUSES))
+    for kind, title in (("paper", "artifacts of the four documents"), ("supplementary", "supplementary checks")):
+        part = status[status["kind"] == kind]
+        if not len(part):
+            continue
+        print(f"== {title} (cite or show a table id of the last column)")
+        print(f"{'id':<{width}}  {'status':<28} rows  tables")
+        for _, r in part.iterrows():
+            print(f"{r['id']:<{width}}  {rp.status_label(r):<28} {r['rows']:>4}  {r['tables'] or '-'}")
+        print()
+    for line in rp.status_tally(status).values():
+        print(line)
     print(f"errata proven: {len(errata)}")
     return 0
 
 
 def _cmd_show(args) -> int:
-    df = rp.read_table(args.id)
+    table_id = rp.resolve_table_id(args.id)
+    df = rp.read_table(table_id)
     if args.format == "csv":
         sys.stdout.write(df.to_csv(index=False, lineterminator="\n"))
     else:
-        path = rp.tables_dir() / f"{args.id}.{args.format}"
+        path = rp.tables_dir() / f"{table_id}.{args.format}"
         sys.stdout.write(path.read_text(encoding="utf-8"))
     return 0
 
@@ -66,6 +72,9 @@ def main(argv: list[str] | None = None) -> int:
     except rp.RegistryError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:                      # e.g. `python -m replication status | head`
+        sys.stderr.close()
+        return 0
 
 
 if __name__ == "__main__":

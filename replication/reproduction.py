@@ -737,20 +737,44 @@ def load_artifacts() -> pd.DataFrame:
     return df
 
 
-def summarize_status(statuses: Iterable[str]) -> str:
-    """One status for an artifact from its rows: the weakest status present.
+ARTIFACT_STATUSES = ("reproduced", "qualitative", "mixed", "analog", "unverifiable", "not-reproduced",
+                     "erratum", "inconsistent", "pending")
+"""Statuses of a whole artifact (``tables/status.csv``): the row statuses plus ``mixed``."""
 
-    The order is ``reproduced`` < ``erratum`` < ``analog`` < ``qualitative`` <
-    ``not-reproduced`` < ``pending``: an artifact is only as reproduced as its worst row.
+
+def summarize_status(statuses: Iterable[str]) -> str:
+    """The reproduction status of an artifact from its rows (CONTRIBUTING.md, "Statuses").
+
+    Errata and inconsistencies are findings about the print, counted beside the status, never
+    deciding it.  Of the other rows: all ``pending`` → ``pending``; all ``reproduced`` or
+    ``qualitative`` → ``reproduced`` (``qualitative`` if none is numeric); all of one other kind
+    (``analog``, ``unverifiable``, ``not-reproduced``) → that kind; any other combination →
+    ``mixed``, whose split the row counts show.  An artifact with only errata (or only
+    inconsistencies) rows is ``erratum`` (``inconsistent``); with no rows, ``pending``.
     """
-    order = ["reproduced", "erratum", "inconsistent", "analog", "qualitative", "unverifiable", "not-reproduced", "pending"]
-    present = [s for s in statuses]
-    if not present:
-        return "pending"
+    present = list(statuses)
     for s in present:
-        if s not in order:
+        if s not in STATUSES:
             raise RegistryError(f"unknown status {s!r}")
-    return max(present, key=order.index)
+    rest = {s for s in present if s not in ("erratum", "inconsistent")}
+    if not rest:
+        return "erratum" if "erratum" in present else "inconsistent" if "inconsistent" in present else "pending"
+    if rest == {"pending"}:
+        return "pending"
+    if rest <= {"reproduced", "qualitative"}:
+        return "reproduced" if "reproduced" in rest else "qualitative"
+    if len(rest) == 1:
+        return rest.pop()
+    return "mixed"
+
+
+def status_label(row: Mapping[str, Any]) -> str:
+    """``status`` of a ``tables/status.csv`` row with its findings about the print, e.g.
+    ``reproduced, 52 errata`` — so that an artifact's status never hides its errata."""
+    n_e, n_i = int(row.get("erratum", 0) or 0), int(row.get("inconsistent", 0) or 0)
+    extra = ([f"{n_e} {'erratum' if n_e == 1 else 'errata'}"] if n_e else []) + \
+            ([f"{n_i} {'inconsistency' if n_i == 1 else 'inconsistencies'}"] if n_i else [])
+    return ", ".join([str(row["status"])] + extra)
 
 
 def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -888,7 +912,8 @@ def _status_row(tid: str, source: str, artifact: str, description: str, present:
     for s in statuses:
         counts[s] += 1
     overall = summarize_status(statuses) if present else "pending"
-    return {"id": tid, "source": source, "artifact": artifact, "description": description,
+    return {"id": tid, "source": source, "kind": "supplementary" if artifact == "supplementary" else "paper",
+            "artifact": artifact, "description": description,
             "status": overall, "rows": sum(counts.values()),
             **{s.replace("-", "_"): counts[s] for s in STATUSES}, "tables": " ".join(present),
             "notebook": " ".join(notebooks)}
@@ -899,18 +924,32 @@ def _write_if_changed(path: Path, content: str) -> None:
         path.write_text(content, encoding="utf-8")
 
 
+def status_tally(status: pd.DataFrame) -> dict[str, str]:
+    """One line per kind of artifact (``paper``, ``supplementary``): how many have each status
+    and how many errata they carry — paper artifacts are never counted with the package's own
+    checks."""
+    out = {}
+    for kind in ("paper", "supplementary"):
+        part = status[status["kind"] == kind]
+        tally = part["status"].value_counts()
+        head = ", ".join(f"{int(tally[s])} {s}" for s in ARTIFACT_STATUSES if int(tally.get(s, 0)))
+        out[kind] = (f"{len(part)} {kind} artifacts: {head}; {int(part['erratum'].sum())} errata and "
+                     f"{int(part['inconsistent'].sum())} inconsistencies recorded in their rows")
+    return out
+
+
 def _status_markdown(status: pd.DataFrame) -> str:
-    tally = status["status"].value_counts()
-    head = ", ".join(f"{s}: {int(tally.get(s, 0))}" for s in STATUSES)
-    lines = [f"Artifacts: {len(status)} ({head}).", "",
-             "| id | artifact | status | rows | description |", "|---|---|---|---|---|"]
-    for _, r in status.iterrows():
-        split = ", ".join(f"{int(r[s.replace('-', '_')])} {s}" for s in STATUSES if int(r[s.replace('-', '_')]))
-        lines.append(
-            f"| `{r['id']}` | {r['artifact']} | **{r['status']}** | {split or '-'} | "
-            f"{str(r['description']).replace('|', '/')} |"
-        )
-    return "\n".join(lines) + "\n"
+    tally = status_tally(status)
+    lines = []
+    for kind, title in (("paper", "Artifacts of the four documents"), ("supplementary", "Supplementary checks")):
+        lines += [f"**{title}** — {tally[kind]}.", "",
+                  "| id | artifact | status | rows | description |", "|---|---|---|---|---|"]
+        for _, r in status[status["kind"] == kind].iterrows():
+            split = ", ".join(f"{int(r[s.replace('-', '_')])} {s}" for s in STATUSES if int(r[s.replace('-', '_')]))
+            lines.append(f"| `{r['id']}` | {r['artifact']} | **{status_label(r)}** | {split or '-'} | "
+                         f"{str(r['description']).replace('|', '/')} |")
+        lines.append("")
+    return "\n".join(lines)
 
 
 def _errata_markdown(errata: pd.DataFrame) -> str:
@@ -923,30 +962,64 @@ def _errata_markdown(errata: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
-def bibtex_for(table_id: str) -> str:
-    """A BibTeX entry citing the exported table ``table_id`` of this package.
+PACKAGE_YEAR = 2026
+"""Year of the package release cited by :func:`bibtex_for` (as in CITATION.cff)."""
 
-    The entry points at the original source through ``related`` / ``note`` and carries the
-    original document's own entry after it.
+
+def resolve_table_id(ident: str) -> str:
+    """The exported table behind ``ident``: a table id, or an artifact id of
+    ``tables/status.csv`` covered by exactly one table.  Raises :class:`RegistryError` saying
+    which tables to use otherwise (an artifact covered by several, or not exported yet)."""
+    validate_id(ident)
+    if (tables_dir() / f"{ident}.csv").exists():
+        return ident
+    status_path = tables_dir() / "status.csv"
+    if status_path.exists():
+        st = pd.read_csv(status_path, dtype=str, keep_default_na=False)
+        hit = st[st["id"] == ident]
+        if len(hit):
+            tables = hit.iloc[0]["tables"].split()
+            if len(tables) == 1:
+                return tables[0]
+            if not tables:
+                raise RegistryError(f"{ident!r} is {hit.iloc[0]['status']}: no table has been exported for it yet")
+            raise RegistryError(f"{ident!r} is covered by several tables: {', '.join(tables)}; name one of them")
+    read_table(ident)                   # not a table either: raises, naming the tables of that source
+    return ident
+
+
+def bibtex_for(table_id: str) -> str:
+    """A BibTeX entry citing the exported table ``table_id`` (or the artifact it covers).
+
+    Year and version of the package, the commit recorded in the table's sidecar (the one on top
+    of which its values were computed, not the checkout's), its status with the row split; a
+    table reproducing a paper relates to that paper's entry, which follows; a supplementary check
+    of the package's own cites the package only.
     """
+    table_id = resolve_table_id(table_id)
     df = read_table(table_id)
     meta = json.loads((tables_dir() / f"{table_id}.json").read_text(encoding="utf-8"))
     source = meta.get("source", table_id.split("-")[0])
-    commit = _git_head(project_root()) or meta.get("git_commit") or "unknown"
+    commit = meta.get("git_commit") or "unknown"
+    version = meta.get("library_version", __version__)
+    counts = df["status"].value_counts()
+    split = ", ".join(f"{int(counts[s])} {s}" for s in STATUSES if int(counts.get(s, 0)))
     overall = summarize_status(df["status"])
-    key = "repro-" + table_id
-    entry = (
-        f"@misc{{{key},\n"
-        f"  title        = {{{{Reproduction of {source}: {meta.get('title', table_id)}}}}},\n"
-        f"  author       = {{{{SINS/GNSS reproduction package contributors}}}},\n"
-        f"  howpublished = {{Table \\texttt{{tables/{table_id}.csv}}, reproduction package \\texttt{{replication}} v{meta.get('library_version', __version__)}}},\n"
-        f"  note         = {{Status: {overall} ({len(df)} rows). Reproduces {source}; cite the original as well. Commit {commit}}},\n"
-        f"  related      = {{{source}}},\n"
-        f"  version      = {{{meta.get('library_version', __version__)}}},\n"
-        f"}}\n"
-    )
-    original = source_bibtex(source)
-    return entry + ("\n" + original if original else "")
+    is_paper = source in SOURCE_KEYS
+    title = meta.get("title", table_id)
+    lines = [f"@misc{{repro-{table_id},",
+             f"  title        = {{{{{title}}}}},",
+             "  author       = {{SINS/GNSS reproduction package contributors}},",
+             f"  year         = {{{PACKAGE_YEAR}}},",
+             f"  version      = {{{version}}},",
+             f"  howpublished = {{Table \\texttt{{tables/{table_id}.csv}} of the reproduction package "
+             f"\\texttt{{replication}} v{version}, commit {commit[:12]}}},",
+             f"  note         = {{Status {overall} ({split}).{' Reproduces ' + source + '; cite the original as well.' if is_paper else ' A supplementary check of the package.'}}},"]
+    if is_paper:
+        lines.append(f"  related      = {{{source}}},")
+    lines.append("}")
+    original = source_bibtex(source) if is_paper else ""
+    return "\n".join(lines) + "\n" + ("\n" + original if original else "")
 
 
 def source_bibtex(key: str) -> str:

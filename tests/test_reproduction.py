@@ -186,10 +186,23 @@ def test_index_lists_every_artifact_and_collects_errata(sandbox):
     assert list(on_disk.columns[:5]) == ["source", "location", "printed", "corrected", "evidence"]
 
 
-def test_summary_status_is_the_weakest():
-    assert rp.summarize_status(["reproduced", "erratum"]) == "erratum"
-    assert rp.summarize_status(["reproduced", "not-reproduced", "analog"]) == "not-reproduced"
-    assert rp.summarize_status([]) == "pending"
+def test_roll_up_rules():
+    """CONTRIBUTING.md, "Statuses": errata and inconsistencies are counted beside the status and
+    never decide it; one marginal row does not stand for a whole table (``mixed``, split shown)."""
+    s = rp.summarize_status
+    assert s(["reproduced"] * 3 + ["erratum"] * 52) == "reproduced"          # errata do not hide, nor decide
+    assert s(["analog", "erratum"]) == "analog"
+    assert s(["reproduced"] * 25 + ["not-reproduced"]) == "mixed"           # not the weakest row
+    assert s(["reproduced", "qualitative"]) == "reproduced"
+    assert s(["qualitative", "qualitative"]) == "qualitative"
+    assert s(["not-reproduced", "not-reproduced", "inconsistent"]) == "not-reproduced"
+    assert s(["erratum", "erratum"]) == "erratum" and s(["inconsistent"]) == "inconsistent"
+    assert s(["pending", "erratum"]) == "pending" and s([]) == "pending"
+    assert s(["reproduced", "pending"]) == "mixed"
+    with pytest.raises(rp.RegistryError, match="unknown status"):
+        s(["fine"])
+    row = {"status": "reproduced", "erratum": 52, "inconsistent": 1}
+    assert rp.status_label(row) == "reproduced, 52 errata, 1 inconsistency"
 
 
 def test_cli_show_cite_and_unknown_id(sandbox, capsys):
@@ -205,7 +218,8 @@ def test_cli_show_cite_and_unknown_id(sandbox, capsys):
     assert cli(["show", "chen2019-table-4-99"]) == 2
     assert "no exported table" in capsys.readouterr().err
     assert cli(["status"]) == 0
-    assert "2 artifacts" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "2 paper artifacts" in out and "reproduced" in out
 
 
 def test_cli_runs_as_module_on_the_real_project():
@@ -258,7 +272,37 @@ def test_an_artifact_can_be_covered_by_check_tables(sandbox):
     rp.compare("chen2019-check-b", [dict(quantity="q", unit="", paper=1, reproduced=2, tolerance=0)],
                title="B", notebook="book/b.ipynb")
     status, _ = rp.build_index()
-    assert status.iloc[0]["status"] == "not-reproduced" and status.iloc[0]["rows"] == 2
+    assert status.iloc[0]["status"] == "mixed" and status.iloc[0]["rows"] == 2
+    assert status.iloc[0]["reproduced"] == 1 and status.iloc[0]["not_reproduced"] == 1
+
+
+def test_every_id_printed_by_status_resolves_in_show_and_cite():
+    """An artifact id resolves to the one table that covers it; otherwise the error names the
+    tables to use (several) or says it is pending."""
+    status = pd.read_csv(rp.tables_dir() / "status.csv", dtype=str, keep_default_na=False)
+    for _, r in status.iterrows():
+        tables = r["tables"].split()
+        for t in tables:
+            assert rp.resolve_table_id(t) == t
+            assert rp.bibtex_for(t).startswith(f"@misc{{repro-{t},")
+        if len(tables) == 1:
+            assert rp.resolve_table_id(r["id"]) == tables[0]
+        elif len(tables) > 1:
+            with pytest.raises(rp.RegistryError, match="several tables"):
+                rp.resolve_table_id(r["id"])
+
+
+def test_cite_gives_year_version_and_the_sidecar_commit():
+    import json as _json
+
+    tid = "fang2020-table-1"
+    meta = _json.loads((rp.tables_dir() / f"{tid}.json").read_text(encoding="utf-8"))
+    bib = rp.bibtex_for(tid)
+    assert f"year         = {{{rp.PACKAGE_YEAR}}}" in bib and f"version      = {{{meta['library_version']}}}" in bib
+    assert meta["git_commit"][:12] in bib and bib.count("fang2020 Table 1") == 1
+    assert "related      = {fang2020}" in bib and "@article{fang2020," in bib
+    own = rp.bibtex_for("toolkit-check-strapdown-ideal")
+    assert "related" not in own and "supplementary check of the package" in own
 
 
 def test_datapackage_describes_every_exported_csv():
