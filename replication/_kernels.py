@@ -687,6 +687,72 @@ def _skew_rows(H, r, u0, u1, u2):
 
 
 @njit(**_NJ)
+def gnss_rows(H, c, lever, wx, wy, wz, L, h, use_pos, use_vel, blk_target, blk_start):
+    """GNSS measurement rows of the error state, chen2019 eqs. (3-17) and (2-13); returns the
+    number of rows written (H must be zero on entry).
+
+    Position rows (0-2 when ``use_pos``): antenna position p + C_b^n l (E, N, U in metres):
+    δp columns (R_N+h)cos L, R_M+h, 1; attitude columns (C l)×; lever-arm state columns -C.
+    Velocity rows (next three when ``use_vel``): antenna velocity v + C (ω_eb^b × l): δv columns
+    I; attitude columns (C(ω×l))×; lever-arm state columns -C (ω_eb^b ×).  Lever-arm states are
+    true minus used (δl = l - l̂).  ``(wx, wy, wz)`` is ω_eb^b, ``lever`` the lever arm in use.
+    """
+    rm, rn = radii_s(L)
+    r = 0
+    if use_pos:
+        la0 = c[0, 0] * lever[0] + c[0, 1] * lever[1] + c[0, 2] * lever[2]
+        la1 = c[1, 0] * lever[0] + c[1, 1] * lever[1] + c[1, 2] * lever[2]
+        la2 = c[2, 0] * lever[0] + c[2, 1] * lever[1] + c[2, 2] * lever[2]
+        H[0, 1] = (rn + h) * math.cos(L)
+        H[1, 0] = rm + h
+        H[2, 2] = 1.0
+        _skew_rows(H, 0, la0, la1, la2)
+        for b in range(blk_target.shape[0]):
+            if blk_target[b] == TARGET_LEVER:
+                for i in range(3):
+                    for jj in range(3):
+                        H[i, blk_start[b] + jj] = -c[i, jj]
+        r = 3
+    if use_vel:
+        cx = wy * lever[2] - wz * lever[1]
+        cy = wz * lever[0] - wx * lever[2]
+        cz = wx * lever[1] - wy * lever[0]
+        u0 = c[0, 0] * cx + c[0, 1] * cy + c[0, 2] * cz
+        u1 = c[1, 0] * cx + c[1, 1] * cy + c[1, 2] * cz
+        u2 = c[2, 0] * cx + c[2, 1] * cy + c[2, 2] * cz
+        H[r + 0, 3] = 1.0
+        H[r + 1, 4] = 1.0
+        H[r + 2, 5] = 1.0
+        _skew_rows(H, r, u0, u1, u2)
+        for b in range(blk_target.shape[0]):
+            if blk_target[b] == TARGET_LEVER:
+                k0 = blk_start[b]
+                for i in range(3):
+                    H[r + i, k0] = -(c[i, 1] * wz - c[i, 2] * wy)          # -(C [ω×])[i, :]
+                    H[r + i, k0 + 1] = -(-c[i, 0] * wz + c[i, 2] * wx)
+                    H[r + i, k0 + 2] = -(c[i, 0] * wy - c[i, 1] * wx)
+        r += 3
+    return r
+
+
+@njit(**_NJ)
+def accumulate_coupling(c, fb, wb, blk_target, blk_kind, blk_start, blk_size, weight, Cpl, B):
+    """Cpl[0:3] += weight · C_b^n B(f^b) for accelerometer blocks and Cpl[3:6] += weight · C_b^n B(ω^b)
+    for gyro blocks, B of :func:`coupling_matrix` for the block's kind (chen2019 eq. (2-10)):
+    identity for a bias, diag(u) for a scale factor, the eq. (2-8) layout for a misalignment."""
+    for b in range(blk_target.shape[0]):
+        tg = blk_target[b]
+        if tg != TARGET_ACCEL and tg != TARGET_GYRO:
+            continue
+        r0 = 0 if tg == TARGET_ACCEL else 3
+        k0, kk = blk_start[b], blk_size[b]
+        coupling_matrix(blk_kind[b], fb if tg == TARGET_ACCEL else wb, B)
+        for i in range(3):
+            for jj in range(kk):
+                Cpl[r0 + i, k0 + jj] += weight * (c[i, 0] * B[0, jj] + c[i, 1] * B[1, jj] + c[i, 2] * B[2, jj])
+
+
+@njit(**_NJ)
 def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp):
     """Feedback of the estimate ``xk``: δp, δv subtracted from ``st`` and ``st_prev``, the attitude
     corrected by q ← q(φ) ⊗ q (normalized), and p̂ += x̂[9:]."""
@@ -803,21 +869,7 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
             fb[i] = dv_c[i] / T
             wb[i] = dth_c[i] / T
         _accumulate_interval(c, fb, st, fsum, Csum, navsum)
-        for b in range(blk_target.shape[0]):
-            tg = blk_target[b]
-            if tg != TARGET_ACCEL and tg != TARGET_GYRO:
-                continue
-            r0 = 0 if tg == TARGET_ACCEL else 3
-            k0, kk = blk_start[b], blk_size[b]
-            if blk_kind[b] == KIND_IDENTITY:
-                for i in range(3):
-                    for jj in range(3):
-                        Cpl[r0 + i, k0 + jj] += c[i, jj]
-            else:
-                coupling_matrix(blk_kind[b], fb if tg == TARGET_ACCEL else wb, B)
-                for i in range(3):
-                    for jj in range(kk):
-                        Cpl[r0 + i, k0 + jj] += c[i, 0] * B[0, jj] + c[i, 1] * B[1, jj] + c[i, 2] * B[2, jj]
+        accumulate_coupling(c, fb, wb, blk_target, blk_kind, blk_start, blk_size, 1.0, Cpl, B)
         nsum += 1
         tsum += T
         dampint = sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, qtmp, c, w_ie, w_en, ta, tb,
@@ -842,53 +894,29 @@ def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
             for i in range(m_meas):
                 for jj in range(n):
                     H[i, jj] = 0.0
+            # antenna velocity v + C (ω_eb^b × l); ω_eb^b ≈ corrected gyro rate - C^T ω_ie
+            rates_s(L, h, st[3], st[4], w_ie, w_en)
+            wbx = dth_c[0] / T - (c[0, 0] * w_ie[0] + c[1, 0] * w_ie[1] + c[2, 0] * w_ie[2])
+            wby = dth_c[1] / T - (c[0, 1] * w_ie[0] + c[1, 1] * w_ie[1] + c[2, 1] * w_ie[2])
+            wbz = dth_c[2] / T - (c[0, 2] * w_ie[0] + c[1, 2] * w_ie[1] + c[2, 2] * w_ie[2])
+            gnss_rows(H, c, lever, wbx, wby, wbz, L, h, use_pos, use_vel, blk_target, blk_start)
             r = 0
             if use_pos:
                 z[0] = (st[1] - gnss_pos[j, 1]) * (rn + h) * cl + la0
                 z[1] = (st[0] - gnss_pos[j, 0]) * (rm + h) + la1
                 z[2] = (st[2] - gnss_pos[j, 2]) + la2
-                H[0, 1] = (rn + h) * cl
-                H[1, 0] = rm + h
-                H[2, 2] = 1.0
-                # (C l)× φ
-                _skew_rows(H, 0, la0, la1, la2)
                 for i in range(3):
                     for jj in range(3):
                         Rm[i, jj] = R_pos[i, jj]
                 r = 3
             if use_vel:
-                # antenna velocity v + C (ω_eb^b × l); ω_eb^b ≈ corrected gyro rate - C^T ω_ie
-                rates_s(L, h, st[3], st[4], w_ie, w_en)
-                ex = c[0, 0] * w_ie[0] + c[1, 0] * w_ie[1] + c[2, 0] * w_ie[2]
-                ey = c[0, 1] * w_ie[0] + c[1, 1] * w_ie[1] + c[2, 1] * w_ie[2]
-                ez = c[0, 2] * w_ie[0] + c[1, 2] * w_ie[1] + c[2, 2] * w_ie[2]
-                wbx = dth_c[0] / T - ex
-                wby = dth_c[1] / T - ey
-                wbz = dth_c[2] / T - ez
                 cx = wby * lever[2] - wbz * lever[1]
                 cy = wbz * lever[0] - wbx * lever[2]
                 cz = wbx * lever[1] - wby * lever[0]
-                u0 = c[0, 0] * cx + c[0, 1] * cy + c[0, 2] * cz
-                u1 = c[1, 0] * cx + c[1, 1] * cy + c[1, 2] * cz
-                u2 = c[2, 0] * cx + c[2, 1] * cy + c[2, 2] * cz
-                z[r + 0] = st[3] + u0 - gnss_vel[j, 0]
-                z[r + 1] = st[4] + u1 - gnss_vel[j, 1]
-                z[r + 2] = st[5] + u2 - gnss_vel[j, 2]
-                H[r + 0, 3] = 1.0
-                H[r + 1, 4] = 1.0
-                H[r + 2, 5] = 1.0
-                _skew_rows(H, r, u0, u1, u2)
                 for i in range(3):
+                    z[r + i] = st[3 + i] + c[i, 0] * cx + c[i, 1] * cy + c[i, 2] * cz - gnss_vel[j, i]
                     for jj in range(3):
                         Rm[r + i, r + jj] = R_vel[i, jj]
-            # lever-arm states: antenna offset error -C δl (state = true - used)
-            for b in range(blk_target.shape[0]):
-                if blk_target[b] == TARGET_LEVER:
-                    k0 = blk_start[b]
-                    if use_pos:
-                        for i in range(3):
-                            for jj in range(3):
-                                H[i, k0 + jj] = -c[i, jj]
             nis = joseph_update(P, H, Rm, z, xk, w1, w2)
             # ---- feedback (gravity compensation: ĝ^n = output rows of fconst, velocity rows, sign -)
             _feedback_nav(xk, st, st_prev, q, p_hat, qtmp)

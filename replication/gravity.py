@@ -892,7 +892,9 @@ def _augmented_kernel(dt, dtheta, dv, st0, q0, gnss_idx, gnss_pos, gnss_vel, R_p
     z9 = np.zeros(9)
     vacc = np.zeros(3)   # weighted mean INS acceleration of the current window
     facc = np.zeros(3)   # weighted mean f^n
-    Cw = np.zeros((3, 3))  # weighted mean C_b^n
+    Cw = np.zeros((6, n))  # window means of C_b^n B(u) per sensor block (rows 0-2: accelerometers)
+    wb = np.empty(3)
+    lever0 = np.zeros(3)   # no antenna lever arm in this filter
     n_sf = 0
     nsum = 0
     tsum = 0.0
@@ -914,14 +916,11 @@ def _augmented_kernel(dt, dtheta, dv, st0, q0, gnss_idx, gnss_pos, gnss_vel, R_p
         if win[k] >= 0:
             for i in range(3):
                 facc[i] += wgt[k] * (c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2])
-                for jj in range(3):
-                    Cw[i, jj] += wgt[k] * c[i, jj]
-        for b in range(tg.shape[0]):
-            if tg[b] == K.TARGET_ACCEL or tg[b] == K.TARGET_GYRO:
-                r0 = 0 if tg[b] == K.TARGET_ACCEL else 3
-                for i in range(3):
-                    for jj in range(3):
-                        Cpl[r0 + i, bst[b] + jj] += c[i, jj]
+        for i in range(3):
+            wb[i] = dth_c[i] / T
+        K.accumulate_coupling(c, fb, wb, tg, kd, bst, bsz, 1.0, Cpl, B)
+        if win[k] >= 0:
+            K.accumulate_coupling(c, fb, wb, tg, kd, bst, bsz, wgt[k], Cw, B)   # window mean of C B(f^b)
         nsum += 1
         tsum += T
         v0, v1, v2 = st[3], st[4], st[5]
@@ -955,12 +954,9 @@ def _augmented_kernel(dt, dtheta, dv, st0, q0, gnss_idx, gnss_pos, gnss_vel, R_p
             z[0] = (st[1] - gnss_pos[j, 1]) * (rn + h) * math.cos(L)
             z[1] = (st[0] - gnss_pos[j, 0]) * (rm + h)
             z[2] = st[2] - gnss_pos[j, 2]
-            H[0, 1] = (rn + h) * math.cos(L)
-            H[1, 0] = rm + h
-            H[2, 2] = 1.0
+            K.gnss_rows(H, c, lever0, 0.0, 0.0, 0.0, L, h, True, True, tg, bst)
             for i in range(3):
                 z[3 + i] = st[3 + i] - gnss_vel[j, i]
-                H[3 + i, 3 + i] = 1.0
                 for jj in range(3):
                     Rm[i, jj] = R_pos[i, jj]
                     Rm[3 + i, 3 + jj] = R_vel[i, jj]
@@ -981,16 +977,15 @@ def _augmented_kernel(dt, dtheta, dv, st0, q0, gnss_idx, gnss_pos, gnss_vel, R_p
                 for b in range(tg.shape[0]):
                     if tg[b] == K.TARGET_ACCEL:
                         for i in range(3):
-                            for jj in range(3):
-                                H[6 + i, bst[b] + jj] += Cw[i, jj]
+                            for jj in range(bsz[b]):
+                                H[6 + i, bst[b] + jj] += Cw[i, bst[b] + jj]
                 n_sf += 1
             K.joseph_update(P, H, Rm, z, xk, w1, w2)
             if sf >= 0:
                 for i in range(3):
                     vacc[i] = 0.0
                     facc[i] = 0.0
-                    for jj in range(3):
-                        Cw[i, jj] = 0.0
+                Cw[:, :] = 0.0
             K._feedback_nav(xk, st, st_prev, q, p_hat, qtmp)
             for i in range(3):
                 acc = 0.0

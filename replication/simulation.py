@@ -460,46 +460,14 @@ def _forward_chunk(dt, dth, dvv, ep_step, gpos, gvel, R_pos, R_vel, lever0,
             # ---------------- measurement matrix from run 0
             K._q2c(q[0], c0)
             L, h = st[0, 0], st[0, 2]
-            rm, rn = K.radii_s(L)
-            cl = math.cos(L)
             for i in range(m):
                 for jj in range(n):
                     H[i, jj] = 0.0
-            la0 = c0[0, 0] * lever[0, 0] + c0[0, 1] * lever[0, 1] + c0[0, 2] * lever[0, 2]
-            la1 = c0[1, 0] * lever[0, 0] + c0[1, 1] * lever[0, 1] + c0[1, 2] * lever[0, 2]
-            la2 = c0[2, 0] * lever[0, 0] + c0[2, 1] * lever[0, 1] + c0[2, 2] * lever[0, 2]
-            H[0, 1] = (rn + h) * cl
-            H[1, 0] = rm + h
-            H[2, 2] = 1.0
-            K._skew_rows(H, 0, la0, la1, la2)
             K.rates_s(L, h, st[0, 3], st[0, 4], w_ie, w_en)
             wx = dth_cp[0, 0] / T - (c0[0, 0] * w_ie[0] + c0[1, 0] * w_ie[1] + c0[2, 0] * w_ie[2])
             wy = dth_cp[0, 1] / T - (c0[0, 1] * w_ie[0] + c0[1, 1] * w_ie[1] + c0[2, 1] * w_ie[2])
             wz = dth_cp[0, 2] / T - (c0[0, 2] * w_ie[0] + c0[1, 2] * w_ie[1] + c0[2, 2] * w_ie[2])
-            cx = wy * lever[0, 2] - wz * lever[0, 1]
-            cy = wz * lever[0, 0] - wx * lever[0, 2]
-            cz = wx * lever[0, 1] - wy * lever[0, 0]
-            u0 = c0[0, 0] * cx + c0[0, 1] * cy + c0[0, 2] * cz
-            u1 = c0[1, 0] * cx + c0[1, 1] * cy + c0[1, 2] * cz
-            u2 = c0[2, 0] * cx + c0[2, 1] * cy + c0[2, 2] * cz
-            H[3, 3] = 1.0
-            H[4, 4] = 1.0
-            H[5, 5] = 1.0
-            K._skew_rows(H, 3, u0, u1, u2)
-            for b in range(tg.shape[0]):
-                if tg[b] == K.TARGET_LEVER:
-                    k0 = bs[b]
-                    for i in range(3):
-                        for jj in range(3):
-                            H[i, k0 + jj] = -c0[i, jj]
-                    # velocity rows: -C (ω_eb^b ×)
-                    for i in range(3):
-                        s0 = c0[i, 1] * wz - c0[i, 2] * wy      # (C skew(ω))[i, 0]
-                        s1 = -c0[i, 0] * wz + c0[i, 2] * wx     # (C skew(ω))[i, 1]
-                        s2 = c0[i, 0] * wy - c0[i, 1] * wx      # (C skew(ω))[i, 2]
-                        H[3 + i, k0] = -s0
-                        H[3 + i, k0 + 1] = -s1
-                        H[3 + i, k0 + 2] = -s2
+            K.gnss_rows(H, c0, lever[0], wx, wy, wz, L, h, True, True, tg, bs)
             # ---------------- gain and covariance (shared)
             PHt = np.empty((n, m))
             for i in range(n):

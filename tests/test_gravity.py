@@ -391,3 +391,22 @@ def test_augmented_filter_with_the_9_dimensional_measurement(noisy_line):
     for use in (False, True):
         assert max(out[use]["latitude"], out[use]["longitude"], out[use]["height"]) < 0.3
     assert out[True] != out[False]
+
+
+@pytest.mark.parametrize("blocks", ["accel scale", "gyro scale", "accel misalignment", "gyro misalignment"])
+def test_augmented_filter_equals_the_core_filter_for_every_block_kind(noisy_line, blocks):
+    """Scale-factor and misalignment blocks couple through C_b^n B(u) (chen2019 eq. (2-10)), not
+    through C_b^n alone: both filters take it from _kernels.accumulate_coupling, so they agree to
+    rounding for every kind (same strapdown, discretization, update, feedback)."""
+    from replication import errors as er
+    from replication import kalman as kf
+
+    tr, dth, dv, gnss, m, init = noisy_line
+    block = {"accel scale": er.accel_scale(1e-4), "gyro scale": er.gyro_scale(1e-4),
+             "accel misalignment": er.accel_misalignment(1e-4), "gyro misalignment": er.gyro_misalignment(1e-4)}[blocks]
+    mg = m.extend(block, er.gravity_shaping([13e-5, 13e-5, 26e-5], 1 / 300.0))
+    ref = kf.closed_loop(tr.t, dth, dv, init, gnss, mg).solution
+    sol = gr.augmented_filter(tr.t, dth, dv, init, gnss, mg)
+    np.testing.assert_allclose(sol.lat, ref.lat, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(sol.v_enu, ref.v_enu, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(sol.q_bn, ref.q_bn, rtol=0, atol=1e-11)
