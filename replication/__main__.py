@@ -12,6 +12,7 @@ def _cmd_status(args) -> int:
     status, errata = rp.build_index(write=args.write)
     if args.source:
         status = status[status["source"] == args.source]
+        errata = errata[errata["source"] == args.source]
     width = max(len(i) for i in status["id"]) if len(status) else 10
     for kind, title in (("paper", "artifacts of the four documents"), ("supplementary", "supplementary checks")):
         part = status[status["kind"] == kind]
@@ -24,7 +25,7 @@ def _cmd_status(args) -> int:
         print()
     for line in rp.status_tally(status).values():
         print(line)
-    print(f"errata proven: {len(errata)}")
+    print(f"errata proven{' in ' + args.source if args.source else ''}: {len(errata)}")
     return 0
 
 

@@ -43,6 +43,34 @@ POLAR_LIMIT_DEG = 89.9
 """Default latitude beyond which local-level (n-frame) navigation quantities are refused."""
 
 
+def _numbers(x, name):
+    """``x`` as a float array; refuses text and other non-numbers instead of converting them."""
+    a = np.asarray(x)
+    if a.dtype.kind not in "biuf":
+        raise ValueError(f"{name} must be a number or an array of numbers, not {type(x).__name__} {x!r:.40}")
+    return a.astype(float)
+
+
+HEIGHT_RANGE = (-11000.0, 100000.0)
+"""Ellipsoidal heights (m) accepted by the height-dependent functions of this module: from the
+deepest ocean trench to the edge of space, a plausibility bound (the platforms of the four
+documents fly below 10 km)."""
+
+
+def check_height(h, *, name: str = "height"):
+    """Validate an ellipsoidal height in metres; return it as an array.  Raises ``ValueError`` for
+    text, NaN or infinity, and for heights outside :data:`HEIGHT_RANGE` (a value in km or feet, or
+    a latitude passed in its place, is the usual cause)."""
+    h = _numbers(h, name)
+    if not np.all(np.isfinite(h)):
+        raise ValueError(f"{name} must be finite (got NaN or infinity)")
+    lo, hi = HEIGHT_RANGE
+    if np.any(h < lo) or np.any(h > hi):
+        raise ValueError(f"{name} {float(h.flat[np.argmax(np.abs(h))]):.6g} m is outside [{lo:g}, {hi:g}] m: heights "
+                         "are ellipsoidal heights in metres")
+    return h
+
+
 def check_latitude(lat, *, polar_limit_deg: float | None = None, name: str = "latitude"):
     """Validate a latitude in radians; return it as an array.
 
@@ -50,7 +78,7 @@ def check_latitude(lat, *, polar_limit_deg: float | None = None, name: str = "la
     is the usual cause) or, if ``polar_limit_deg`` is given, within the n-frame singularity at
     the pole (|L| ≥ ``polar_limit_deg``), where tan L and 1/cos L blow up.
     """
-    lat = np.asarray(lat, dtype=float)
+    lat = _numbers(lat, name)
     if not np.all(np.isfinite(lat)):
         raise ValueError(f"{name} must be finite")
     if np.any(np.abs(lat) > np.pi / 2 + 1e-12):
@@ -92,7 +120,7 @@ def transport_rate_enu(lat, h, v_enu, *, polar_limit_deg: float = POLAR_LIMIT_DE
     chen2019 eq. (3-2) (the ω_en^n term).  Refuses latitudes inside the polar singularity.
     """
     lat = check_latitude(lat, polar_limit_deg=polar_limit_deg)
-    h = np.asarray(h, dtype=float)
+    h = check_height(h)
     v = np.asarray(v_enu, dtype=float)
     if v.shape[-1] != 3:
         raise ValueError(f"v_enu must have a last axis of length 3, got shape {v.shape}")
@@ -120,7 +148,7 @@ def normal_gravity(lat, h=0.0):
     chen2019 eq. (3-1) is checked.
     """
     lat = check_latitude(lat)
-    h = np.asarray(h, dtype=float)
+    h = check_height(h)
     s2 = np.sin(lat) ** 2
     g0 = normal_gravity_ellipsoid(lat)
     return g0 * (1.0 - 2.0 / A * (1.0 + F + M_RATIO - 2.0 * F * s2) * h + 3.0 * h**2 / A**2)
@@ -174,7 +202,7 @@ def normal_gravity_closed_form(lat, h=0.0):
 
 
 def _check_height(h, name: str = "height"):
-    h = np.asarray(h, dtype=float)
+    h = check_height(h)
     if not np.all(np.isfinite(h)):
         raise ValueError(f"{name} must be finite (metres above the ellipsoid)")
     if np.any(h <= -B + 1000.0):
@@ -427,7 +455,7 @@ def geodetic_to_ecef(lat, lon, h):
     """Geodetic (L, λ, h) to ECEF coordinates (m)."""
     lat = check_latitude(lat)
     lon = np.asarray(lon, dtype=float)
-    h = np.asarray(h, dtype=float)
+    h = check_height(h)
     _, rn = radii(lat)
     x = (rn + h) * np.cos(lat) * np.cos(lon)
     y = (rn + h) * np.cos(lat) * np.sin(lon)

@@ -183,7 +183,11 @@ def parse_paper_file(path: str | os.PathLike) -> PaperTable:
     path = Path(path)
     if not path.exists():
         raise RegistryError(f"paper-value file not found: {path}")
-    text = path.read_text(encoding="utf-8")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise RegistryError(f"{path}: not UTF-8 text (byte {exc.start} is {exc.object[exc.start:exc.start + 1]!r}); "
+                            "save the transcription as UTF-8") from None
     provenance: dict[str, str] = {}
     body_lines: list[str] = []
     for lineno, line in enumerate(text.splitlines(), 1):

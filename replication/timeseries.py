@@ -142,6 +142,8 @@ def inversion_test(y, segments: int, *, alpha: float = 0.05) -> InversionTest:
         raise ValueError(f"a series of {y.size} samples cannot be cut into {m} segments of >= 2 samples; use fewer segments")
     if not 0 < alpha < 1:
         raise ValueError("alpha must lie in (0, 1)")
+    if np.ptp(y) == 0:
+        raise ValueError("the series is constant: it has no stochastic part whose stationarity could be tested")
     L = y.size // m
     means = y[: L * m].reshape(m, L).mean(axis=1)
     A = inversion_count(means)
@@ -375,6 +377,29 @@ def ar_least_squares(y, p: int) -> tuple[np.ndarray, float]:
     return phi, float(res @ res / D.size)
 
 
+def require_stationary_series(y, segments: int = 20, *, alpha: float = 0.05, max_lag: int = 12) -> None:
+    """The premise of chen2019 step 2 (Fig. 3-4): the series passes the two-sided inversion test
+    with ``segments`` and the ADF test (at most ``max_lag`` augmentation lags, chosen by AIC)
+    rejects a unit root.  Raises :class:`NonStationaryError` saying which test failed and what
+    to do; shared by :func:`fit_ar` and :func:`select_order`."""
+    from statsmodels.tsa.stattools import adfuller
+
+    t = inversion_test(y, segments, alpha=alpha)
+    if not t.stationary:
+        raise NonStationaryError(
+            f"the series is not stationary: inversion test statistic {t.statistic_two_sided:.2f} >= "
+            f"{t.critical:.2f} with m={segments} segments (A={t.count}, E(A)={t.expected:.1f}). "
+            f"chen2019 step 2 fits AR models to stationary series only: difference it first "
+            f"(timeseries.difference / make_stationary) or remove the trend"
+        )
+    adf_p = adfuller(y, maxlag=max_lag, regression="c", autolag="AIC", result_object=False)[1]
+    if adf_p >= alpha:
+        raise NonStationaryError(
+            f"the series is not stationary: the ADF test cannot reject a unit root (p = {adf_p:.3f} >= "
+            f"{alpha}). Difference it first (timeseries.difference / make_stationary)"
+        )
+
+
 def fit_ar(y, p: int, *, segments: int = 20, alpha: float = 0.05, check: bool = True, demean: bool = True):
     """Fit AR(p) by conditional least squares with statsmodels ``AutoReg`` (chen2019 eq. 3-11/3-12).
 
@@ -394,20 +419,7 @@ def fit_ar(y, p: int, *, segments: int = 20, alpha: float = 0.05, check: bool = 
     if demean:
         y = y - y.mean()
     if check:
-        t = inversion_test(y, segments, alpha=alpha)
-        if not t.stationary:
-            raise NonStationaryError(
-                f"the series is not stationary: inversion test statistic {t.statistic_two_sided:.2f} >= "
-                f"{t.critical:.2f} with m={segments} segments (A={t.count}, E(A)={t.expected:.1f}). "
-                f"chen2019 step 2 fits AR models to stationary series only: difference it first "
-                f"(timeseries.difference / make_stationary) or remove the trend"
-            )
-        adf_p = adfuller(y, maxlag=max(12, 2 * int(p)), regression="c", autolag="AIC", result_object=False)[1]
-        if adf_p >= alpha:
-            raise NonStationaryError(
-                f"the series is not stationary: the ADF test cannot reject a unit root (p = {adf_p:.3f} >= "
-                f"{alpha}). Difference it first (timeseries.difference / make_stationary)"
-            )
+        require_stationary_series(y, segments, alpha=alpha, max_lag=max(12, 2 * int(p)))
     res = AutoReg(y, int(p), trend="n").fit()
     if check and not is_stationary(res.params):
         raise NonStationaryError(
@@ -464,11 +476,18 @@ def aic_by_order(y, max_order: int | None = None, *, demean: bool = True) -> pd.
     return pd.DataFrame(rows).set_index("order")
 
 
-def select_order(y, max_order: int | None = None, *, demean: bool = True) -> int:
-    """AR order minimizing AIC over 1..min(max_order, sqrt(n)), by statsmodels ``ar_select_order``."""
+def select_order(y, max_order: int | None = None, *, demean: bool = True, check: bool = True,
+                 segments: int = 20) -> int:
+    """AR order minimizing AIC over 1..min(max_order, sqrt(n)), by statsmodels ``ar_select_order``.
+
+    With ``check`` (the default) the series must be stationary as for :func:`fit_ar`
+    (:func:`require_stationary_series`): an order selected on a random walk means nothing.
+    """
     from statsmodels.tsa.ar_model import ar_select_order
 
     y = _series(y, min_length=8)
+    if check:
+        require_stationary_series(y, segments, max_lag=12)
     if demean:
         y = y - y.mean()
     cap = order_cap(y.size)

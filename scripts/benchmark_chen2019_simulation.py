@@ -2,7 +2,7 @@
 
     python scripts/benchmark_chen2019_simulation.py [--repeats N]
 
-Workload (issue target: ≤ 30 s for one 45-state run on a 2-core machine): the Table 4-42 flight
+Workload (budget: ≤ 30 s for one 45-state run on a 2-core machine): the Table 4-42 flight
 at 100 Hz (510 000 IMU samples), 20-Hz GNSS (102 000 epochs), the sensor errors of Table 4-41
 (``simulation.table_4_41_setup``), the 45-state model of chen2019 eqs. (2-14)/(2-15)
 (``simulation.filter_model("45", ...)``), processed by ``simulation.run_batch`` with

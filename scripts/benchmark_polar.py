@@ -2,7 +2,7 @@
 
     python scripts/benchmark_polar.py
 
-Workload (issue 9): both 20-run Monte Carlos of fang2020 §3 — 10 h at 100 Hz (3.6 M steps per
+Workload: both 20-run Monte Carlos of fang2020 §3 — 10 h at 100 Hz (3.6 M steps per
 run), fixes at 2 h and 3.5 h, plus the reset-only continuation of one run per case — exactly as
 ``book/fang2020/01_polar_grid_calibration.ipynb`` runs them (``replication.polar.run_fang2020``).
 Compilation is excluded (a short warm-up run first).  Budget: ≤ 180 s added to ``make test``.

@@ -345,3 +345,15 @@ def test_table_1_3_third_imu_is_class_5_not_nus6():
     prose_names = {"NUS4": "NUS4", "DUS5": "DUS5", "NUS5": "NUS6", "CUS6": "CUS6"}
     by_prose = acc.groupby([int(prose_names[n][-1]) for n in acc.index]).nunique()
     assert (by_prose.loc[6] > 1).any()                  # prose names: class 6 would be ambiguous
+
+
+def test_inputs_that_are_not_numbers_or_heights_are_refused():
+    import pytest as _pytest
+
+    with _pytest.raises(ValueError, match="must be a number"):
+        earth.normal_gravity("0.5", "100")
+    with _pytest.raises(ValueError, match="finite"):
+        earth.normal_gravity(0.5, float("nan"))
+    with _pytest.raises(ValueError, match="metres"):
+        earth.normal_gravity(0.5, 2.0e6)
+    assert earth.normal_gravity(0.5, 100.0) > 9.7

@@ -68,7 +68,7 @@ def test_markov_and_gravity_blocks_dynamics():
 
 
 def test_linear_model_predicts_nonlinear_error_growth(maneuvering):
-    """Issue requirement: from small initial errors and biases, the linear model's prediction
+    """Requirement: from small initial errors and biases, the linear model's prediction
     matches the nonlinear (strapdown) error growth within 2 % over 10 min of maneuvers
     (free vertical channel; errors compared every 0.1 s, relative to each component's peak)."""
     m = er.model_15()

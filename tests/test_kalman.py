@@ -122,7 +122,7 @@ def flight():
 
 
 def test_closed_loop_recovers_injected_biases(flight):
-    """Issue requirement: constant biases injected on a maneuvering flight are recovered within 3σ."""
+    """Requirement: constant biases injected on a maneuvering flight are recovered within 3σ."""
     model = _model(47 * DEG, 6000.0)
     rng = np.random.default_rng(2019)
     errs = se.ImuErrors(gyro=se.TriadErrors(bias=np.array([0.05, -0.04, 0.06]) * DEG_PER_H, white_psd=model.gyro_psd),
@@ -144,7 +144,7 @@ def test_closed_loop_recovers_injected_biases(flight):
 
 
 def test_nees_monte_carlo_within_band(flight):
-    """Issue requirement: NEES over 20 Monte-Carlo runs stays in its 95 % band ≥ 90 % of the time
+    """Requirement: NEES over 20 Monte-Carlo runs stays in its 95 % band ≥ 90 % of the time
     (here on a 10-min maneuvering flight; the 1-h case runs in the book chapter and the benchmark).
     Seed fixed before the first run."""
     mc = kf.monte_carlo(flight, _model(47 * DEG, 6000.0), n_runs=20, seed=20231, workers=2)

@@ -333,3 +333,10 @@ def test_load_table_gives_typed_columns_and_provenance():
     assert len(df.attrs["git_commit"]) == 40
     with pytest.raises(rp.RegistryError, match="no exported table"):
         replication.load_table("fang2020-table-99")
+
+
+def test_a_paper_file_that_is_not_utf8_is_refused_with_a_message(tmp_path):
+    bad = tmp_path / "chen2019-table-9-9.csv"
+    bad.write_bytes("# document: chen2019\nquantity,unit,value\n\xb5,m,1\n".encode("latin-1"))
+    with pytest.raises(rp.RegistryError, match="not UTF-8"):
+        rp.parse_paper_file(bad)

@@ -37,7 +37,7 @@ def chen_flight():
 
 
 def test_ideal_sensors_chen2019_flight_height_held(chen_flight):
-    """Issue requirement: along the 5100-s Table 4-42 flight, height held to truth, ideal
+    """Requirement: along the 5100-s Table 4-42 flight, height held to truth, ideal
     increments: horizontal error ≤ 0.05 m and attitude error ≤ 1e-6 rad throughout."""
     traj = chen_flight
     sol = sd.mechanize(traj.t, traj.dtheta, traj.dv, traj.initial_state(), vertical="hold",
@@ -50,7 +50,7 @@ def test_ideal_sensors_chen2019_flight_height_held(chen_flight):
 
 
 def test_ideal_sensors_turntable_hour():
-    """Issue requirement: a 1-h rotation-rich turntable sequence keeps attitude within 1e-7 rad."""
+    """Requirement: a 1-h rotation-rich turntable sequence keeps attitude within 1e-7 rad."""
     segs, h0 = tr.rotation_rich_turntable(3600.0)
     traj = tr.generate(segs, 40 * DEG, 116 * DEG, 50.0, heading=h0, speed=0.0)
     assert np.abs(traj.w_ib_b).max() > 8.9 * DEG              # 9°/s moves

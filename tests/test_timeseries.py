@@ -300,3 +300,13 @@ def test_select_order_checked_flags_a_round_off_aic_column():
     # random walk): the normal equations lose their digits and the AIC column jumps upwards
     smooth = np.convolve(np.cumsum(np.cumsum(rng.standard_normal(6000))), np.ones(1000) / 1000, "valid")
     assert not ts.select_order_checked(smooth, 10)[1]
+
+
+def test_order_selection_and_stationarity_refuse_what_they_cannot_judge():
+    rng = np.random.default_rng(12)
+    walk = np.cumsum(rng.standard_normal(2000))
+    with pytest.raises(ts.NonStationaryError, match="not stationary"):
+        ts.select_order(walk, 10)                      # as fit_ar: no order for a random walk
+    assert ts.select_order(walk, 10, check=False) >= 1  # the unchecked AIC still runs when asked
+    with pytest.raises(ValueError, match="constant"):
+        ts.inversion_test(np.full(200, 3.0), 10)
