@@ -22,7 +22,7 @@ _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
 # block targets / couplings (see replication.errors)
 TARGET_ACCEL, TARGET_GYRO, TARGET_GRAVITY, TARGET_LEVER, TARGET_NONE = 0, 1, 2, 3, 4
-KIND_IDENTITY, KIND_SCALE, KIND_MISALIGN = 0, 1, 2
+KIND_IDENTITY, KIND_SCALE, KIND_MISALIGN, KIND_MISALIGN_T22 = 0, 1, 2, 3
 _TWELFTH = 1.0 / 12.0
 
 
@@ -296,7 +296,7 @@ def coupling_matrix(kind, u, out):
         out[0, 0] = u[0]
         out[1, 1] = u[1]
         out[2, 2] = u[2]
-    else:
+    elif kind == KIND_MISALIGN:
         # parameters [xy, yx, xz, zx, yz, zy] of δC (chen2019 eq. (2-8))
         out[2, 0] = -u[0]
         out[2, 1] = u[1]
@@ -304,6 +304,15 @@ def coupling_matrix(kind, u, out):
         out[1, 3] = -u[2]
         out[0, 4] = -u[1]
         out[0, 5] = u[2]
+    else:
+        # the same parameters as chen2019 Table 2-2 prints them (F32/F33, F52/F53): axis i senses
+        # axis j with coefficient A_ij, δu_x = A_xy u_y + A_xz u_z, δu_y = A_yx u_x + A_yz u_z, ...
+        out[0, 0] = u[1]
+        out[1, 1] = u[0]
+        out[0, 2] = u[2]
+        out[2, 3] = u[0]
+        out[1, 4] = u[2]
+        out[2, 5] = u[1]
 
 
 @njit(**_NJ)

@@ -51,7 +51,11 @@ __all__ = ["StateBlock", "ErrorModel", "NavPoint", "nav_block_labels", "accel_bi
 NAV_LABELS = ("dL", "dlon", "dh", "dvE", "dvN", "dvU", "phiE", "phiN", "phiU")
 _TARGETS = {"accel": K.TARGET_ACCEL, "gyro": K.TARGET_GYRO, "gravity": K.TARGET_GRAVITY,
             "lever_arm": K.TARGET_LEVER, "none": K.TARGET_NONE}
-_KINDS = {"identity": K.KIND_IDENTITY, "scale": K.KIND_SCALE, "misalignment": K.KIND_MISALIGN}
+_KINDS = {"identity": K.KIND_IDENTITY, "scale": K.KIND_SCALE, "misalignment": K.KIND_MISALIGN,
+          "misalignment-table-2-2": K.KIND_MISALIGN_T22}
+MISALIGNMENT_COUPLINGS = {"eq-2-8": "misalignment", "table-2-2": "misalignment-table-2-2"}
+"""How the six misalignment parameters [xy, yx, xz, zx, yz, zy] couple: as eq. (2-8) lays out δC,
+or as Table 2-2 prints F32/F33 and F52/F53 (chen2019 — the two printed parts disagree)."""
 _MIS_LABELS = ("xy", "yx", "xz", "zx", "yz", "zy")
 
 
@@ -68,7 +72,7 @@ class StateBlock:
     * ``target`` — what it perturbs: ``"accel"`` (f^b), ``"gyro"`` (ω_ib^b), ``"gravity"``
       (g^n), ``"lever_arm"`` (GNSS antenna offset, measurement only) or ``"none"``;
     * ``kind`` — coupling B(u) for accel/gyro targets: ``"identity"``, ``"scale"``,
-      ``"misalignment"`` (chen2019 eq. (2-8));
+      ``"misalignment"`` (chen2019 eq. (2-8)) or ``"misalignment-table-2-2"`` (as Table 2-2 prints it);
     * ``dynamics`` — k×k matrix A of ẋ = A x + w (zeros: random constant);
     * ``noise_psd`` — k×k intensity of w;
     * ``output`` — 3×k matrix mapping the block to δg^n (gravity blocks);
@@ -92,7 +96,7 @@ class StateBlock:
             raise ValueError(f"block {self.name!r}: target must be one of {sorted(_TARGETS)}, got {self.target!r}")
         if self.kind not in _KINDS:
             raise ValueError(f"block {self.name!r}: kind must be one of {sorted(_KINDS)}, got {self.kind!r}")
-        need = {"identity": 3, "scale": 3, "misalignment": 6}[self.kind]
+        need = {"identity": 3, "scale": 3, "misalignment": 6, "misalignment-table-2-2": 6}[self.kind]
         if self.target in ("accel", "gyro") and k != need:
             raise ValueError(f"block {self.name!r}: a {self.kind} block has {need} states, got {k} labels")
         if self.target == "lever_arm" and k != 3:
@@ -383,15 +387,23 @@ def gyro_scale(sd=0.0, *, name="gyro_scale"):
                       fd_step=1e-3)
 
 
-def accel_misalignment(sd=0.0, *, name="accel_misalignment"):
-    """Accelerometer non-orthogonality δA (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad."""
-    return StateBlock(name, _MIS_LABELS, "accel", "misalignment",
+def _coupling_kind(coupling):
+    if coupling not in MISALIGNMENT_COUPLINGS:
+        raise ValueError(f"coupling must be one of {sorted(MISALIGNMENT_COUPLINGS)}, got {coupling!r}")
+    return MISALIGNMENT_COUPLINGS[coupling]
+
+
+def accel_misalignment(sd=0.0, *, name="accel_misalignment", coupling="eq-2-8"):
+    """Accelerometer non-orthogonality δA (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad,
+    coupled as ``coupling`` says (:data:`MISALIGNMENT_COUPLINGS`)."""
+    return StateBlock(name, _MIS_LABELS, "accel", _coupling_kind(coupling),
                       sd=np.broadcast_to(np.asarray(sd, float), (6,)), fd_step=1e-3)
 
 
-def gyro_misalignment(sd=0.0, *, name="gyro_misalignment"):
-    """Gyro non-orthogonality δG (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad."""
-    return StateBlock(name, _MIS_LABELS, "gyro", "misalignment",
+def gyro_misalignment(sd=0.0, *, name="gyro_misalignment", coupling="eq-2-8"):
+    """Gyro non-orthogonality δG (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad, coupled as
+    ``coupling`` says (:data:`MISALIGNMENT_COUPLINGS`)."""
+    return StateBlock(name, _MIS_LABELS, "gyro", _coupling_kind(coupling),
                       sd=np.broadcast_to(np.asarray(sd, float), (6,)), fd_step=1e-3)
 
 

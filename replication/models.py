@@ -147,9 +147,14 @@ def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
              accel_bias_sd=0.0, accel_markov_sigma=0.0, accel_markov_tau=3600.0, accel_scale_sd=0.0,
              accel_misalignment_sd=0.0, gyro_bias_sd=0.0, gyro_markov_sigma=0.0, gyro_markov_tau=3600.0,
              gyro_scale_sd=0.0, gyro_misalignment_sd=0.0, gravity_sigma=0.0, gravity_beta=1e-3,
-             lever_arm_sd=0.0, accel_psd=0.0, gyro_psd=0.0, lat=0.0, h=0.0) -> E.ErrorModel:
+             lever_arm_sd=0.0, accel_psd=0.0, gyro_psd=0.0, lat=0.0, h=0.0,
+             misalignment_coupling: str = "eq-2-8") -> E.ErrorModel:
     """The 45-state SINS/GNSS error model of chen2019 eqs. (2-14), (2-15) and Table 2-2, in the
     text's state order (see the module docstring; ``model.labels`` / :func:`state_symbols`).
+
+    ``misalignment_coupling``: ``"eq-2-8"`` (the layout of δC in eq. (2-8), default) or
+    ``"table-2-2"`` (the F32/F33, F52/F53 columns as Table 2-2 prints them) — the report's two
+    printed parts disagree on it (:data:`replication.errors.MISALIGNMENT_COUPLINGS`).
 
     Dynamics: eq. (2-15) with every first-order term (:meth:`replication.errors.ErrorModel.F`); random
     constants (eq. (2-5), (2-6), (2-9)): ẋ = 0; first-order Gauss-Markov biases (eq. (2-5)):
@@ -171,11 +176,11 @@ def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
         E.accel_bias(_nonneg(accel_bias_sd, "accel_bias_sd")),
         _markov_block("accel", accel_markov_sigma, accel_markov_tau, "accel_markov"),
         E.accel_scale(_nonneg(accel_scale_sd, "accel_scale_sd")),
-        E.accel_misalignment(_nonneg(accel_misalignment_sd, "accel_misalignment_sd", 6)),
+        E.accel_misalignment(_nonneg(accel_misalignment_sd, "accel_misalignment_sd", 6), coupling=misalignment_coupling),
         E.gyro_bias(_nonneg(gyro_bias_sd, "gyro_bias_sd")),
         _markov_block("gyro", gyro_markov_sigma, gyro_markov_tau, "gyro_markov"),
         E.gyro_scale(_nonneg(gyro_scale_sd, "gyro_scale_sd")),
-        E.gyro_misalignment(_nonneg(gyro_misalignment_sd, "gyro_misalignment_sd", 6)),
+        E.gyro_misalignment(_nonneg(gyro_misalignment_sd, "gyro_misalignment_sd", 6), coupling=misalignment_coupling),
         E.gravity_shaping(_nonneg(gravity_sigma, "gravity_sigma"), beta),
         E.lever_arm(_nonneg(lever_arm_sd, "lever_arm_sd")),
     )

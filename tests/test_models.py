@@ -263,3 +263,19 @@ def test_printed_table_2_2_differs_exactly_at_the_listed_elements(maneuvering):
         vc = np.hstack([Vb[a], Vb[b]]).T
         for col in pc:
             assert min(min(np.abs(col - v).max(), np.abs(col + v).max()) for v in vc) < 1e-12
+
+
+def test_table_2_2_misalignment_blocks_follow_the_table_coupling():
+    """With misalignment_coupling="table-2-2" the model's F32/F33/F52/F53 are the printed blocks at
+    a generic point (the same analytic columns: rounding), with the eq. (2-8) default they are not
+    (order and signs differ: up to 100 % of the block scale)."""
+    p = M.table_2_2_reference_point()
+    printed = M.table_2_2_printed(p, accel_markov_tau=3600.0, gyro_markov_tau=600.0)
+    for coupling, agree in (("table-2-2", True), ("eq-2-8", False)):
+        m = M.model_45(accel_markov_tau=3600.0, gyro_markov_tau=600.0, misalignment_coupling=coupling)
+        v = M.table_2_2_verified(m, p)
+        for b in ("F32", "F33", "F52", "F53"):
+            rel = np.max(np.abs(v[b] - printed[b])) / np.max(np.abs(printed[b]))
+            assert (rel < 1e-12) == agree, (coupling, b, rel)
+    with pytest.raises(ValueError, match="coupling"):
+        M.model_45(misalignment_coupling="eq-2-9")
