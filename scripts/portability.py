@@ -40,7 +40,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "scripts"))
-from run_notebooks import _order, book_notebooks  # noqa: E402
+from run_notebooks import _order, book_notebooks, cost  # noqa: E402
 
 CONFIGS: dict[str, dict[str, str]] = {
     "baseline": {
@@ -76,9 +76,14 @@ def _git_state() -> str:
 
 
 def _shards(paths: list[Path], n: int) -> list[list[Path]]:
+    """Longest-processing-time-first: each notebook, slowest first, goes to the shard with the least
+    estimated work so far (run_notebooks.COST), so that the shards finish together."""
     shards: list[list[Path]] = [[] for _ in range(n)]
-    for i, p in enumerate(_order(paths)):  # slowest first, dealt round-robin
-        shards[i % n].append(p)
+    load = [0.0] * n
+    for p in _order(paths):
+        k = min(range(n), key=lambda i: load[i])
+        shards[k].append(p)
+        load[k] += cost(p)
     return [s for s in shards if s]
 
 

@@ -76,8 +76,16 @@ IMAGE_RMS = 1.0
 """Largest RMS pixel difference (0-255) at which a stored figure is kept."""
 
 # the slowest notebooks first, so that two workers finish together
-FIRST = ("fang2020/01", "chen2019/07", "chen2019/06", "chen2019/03b", "duan2023/01", "chen2019/02_",
-         "an2021/01", "foundations/02", "chen2019/05", "chen2019/04")
+COST = {"chen2019/07": 100, "chen2019/06": 100, "fang2020/01": 85, "duan2023/01": 52, "an2021/01": 50,
+        "chen2019/02_": 33, "foundations/02": 30, "chen2019/05": 30, "chen2019/03b": 17, "chen2019/04": 11}
+"""Approximate execution time (s) of the slow notebooks on the 2-core reference machine (``make
+notebooks`` prints the measured ones); the others take a few seconds.  Used to start the slowest
+first and to balance shards (``scripts/portability.py``)."""
+
+
+def cost(path: Path) -> float:
+    rel = Path(path).as_posix()
+    return float(next((v for k, v in COST.items() if k in rel), 5.0))
 
 
 def image_rms(a: str, b: str) -> float:
@@ -137,10 +145,8 @@ def execute(path: Path, timeout: int, rms: float = IMAGE_RMS) -> float:
 
 
 def _order(paths: list[Path]) -> list[Path]:
-    def rank(p: Path) -> int:
-        rel = p.as_posix()
-        return next((i for i, key in enumerate(FIRST) if key in rel), len(FIRST))
-    return sorted(paths, key=rank)
+    """Slowest first (:data:`COST`), ties by path."""
+    return sorted(paths, key=lambda p: (-cost(p), p.as_posix()))
 
 
 def _run_one(path: Path, timeout: int, rms: float) -> tuple[Path, float | None, str]:
