@@ -46,7 +46,7 @@ from .rotations import euler_to_dcm, rotvec_to_dcm
 
 __all__ = ["StateBlock", "ErrorModel", "NavPoint", "nav_block_labels", "accel_bias", "gyro_bias",
            "accel_markov", "gyro_markov", "accel_scale", "gyro_scale", "accel_misalignment",
-           "gyro_misalignment", "gravity_shaping", "lever_arm", "model_15", "NAV_LABELS"]
+           "gyro_misalignment", "gravity_shaping", "lever_arm", "model_15", "NAV_LABELS", "MISALIGNMENT_COUPLINGS"]
 
 NAV_LABELS = ("dL", "dlon", "dh", "dvE", "dvN", "dvU", "phiE", "phiN", "phiU")
 _TARGETS = {"accel": K.TARGET_ACCEL, "gyro": K.TARGET_GYRO, "gravity": K.TARGET_GRAVITY,

@@ -683,7 +683,7 @@ COMPACT_COLUMNS = ("quantity", "paper", "reproduced", "status", "note")
 """What a reader sees of every comparison table: the printed and the reproduced value, the status
 and its reason (the ``note``); the long format is one click away (:func:`display_table`)."""
 
-_HEADINGS = {"note": "reason", "abs_error": "|error|", "rel_error": "rel. error"}
+_HEADINGS = {"note": "reason", "abs_error": "abs. error", "rel_error": "rel. error"}
 
 
 def _md_rows(df: pd.DataFrame, cols: list[str]) -> list[str]:
@@ -956,14 +956,26 @@ def _status_markdown(status: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+def _formula(text: str) -> str:
+    """A corrected expression written in LaTeX is shown as inline maths; plain text stays text."""
+    t = str(text)
+    return f"${t}$" if "\\" in t and "$" not in t else t
+
+
 def _errata_markdown(errata: pd.DataFrame) -> str:
     if errata.empty:
         return "No erratum has been proven yet.\n"
-    lines = ["| source | location | printed | corrected | evidence |", "|---|---|---|---|---|"]
-    for _, r in errata.iterrows():
-        cells = [str(r[c]).replace("|", "\\|").replace("\n", " ") for c in ("source", "location", "printed", "corrected", "evidence")]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
+    lines = []
+    for source in [k for k in SOURCE_KEYS if k in set(errata["source"])] + \
+            sorted(set(errata["source"]) - set(SOURCE_KEYS)):
+        part = errata[errata["source"] == source]
+        lines += [f"## {source} ({len(part)} {'erratum' if len(part) == 1 else 'errata'})", "",
+                  "| location | printed | corrected | evidence |", "|---|---|---|---|"]
+        for _, r in part.iterrows():
+            cells = [str(r["location"]), str(r["printed"]), _formula(r["corrected"]), str(r["evidence"])]
+            lines.append("| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
+        lines.append("")
+    return "\n".join(lines)
 
 
 PACKAGE_YEAR = 2026

@@ -34,7 +34,7 @@ __all__ = [
     "NonStationaryError", "InversionTest", "inversion_count", "inversion_moments", "inversion_distribution", "inversion_test",
     "stationarity_report", "difference", "make_stationary", "acf_printed", "pacf_printed",
     "correlogram", "cutoff_lag", "Identification", "identify_model", "ar_design",
-    "ar_least_squares", "fit_ar", "order_cap", "aic_by_order", "select_order",
+    "ar_least_squares", "require_stationary_series", "fit_ar", "order_cap", "aic_by_order", "select_order",
     "aic_increment_bound", "ar_poles", "is_stationary", "ar_autocorrelation", "ar_variance",
     "check_ar_model", "simulate_ar", "aic_batch", "order_recovery",
 ]
