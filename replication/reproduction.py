@@ -937,8 +937,9 @@ def status_tally(status: pd.DataFrame) -> dict[str, str]:
         part = status[status["kind"] == kind]
         tally = part["status"].value_counts()
         head = ", ".join(f"{int(tally[s])} {s}" for s in ARTIFACT_STATUSES if int(tally.get(s, 0)))
-        out[kind] = (f"{len(part)} {kind} artifacts: {head}; {int(part['erratum'].sum())} errata and "
-                     f"{int(part['inconsistent'].sum())} inconsistencies recorded in their rows")
+        n_e, n_i = int(part["erratum"].sum()), int(part["inconsistent"].sum())
+        out[kind] = (f"{len(part)} {kind} artifacts: {head}; {n_e} {'erratum' if n_e == 1 else 'errata'} and "
+                     f"{n_i} {'inconsistency' if n_i == 1 else 'inconsistencies'} recorded in their rows")
     return out
 
 
