@@ -943,15 +943,33 @@ def status_tally(status: pd.DataFrame) -> dict[str, str]:
     return out
 
 
+def _chapter_link(row) -> str:
+    nb = str(row.get("notebook", "")).split()
+    if not nb or not nb[0].startswith("book/"):
+        return f"`{row['id']}`"
+    return f"{{doc}}`{row['id']} </{nb[0][len('book/'):].removesuffix('.ipynb')}>`"
+
+
 def _status_markdown(status: pd.DataFrame) -> str:
     tally = status_tally(status)
-    lines = []
+    paper = status[status["kind"] == "paper"]
+    present = set(paper["status"])
+    cols = [s for s in ARTIFACT_STATUSES if s not in ("erratum", "inconsistent") and s in present]  # the others are 0
+    by = {src: paper[paper["source"] == src] for src in SOURCE_KEYS}
+    lines = ["**At a glance** — the artifacts of each document by status, and the errata and "
+             "inconsistencies their rows record:", "",
+             "| | " + " | ".join(SOURCE_KEYS) + " |", "|---|" + "---|" * len(SOURCE_KEYS),
+             "| artifacts | " + " | ".join(str(len(by[k])) for k in SOURCE_KEYS) + " |"]
+    lines += [f"| {c} | " + " | ".join(str(int((by[k]["status"] == c).sum())) for k in SOURCE_KEYS) + " |" for c in cols]
+    lines += [f"| {name} | " + " | ".join(str(int(by[k][col].sum())) for k in SOURCE_KEYS) + " |"
+              for name, col in (("errata", "erratum"), ("inconsistencies", "inconsistent"))]
+    lines.append("")
     for kind, title in (("paper", "Artifacts of the four documents"), ("supplementary", "Supplementary checks")):
         lines += [f"**{title}** — {tally[kind]}.", "",
                   "| id | artifact | status | rows | description |", "|---|---|---|---|---|"]
         for _, r in status[status["kind"] == kind].iterrows():
             split = ", ".join(f"{int(r[s.replace('-', '_')])} {s}" for s in STATUSES if int(r[s.replace('-', '_')]))
-            lines.append(f"| `{r['id']}` | {r['artifact']} | **{status_label(r)}** | {split or '-'} | "
+            lines.append(f"| {_chapter_link(r)} | {r['artifact']} | **{status_label(r)}** | {split or '-'} | "
                          f"{str(r['description']).replace('|', '/')} |")
         lines.append("")
     return "\n".join(lines)
