@@ -15,7 +15,7 @@ export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
 NOTEBOOKS := $(shell find book -name '*.ipynb' -not -path '*/_build/*' -not -path '*/.ipynb_checkpoints/*' | sort)
 
-.PHONY: help env lock book notebooks notebook tables html test unit units unit-portable portability nbval \
+.PHONY: help env lock book notebooks notebook tables html test unit units unit-portable portability suite nbval \
         check-notebooks check-tables html-strict browser bench clean
 
 help:
@@ -59,7 +59,7 @@ html: env
 	$(VENV)/bin/jupyter-book build book --path-output book --quiet
 
 # ---------------------------------------------------------------- tests
-test: env units portability check-notebooks tables check-tables html-strict browser
+test: env suite check-notebooks tables check-tables html-strict browser
 
 unit: env
 	$(PY) -m pytest -q tests -m "not browser"
@@ -71,6 +71,10 @@ units: env
 # the unit tests once more on a perturbed numerical code path (scripts/portability.py says why)
 unit-portable: env
 	$(PY) scripts/portability.py unit tests -m "not browser and not slow"
+
+# the two above as one queue of jobs on every core, slowest first (what `make test` runs)
+suite: env
+	$(PY) scripts/portability.py suite $(NOTEBOOKS)
 
 # every notebook re-executed under two perturbed numerical configurations: strict nbval against
 # the stored outputs, and tables/ unchanged

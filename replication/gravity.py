@@ -765,7 +765,10 @@ def ar_continuous(phi, sigma2: float, dt: float):
     Returns ``(A_c, Q_c, P, embeddable)``.  A real logarithm needs no pole on the negative real
     axis (refused with a message); Q_c must be positive semi-definite for a continuous process
     with white driving noise to exist — when it is not (``embeddable`` False) its negative
-    eigenvalues are set to zero, which keeps the transition and raises the variance slightly.
+    eigenvalues are set to zero, which keeps the transition and raises the variance (by a factor
+    1.9 for the sign-reversed east model of eq. (4-13)).  A rank-one e_1 sigma² e_1^T is the
+    sampled noise of a continuous process with PSD Q_c only for an AR(1) model, so an AR(2) or
+    AR(3) model is in general not embeddable.
     """
     from scipy.linalg import logm, solve_continuous_lyapunov, solve_discrete_lyapunov
 

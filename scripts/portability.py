@@ -3,6 +3,7 @@
     python scripts/portability.py nbval [NOTEBOOK ...]   # strict nbval under every configuration
     python scripts/portability.py unit [PYTEST ARGS ...] # the unit tests under the first one
     python scripts/portability.py units                 # natively and under the first one, side by side
+    python scripts/portability.py suite                 # all of the above as one job queue (make test)
     python scripts/portability.py show                  # the configurations, as shell exports
 
 A stored number must carry only the digits that every IEEE-754 machine computes (CONTRIBUTING.md,
@@ -155,6 +156,75 @@ def units() -> int:
     return rc
 
 
+SMALL_NOTEBOOK_S = 12.0
+"""Notebooks estimated below this many seconds are run together, one job per configuration
+(a pytest process and its start-up per notebook would cost more than the notebook)."""
+
+
+def _pytest_nbval(paths: list[Path]) -> list[str]:
+    return [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--nbval", "--nbval-current-env",
+            *map(str, paths), "--nbval-sanitize-with", str(ROOT / "book" / "sanitize.cfg"),
+            "--nbval-cell-timeout=900", "-o", "testpaths=", "-o", "addopts="]
+
+
+def suite_jobs(paths: list[Path], configs: list[str]) -> list[tuple[str, list[str], dict | None, float]]:
+    """Every job of ``make test``'s numerical part: the unit tests natively and under the first
+    configuration, and each notebook under each configuration (small ones grouped), as
+    (label, command, environment, estimated seconds), slowest first."""
+    first = next(iter(CONFIGS))
+    jobs: list[tuple[str, list[str], dict | None, float]] = [
+        ("unit tests natively", [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests", "-m",
+                                 "not browser"], None, 100.0),
+        (f"unit tests under '{first}'", [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests",
+                                         "-m", "not browser and not slow"], environment(first), 50.0)]
+    for name in configs:
+        env = environment(name)
+        small = [p for p in paths if cost(p) < SMALL_NOTEBOOK_S]
+        for p in [p for p in paths if cost(p) >= SMALL_NOTEBOOK_S]:
+            jobs.append((f"nbval under '{name}': {p.relative_to(ROOT)}", _pytest_nbval([p]), env, cost(p)))
+        if small:
+            jobs.append((f"nbval under '{name}': {len(small)} short notebooks", _pytest_nbval(small), env,
+                         sum(cost(p) for p in small)))
+    return sorted(jobs, key=lambda j: -j[3])
+
+
+def suite(paths: list[Path], jobs: int, configs: list[str]) -> int:
+    """The unit tests and the perturbed re-execution of every notebook as one queue of jobs on
+    ``jobs`` workers, slowest first, each worker taking the next job as it finishes (so that no
+    core idles while work is left); then ``tables/`` and ``book/`` must be unchanged."""
+    before = _git_state()
+    todo = suite_jobs(paths, configs)
+    for name in configs:
+        print(f"== {name}: " + " ".join(f"{k}={v}" for k, v in CONFIGS[name].items()), flush=True)
+    t_start = time.perf_counter()
+
+    def run(i_job):
+        i, (label, cmd, env, _) = i_job
+        t0 = time.perf_counter()
+        r = _run_shard(cmd, env if env is not None else {**os.environ, **COMMON}, delay=3.0 * i if i < jobs else 0.0)
+        return label, r, time.perf_counter() - t0
+
+    failed = []
+    with ThreadPoolExecutor(jobs) as pool:
+        for label, r, dt in pool.map(run, enumerate(todo)):
+            print(f"== {label}: {'ok' if r.returncode == 0 else 'FAILED'} in {dt:.0f} s", flush=True)
+            if r.returncode != 0:
+                failed.append(label)
+                sys.stdout.write(r.stdout)
+                sys.stderr.write(r.stderr)
+            else:
+                sys.stdout.write(r.stdout.strip().splitlines()[-1] + "\n" if r.stdout.strip() else "")
+    print(f"== {len(todo)} jobs on {jobs} workers in {time.perf_counter() - t_start:.0f} s", flush=True)
+    if failed:
+        print("failed: " + "; ".join(failed), file=sys.stderr)
+        return 1
+    if _git_state() != before:
+        subprocess.run(["git", "status", "--short", "--", "tables", "book"], cwd=ROOT)
+        print("re-executing changed tables/ or book/", file=sys.stderr)
+        return 1
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -165,6 +235,10 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("unit")
     p.add_argument("pytest_args", nargs=argparse.REMAINDER)
     sub.add_parser("units")
+    p = sub.add_parser("suite")
+    p.add_argument("notebooks", nargs="*", type=Path)
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    p.add_argument("--config", action="append", choices=list(CONFIGS), help="default: every configuration")
     sub.add_parser("show")
     args = ap.parse_args(argv)
     if args.cmd == "units":
@@ -176,6 +250,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.cmd == "unit":
         return unit(args.pytest_args or ["tests", "-m", "not browser"])
     paths = [p.resolve() for p in args.notebooks] or book_notebooks()
+    if args.cmd == "suite":
+        return suite(paths, max(1, args.jobs), args.config or list(CONFIGS))
     return nbval(paths, max(1, args.jobs), args.config or list(CONFIGS))
 
 

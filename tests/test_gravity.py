@@ -298,19 +298,37 @@ def test_direct_difference_from_filter_obeys_eq_3_8():
 
 # --------------------------------------------------------------------------- step 3: the augmented filter
 
-def test_ar_continuous_is_exact_at_the_samples():
+@pytest.mark.parametrize("phi, embeddable", [
+    ([0.8], True),     # AR(1): Q_c = -2 ln(a) P / dt > 0, a sampled Gauss-Markov process
+    (PHI_E, False),    # AR(3) with rank-one e_1 sigma² e_1^T noise: no PSD Q_c can produce it
+])
+def test_ar_continuous_is_exact_at_the_samples(phi, embeddable):
+    """eq. (3-17): exp(A_c dt) = A always; the exact noise and covariance only when embeddable."""
     from scipy.linalg import expm
 
     s2, dt = 1e-10, 50.0
-    Ac, Qc, P, emb = gr.ar_continuous(PHI_E, s2, dt)
-    A = gr.ar_companion(PHI_E)
+    Ac, Qc, P, emb = gr.ar_continuous(phi, s2, dt)
+    A = gr.ar_companion(phi)
+    assert emb is embeddable
     np.testing.assert_allclose(expm(Ac * dt), A, atol=1e-10)
-    if emb:  # the discrete noise of the sampled process is the AR model's e_1 sigma² e_1^T
-        Qd = np.zeros((3, 3))
+    assert np.all(np.linalg.eigvalsh(np.atleast_2d(Qc)) >= -1e-12 * np.abs(Qc).max())
+    var_ar = ts.ar_variance(phi, s2)
+    if embeddable:  # the discrete noise of the sampled process is the AR model's e_1 sigma² e_1^T
+        Qd = np.zeros_like(A)
         Qd[0, 0] = s2
         np.testing.assert_allclose(P - A @ P @ A.T, Qd, atol=1e-9 * s2)
-        assert P[0, 0] == pytest.approx(ts.ar_variance(PHI_E, s2), rel=1e-9)
-    assert np.all(np.linalg.eigvalsh(Qc) >= -1e-12 * np.abs(Qc).max())
+        assert P[0, 0] == pytest.approx(var_ar, rel=1e-9)
+        if len(phi) == 1:  # AR(1) closed form: a first-order Gauss-Markov process
+            assert Qc[0, 0] == pytest.approx(-2 * math.log(phi[0]) / dt * var_ar, rel=1e-9)
+    else:  # negative eigenvalues of Q_c clipped: same transition, variance raised, never lowered
+        assert P[0, 0] >= var_ar * (1 - 1e-9)
+        Qd = np.zeros_like(A)
+        Qd[0, 0] = s2
+        assert not np.allclose(P - A @ P @ A.T, Qd, atol=1e-3 * s2)
+
+
+def test_ar_continuous_refusals_and_block():
+    s2, dt = 1e-10, 50.0
     with pytest.raises(ValueError, match="negative real axis"):
         gr.ar_continuous([-0.5, 0.1, 0.02], s2, dt)
     blk, P0, _ = gr.ar_gravity_block([(PHI_E, s2)] * 3, dt)
