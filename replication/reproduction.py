@@ -701,7 +701,8 @@ def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterabl
     ``note``, headed "reason") are always shown.  For a table returned by :func:`compare`, a
     download link to its CSV and a collapsed copy of the full long format follow.  Returns an
     IPython ``Markdown`` object whose text is a ``{table}`` directive; the book renders it as a
-    numbered table labelled ``name`` (reference it with ``{numref}``).
+    numbered table labelled ``name`` (reference it with ``{numref}``); a table returned by
+    :func:`compare` is also a target named by its id (``{ref}`` with the table id).
     """
     from IPython.display import Markdown
 
@@ -714,6 +715,8 @@ def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterabl
         raise RegistryError(f"display_table: name {name!r} must be lower-case letters, digits and '-'")
     lines = [f"```{{table}} {caption}", f":name: {name}", "", *_md_rows(df, cols), "```"]
     table_id, notebook = df.attrs.get("table_id"), df.attrs.get("notebook")
+    if table_id:  # a target named by the table id: the findings box and the part pages link to it
+        lines = [f"({table_id})=", "", *lines]
     if table_id and notebook:
         up = "../" * (len(Path(notebook).parts) - 1)
         full = [c for c in TABLE_COLUMNS if c in df.columns and c not in ("paper_text", "reproduced_text", "tolerance_kind")
@@ -822,6 +825,11 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
         _write_if_changed(d / "errata.csv", errata.to_csv(index=False, lineterminator="\n"))
         _write_if_changed(d / "status.md", _status_markdown(status))
         _write_if_changed(d / "errata.md", _errata_markdown(errata))
+        for src in SOURCE_KEYS:
+            _write_if_changed(d / f"status-{src}.md", _paper_summary_markdown(status, src))
+        notebooks = sorted({n for ns in status["notebook"].astype(str) for n in ns.split() if n.startswith("book/")})
+        for nb in notebooks:
+            _write_if_changed(d / findings_file(nb), _findings_markdown(status, nb))
         write_datapackage()
     return status, errata
 
@@ -950,6 +958,139 @@ def _chapter_link(row) -> str:
     return f"{{doc}}`{row['id']} </{nb[0][len('book/'):].removesuffix('.ipynb')}>`"
 
 
+STATUS_COLOURS = {"reproduced": "#2e7d32", "qualitative": "#81c784", "mixed": "#f9a825", "analog": "#90a4ae",
+                  "unverifiable": "#bdbdbd", "not-reproduced": "#c62828", "pending": "#eeeeee"}
+"""Colour of each artifact status in the status bars of the book (colour-blind safe order:
+green shades for reproduced, amber for mixed, grey for analog, red for not reproduced)."""
+
+
+def status_bar_html(counts: Mapping[str, int]) -> str:
+    """A horizontal bar of artifact statuses (inline HTML, one segment per status, width ∝ count,
+    the count written in it and the status in its tooltip) followed by its legend."""
+    total = sum(int(v) for v in counts.values())
+    if total <= 0:
+        raise RegistryError("status_bar_html: no artifact to draw")
+    segs, legend = [], []
+    for st in ARTIFACT_STATUSES:
+        n = int(counts.get(st, 0))
+        if st not in STATUS_COLOURS or n == 0:
+            continue
+        w = 100.0 * n / total
+        segs.append(f'<span class="status-seg" style="width:{w:.2f}%;background:{STATUS_COLOURS[st]}" '
+                    f'title="{n} {st}">{n}</span>')
+        legend.append(f'<span class="status-key" style="background:{STATUS_COLOURS[st]}"></span>{st} {n}')
+    return (f'<div class="status-bar">{"".join(segs)}</div>'
+            f'<div class="status-legend">{" &nbsp; ".join(legend)}</div>')
+
+
+def _notebook_targets(root: Path, notebook: str) -> set[str]:
+    """The table ids a stored notebook displays with a target (see :func:`display_table`)."""
+    path = root / notebook
+    if not notebook or not path.exists():
+        return set()
+    return set(re.findall(r"\(([a-z0-9][a-z0-9-]*)\)=", path.read_text(encoding="utf-8")))
+
+
+def _table_links(row, root: Path, up: str) -> str:
+    """Each table of an artifact: a link to where the chapter shows it (when it does) and its CSV."""
+    nb = str(row.get("notebook", "")).split()
+    shown = set().union(*(_notebook_targets(root, n) for n in nb)) if nb else set()
+    out = []
+    for tid in str(row.get("tables", "")).split():
+        ref = f"{{ref}}`shown <{tid}>`" if tid in shown else ""
+        out.append(f"{{download}}`{tid}.csv <{up}tables/{tid}.csv>`" + (f" ({ref})" if ref else ""))
+    return "<br>".join(out) or "-"
+
+
+def _row_split(r) -> str:
+    return ", ".join(f"{int(r[s.replace('-', '_')])} {s}" for s in STATUSES if int(r[s.replace('-', '_')])) or "-"
+
+
+def _paper_summary_markdown(status: pd.DataFrame, source: str) -> str:
+    """The reproduction record of one document for its part's index page: status bar, tally and
+    one row per paper artifact (linked to its chapter, to the table where it is shown, to its CSV),
+    then the supplementary checks of the same chapters, counted apart."""
+    root = project_root()
+    part = status[status["source"] == source]
+    lines = []
+    for kind, title in (("paper", "Artifacts of the paper"), ("supplementary", "Supplementary checks of the chapters")):
+        sub = part[part["kind"] == kind]
+        if sub.empty:
+            continue
+        tally = status_tally(sub)[kind]
+        lines += [f"**{title}** — {tally}.", "", status_bar_html(sub["status"].value_counts().to_dict()), "",
+                  "| id | artifact | status | rows | tables |", "|---|---|---|---|---|"]
+        for _, r in sub.iterrows():
+            lines.append(f"| {_chapter_link(r)} | {r['artifact']} | **{status_label(r)}** | {_row_split(r)} | "
+                         f"{_table_links(r, root, '../../')} |")
+        lines.append("")
+    lines.append("Statuses are defined on the {doc}`status page </status>`; the errata of every document "
+                 "are collected in the {doc}`errata register </errata>`.")
+    return "\n".join(lines) + "\n"
+
+
+FINDING_REASON_STATUSES = ("not-reproduced", "analog", "unverifiable")
+"""Row statuses whose notes a findings box quotes as the reason an artifact is not reproduced."""
+
+
+def _short(text: str, n: int = 220) -> str:
+    t = " ".join(str(text).split()).replace("|", "/")
+    return t if len(t) <= n else t[: n - 1].rsplit(" ", 1)[0] + " …"
+
+
+def _findings_markdown(status: pd.DataFrame, notebook: str) -> str:
+    """The findings box at the top of a chapter: which of its artifacts reproduced, which did not
+    and why (the notes of their not-reproduced, analog and unverifiable rows), the errata and
+    inconsistencies found, each linked to the table that shows the evidence."""
+    root = project_root()
+    mine = status[status["notebook"].astype(str).str.split().apply(lambda ns: notebook in ns)]
+    shown = _notebook_targets(root, notebook)
+
+    def link(r):
+        tids = [t for t in str(r["tables"]).split() if t in shown]
+        name = f"{r['artifact']}" if r["kind"] == "paper" else f"check {r['id']}"
+        return f"{{ref}}`{name} <{tids[0]}>`" if tids else name
+
+    lines = [":::{admonition} Findings of this chapter", ":class: tip", ""]
+    for kind, title in (("paper", "Paper artifacts"), ("supplementary", "Supplementary checks")):
+        sub = mine[mine["kind"] == kind]
+        if sub.empty:
+            continue
+        lines.append(f"**{title}** ({len(sub)}): " + status_tally(sub)[kind].split(": ", 1)[1] + ".")
+        lines.append("")
+        ok = sub[sub["status"].isin(["reproduced", "qualitative"])]
+        if len(ok):
+            lines.append("- reproduced or checked: " + ", ".join(link(r) for _, r in ok.iterrows()))
+        for _, r in sub[~sub["status"].isin(["reproduced", "qualitative"])].iterrows():
+            notes, seen = [], set()
+            tables = [read_table(tid) for tid in str(r["tables"]).split()]
+            for st in FINDING_REASON_STATUSES:  # the strongest reason first
+                for df in tables:
+                    for nt in df.loc[df["status"] == st, "note"]:
+                        key = re.sub(r"-?\d[\d.,e+-]*", "#", str(nt))  # the same reason with other numbers
+                        if nt and key not in seen:
+                            seen.add(key)
+                            notes.append(_short(nt))
+            why = ("; ".join(notes[:2]) + (f" (and {len(notes) - 2} more: see the table)" if len(notes) > 2 else "")) or "-"
+            lines.append(f"- {link(r)}: **{status_label(r)}** ({_row_split(r)}) — {why}")
+        n_e, n_i = int(sub["erratum"].sum()), int(sub["inconsistent"].sum())
+        if n_e or n_i:
+            lines.append(f"- {n_e} {'erratum' if n_e == 1 else 'errata'} and {n_i} "
+                         f"{'inconsistency' if n_i == 1 else 'inconsistencies'} recorded "
+                         "(the {doc}`errata register </errata>` lists the errata)")
+        lines.append("")
+    if len(lines) == 3:
+        lines.append("This chapter exports no comparison table.")
+    lines += ["Statuses as defined on the {doc}`status page </status>`.", ":::"]
+    return "\n".join(lines) + "\n"
+
+
+def findings_file(notebook: str) -> str:
+    """File name of a chapter's findings box in ``tables/`` (``findings-<part>-<stem>.md``)."""
+    p = Path(notebook)
+    return f"findings-{p.parent.name}-{p.stem}.md"
+
+
 def _status_markdown(status: pd.DataFrame) -> str:
     tally = status_tally(status)
     paper = status[status["kind"] == "paper"]
@@ -964,13 +1105,16 @@ def _status_markdown(status: pd.DataFrame) -> str:
     lines += [f"| {name} | " + " | ".join(str(int(by[k][col].sum())) for k in SOURCE_KEYS) + " |"
               for name, col in (("errata", "erratum"), ("inconsistencies", "inconsistent"))]
     lines.append("")
+    for k in SOURCE_KEYS:
+        if len(by[k]):
+            lines += [f"**{k}** ({{doc}}`its part </{k}/index>`)", "",
+                      status_bar_html(by[k]["status"].value_counts().to_dict()), ""]
     for kind, title in (("paper", "Artifacts of the four documents"), ("supplementary", "Supplementary checks")):
         lines += [f"**{title}** — {tally[kind]}.", "",
-                  "| id | artifact | status | rows | description |", "|---|---|---|---|---|"]
+                  "| id | artifact | status | rows | description | tables |", "|---|---|---|---|---|---|"]
         for _, r in status[status["kind"] == kind].iterrows():
-            split = ", ".join(f"{int(r[s.replace('-', '_')])} {s}" for s in STATUSES if int(r[s.replace('-', '_')]))
-            lines.append(f"| {_chapter_link(r)} | {r['artifact']} | **{status_label(r)}** | {split or '-'} | "
-                         f"{str(r['description']).replace('|', '/')} |")
+            lines.append(f"| {_chapter_link(r)} | {r['artifact']} | **{status_label(r)}** | {_row_split(r)} | "
+                         f"{str(r['description']).replace('|', '/')} | {_table_links(r, project_root(), '../')} |")
         lines.append("")
     return "\n".join(lines)
 
