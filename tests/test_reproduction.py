@@ -340,3 +340,35 @@ def test_a_paper_file_that_is_not_utf8_is_refused_with_a_message(tmp_path):
     bad.write_bytes("# document: chen2019\nquantity,unit,value\n\xb5,m,1\n".encode("latin-1"))
     with pytest.raises(rp.RegistryError, match="not UTF-8"):
         rp.parse_paper_file(bad)
+
+
+def test_status_bar_widths_and_refusal():
+    html = rp.status_bar_html({"reproduced": 3, "analog": 1, "mixed": 0})
+    assert 'width:75.00%' in html and 'width:25.00%' in html
+    assert "mixed" not in html  # a status with no artifact draws no segment
+    assert html.index("reproduced") < html.index("analog")  # the order of ARTIFACT_STATUSES
+    with pytest.raises(rp.RegistryError, match="no artifact"):
+        rp.status_bar_html({})
+
+
+def test_findings_box_states_the_reason_of_every_unreproduced_artifact():
+    status, _ = rp.build_index(write=False)
+    nb = "book/duan2023/01_sins_ads_error_correction.ipynb"
+    box = rp._findings_markdown(status, nb)
+    assert box.startswith(":::{admonition} Findings of this chapter") and box.rstrip().endswith(":::")
+    mine = status[status["notebook"].str.contains(nb, regex=False)]
+    for _, r in mine[~mine["status"].isin(["reproduced", "qualitative"])].iterrows():
+        name = r["artifact"] if r["kind"] == "paper" else r["id"]
+        line = next(l for l in box.splitlines() if f"**{rp.status_label(r)}**" in l and name in l)
+        assert " — " in line and not line.endswith("— -")  # a reason is quoted
+    # the paper artifacts and the package's own checks are counted apart
+    assert "**Paper artifacts**" in box and "**Supplementary checks**" in box
+
+
+def test_part_summary_links_every_artifact_of_its_paper():
+    status, _ = rp.build_index(write=False)
+    md = rp._paper_summary_markdown(status, "fang2020")
+    ids = status.loc[status["source"] == "fang2020", "id"]
+    for i in ids:
+        assert f"{{doc}}`{i} " in md
+    assert "../../tables/fang2020-table-1.csv" in md and "chen2019" not in md
