@@ -1,4 +1,10 @@
-"""Open the built book in headless Chromium, offline: pages load, math renders, figures show.
+"""Open the built book in headless Chromium, offline, and check what a reader sees.
+
+Every page: loads without a request leaving the machine or failing, raises no JavaScript error,
+leaves no raw ``$``/LaTeX outside rendered maths, shows no figure twice, and every local link
+(with its ``#anchor``) resolves.  The status page, each part's page and one chapter per paper:
+no table wider than the content column at 1280 px (the status and reason columns visible), the
+status bars and the findings boxes present.  Math renders with the local MathJax; figures decode.
 
 Run after the book is built (``make html-strict``); ``make test`` does both. Every request the
 pages make is recorded: any request that leaves the local server, or fails, is an error. A
@@ -8,8 +14,10 @@ screenshot of one chapter is kept in ``book/_build/screenshot.png``.
 from __future__ import annotations
 
 import functools
+import html as html_lib
 import http.server
 import os
+import re
 import shutil
 import threading
 from pathlib import Path
@@ -63,10 +71,14 @@ def browser():
         b.close()
 
 
-def _visit(browser, url: str):
-    """Load ``url``; return (page, external requests, failed requests)."""
+def _visit(browser, url: str, errors: list | None = None):
+    """Load ``url``; return (page, external requests, failed requests); JavaScript errors of the
+    page are appended to ``errors``."""
     page = browser.new_page(viewport={"width": 1280, "height": 900})
     external, failed = [], []
+    if errors is not None:
+        page.on("pageerror", lambda exc: errors.append(str(exc)))
+        page.on("console", lambda msg: errors.append(msg.text) if msg.type == "error" else None)
 
     def on_request(req):
         host = urlparse(req.url).hostname
@@ -82,18 +94,109 @@ def _visit(browser, url: str):
     return page, external, failed
 
 
+RAW_TEX = re.compile(r"\$|\\(frac|mathrm|mathbf|left|right|begin|end|sqrt|delta|phi|omega)\b")
+"""What must not be left in the visible text once MathJax has run."""
+
+VISIBLE_TEXT_JS = """() => {
+  const art = document.querySelector('.bd-article') || document.body;
+  const c = art.cloneNode(true);
+  c.querySelectorAll('pre, code, mjx-container, script, style, .cell_input, .MathJax, .math').forEach(e => e.remove());
+  return c.innerText;
+}"""
+
+WAIT_MATH_JS = "() => (window.MathJax && MathJax.startup && MathJax.startup.promise) ? MathJax.startup.promise.then(() => true) : true"
+
+
+def _local_link_problems(page_path: Path) -> list[str]:
+    """Local links of a built page whose file or ``#anchor`` does not exist."""
+    text = page_path.read_text(encoding="utf-8")
+    problems = []
+    for href in set(re.findall(r'href="([^"]+)"', text)):
+        href = html_lib.unescape(href)
+        if href.startswith(("http:", "https:", "mailto:", "javascript:", "data:")):
+            continue
+        target, _, frag = href.partition("#")
+        target = target.split("?")[0]
+        path = (page_path.parent / target).resolve() if target else page_path
+        if path.is_dir():
+            path = path / "index.html"
+        if not path.exists():
+            problems.append(f"{href} (no such file)")
+        elif frag and path.suffix == ".html" and f'id="{frag}"' not in path.read_text(encoding="utf-8"):
+            problems.append(f"{href} (no such anchor)")
+    return sorted(problems)
+
+
 def test_every_page_loads_offline(server, browser):
+    """Every page: offline, no failed request, no JavaScript error, no raw TeX, no figure shown
+    twice, every local link and anchor resolving."""
     pages = _pages()
     assert len(pages) >= 5, "the book has too few pages"
     problems = []
     for p in pages:
         rel = p.relative_to(HTML).as_posix()
-        page, external, failed = _visit(browser, f"{server}/{rel}")
+        js_errors: list[str] = []
+        page, external, failed = _visit(browser, f"{server}/{rel}", js_errors)
+        page.evaluate(WAIT_MATH_JS)
+        raw = sorted(set(m.group(0) for m in RAW_TEX.finditer(page.evaluate(VISIBLE_TEXT_JS))))
+        imgs = page.evaluate("Array.from(document.images).map(i => i.getAttribute('src')).filter(s => s && s.includes('_images/'))")
+        page.close()
         if external:
             problems.append(f"{rel}: requests leaving the machine: {external[:3]}")
         if failed:
             problems.append(f"{rel}: failed requests: {failed[:3]}")
+        if js_errors:
+            problems.append(f"{rel}: JavaScript errors: {js_errors[:3]}")
+        if raw:
+            problems.append(f"{rel}: raw TeX outside rendered maths: {raw[:5]}")
+        twice = sorted({i for i in imgs if imgs.count(i) > 1})
+        if twice:
+            problems.append(f"{rel}: figures shown twice: {twice[:3]}")
+        links = _local_link_problems(p)
+        if links:
+            problems.append(f"{rel}: broken local links: {links[:5]}")
+    assert not problems, "\n".join(problems)
+
+
+def _chapter_of_each_paper() -> list[str]:
+    out = []
+    for part in ("chen2019", "fang2020", "duan2023", "an2021"):
+        chapters = sorted(p for p in (HTML / part).glob("*.html") if p.name != "index.html")
+        assert chapters, f"no chapter page for {part}"
+        out.append(chapters[-1].relative_to(HTML).as_posix())
+    return out
+
+
+CLIPPED_JS = """() => {
+  const art = document.querySelector('.bd-article');
+  const right = art.getBoundingClientRect().right;
+  return Array.from(art.querySelectorAll('table')).filter(t => t.offsetParent !== null).map(t => {
+    const box = t.parentElement;
+    return {right: t.getBoundingClientRect().right, scroll: box.scrollWidth - box.clientWidth,
+            head: (t.tHead ? t.tHead.innerText : '').slice(0, 60)};
+  }).filter(t => t.right > right + 2 || t.scroll > 2);
+}"""
+
+
+def test_overview_and_chapters_fit_at_1280_px(server, browser):
+    """The status page, the part pages and one chapter per paper: no table clipped or scrolled at
+    1280 px; the status bars on the overview pages; a findings box at the top of each chapter."""
+    problems = []
+    overview = ["status.html"] + [f"{p}/index.html" for p in ("chen2019", "fang2020", "duan2023", "an2021")]
+    for rel in overview + _chapter_of_each_paper():
+        page, _, _ = _visit(browser, f"{server}/{rel}")
+        clipped = page.evaluate(CLIPPED_JS)
+        bars = page.locator(".status-bar").count()
+        findings = page.locator(".admonition:has(.admonition-title:text('Findings of this chapter'))").count()
+        if rel == "status.html":
+            page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot-status.png"), full_page=False)
         page.close()
+        if clipped:
+            problems.append(f"{rel}: tables wider than the content column: {clipped[:3]}")
+        if rel in overview and bars == 0:
+            problems.append(f"{rel}: no status bar")
+        if rel not in overview and findings != 1:
+            problems.append(f"{rel}: {findings} findings boxes (expected one)")
     assert not problems, "\n".join(problems)
 
 
