@@ -35,7 +35,9 @@ GLUE_DIGITS = 6
 def glue(name: str, value, display: bool = True, digits: int = GLUE_DIGITS):
     """``myst_nb.glue(name, value, display)`` with numpy scalars made plain (see :func:`plain`).
 
-    A float is rounded to ``digits`` significant digits before it is stored.
+    A float is rounded to ``digits`` significant digits before it is stored.  A matplotlib
+    figure is closed once glued, so that the inline backend does not show it a second time at the
+    end of the cell (the book shows it where ``{glue:figure}`` places it).
     """
     from myst_nb import glue as _glue
 
@@ -48,7 +50,12 @@ def glue(name: str, value, display: bool = True, digits: int = GLUE_DIGITS):
         if not isinstance(digits, int) or isinstance(digits, bool) or digits < 1:
             raise ValueError(f"glue {name!r}: digits must be a positive integer, not {digits!r}")
         value = float(format(value, f".{digits}g"))
-    return _glue(name, value, display=display)
+    out = _glue(name, value, display=display)
+    if type(value).__module__.startswith("matplotlib.figure"):
+        import matplotlib.pyplot as plt
+
+        plt.close(value)
+    return out
 
 
 def sig(value, digits: int = 3):

@@ -607,7 +607,10 @@ TABLE_2_2_CORRECTED_TEXT = {
     "F53": r"columns G_zx, G_yz, G_zy: [-C_{\cdot 2}\omega_z,\ -C_{\cdot 1}\omega_y,\ C_{\cdot 1}\omega_z]",
 }
 """Corrected expressions of the Table 2-2 blocks whose printed form differs (see
-:func:`table_2_2_corrected`)."""
+:func:`table_2_2_corrected`), in LaTeX; the chapter renders them.
+
+:meta hide-value:
+"""
 
 
 def table_2_2_verified(model, point) -> dict:

@@ -113,3 +113,16 @@ def test_a_formula_line_read_as_a_list_item_is_caught():
     assert len(check_notebooks.math_line_problems(broken)) == 1
     assert check_notebooks.math_line_problems(fixed) == []
     assert check_notebooks.math_line_problems("$$\nx\n- y\n$$") == []     # display maths is not inline
+
+
+def test_book_glue_closes_a_figure_once_glued():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from replication.book import glue
+
+    fig, _ = plt.subplots()
+    glue("fig-test", fig, display=False)
+    assert not plt.fignum_exists(fig.number)  # not shown a second time at the end of the cell
