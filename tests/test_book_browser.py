@@ -4,7 +4,8 @@ Every page: loads without a request leaving the machine or failing, raises no Ja
 leaves no raw ``$``/LaTeX outside rendered maths, shows no figure twice, and every local link
 (with its ``#anchor``) resolves.  The status page, each part's page and one chapter per paper:
 no table wider than the content column at 1280 px (the status and reason columns visible), the
-status bars and the findings boxes present.  Math renders with the local MathJax; figures decode.
+status bars and the findings boxes present (a table with a status column must fit: data frames
+printed by a notebook may scroll).  Math renders with the local MathJax; figures decode.
 
 Run after the book is built (``make html-strict``); ``make test`` does both. Every request the
 pages make is recorded: any request that leaves the local server, or fails, is an error. A
@@ -170,7 +171,8 @@ def _chapter_of_each_paper() -> list[str]:
 CLIPPED_JS = """() => {
   const art = document.querySelector('.bd-article');
   const right = art.getBoundingClientRect().right;
-  return Array.from(art.querySelectorAll('table')).filter(t => t.offsetParent !== null).map(t => {
+  const withStatus = t => Array.from(t.querySelectorAll('th')).some(h => h.innerText.trim() === 'status');
+  return Array.from(art.querySelectorAll('table')).filter(t => t.offsetParent !== null && withStatus(t)).map(t => {
     const box = t.parentElement;
     return {right: t.getBoundingClientRect().right, scroll: box.scrollWidth - box.clientWidth,
             head: (t.tHead ? t.tHead.innerText : '').slice(0, 60)};
