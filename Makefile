@@ -59,7 +59,7 @@ html: env
 	$(VENV)/bin/jupyter-book build book --path-output book --quiet
 
 # ---------------------------------------------------------------- tests
-test: env suite check-notebooks tables check-tables html-strict browser
+test: env check-notebooks suite tables check-tables
 
 unit: env
 	$(PY) -m pytest -q tests -m "not browser"
@@ -72,9 +72,10 @@ units: env
 unit-portable: env
 	$(PY) scripts/portability.py unit tests -m "not browser and not slow"
 
-# the two above as one queue of jobs on every core, slowest first (what `make test` runs)
+# the unit tests, the perturbed notebooks, the strict book build and the browser check as one
+# queue of jobs on every core, slowest first (what `make test` runs)
 suite: env
-	$(PY) scripts/portability.py suite $(NOTEBOOKS)
+	$(PY) scripts/portability.py suite --book $(NOTEBOOKS)
 
 # every notebook re-executed under two perturbed numerical configurations: strict nbval against
 # the stored outputs, and tables/ unchanged

@@ -167,16 +167,20 @@ def _pytest_nbval(paths: list[Path]) -> list[str]:
             "--nbval-cell-timeout=900", "-o", "testpaths=", "-o", "addopts="]
 
 
-def suite_jobs(paths: list[Path], configs: list[str]) -> list[tuple[str, list[str], dict | None, float]]:
-    """Every job of ``make test``'s numerical part: the unit tests natively and under the first
-    configuration, and each notebook under each configuration (small ones grouped), as
-    (label, command, environment, estimated seconds), slowest first."""
+def suite_jobs(paths: list[Path], configs: list[str], book: bool = False) -> list[tuple[str, list[str], dict | None, float]]:
+    """Every job of ``make test`` but the index checks: the unit tests natively and under the
+    first configuration, each notebook under each configuration (small ones grouped) and, with
+    ``book``, the strict book build followed by the browser check; as (label, command,
+    environment, estimated seconds), slowest first."""
     first = next(iter(CONFIGS))
     jobs: list[tuple[str, list[str], dict | None, float]] = [
         ("unit tests natively", [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests", "-m",
                                  "not browser"], None, 100.0),
         (f"unit tests under '{first}'", [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests",
                                          "-m", "not browser and not slow"], environment(first), 50.0)]
+    if book:  # the strict book build and the browser check read only stored files: any time will do
+        jobs.append(("strict book build and browser check",
+                     ["make", "--no-print-directory", "html-strict", "browser"], None, 110.0))
     for name in configs:
         env = environment(name)
         small = [p for p in paths if cost(p) < SMALL_NOTEBOOK_S]
@@ -188,12 +192,12 @@ def suite_jobs(paths: list[Path], configs: list[str]) -> list[tuple[str, list[st
     return sorted(jobs, key=lambda j: -j[3])
 
 
-def suite(paths: list[Path], jobs: int, configs: list[str]) -> int:
+def suite(paths: list[Path], jobs: int, configs: list[str], book: bool = False) -> int:
     """The unit tests and the perturbed re-execution of every notebook as one queue of jobs on
     ``jobs`` workers, slowest first, each worker taking the next job as it finishes (so that no
     core idles while work is left); then ``tables/`` and ``book/`` must be unchanged."""
     before = _git_state()
-    todo = suite_jobs(paths, configs)
+    todo = suite_jobs(paths, configs, book)
     for name in configs:
         print(f"== {name}: " + " ".join(f"{k}={v}" for k, v in CONFIGS[name].items()), flush=True)
     t_start = time.perf_counter()
@@ -239,6 +243,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("notebooks", nargs="*", type=Path)
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     p.add_argument("--config", action="append", choices=list(CONFIGS), help="default: every configuration")
+    p.add_argument("--book", action="store_true", help="also build the book strictly and run the browser check")
     sub.add_parser("show")
     args = ap.parse_args(argv)
     if args.cmd == "units":
@@ -251,7 +256,7 @@ def main(argv: list[str] | None = None) -> int:
         return unit(args.pytest_args or ["tests", "-m", "not browser"])
     paths = [p.resolve() for p in args.notebooks] or book_notebooks()
     if args.cmd == "suite":
-        return suite(paths, max(1, args.jobs), args.config or list(CONFIGS))
+        return suite(paths, max(1, args.jobs), args.config or list(CONFIGS), args.book)
     return nbval(paths, max(1, args.jobs), args.config or list(CONFIGS))
 
 
