@@ -1135,7 +1135,8 @@ def _errata_markdown(errata: pd.DataFrame) -> str:
         lines += [f"## {source} ({len(part)} {'erratum' if len(part) == 1 else 'errata'})", "",
                   "| location | printed | corrected | evidence |", "|---|---|---|---|"]
         for _, r in part.iterrows():
-            cells = [str(r["location"]), str(r["printed"]), _formula(r["corrected"]), str(r["evidence"])]
+            evidence = re.sub(r"book/([\w/.-]+?)\.ipynb", r"{doc}`/\1`", str(r["evidence"]))  # link the chapter
+            cells = [str(r["location"]), str(r["printed"]), _formula(r["corrected"]), evidence]
             lines.append("| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
         lines.append("")
     return "\n".join(lines)
