@@ -200,6 +200,13 @@ AMBIGUOUS = 0.95
 largest lies almost equally in two directions: its assignment (observable or not) hangs on a
 few per cent of its components and is no verdict (``ObservabilityDegrees.ambiguity``)."""
 
+LEVEL_COMBINATIONS = frozenset({"accel_bias.z", "accel_scale.z", "gyro_bias.x", "gyro_bias.y", "gyro_bias.z"})
+"""States that straight and level flight observes only in combinations (chen2019 Table 2-3, first
+column): ∇_z with f_z δK_az (both enter through C_b^n e_z), each gyro drift with its scale factor
+and misalignments times the constant ω_ib^b (and ε_E with φ_U).  Alone each is unobservable (the
+exact null-space criterion of :mod:`replication.crosschecks.chen2019_observability`); which
+member an SVD assignment names depends on the states' scaling."""
+
 
 def _clusters(sig, tol):
     """Indices of the singular values (descending) grouped where consecutive ones differ by no

@@ -10,23 +10,29 @@ A stored number must carry only the digits that every IEEE-754 machine computes 
 "Precision").  What differs between real x86-64 machines, and how each configuration reaches it
 on this one:
 
-* SIMD width and instruction set of compiled loops: numba compiles for the host CPU unless
-  ``NUMBA_CPU_NAME`` says otherwise; numpy dispatches its loops (sums, transcendental functions,
-  sorting) to AVX512/AVX2/SSE variants at import, restricted by ``NPY_DISABLE_CPU_FEATURES``.
-* FMA contraction: present with AVX2/FMA3 targets (numba host, OpenBLAS Haswell/Zen kernels),
-  absent on the generic and Sandy Bridge targets used below.
+* SIMD width of numpy's loops: numpy dispatches its loops (sums, transcendental functions,
+  sorting) to AVX512/AVX2/SSE variants at import, restricted by ``NPY_DISABLE_CPU_FEATURES``;
+  each variant has its own summation order and its own implementation of sin/exp/log.
 * BLAS kernels: OpenBLAS picks a kernel family per CPU (different blocking, so a different
-  summation order in every product and factorization); ``OPENBLAS_CORETYPE`` forces one.
-* Transcendental functions: numpy's own SIMD implementations per dispatch level, and glibc's
-  ifunc variants (FMA/AVX2 versions of exp, log, sin, pow ...), disabled by ``GLIBC_TUNABLES``.
+  summation order in every product and factorization, with or without FMA); ``OPENBLAS_CORETYPE``
+  forces one.
+* Transcendental functions of the C library: glibc's ifunc variants (FMA/AVX2 versions of exp,
+  log, sin, pow ...), disabled by ``GLIBC_TUNABLES``.
+* Compiled loops: numba compiles for the host CPU unless ``NUMBA_CPU_NAME`` says otherwise.
+  Without fastmath it neither contracts a·b+c into an FMA nor reassociates a reduction, so its
+  results do not depend on the target: ``tests/test_tooling.py::
+  test_compiled_kernels_are_bit_identical_across_numba_targets`` checks the package's kernels
+  bit for bit on the host, generic and Sandy Bridge targets.  Both configurations compile for
+  the generic target (one compilation serves both).
 
-``baseline`` is an x86-64 machine without AVX (SSE2-era code everywhere); ``avx`` is an AVX
-machine without FMA/AVX2 for numba and BLAS while numpy keeps its AVX2 loops.  Together with the
-native path used by ``make book`` these are three different code paths for every kind of
-arithmetic the package does; AVX512 code cannot run on every machine, but the mechanism by which
-it would differ (another accumulation order, another transcendental implementation) is the one
-exercised here.  Notebooks run in parallel (one shard per core); nbval compares every text
-output exactly (book/conftest.py lists what it skips), and ``tables/`` must be unchanged.
+``baseline`` is an x86-64 machine without AVX (SSE2 loops in numpy, OpenBLAS Nehalem kernels,
+glibc without its FMA/AVX2 variants); ``avx2`` an AVX2 machine without AVX512 (numpy's AVX2
+loops, OpenBLAS Haswell kernels with FMA, glibc native).  Together with the native path used by
+``make book`` (numpy AVX512 where the CPU has it, OpenBLAS's kernel for the CPU) these are three
+different code paths for every kind of arithmetic the package does: a number stable across all
+three differs by less than its stored precision on any x86-64 machine with the locked packages.
+Notebooks run in parallel (one shard per core); nbval compares every text output exactly
+(book/conftest.py lists what it skips), and ``tables/`` must be unchanged.
 """
 
 from __future__ import annotations
@@ -50,9 +56,10 @@ CONFIGS: dict[str, dict[str, str]] = {
         "OPENBLAS_CORETYPE": "Nehalem",
         "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA",
     },
-    "avx": {
-        "NUMBA_CPU_NAME": "sandybridge",
-        "OPENBLAS_CORETYPE": "Sandybridge",
+    "avx2": {
+        "NUMBA_CPU_NAME": "generic",
+        "NPY_DISABLE_CPU_FEATURES": "X86_V4 AVX512_ICL AVX512_SPR",
+        "OPENBLAS_CORETYPE": "Haswell",
     },
 }
 COMMON = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "PYTHONHASHSEED": "0",

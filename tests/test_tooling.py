@@ -1,12 +1,15 @@
-"""The notebook runner and checker that `make book` / `make test` rely on."""
+"""The notebook runner and checker that `make book` / `make test` rely on, and the premise of
+the portability configurations."""
 
 from __future__ import annotations
 
 import json
+import os
 import sys
 from pathlib import Path
 
 import nbformat
+import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scripts"))
 import check_notebooks  # noqa: E402
@@ -126,3 +129,47 @@ def test_book_glue_closes_a_figure_once_glued():
     fig, _ = plt.subplots()
     glue("fig-test", fig, display=False)
     assert not plt.fignum_exists(fig.number)  # not shown a second time at the end of the cell
+
+
+_TARGET_PROBE = r"""
+import hashlib, numpy as np
+from replication import _kernels as K, _polar_kernels as PK
+rng = np.random.default_rng(5)
+n = 2000
+dt = np.full(n, 0.01)
+dth = 1e-4 * rng.standard_normal((n, 3)); dv = 0.098 * np.tile([0.0, 0.0, 1.0], (n, 1)) + 1e-3 * rng.standard_normal((n, 3))
+st0 = np.array([0.7, 2.0, 500.0, 50.0, 10.0, 0.0]); q0 = np.array([1.0, 0.0, 0.0, 0.0])
+out_st, out_q = np.empty((n + 1, 6)), np.empty((n + 1, 4))
+K.strapdown_kernel(dt, dth, dv, st0, q0, 0, np.zeros(n + 1), np.zeros(n + 1), np.zeros(3), out_st, out_q)
+F = 0.01 * rng.standard_normal((15, 15)); Qc = np.eye(15) * 1e-6
+Phi, Qd, w1, w2 = (np.empty((15, 15)) for _ in range(4))
+K.discretize_series(F, Qc, 0.05, 4, Phi, Qd, w1, w2)
+p = np.zeros(PK.N_TRAJ); p[1], p[3], p[4:8] = 1.4, 1e-6, (0.3, 0.05, 0.08, 0.02); p[8:11] = (10.0, 12.0, 15.0)
+cbe, re, rde = np.empty((3, 3)), np.empty(3), np.empty(3)
+acc = []
+for t in np.linspace(0.0, 3600.0, 500):
+    PK.truth(t, p, cbe, re, rde); acc.append(np.concatenate([cbe.ravel(), re, rde]))
+print(hashlib.sha256(np.concatenate([out_st.ravel(), out_q.ravel(), Phi.ravel(), Qd.ravel(),
+                                     np.ravel(acc)]).tobytes()).hexdigest())
+"""
+
+
+@pytest.mark.slow
+def test_compiled_kernels_are_bit_identical_across_numba_targets(tmp_path):
+    """The premise of the portability configurations (scripts/portability.py): numba compiles
+    without fastmath, so neither FMA contraction nor reassociation happens, and the package's
+    kernels (strapdown, the Van Loan series, the polar truth with its transcendentals) give
+    the same bits for the host CPU, a generic x86-64 and Sandy Bridge targets."""
+    import subprocess
+    import sys
+
+    digests = {}
+    for cpu in ("host", "generic", "sandybridge"):
+        env = {k: v for k, v in os.environ.items() if k != "NUMBA_CPU_NAME"}
+        env["NUMBA_CACHE_DIR"] = str(tmp_path / cpu)  # compile afresh for this target
+        if cpu != "host":
+            env["NUMBA_CPU_NAME"] = cpu
+        r = subprocess.run([sys.executable, "-c", _TARGET_PROBE], env=env, capture_output=True, text=True, check=True)
+        digests[cpu] = r.stdout.strip()
+    assert len(digests["host"]) == 64
+    assert len(set(digests.values())) == 1, digests
