@@ -196,7 +196,29 @@ def suite_jobs(paths: list[Path], configs: list[str], book: bool = False) -> lis
         if small:
             jobs.append((f"nbval under '{name}': {len(small)} short notebooks", _pytest_nbval(small), env,
                          sum(cost(p) for p in small)))
-    return sorted(jobs, key=lambda j: -j[3])
+    return _interleave(sorted(jobs, key=lambda j: -j[3]))
+
+
+def _interleave(jobs: list) -> list:
+    """Slowest first, but the same notebook under two configurations never starts at the same
+    time: both configurations compile numba's kernels for the same target, so the second run of
+    a notebook should start once the first has compiled them (numba's cache then serves it).
+    Each notebook job of a later configuration moves one place behind the next job."""
+    out = list(jobs)
+    seen: set[str] = set()
+    i = 0
+    while i < len(out) - 1:
+        label = out[i][0]
+        nb = label.split(": ", 1)[1] if label.startswith("nbval under") else None
+        if nb is not None and nb in seen:
+            out[i], out[i + 1] = out[i + 1], out[i]
+            seen.add(out[i][0].split(": ", 1)[1] if out[i][0].startswith("nbval under") else out[i][0])
+            i += 2
+            continue
+        if nb is not None:
+            seen.add(nb)
+        i += 1
+    return out
 
 
 def suite(paths: list[Path], jobs: int, configs: list[str], book: bool = False) -> int:
