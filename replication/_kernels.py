@@ -497,20 +497,6 @@ def discretize_series(F, Qc, T, order, Phi, Qd, w1, w2):
 
 
 @njit(**_NJ)
-def _propagate_P(Phi, P, Qd, w1):
-    n = P.shape[0]
-    _matmul_sp(Phi, P, w1)
-    for i in range(n):
-        for j in range(i, n):
-            acc = 0.0
-            for k in range(n):
-                acc += w1[i, k] * Phi[j, k]
-            v = acc + 0.5 * (Qd[i, j] + Qd[j, i])
-            P[i, j] = v
-            P[j, i] = v
-
-
-@njit(**_NJ)
 def _chol_solve_scaled(P, e):
     """eᵀ P⁻¹ e with P scaled to a correlation matrix first (P may span many decades)."""
     n = P.shape[0]
@@ -532,48 +518,6 @@ def _chol_solve_scaled(P, e):
     for i in range(n):
         s += y[i] * y[i]
     return s
-
-
-@njit(**_NJ)
-def joseph_update(P, H, R, z, x, w1, w2):
-    """Joseph-form update with a diagonal R, applied one measurement at a time.
-
-    For each row h, r of (H, R): ν = z_i - h x, b = P h, s = hᵀb + r, K = b/s, x += K ν and
-    P ← (I - K hᵀ) P (I - K hᵀ)ᵀ + r K Kᵀ = P - K bᵀ - b Kᵀ + s K Kᵀ (the Joseph form expanded,
-    valid for any gain).  x starts from zero (closed loop).  Returns the NIS νᵀS⁻¹ν of the whole
-    vector, which the sequential innovations give exactly as Σ ν_i²/s_i.
-    """
-    n = P.shape[0]
-    m = H.shape[0]
-    bvec = w1[0]
-    kvec = w1[1]
-    for i in range(n):
-        x[i] = 0.0
-    nis = 0.0
-    for r in range(m):
-        nu = z[r]
-        for k in range(n):
-            nu -= H[r, k] * x[k]
-        for i in range(n):
-            acc = 0.0
-            for k in range(n):
-                hk = H[r, k]
-                if hk != 0.0:
-                    acc += P[i, k] * hk
-            bvec[i] = acc
-        sv = R[r, r]
-        for k in range(n):
-            sv += H[r, k] * bvec[k]
-        for i in range(n):
-            kvec[i] = bvec[i] / sv
-            x[i] += kvec[i] * nu
-        for i in range(n):
-            for j in range(i, n):
-                v = P[i, j] - kvec[i] * bvec[j] - bvec[i] * kvec[j] + sv * kvec[i] * kvec[j]
-                P[i, j] = v
-                P[j, i] = v
-        nis += nu * nu / sv
-    return nis
 
 
 # ----------------------------------------------------------------------------- closed loop
@@ -598,8 +542,8 @@ def _apply_corrections(u, T, p_hat, blk_target, blk_kind, blk_start, blk_size, t
 
 
 # ----------------------------------------------------------------------------- closed-loop steps
-# Shared by closed_loop_kernel, the batched filter of replication.simulation and the augmented
-# filter of replication.gravity: one GNSS interval's time update, the feedback, the resets.
+# Steps of the closed-loop filter of replication.closedloop: interval sums, discretization,
+# feedback, resets.
 
 @njit(**_NJ)
 def _accumulate_interval(c, fb, st, fsum, Csum, navsum):
@@ -646,42 +590,6 @@ def _interval_discretize(F, qc_const, Cm, q_accel, q_gyro, T, order, Qc, Phi, Qd
             Qc[3 + i, 3 + jj] += sa
             Qc[6 + i, 6 + jj] += sg
     discretize_series(F, Qc, T, order, Phi, Qd, w1, w2)
-
-
-@njit(**_NJ)
-def _interval_time_update(navsum, fsum, Csum, Cpl, nsum, tsum, fconst, qc_const, q_accel, q_gyro, order,
-                          F, Qc, Phi, Qd, w1, w2, P):
-    """Time update over one GNSS interval from the sums of ``_accumulate_interval`` over ``nsum``
-    IMU steps of total length ``tsum``: F of the averaged inputs (``build_F_core``) plus the
-    averaged block couplings ``Cpl`` (rows 0-2 accelerometer into δv, rows 3-5 gyro into φ with
-    sign -), Qc with the navigation white noise at the mean C_b^n (``Csum`` is averaged in place),
-    (Φ, Q_d) and P = Φ P Φᵀ + Q_d."""
-    n = F.shape[0]
-    inv = 1.0 / nsum
-    build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
-                 fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, fconst, F)
-    for i in range(3):
-        for jj in range(9, n):
-            F[3 + i, jj] += Cpl[i, jj] * inv
-            F[6 + i, jj] -= Cpl[3 + i, jj] * inv
-    for i in range(3):
-        for jj in range(3):
-            Csum[i, jj] *= inv
-    _interval_discretize(F, qc_const, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2)
-    _propagate_P(Phi, P, Qd, w1)
-
-
-@njit(**_NJ)
-def _propagate_estimates(Phi, p_hat, tmp):
-    """Sensor-error estimates follow their own dynamics: p̂ = Φ[9:, 9:] p̂ (``tmp`` scratch)."""
-    n_aug = p_hat.shape[0]
-    for i in range(n_aug):
-        acc = 0.0
-        for jj in range(n_aug):
-            acc += Phi[9 + i, 9 + jj] * p_hat[jj]
-        tmp[i] = acc
-    for i in range(n_aug):
-        p_hat[i] = tmp[i]
 
 
 @njit(**_NJ)
@@ -800,174 +708,3 @@ def _feedback_blocks(p_hat, blk_target, blk_start, blk_size, fconst, lever0, lev
                 g_extra[i] = acc
 
 
-@njit(**_NJ)
-def closed_loop_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains,
-                       gnss_idx, gnss_pos, gnss_vel, use_pos, use_vel, R_pos, R_vel, lever0,
-                       P0, fconst, qc_const, q_accel, q_gyro,
-                       blk_target, blk_kind, blk_start, blk_size, order,
-                       truth_st, truth_q, truth_p, compute_nees,
-                       store_nav, out_st, out_q,
-                       ep_st, ep_q, ep_phat, ep_Pdiag, ep_nis, ep_nees, ep_innov, ep_P):
-    """Closed-loop (feedback) INS/GNSS error-state Kalman filter over a whole record.
-
-    IMU-rate strapdown with the current sensor-error estimates removed from the increments;
-    F averaged over each GNSS interval, (Φ, Q_d) by the Van Loan series, Joseph update with the
-    GNSS position (E, N, U metres at the antenna, chen2019 eq. (2-13)) and/or velocity, then
-    feedback of the navigation errors and accumulation of the sensor-error estimates.
-    """
-    n_imu = dtheta.shape[0]
-    n = P0.shape[0]
-    n_aug = n - 9
-    st = st0.copy()
-    st_prev = st0.copy()
-    q = q0.copy()
-    qtmp = np.empty(4)
-    c = np.empty((3, 3))
-    w_ie = np.empty(3)
-    w_en = np.empty(3)
-    ta = np.empty(3)
-    tb = np.empty(3)
-    g_extra = np.zeros(3)
-    trig = np.array([st0[0], math.sin(st0[0]), math.cos(st0[0])])
-    P = P0.copy()
-    p_hat = np.zeros(n_aug)
-    lever = lever0.copy()
-    Fsum = np.zeros((n, n))
-    Csum = np.zeros((3, 3))
-    Cpl = np.zeros((6, n))
-    fsum = np.zeros(3)
-    navsum = np.zeros(5)
-    Phi = np.empty((n, n))
-    Qd = np.empty((n, n))
-    Qc = np.empty((n, n))
-    w1 = np.empty((n, n))
-    w2 = np.empty((n, n))
-    B = np.empty((3, 6))
-    dth_c = np.empty(3)
-    dv_c = np.empty(3)
-    dth_cp = np.zeros(3)
-    dv_cp = np.zeros(3)
-    fb = np.empty(3)
-    wb = np.empty(3)
-    xk = np.empty(n)
-    e = np.empty(n)
-    m_meas = 3 * (use_pos + use_vel)
-    H = np.zeros((m_meas, n))
-    Rm = np.zeros((m_meas, m_meas))
-    z = np.zeros(m_meas)
-    dampint = 0.0
-    nsum = 0
-    tsum = 0.0
-    j = 0
-    n_ep = gnss_idx.shape[0]
-    if store_nav:
-        out_st[0, :] = st
-        out_q[0, :] = q
-    for k in range(n_imu):
-        T = dt[k]
-        _apply_corrections(dtheta[k], T, p_hat, blk_target, blk_kind, blk_start, blk_size, 1, dth_c, B)
-        _apply_corrections(dv[k], T, p_hat, blk_target, blk_kind, blk_start, blk_size, 0, dv_c, B)
-        if k == 0:
-            dth_cp[:] = dth_c
-            dv_cp[:] = dv_c
-        # inputs of F at the start of the step (nav state k, corrected IMU of the step), summed
-        # over the GNSS interval: F is affine in f^n and in the couplings C_b^n B(u), and the
-        # navigation state barely moves in an interval, so F(averages) = average of F to O(T²)
-        _q2c(q, c)
-        for i in range(3):
-            fb[i] = dv_c[i] / T
-            wb[i] = dth_c[i] / T
-        _accumulate_interval(c, fb, st, fsum, Csum, navsum)
-        accumulate_coupling(c, fb, wb, blk_target, blk_kind, blk_start, blk_size, 1.0, Cpl, B)
-        nsum += 1
-        tsum += T
-        dampint = sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, qtmp, c, w_ie, w_en, ta, tb,
-                          vmode, h_ref[k + 1] if vmode == 1 else h_ref[k], vu_ref[k + 1], gains,
-                          dampint, g_extra, trig)
-        dth_cp[:] = dth_c
-        dv_cp[:] = dv_c
-        if j < n_ep and gnss_idx[j] == k + 1:
-            # ---- time update over the interval (nav white noise: G = [0; C; -C])
-            _interval_time_update(navsum, fsum, Csum, Cpl, nsum, tsum, fconst, qc_const, q_accel, q_gyro, order,
-                                  Fsum, Qc, Phi, Qd, w1, w2, P)
-            # sensor-error estimates follow their own dynamics (Markov decay)
-            _propagate_estimates(Phi, p_hat, xk)
-            # ---- measurement
-            _q2c(q, c)
-            L, h = st[0], st[2]
-            rm, rn = radii_s(L)
-            cl = math.cos(L)
-            la0 = c[0, 0] * lever[0] + c[0, 1] * lever[1] + c[0, 2] * lever[2]
-            la1 = c[1, 0] * lever[0] + c[1, 1] * lever[1] + c[1, 2] * lever[2]
-            la2 = c[2, 0] * lever[0] + c[2, 1] * lever[1] + c[2, 2] * lever[2]
-            for i in range(m_meas):
-                for jj in range(n):
-                    H[i, jj] = 0.0
-            # antenna velocity v + C (ω_eb^b × l); ω_eb^b ≈ corrected gyro rate - C^T ω_ie
-            rates_s(L, h, st[3], st[4], w_ie, w_en)
-            wbx = dth_c[0] / T - (c[0, 0] * w_ie[0] + c[1, 0] * w_ie[1] + c[2, 0] * w_ie[2])
-            wby = dth_c[1] / T - (c[0, 1] * w_ie[0] + c[1, 1] * w_ie[1] + c[2, 1] * w_ie[2])
-            wbz = dth_c[2] / T - (c[0, 2] * w_ie[0] + c[1, 2] * w_ie[1] + c[2, 2] * w_ie[2])
-            gnss_rows(H, c, lever, wbx, wby, wbz, L, h, use_pos, use_vel, blk_target, blk_start)
-            r = 0
-            if use_pos:
-                z[0] = (st[1] - gnss_pos[j, 1]) * (rn + h) * cl + la0
-                z[1] = (st[0] - gnss_pos[j, 0]) * (rm + h) + la1
-                z[2] = (st[2] - gnss_pos[j, 2]) + la2
-                for i in range(3):
-                    for jj in range(3):
-                        Rm[i, jj] = R_pos[i, jj]
-                r = 3
-            if use_vel:
-                cx = wby * lever[2] - wbz * lever[1]
-                cy = wbz * lever[0] - wbx * lever[2]
-                cz = wbx * lever[1] - wby * lever[0]
-                for i in range(3):
-                    z[r + i] = st[3 + i] + c[i, 0] * cx + c[i, 1] * cy + c[i, 2] * cz - gnss_vel[j, i]
-                    for jj in range(3):
-                        Rm[r + i, r + jj] = R_vel[i, jj]
-            nis = joseph_update(P, H, Rm, z, xk, w1, w2)
-            # ---- feedback (gravity compensation: ĝ^n = output rows of fconst, velocity rows, sign -)
-            _feedback_nav(xk, st, st_prev, q, p_hat, qtmp)
-            _feedback_blocks(p_hat, blk_target, blk_start, blk_size, fconst, lever0, lever, g_extra)
-            # ---- records
-            ep_st[j, :] = st
-            ep_q[j, :] = q
-            for i in range(n_aug):
-                ep_phat[j, i] = p_hat[i]
-            for i in range(n):
-                ep_Pdiag[j, i] = P[i, i]
-            ep_nis[j] = nis
-            for i in range(m_meas):
-                ep_innov[j, i] = z[i]
-            if ep_P.shape[0] > 0:
-                ep_P[j, :, :] = P
-            if compute_nees:
-                e[0] = st[0] - truth_st[j, 0]
-                e[1] = st[1] - truth_st[j, 1]
-                e[2] = st[2] - truth_st[j, 2]
-                e[3] = st[3] - truth_st[j, 3]
-                e[4] = st[4] - truth_st[j, 4]
-                e[5] = st[5] - truth_st[j, 5]
-                # φ from Ĉ C^T = exp(-φ×): quaternion of q̂ ⊗ q_true*
-                t0, t1, t2, t3 = truth_q[j, 0], -truth_q[j, 1], -truth_q[j, 2], -truth_q[j, 3]
-                a1, b1, c1, d1 = q[0], q[1], q[2], q[3]
-                r0 = a1 * t0 - b1 * t1 - c1 * t2 - d1 * t3
-                r1 = a1 * t1 + b1 * t0 + c1 * t3 - d1 * t2
-                r2 = a1 * t2 - b1 * t3 + c1 * t0 + d1 * t1
-                r3 = a1 * t3 + b1 * t2 - c1 * t1 + d1 * t0
-                sg = 1.0 if r0 >= 0 else -1.0
-                e[6] = -2.0 * sg * r1
-                e[7] = -2.0 * sg * r2
-                e[8] = -2.0 * sg * r3
-                for i in range(n_aug):
-                    e[9 + i] = truth_p[j, i] - p_hat[i]
-                ep_nees[j] = _chol_solve_scaled(P, e)
-            j += 1
-            _reset_interval(Cpl, fsum, Csum, navsum)
-            nsum = 0
-            tsum = 0.0
-        if store_nav:
-            out_st[k + 1, :] = st
-            out_q[k + 1, :] = q
-    return p_hat

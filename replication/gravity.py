@@ -25,11 +25,10 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 from scipy import integrate, interpolate, signal
 
 from . import earth
-from . import _kernels as K
+from . import closedloop as CL
 from .timeseries import _phi, ar_poles, is_stationary
 from .units import MGAL
 
@@ -848,162 +847,6 @@ def slope_weights(t_gnss, t_imu) -> np.ndarray:
     return C[seg] * np.diff(ti)
 
 
-@njit(cache=True, nogil=True)
-def _augmented_kernel(dt, dtheta, dv, st0, q0, gnss_idx, gnss_pos, gnss_vel, R_pos, R_vel, P0, fconst, qc_const,
-                      q_accel, q_gyro, tg, kd, bst, bsz, order, wgt, win, win_end, a_gnss, R_sf, Hg, gS, gstart,
-                      ar_tick, Tg, Qg, out_st, out_q):
-    n_imu = dtheta.shape[0]
-    n = P0.shape[0]
-    n_aug = n - 9
-    st = st0.copy()
-    st_prev = st0.copy()
-    q = q0.copy()
-    qtmp = np.empty(4)
-    c = np.empty((3, 3))
-    w_ie = np.empty(3)
-    w_en = np.empty(3)
-    ta = np.empty(3)
-    tb = np.empty(3)
-    g_extra = np.zeros(3)
-    trig = np.array([st0[0], math.sin(st0[0]), math.cos(st0[0])])
-    gains = np.zeros(3)
-    Ta = np.ascontiguousarray(Tg[9:, 9:])
-    P = P0.copy()
-    p_hat = np.zeros(n_aug)
-    Fsum = np.zeros((n, n))
-    Csum = np.zeros((3, 3))
-    Cpl = np.zeros((6, n))
-    fsum = np.zeros(3)
-    navsum = np.zeros(5)
-    Phi = np.empty((n, n))
-    Qd = np.empty((n, n))
-    Qc = np.empty((n, n))
-    w1 = np.empty((n, n))
-    w2 = np.empty((n, n))
-    B = np.empty((3, 6))
-    dth_c = np.empty(3)
-    dv_c = np.empty(3)
-    dth_cp = np.zeros(3)
-    dv_cp = np.zeros(3)
-    fb = np.empty(3)
-    xk = np.empty(n)
-    H6 = np.zeros((6, n))
-    R6 = np.zeros((6, 6))
-    z6 = np.zeros(6)
-    H9 = np.zeros((9, n))
-    R9 = np.zeros((9, 9))
-    z9 = np.zeros(9)
-    vacc = np.zeros(3)   # weighted mean INS acceleration of the current window
-    facc = np.zeros(3)   # weighted mean f^n
-    Cw = np.zeros((6, n))  # window means of C_b^n B(u) per sensor block (rows 0-2: accelerometers)
-    wb = np.empty(3)
-    lever0 = np.zeros(3)   # no antenna lever arm in this filter
-    n_sf = 0
-    nsum = 0
-    tsum = 0.0
-    j = 0
-    n_ep = gnss_idx.shape[0]
-    out_st[0, :] = st
-    out_q[0, :] = q
-    for k in range(n_imu):
-        T = dt[k]
-        K._apply_corrections(dtheta[k], T, p_hat, tg, kd, bst, bsz, 1, dth_c, B)
-        K._apply_corrections(dv[k], T, p_hat, tg, kd, bst, bsz, 0, dv_c, B)
-        if k == 0:
-            dth_cp[:] = dth_c
-            dv_cp[:] = dv_c
-        K._q2c(q, c)
-        for i in range(3):
-            fb[i] = dv_c[i] / T
-        K._accumulate_interval(c, fb, st, fsum, Csum, navsum)
-        if win[k] >= 0:
-            for i in range(3):
-                facc[i] += wgt[k] * (c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2])
-        for i in range(3):
-            wb[i] = dth_c[i] / T
-        K.accumulate_coupling(c, fb, wb, tg, kd, bst, bsz, 1.0, Cpl, B)
-        if win[k] >= 0:
-            K.accumulate_coupling(c, fb, wb, tg, kd, bst, bsz, wgt[k], Cw, B)   # window mean of C B(f^b)
-        nsum += 1
-        tsum += T
-        v0, v1, v2 = st[3], st[4], st[5]
-        K.sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, qtmp, c, w_ie, w_en, ta, tb,
-                  0, 0.0, 0.0, gains, 0.0, g_extra, trig)
-        if win[k] >= 0:
-            vacc[0] += wgt[k] * (st[3] - v0) / T
-            vacc[1] += wgt[k] * (st[4] - v1) / T
-            vacc[2] += wgt[k] * (st[5] - v2) / T
-        dth_cp[:] = dth_c
-        dv_cp[:] = dv_c
-        if j < n_ep and gnss_idx[j] == k + 1:
-            K._interval_time_update(navsum, fsum, Csum, Cpl, nsum, tsum, fconst, qc_const, q_accel, q_gyro, order,
-                                    Fsum, Qc, Phi, Qd, w1, w2, P)
-            K._propagate_estimates(Phi, p_hat, xk)
-            if ar_tick[j]:
-                # discrete AR step of the gravity states (held between steps): P <- T P T' + Q
-                P[:, :] = Tg @ P @ Tg.T + Qg
-                xk[9:] = Ta @ p_hat
-                p_hat[:] = xk[9:]
-            # ---- position / velocity rows of (3-18)
-            L, h = st[0], st[2]
-            rm, rn = K.radii_s(L)
-            sf = win_end[j]
-            H = H9 if sf >= 0 else H6
-            Rm = R9 if sf >= 0 else R6
-            z = z9 if sf >= 0 else z6
-            for i in range(H.shape[0]):
-                for jj in range(n):
-                    H[i, jj] = 0.0
-            z[0] = (st[1] - gnss_pos[j, 1]) * (rn + h) * math.cos(L)
-            z[1] = (st[0] - gnss_pos[j, 0]) * (rm + h)
-            z[2] = st[2] - gnss_pos[j, 2]
-            K.gnss_rows(H, c, lever0, 0.0, 0.0, 0.0, L, h, True, True, tg, bst)
-            for i in range(3):
-                z[3 + i] = st[3 + i] - gnss_vel[j, i]
-                for jj in range(3):
-                    Rm[i, jj] = R_pos[i, jj]
-                    Rm[3 + i, 3 + jj] = R_vel[i, jj]
-            # ---- specific-force rows of (3-18): INS acceleration minus GNSS acceleration, same window
-            if sf >= 0:
-                for i in range(3):
-                    z[6 + i] = vacc[i] - a_gnss[sf, i]
-                    Rm[6 + i, 6 + i] = R_sf[sf, i]
-                    for jj in range(n_aug):
-                        H[6 + i, 9 + jj] = Hg[i, jj]
-                # f^n x phi
-                H[6, 7] = -facc[2]
-                H[6, 8] = facc[1]
-                H[7, 6] = facc[2]
-                H[7, 8] = -facc[0]
-                H[8, 6] = -facc[1]
-                H[8, 7] = facc[0]
-                for b in range(tg.shape[0]):
-                    if tg[b] == K.TARGET_ACCEL:
-                        for i in range(3):
-                            for jj in range(bsz[b]):
-                                H[6 + i, bst[b] + jj] += Cw[i, bst[b] + jj]
-                n_sf += 1
-            K.joseph_update(P, H, Rm, z, xk, w1, w2)
-            if sf >= 0:
-                for i in range(3):
-                    vacc[i] = 0.0
-                    facc[i] = 0.0
-                Cw[:, :] = 0.0
-            K._feedback_nav(xk, st, st_prev, q, p_hat, qtmp)
-            for i in range(3):
-                acc = 0.0
-                for jj in range(gS.shape[1]):
-                    acc += gS[i, jj] * p_hat[gstart - 9 + jj]
-                g_extra[i] = acc
-            j += 1
-            K._reset_interval(Cpl, fsum, Csum, navsum)
-            nsum = 0
-            tsum = 0.0
-        out_st[k + 1, :] = st
-        out_q[k + 1, :] = q
-    return n_sf
-
-
 def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float | None = None, P0=None,
                      discrete=None, use_specific_force: bool = True, series_order: int = 4):
     """Closed-loop INS/GNSS filter with the 9-dimensional measurement of chen2019 eq. (3-18).
@@ -1051,7 +894,6 @@ def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float 
         raise ValueError("the model needs exactly one gravity block (errors.gravity_shaping or ar_gravity_block)")
     gblk = model.block(names[0])
     gs = model.slices[names[0]]
-    fconst, qc, tg, kd, bst, bsz = model._encoding()
     P0 = model.P0() if P0 is None else np.asarray(P0, float)
     if P0.shape != (model.n, model.n):
         raise ValueError(f"P0 must be {model.n}x{model.n}")
@@ -1101,13 +943,28 @@ def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float 
         ar_tick[np.arange(m, len(idx), m)] = 1
     if not use_specific_force:
         win_end[:] = -1
-    out_st = np.empty((n + 1, 6))
-    out_q = np.empty((n + 1, 4))
     R_pos = np.diag(np.broadcast_to(np.asarray(gnss.sigma_pos, float), (3,)) ** 2)
     R_vel = np.diag(np.broadcast_to(np.asarray(gnss.sigma_vel, float), (3,)) ** 2)
-    _augmented_kernel(np.diff(t), dtheta, dv, initial.vector(), dcm_to_quat(initial.C_bn), idx,
-                      np.ascontiguousarray(gnss.position), np.ascontiguousarray(gnss.v_enu, float), R_pos, R_vel,
-                      np.ascontiguousarray(P0), fconst, qc, model.accel_psd, model.gyro_psd, tg, kd, bst, bsz,
-                      int(series_order), wgt, win, win_end, a_g, R_sf, Hg, np.ascontiguousarray(gblk.output, float),
-                      int(gs.start), ar_tick, Tg, Qg, out_st, out_q)
-    return NavSolution(t, out_st[:, 0], out_st[:, 1], out_st[:, 2], out_st[:, 3:6], out_q)
+    spec = CL.build_spec(model, R_pos=R_pos, R_vel=R_vel, series_order=series_order,
+                         ar=(Tg, Qg) if discrete is not None else None, sf_H=Hg)
+    gpos = np.ascontiguousarray(gnss.position, dtype=float)[None]
+    gvel = np.ascontiguousarray(gnss.v_enu, dtype=float)[None]
+    dtv = np.diff(t)
+
+    def inputs(ci, k0, k1, eps):
+        j0 = int(np.searchsorted(idx, eps[0]))
+        j1 = j0 + len(eps)
+        none = CL.no_windows(k1 - k0, j1 - j0, 1, model.n - 9)
+        return CL.ChunkInputs(dt=np.ascontiguousarray(dtv[k0:k1]), dth=np.ascontiguousarray(dtheta[None, k0:k1]),
+                              dvv=np.ascontiguousarray(dv[None, k0:k1]), h_ref=np.zeros(k1 - k0 + 1),
+                              vu_ref=np.zeros(k1 - k0 + 1), ep_step=(np.asarray(eps, np.int64) - 1 - k0),
+                              gpos=np.ascontiguousarray(gpos[:, j0:j1]), gvel=np.ascontiguousarray(gvel[:, j0:j1]),
+                              sf_w=np.ascontiguousarray(wgt[k0:k1]), sf_win=np.ascontiguousarray(win[k0:k1]),
+                              sf_end=np.ascontiguousarray(win_end[j0:j1]), sf_a=np.ascontiguousarray(a_g),
+                              sf_R=np.ascontiguousarray(R_sf), ar_tick=np.ascontiguousarray(ar_tick[j0:j1]),
+                              truth_st=none["truth_st"], truth_q=none["truth_q"], truth_p=none["truth_p"])
+
+    state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], np.zeros(3))
+    rec = CL.run(spec, state, P0, idx, n, inputs, store_nav=True, workers=1)
+    return NavSolution(t, rec.nav_st[0, :, 0], rec.nav_st[0, :, 1], rec.nav_st[0, :, 2], rec.nav_st[0, :, 3:6],
+                       rec.nav_q[0])

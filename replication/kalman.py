@@ -14,7 +14,6 @@ spread over threads (the compiled loop releases the GIL).
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +22,7 @@ from scipy import stats
 
 from . import earth
 from . import _kernels as K
+from . import closedloop as CL
 from .errors import ErrorModel
 from .rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from .sensors import GnssMeasurements, ImuErrors, TriadErrors
@@ -258,46 +258,54 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     P0 = model.P0() if P0 is None else np.asarray(P0, float)
     if P0.shape != (model.n, model.n):
         raise ValueError(f"P0 must be {model.n}×{model.n}")
-    fconst, qc, tg, kd, st, sz = model._encoding()
     m_ep = len(gnss.index)
     n_aug = model.n - 9
-    R_pos = np.diag(np.asarray(gnss.sigma_pos, float) ** 2)
-    R_vel = np.diag(np.asarray(gnss.sigma_vel, float) ** 2)
-    gpos = np.ascontiguousarray(gnss.position)
-    gvel = np.ascontiguousarray(gnss.v_enu, float)
     compute_nees = truth is not None
+    idx = np.asarray(gnss.index, np.int64)
     if compute_nees:
         if len(truth.t) != n + 1:
             raise ValueError("truth must have the same samples as the IMU record")
-        idx = gnss.index
         tst = np.column_stack([truth.lat[idx], truth.lon[idx], truth.h[idx], truth.v_enu[idx]])
         tq = dcm_to_quat(euler_to_dcm(truth.hpr[idx, 0], truth.hpr[idx, 1], truth.hpr[idx, 2]))
-        tp = np.zeros((m_ep, n_aug)) if true_params is None else np.ascontiguousarray(
-            np.broadcast_to(np.asarray(true_params, float), (m_ep, n_aug)))
+        tp = np.zeros((m_ep, n_aug)) if true_params is None else np.broadcast_to(
+            np.asarray(true_params, float), (m_ep, n_aug))
     else:
-        tst, tq, tp = np.zeros((1, 6)), np.zeros((1, 4)), np.zeros((1, max(n_aug, 1)))
-    out_st = np.empty((n + 1 if store_nav else 1, 6))
-    out_q = np.empty((n + 1 if store_nav else 1, 4))
-    ep_st = np.empty((m_ep, 6))
-    ep_q = np.empty((m_ep, 4))
-    ep_p = np.empty((m_ep, n_aug))
-    ep_pd = np.empty((m_ep, model.n))
-    ep_nis = np.empty(m_ep)
-    ep_nees = np.full(m_ep, np.nan)
+        tst, tq, tp = np.zeros((m_ep, 6)), np.zeros((m_ep, 4)), np.zeros((m_ep, n_aug))
+    spec = CL.build_spec(model, R_pos=np.diag(np.asarray(gnss.sigma_pos, float) ** 2),
+                         R_vel=np.diag(np.broadcast_to(np.asarray(gnss.sigma_vel, float), (3,)) ** 2),
+                         lever_arm_b=gnss.lever_arm_b, use_position=use_position, use_velocity=use_velocity,
+                         vmode=_VMODES[vertical], gains=gains, series_order=series_order, nees=compute_nees)
+    state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], gnss.lever_arm_b)
+    rec = CL.run(spec, state, P0, idx, n, _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp),
+                 store_nav=store_nav, chunk_epochs=max(m_ep, 2), workers=1)
     nm = 3 * (int(use_position) + int(use_velocity))
-    ep_inn = np.empty((m_ep, nm))
-    ep_P = np.empty((m_ep if store_P else 0, model.n, model.n))
-    K.closed_loop_kernel(np.diff(t), dtheta, dv, initial.vector(), dcm_to_quat(initial.C_bn), _VMODES[vertical],
-                         href, vuref, gains, np.asarray(gnss.index, np.int64), gpos, gvel, int(use_position),
-                         int(use_velocity), R_pos, R_vel, np.asarray(gnss.lever_arm_b, float),
-                         np.ascontiguousarray(P0), fconst, qc, model.accel_psd, model.gyro_psd, tg, kd, st, sz,
-                         int(series_order), np.ascontiguousarray(tst), np.ascontiguousarray(tq), tp, compute_nees,
-                         store_nav, out_st, out_q, ep_st, ep_q, ep_p, ep_pd, ep_nis, ep_nees, ep_inn, ep_P)
     sol = None
     if store_nav:
-        sol = NavSolution(t, out_st[:, 0], out_st[:, 1], out_st[:, 2], out_st[:, 3:6], out_q)
-    return ClosedLoopResult(model, t[gnss.index], ep_st, ep_q, ep_p, ep_pd, ep_inn, ep_nis,
-                            ep_nees if compute_nees else None, ep_P if store_P else None, sol)
+        sol = NavSolution(t, rec.nav_st[0, :, 0], rec.nav_st[0, :, 1], rec.nav_st[0, :, 2], rec.nav_st[0, :, 3:6],
+                          rec.nav_q[0])
+    return ClosedLoopResult(model, t[idx], rec.st[0], rec.q[0], rec.p_hat[0], rec.pdiag_all, rec.innov[0, :, :nm],
+                            rec.nis[0], rec.nees[0] if compute_nees else None, rec.P if store_P else None, sol)
+
+
+def _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp):
+    """The :data:`replication.closedloop.ChunkInputs` of one recorded run, chunk by chunk."""
+    gpos = np.ascontiguousarray(gnss.position, dtype=float)[None]
+    gvel = np.ascontiguousarray(gnss.v_enu, dtype=float)[None]
+    dt = np.diff(t)
+    tp = np.ascontiguousarray(tp)[None]
+
+    def inputs(ci, k0, k1, eps):
+        j0 = int(np.searchsorted(idx, eps[0])) if len(eps) else 0
+        j1 = j0 + len(eps)
+        extra = CL.no_windows(k1 - k0, j1 - j0, 1, tp.shape[2])
+        extra.update(truth_st=np.ascontiguousarray(tst[j0:j1]), truth_q=np.ascontiguousarray(tq[j0:j1]),
+                     truth_p=np.ascontiguousarray(tp[:, j0:j1]))
+        return CL.ChunkInputs(dt=np.ascontiguousarray(dt[k0:k1]), dth=np.ascontiguousarray(dtheta[None, k0:k1]),
+                              dvv=np.ascontiguousarray(dv[None, k0:k1]), h_ref=np.ascontiguousarray(href[k0:k1 + 1]),
+                              vu_ref=np.ascontiguousarray(vuref[k0:k1 + 1]),
+                              ep_step=(np.asarray(eps, np.int64) - 1 - k0), gpos=np.ascontiguousarray(gpos[:, j0:j1]),
+                              gvel=np.ascontiguousarray(gvel[:, j0:j1]), **extra)
+    return inputs
 
 
 def perturb_state(state: NavState, model: ErrorModel, rng=None) -> NavState:
@@ -331,32 +339,6 @@ class MonteCarloResult:
         return float(np.mean((m >= lo) & (m <= hi)))
 
 
-def _one_run(args):
-    (traj, gnss_clean_idx, model, white_a, white_g, sigma_pos, sigma_vel, seed, kw) = args
-    rng = np.random.default_rng(seed)
-    n = traj.n
-    T = np.diff(traj.t)[:, None]
-    # truth of the random constants from the model's prior
-    p_true = np.zeros(model.n - 9)
-    for b in model.blocks:
-        s = model.slices[b.name]
-        p_true[s.start - 9:s.stop - 9] = b.sd * rng.standard_normal(b.size)
-    errs = ImuErrors(
-        gyro=TriadErrors(bias=p_true[model.slices["gyro_bias"].start - 9:model.slices["gyro_bias"].stop - 9],
-                         white_psd=white_g),
-        accel=TriadErrors(bias=p_true[model.slices["accel_bias"].start - 9:model.slices["accel_bias"].stop - 9],
-                          white_psd=white_a))
-    dth = traj.dtheta + errs.gyro.bias * T + rng.standard_normal((n, 3)) * np.sqrt(white_g * T)
-    dvv = traj.dv + errs.accel.bias * T + rng.standard_normal((n, 3)) * np.sqrt(white_a * T)
-    from .sensors import gnss_measurements
-
-    gnss = gnss_measurements(traj, rate_hz=kw["gnss_rate_hz"], sigma_pos=sigma_pos, sigma_vel=sigma_vel, rng=rng)
-    init = perturb_state(traj.initial_state(), model, rng)
-    res = closed_loop(traj.t, dth, dvv, init, gnss, model, truth=traj, true_params=p_true, store_nav=False,
-                      vertical=kw["vertical"], h_ref=kw["h_ref"], vu_ref=kw["vu_ref"])
-    return res, p_true
-
-
 def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gnss_rate_hz: float = 10.0,
                 sigma_pos=(0.03, 0.03, 0.1), sigma_vel=0.03, vertical: str = "free", workers: int = 2,
                 h_ref=None, vu_ref=None) -> MonteCarloResult:
@@ -364,29 +346,98 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     drawn from the blocks' ``sd`` (accel_bias, gyro_bias required), white noise from the model's
     ``accel_psd``/``gyro_psd``, GNSS noise, initial navigation errors from ``nav_sd``.
 
-    Per-run generators come from ``SeedSequence(seed).spawn(n_runs)`` so results do not depend
-    on thread scheduling; runs execute on ``workers`` threads (the compiled loop releases the GIL).
+    One batch of :mod:`replication.closedloop` (run 0 leads, the others follow on ``workers``
+    threads; the result does not depend on ``workers``).  Per-run generators come from
+    ``SeedSequence(seed).spawn(n_runs)``.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The true motion (:func:`replication.trajectory.generate`).
+    model : ErrorModel
+        The filter's model; its prior draws the truth of the random constants.
+    n_runs, seed : int
+        Number of runs and the seed of their generators.
+    gnss_rate_hz, sigma_pos, sigma_vel :
+        GNSS fixes (:func:`replication.sensors.gnss_measurements`).
+    vertical, h_ref, vu_ref :
+        Vertical channel, as in :func:`closed_loop`.
+    workers : int
+        Threads for the runs that follow run 0.
+
+    Returns
+    -------
+    MonteCarloResult
     """
-    if n_runs < 1:
+    from .sensors import gnss_measurements
+
+    if int(n_runs) < 1:
         raise ValueError("n_runs must be at least 1")
+    if vertical not in _VMODES:
+        raise ValueError(f"vertical must be one of {sorted(_VMODES)}")
     for need in ("accel_bias", "gyro_bias"):
         model.block(need)
-    seeds = np.random.SeedSequence(seed).spawn(n_runs)
-    kw = dict(gnss_rate_hz=gnss_rate_hz, vertical=vertical, h_ref=h_ref, vu_ref=vu_ref)
-    args = [(traj, None, model, model.accel_psd, model.gyro_psd, sigma_pos, sigma_vel, s, kw) for s in seeds]
-    if workers > 1:
-        with ThreadPoolExecutor(max_workers=workers) as ex:
-            out = list(ex.map(_one_run, args))
-    else:
-        out = [_one_run(a) for a in args]
-    res0 = out[0][0]
+    n_runs = int(n_runs)
+    n = traj.n
+    T = np.diff(traj.t)[:, None]
+    n_aug = model.n - 9
+    dth = np.empty((n_runs, n, 3))
+    dvv = np.empty((n_runs, n, 3))
+    p_true = np.zeros((n_runs, n_aug))
+    gn, st0, q0 = [], np.empty((n_runs, 6)), np.empty((n_runs, 4))
+    for r, ss in enumerate(np.random.SeedSequence(seed).spawn(n_runs)):
+        rng = np.random.default_rng(ss)
+        for b in model.blocks:
+            sl = model.slices[b.name]
+            p_true[r, sl.start - 9:sl.stop - 9] = b.sd * rng.standard_normal(b.size)
+        gb = p_true[r, model.slices["gyro_bias"].start - 9:model.slices["gyro_bias"].stop - 9]
+        ab = p_true[r, model.slices["accel_bias"].start - 9:model.slices["accel_bias"].stop - 9]
+        dth[r] = traj.dtheta + gb * T + rng.standard_normal((n, 3)) * np.sqrt(model.gyro_psd * T)
+        dvv[r] = traj.dv + ab * T + rng.standard_normal((n, 3)) * np.sqrt(model.accel_psd * T)
+        gn.append(gnss_measurements(traj, rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, rng=rng))
+        init = perturb_state(traj.initial_state(), model, rng)
+        st0[r] = init.vector()
+        q0[r] = dcm_to_quat(init.C_bn)
+    g0 = gn[0]
+    idx = np.asarray(g0.index, np.int64)
+    m_ep = len(idx)
+    gpos = np.stack([g.position for g in gn])
+    gvel = np.stack([np.asarray(g.v_enu, float) for g in gn])
+    tst = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
+    tq = dcm_to_quat(euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2]))
+    tp = np.ascontiguousarray(np.broadcast_to(p_true[:, None, :], (n_runs, m_ep, n_aug)))
+    href = np.zeros(n + 1) if h_ref is None else np.ascontiguousarray(np.broadcast_to(h_ref, (n + 1,)), float)
+    vuref = np.zeros(n + 1) if vu_ref is None else np.ascontiguousarray(np.broadcast_to(vu_ref, (n + 1,)), float)
+    if vertical != "free" and h_ref is None:
+        raise ValueError(f"vertical={vertical!r} needs h_ref")
+    gains = vertical_damping_gains(100.0, traj.lat[0], traj.h[0]) if vertical == "damped" else np.zeros(3)
+    spec = CL.build_spec(model, R_pos=np.diag(np.broadcast_to(np.asarray(sigma_pos, float), (3,)) ** 2),
+                         R_vel=np.diag(np.broadcast_to(np.asarray(sigma_vel, float), (3,)) ** 2),
+                         lever_arm_b=g0.lever_arm_b, vmode=_VMODES[vertical], gains=gains, nees=True)
+    dt = np.diff(traj.t)
+
+    def inputs(ci, k0, k1, eps):
+        j0 = int(np.searchsorted(idx, eps[0]))
+        j1 = j0 + len(eps)
+        extra = CL.no_windows(k1 - k0, j1 - j0, n_runs, n_aug)
+        extra.update(truth_st=np.ascontiguousarray(tst[j0:j1]), truth_q=np.ascontiguousarray(tq[j0:j1]),
+                     truth_p=np.ascontiguousarray(tp[:, j0:j1]))
+        return CL.ChunkInputs(dt=np.ascontiguousarray(dt[k0:k1]), dth=np.ascontiguousarray(dth[:, k0:k1]),
+                              dvv=np.ascontiguousarray(dvv[:, k0:k1]), h_ref=np.ascontiguousarray(href[k0:k1 + 1]),
+                              vu_ref=np.ascontiguousarray(vuref[k0:k1 + 1]),
+                              ep_step=(np.asarray(eps, np.int64) - 1 - k0),
+                              gpos=np.ascontiguousarray(gpos[:, j0:j1]), gvel=np.ascontiguousarray(gvel[:, j0:j1]),
+                              **extra)
+
+    rec = CL.run(spec, CL.initial_batch_state(st0, q0, g0.lever_arm_b), model.P0(), idx, n, inputs,
+                 workers=workers)
     return MonteCarloResult(
-        t_epoch=res0.t_epoch,
-        nees=np.stack([r.nees for r, _ in out]),
-        nis=np.stack([r.nis for r, _ in out]),
-        final_estimates=np.stack([r.estimates[-1] for r, _ in out]),
-        true_params=np.stack([p for _, p in out]),
-        final_sigma=np.stack([np.sqrt(r.P_diag[-1]) for r, _ in out]),
-        P_diag_run0=res0.P_diag,
+        t_epoch=traj.t[idx],
+        nees=rec.nees,
+        nis=rec.nis,
+        final_estimates=rec.p_hat[:, -1].copy(),
+        true_params=p_true,
+        final_sigma=np.tile(np.sqrt(rec.pdiag_all[-1]), (n_runs, 1)),
+        P_diag_run0=rec.pdiag_all,
         n_states=model.n,
     )

@@ -48,14 +48,13 @@ from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
-from numba import njit
 from scipy import stats
 from scipy.signal import lfilter
 
 from . import earth
 from . import errors as E
 from . import models as M
-from . import _kernels as K
+from . import closedloop as CL
 from .rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from .sensors import lever_arm_offset, misalignment_matrix
 from .units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MGAL, MICRO_G
@@ -305,350 +304,6 @@ def filter_model(kind: str, setup: SimulationSetup, lat: float, h: float) -> E.E
                       lever_arm_sd=s.lever_arm_sd, **nav)
 
 
-# ----------------------------------------------------------------------------- compiled kernels
-
-_NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
-
-
-@njit(**_NJ)
-def _propagate_sparse(Phi, P, Qd, W, nzc, nzv, cnt):
-    """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (Φ of an INS error model is sparse)."""
-    n = P.shape[0]
-    for i in range(n):
-        c = 0
-        for k in range(n):
-            v = Phi[i, k]
-            if v != 0.0:
-                nzc[i, c] = k
-                nzv[i, c] = v
-                c += 1
-        cnt[i] = c
-    for i in range(n):
-        for j in range(n):
-            W[i, j] = 0.0
-        for t in range(cnt[i]):
-            k = nzc[i, t]
-            v = nzv[i, t]
-            for j in range(n):
-                W[i, j] += v * P[k, j]
-    for i in range(n):
-        for j in range(i, n):
-            acc = 0.0
-            for t in range(cnt[j]):
-                acc += W[i, nzc[j, t]] * nzv[j, t]
-            v = acc + 0.5 * (Qd[i, j] + Qd[j, i])
-            P[i, j] = v
-            P[j, i] = v
-
-
-@njit(**_NJ)
-def _forward_chunk(dt, dth, dvv, ep_step, gpos, gvel, R_pos, R_vel, lever0,
-                   st, st_prev, q, p_hat, lever, g_extra, dth_cp, dv_cp, trig, flags, P, Pbar, use_pbar,
-                   fconst, qc_const, q_accel, q_gyro, tg, kd, bs, bz, order, dyn_rows,
-                   truth_st, truth_q,
-                   out_err, out_phat, out_pdiag, out_nis, out_flag, out_P, out_Pbar,
-                   record, rec_Pf, rec_Pp, rec_Phi, rec_x):
-    """Closed-loop filter over one chunk of IMU steps for R runs sharing one covariance.
-
-    Per IMU step and run: sensor-error corrections (accumulated estimates), strapdown
-    (:func:`replication._kernels.sd_step`, chen2019 eq. (3-2)).  Per GNSS epoch (after step
-    ``ep_step[j]``): F at the interval means of run 0 (chen2019 eq. (2-15) via
-    :func:`replication._kernels.build_F`), (Φ, Q_d) by the Van Loan series, P⁻ = Φ P Φᵀ + Q_d,
-    gain from run 0's H (antenna position and velocity with the lever arm of eq. (2-13)),
-    Joseph update written as P − K(HP) − (HP)ᵀKᵀ + K S Kᵀ, then per run: innovation, correction,
-    NIS and feedback.  Records navigation errors against ``truth_st``/``truth_q``.
-    """
-    R = st.shape[0]
-    n_steps = dth.shape[1]
-    n = P.shape[0]
-    n_aug = n - 9
-    n_ep = ep_step.shape[0]
-    qtmp = np.empty(4)
-    c = np.empty((3, 3))
-    c0 = np.empty((3, 3))
-    w_ie = np.empty(3)
-    w_en = np.empty(3)
-    ta = np.empty(3)
-    tb = np.empty(3)
-    gains = np.zeros(3)
-    B = np.empty((3, 6))
-    dth_c = np.empty(3)
-    dv_c = np.empty(3)
-    fb = np.empty(3)
-    wb = np.empty(3)
-    F = np.zeros((n, n))
-    Phi = np.empty((n, n))
-    Qd = np.empty((n, n))
-    Qc = np.empty((n, n))
-    w1 = np.empty((n, n))
-    w2 = np.empty((n, n))
-    nzc = np.empty((n, n), np.int64)
-    nzv = np.empty((n, n))
-    cnt = np.empty(n, np.int64)
-    m = 6
-    H = np.zeros((m, n))
-    Rm = np.zeros((m, m))
-    for i in range(3):
-        for jj in range(3):
-            Rm[i, jj] = R_pos[i, jj]
-            Rm[3 + i, 3 + jj] = R_vel[i, jj]
-    z = np.empty(m)
-    xk = np.empty(n)
-    tmp = np.empty(n_aug)
-    # interval accumulators of run 0: lat, h, vE, vN, vU, C (9), Σdv (3), Σdθ (3), T, count
-    acc = np.zeros(23)
-    j = 0
-    for k in range(n_steps):
-        T = dt[k]
-        for r in range(R):
-            K._apply_corrections(dth[r, k], T, p_hat[r], tg, kd, bs, bz, 1, dth_c, B)
-            K._apply_corrections(dvv[r, k], T, p_hat[r], tg, kd, bs, bz, 0, dv_c, B)
-            if flags[0] == 1:
-                for i in range(3):
-                    dth_cp[r, i] = dth_c[i]
-                    dv_cp[r, i] = dv_c[i]
-            if r == 0:
-                K._q2c(q[0], c0)
-                acc[0] += st[0, 0]
-                acc[1] += st[0, 2]
-                acc[2] += st[0, 3]
-                acc[3] += st[0, 4]
-                acc[4] += st[0, 5]
-                for i in range(3):
-                    for jj in range(3):
-                        acc[5 + 3 * i + jj] += c0[i, jj]
-                    acc[14 + i] += dv_c[i]
-                    acc[17 + i] += dth_c[i]
-                acc[20] += T
-                acc[21] += 1.0
-            K.sd_step(T, dth_c, dv_c, dth_cp[r], dv_cp[r], st[r], st_prev[r], q[r], qtmp, c, w_ie, w_en, ta, tb,
-                      0, 0.0, 0.0, gains, 0.0, g_extra[r], trig[r])
-            for i in range(3):
-                dth_cp[r, i] = dth_c[i]
-                dv_cp[r, i] = dv_c[i]
-        flags[0] = 0
-        if j < n_ep and ep_step[j] == k:
-            # ---------------- time update (run 0's interval means)
-            na = acc[21]
-            tsum = acc[20]
-            for i in range(3):
-                for jj in range(3):
-                    c0[i, jj] = acc[5 + 3 * i + jj] / na
-                fb[i] = acc[14 + i] / tsum
-                wb[i] = acc[17 + i] / tsum
-            K.build_F(acc[0] / na, acc[1] / na, acc[2] / na, acc[3] / na, acc[4] / na, c0, fb, wb, fconst,
-                      tg, kd, bs, bz, F)
-            K._interval_discretize(F, qc_const, c0, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2)
-            _propagate_sparse(Phi, P, Qd, w1, nzc, nzv, cnt)
-            if use_pbar:
-                _propagate_sparse(Phi, Pbar, Qd, w1, nzc, nzv, cnt)
-            if record:
-                for i in range(n):
-                    for jj in range(n):
-                        rec_Phi[j, i, jj] = Phi[i, jj]
-                        rec_Pp[j, i, jj] = P[i, jj]
-            # sensor-error estimates with dynamics (Markov, gravity) follow Φ
-            for r in range(R):
-                for t in range(dyn_rows.shape[0]):
-                    i = dyn_rows[t]
-                    s_ = 0.0
-                    for jj in range(n_aug):
-                        s_ += Phi[9 + i, 9 + jj] * p_hat[r, jj]
-                    tmp[t] = s_
-                for t in range(dyn_rows.shape[0]):
-                    p_hat[r, dyn_rows[t]] = tmp[t]
-            # ---------------- measurement matrix from run 0
-            K._q2c(q[0], c0)
-            L, h = st[0, 0], st[0, 2]
-            for i in range(m):
-                for jj in range(n):
-                    H[i, jj] = 0.0
-            K.rates_s(L, h, st[0, 3], st[0, 4], w_ie, w_en)
-            wx = dth_cp[0, 0] / T - (c0[0, 0] * w_ie[0] + c0[1, 0] * w_ie[1] + c0[2, 0] * w_ie[2])
-            wy = dth_cp[0, 1] / T - (c0[0, 1] * w_ie[0] + c0[1, 1] * w_ie[1] + c0[2, 1] * w_ie[2])
-            wz = dth_cp[0, 2] / T - (c0[0, 2] * w_ie[0] + c0[1, 2] * w_ie[1] + c0[2, 2] * w_ie[2])
-            K.gnss_rows(H, c0, lever[0], wx, wy, wz, L, h, True, True, tg, bs)
-            # ---------------- gain and covariance (shared)
-            PHt = np.empty((n, m))
-            for i in range(n):
-                for a in range(m):
-                    s_ = 0.0
-                    for kk in range(n):
-                        hv = H[a, kk]
-                        if hv != 0.0:
-                            s_ += P[i, kk] * hv
-                    PHt[i, a] = s_
-            S = Rm.copy()
-            for a in range(m):
-                for b2 in range(m):
-                    s_ = 0.0
-                    for kk in range(n):
-                        hv = H[a, kk]
-                        if hv != 0.0:
-                            s_ += hv * PHt[kk, b2]
-                    S[a, b2] += s_
-            for a in range(m):
-                for b2 in range(a + 1, m):
-                    v = 0.5 * (S[a, b2] + S[b2, a])
-                    S[a, b2] = v
-                    S[b2, a] = v
-            Sinv = np.linalg.inv(S)
-            Kg = PHt @ Sinv
-            KS = Kg @ S
-            for i in range(n):
-                for jj in range(i, n):
-                    s_ = P[i, jj]
-                    for a in range(m):
-                        s_ += -Kg[i, a] * PHt[jj, a] - PHt[i, a] * Kg[jj, a] + KS[i, a] * Kg[jj, a]
-                    P[i, jj] = s_
-                    P[jj, i] = s_
-            # ---------------- per run: innovation, correction, feedback
-            for r in range(R):
-                K._q2c(q[r], c)
-                Lr, hr = st[r, 0], st[r, 2]
-                rmr, rnr = K.radii_s(Lr)
-                la0 = c[0, 0] * lever[r, 0] + c[0, 1] * lever[r, 1] + c[0, 2] * lever[r, 2]
-                la1 = c[1, 0] * lever[r, 0] + c[1, 1] * lever[r, 1] + c[1, 2] * lever[r, 2]
-                la2 = c[2, 0] * lever[r, 0] + c[2, 1] * lever[r, 1] + c[2, 2] * lever[r, 2]
-                z[0] = (st[r, 1] - gpos[r, j, 1]) * (rnr + hr) * math.cos(Lr) + la0
-                z[1] = (st[r, 0] - gpos[r, j, 0]) * (rmr + hr) + la1
-                z[2] = (st[r, 2] - gpos[r, j, 2]) + la2
-                K.rates_s(Lr, hr, st[r, 3], st[r, 4], w_ie, w_en)
-                wx = dth_cp[r, 0] / T - (c[0, 0] * w_ie[0] + c[1, 0] * w_ie[1] + c[2, 0] * w_ie[2])
-                wy = dth_cp[r, 1] / T - (c[0, 1] * w_ie[0] + c[1, 1] * w_ie[1] + c[2, 1] * w_ie[2])
-                wz = dth_cp[r, 2] / T - (c[0, 2] * w_ie[0] + c[1, 2] * w_ie[1] + c[2, 2] * w_ie[2])
-                cx = wy * lever[r, 2] - wz * lever[r, 1]
-                cy = wz * lever[r, 0] - wx * lever[r, 2]
-                cz = wx * lever[r, 1] - wy * lever[r, 0]
-                for i in range(3):
-                    z[3 + i] = st[r, 3 + i] + c[i, 0] * cx + c[i, 1] * cy + c[i, 2] * cz - gvel[r, j, i]
-                nis = 0.0
-                for a in range(m):
-                    for b2 in range(m):
-                        nis += z[a] * Sinv[a, b2] * z[b2]
-                out_nis[r, j] = nis
-                for i in range(n):
-                    s_ = 0.0
-                    for a in range(m):
-                        s_ += Kg[i, a] * z[a]
-                    xk[i] = s_
-                if record:
-                    for i in range(n):
-                        rec_x[r, j, i] = xk[i]
-                K._feedback_nav(xk, st[r], st_prev[r], q[r], p_hat[r], qtmp)
-                K._feedback_blocks(p_hat[r], tg, bs, bz, fconst, lever0, lever[r], g_extra[r])
-                # ---------------- records
-                for i in range(3):
-                    out_err[r, j, i] = st[r, i] - truth_st[j, i]
-                    out_err[r, j, 3 + i] = st[r, 3 + i] - truth_st[j, 3 + i]
-                t0, t1, t2, t3 = truth_q[j, 0], -truth_q[j, 1], -truth_q[j, 2], -truth_q[j, 3]
-                a1, b1, c1, d1 = q[r, 0], q[r, 1], q[r, 2], q[r, 3]
-                r0 = a1 * t0 - b1 * t1 - c1 * t2 - d1 * t3
-                r1 = a1 * t1 + b1 * t0 + c1 * t3 - d1 * t2
-                r2 = a1 * t2 - b1 * t3 + c1 * t0 + d1 * t1
-                r3 = a1 * t3 + b1 * t2 - c1 * t1 + d1 * t0
-                sg = 1.0 if r0 >= 0 else -1.0
-                out_err[r, j, 6] = -2.0 * sg * r1
-                out_err[r, j, 7] = -2.0 * sg * r2
-                out_err[r, j, 8] = -2.0 * sg * r3
-                for i in range(n_aug):
-                    out_phat[r, j, i] = p_hat[r, i]
-            for i in range(n):
-                out_pdiag[j, i] = P[i, i]
-            if record:
-                for i in range(n):
-                    for jj in range(n):
-                        rec_Pf[j, i, jj] = P[i, jj]
-            f = out_flag[j]
-            if f >= 0:
-                for i in range(n):
-                    for jj in range(n):
-                        out_P[f, i, jj] = P[i, jj]
-                        if use_pbar:
-                            out_Pbar[f, i, jj] = Pbar[i, jj]
-            for i in range(23):
-                acc[i] = 0.0
-            j += 1
-    return j
-
-
-@njit(**_NJ)
-def _rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, out_ds, out_Ps, out_psdiag, with_cov):
-    """Backward RTS pass over one chunk (see the module docstring); ``ds`` (R×n) and ``Ps`` hold
-    the smoothed error estimate and covariance at the epoch after the chunk on entry (when
-    ``has_next``) and at the chunk's first epoch on return.  Without ``with_cov`` only the
-    state recursion runs (C_k needs P_k⁺, P_{k+1}⁻ and Φ_k, not P^s)."""
-    E_ = Pf.shape[0]
-    R = ds.shape[0]
-    n = Pf.shape[1]
-    d = np.empty(n)
-    Rc = np.empty((n, n))
-    rhs = np.empty((n, n))
-    tmp = np.empty(n)
-    for jj in range(E_ - 1, -1, -1):
-        if jj == E_ - 1 and not has_next:
-            for r in range(R):
-                for i in range(n):
-                    ds[r, i] = 0.0
-            for i in range(n):
-                for k in range(n):
-                    Ps[i, k] = Pf[jj, i, k]
-        else:
-            if jj == E_ - 1:
-                Pp1 = Pp_n
-                Ph1 = Phi_n
-                x1 = x_n
-            else:
-                Pp1 = Pp[jj + 1]
-                Ph1 = Phi[jj + 1]
-                x1 = xrec[:, jj + 1, :]
-            for i in range(n):
-                # a state with zero prior variance (no prior, no noise) decouples: unit scale,
-                # its row of Φ P⁺ is zero, so its column of C_k is zero
-                d[i] = math.sqrt(Pp1[i, i]) if Pp1[i, i] > 0.0 else 1.0
-            for i in range(n):
-                for k in range(n):
-                    Rc[i, k] = Pp1[i, k] / (d[i] * d[k])
-                if Pp1[i, i] <= 0.0:
-                    Rc[i, i] = 1.0
-            A = Ph1 @ Pf[jj]
-            for i in range(n):
-                for k in range(n):
-                    rhs[i, k] = A[i, k] / d[i]
-            Y = np.linalg.solve(Rc, rhs)
-            Cm = np.empty((n, n))
-            for i in range(n):
-                for k in range(n):
-                    Cm[k, i] = Y[i, k] / d[i]
-            for r in range(R):
-                for i in range(n):
-                    tmp[i] = ds[r, i] + x1[r, i]
-                for i in range(n):
-                    s_ = 0.0
-                    for k in range(n):
-                        s_ += Cm[i, k] * tmp[k]
-                    ds[r, i] = s_
-            if with_cov:
-                D = Ps - Pp1
-                G = Cm @ D @ Cm.T
-                for i in range(n):
-                    for k in range(i, n):
-                        v = Pf[jj, i, k] + 0.5 * (G[i, k] + G[k, i])
-                        Ps[i, k] = v
-                        Ps[k, i] = v
-        for i in range(n):
-            out_psdiag[jj, i] = Ps[i, i]
-        f = out_flag[jj]
-        if f >= 0:
-            for r in range(R):
-                for i in range(n):
-                    out_ds[r, f, i] = ds[r, i]
-            if with_cov:
-                for i in range(n):
-                    for k in range(n):
-                        out_Ps[f, i, k] = Ps[i, k]
-
-
 # ----------------------------------------------------------------------------- truth generation
 
 _NAMES_CONST = ("gyro_bias", "accel_bias", "gyro_scale", "accel_scale", "gyro_misalignment",
@@ -864,7 +519,7 @@ def _check_traj(traj, setup):
 def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int = 20, seed: int = 0,
               chunk_epochs: int = 1000, record_every: int = 20, smoother: bool = False,
               smoother_covariance: bool = True, prior_covariance: bool = False, first_run: int = 0,
-              fixed_constants: bool = False, series_order: int = 4) -> BatchResult:
+              fixed_constants: bool = False, series_order: int = 4, workers: int = 2) -> BatchResult:
     """Monte Carlo of the closed-loop INS/GNSS filter of ``model`` on ``traj`` with the truth of
     ``setup`` (chen2019 eq. (2-10) sensor errors, eq. (2-12) gravity disturbance, eq. (2-13)
     lever arm, Table 4-41 noise), batched across ``n_runs`` runs (see the module docstring).
@@ -899,125 +554,66 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
         raise ValueError("first_run must be non-negative")
     truth = _Truth(setup, traj, n_runs, seed, model.nav_sd, first_run=int(first_run),
                    fixed_constants=bool(fixed_constants))
-    fconst, qc, tg, kd, bs, bz = model._encoding()
     n = model.n
     n_aug = n - 9
-    dyn_rows = np.array([i - 9 for i in range(9, n) if np.any(fconst[i, 9:] != 0)], dtype=np.int64)
-    R_pos = np.diag(np.asarray(setup.sigma_pos, float) ** 2)
-    R_vel = np.diag(np.full(3, setup.sigma_vel ** 2))
     lever0 = np.asarray(setup.lever_arm_b, float)
+    spec = CL.build_spec(model, R_pos=np.diag(np.asarray(setup.sigma_pos, float) ** 2),
+                         R_vel=np.diag(np.full(3, setup.sigma_vel ** 2)), lever_arm_b=lever0,
+                         series_order=series_order, prior_covariance=prior_covariance)
     st, q = truth.initial_states()
-    state = dict(st=st, st_prev=st.copy(), q=q, p_hat=np.zeros((n_runs, n_aug)),
-                 lever=np.tile(lever0, (n_runs, 1)), g_extra=np.zeros((n_runs, 3)),
-                 dth_cp=np.zeros((n_runs, 3)), dv_cp=np.zeros((n_runs, 3)), flags=np.array([1], np.int64),
-                 trig=np.column_stack([st[:, 0], np.sin(st[:, 0]), np.cos(st[:, 0])]),
-                 P=model.P0(), Pbar=model.P0())
-    ar = {k: v.copy() for k, v in truth.x0.items()}
-    rec_mask = (np.arange(n_ep) + 1) % record_every == 0
-    rec_ep = np.nonzero(rec_mask)[0]
-    m_rec = len(rec_ep)
-    rec_pos = np.full(n_ep, -1, np.int64)
-    rec_pos[rec_ep] = np.arange(m_rec)
-    nav_err = np.empty((n_runs, m_rec, 9))
-    p_hat_rec = np.empty((n_runs, m_rec, n_aug))
-    procs_rec = {k: np.empty((n_runs, m_rec, 3)) for k in ("gyro_markov", "accel_markov", "gravity")}
-    P_rec = np.empty((m_rec, n, n))
-    Pbar_rec = np.empty((m_rec, n, n)) if prior_covariance else np.empty((0, n, n))
-    nis_rec = np.empty((n_runs, m_rec))
-    pdiag_all = np.empty((n_ep, n))
     idx = ep_samples
     truth_st = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
     truth_q = dcm_to_quat(euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2]))
     dtv = np.diff(traj.t)
-    chunks = [(j0, min(j0 + chunk_epochs, n_ep)) for j0 in range(0, n_ep, chunk_epochs)]
-    checkpoints = []
-    empty3 = np.empty((0, n, n))
-    emptyx = np.empty((n_runs, 0, n))
+    rec_ep = np.nonzero((np.arange(n_ep) + 1) % record_every == 0)[0]
+    rec_pos = np.full(n_ep, -1, np.int64)
+    rec_pos[rec_ep] = np.arange(len(rec_ep))
+    procs_rec = {k: np.empty((n_runs, len(rec_ep), 3)) for k in ("gyro_markov", "accel_markov", "gravity")}
+    ar_start = {0: {k: v.copy() for k, v in truth.x0.items()}}
 
-    def run_chunk(ci, st_, ar_, record):
-        j0, j1 = chunks[ci]
-        k0 = 0 if ci == 0 else ep_samples[j0 - 1]
-        k1 = N if ci == len(chunks) - 1 else ep_samples[j1 - 1]
-        eps = ep_samples[j0:j1]
+    def inputs(ci, k0, k1, eps):
+        # the AR(1) state at the chunk's start is kept, so that a replay draws the same inputs
+        ar_ = {k: v.copy() for k, v in ar_start[ci].items()}
         dth, dvv, gpos, gvel, procs = truth.chunk(ci, k0, k1, eps, ar_)
-        E_ = j1 - j0
-        ep_step = (eps - 1 - k0).astype(np.int64)
-        out_err = np.empty((n_runs, E_, 9))
-        out_phat = np.empty((n_runs, E_, n_aug))
-        out_nis = np.empty((n_runs, E_))
-        out_pd = np.empty((E_, n))
-        flag = rec_pos[j0:j1] - (rec_pos[j0:j1][rec_pos[j0:j1] >= 0].min() if np.any(rec_pos[j0:j1] >= 0) else 0)
-        flag = np.where(rec_pos[j0:j1] >= 0, flag, -1).astype(np.int64)
-        n_f = int(np.sum(flag >= 0))
-        oP = np.empty((n_f, n, n))
-        oPb = np.empty((n_f, n, n)) if prior_covariance else empty3
-        if record:
-            rPf, rPp, rPhi = (np.empty((E_, n, n)) for _ in range(3))
-            rx = np.empty((n_runs, E_, n))
-        else:
-            rPf = rPp = rPhi = empty3
-            rx = emptyx
-        _forward_chunk(dtv[k0:k1], dth, dvv, ep_step, gpos, gvel, R_pos, R_vel, lever0,
-                       st_["st"], st_["st_prev"], st_["q"], st_["p_hat"], st_["lever"], st_["g_extra"],
-                       st_["dth_cp"], st_["dv_cp"], st_["trig"], st_["flags"], st_["P"], st_["Pbar"], prior_covariance,
-                       fconst, qc, model.accel_psd, model.gyro_psd, tg, kd, bs, bz, int(series_order), dyn_rows,
-                       np.ascontiguousarray(truth_st[j0:j1]), np.ascontiguousarray(truth_q[j0:j1]),
-                       out_err, out_phat, out_pd, out_nis, flag, oP, oPb, record, rPf, rPp, rPhi, rx)
-        return dict(j0=j0, j1=j1, err=out_err, phat=out_phat, nis=out_nis, pd=out_pd, flag=flag, P=oP, Pb=oPb,
-                    procs=procs, rec=(rPf, rPp, rPhi, rx))
+        if ci + 1 not in ar_start:
+            ar_start[ci + 1] = ar_
+            j0 = int(np.searchsorted(ep_samples, eps[0]))
+            pos = rec_pos[j0:j0 + len(eps)]
+            for k in procs_rec:
+                procs_rec[k][:, pos[pos >= 0]] = procs[k][:, pos >= 0]
+        extra = CL.no_windows(k1 - k0, len(eps), n_runs, n_aug)
+        return CL.ChunkInputs(dt=np.ascontiguousarray(dtv[k0:k1]), dth=dth, dvv=dvv, h_ref=np.zeros(k1 - k0 + 1),
+                              vu_ref=np.zeros(k1 - k0 + 1), ep_step=(np.asarray(eps) - 1 - k0).astype(np.int64),
+                              gpos=gpos, gvel=gvel, **extra)
 
-    for ci in range(len(chunks)):
-        if smoother:
-            checkpoints.append(({k: v.copy() for k, v in state.items()}, {k: v.copy() for k, v in ar.items()}))
-        out = run_chunk(ci, state, ar, False)
-        j0, j1 = out["j0"], out["j1"]
-        sel = out["flag"] >= 0
-        pos = rec_pos[j0:j1][sel]
-        nav_err[:, pos] = out["err"][:, sel]
-        p_hat_rec[:, pos] = out["phat"][:, sel]
-        nis_rec[:, pos] = out["nis"][:, sel]
-        for k in procs_rec:
-            procs_rec[k][:, pos] = out["procs"][k][:, sel]
-        P_rec[pos] = out["P"]
-        if prior_covariance:
-            Pbar_rec[pos] = out["Pb"]
-        pdiag_all[j0:j1] = out["pd"]
-    ds_rec = Ps_rec = None
-    if smoother:
-        ds_rec = np.empty((n_runs, m_rec, n))
-        Ps_rec = np.empty((m_rec, n, n)) if smoother_covariance else None
-        ds = np.zeros((n_runs, n))
-        Ps = np.zeros((n, n))
-        nxt = None
-        for ci in range(len(chunks) - 1, -1, -1):
-            st_c, ar_c = checkpoints[ci]
-            out = run_chunk(ci, st_c, ar_c, True)
-            rPf, rPp, rPhi, rx = out["rec"]
-            j0, j1 = out["j0"], out["j1"]
-            E_ = j1 - j0
-            flag = out["flag"]
-            n_f = int(np.sum(flag >= 0))
-            o_ds = np.empty((n_runs, n_f, n))
-            o_Ps = np.empty((n_f if smoother_covariance else 0, n, n))
-            o_pd = np.empty((E_, n))
-            if nxt is None:
-                    _rts_chunk(rPf, rPp, rPhi, rx, False, rPp[0], rPhi[0], np.ascontiguousarray(rx[:, 0, :]), ds, Ps,
-                           flag, o_ds, o_Ps, o_pd, smoother_covariance)
-            else:
-                _rts_chunk(rPf, rPp, rPhi, rx, True, nxt[0], nxt[1], nxt[2], ds, Ps, flag, o_ds, o_Ps, o_pd,
-                           smoother_covariance)
-            nxt = (rPp[0].copy(), rPhi[0].copy(), np.ascontiguousarray(rx[:, 0, :]))
-            pos = rec_pos[j0:j1][flag >= 0]
-            ds_rec[:, pos] = o_ds
-            if smoother_covariance:
-                Ps_rec[pos] = o_Ps
-            checkpoints[ci] = None
+    rec = CL.run(spec, CL.initial_batch_state(st, q, lever0), model.P0(), ep_samples, N, inputs,
+                 record_every=record_every, chunk_epochs=chunk_epochs, smoother=smoother,
+                 smoother_covariance=smoother_covariance, workers=workers)
+    nav_err = navigation_errors(rec.st, rec.q, truth_st[rec_ep], truth_q[rec_ep])
     p_true = truth_parameters(model, truth.const, procs_rec)
     return BatchResult(model=model, setup=setup, t=traj.t[ep_samples[rec_ep]], epoch_index=ep_samples[rec_ep],
-                       nav_err=nav_err, p_hat=p_hat_rec, p_true=p_true, P=P_rec,
-                       P_bar=Pbar_rec if prior_covariance else None, nis=nis_rec, t_all=traj.t[ep_samples],
-                       P_diag_all=pdiag_all, ds=ds_rec, P_s=Ps_rec, seed=int(seed), const=truth.const,
-                       lat0=float(traj.lat[0]), h0=float(traj.h[0]))
+                       nav_err=nav_err, p_hat=rec.p_hat, p_true=p_true, P=rec.P, P_bar=rec.P_bar, nis=rec.nis,
+                       t_all=traj.t[ep_samples], P_diag_all=rec.pdiag_all, ds=rec.ds, P_s=rec.P_s, seed=int(seed),
+                       const=truth.const, lat0=float(traj.lat[0]), h0=float(traj.h[0]))
+
+
+def navigation_errors(st, q, truth_st, truth_q) -> np.ndarray:
+    """Navigation errors (runs × epochs × 9: δL, δλ, δh, δv_ENU, φ) of states ``st`` (runs × epochs
+    × 6) and quaternions ``q`` (q_b^n) against the truth; φ from Ĉ Cᵀ = exp(−φ×) via the
+    quaternion q̂ ⊗ q_true*."""
+    st = np.asarray(st, float)
+    q = np.asarray(q, float)
+    e = np.empty(st.shape[:2] + (9,))
+    e[..., :6] = st - np.asarray(truth_st)[None]
+    t = np.asarray(truth_q, float)[None] * np.array([1.0, -1.0, -1.0, -1.0])
+    a1, b1, c1, d1 = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    t0, t1, t2, t3 = t[..., 0], t[..., 1], t[..., 2], t[..., 3]
+    r0 = a1 * t0 - b1 * t1 - c1 * t2 - d1 * t3
+    sg = np.where(r0 >= 0, 1.0, -1.0)
+    e[..., 6] = -2.0 * sg * (a1 * t1 + b1 * t0 + c1 * t3 - d1 * t2)
+    e[..., 7] = -2.0 * sg * (a1 * t2 - b1 * t3 + c1 * t0 + d1 * t1)
+    e[..., 8] = -2.0 * sg * (a1 * t3 + b1 * t2 - c1 * t1 + d1 * t0)
+    return e
 
 
 # ----------------------------------------------------------------------------- diagnostics

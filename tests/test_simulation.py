@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from replication import errors as er, kalman as kf, reproduction as rp, sensors as se, simulation as sim
+from replication import closedloop as cl, errors as er, kalman as kf, reproduction as rp, sensors as se, simulation as sim
 from replication import trajectory as tr
 from replication.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MICRO_G
 
@@ -148,7 +148,7 @@ def test_batched_filter_agrees_with_the_core_closed_loop(short_flight, model, le
 # ----------------------------------------------------------------------------- smoother
 
 def test_closed_loop_rts_equals_textbook_rts_with_feedback_inputs():
-    """sim._rts_chunk (closed-loop form, chunked with carries) = kalman.rts_smoother with
+    """cl.rts_chunk (closed-loop form, chunked with carries) = kalman.rts_smoother with
     x_f = 0 and x_p[k+1] = -x_{k+1} on random small SPD systems."""
     rng = np.random.default_rng(0)
     n, N, R = 4, 12, 2
@@ -174,10 +174,10 @@ def test_closed_loop_rts_equals_textbook_rts_with_feedback_inputs():
         o_ds, o_Ps, o_pd = np.empty((R, E_, n)), np.empty((E_, n, n)), np.empty((E_, n))
         args = (Pf[j0:j1].copy(), Pp[j0:j1].copy(), Phi[j0:j1].copy(), np.ascontiguousarray(x[:, j0:j1]))
         if nxt is None:
-            sim._rts_chunk(*args, False, Pp[0], Phi[0], np.ascontiguousarray(x[:, 0]), ds, Ps, flag, o_ds, o_Ps,
+            cl.rts_chunk(*args, False, Pp[0], Phi[0], np.ascontiguousarray(x[:, 0]), ds, Ps, flag, o_ds, o_Ps,
                            o_pd, True)
         else:
-            sim._rts_chunk(*args, True, *nxt, ds, Ps, flag, o_ds, o_Ps, o_pd, True)
+            cl.rts_chunk(*args, True, *nxt, ds, Ps, flag, o_ds, o_Ps, o_pd, True)
         nxt = (Pp[j0].copy(), Phi[j0].copy(), np.ascontiguousarray(x[:, j0]))
         out_ds[:, j0:j1] = o_ds
         out_Ps[j0:j1] = o_Ps

@@ -1,0 +1,834 @@
+"""The closed-loop (feedback) INS/GNSS error-state Kalman filter: one compiled loop for every
+chapter, batched over Monte-Carlo runs.
+
+One IMU step of every run: the accumulated sensor-error estimates are removed from the
+increments (chen2019 eq. (2-10)) and the strapdown of :func:`replication._kernels.sd_step`
+(chen2019 eq. (3-2)) advances the run.  One GNSS epoch: the error-state F of
+:func:`replication._kernels.build_F_core` plus the sensor-block couplings C_b^n B(u) — both
+averaged over the interval's IMU steps (F is affine in them, so this is the interval mean of F)
+— gives (Φ, Q_d) by the Van Loan series; P⁻ = Φ P Φᵀ + Q_d; the measurement rows are written
+once, in :func:`replication._kernels.gnss_rows` (antenna position and velocity with the lever arm,
+chen2019 eq. (2-13)) and :func:`_specific_force_rows` (chen2019 eq. (3-18)); the update is the
+Joseph form one (independent) measurement at a time; then the navigation errors are fed back and
+the sensor-error estimates accumulated.  Optional: a vertical channel held or damped
+(:mod:`replication.strapdown`), discrete AR transitions of a gravity block at chosen epochs, the
+recording of (P⁺, P⁻, Φ, x̂) for the Rauch-Tung-Striebel smoother, NEES against a truth.
+
+**Batches.** The covariance, the gains and the measurement matrix of a batch come from its
+first run (the *lead*); every run applies them to its own innovations, so run 0 is an exact
+extended Kalman filter and the other runs are the same filter linearized along run 0 (their
+navigation errors differ by metres and milliradians: the difference is second order).  A batch
+of one is the single-run filter.  The lead's pass records per epoch what the other runs need
+(H rows, gains, innovation variances, the Φ rows of the sensor-error dynamics), so the runs can
+follow on other threads, chunk by chunk, while the lead goes on: the result does not depend on
+the number of threads.
+
+:func:`run` is the driver (chunks, threads, records, RTS); :func:`build_spec` bundles the
+configuration of an :class:`replication.errors.ErrorModel`.  The public entry points are
+:func:`replication.kalman.closed_loop` (one run), :func:`replication.kalman.monte_carlo`,
+:func:`replication.simulation.run_batch` (chen2019 §4.2) and
+:func:`replication.gravity.augmented_filter` (chen2019 eq. (3-18)).
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections import namedtuple
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from numba import njit
+
+from . import _kernels as K
+from .errors import ErrorModel
+
+__all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "initial_batch_state", "Records", "run"]
+
+_NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+_MMAX = 9   # at most 9 measurement rows: position, velocity, specific force
+
+#: Configuration of the filter (numba-compatible bundle).  ``fconst``/``qc`` are the model's
+#: constant F and process-noise parts, ``tg/kd/bs/bz`` its block encoding
+#: (:meth:`replication.errors.ErrorModel._encoding`), ``dyn_rows`` the augmented states with
+#: dynamics, ``ar_T``/``ar_Q`` the discrete AR transition applied at ``ar_tick`` epochs,
+#: ``sf_H`` the gravity columns of the specific-force rows.
+Spec = namedtuple("Spec", ["fconst", "qc", "q_accel", "q_gyro", "tg", "kd", "bs", "bz", "order", "dyn_rows",
+                           "use_pos", "use_vel", "R_pos", "R_vel", "lever0", "vmode", "gains",
+                           "ar_T", "ar_Q", "sf_H", "use_pbar", "nees"])
+
+#: Inputs of one chunk of IMU steps (``R`` runs): increments (R × K × 3), step lengths, vertical
+#: references (K + 1), the step after which each GNSS epoch falls, the fixes (R × E × 3), the
+#: specific-force windows (per step: weight and window id, per epoch: id of the window ending
+#: there, per window: GNSS acceleration and variance), AR ticks per epoch, truth for the NEES.
+ChunkInputs = namedtuple("ChunkInputs", ["dt", "dth", "dvv", "h_ref", "vu_ref", "ep_step", "gpos", "gvel",
+                                         "sf_w", "sf_win", "sf_end", "sf_a", "sf_R", "ar_tick",
+                                         "truth_st", "truth_q", "truth_p"])
+
+#: Per-run state carried from chunk to chunk.
+BatchState = namedtuple("BatchState", ["st", "st_prev", "q", "p_hat", "lever", "g_extra", "dth_cp", "dv_cp",
+                                       "trig", "damp", "vacc", "first"])
+
+#: The lead's state carried from chunk to chunk: covariance (and the covariance propagated
+#: without measurements), window sums of f^n and of the accelerometer couplings.
+LeadState = namedtuple("LeadState", ["P", "Pbar", "facc", "Cw"])
+
+#: What the lead leaves, per epoch, for the runs that follow it.
+Gains = namedtuple("Gains", ["m", "H", "Kg", "s", "Phid", "P"])
+
+#: Outputs of one chunk (per run and epoch unless noted).
+ChunkOut = namedtuple("ChunkOut", ["st", "q", "phat", "nis", "innov", "nees", "nav_st", "nav_q", "pdiag",
+                                   "flag", "P", "Pbar", "rec_Pf", "rec_Pp", "rec_Phi", "rec_x"])
+
+
+# ----------------------------------------------------------------------------- compiled pieces
+
+@njit(**_NJ)
+def _propagate_sparse(Phi, P, Qd, W, nzc, nzv, cnt):
+    """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (Φ of an INS error model is sparse)."""
+    n = P.shape[0]
+    for i in range(n):
+        c = 0
+        for k in range(n):
+            v = Phi[i, k]
+            if v != 0.0:
+                nzc[i, c] = k
+                nzv[i, c] = v
+                c += 1
+        cnt[i] = c
+    for i in range(n):
+        for j in range(n):
+            W[i, j] = 0.0
+        for t in range(cnt[i]):
+            k = nzc[i, t]
+            v = nzv[i, t]
+            for j in range(n):
+                W[i, j] += v * P[k, j]
+    for i in range(n):
+        for j in range(i, n):
+            acc = 0.0
+            for t in range(cnt[j]):
+                acc += W[i, nzc[j, t]] * nzv[j, t]
+            v = acc + 0.5 * (Qd[i, j] + Qd[j, i])
+            P[i, j] = v
+            P[j, i] = v
+
+
+@njit(**_NJ)
+def _specific_force_rows(H, r, facc, Cw, sf_H, tg, bs, bz):
+    """Rows r..r+2 of H for the specific-force measurement of chen2019 eq. (3-18): the window
+    mean of C_b^n f^b minus the GNSS acceleration = f^n × φ + C_b^n ∇ − δg^n: attitude columns
+    (f^n×) at the window mean ``facc``, accelerometer-block columns the window means ``Cw`` of
+    C_b^n B(f^b) (rows 0-2), gravity columns ``sf_H``."""
+    n_aug = sf_H.shape[1]
+    for i in range(3):
+        for jj in range(n_aug):
+            H[r + i, 9 + jj] = sf_H[i, jj]
+    H[r + 0, 7] = -facc[2]
+    H[r + 0, 8] = facc[1]
+    H[r + 1, 6] = facc[2]
+    H[r + 1, 8] = -facc[0]
+    H[r + 2, 6] = -facc[1]
+    H[r + 2, 7] = facc[0]
+    for b in range(tg.shape[0]):
+        if tg[b] == K.TARGET_ACCEL:
+            for i in range(3):
+                for jj in range(bz[b]):
+                    H[r + i, bs[b] + jj] += Cw[i, bs[b] + jj]
+
+
+@njit(**_NJ)
+def _body_rate(dth, T, c, st, w_ie, w_en):
+    """ω_eb^b ≈ corrected gyro rate of the last step − C_b^nᵀ ω_ie^n (for the lever-arm rows)."""
+    K.rates_s(st[0], st[2], st[3], st[4], w_ie, w_en)
+    wx = dth[0] / T - (c[0, 0] * w_ie[0] + c[1, 0] * w_ie[1] + c[2, 0] * w_ie[2])
+    wy = dth[1] / T - (c[0, 1] * w_ie[0] + c[1, 1] * w_ie[1] + c[2, 1] * w_ie[2])
+    wz = dth[2] / T - (c[0, 2] * w_ie[0] + c[1, 2] * w_ie[1] + c[2, 2] * w_ie[2])
+    return wx, wy, wz
+
+
+@njit(**_NJ)
+def _innovations(st, c, lever, wx, wy, wz, gpos, gvel, use_pos, use_vel, z):
+    """GNSS innovations INS − GNSS at the antenna (rows as in :func:`replication._kernels.gnss_rows`);
+    returns the number of rows written."""
+    rm, rn = K.radii_s(st[0])
+    h = st[2]
+    r = 0
+    if use_pos:
+        la0 = c[0, 0] * lever[0] + c[0, 1] * lever[1] + c[0, 2] * lever[2]
+        la1 = c[1, 0] * lever[0] + c[1, 1] * lever[1] + c[1, 2] * lever[2]
+        la2 = c[2, 0] * lever[0] + c[2, 1] * lever[1] + c[2, 2] * lever[2]
+        z[0] = (st[1] - gpos[1]) * (rn + h) * math.cos(st[0]) + la0
+        z[1] = (st[0] - gpos[0]) * (rm + h) + la1
+        z[2] = (st[2] - gpos[2]) + la2
+        r = 3
+    if use_vel:
+        cx = wy * lever[2] - wz * lever[1]
+        cy = wz * lever[0] - wx * lever[2]
+        cz = wx * lever[1] - wy * lever[0]
+        for i in range(3):
+            z[r + i] = st[3 + i] + c[i, 0] * cx + c[i, 1] * cy + c[i, 2] * cz - gvel[i]
+        r += 3
+    return r
+
+
+@njit(**_NJ)
+def _attitude_error(q, tq, e):
+    """φ (e[6:9]) from Ĉ Cᵀ = exp(−φ×): the quaternion of q̂ ⊗ q_true*."""
+    t0, t1, t2, t3 = tq[0], -tq[1], -tq[2], -tq[3]
+    a1, b1, c1, d1 = q[0], q[1], q[2], q[3]
+    r0 = a1 * t0 - b1 * t1 - c1 * t2 - d1 * t3
+    r1 = a1 * t1 + b1 * t0 + c1 * t3 - d1 * t2
+    r2 = a1 * t2 - b1 * t3 + c1 * t0 + d1 * t1
+    r3 = a1 * t3 + b1 * t2 - c1 * t1 + d1 * t0
+    sg = 1.0 if r0 >= 0 else -1.0
+    e[6] = -2.0 * sg * r1
+    e[7] = -2.0 * sg * r2
+    e[8] = -2.0 * sg * r3
+
+
+@njit(**_NJ)
+def _lead_time_update(spec, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt, lead):
+    """F as the interval mean (``build_F_core`` at the mean inputs plus the mean couplings ``Cpl``),
+    (Φ, Q_d) by the Van Loan series with the navigation white noise at the mean C_b^n, then
+    P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements)."""
+    n = F.shape[0]
+    inv = 1.0 / nsum
+    K.build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
+                   fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, spec.fconst, F)
+    for i in range(3):
+        for jj in range(9, n):
+            F[3 + i, jj] += Cpl[i, jj] * inv
+            F[6 + i, jj] -= Cpl[3 + i, jj] * inv
+    for i in range(3):
+        for jj in range(3):
+            Csum[i, jj] *= inv
+    K._interval_discretize(F, spec.qc, Csum, spec.q_accel, spec.q_gyro, tsum, spec.order, Qc, Phi, Qd, w1, w2)
+    _propagate_sparse(Phi, lead.P, Qd, w1, nzc, nzv, cnt)
+    if spec.use_pbar:
+        _propagate_sparse(Phi, lead.Pbar, Qd, w1, nzc, nzv, cnt)
+
+
+@njit(**_NJ)
+def _lead_gains(P, H, m, Rd, gK, gs):
+    """Sequential Joseph update of P for rows 0..m-1 of H (variances ``Rd``): gains ``gK[a]`` and
+    innovation variances ``gs[a]`` (see :func:`replication._kernels.joseph_update`)."""
+    n = P.shape[0]
+    for a in range(m):
+        for i in range(n):
+            acc = 0.0
+            for k in range(n):
+                hk = H[a, k]
+                if hk != 0.0:
+                    acc += P[i, k] * hk
+            gK[a, i] = acc
+        sv = Rd[a]
+        for k in range(n):
+            sv += H[a, k] * gK[a, k]
+        bvec = gK[a].copy()
+        for i in range(n):
+            gK[a, i] = bvec[i] / sv
+        gs[a] = sv
+        for i in range(n):
+            for j in range(i, n):
+                v = P[i, j] - gK[a, i] * bvec[j] - bvec[i] * gK[a, j] + sv * gK[a, i] * gK[a, j]
+                P[i, j] = v
+                P[j, i] = v
+
+
+@njit(**_NJ)
+def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
+    """One chunk of the closed-loop filter for the runs of ``bs_`` (see the module docstring).
+
+    ``is_lead``: run 0 of ``bs_`` is the lead — the covariance (``lead``) is propagated and
+    updated from it and the gains are written to ``gains`` for every epoch; otherwise the runs
+    follow ``gains`` written by the lead's pass over the same chunk.  Returns the number of
+    GNSS epochs processed.
+    """
+    R = inp.dth.shape[0]
+    n_steps = inp.dt.shape[0]
+    n = spec.fconst.shape[0]
+    n_aug = n - 9
+    n_ep = inp.ep_step.shape[0]
+    n_dyn = spec.dyn_rows.shape[0]
+    qtmp = np.empty(4)
+    c = np.empty((3, 3))
+    w_ie = np.empty(3)
+    w_en = np.empty(3)
+    ta = np.empty(3)
+    tb = np.empty(3)
+    B = np.empty((3, 6))
+    dth_c = np.empty(3)
+    dv_c = np.empty(3)
+    fb = np.empty(3)
+    wb = np.empty(3)
+    F = np.zeros((n, n))
+    Phi = np.empty((n, n))
+    Qd = np.empty((n, n))
+    Qc = np.empty((n, n))
+    w1 = np.empty((n, n))
+    w2 = np.empty((n, n))
+    nzc = np.empty((n, n), np.int64)
+    nzv = np.empty((n, n))
+    cnt = np.empty(n, np.int64)
+    Csum = np.zeros((3, 3))
+    Cpl = np.zeros((6, n))
+    fsum = np.zeros(3)
+    navsum = np.zeros(5)
+    H = np.zeros((_MMAX, n))
+    Rd = np.zeros(_MMAX)
+    z = np.empty(_MMAX)
+    xk = np.empty(n)
+    e = np.empty(n)
+    tmp = np.empty(max(n_dyn, 1))
+    Ta = np.ascontiguousarray(spec.ar_T[9:, 9:])
+    store_nav = out.nav_st.shape[1] > 0
+    record = out.rec_x.shape[1] > 0
+    nsum = 0
+    tsum = 0.0
+    if store_nav:
+        for r in range(R):
+            out.nav_st[r, 0, :] = bs_.st[r]
+            out.nav_q[r, 0, :] = bs_.q[r]
+    j = 0
+    for k in range(n_steps):
+        T = inp.dt[k]
+        w_sf = inp.sf_w[k]
+        in_win = inp.sf_win[k] >= 0
+        for r in range(R):
+            K._apply_corrections(inp.dth[r, k], T, bs_.p_hat[r], spec.tg, spec.kd, spec.bs, spec.bz, 1, dth_c, B)
+            K._apply_corrections(inp.dvv[r, k], T, bs_.p_hat[r], spec.tg, spec.kd, spec.bs, spec.bz, 0, dv_c, B)
+            if bs_.first[0] == 1:
+                for i in range(3):
+                    bs_.dth_cp[r, i] = dth_c[i]
+                    bs_.dv_cp[r, i] = dv_c[i]
+            if is_lead and r == 0:
+                # inputs of F at the start of the step, summed over the GNSS interval
+                K._q2c(bs_.q[0], c)
+                for i in range(3):
+                    fb[i] = dv_c[i] / T
+                    wb[i] = dth_c[i] / T
+                K._accumulate_interval(c, fb, bs_.st[0], fsum, Csum, navsum)
+                K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, 1.0, Cpl, B)
+                if in_win:
+                    for i in range(3):
+                        lead.facc[i] += w_sf * (c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2])
+                    K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, w_sf, lead.Cw, B)
+                nsum += 1
+                tsum += T
+            v0, v1, v2 = bs_.st[r, 3], bs_.st[r, 4], bs_.st[r, 5]
+            href = inp.h_ref[k + 1] if spec.vmode == 1 else inp.h_ref[k]
+            bs_.damp[r] = K.sd_step(T, dth_c, dv_c, bs_.dth_cp[r], bs_.dv_cp[r], bs_.st[r], bs_.st_prev[r], bs_.q[r],
+                                    qtmp, c, w_ie, w_en, ta, tb, spec.vmode, href, inp.vu_ref[k + 1], spec.gains,
+                                    bs_.damp[r], bs_.g_extra[r], bs_.trig[r])
+            if in_win:
+                bs_.vacc[r, 0] += w_sf * (bs_.st[r, 3] - v0) / T
+                bs_.vacc[r, 1] += w_sf * (bs_.st[r, 4] - v1) / T
+                bs_.vacc[r, 2] += w_sf * (bs_.st[r, 5] - v2) / T
+            for i in range(3):
+                bs_.dth_cp[r, i] = dth_c[i]
+                bs_.dv_cp[r, i] = dv_c[i]
+        bs_.first[0] = 0
+        if j < n_ep and inp.ep_step[j] == k:
+            _epoch(spec, inp, bs_, lead, gains, out, is_lead, j, T, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi,
+                   Qd, w1, w2, nzc, nzv, cnt, H, Rd, z, xk, e, tmp, Ta, c, qtmp, w_ie, w_en, record)
+            K._reset_interval(Cpl, fsum, Csum, navsum)
+            nsum = 0
+            tsum = 0.0
+            j += 1
+        if store_nav:
+            for r in range(R):
+                out.nav_st[r, k + 1, :] = bs_.st[r]
+                out.nav_q[r, k + 1, :] = bs_.q[r]
+    return j
+
+
+@njit(**_NJ)
+def _epoch(spec, inp, bs_, lead, gains, out, is_lead, j, T, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd,
+           w1, w2, nzc, nzv, cnt, H, Rd, z, xk, e, tmp, Ta, c, qtmp, w_ie, w_en, record):
+    """One GNSS epoch of :func:`filter_chunk`: time update and gains (lead), then every run's
+    innovation, correction, feedback and records."""
+    R = inp.dth.shape[0]
+    n = spec.fconst.shape[0]
+    n_aug = n - 9
+    n_dyn = spec.dyn_rows.shape[0]
+    if True:
+        sf = inp.sf_end[j]
+        # ---------------- time update (lead)
+        if is_lead:
+            _lead_time_update(spec, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt, lead)
+            for t in range(n_dyn):
+                for jj in range(n_aug):
+                    gains.Phid[j, t, jj] = Phi[9 + spec.dyn_rows[t], 9 + jj]
+            if record:
+                out.rec_Phi[j] = Phi
+                out.rec_Pp[j] = lead.P
+        # sensor-error estimates with dynamics (Markov, gravity) follow Φ
+        for r in range(R):
+            for t in range(n_dyn):
+                s_ = 0.0
+                for jj in range(n_aug):
+                    s_ += gains.Phid[j, t, jj] * bs_.p_hat[r, jj]
+                tmp[t] = s_
+            for t in range(n_dyn):
+                bs_.p_hat[r, spec.dyn_rows[t]] = tmp[t]
+        if inp.ar_tick[j]:
+            # discrete AR step of the gravity states (held between steps): x ← T x, P ← T P Tᵀ + Q
+            if is_lead:
+                lead.P[:, :] = spec.ar_T @ lead.P @ spec.ar_T.T + spec.ar_Q
+                if spec.use_pbar:
+                    lead.Pbar[:, :] = spec.ar_T @ lead.Pbar @ spec.ar_T.T + spec.ar_Q
+            for r in range(R):
+                bs_.p_hat[r, :] = Ta @ bs_.p_hat[r]
+        # ---------------- measurement rows and gains (lead)
+        if is_lead:
+            K._q2c(bs_.q[0], c)
+            for i in range(_MMAX):
+                for jj in range(n):
+                    H[i, jj] = 0.0
+            wx, wy, wz = _body_rate(bs_.dth_cp[0], T, c, bs_.st[0], w_ie, w_en)
+            m = K.gnss_rows(H, c, bs_.lever[0], wx, wy, wz, bs_.st[0, 0], bs_.st[0, 2], spec.use_pos, spec.use_vel,
+                            spec.tg, spec.bs)
+            for i in range(3):
+                if spec.use_pos:
+                    Rd[i] = spec.R_pos[i, i]
+                if spec.use_vel:
+                    Rd[m - 3 + i] = spec.R_vel[i, i]
+            if sf >= 0:
+                _specific_force_rows(H, m, lead.facc, lead.Cw, spec.sf_H, spec.tg, spec.bs, spec.bz)
+                for i in range(3):
+                    Rd[m + i] = inp.sf_R[sf, i]
+                m += 3
+            gains.m[j] = m
+            _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j])
+            for a in range(m):
+                gains.H[j, a, :] = H[a]
+            if gains.P.shape[0] > 0:
+                gains.P[j] = lead.P
+            if sf >= 0:
+                lead.facc[:] = 0.0
+                lead.Cw[:, :] = 0.0
+        m = gains.m[j]
+        # ---------------- per run: innovation, correction, feedback, records
+        for r in range(R):
+            K._q2c(bs_.q[r], c)
+            wx, wy, wz = _body_rate(bs_.dth_cp[r], T, c, bs_.st[r], w_ie, w_en)
+            mr = _innovations(bs_.st[r], c, bs_.lever[r], wx, wy, wz, inp.gpos[r, j], inp.gvel[r, j],
+                              spec.use_pos, spec.use_vel, z)
+            if sf >= 0:
+                for i in range(3):
+                    z[mr + i] = bs_.vacc[r, i] - inp.sf_a[sf, i]
+                    bs_.vacc[r, i] = 0.0
+            for i in range(n):
+                xk[i] = 0.0
+            nis = 0.0
+            for a in range(m):
+                nu = z[a]
+                for kk in range(n):
+                    nu -= gains.H[j, a, kk] * xk[kk]
+                for i in range(n):
+                    xk[i] += gains.Kg[j, a, i] * nu
+                nis += nu * nu / gains.s[j, a]
+            out.nis[r, j] = nis
+            for a in range(m):
+                out.innov[r, j, a] = z[a]
+            if record:
+                out.rec_x[r, j, :] = xk
+            K._feedback_nav(xk, bs_.st[r], bs_.st_prev[r], bs_.q[r], bs_.p_hat[r], qtmp)
+            K._feedback_blocks(bs_.p_hat[r], spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, bs_.lever[r],
+                               bs_.g_extra[r])
+            out.st[r, j, :] = bs_.st[r]
+            out.q[r, j, :] = bs_.q[r]
+            out.phat[r, j, :] = bs_.p_hat[r]
+            if spec.nees:
+                for i in range(6):
+                    e[i] = bs_.st[r, i] - inp.truth_st[j, i]
+                _attitude_error(bs_.q[r], inp.truth_q[j], e)
+                for i in range(n_aug):
+                    e[9 + i] = inp.truth_p[r, j, i] - bs_.p_hat[r, i]
+                out.nees[r, j] = K._chol_solve_scaled(gains.P[j], e)
+        if is_lead:
+            for i in range(n):
+                out.pdiag[j, i] = lead.P[i, i]
+            if record:
+                out.rec_Pf[j] = lead.P
+            f = out.flag[j]
+            if f >= 0:
+                out.P[f] = lead.P
+                if spec.use_pbar:
+                    out.Pbar[f] = lead.Pbar
+
+
+@njit(**_NJ)
+def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, out_ds, out_Ps, out_psdiag, with_cov):
+    """Backward Rauch-Tung-Striebel pass over one chunk of the closed-loop filter.
+
+    The filter feeds its estimate back, so its error state after each update is zero and the
+    smoothed error is d_k = C_k (d_{k+1} + x̂_{k+1}) with C_k = P_k⁺ Φ_kᵀ (P_{k+1}⁻)⁻¹ (x̂ the
+    update's estimate before feedback), P^s_k = P_k⁺ + C_k (P^s_{k+1} − P_{k+1}⁻) C_kᵀ.  ``ds``
+    (runs × n) and ``Ps`` hold the smoothed error and covariance at the epoch after the chunk on
+    entry (when ``has_next``) and at the chunk's first epoch on return.  Without ``with_cov`` only
+    the state recursion runs (C_k needs P_k⁺, P_{k+1}⁻ and Φ_k, not P^s)."""
+    E_ = Pf.shape[0]
+    R = ds.shape[0]
+    n = Pf.shape[1]
+    d = np.empty(n)
+    Rc = np.empty((n, n))
+    rhs = np.empty((n, n))
+    tmp = np.empty(n)
+    for jj in range(E_ - 1, -1, -1):
+        if jj == E_ - 1 and not has_next:
+            for r in range(R):
+                for i in range(n):
+                    ds[r, i] = 0.0
+            for i in range(n):
+                for k in range(n):
+                    Ps[i, k] = Pf[jj, i, k]
+        else:
+            if jj == E_ - 1:
+                Pp1 = Pp_n
+                Ph1 = Phi_n
+                x1 = x_n
+            else:
+                Pp1 = Pp[jj + 1]
+                Ph1 = Phi[jj + 1]
+                x1 = xrec[:, jj + 1, :]
+            for i in range(n):
+                # a state with zero prior variance (no prior, no noise) decouples: unit scale,
+                # its row of Φ P⁺ is zero, so its column of C_k is zero
+                d[i] = math.sqrt(Pp1[i, i]) if Pp1[i, i] > 0.0 else 1.0
+            for i in range(n):
+                for k in range(n):
+                    Rc[i, k] = Pp1[i, k] / (d[i] * d[k])
+                if Pp1[i, i] <= 0.0:
+                    Rc[i, i] = 1.0
+            A = Ph1 @ Pf[jj]
+            for i in range(n):
+                for k in range(n):
+                    rhs[i, k] = A[i, k] / d[i]
+            Y = np.linalg.solve(Rc, rhs)
+            Cm = np.empty((n, n))
+            for i in range(n):
+                for k in range(n):
+                    Cm[k, i] = Y[i, k] / d[i]
+            for r in range(R):
+                for i in range(n):
+                    tmp[i] = ds[r, i] + x1[r, i]
+                for i in range(n):
+                    s_ = 0.0
+                    for k in range(n):
+                        s_ += Cm[i, k] * tmp[k]
+                    ds[r, i] = s_
+            if with_cov:
+                D = Ps - Pp1
+                G = Cm @ D @ Cm.T
+                for i in range(n):
+                    for k in range(i, n):
+                        v = Pf[jj, i, k] + 0.5 * (G[i, k] + G[k, i])
+                        Ps[i, k] = v
+                        Ps[k, i] = v
+        for i in range(n):
+            out_psdiag[jj, i] = Ps[i, i]
+        f = out_flag[jj]
+        if f >= 0:
+            for r in range(R):
+                for i in range(n):
+                    out_ds[r, f, i] = ds[r, i]
+            if with_cov:
+                for i in range(n):
+                    for k in range(n):
+                        out_Ps[f, i, k] = Ps[i, k]
+
+
+# ----------------------------------------------------------------------------- configuration
+
+def build_spec(model: ErrorModel, *, R_pos, R_vel, lever_arm_b=(0.0, 0.0, 0.0), use_position: bool = True,
+               use_velocity: bool = True, vmode: int = 0, gains=(0.0, 0.0, 0.0), series_order: int = 4,
+               ar=None, sf_H=None, prior_covariance: bool = False, nees: bool = False) -> Spec:
+    """The filter's configuration for ``model``.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The error-state model (15 states or any extension, :mod:`replication.errors`).
+    R_pos, R_vel : (3, 3) array_like
+        Diagonal GNSS position (ENU metres) and velocity noise covariances.
+    lever_arm_b : (3,) array_like
+        Antenna lever arm in the body frame used by the filter (chen2019 eq. (2-13)).
+    use_position, use_velocity : bool
+        Which GNSS rows to use (at least one).
+    vmode, gains : int, (3,) array_like
+        Vertical channel: 0 free, 1 held, 2 damped with ``gains`` (:mod:`replication.strapdown`).
+    series_order : int
+        Order of the Van Loan series for (Φ, Q_d).
+    ar : tuple (T, Q) of (n, n) arrays, optional
+        Discrete transition applied at the epochs flagged in ``ChunkInputs.ar_tick``.
+    sf_H : (3, n - 9) array_like, optional
+        Gravity columns of the specific-force rows (chen2019 eq. (3-18)).
+    prior_covariance : bool
+        Also propagate the covariance without measurements.
+    nees : bool
+        Compute the NEES against the truth of the inputs.
+
+    Returns
+    -------
+    Spec
+    """
+    if not isinstance(model, ErrorModel):
+        raise TypeError("model must be a replication.errors.ErrorModel")
+    if not (use_position or use_velocity):
+        raise ValueError("use at least one of GNSS position and velocity")
+    R_pos = np.asarray(R_pos, float)
+    R_vel = np.asarray(R_vel, float)
+    for name, M in (("R_pos", R_pos), ("R_vel", R_vel)):
+        if M.shape != (3, 3) or np.any(M != np.diag(np.diag(M))) or np.any(np.diag(M) <= 0):
+            raise ValueError(f"{name} must be a 3×3 diagonal matrix with positive variances (independent axes)")
+    if int(series_order) < 1:
+        raise ValueError("series_order must be at least 1")
+    fconst, qc, tg, kd, bs, bz = model._encoding()
+    n = model.n
+    dyn = np.array([i - 9 for i in range(9, n) if np.any(fconst[i, 9:] != 0)], dtype=np.int64)
+    if ar is None:
+        arT, arQ = np.eye(n), np.zeros((n, n))
+    else:
+        arT, arQ = (np.ascontiguousarray(a, dtype=float) for a in ar)
+        if arT.shape != (n, n) or arQ.shape != (n, n):
+            raise ValueError(f"ar = (T, Q) must be {n}×{n}")
+    sfH = np.zeros((3, n - 9)) if sf_H is None else np.ascontiguousarray(sf_H, dtype=float)
+    if sfH.shape != (3, n - 9):
+        raise ValueError(f"sf_H must be 3×{n - 9}")
+    return Spec(fconst, qc, np.asarray(model.accel_psd, float), np.asarray(model.gyro_psd, float), tg, kd, bs, bz,
+                int(series_order), dyn, bool(use_position), bool(use_velocity), R_pos, R_vel,
+                np.asarray(lever_arm_b, float).copy(), int(vmode), np.asarray(gains, float), arT, arQ, sfH,
+                bool(prior_covariance), bool(nees))
+
+
+def initial_batch_state(st, q, lever0) -> BatchState:
+    """Per-run state at the start: navigation states ``st`` (R × 6: L, λ, h, vE, vN, vU),
+    quaternions ``q`` (R × 4), the lever arm in use ``lever0``."""
+    st = np.ascontiguousarray(st, dtype=float)
+    q = np.ascontiguousarray(q, dtype=float)
+    if st.ndim != 2 or st.shape[1] != 6 or q.shape != (st.shape[0], 4):
+        raise ValueError("st must be R×6 and q R×4")
+    R = st.shape[0]
+    return BatchState(st, st.copy(), q, None, np.tile(np.asarray(lever0, float), (R, 1)), np.zeros((R, 3)),
+                      np.zeros((R, 3)), np.zeros((R, 3)), np.column_stack([st[:, 0], np.sin(st[:, 0]),
+                                                                            np.cos(st[:, 0])]),
+                      np.zeros(R), np.zeros((R, 3)), np.array([1], np.int64))
+
+
+def _with_phat(bs: BatchState, n_aug: int) -> BatchState:
+    return bs._replace(p_hat=np.zeros((bs.st.shape[0], n_aug))) if bs.p_hat is None else bs
+
+
+def _split(bs: BatchState, sl) -> BatchState:
+    """Views of the runs ``sl`` of a batch state (the flag is per group)."""
+    return BatchState(*(v[sl] if k != "first" else v.copy() for k, v in zip(BatchState._fields, bs)))
+
+
+# ----------------------------------------------------------------------------- driver
+
+@dataclass
+class Records:
+    """Outputs of :func:`run` at the recorded epochs (runs × epochs unless noted).
+
+    ``st``/``q`` the navigation state after feedback, ``p_hat`` the accumulated sensor-error
+    estimates, ``nis``, ``innov`` (rows as used), ``nees`` (or None), ``P`` (recorded epochs × n ×
+    n), ``P_bar`` (or None), ``pdiag_all`` (every epoch × n), ``nav_st``/``nav_q`` the IMU-rate
+    solution (or None), ``ds``/``P_s`` the smoothed error and covariance (or None)."""
+
+    epochs: np.ndarray
+    st: np.ndarray
+    q: np.ndarray
+    p_hat: np.ndarray
+    nis: np.ndarray
+    innov: np.ndarray
+    nees: np.ndarray | None
+    P: np.ndarray
+    P_bar: np.ndarray | None
+    pdiag_all: np.ndarray
+    nav_st: np.ndarray | None = None
+    nav_q: np.ndarray | None = None
+    ds: np.ndarray | None = None
+    P_s: np.ndarray | None = None
+
+
+def _empty_gains(E_, n, n_dyn, n_aug, with_P):
+    return Gains(np.zeros(E_, np.int64), np.zeros((E_, _MMAX, n)), np.zeros((E_, _MMAX, n)),
+                 np.ones((E_, _MMAX)), np.zeros((E_, max(n_dyn, 0), n_aug)),
+                 np.empty((E_ if with_P else 0, n, n)))
+
+
+def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
+        inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *, record_every: int = 1,
+        chunk_epochs: int = 2000, smoother: bool = False, smoother_covariance: bool = True,
+        store_nav: bool = False, store_P_all: bool = False, workers: int = 2) -> Records:
+    """Run the closed-loop filter of ``spec`` over ``n_steps`` IMU steps for the runs of ``state``.
+
+    Parameters
+    ----------
+    spec : Spec
+        From :func:`build_spec`.
+    state : BatchState
+        From :func:`initial_batch_state` (modified in place).
+    P0 : (n, n) array_like
+        Initial covariance.
+    ep_samples : (E,) array_like of int
+        IMU sample index of each GNSS epoch (1..n_steps, strictly increasing).
+    n_steps : int
+        Number of IMU steps.
+    inputs : callable
+        ``inputs(chunk, k0, k1, ep_samples_of_chunk)`` → :data:`ChunkInputs` for steps k0..k1-1
+        (deterministic: the smoother replays chunks).
+    record_every : int
+        Record every ``record_every``-th epoch (the P's and the per-run records).
+    chunk_epochs : int
+        Epochs per chunk (memory of the gains and of the smoother's records).
+    smoother, smoother_covariance : bool
+        Add the RTS pass (replaying the forward pass chunk by chunk), with or without P^s.
+    store_nav : bool
+        Keep the IMU-rate solution (single chunk only).
+    store_P_all : bool
+        Record P at every recorded epoch (always done; kept for clarity of the call sites).
+    workers : int
+        Threads for the runs that follow the lead (≥ 1; results do not depend on it).
+
+    Returns
+    -------
+    Records
+    """
+    ep = np.asarray(ep_samples, np.int64)
+    n = spec.fconst.shape[0]
+    n_aug = n - 9
+    if ep.ndim != 1 or len(ep) < 1 or np.any(np.diff(ep) <= 0) or ep[0] < 1 or ep[-1] > n_steps:
+        raise ValueError(f"ep_samples must be strictly increasing sample indices in 1..{n_steps}")
+    if int(record_every) < 1 or int(chunk_epochs) < 2 or int(workers) < 1:
+        raise ValueError("record_every ≥ 1, chunk_epochs ≥ 2 and workers ≥ 1 are required")
+    P0 = np.array(P0, dtype=float)
+    if P0.shape != (n, n):
+        raise ValueError(f"P0 must be {n}×{n}")
+    state = _with_phat(state, n_aug)
+    R = state.st.shape[0]
+    n_ep = len(ep)
+    chunks = [(j0, min(j0 + int(chunk_epochs), n_ep)) for j0 in range(0, n_ep, int(chunk_epochs))]
+    if store_nav and len(chunks) > 1:
+        chunks = [(0, n_ep)]
+    rec_mask = (np.arange(n_ep) + 1) % int(record_every) == 0
+    rec_ep = np.nonzero(rec_mask)[0]
+    m_rec = len(rec_ep)
+    rec_pos = np.full(n_ep, -1, np.int64)
+    rec_pos[rec_ep] = np.arange(m_rec)
+    res = Records(epochs=rec_ep, st=np.empty((R, m_rec, 6)), q=np.empty((R, m_rec, 4)),
+                  p_hat=np.empty((R, m_rec, n_aug)), nis=np.empty((R, m_rec)), innov=np.zeros((R, m_rec, _MMAX)),
+                  nees=np.full((R, m_rec), np.nan) if spec.nees else None, P=np.empty((m_rec, n, n)),
+                  P_bar=np.empty((m_rec, n, n)) if spec.use_pbar else None, pdiag_all=np.empty((n_ep, n)))
+    lead = LeadState(P0.copy(), P0.copy(), np.zeros(3), np.zeros((6, n)))
+    n_dyn = len(spec.dyn_rows)
+    n_groups = min(int(workers), R - 1) if R > 1 else 0
+    groups = [slice(1 + g * (R - 1) // n_groups, 1 + (g + 1) * (R - 1) // n_groups) for g in range(n_groups)]
+
+    def bounds(ci):
+        j0, j1 = chunks[ci]
+        k0 = 0 if ci == 0 else int(ep[j0 - 1])
+        k1 = n_steps if ci == len(chunks) - 1 else int(ep[j1 - 1])
+        return j0, j1, k0, k1
+
+    def chunk_out(ci, j0, j1, k0, k1, record):
+        E_ = j1 - j0
+        flag = rec_pos[j0:j1] - (rec_pos[j0:j1][rec_pos[j0:j1] >= 0].min() if np.any(rec_pos[j0:j1] >= 0) else 0)
+        flag = np.where(rec_pos[j0:j1] >= 0, flag, -1).astype(np.int64)
+        n_f = int(np.sum(flag >= 0))
+        nav = (k1 - k0 + 1) if store_nav else 0
+        e3 = np.empty((0, n, n))
+        return ChunkOut(np.empty((R, E_, 6)), np.empty((R, E_, 4)), np.empty((R, E_, n_aug)), np.empty((R, E_)),
+                        np.zeros((R, E_, _MMAX)), np.full((R, E_), np.nan) if spec.nees else np.empty((R, 0)),
+                        np.empty((R, nav, 6)), np.empty((R, nav, 4)), np.empty((E_, n)), flag,
+                        np.empty((n_f, n, n)), np.empty((n_f, n, n)) if spec.use_pbar else e3,
+                        np.empty((E_, n, n)) if record else e3, np.empty((E_, n, n)) if record else e3,
+                        np.empty((E_, n, n)) if record else e3,
+                        np.empty((R, E_, n)) if record else np.empty((R, 0, n)))
+
+    def view(o: ChunkOut, sl) -> ChunkOut:
+        per_run = {"st", "q", "phat", "nis", "innov", "nees", "nav_st", "nav_q", "rec_x"}
+        return ChunkOut(*(v[sl] if k in per_run else v for k, v in zip(ChunkOut._fields, o)))
+
+    def inp_view(x: ChunkInputs, sl) -> ChunkInputs:
+        per_run = {"dth", "dvv", "gpos", "gvel", "truth_p"}
+        return ChunkInputs(*(v[sl] if k in per_run else v for k, v in zip(ChunkInputs._fields, x)))
+
+    def forward(ci, st_, lead_, record):
+        """Lead over the chunk, then the groups of followers (threads), joined before return."""
+        j0, j1, k0, k1 = bounds(ci)
+        x = inputs(ci, k0, k1, ep[j0:j1])
+        o = chunk_out(ci, j0, j1, k0, k1, record)
+        g = _empty_gains(j1 - j0, n, n_dyn, n_aug, spec.nees)
+        filter_chunk(spec, inp_view(x, slice(0, 1)), _split(st_, slice(0, 1)), lead_, g, view(o, slice(0, 1)), True)
+        if groups:
+            def follow(sl):
+                filter_chunk(spec, inp_view(x, sl), _split(st_, sl), lead_, g, view(o, sl), False)
+            threads = [threading.Thread(target=follow, args=(sl,)) for sl in groups[1:]]
+            for t in threads:
+                t.start()
+            follow(groups[0])
+            for t in threads:
+                t.join()
+        st_.first[0] = 0
+        return j0, j1, o
+
+    checkpoints = []
+    for ci in range(len(chunks)):
+        if smoother:
+            checkpoints.append((BatchState(*(v.copy() for v in state)), LeadState(*(v.copy() for v in lead))))
+        j0, j1, o = forward(ci, state, lead, False)
+        sel = o.flag >= 0
+        pos = rec_pos[j0:j1][sel]
+        res.st[:, pos] = o.st[:, sel]
+        res.q[:, pos] = o.q[:, sel]
+        res.p_hat[:, pos] = o.phat[:, sel]
+        res.nis[:, pos] = o.nis[:, sel]
+        res.innov[:, pos] = o.innov[:, sel]
+        if spec.nees:
+            res.nees[:, pos] = o.nees[:, sel]
+        res.P[pos] = o.P
+        if spec.use_pbar:
+            res.P_bar[pos] = o.Pbar
+        res.pdiag_all[j0:j1] = o.pdiag
+        if store_nav:
+            res.nav_st, res.nav_q = o.nav_st, o.nav_q
+    if smoother:
+        res.ds = np.empty((R, m_rec, n))
+        res.P_s = np.empty((m_rec, n, n)) if smoother_covariance else None
+        ds = np.zeros((R, n))
+        Ps = np.zeros((n, n))
+        nxt = None
+        for ci in range(len(chunks) - 1, -1, -1):
+            st_c, lead_c = checkpoints[ci]
+            j0, j1, o = forward(ci, st_c, lead_c, True)
+            E_ = j1 - j0
+            n_f = int(np.sum(o.flag >= 0))
+            o_ds = np.empty((R, n_f, n))
+            o_Ps = np.empty((n_f if smoother_covariance else 0, n, n))
+            o_pd = np.empty((E_, n))
+            if nxt is None:
+                rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, False, o.rec_Pp[0], o.rec_Phi[0],
+                          np.ascontiguousarray(o.rec_x[:, 0, :]), ds, Ps, o.flag, o_ds, o_Ps, o_pd,
+                          smoother_covariance)
+            else:
+                rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, True, nxt[0], nxt[1], nxt[2], ds, Ps, o.flag,
+                          o_ds, o_Ps, o_pd, smoother_covariance)
+            nxt = (o.rec_Pp[0].copy(), o.rec_Phi[0].copy(), np.ascontiguousarray(o.rec_x[:, 0, :]))
+            pos = rec_pos[j0:j1][o.flag >= 0]
+            res.ds[:, pos] = o_ds
+            if smoother_covariance:
+                res.P_s[pos] = o_Ps
+            checkpoints[ci] = None
+    return res
+
+
+def no_windows(n_steps: int, n_epochs: int, n_runs: int, n_aug: int):
+    """The specific-force, AR and truth fields of :data:`ChunkInputs` when unused."""
+    return dict(sf_w=np.zeros(n_steps), sf_win=np.full(n_steps, -1, np.int64),
+                sf_end=np.full(n_epochs, -1, np.int64), sf_a=np.zeros((1, 3)), sf_R=np.ones((1, 3)),
+                ar_tick=np.zeros(n_epochs, np.int64), truth_st=np.zeros((n_epochs, 6)),
+                truth_q=np.zeros((n_epochs, 4)), truth_p=np.zeros((n_runs, n_epochs, n_aug)))

@@ -1,0 +1,152 @@
+"""The one closed-loop filter (replication.closedloop): its update against the textbook Joseph
+form, its GNSS rows against numerical Jacobians of the antenna measurement, its couplings against
+the error model, batches independent of the thread count, and every entry point on one kernel."""
+
+import numpy as np
+import pytest
+
+from replication import _kernels as K, closedloop as cl, earth, errors as er, kalman as kf, simulation as sim
+from replication import trajectory as tr
+from replication.rotations import rotvec_to_dcm
+from replication.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MICRO_G
+
+
+def test_sequential_gains_equal_the_joseph_update():
+    """A diagonal R: the sequential scalar updates give the batch Joseph P⁺ and the batch estimate
+    (to rounding; κ(P) ≈ 1e2 here)."""
+    rng = np.random.default_rng(7)
+    n, m = 12, 6
+    A = rng.normal(size=(n, n))
+    P = A @ A.T + n * np.eye(n)
+    H = rng.normal(size=(m, n)) * (rng.random((m, n)) < 0.5)
+    Rd = rng.uniform(0.5, 2.0, m)
+    z = rng.normal(size=m)
+    gK, gs = np.empty((9, n)), np.empty(9)
+    Pseq = P.copy()
+    cl._lead_gains(Pseq, np.vstack([H, np.zeros((9 - m, n))]), m, np.r_[Rd, np.ones(9 - m)], gK, gs)
+    x = np.zeros(n)
+    for a in range(m):
+        x += gK[a] * (z[a] - H[a] @ x)
+    x_ref, P_ref, nu, S = kf.update(np.zeros(n), P, z, H, np.diag(Rd))
+    assert np.allclose(Pseq, P_ref, rtol=0, atol=1e-12 * np.abs(P).max())
+    assert np.allclose(x, x_ref, rtol=0, atol=1e-12 * np.abs(x_ref).max())
+
+
+# ----------------------------------------------------------------------------- H rows vs numerical Jacobians
+
+def _measurement(x, st_hat, C_hat, lever_used, w_eb):
+    """INS-predicted minus true antenna position (ENU metres) and velocity when the true state
+    differs from the INS one by the error x = [δL, δλ, δh, δv, φ, δl] (INS − true; Ĉ = (I − φ×) C;
+    δl = true − used lever arm).  The position difference of the two points is taken in metres at
+    the INS point (δL (R_M + h), δλ (R_N + h) cos L, δh: the measurement's definition), so no
+    geodetic coordinates are subtracted."""
+    rm, rn = earth.radii(st_hat[0])
+    dp = np.array([x[1] * (rn + st_hat[2]) * np.cos(st_hat[0]), x[0] * (rm + st_hat[2]), x[2]])
+    C_true = rotvec_to_dcm(x[6:9]) @ C_hat           # C = exp(φ×) Ĉ, inverse of Ĉ ≈ (I − φ×) C
+    l_true = lever_used + x[9:12]
+    z_pos = dp + C_hat @ lever_used - C_true @ l_true
+    z_vel = x[3:6] + C_hat @ np.cross(w_eb, lever_used) - C_true @ np.cross(w_eb, l_true)
+    return np.r_[z_pos, z_vel]
+
+
+@pytest.mark.parametrize("lever", [(0.0, 0.0, 0.0), (0.4, -1.2, 2.5)])
+def test_gnss_rows_are_the_jacobian_of_the_antenna_measurement(lever):
+    """chen2019 eq. (2-13): H of :func:`replication._kernels.gnss_rows` (position and velocity at the
+    antenna, lever-arm state columns) equals the central-difference Jacobian of the nonlinear
+    measurement, column-relative difference < 1e-6 (steps 1e-7 of each state's scale: the
+    truncation error is O(step²), the rounding O(1e-16/step))."""
+    st = np.array([0.8, 2.0, 3000.0, 80.0, -40.0, 2.0])
+    C = rotvec_to_dcm(np.array([0.05, -0.03, 1.1]))
+    w_eb = np.array([0.01, -0.02, 0.15])
+    lever = np.asarray(lever, float)
+    n = 12
+    H = np.zeros((6, n))
+    tg = np.array([K.TARGET_LEVER], np.int64)
+    rows = K.gnss_rows(H, C, lever, *w_eb, st[0], st[2], True, True, tg, np.array([9], np.int64))
+    assert rows == 6
+    scale = np.r_[1e-6, 1e-6, 1.0, 0.1, 0.1, 0.1, 1e-3, 1e-3, 1e-3, 0.1, 0.1, 0.1]
+    J = np.empty((6, n))
+    for i in range(n):
+        d = np.zeros(n)
+        d[i] = 1e-3 * scale[i]
+        J[:, i] = (_measurement(d, st, C, lever, w_eb) - _measurement(-d, st, C, lever, w_eb)) / (2 * d[i])
+    col = np.maximum(np.abs(J).max(0), np.abs(H).max(0)) + 1e-300
+    assert np.max(np.abs(H - J) / col) < 1e-6
+
+
+@pytest.mark.parametrize("kind", ["bias", "scale", "misalignment"])
+def test_interval_couplings_are_the_error_model_columns(kind):
+    """The couplings the filter accumulates (C_b^n B(u), :func:`replication._kernels.accumulate_coupling`)
+    are F's sensor-block columns of :class:`replication.errors.ErrorModel` (chen2019 eq. (2-10)),
+    accelerometer into δv with sign +, gyro into φ with sign −: exact to rounding."""
+    m = er.model_15(lat=0.8, h=1000.0, accel_bias_sd=1e-4, gyro_bias_sd=1e-7)
+    if kind == "bias":
+        blocks = [m.block("accel_bias"), m.block("gyro_bias")]
+    else:
+        blocks = {"scale": [er.accel_scale(1e-4), er.gyro_scale(1e-5)],
+                  "misalignment": [er.accel_misalignment(1e-4), er.gyro_misalignment(1e-5)]}[kind]
+        m = m.extend(*blocks)
+    C = rotvec_to_dcm(np.array([0.1, -0.2, 0.9]))
+    f_b, w_b = np.array([0.3, -0.4, 9.9]), np.array([0.02, -0.01, 0.1])
+    fconst, _, tg, kd, bs, bz = m._encoding()
+    Cpl = np.zeros((6, m.n))
+    K.accumulate_coupling(C, f_b, w_b, tg, kd, bs, bz, 1.0, Cpl, np.empty((3, 6)))
+    F = m.F(er.NavPoint(0.8, 2.0, 1000.0, np.array([50.0, 20.0, 0.0]), C, f_b, w_b))
+    sl = [m.slices[b.name] for b in blocks]
+    for b, s in zip(blocks, sl):
+        rows, sign = (slice(0, 3), 1.0) if b.target == "accel" else (slice(3, 6), -1.0)
+        frow = slice(3, 6) if b.target == "accel" else slice(6, 9)
+        assert np.allclose(sign * Cpl[rows, s], F[frow, s], rtol=1e-14, atol=1e-18)
+
+
+# ----------------------------------------------------------------------------- batches
+
+@pytest.fixture(scope="module")
+def short_flight():
+    return tr.generate([tr.Straight(20.0), tr.Turn(40.0, np.pi / 2), tr.Straight(20.0)], 47 * DEG, 115 * DEG,
+                       6000.0, heading=45 * DEG, speed=100.0, dt=0.01)
+
+
+def _setup(**kw):
+    base = dict(imu_rate_hz=100.0, gnss_rate_hz=10.0, gyro_bias_sd=0.05 * DEG_PER_H, gyro_markov_sigma=0.02 * DEG_PER_H,
+                gyro_markov_tau=300.0, gyro_white_psd=(0.02 * DEG_PER_H) ** 2, accel_bias_sd=100 * MICRO_G,
+                accel_markov_sigma=50 * MICRO_G, accel_markov_tau=600.0, accel_white_psd=(30 * MICRO_G) ** 2,
+                scale_sd=2e-5, misalignment_sd=10 * ARCSEC, sigma_pos=(0.05, 0.05, 0.1), sigma_vel=0.02,
+                position_sd=(0.05, 0.05, 0.1), velocity_sd=0.02, attitude_sd=(30 * ARCSEC, 30 * ARCSEC, 10 * ARCMIN),
+                gravity_sigma=0.0, lever_arm_b=(0.2, 0.5, 1.0), lever_arm_sd=0.05, flight_duration=80.0)
+    base.update(kw)
+    return sim.SimulationSetup(**base)
+
+
+@pytest.mark.parametrize("model", ["15", "36", "45"])
+def test_batch_results_do_not_depend_on_the_thread_count_or_the_chunking(short_flight, model):
+    """Runs 1.. follow run 0's gains on other threads: the same numbers with 1 or 3 worker
+    threads (exactly), and chunk boundaries fall at epochs, so the chunk length does not move run
+    0 either beyond rounding."""
+    s = _setup()
+    m = sim.filter_model(model, s, short_flight.lat[0], short_flight.h[0])
+    a = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, record_every=5, chunk_epochs=300, workers=1)
+    b = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, record_every=5, chunk_epochs=300, workers=3)
+    assert np.array_equal(a.errors(), b.errors()) and np.array_equal(a.p_hat, b.p_hat)
+    assert np.array_equal(a.nis, b.nis) and np.array_equal(a.P, b.P)
+
+
+def test_monte_carlo_does_not_depend_on_the_thread_count(short_flight):
+    m = er.model_15(position_sd=1.0, velocity_sd=0.05, attitude_sd=(1e-4, 1e-4, 1e-3), lat=47 * DEG, h=6000.0,
+                    accel_bias_sd=100 * MICRO_G, gyro_bias_sd=0.05 * DEG_PER_H, accel_psd=(20 * MICRO_G) ** 2,
+                    gyro_psd=(0.005 * DEG_PER_H) ** 2)
+    a = kf.monte_carlo(short_flight, m, n_runs=4, seed=1, workers=1)
+    b = kf.monte_carlo(short_flight, m, n_runs=4, seed=1, workers=2)
+    assert np.array_equal(a.nees, b.nees) and np.array_equal(a.final_estimates, b.final_estimates)
+
+
+def test_bad_configuration_is_refused():
+    m = er.model_15(lat=0.8, h=0.0)
+    with pytest.raises(ValueError, match="diagonal"):
+        cl.build_spec(m, R_pos=np.ones((3, 3)), R_vel=np.eye(3))
+    with pytest.raises(ValueError, match="at least one"):
+        cl.build_spec(m, R_pos=np.eye(3), R_vel=np.eye(3), use_position=False, use_velocity=False)
+    with pytest.raises(TypeError, match="ErrorModel"):
+        cl.build_spec("15", R_pos=np.eye(3), R_vel=np.eye(3))
+    with pytest.raises(ValueError, match="R×6"):
+        cl.initial_batch_state(np.zeros(6), np.zeros(4), np.zeros(3))
