@@ -35,6 +35,7 @@ from __future__ import annotations
 import math
 import threading
 from collections import namedtuple
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Callable
 
@@ -757,73 +758,112 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         per_run = {"dth", "dvv", "gpos", "gvel", "truth_p"}
         return ChunkInputs(*(v[sl] if k in per_run else v for k, v in zip(ChunkInputs._fields, x)))
 
-    def forward(ci, st_, lead_, record):
-        """Lead over the chunk, then the groups of followers (threads), joined before return."""
+    def prepare(ci, record):
         j0, j1, k0, k1 = bounds(ci)
-        x = inputs(ci, k0, k1, ep[j0:j1])
-        o = chunk_out(ci, j0, j1, k0, k1, record)
-        g = _empty_gains(j1 - j0, n, n_dyn, n_aug, spec.nees)
+        return (j0, j1, inputs(ci, k0, k1, ep[j0:j1]), chunk_out(ci, j0, j1, k0, k1, record),
+                _empty_gains(j1 - j0, n, n_dyn, n_aug, spec.nees))
+
+    def lead_pass(st_, lead_, x, g, o):
         filter_chunk(spec, inp_view(x, slice(0, 1)), _split(st_, slice(0, 1)), lead_, g, view(o, slice(0, 1)), True)
-        if groups:
-            def follow(sl):
-                filter_chunk(spec, inp_view(x, sl), _split(st_, sl), lead_, g, view(o, sl), False)
-            threads = [threading.Thread(target=follow, args=(sl,)) for sl in groups[1:]]
-            for t in threads:
-                t.start()
-            follow(groups[0])
-            for t in threads:
-                t.join()
+
+    def start_followers(st_, lead_, x, g, o):
+        """Threads running the followers of one chunk (their state views are taken now)."""
+        threads = [threading.Thread(target=filter_chunk, args=(spec, inp_view(x, sl), _split(st_, sl), lead_, g,
+                                                               view(o, sl), False)) for sl in groups]
+        for t in threads:
+            t.start()
         st_.first[0] = 0
+        return threads
+
+    def forward(ci, st_, lead_, record):
+        """Lead over the chunk, then its followers, joined before return."""
+        j0, j1, x, o, g = prepare(ci, record)
+        lead_pass(st_, lead_, x, g, o)
+        for t in start_followers(st_, lead_, x, g, o):
+            t.join()
         return j0, j1, o
 
+    # forward pass, pipelined: the lead runs chunk c while the followers finish chunk c − 1
     checkpoints = []
-    for ci in range(len(chunks)):
+    pending = None
+    for ci in range(len(chunks) + 1):
+        if ci < len(chunks):
+            j0, j1, x, o, g = prepare(ci, False)
+            row0 = (BatchState(*(v[:1].copy() for v in state)), LeadState(*(v.copy() for v in lead)))
+            lead_pass(state, lead, x, g, o)
+        if pending is not None:
+            for t in pending[0]:
+                t.join()
+            _collect(res, pending[1], pending[2], pending[3], rec_pos, spec, store_nav)
+            pending = None
+        if ci == len(chunks):
+            break
         if smoother:
-            checkpoints.append((BatchState(*(v.copy() for v in state)), LeadState(*(v.copy() for v in lead))))
-        j0, j1, o = forward(ci, state, lead, False)
-        sel = o.flag >= 0
-        pos = rec_pos[j0:j1][sel]
-        res.st[:, pos] = o.st[:, sel]
-        res.q[:, pos] = o.q[:, sel]
-        res.p_hat[:, pos] = o.phat[:, sel]
-        res.nis[:, pos] = o.nis[:, sel]
-        res.innov[:, pos] = o.innov[:, sel]
-        if spec.nees:
-            res.nees[:, pos] = o.nees[:, sel]
-        res.P[pos] = o.P
-        if spec.use_pbar:
-            res.P_bar[pos] = o.Pbar
-        res.pdiag_all[j0:j1] = o.pdiag
-        if store_nav:
-            res.nav_st, res.nav_q = o.nav_st, o.nav_q
+            ck = BatchState(*(v.copy() for v in state))
+            for v, v0 in zip(ck, row0[0]):
+                v[:1] = v0
+            checkpoints.append((ck, row0[1]))
+        pending = (start_followers(state, lead, x, g, o), j0, j1, o)
     if smoother:
-        res.ds = np.empty((R, m_rec, n))
-        res.P_s = np.empty((m_rec, n, n)) if smoother_covariance else None
-        ds = np.zeros((R, n))
-        Ps = np.zeros((n, n))
-        nxt = None
+        _smooth(res, chunks, checkpoints, forward, rec_pos, R, n, m_rec, smoother_covariance)
+    return res
+
+
+def _collect(res: Records, j0, j1, o, rec_pos, spec, store_nav):
+    """Copy one chunk's outputs at the recorded epochs into ``res``."""
+    sel = o.flag >= 0
+    pos = rec_pos[j0:j1][sel]
+    res.st[:, pos] = o.st[:, sel]
+    res.q[:, pos] = o.q[:, sel]
+    res.p_hat[:, pos] = o.phat[:, sel]
+    res.nis[:, pos] = o.nis[:, sel]
+    res.innov[:, pos] = o.innov[:, sel]
+    if spec.nees:
+        res.nees[:, pos] = o.nees[:, sel]
+    res.P[pos] = o.P
+    if spec.use_pbar:
+        res.P_bar[pos] = o.Pbar
+    res.pdiag_all[j0:j1] = o.pdiag
+    if store_nav:
+        res.nav_st, res.nav_q = o.nav_st, o.nav_q
+
+
+def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, with_cov):
+    """RTS pass: chunks replayed from their checkpoints (newest first) on a second thread while
+    the backward recursion runs over the chunk replayed before."""
+    res.ds = np.empty((R, m_rec, n))
+    res.P_s = np.empty((m_rec, n, n)) if with_cov else None
+    ds = np.zeros((R, n))
+    Ps = np.zeros((n, n))
+    nxt = None
+
+    def replay(ci):
+        st_c, lead_c = checkpoints[ci]
+        checkpoints[ci] = None
+        return forward(ci, st_c, lead_c, True)
+
+    with ThreadPoolExecutor(max_workers=1) as ex:
+        fut = ex.submit(replay, len(chunks) - 1)
         for ci in range(len(chunks) - 1, -1, -1):
-            st_c, lead_c = checkpoints[ci]
-            j0, j1, o = forward(ci, st_c, lead_c, True)
+            j0, j1, o = fut.result()
+            if ci > 0:
+                fut = ex.submit(replay, ci - 1)
             E_ = j1 - j0
             n_f = int(np.sum(o.flag >= 0))
             o_ds = np.empty((R, n_f, n))
-            o_Ps = np.empty((n_f if smoother_covariance else 0, n, n))
+            o_Ps = np.empty((n_f if with_cov else 0, n, n))
             o_pd = np.empty((E_, n))
             if nxt is None:
                 rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, False, o.rec_Pp[0], o.rec_Phi[0],
-                          np.ascontiguousarray(o.rec_x[:, 0, :]), ds, Ps, o.flag, o_ds, o_Ps, o_pd,
-                          smoother_covariance)
+                          np.ascontiguousarray(o.rec_x[:, 0, :]), ds, Ps, o.flag, o_ds, o_Ps, o_pd, with_cov)
             else:
                 rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, True, nxt[0], nxt[1], nxt[2], ds, Ps, o.flag,
-                          o_ds, o_Ps, o_pd, smoother_covariance)
+                          o_ds, o_Ps, o_pd, with_cov)
             nxt = (o.rec_Pp[0].copy(), o.rec_Phi[0].copy(), np.ascontiguousarray(o.rec_x[:, 0, :]))
             pos = rec_pos[j0:j1][o.flag >= 0]
             res.ds[:, pos] = o_ds
-            if smoother_covariance:
+            if with_cov:
                 res.P_s[pos] = o_Ps
-            checkpoints[ci] = None
-    return res
 
 
 def no_windows(n_steps: int, n_epochs: int, n_runs: int, n_aug: int):

@@ -2,8 +2,9 @@
 batched closed-loop Kalman filter with a Rauch-Tung-Striebel smoother pass for the 15-, 36- and
 45-state models.
 
-What this module adds to the navigation core (:mod:`replication.kalman` runs one closed-loop
-filter per call and keeps neither the per-epoch transition matrices nor the prior covariances):
+What this module adds to the navigation core: the truth of the chapter's Monte Carlo and the
+chapter's diagnostics; the filter itself is :mod:`replication.closedloop`, the one closed-loop
+filter of the package.
 
 * :func:`table_4_41_setup` — the sensor errors of chen2019 Table 4-41 in SI units, with the two
   readings the print leaves open made explicit: the unit of the misalignment angle "1.5"
@@ -14,20 +15,19 @@ filter per call and keeps neither the per-epoch transition matrices nor the prio
 * :func:`filter_model` — the 15-state (:func:`replication.errors.model_15`), 36-state
   (:func:`replication.models.model_36`) and 45-state (:func:`replication.models.model_45`) models
   built from one setup;
-* :func:`run_batch` — a Monte Carlo of the closed-loop (feedback) filter *batched across runs*:
-  every run has its own truth (sensor errors, Markov paths, gravity disturbance, lever arm, GNSS
-  noise, initial errors), its own strapdown, innovations and feedback; the covariance recursion
-  (Φ, Q_d, P, gain K) is computed once per epoch along the first run's solution and shared —
-  to first order the gain of an error-state filter depends on the trajectory, not on the
-  realisation (the first run is an exact extended filter; the others use its gains, see
-  ``tests/test_simulation.py``).  Optionally the covariance propagated *without* measurements
-  (for the observable subspace of the NEES) and an RTS smoother pass, run backwards chunk by
-  chunk from checkpoints so that memory stays bounded (the forward chunk is replayed with the
-  smoother's inputs Φ_k, P_k⁻, P_k⁺ and the applied corrections stored);
+* :func:`run_batch` — a Monte Carlo of the closed-loop (feedback) filter *batched across runs*
+  (:func:`replication.closedloop.run`): every run has its own truth (sensor errors, Markov paths,
+  gravity disturbance, lever arm, GNSS noise, initial errors), its own strapdown, innovations and
+  feedback; the covariance recursion (Φ, Q_d, P, gains) is computed once per epoch along the
+  first run's solution and shared — to first order the gain of an error-state filter depends on
+  the trajectory, not on the realisation (the first run is an exact extended filter; the others
+  use its gains, see ``tests/test_simulation.py``).  Optionally the covariance propagated
+  *without* measurements (for the observable subspace of the NEES) and an RTS smoother pass, run
+  backwards chunk by chunk from checkpoints so that memory stays bounded;
 * diagnostics: NEES of the full state and of the observable subspace (:func:`observable_nees`),
   χ² bands, attitude RMS with Monte-Carlo confidence intervals, the improvement percentages.
 
-Closed-loop smoothing (the derivation behind the chunked smoother kernel ``_rts_chunk``): let e_k⁺ be the error of the
+Closed-loop smoothing (the derivation behind :func:`replication.closedloop.rts_chunk`): let e_k⁺ be the error of the
 solution after feedback at epoch k (navigation: computed − true; sensor states: true −
 compensated, the convention of :mod:`replication.errors`) and x_k the correction applied at
 epoch k (so e_k⁻ = e_k⁺ + x_k).  The filtered estimate of e_k⁺ is 0 with covariance P_k⁺, the
