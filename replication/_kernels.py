@@ -678,14 +678,10 @@ def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp):
         st[i] -= xk[i]
         st_prev[i] -= xk[i]
     _rv2q(xk[6], xk[7], xk[8], qtmp)
-    a1, b1, c1, d1 = qtmp[0], qtmp[1], qtmp[2], qtmp[3]
-    q0_, q1_, q2_, q3_ = q[0], q[1], q[2], q[3]
-    n0 = a1 * q0_ - b1 * q1_ - c1 * q2_ - d1 * q3_
-    n1 = a1 * q1_ + b1 * q0_ + c1 * q3_ - d1 * q2_
-    n2 = a1 * q2_ - b1 * q3_ + c1 * q0_ + d1 * q1_
-    n3 = a1 * q3_ + b1 * q2_ - c1 * q1_ + d1 * q0_
-    nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2 + n3 * n3)
-    q[0], q[1], q[2], q[3] = n0 / nn, n1 / nn, n2 / nn, n3 / nn
+    nq = np.empty(4)
+    _qmul(qtmp, q, nq)
+    nn = math.sqrt(nq[0] * nq[0] + nq[1] * nq[1] + nq[2] * nq[2] + nq[3] * nq[3])
+    q[0], q[1], q[2], q[3] = nq[0] / nn, nq[1] / nn, nq[2] / nn, nq[3] / nn
     for i in range(n_aug):
         p_hat[i] += xk[9 + i]
 

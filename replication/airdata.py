@@ -621,7 +621,7 @@ def duan2023_flight(*, dt: float = 0.02, start_speed: float = 10.0, height0: flo
 
 
 @dataclass
-class SimulationSetup:
+class AirdataSetup:
     """duan2023 §3 simulation parameters (SI) and this package's stated choices.
 
     Printed: correction interval 30 s; gyro constant drift and random drift 0.01 °/h;
@@ -871,7 +871,7 @@ def correction_experiment(traj, *, tilt: float = 0.0, dh0: float = 0.0, dvu0: fl
     start = NavState(s0.lat, s0.lon, s0.h + dh0, s0.v_enu + np.array([0.0, 0.0, dvu0]),
                      rotvec_to_dcm(-tilt * u0) @ s0.C_bn)
     end = _end_state(mechanize(traj.t[k0:k1 + 1], traj.dtheta[k0:k1], traj.dv[k0:k1], start))
-    setup = SimulationSetup(correction_interval=interval, gate="none", attitude_sign=attitude_sign)
+    setup = AirdataSetup(correction_interval=interval, gate="none", attitude_sign=attitude_sign)
     new, info = error_correction_step((start.lat, start.lon, start.h), end, traj.h[k1], setup)
     es, u = axes(k1)
     ct = euler_to_dcm(*traj.hpr[k1])
@@ -909,7 +909,7 @@ def bias_experiment(accel_bias_up: float, *, n_intervals: int = 10, interval: fl
                        heading=0.5, speed=speed)
     dv = traj.dv.copy()
     dv[:, 2] += accel_bias_up * np.diff(traj.t)        # body up = nav up in level, wings-level flight
-    setup = SimulationSetup(correction_interval=interval, gate="none", attitude_sign=attitude_sign)
+    setup = AirdataSetup(correction_interval=interval, gate="none", attitude_sign=attitude_sign)
     step = int(round(interval / dt))
     state = traj.initial_state()
     u = np.cross(np.array([np.sin(0.5), np.cos(0.5), 0.0]), [0.0, 0.0, 1.0])
@@ -1102,7 +1102,7 @@ class MonteCarlo:
     t: np.ndarray
     errors: dict
     infos: list
-    setup: SimulationSetup
+    setup: AirdataSetup
     seed: int
 
     def summary(self, statistic: str = "max", until: float | None = None):
@@ -1132,7 +1132,7 @@ class MonteCarlo:
         return pd.DataFrame(rows)
 
 
-def simulate(traj, setup: SimulationSetup, *, n_runs: int = 10, seed: int = 2023, every: int = 50,
+def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, every: int = 50,
              systems=SYSTEMS, gains_pack=None) -> MonteCarlo:
     """Monte Carlo of the three systems of duan2023 §3 on one trajectory.
 
@@ -1192,7 +1192,7 @@ def table1_rows(mc: MonteCarlo, paper, statistic: str = "max", until: float | No
     return rows
 
 
-def pure_sins_initial_errors_only(traj, setup: SimulationSetup) -> dict:
+def pure_sins_initial_errors_only(traj, setup: AirdataSetup) -> dict:
     """Pure SINS driven by the printed initial errors alone (every sensor error zero): final
     misalignment (°), velocity error (m/s) and position error (km), 3-axis norms — the reading
     under which duan2023 Table 1's pure-SINS column is computed if its sensors were ideal."""
@@ -1321,7 +1321,7 @@ def plot_error_histories(mc: MonteCarlo, quantity: str, *, scale=1.0, unit="", a
     return fig
 
 
-def sweep(traj, setup: SimulationSetup, changes, *, n_runs: int = 3, seed: int = 7):
+def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7):
     """Sensitivity of the proposed method: one Monte Carlo per dict of ``changes`` to ``setup``.
 
     Returns a DataFrame with the changed values and the run-mean of the flight maxima and the
@@ -1331,7 +1331,7 @@ def sweep(traj, setup: SimulationSetup, changes, *, n_runs: int = 3, seed: int =
 
     rows = []
     for ch in changes:
-        s2 = SimulationSetup(**{**setup.__dict__, **ch})
+        s2 = AirdataSetup(**{**setup.__dict__, **ch})
         mc = simulate(traj, s2, n_runs=n_runs, seed=seed, systems=("proposed SINS/ADS",))
         mx = mc.summary("max").query("system == 'proposed SINS/ADS'")
         fi = mc.summary("final").query("system == 'proposed SINS/ADS'")

@@ -177,16 +177,13 @@ def _innovations(st, c, lever, wx, wy, wz, gpos, gvel, use_pos, use_vel, z):
 @njit(**_NJ)
 def _attitude_error(q, tq, e):
     """φ (e[6:9]) from Ĉ Cᵀ = exp(−φ×): the quaternion of q̂ ⊗ q_true*."""
-    t0, t1, t2, t3 = tq[0], -tq[1], -tq[2], -tq[3]
-    a1, b1, c1, d1 = q[0], q[1], q[2], q[3]
-    r0 = a1 * t0 - b1 * t1 - c1 * t2 - d1 * t3
-    r1 = a1 * t1 + b1 * t0 + c1 * t3 - d1 * t2
-    r2 = a1 * t2 - b1 * t3 + c1 * t0 + d1 * t1
-    r3 = a1 * t3 + b1 * t2 - c1 * t1 + d1 * t0
-    sg = 1.0 if r0 >= 0 else -1.0
-    e[6] = -2.0 * sg * r1
-    e[7] = -2.0 * sg * r2
-    e[8] = -2.0 * sg * r3
+    tc = np.array([tq[0], -tq[1], -tq[2], -tq[3]])
+    r = np.empty(4)
+    K._qmul(q, tc, r)
+    sg = 1.0 if r[0] >= 0 else -1.0
+    e[6] = -2.0 * sg * r[1]
+    e[7] = -2.0 * sg * r[2]
+    e[8] = -2.0 * sg * r[3]
 
 
 @njit(**_NJ)

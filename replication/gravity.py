@@ -25,11 +25,12 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg
 from scipy import integrate, interpolate, signal
 
 from . import earth
 from . import closedloop as CL
-from .timeseries import _phi, ar_poles, is_stationary
+from .timeseries import ar_coefficients, ar_poles, is_stationary
 from .units import MGAL
 
 __all__ = [
@@ -350,12 +351,10 @@ def ar_companion(phi) -> np.ndarray:
     eigenvalues are the poles (:func:`replication.timeseries.ar_poles`).  The gravity-disturbance
     state delta d of chen2019 eq. (3-17) for one axis.
     """
-    phi = _phi(phi)
-    p = phi.size
-    A = np.zeros((p, p))
-    A[0] = phi
-    A[1:, :-1] = np.eye(p - 1)
-    return A
+    phi = ar_coefficients(phi)
+    if phi.size == 1:
+        return phi.reshape(1, 1).copy()
+    return scipy.linalg.companion(np.r_[1.0, -phi])
 
 
 def ar_state_space(phi, dt: float):
@@ -404,7 +403,7 @@ def gravity_augmentation(models, dt: float, *, require_stationary: bool = True) 
         raise ValueError("give three (phi, sigma2) models, for the east, north and up components")
     blocks, qs, orders = [], [], []
     for axis, (phi, s2) in zip("ENU", models):
-        phi = _phi(phi)
+        phi = ar_coefficients(phi)
         if not s2 > 0:
             raise ValueError(f"{axis}: the noise variance must be positive")
         if require_stationary and not is_stationary(phi):
@@ -771,7 +770,7 @@ def ar_continuous(phi, sigma2: float, dt: float):
     """
     from scipy.linalg import logm, solve_continuous_lyapunov, solve_discrete_lyapunov
 
-    phi = _phi(phi)
+    phi = ar_coefficients(phi)
     if not (sigma2 > 0 and dt > 0):
         raise ValueError("sigma2 ((m/s²)²) and dt (s) must be positive")
     if not is_stationary(phi):

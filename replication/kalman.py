@@ -26,7 +26,7 @@ from . import closedloop as CL
 from .errors import ErrorModel
 from .rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from .sensors import GnssMeasurements, ImuErrors, TriadErrors
-from .strapdown import NavSolution, NavState, _VMODES, validate_increments, validate_time, vertical_damping_gains
+from .strapdown import NavSolution, NavState, VERTICAL_MODES, validate_increments, validate_time, vertical_damping_gains
 
 __all__ = ["van_loan", "discretize_series", "predict", "update", "rts_smoother", "nees", "nis", "chi2_band",
            "ClosedLoopResult", "closed_loop", "perturb_state", "MonteCarloResult", "monte_carlo",
@@ -248,8 +248,8 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     _prepare(t, dtheta, dv, gnss, model, n)
     if not (use_position or use_velocity):
         raise ValueError("use at least one of GNSS position and velocity")
-    if vertical not in _VMODES:
-        raise ValueError(f"vertical must be one of {sorted(_VMODES)}")
+    if vertical not in VERTICAL_MODES:
+        raise ValueError(f"vertical must be one of {sorted(VERTICAL_MODES)}")
     href = np.zeros(n + 1) if h_ref is None else np.ascontiguousarray(np.broadcast_to(h_ref, (n + 1,)), float)
     vuref = np.zeros(n + 1) if vu_ref is None else np.ascontiguousarray(np.broadcast_to(vu_ref, (n + 1,)), float)
     if vertical != "free" and h_ref is None:
@@ -274,7 +274,7 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     spec = CL.build_spec(model, R_pos=np.diag(np.asarray(gnss.sigma_pos, float) ** 2),
                          R_vel=np.diag(np.broadcast_to(np.asarray(gnss.sigma_vel, float), (3,)) ** 2),
                          lever_arm_b=gnss.lever_arm_b, use_position=use_position, use_velocity=use_velocity,
-                         vmode=_VMODES[vertical], gains=gains, series_order=series_order, nees=compute_nees)
+                         vmode=VERTICAL_MODES[vertical], gains=gains, series_order=series_order, nees=compute_nees)
     state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], gnss.lever_arm_b)
     rec = CL.run(spec, state, P0, idx, n, _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp),
                  store_nav=store_nav, chunk_epochs=max(m_ep, 2), workers=1)
@@ -373,8 +373,8 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
 
     if int(n_runs) < 1:
         raise ValueError("n_runs must be at least 1")
-    if vertical not in _VMODES:
-        raise ValueError(f"vertical must be one of {sorted(_VMODES)}")
+    if vertical not in VERTICAL_MODES:
+        raise ValueError(f"vertical must be one of {sorted(VERTICAL_MODES)}")
     for need in ("accel_bias", "gyro_bias"):
         model.block(need)
     n_runs = int(n_runs)
@@ -413,7 +413,7 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     gains = vertical_damping_gains(100.0, traj.lat[0], traj.h[0]) if vertical == "damped" else np.zeros(3)
     spec = CL.build_spec(model, R_pos=np.diag(np.broadcast_to(np.asarray(sigma_pos, float), (3,)) ** 2),
                          R_vel=np.diag(np.broadcast_to(np.asarray(sigma_vel, float), (3,)) ** 2),
-                         lever_arm_b=g0.lever_arm_b, vmode=_VMODES[vertical], gains=gains, nees=True)
+                         lever_arm_b=g0.lever_arm_b, vmode=VERTICAL_MODES[vertical], gains=gains, nees=True)
     dt = np.diff(traj.t)
 
     def inputs(ci, k0, k1, eps):

@@ -28,9 +28,9 @@ from . import _kernels as K
 from .rotations import (dcm_to_euler, dcm_to_quat, euler_to_dcm, quat_to_dcm, skew, vee, _mat3)
 
 __all__ = ["NavState", "NavSolution", "mechanize", "navigation_rates", "vertical_damping_gains",
-           "validate_time", "validate_increments"]
+           "validate_time", "validate_increments", "VERTICAL_MODES"]
 
-_VMODES = {"free": 0, "hold": 1, "damped": 2}
+VERTICAL_MODES = {"free": 0, "hold": 1, "damped": 2}
 
 
 @dataclass
@@ -168,8 +168,8 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
     t = validate_time(t, n)
     if not isinstance(initial, NavState):
         raise TypeError("initial must be a NavState (e.g. Trajectory.initial_state())")
-    if vertical not in _VMODES:
-        raise ValueError(f"vertical must be one of {sorted(_VMODES)}, got {vertical!r}")
+    if vertical not in VERTICAL_MODES:
+        raise ValueError(f"vertical must be one of {sorted(VERTICAL_MODES)}, got {vertical!r}")
     earth.check_latitude(initial.lat, polar_limit_deg=polar_limit_deg, name="initial latitude")
     if vertical in ("hold", "damped"):
         if h_ref is None:
@@ -187,7 +187,7 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
     q0 = dcm_to_quat(initial.C_bn)
     out_st = np.empty((n + 1, 6))
     out_q = np.empty((n + 1, 4))
-    K.strapdown_kernel(np.diff(t), dtheta, dv, st0, q0, _VMODES[vertical], href, vuref, gains, out_st, out_q)
+    K.strapdown_kernel(np.diff(t), dtheta, dv, st0, q0, VERTICAL_MODES[vertical], href, vuref, gains, out_st, out_q)
     lat = out_st[:, 0]
     if np.any(np.abs(lat) >= np.radians(polar_limit_deg)) or not np.all(np.isfinite(lat)):
         bad = int(np.argmax(~np.isfinite(lat) | (np.abs(lat) >= np.radians(polar_limit_deg))))

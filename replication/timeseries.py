@@ -31,7 +31,7 @@ import pandas as pd
 from scipy import linalg, signal, stats
 
 __all__ = [
-    "NonStationaryError", "InversionTest", "inversion_count", "inversion_moments", "inversion_distribution", "inversion_test",
+    "NonStationaryError", "ar_coefficients", "InversionTest", "inversion_count", "inversion_moments", "inversion_distribution", "inversion_test",
     "stationarity_report", "difference", "make_stationary", "acf_printed", "pacf_printed",
     "correlogram", "cutoff_lag", "Identification", "identify_model", "ar_design",
     "ar_least_squares", "require_stationary_series", "fit_ar", "order_cap", "aic_by_order", "select_order",
@@ -55,7 +55,8 @@ def _series(y, name: str = "y", min_length: int = 3) -> np.ndarray:
     return y
 
 
-def _phi(phi) -> np.ndarray:
+def ar_coefficients(phi) -> np.ndarray:
+    """AR coefficients [φ_1, ..., φ_p] as a validated 1-D float array (a scalar is AR(1))."""
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     if phi.ndim != 1 or phi.size == 0 or not np.all(np.isfinite(phi)):
         raise ValueError("phi must be a non-empty 1-D array of finite AR coefficients [phi_1, ..., phi_p]")
@@ -545,7 +546,7 @@ def aic_increment_bound(aic_values, *, penalty_per_order: float = 2.0) -> dict:
 
 def ar_poles(phi) -> np.ndarray:
     """Poles of y_t = sum phi_i y_{t-i} + w_t: roots of z^p - phi_1 z^{p-1} - ... - phi_p."""
-    phi = _phi(phi)
+    phi = ar_coefficients(phi)
     return np.roots(np.r_[1.0, -phi])
 
 
@@ -555,7 +556,7 @@ def is_stationary(phi) -> bool:
 
 
 def _require_stationary(phi, what: str = "the AR model") -> np.ndarray:
-    phi = _phi(phi)
+    phi = ar_coefficients(phi)
     if not is_stationary(phi):
         raise NonStationaryError(
             f"{what} is not stationary (largest pole modulus {np.max(np.abs(ar_poles(phi))):.4f} >= 1): "
@@ -592,7 +593,7 @@ def check_ar_model(phi, sigma2: float, *, dt: float | None = None, speed: float 
     where the AR spectrum peaks), ``correlation_samples`` (-1/ln|dominant pole|), and with ``dt``
     the correlation time (s), with ``speed`` the correlation distance (m).
     """
-    phi = _phi(phi)
+    phi = ar_coefficients(phi)
     if not sigma2 > 0:
         raise ValueError("the noise variance sigma2 must be positive")
     poles = ar_poles(phi)
@@ -679,7 +680,7 @@ def order_recovery(phi, sigma2: float, n: int, *, n_series: int, max_order: int,
     0..max_order, capped at sqrt(n)).  Returns the selection frequency indexed by order; the
     frequency at ``len(phi)`` is the recovery rate.
     """
-    phi = _phi(phi)
+    phi = ar_coefficients(phi)
     if max_order > order_cap(n):
         raise ValueError(f"max_order {max_order} exceeds the cap floor(sqrt({n})) = {order_cap(n)}")
     rng = np.random.default_rng(seed)

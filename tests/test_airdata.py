@@ -195,14 +195,14 @@ def test_ads_measurements_statistics(short_flight):
 
 
 def test_setup_from_paper_and_validation():
-    s = ad.SimulationSetup.from_paper(rp.load_paper("duan2023-claim-simulation-setup"))
+    s = ad.AirdataSetup.from_paper(rp.load_paper("duan2023-claim-simulation-setup"))
     assert s.correction_interval == 30.0 and s.sigma_height == 1.0
     assert s.gyro_bias == pytest.approx(0.01 * np.pi / 180 / 3600)
     assert s.accel_bias == pytest.approx(100e-6 * 9.80665)
     for bad, msg in ((dict(gate="never"), "gate"), (dict(threshold=0.0), "threshold"),
                      (dict(attitude_sign=2.0), "attitude_sign"), (dict(correction_interval=-1.0), "positive")):
         with pytest.raises(ValueError, match=msg):
-            ad.SimulationSetup(**bad)
+            ad.AirdataSetup(**bad)
 
 
 def test_error_correction_step_meets_ads_height(short_flight):
@@ -213,23 +213,23 @@ def test_error_correction_step_meets_ads_height(short_flight):
     s0 = tr_.initial_state(k0)
     end = tr_.initial_state(k1)
     end = NavState(end.lat, end.lon, end.h + 3.0, end.v_enu + [0, 0, 0.05], end.C_bn)
-    setup = ad.SimulationSetup(gate="none")
+    setup = ad.AirdataSetup(gate="none")
     new, info = ad.error_correction_step((s0.lat, s0.lon, s0.h), end, tr_.h[k1], setup)
     assert new.h == pytest.approx(tr_.h[k1], abs=1e-9)           # height reset to the ADS
     assert info["dh"] == pytest.approx(-3.0, abs=1e-9)
     assert np.linalg.norm(new.v_enu) == pytest.approx(np.linalg.norm(end.v_enu), rel=1e-6)  # assumption 4 (2nd order)
     assert abs(info["ratio"] - 1 / 30) < 2e-3                     # uniform motion: Sdot/S = 1/T
     gated, ginfo = ad.error_correction_step((s0.lat, s0.lon, s0.h), end, tr_.h[k1],
-                                            ad.SimulationSetup(threshold=0.01, gate="skip"))
+                                            ad.AirdataSetup(threshold=0.01, gate="skip"))
     assert ginfo["gated"] and gated.h == end.h
     ho, _ = ad.error_correction_step((s0.lat, s0.lon, s0.h), end, tr_.h[k1],
-                                     ad.SimulationSetup(threshold=0.01, gate="height-only"))
+                                     ad.AirdataSetup(threshold=0.01, gate="height-only"))
     assert ho.h == pytest.approx(tr_.h[k1]) and np.all(ho.v_enu == end.v_enu)
 
 
 def test_three_systems_short_run(short_flight):
     """3 min: the ADS-aided systems bound the vertical error that the free SINS lets grow."""
-    setup = ad.SimulationSetup(correction_interval=30.0, threshold=1.0)
+    setup = ad.AirdataSetup(correction_interval=30.0, threshold=1.0)
     mc = ad.simulate(short_flight, setup, n_runs=2, seed=1, every=10)
     s = mc.summary("final").groupby("system").mean(numeric_only=True)
     up = {k: float(np.mean(np.abs(v["enu"][:, -1, 2]))) for k, v in mc.errors.items()}
