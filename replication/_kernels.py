@@ -670,7 +670,7 @@ def accumulate_coupling(c, fb, wb, blk_target, blk_kind, blk_start, blk_size, we
 
 
 @njit(**_NJ)
-def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp):
+def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp, nq):
     """Feedback of the estimate ``xk``: δp, δv subtracted from ``st`` and ``st_prev``, the attitude
     corrected by q ← q(φ) ⊗ q (normalized), and p̂ += x̂[9:]."""
     n_aug = xk.shape[0] - 9
@@ -678,7 +678,6 @@ def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp):
         st[i] -= xk[i]
         st_prev[i] -= xk[i]
     _rv2q(xk[6], xk[7], xk[8], qtmp)
-    nq = np.empty(4)
     _qmul(qtmp, q, nq)
     nn = math.sqrt(nq[0] * nq[0] + nq[1] * nq[1] + nq[2] * nq[2] + nq[3] * nq[3])
     q[0], q[1], q[2], q[3] = nq[0] / nn, nq[1] / nn, nq[2] / nn, nq[3] / nn

@@ -187,14 +187,15 @@ def _attitude_error(q, tq, e):
 
 
 @njit(**_NJ)
-def _lead_time_update(spec, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt, lead):
+def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd, w1,
+                      w2, nzc, nzv, cnt, P, Pbar, use_pbar):
     """F as the interval mean (``build_F_core`` at the mean inputs plus the mean couplings ``Cpl``),
     (Φ, Q_d) by the Van Loan series with the navigation white noise at the mean C_b^n, then
     P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements)."""
     n = F.shape[0]
     inv = 1.0 / nsum
     K.build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
-                   fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, spec.fconst, F)
+                   fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, fconst, F)
     for i in range(3):
         for jj in range(9, n):
             F[3 + i, jj] += Cpl[i, jj] * inv
@@ -202,14 +203,14 @@ def _lead_time_update(spec, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd,
     for i in range(3):
         for jj in range(3):
             Csum[i, jj] *= inv
-    K._interval_discretize(F, spec.qc, Csum, spec.q_accel, spec.q_gyro, tsum, spec.order, Qc, Phi, Qd, w1, w2)
-    _propagate_sparse(Phi, lead.P, Qd, w1, nzc, nzv, cnt)
-    if spec.use_pbar:
-        _propagate_sparse(Phi, lead.Pbar, Qd, w1, nzc, nzv, cnt)
+    K._interval_discretize(F, qc, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2)
+    _propagate_sparse(Phi, P, Qd, w1, nzc, nzv, cnt)
+    if use_pbar:
+        _propagate_sparse(Phi, Pbar, Qd, w1, nzc, nzv, cnt)
 
 
 @njit(**_NJ)
-def _lead_gains(P, H, m, Rd, gK, gs):
+def _lead_gains(P, H, m, Rd, gK, gs, bvec):
     """Sequential Joseph update of P for rows 0..m-1 of H (variances ``Rd``): gains ``gK[a]`` and
     innovation variances ``gs[a]`` (see :func:`replication._kernels.joseph_update`)."""
     n = P.shape[0]
@@ -224,7 +225,8 @@ def _lead_gains(P, H, m, Rd, gK, gs):
         sv = Rd[a]
         for k in range(n):
             sv += H[a, k] * gK[a, k]
-        bvec = gK[a].copy()
+        for i in range(n):
+            bvec[i] = gK[a, i]
         for i in range(n):
             gK[a, i] = bvec[i] / sv
         gs[a] = sv
@@ -235,32 +237,82 @@ def _lead_gains(P, H, m, Rd, gK, gs):
                 P[j, i] = v
 
 
+@njit(inline="always", **_NJ)
+def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_cp, trig, vacc, damp, first,
+               lead_acc, lead, sums, fsum, Csum, navsum, Cpl, nav_st, nav_q, nav_last, w):
+    """IMU steps k0..k1-1 of run ``r`` (views of its state taken once per interval): corrections,
+    strapdown, window sums; the lead's interval sums of the inputs of F when ``lead_acc``; the
+    IMU-rate solution for steps before ``nav_last``.  Returns the damping-loop integrator."""
+    u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en, ta, tb = w
+    store_nav = nav_st.shape[0] > 0
+    for k in range(k0, k1):
+        T = inp.dt[k]
+        for i in range(3):
+            u[i] = inp.dth[r, k, i]
+        K._apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 1, dth_c, B)
+        for i in range(3):
+            u[i] = inp.dvv[r, k, i]
+        K._apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 0, dv_c, B)
+        if first and k == 0:
+            for i in range(3):
+                dth_cp[i] = dth_c[i]
+                dv_cp[i] = dv_c[i]
+        w_sf = inp.sf_w[k]
+        in_win = inp.sf_win[k] >= 0
+        if lead_acc:
+            # inputs of F at the start of the step, summed over the GNSS interval
+            K._q2c(q, c)
+            for i in range(3):
+                fb[i] = dv_c[i] / T
+                wb[i] = dth_c[i] / T
+            K._accumulate_interval(c, fb, st, fsum, Csum, navsum)
+            K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, 1.0, Cpl, B)
+            if in_win:
+                for i in range(3):
+                    lead.facc[i] += w_sf * (c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2])
+                K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, w_sf, lead.Cw, B)
+            sums[0] += 1.0
+            sums[1] += T
+        v0, v1, v2 = st[3], st[4], st[5]
+        href = inp.h_ref[k + 1] if spec.vmode == 1 else inp.h_ref[k]
+        damp = K.sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, qtmp, c, w_ie, w_en, ta, tb, spec.vmode,
+                         href, inp.vu_ref[k + 1], spec.gains, damp, g_extra, trig)
+        if in_win:
+            vacc[0] += w_sf * (st[3] - v0) / T
+            vacc[1] += w_sf * (st[4] - v1) / T
+            vacc[2] += w_sf * (st[5] - v2) / T
+        for i in range(3):
+            dth_cp[i] = dth_c[i]
+            dv_cp[i] = dv_c[i]
+        if store_nav and k < nav_last:
+            for i in range(6):
+                nav_st[k + 1, i] = st[i]
+            for i in range(4):
+                nav_q[k + 1, i] = q[i]
+    return damp
+
+
 @njit(**_NJ)
 def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     """One chunk of the closed-loop filter for the runs of ``bs_`` (see the module docstring).
 
     ``is_lead``: run 0 of ``bs_`` is the lead — the covariance (``lead``) is propagated and
     updated from it and the gains are written to ``gains`` for every epoch; otherwise the runs
-    follow ``gains`` written by the lead's pass over the same chunk.  Returns the number of
-    GNSS epochs processed.
+    follow ``gains`` written by the lead's pass over the same chunk.  The runs advance one GNSS
+    interval at a time.  Returns the number of GNSS epochs processed.
     """
     R = inp.dth.shape[0]
     n_steps = inp.dt.shape[0]
     n = spec.fconst.shape[0]
-    n_aug = n - 9
     n_ep = inp.ep_step.shape[0]
     n_dyn = spec.dyn_rows.shape[0]
-    qtmp = np.empty(4)
+    n_aug = n - 9
     c = np.empty((3, 3))
+    qtmp = np.empty(4)
     w_ie = np.empty(3)
     w_en = np.empty(3)
-    ta = np.empty(3)
-    tb = np.empty(3)
-    B = np.empty((3, 6))
-    dth_c = np.empty(3)
-    dv_c = np.empty(3)
-    fb = np.empty(3)
-    wb = np.empty(3)
+    w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en,
+         np.empty(3), np.empty(3))
     F = np.zeros((n, n))
     Phi = np.empty((n, n))
     Qd = np.empty((n, n))
@@ -274,188 +326,163 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     Cpl = np.zeros((6, n))
     fsum = np.zeros(3)
     navsum = np.zeros(5)
+    sums = np.zeros(2)
     H = np.zeros((_MMAX, n))
     Rd = np.zeros(_MMAX)
     z = np.empty(_MMAX)
     xk = np.empty(n)
     e = np.empty(n)
-    tmp = np.empty(max(n_dyn, 1))
+    tmp = np.empty(max(n_dyn, n))
     Ta = np.ascontiguousarray(spec.ar_T[9:, 9:])
     store_nav = out.nav_st.shape[1] > 0
     record = out.rec_x.shape[1] > 0
-    nsum = 0
-    tsum = 0.0
     if store_nav:
         for r in range(R):
             out.nav_st[r, 0, :] = bs_.st[r]
             out.nav_q[r, 0, :] = bs_.q[r]
+    first = bs_.first[0] == 1
     j = 0
-    for k in range(n_steps):
-        T = inp.dt[k]
-        w_sf = inp.sf_w[k]
-        in_win = inp.sf_win[k] >= 0
+    k = 0
+    while k < n_steps:
+        has_ep = j < n_ep
+        k_end = inp.ep_step[j] + 1 if has_ep else n_steps
         for r in range(R):
-            K._apply_corrections(inp.dth[r, k], T, bs_.p_hat[r], spec.tg, spec.kd, spec.bs, spec.bz, 1, dth_c, B)
-            K._apply_corrections(inp.dvv[r, k], T, bs_.p_hat[r], spec.tg, spec.kd, spec.bs, spec.bz, 0, dv_c, B)
-            if bs_.first[0] == 1:
-                for i in range(3):
-                    bs_.dth_cp[r, i] = dth_c[i]
-                    bs_.dv_cp[r, i] = dv_c[i]
-            if is_lead and r == 0:
-                # inputs of F at the start of the step, summed over the GNSS interval
-                K._q2c(bs_.q[0], c)
-                for i in range(3):
-                    fb[i] = dv_c[i] / T
-                    wb[i] = dth_c[i] / T
-                K._accumulate_interval(c, fb, bs_.st[0], fsum, Csum, navsum)
-                K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, 1.0, Cpl, B)
-                if in_win:
-                    for i in range(3):
-                        lead.facc[i] += w_sf * (c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2])
-                    K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, w_sf, lead.Cw, B)
-                nsum += 1
-                tsum += T
-            v0, v1, v2 = bs_.st[r, 3], bs_.st[r, 4], bs_.st[r, 5]
-            href = inp.h_ref[k + 1] if spec.vmode == 1 else inp.h_ref[k]
-            bs_.damp[r] = K.sd_step(T, dth_c, dv_c, bs_.dth_cp[r], bs_.dv_cp[r], bs_.st[r], bs_.st_prev[r], bs_.q[r],
-                                    qtmp, c, w_ie, w_en, ta, tb, spec.vmode, href, inp.vu_ref[k + 1], spec.gains,
-                                    bs_.damp[r], bs_.g_extra[r], bs_.trig[r])
-            if in_win:
-                bs_.vacc[r, 0] += w_sf * (bs_.st[r, 3] - v0) / T
-                bs_.vacc[r, 1] += w_sf * (bs_.st[r, 4] - v1) / T
-                bs_.vacc[r, 2] += w_sf * (bs_.st[r, 5] - v2) / T
-            for i in range(3):
-                bs_.dth_cp[r, i] = dth_c[i]
-                bs_.dv_cp[r, i] = dv_c[i]
+            bs_.damp[r] = _run_steps(spec, inp, r, k, k_end, bs_.st[r], bs_.st_prev[r], bs_.q[r], bs_.p_hat[r],
+                                     bs_.g_extra[r], bs_.dth_cp[r], bs_.dv_cp[r], bs_.trig[r], bs_.vacc[r],
+                                     bs_.damp[r], first, is_lead and r == 0, lead, sums, fsum, Csum, navsum, Cpl,
+                                     out.nav_st[r], out.nav_q[r], k_end - 1 if has_ep else k_end, w)
+        first = False
         bs_.first[0] = 0
-        if j < n_ep and inp.ep_step[j] == k:
-            _epoch(spec, inp, bs_, lead, gains, out, is_lead, j, T, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi,
-                   Qd, w1, w2, nzc, nzv, cnt, H, Rd, z, xk, e, tmp, Ta, c, qtmp, w_ie, w_en, record)
-            K._reset_interval(Cpl, fsum, Csum, navsum)
-            nsum = 0
-            tsum = 0.0
-            j += 1
-        if store_nav:
-            for r in range(R):
-                out.nav_st[r, k + 1, :] = bs_.st[r]
-                out.nav_q[r, k + 1, :] = bs_.q[r]
-    return j
-
-
-@njit(**_NJ)
-def _epoch(spec, inp, bs_, lead, gains, out, is_lead, j, T, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd,
-           w1, w2, nzc, nzv, cnt, H, Rd, z, xk, e, tmp, Ta, c, qtmp, w_ie, w_en, record):
-    """One GNSS epoch of :func:`filter_chunk`: time update and gains (lead), then every run's
-    innovation, correction, feedback and records."""
-    R = inp.dth.shape[0]
-    n = spec.fconst.shape[0]
-    n_aug = n - 9
-    n_dyn = spec.dyn_rows.shape[0]
-    if True:
-        sf = inp.sf_end[j]
-        # ---------------- time update (lead)
-        if is_lead:
-            _lead_time_update(spec, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt, lead)
-            for t in range(n_dyn):
-                for jj in range(n_aug):
-                    gains.Phid[j, t, jj] = Phi[9 + spec.dyn_rows[t], 9 + jj]
-            if record:
-                out.rec_Phi[j] = Phi
-                out.rec_Pp[j] = lead.P
-        # sensor-error estimates with dynamics (Markov, gravity) follow Φ
-        for r in range(R):
-            for t in range(n_dyn):
-                s_ = 0.0
-                for jj in range(n_aug):
-                    s_ += gains.Phid[j, t, jj] * bs_.p_hat[r, jj]
-                tmp[t] = s_
-            for t in range(n_dyn):
-                bs_.p_hat[r, spec.dyn_rows[t]] = tmp[t]
-        if inp.ar_tick[j]:
-            # discrete AR step of the gravity states (held between steps): x ← T x, P ← T P Tᵀ + Q
+        if has_ep:
+            # ---------------- one GNSS epoch: time update and gains (lead), then every run's
+            # innovation, correction, feedback and records
+            T = inp.dt[k_end - 1]
+            nsum = int(sums[0])
+            tsum = sums[1]
+            sf = inp.sf_end[j]
+            # ---------------- time update (lead)
             if is_lead:
-                lead.P[:, :] = spec.ar_T @ lead.P @ spec.ar_T.T + spec.ar_Q
-                if spec.use_pbar:
-                    lead.Pbar[:, :] = spec.ar_T @ lead.Pbar @ spec.ar_T.T + spec.ar_Q
+                _lead_time_update(spec.fconst, spec.qc, spec.q_accel, spec.q_gyro, spec.order, navsum, fsum, Csum, Cpl,
+                                  nsum, tsum, F, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt, lead.P, lead.Pbar, spec.use_pbar)
+                for t in range(n_dyn):
+                    for jj in range(n_aug):
+                        gains.Phid[j, t, jj] = Phi[9 + spec.dyn_rows[t], 9 + jj]
+                if record:
+                    out.rec_Phi[j] = Phi
+                    out.rec_Pp[j] = lead.P
+            # sensor-error estimates with dynamics (Markov, gravity) follow Φ
             for r in range(R):
-                bs_.p_hat[r, :] = Ta @ bs_.p_hat[r]
-        # ---------------- measurement rows and gains (lead)
-        if is_lead:
-            K._q2c(bs_.q[0], c)
-            for i in range(_MMAX):
-                for jj in range(n):
-                    H[i, jj] = 0.0
-            wx, wy, wz = _body_rate(bs_.dth_cp[0], T, c, bs_.st[0], w_ie, w_en)
-            m = K.gnss_rows(H, c, bs_.lever[0], wx, wy, wz, bs_.st[0, 0], bs_.st[0, 2], spec.use_pos, spec.use_vel,
-                            spec.tg, spec.bs)
-            for i in range(3):
-                if spec.use_pos:
-                    Rd[i] = spec.R_pos[i, i]
-                if spec.use_vel:
-                    Rd[m - 3 + i] = spec.R_vel[i, i]
-            if sf >= 0:
-                _specific_force_rows(H, m, lead.facc, lead.Cw, spec.sf_H, spec.tg, spec.bs, spec.bz)
+                for t in range(n_dyn):
+                    s_ = 0.0
+                    for jj in range(n_aug):
+                        s_ += gains.Phid[j, t, jj] * bs_.p_hat[r, jj]
+                    tmp[t] = s_
+                for t in range(n_dyn):
+                    bs_.p_hat[r, spec.dyn_rows[t]] = tmp[t]
+            if inp.ar_tick[j]:
+                # discrete AR step of the gravity states (held between steps): x ← T x, P ← T P Tᵀ + Q
+                if is_lead:
+                    lead.P[:, :] = spec.ar_T @ lead.P @ spec.ar_T.T + spec.ar_Q
+                    if spec.use_pbar:
+                        lead.Pbar[:, :] = spec.ar_T @ lead.Pbar @ spec.ar_T.T + spec.ar_Q
+                for r in range(R):
+                    bs_.p_hat[r, :] = Ta @ bs_.p_hat[r]
+            # ---------------- measurement rows and gains (lead)
+            if is_lead:
+                K._q2c(bs_.q[0], c)
+                for i in range(_MMAX):
+                    for jj in range(n):
+                        H[i, jj] = 0.0
+                wx, wy, wz = _body_rate(bs_.dth_cp[0], T, c, bs_.st[0], w_ie, w_en)
+                m = K.gnss_rows(H, c, bs_.lever[0], wx, wy, wz, bs_.st[0, 0], bs_.st[0, 2], spec.use_pos, spec.use_vel,
+                                spec.tg, spec.bs)
                 for i in range(3):
-                    Rd[m + i] = inp.sf_R[sf, i]
-                m += 3
-            gains.m[j] = m
-            _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j])
-            for a in range(m):
-                gains.H[j, a, :] = H[a]
-            if gains.P.shape[0] > 0:
-                gains.P[j] = lead.P
-            if sf >= 0:
-                lead.facc[:] = 0.0
-                lead.Cw[:, :] = 0.0
-        m = gains.m[j]
-        # ---------------- per run: innovation, correction, feedback, records
-        for r in range(R):
-            K._q2c(bs_.q[r], c)
-            wx, wy, wz = _body_rate(bs_.dth_cp[r], T, c, bs_.st[r], w_ie, w_en)
-            mr = _innovations(bs_.st[r], c, bs_.lever[r], wx, wy, wz, inp.gpos[r, j], inp.gvel[r, j],
-                              spec.use_pos, spec.use_vel, z)
-            if sf >= 0:
-                for i in range(3):
-                    z[mr + i] = bs_.vacc[r, i] - inp.sf_a[sf, i]
-                    bs_.vacc[r, i] = 0.0
-            for i in range(n):
-                xk[i] = 0.0
-            nis = 0.0
-            for a in range(m):
-                nu = z[a]
-                for kk in range(n):
-                    nu -= gains.H[j, a, kk] * xk[kk]
+                    if spec.use_pos:
+                        Rd[i] = spec.R_pos[i, i]
+                    if spec.use_vel:
+                        Rd[m - 3 + i] = spec.R_vel[i, i]
+                if sf >= 0:
+                    _specific_force_rows(H, m, lead.facc, lead.Cw, spec.sf_H, spec.tg, spec.bs, spec.bz)
+                    for i in range(3):
+                        Rd[m + i] = inp.sf_R[sf, i]
+                    m += 3
+                gains.m[j] = m
+                _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j], tmp)
+                for a in range(m):
+                    gains.H[j, a, :] = H[a]
+                if gains.P.shape[0] > 0:
+                    gains.P[j] = lead.P
+                if sf >= 0:
+                    lead.facc[:] = 0.0
+                    lead.Cw[:, :] = 0.0
+            m = gains.m[j]
+            # ---------------- per run: innovation, correction, feedback, records
+            gH = gains.H[j]
+            gK = gains.Kg[j]
+            gS = gains.s[j]
+            for r in range(R):
+                st_r = bs_.st[r]
+                q_r = bs_.q[r]
+                ph_r = bs_.p_hat[r]
+                lev_r = bs_.lever[r]
+                K._q2c(q_r, c)
+                wx, wy, wz = _body_rate(bs_.dth_cp[r], T, c, st_r, w_ie, w_en)
+                mr = _innovations(st_r, c, lev_r, wx, wy, wz, inp.gpos[r, j], inp.gvel[r, j],
+                                  spec.use_pos, spec.use_vel, z)
+                if sf >= 0:
+                    for i in range(3):
+                        z[mr + i] = bs_.vacc[r, i] - inp.sf_a[sf, i]
+                        bs_.vacc[r, i] = 0.0
                 for i in range(n):
-                    xk[i] += gains.Kg[j, a, i] * nu
-                nis += nu * nu / gains.s[j, a]
-            out.nis[r, j] = nis
-            for a in range(m):
-                out.innov[r, j, a] = z[a]
-            if record:
-                out.rec_x[r, j, :] = xk
-            K._feedback_nav(xk, bs_.st[r], bs_.st_prev[r], bs_.q[r], bs_.p_hat[r], qtmp)
-            K._feedback_blocks(bs_.p_hat[r], spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, bs_.lever[r],
-                               bs_.g_extra[r])
-            out.st[r, j, :] = bs_.st[r]
-            out.q[r, j, :] = bs_.q[r]
-            out.phat[r, j, :] = bs_.p_hat[r]
-            if spec.nees:
+                    xk[i] = 0.0
+                nis = 0.0
+                for a in range(m):
+                    nu = z[a]
+                    for kk in range(n):
+                        nu -= gH[a, kk] * xk[kk]
+                    for i in range(n):
+                        xk[i] += gK[a, i] * nu
+                    nis += nu * nu / gS[a]
+                out.nis[r, j] = nis
+                for a in range(m):
+                    out.innov[r, j, a] = z[a]
+                if record:
+                    out.rec_x[r, j, :] = xk
+                K._feedback_nav(xk, st_r, bs_.st_prev[r], q_r, ph_r, qtmp, e)
+                K._feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, bs_.g_extra[r])
                 for i in range(6):
-                    e[i] = bs_.st[r, i] - inp.truth_st[j, i]
-                _attitude_error(bs_.q[r], inp.truth_q[j], e)
+                    out.st[r, j, i] = st_r[i]
+                for i in range(4):
+                    out.q[r, j, i] = q_r[i]
                 for i in range(n_aug):
-                    e[9 + i] = inp.truth_p[r, j, i] - bs_.p_hat[r, i]
-                out.nees[r, j] = K._chol_solve_scaled(gains.P[j], e)
-        if is_lead:
-            for i in range(n):
-                out.pdiag[j, i] = lead.P[i, i]
-            if record:
-                out.rec_Pf[j] = lead.P
-            f = out.flag[j]
-            if f >= 0:
-                out.P[f] = lead.P
-                if spec.use_pbar:
-                    out.Pbar[f] = lead.Pbar
+                    out.phat[r, j, i] = ph_r[i]
+                if spec.nees:
+                    for i in range(6):
+                        e[i] = st_r[i] - inp.truth_st[j, i]
+                    _attitude_error(q_r, inp.truth_q[j], e)
+                    for i in range(n_aug):
+                        e[9 + i] = inp.truth_p[r, j, i] - ph_r[i]
+                    out.nees[r, j] = K._chol_solve_scaled(gains.P[j], e)
+            if is_lead:
+                for i in range(n):
+                    out.pdiag[j, i] = lead.P[i, i]
+                if record:
+                    out.rec_Pf[j] = lead.P
+                f = out.flag[j]
+                if f >= 0 and out.P.shape[0] > 0:
+                    out.P[f] = lead.P
+                    if spec.use_pbar:
+                        out.Pbar[f] = lead.Pbar
+            K._reset_interval(Cpl, fsum, Csum, navsum)
+            sums[0] = 0.0
+            sums[1] = 0.0
+            j += 1
+            if store_nav:
+                for r in range(R):
+                    out.nav_st[r, k_end, :] = bs_.st[r]
+                    out.nav_q[r, k_end, :] = bs_.q[r]
+        k = k_end
+    return j
 
 
 @njit(**_NJ)
@@ -643,7 +670,7 @@ class Records:
     nis: np.ndarray
     innov: np.ndarray
     nees: np.ndarray | None
-    P: np.ndarray
+    P: np.ndarray | None
     P_bar: np.ndarray | None
     pdiag_all: np.ndarray
     nav_st: np.ndarray | None = None
@@ -661,7 +688,7 @@ def _empty_gains(E_, n, n_dyn, n_aug, with_P):
 def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *, record_every: int = 1,
         chunk_epochs: int = 2000, smoother: bool = False, smoother_covariance: bool = True,
-        store_nav: bool = False, store_P_all: bool = False, workers: int = 2) -> Records:
+        store_nav: bool = False, store_P: bool = True, workers: int = 2) -> Records:
     """Run the closed-loop filter of ``spec`` over ``n_steps`` IMU steps for the runs of ``state``.
 
     Parameters
@@ -686,9 +713,9 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     smoother, smoother_covariance : bool
         Add the RTS pass (replaying the forward pass chunk by chunk), with or without P^s.
     store_nav : bool
-        Keep the IMU-rate solution (single chunk only).
-    store_P_all : bool
-        Record P at every recorded epoch (always done; kept for clarity of the call sites).
+        Keep the IMU-rate solution.
+    store_P : bool
+        Keep the covariance at the recorded epochs (``Records.P``; its diagonal is always kept).
     workers : int
         Threads for the runs that follow the lead (≥ 1; results do not depend on it).
 
@@ -710,8 +737,6 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     R = state.st.shape[0]
     n_ep = len(ep)
     chunks = [(j0, min(j0 + int(chunk_epochs), n_ep)) for j0 in range(0, n_ep, int(chunk_epochs))]
-    if store_nav and len(chunks) > 1:
-        chunks = [(0, n_ep)]
     rec_mask = (np.arange(n_ep) + 1) % int(record_every) == 0
     rec_ep = np.nonzero(rec_mask)[0]
     m_rec = len(rec_ep)
@@ -719,8 +744,11 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     rec_pos[rec_ep] = np.arange(m_rec)
     res = Records(epochs=rec_ep, st=np.empty((R, m_rec, 6)), q=np.empty((R, m_rec, 4)),
                   p_hat=np.empty((R, m_rec, n_aug)), nis=np.empty((R, m_rec)), innov=np.zeros((R, m_rec, _MMAX)),
-                  nees=np.full((R, m_rec), np.nan) if spec.nees else None, P=np.empty((m_rec, n, n)),
-                  P_bar=np.empty((m_rec, n, n)) if spec.use_pbar else None, pdiag_all=np.empty((n_ep, n)))
+                  nees=np.full((R, m_rec), np.nan) if spec.nees else None,
+                  P=np.empty((m_rec, n, n)) if store_P else None,
+                  P_bar=np.empty((m_rec, n, n)) if spec.use_pbar else None, pdiag_all=np.empty((n_ep, n)),
+                  nav_st=np.empty((R, n_steps + 1, 6)) if store_nav else None,
+                  nav_q=np.empty((R, n_steps + 1, 4)) if store_nav else None)
     lead = LeadState(P0.copy(), P0.copy(), np.zeros(3), np.zeros((6, n)))
     n_dyn = len(spec.dyn_rows)
     n_groups = min(int(workers), R - 1) if R > 1 else 0
@@ -742,7 +770,7 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         return ChunkOut(np.empty((R, E_, 6)), np.empty((R, E_, 4)), np.empty((R, E_, n_aug)), np.empty((R, E_)),
                         np.zeros((R, E_, _MMAX)), np.full((R, E_), np.nan) if spec.nees else np.empty((R, 0)),
                         np.empty((R, nav, 6)), np.empty((R, nav, 4)), np.empty((E_, n)), flag,
-                        np.empty((n_f, n, n)), np.empty((n_f, n, n)) if spec.use_pbar else e3,
+                        np.empty((n_f, n, n)) if store_P else e3, np.empty((n_f, n, n)) if spec.use_pbar and store_P else e3,
                         np.empty((E_, n, n)) if record else e3, np.empty((E_, n, n)) if record else e3,
                         np.empty((E_, n, n)) if record else e3,
                         np.empty((R, E_, n)) if record else np.empty((R, 0, n)))
@@ -791,7 +819,7 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         if pending is not None:
             for t in pending[0]:
                 t.join()
-            _collect(res, pending[1], pending[2], pending[3], rec_pos, spec, store_nav)
+            _collect(res, pending[1], pending[2], pending[3], rec_pos, spec, pending[4])
             pending = None
         if ci == len(chunks):
             break
@@ -800,14 +828,15 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
             for v, v0 in zip(ck, row0[0]):
                 v[:1] = v0
             checkpoints.append((ck, row0[1]))
-        pending = (start_followers(state, lead, x, g, o), j0, j1, o)
+        pending = (start_followers(state, lead, x, g, o), j0, j1, o, bounds(ci)[2] if store_nav else None)
     if smoother:
         _smooth(res, chunks, checkpoints, forward, rec_pos, R, n, m_rec, smoother_covariance)
     return res
 
 
-def _collect(res: Records, j0, j1, o, rec_pos, spec, store_nav):
-    """Copy one chunk's outputs at the recorded epochs into ``res``."""
+def _collect(res: Records, j0, j1, o, rec_pos, spec, k0):
+    """Copy one chunk's outputs at the recorded epochs into ``res`` (and its IMU-rate solution
+    from step ``k0`` when it is kept)."""
     sel = o.flag >= 0
     pos = rec_pos[j0:j1][sel]
     res.st[:, pos] = o.st[:, sel]
@@ -817,12 +846,14 @@ def _collect(res: Records, j0, j1, o, rec_pos, spec, store_nav):
     res.innov[:, pos] = o.innov[:, sel]
     if spec.nees:
         res.nees[:, pos] = o.nees[:, sel]
-    res.P[pos] = o.P
-    if spec.use_pbar:
+    if res.P is not None:
+        res.P[pos] = o.P
+    if spec.use_pbar and res.P is not None:
         res.P_bar[pos] = o.Pbar
     res.pdiag_all[j0:j1] = o.pdiag
-    if store_nav:
-        res.nav_st, res.nav_q = o.nav_st, o.nav_q
+    if k0 is not None:
+        res.nav_st[:, k0:k0 + o.nav_st.shape[1]] = o.nav_st
+        res.nav_q[:, k0:k0 + o.nav_q.shape[1]] = o.nav_q
 
 
 def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, with_cov):

@@ -964,6 +964,6 @@ def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float 
                               truth_st=none["truth_st"], truth_q=none["truth_q"], truth_p=none["truth_p"])
 
     state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], np.zeros(3))
-    rec = CL.run(spec, state, P0, idx, n, inputs, store_nav=True, workers=1)
+    rec = CL.run(spec, state, P0, idx, n, inputs, store_nav=True, store_P=False, workers=1)
     return NavSolution(t, rec.nav_st[0, :, 0], rec.nav_st[0, :, 1], rec.nav_st[0, :, 2], rec.nav_st[0, :, 3:6],
                        rec.nav_q[0])

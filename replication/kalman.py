@@ -14,6 +14,7 @@ spread over threads (the compiled loop releases the GIL).
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -277,7 +278,7 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
                          vmode=VERTICAL_MODES[vertical], gains=gains, series_order=series_order, nees=compute_nees)
     state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], gnss.lever_arm_b)
     rec = CL.run(spec, state, P0, idx, n, _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp),
-                 store_nav=store_nav, chunk_epochs=max(m_ep, 2), workers=1)
+                 store_nav=store_nav, store_P=store_P, workers=1)
     nm = 3 * (int(use_position) + int(use_velocity))
     sol = None
     if store_nav:
@@ -384,8 +385,10 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     dth = np.empty((n_runs, n, 3))
     dvv = np.empty((n_runs, n, 3))
     p_true = np.zeros((n_runs, n_aug))
-    gn, st0, q0 = [], np.empty((n_runs, 6)), np.empty((n_runs, 4))
-    for r, ss in enumerate(np.random.SeedSequence(seed).spawn(n_runs)):
+    gn, st0, q0 = [None] * n_runs, np.empty((n_runs, 6)), np.empty((n_runs, 4))
+
+    def draw(r, ss):
+        # one run's truth from its own generator (numpy releases the GIL while filling the arrays)
         rng = np.random.default_rng(ss)
         for b in model.blocks:
             sl = model.slices[b.name]
@@ -394,10 +397,14 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
         ab = p_true[r, model.slices["accel_bias"].start - 9:model.slices["accel_bias"].stop - 9]
         dth[r] = traj.dtheta + gb * T + rng.standard_normal((n, 3)) * np.sqrt(model.gyro_psd * T)
         dvv[r] = traj.dv + ab * T + rng.standard_normal((n, 3)) * np.sqrt(model.accel_psd * T)
-        gn.append(gnss_measurements(traj, rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, rng=rng))
+        gn[r] = gnss_measurements(traj, rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, rng=rng)
         init = perturb_state(traj.initial_state(), model, rng)
         st0[r] = init.vector()
         q0[r] = dcm_to_quat(init.C_bn)
+
+    seeds = np.random.SeedSequence(seed).spawn(n_runs)
+    with ThreadPoolExecutor(max_workers=max(int(workers), 1)) as ex:
+        list(ex.map(draw, range(n_runs), seeds))
     g0 = gn[0]
     idx = np.asarray(g0.index, np.int64)
     m_ep = len(idx)
@@ -430,7 +437,7 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
                               **extra)
 
     rec = CL.run(spec, CL.initial_batch_state(st0, q0, g0.lever_arm_b), model.P0(), idx, n, inputs,
-                 workers=workers)
+                 store_P=False, workers=workers)
     return MonteCarloResult(
         t_epoch=traj.t[idx],
         nees=rec.nees,

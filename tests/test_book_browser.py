@@ -128,37 +128,6 @@ def _local_link_problems(page_path: Path) -> list[str]:
     return sorted(problems)
 
 
-def test_every_page_loads_offline(server, browser):
-    """Every page: offline, no failed request, no JavaScript error, no raw TeX, no figure shown
-    twice, every local link and anchor resolving."""
-    pages = _pages()
-    assert len(pages) >= 5, "the book has too few pages"
-    problems = []
-    for p in pages:
-        rel = p.relative_to(HTML).as_posix()
-        js_errors: list[str] = []
-        page, external, failed = _visit(browser, f"{server}/{rel}", js_errors)
-        page.evaluate(WAIT_MATH_JS)
-        raw = sorted(set(m.group(0) for m in RAW_TEX.finditer(page.evaluate(VISIBLE_TEXT_JS))))
-        imgs = page.evaluate("Array.from(document.images).map(i => i.getAttribute('src')).filter(s => s && s.includes('_images/'))")
-        page.close()
-        if external:
-            problems.append(f"{rel}: requests leaving the machine: {external[:3]}")
-        if failed:
-            problems.append(f"{rel}: failed requests: {failed[:3]}")
-        if js_errors:
-            problems.append(f"{rel}: JavaScript errors: {js_errors[:3]}")
-        if raw:
-            problems.append(f"{rel}: raw TeX outside rendered maths: {raw[:5]}")
-        twice = sorted({i for i in imgs if imgs.count(i) > 1})
-        if twice:
-            problems.append(f"{rel}: figures shown twice: {twice[:3]}")
-        links = _local_link_problems(p)
-        if links:
-            problems.append(f"{rel}: broken local links: {links[:5]}")
-    assert not problems, "\n".join(problems)
-
-
 def _chapter_of_each_paper() -> list[str]:
     out = []
     for part in ("chen2019", "fang2020", "duan2023", "an2021"):
@@ -180,55 +149,98 @@ CLIPPED_JS = """() => {
 }"""
 
 
-def test_overview_and_chapters_fit_at_1280_px(server, browser):
-    """The status page, the part pages and one chapter per paper: no table clipped or scrolled at
-    1280 px; the status bars on the overview pages; a findings box at the top of each chapter."""
-    problems = []
-    overview = ["status.html"] + [f"{p}/index.html" for p in ("chen2019", "fang2020", "duan2023", "an2021")]
-    for rel in overview + _chapter_of_each_paper():
-        page, _, _ = _visit(browser, f"{server}/{rel}")
-        clipped = page.evaluate(CLIPPED_JS)
-        bars = page.locator(".status-bar").count()
-        findings = page.locator(".admonition:has(.admonition-title:text('Findings of this chapter'))").count()
-        if rel == "status.html":
-            page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot-status.png"), full_page=False)
+FIGURES_JS = "Array.from(document.images).filter(i => i.src.includes('_images/')).map(i => i.naturalWidth)"
+MATHJAX_SRC_JS = "Array.from(document.scripts).map(s => s.src).filter(s => s.includes('mathjax'))"
+FINDINGS = ".admonition:has(.admonition-title:text('Findings of this chapter'))"
+OVERVIEW = ["status.html"] + [f"{p}/index.html" for p in ("chen2019", "fang2020", "duan2023", "an2021")]
+
+
+@pytest.fixture(scope="module")
+def seen(server, browser):
+    """Every page visited once at 1280 px, with what each test below checks recorded."""
+    wide = set(OVERVIEW + _chapter_of_each_paper())
+    out = {}
+    shot = False
+    for p in _pages():
+        rel = p.relative_to(HTML).as_posix()
+        text = p.read_text(encoding="utf-8")
+        js_errors: list[str] = []
+        page, external, failed = _visit(browser, f"{server}/{rel}", js_errors)
+        page.evaluate(WAIT_MATH_JS)
+        r = dict(external=external, failed=failed, js_errors=js_errors,
+                 raw=sorted(set(m.group(0) for m in RAW_TEX.finditer(page.evaluate(VISIBLE_TEXT_JS)))),
+                 imgs=page.evaluate("Array.from(document.images).map(i => i.getAttribute('src'))"
+                                    ".filter(s => s && s.includes('_images/'))"),
+                 has_math=r"\(" in text or "math notranslate" in text,
+                 has_figure="<img" in text and "_images/" in text, links=_local_link_problems(p))
+        if r["has_math"]:
+            r.update(mjx=page.locator("mjx-container").count(), mjx_errors=page.locator("mjx-merror").count(),
+                     mathjax_src=page.evaluate(MATHJAX_SRC_JS))
+        if r["has_figure"]:
+            r["widths"] = page.evaluate(FIGURES_JS)
+            if not shot:
+                page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot.png"), full_page=False)
+                shot = True
+        if rel in wide:
+            r.update(clipped=page.evaluate(CLIPPED_JS), bars=page.locator(".status-bar").count(),
+                     findings=page.locator(FINDINGS).count())
+            if rel == "status.html":
+                page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot-status.png"), full_page=False)
         page.close()
-        if clipped:
-            problems.append(f"{rel}: tables wider than the content column: {clipped[:3]}")
-        if rel in overview and bars == 0:
-            problems.append(f"{rel}: no status bar")
-        if rel not in overview and findings != 1:
-            problems.append(f"{rel}: {findings} findings boxes (expected one)")
+        out[rel] = r
+    return out
+
+
+def test_every_page_loads_offline(seen):
+    """Every page: offline, no failed request, no JavaScript error, no raw TeX, no figure shown
+    twice, every local link and anchor resolving."""
+    assert len(seen) >= 5, "the book has too few pages"
+    problems = []
+    for rel, r in seen.items():
+        if r["external"]:
+            problems.append(f"{rel}: requests leaving the machine: {r['external'][:3]}")
+        if r["failed"]:
+            problems.append(f"{rel}: failed requests: {r['failed'][:3]}")
+        if r["js_errors"]:
+            problems.append(f"{rel}: JavaScript errors: {r['js_errors'][:3]}")
+        if r["raw"]:
+            problems.append(f"{rel}: raw TeX outside rendered maths: {r['raw'][:5]}")
+        twice = sorted({i for i in r["imgs"] if r["imgs"].count(i) > 1})
+        if twice:
+            problems.append(f"{rel}: figures shown twice: {twice[:3]}")
+        if r["links"]:
+            problems.append(f"{rel}: broken local links: {r['links'][:5]}")
     assert not problems, "\n".join(problems)
 
 
-def test_math_is_rendered_by_the_local_mathjax(server, browser):
-    with_math = [p for p in _pages() if r"\(" in p.read_text(encoding="utf-8") or "math notranslate" in p.read_text(encoding="utf-8")]
+def test_overview_and_chapters_fit_at_1280_px(seen):
+    """The status page, the part pages and one chapter per paper: no table clipped or scrolled at
+    1280 px; the status bars on the overview pages; a findings box at the top of each chapter."""
+    problems = []
+    for rel in OVERVIEW + _chapter_of_each_paper():
+        r = seen[rel]
+        if r["clipped"]:
+            problems.append(f"{rel}: tables wider than the content column: {r['clipped'][:3]}")
+        if rel in OVERVIEW and r["bars"] == 0:
+            problems.append(f"{rel}: no status bar")
+        if rel not in OVERVIEW and r["findings"] != 1:
+            problems.append(f"{rel}: {r['findings']} findings boxes (expected one)")
+    assert not problems, "\n".join(problems)
+
+
+def test_math_is_rendered_by_the_local_mathjax(seen, server):
+    with_math = {rel: r for rel, r in seen.items() if r["has_math"]}
     assert with_math, "no page with math found"
-    for p in with_math[:6]:
-        rel = p.relative_to(HTML).as_posix()
-        page, _, _ = _visit(browser, f"{server}/{rel}")
-        page.wait_for_selector("mjx-container", timeout=30_000)
-        n = page.locator("mjx-container").count()
-        errors = page.locator("mjx-merror").count()
-        src = page.evaluate("Array.from(document.scripts).map(s => s.src).filter(s => s.includes('mathjax'))")
-        page.close()
-        assert n > 0, f"{rel}: MathJax rendered nothing"
-        assert errors == 0, f"{rel}: {errors} MathJax errors"
-        assert src and all(s.startswith(server) for s in src), f"{rel}: MathJax not served locally: {src}"
+    for rel, r in with_math.items():
+        assert r["mjx"] > 0, f"{rel}: MathJax rendered nothing"
+        assert r["mjx_errors"] == 0, f"{rel}: {r['mjx_errors']} MathJax errors"
+        src = r["mathjax_src"]
+        assert src and all(x.startswith(server) for x in src), f"{rel}: MathJax not served locally: {src}"
 
 
-def test_figures_are_present_and_decoded(server, browser):
-    with_fig = [p for p in _pages() if "<img" in p.read_text(encoding="utf-8") and "_images/" in p.read_text(encoding="utf-8")]
+def test_figures_are_present_and_decoded(seen):
+    with_fig = {rel: r for rel, r in seen.items() if r["has_figure"]}
     assert with_fig, "no page with a figure found"
-    shot_taken = False
-    for p in with_fig:
-        rel = p.relative_to(HTML).as_posix()
-        page, _, _ = _visit(browser, f"{server}/{rel}")
-        widths = page.evaluate("Array.from(document.images).filter(i => i.src.includes('_images/')).map(i => i.naturalWidth)")
-        if not shot_taken:
-            page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot.png"), full_page=False)
-            shot_taken = True
-        page.close()
-        assert widths and all(w > 0 for w in widths), f"{rel}: a figure failed to decode ({widths})"
+    for rel, r in with_fig.items():
+        assert r["widths"] and all(w > 0 for w in r["widths"]), f"{rel}: a figure failed to decode ({r['widths']})"
     assert (ROOT / "book" / "_build" / "screenshot.png").stat().st_size > 10_000
