@@ -26,7 +26,8 @@ help:
 	@echo "make nbval  - strict nbval of every notebook on this machine's native code path"
 	@echo "make notebook NB=book/part/file.ipynb - execute one notebook in place"
 	@echo "make lock   - recompile requirements.lock from requirements.in (needs network to PyPI)"
-	@echo "make bench  - run the benchmark scripts, writing benchmarks/*.json (optional pyins comparison from requirements-bench.lock)"
+	@echo "make bench  - run the benchmark scripts, writing benchmarks/*.json (optional pyins comparison from requirements-bench.lock;"
+	@echo "              BENCH_BEFORE=<commit> times the closed-loop filter of an earlier tree beside the current one)"
 
 # ---------------------------------------------------------------- environment
 env: $(STAMP)
@@ -105,6 +106,7 @@ bench: env
 	$(PY) scripts/benchmark_navigation.py
 	$(PY) scripts/benchmark_polar.py
 	$(PY) scripts/benchmark_chen2019_simulation.py
+	$(PY) scripts/benchmark_closed_loop.py $(if $(BENCH_BEFORE),--before $(BENCH_BEFORE))
 
 clean:
 	rm -rf book/_build .pytest_cache

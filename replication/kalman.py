@@ -6,10 +6,11 @@ Generic linear pieces (any state size):
 :func:`rts_smoother`, :func:`nees`, :func:`nis`, :func:`chi2_band`.
 
 INS/GNSS: :func:`closed_loop` runs strapdown (:mod:`replication.strapdown`) and the error-state
-filter of an :class:`replication.errors.ErrorModel` (15 states or any extension) in one compiled
-loop, with feedback of navigation errors and accumulated sensor-error estimates;
-:func:`monte_carlo` repeats it over independent sensor/GNSS/initial-error realisations, runs
-spread over threads (the compiled loop releases the GIL).
+filter of an :class:`replication.errors.ErrorModel` (15 states or any extension) — the one
+closed-loop filter of :mod:`replication.closedloop` — with feedback of navigation errors and
+accumulated sensor-error estimates; :func:`monte_carlo` runs it as one batch over independent
+sensor/GNSS/initial-error realisations (run 0 leads the covariance and the gains, the other runs
+follow on threads; the result does not depend on the number of threads).
 """
 
 from __future__ import annotations
