@@ -46,6 +46,25 @@ from functools import lru_cache
 import numpy as np
 
 from . import earth
+import pandas as pd
+from .errors import NavPoint, model_15
+from . import trajectory as tr
+from .units import DEG
+from .units import DEG_PER_H, MICRO_G
+from .strapdown import NavState
+from .strapdown import mechanize
+from .rotations import orthonormalize, quat_to_dcm
+from .rotations import rotvec_to_dcm
+from .rotations import attitude_error, euler_to_dcm, rotvec_to_dcm
+from .strapdown import NavState, mechanize
+from .rotations import attitude_error, euler_to_dcm
+from .errors import StateBlock, model_15
+from .errors import NavPoint
+from .kalman import update, van_loan
+from .rotations import quat_to_dcm, rotvec_to_dcm
+from scipy import stats
+from dataclasses import replace
+from .errors import model_15
 
 __all__ = [
     "pitch_correction", "rotation_axis", "rodrigues", "rotation_vector_from_dcm",
@@ -455,7 +474,6 @@ def check_elements(paper, reading: str = "B", state: str = "climb", rel_tol: flo
     rel_tol·max(abs(paper), abs(derived), tiny)), comparable (False for elements of eqs. (14)-(15), whose split over the
     states is not unique — checked row-wise by :func:`manifold_residuals`)).
     """
-    import pandas as pd
 
     st = reference_state(state)
     dc = derived_coefficients(reading)
@@ -489,7 +507,6 @@ def manifold_residuals(paper, reading: str = "B", states=("climb", "level"), con
     interval.  Returns a DataFrame: equation, row, state, convention, printed (Σ M a), derived
     (d a/dt), rel_residual.
     """
-    import pandas as pd
 
     dc = derived_coefficients(reading)
     els = printed_elements(paper, reading)
@@ -545,7 +562,6 @@ def sins_error_matrix(point):
     error) and the nine blocks ``M_phiphi`` ... ``M_pp``.  ``point`` is an
     :class:`replication.errors.NavPoint`.
     """
-    from .errors import NavPoint, model_15
 
     if not isinstance(point, NavPoint):
         raise TypeError("point must be a replication.errors.NavPoint (e.g. NavPoint.from_trajectory(traj, k))")
@@ -607,8 +623,6 @@ def duan2023_flight(*, dt: float = 0.02, start_speed: float = 10.0, height0: flo
     V_c = (729 km - 120 s · start_speed) / 3660 s makes the along-track range exactly 729 km
     (≈ 198.9 m/s with the defaults).  Returns a :class:`replication.trajectory.Trajectory`.
     """
-    from . import trajectory as tr
-    from .units import DEG
 
     if not (0 < start_speed < 100):
         raise ValueError("start_speed must lie in (0, 100) m/s (flight segments need forward speed)")
@@ -657,7 +671,6 @@ class AirdataSetup:
     @classmethod
     def from_paper(cls, paper_setup, **overrides):
         """Printed values from ``duan2023-claim-simulation-setup`` (units converted), plus overrides."""
-        from .units import DEG_PER_H, MICRO_G
 
         v = paper_setup.value
         kw = dict(correction_interval=v("correction interval"), gyro_bias=v("gyro constant drift") * DEG_PER_H,
@@ -683,7 +696,6 @@ class AirdataSetup:
 
 
 def _initial_state(traj, setup):
-    from .strapdown import NavState
 
     st = traj.initial_state()
     rm, rn = earth.radii(st.lat)
@@ -724,7 +736,6 @@ class _Recorder:
 
 
 def _segment(t, dth, dv, k0, k1, state, every):
-    from .strapdown import mechanize
 
     sol = mechanize(t[k0:k1 + 1], dth[k0:k1], dv[k0:k1], state)
     ks = np.arange(k0, k1 + 1)
@@ -734,8 +745,6 @@ def _segment(t, dth, dv, k0, k1, state, every):
 
 
 def _end_state(sol):
-    from .strapdown import NavState
-    from .rotations import orthonormalize, quat_to_dcm
 
     return NavState(float(sol.lat[-1]), float(sol.lon[-1]), float(sol.h[-1]), sol.v_enu[-1].copy(),
                     orthonormalize(quat_to_dcm(sol.q_bn[-1])))
@@ -759,8 +768,6 @@ def error_correction_step(origin, state, h_ads, setup):
     (``gate="skip"``: the step-like height error of Fig. 5) or only its height is reset
     (``"height-only"``: the remedy the paper proposes).
     """
-    from .strapdown import NavState
-    from .rotations import rotvec_to_dcm
 
     lat0, lon0, h0 = origin
     rm, rn = earth.radii(state.lat)
@@ -821,8 +828,6 @@ def correction_experiment_flight(kind: str = "cruise", *, dt: float = 0.02):
     (raised-cosine speed change over the 60 s: mean along-track acceleration ±1 m/s² over the
     first 30 s).  Returns a :class:`replication.trajectory.Trajectory`.
     """
-    from . import trajectory as tr
-    from .units import DEG
 
     if kind not in EXPERIMENT_KINDS:
         raise ValueError(f"kind must be one of {EXPERIMENT_KINDS}, got {kind!r}")
@@ -848,8 +853,6 @@ def correction_experiment(traj, *, tilt: float = 0.0, dh0: float = 0.0, dvu0: fl
     ``tilt`` (component of φ along u, rad), ``dh`` (m), ``dvu`` (m/s), ``dvs`` (along-track
     velocity, m/s); plus ``dhc`` (δh^c, m), ``S`` (m), ``phic`` (φ^c·u, rad) and ``dhc_over_S``.
     """
-    from .rotations import attitude_error, euler_to_dcm, rotvec_to_dcm
-    from .strapdown import NavState, mechanize
 
     if attitude_sign not in (1.0, -1.0, 0.0):
         raise ValueError("attitude_sign must be +1, -1 or 0")
@@ -899,9 +902,6 @@ def bias_experiment(accel_bias_up: float, *, n_intervals: int = 10, interval: fl
     ``dhc_steady`` = -bT² and ``tilt_step`` = -attitude_sign · dhc_steady/(V T) (the tilt change
     per interval, signed as the correction applies it).
     """
-    from . import trajectory as tr
-    from .rotations import attitude_error, euler_to_dcm
-    from .units import DEG
 
     if n_intervals < 2:
         raise ValueError("n_intervals must be at least 2 (the first interval is the transient)")
@@ -937,7 +937,6 @@ def correction_experiment_table(cases=EXPERIMENT_CASES, signs=(-1.0, 1.0)):
     Returns a DataFrame: flight, injected, value, sign, dh^c (m), φ^c·u (mrad), tilt before/after
     (mrad), up-velocity error before/after (m/s), along-track velocity error (m/s).
     """
-    import pandas as pd
 
     flights = {}
     rows = []
@@ -980,7 +979,6 @@ def literature_filter_model(setup):
     first-order Markov states for the air data (height error and airspeed error, σ =
     ``sigma_height`` / ``sigma_airspeed``, τ = ``markov_tau``) — "建立一阶马尔可夫过程".
     """
-    from .errors import StateBlock, model_15
 
     rm, rn = earth.radii(np.radians(45.0))
     m = model_15(position_sd=setup.initial_position_error, velocity_sd=setup.initial_velocity_error,
@@ -1004,8 +1002,6 @@ def literature_gains(traj, setup):
     Φ and Q_d by Van Loan) and does not depend on the measured values, so the gains are computed
     once.  Returns (epoch indices, gains (m × n × 2), H (m × 2 × n), Φ_ads (2×2), model).
     """
-    from .errors import NavPoint
-    from .kalman import update, van_loan
 
     model = literature_filter_model(setup)
     n = model.n
@@ -1041,8 +1037,6 @@ def literature_gains(traj, setup):
 def run_literature(traj, dth, dv, ads, setup, gains_pack, *, every: int = 50):
     """The literature SINS/ADS (refs. [15-17] as read by this package): closed-loop error-state
     Kalman filter with ADS height and airspeed, feedback of δp, δv, φ, accumulated ∇̂, ε̂."""
-    from .rotations import quat_to_dcm, rotvec_to_dcm
-    from .strapdown import NavState, mechanize
 
     ep, gains, Hs, phi_ads, model = gains_pack
     sl = model.slices
@@ -1080,7 +1074,6 @@ def run_literature(traj, dth, dv, ads, setup, gains_pack, *, every: int = 50):
 def navigation_errors(traj, rec):
     """Errors of recorded states against the truth: dict with ``t``, ``enu`` (m), ``v`` (m/s),
     ``phi`` (rad, Ĉ = exp(-φ×) C) on the recorder's grid."""
-    from .rotations import attitude_error, euler_to_dcm
 
     i = rec.idx
     rm, rn = earth.radii(traj.lat[i])
@@ -1109,7 +1102,6 @@ class MonteCarlo:
         """Per run and system: misalignment (°), velocity error (m/s), position error (km) — the
         3-axis norm, reduced over the flight (or over t ≤ ``until`` s) by ``statistic`` ("max",
         "final" or "rms")."""
-        import pandas as pd
 
         if statistic not in ("max", "final", "rms"):
             raise ValueError("statistic must be 'max', 'final' or 'rms'")
@@ -1175,7 +1167,6 @@ def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, e
 def table1_rows(mc: MonteCarlo, paper, statistic: str = "max", until: float | None = None):
     """Rows of duan2023 Table 1: paper vs the Monte-Carlo mean, std and two-sided 95 % Student-t
     interval of the mean (``lo``, ``hi``) of ``statistic`` (over t ≤ ``until`` if given)."""
-    from scipy import stats
 
     s = mc.summary(statistic, until=until)
     rows = []
@@ -1196,7 +1187,6 @@ def pure_sins_initial_errors_only(traj, setup: AirdataSetup) -> dict:
     """Pure SINS driven by the printed initial errors alone (every sensor error zero): final
     misalignment (°), velocity error (m/s) and position error (km), 3-axis norms — the reading
     under which duan2023 Table 1's pure-SINS column is computed if its sensors were ideal."""
-    from dataclasses import replace
 
     ideal = replace(setup, gyro_bias=0.0, gyro_random=0.0, accel_bias=0.0, accel_random=0.0)
     dth, dv = _corrupt(traj, ideal, np.random.default_rng(0))  # zero noise: the draws do not enter
@@ -1327,7 +1317,6 @@ def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7)
     Returns a DataFrame with the changed values and the run-mean of the flight maxima and the
     final values (misalignment °, velocity m/s, position km) and the gated corrections per run.
     """
-    import pandas as pd
 
     rows = []
     for ch in changes:
@@ -1404,7 +1393,6 @@ def eq1_checks(point):
     G_gyro = k C_b^n (attitude rows), G_accel = k C_b^n (velocity rows), largest position forcing,
     and the largest difference between the analytic F and the numerical Jacobian of the
     mechanization (relative to the largest element of each column)."""
-    from .errors import model_15
 
     m = sins_error_matrix(point)
     C = np.asarray(point.C_bn, float)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numbers
 
 import numpy as np
+import pandas as pd
 
 
 def plain(value):
@@ -64,7 +65,6 @@ def sig(value, digits: int = 3):
     For printed output of results whose last digits depend on the code path (long nonlinear
     runs, Monte-Carlo statistics): see the precision policy of CONTRIBUTING.md.
     """
-    import pandas as pd
 
     if not isinstance(digits, int) or isinstance(digits, bool) or digits < 1:
         raise ValueError(f"digits must be a positive integer, not {digits!r}")

@@ -30,6 +30,7 @@ from . import trajectory as tr
 from .sensors import ImuErrors, TriadErrors, apply_imu_errors
 from .strapdown import mechanize
 from .units import DEG
+import pandas as pd
 
 __all__ = ["consequence_flight", "single_errors", "error_features", "error_effects", "classify", "CONSEQUENCE_RULES"]
 
@@ -103,7 +104,6 @@ def error_effects(traj=None, errors: dict | None = None, *, noise_runs: int = 4,
     """:func:`error_features` for every entry of ``errors`` (default :func:`single_errors`);
     random-noise entries are averaged over ``noise_runs`` realisations.  Returns a DataFrame
     indexed by (error class, triad)."""
-    import pandas as pd
 
     traj = consequence_flight() if traj is None else traj
     errors = single_errors() if errors is None else errors

@@ -43,6 +43,7 @@ import numpy as np
 from . import earth
 from . import _kernels as K
 from .rotations import euler_to_dcm, rotvec_to_dcm
+from .strapdown import navigation_rates
 
 __all__ = ["StateBlock", "ErrorModel", "NavPoint", "nav_block_labels", "accel_bias", "gyro_bias",
            "accel_markov", "gyro_markov", "accel_scale", "gyro_scale", "accel_misalignment",
@@ -249,7 +250,6 @@ class ErrorModel:
         Ĉ = exp(-ε e_j×) C, sensor blocks through their coupling B(u) on f^b or ω_ib^b, gravity
         blocks through g^n.  Rows of the augmented blocks are their (constant) dynamics.
         """
-        from .strapdown import navigation_rates
 
         n = self.n
         eps = np.array([1e-5, 1e-5, 100.0, 1.0, 1.0, 1.0, 1e-4, 1e-4, 1e-4]

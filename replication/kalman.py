@@ -29,6 +29,7 @@ from .errors import ErrorModel
 from .rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from .sensors import GnssMeasurements, ImuErrors, TriadErrors
 from .strapdown import NavSolution, NavState, VERTICAL_MODES, validate_increments, validate_time, vertical_damping_gains
+from .sensors import gnss_measurements
 
 __all__ = ["van_loan", "discretize_series", "predict", "update", "rts_smoother", "nees", "nis", "chi2_band",
            "ClosedLoopResult", "closed_loop", "perturb_state", "MonteCarloResult", "monte_carlo",
@@ -371,7 +372,6 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     -------
     MonteCarloResult
     """
-    from .sensors import gnss_measurements
 
     if int(n_runs) < 1:
         raise ValueError("n_runs must be at least 1")

@@ -49,7 +49,6 @@ model's order (accelerometer group before gyro group, lever arm last):
 
 Typical use::
 
-    from replication import models, errors
     m = models.model_45(accel_bias_sd=..., gyro_bias_sd=..., ...)     # an errors.ErrorModel
     F = m.F(errors.NavPoint.from_trajectory(traj, k))                   # 45 × 45
     G, q, w = models.noise_input(m, C_bn)                               # G (45 × 15), PSDs, labels
@@ -71,6 +70,10 @@ from . import earth
 from . import errors as E
 from .rotations import rotvec_to_dcm, skew
 from .sensors import _vec
+from replication import models, errors
+from .rotations import euler_to_dcm
+from ._kernels import KIND_MISALIGN, coupling_matrix
+import pandas as pd
 
 __all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "EXTEND_ORDER_45", "NAV_SYMBOLS", "model_45", "model_36",
            "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
@@ -518,7 +521,6 @@ def table_2_2_reference_point():
     """A generic evaluation point for the Table 2-2 comparison: the chen2019 flight conditions
     (47°N, 115°E, 6000 m, heading ≈ 45°) with a climb (v_U = 5 m/s), bank, and non-zero
     components of f^b and ω_ib^b, so that no printed element vanishes by accident."""
-    from .rotations import euler_to_dcm
     return E.NavPoint(math.radians(47.0), math.radians(115.0), 6000.0, np.array([70.7, 68.0, 5.0]),
                       euler_to_dcm(0.7, 0.05, 0.17), np.array([0.3, -0.4, 9.7]), np.array([0.01, -0.02, 0.03]))
 
@@ -586,7 +588,6 @@ def table_2_2_corrected(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.
     B["F23"] = skew(np.array([q["fE"], q["fN"], q["fU"]]))
     C = np.asarray(point.C_bn, float)
     Bm = np.empty((3, 6))
-    from ._kernels import KIND_MISALIGN, coupling_matrix
     coupling_matrix(KIND_MISALIGN, np.asarray(point.f_b, float), Bm)
     B["F32"], B["F33"] = (C @ Bm)[:, :3], (C @ Bm)[:, 3:]
     coupling_matrix(KIND_MISALIGN, np.asarray(point.w_ib_b, float), Bm)
@@ -668,7 +669,6 @@ def jacobian_agreement(model, traj, indices) -> "pandas.DataFrame":
     ``model.F`` and ``model.numerical_jacobian`` for every non-zero (row block × column block)
     of the navigation rows (relative to the block's largest element).  Columns ``row_block``,
     ``column_block``, ``max_rel_diff``."""
-    import pandas as pd
 
     _check_model(model)
     rows = {"position": slice(0, 3), "velocity": slice(3, 6), "attitude": slice(6, 9)}

@@ -55,6 +55,14 @@ import numpy as np
 
 from . import errors as E
 from .kalman import discretize_series, update
+import scipy.linalg
+from .models import measurement_matrix
+from scipy import stats
+from . import trajectory as tr
+from . import earth
+from .rotations import body_rate_from_euler_rates, euler_to_dcm
+from .trajectory import Trajectory
+import pandas as pd
 
 __all__ = ["observability_matrix", "stripped_observability_matrix", "total_observability_matrix", "som_condition",
            "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
@@ -115,7 +123,6 @@ def stripped_observability_matrix(systems, n_powers=None) -> np.ndarray:
 
 def total_observability_matrix(systems, durations, n_powers=None) -> np.ndarray:
     """The TOM [Q_1; Q_2 Φ_1; Q_3 Φ_2 Φ_1; ...] with Φ_j = exp(F_j Δ_j) (``durations`` Δ_j, s)."""
-    import scipy.linalg
 
     sy = _systems(systems)
     d = np.asarray(durations, float)
@@ -327,7 +334,6 @@ def piecewise_systems(model, traj, spans, *, evaluate: str = "mid", lever_arm_b=
     report's H) or ``"rad"`` (H = I on δL, δλ).  ``states`` (labels) restricts F and H to a
     subset (the others are dropped, i.e. assumed absent from the model).
     """
-    from .models import measurement_matrix
 
     if not isinstance(model, E.ErrorModel):
         raise TypeError("model must be a replication.errors.ErrorModel (e.g. models.model_45())")
@@ -386,7 +392,6 @@ def covariance_observability(model, traj, t0: float, t1: float, *, update_interv
     the model as in :func:`piecewise_systems`.  Returns the ratios (and, with
     ``return_history``, the epoch times and √diag P history).
     """
-    from .models import measurement_matrix
 
     if not isinstance(model, E.ErrorModel):
         raise TypeError("model must be a replication.errors.ErrorModel (e.g. models.model_45())")
@@ -436,7 +441,6 @@ def covariance_observability(model, traj, t0: float, t1: float, *, update_interv
 def spearman(a, b) -> float:
     """Spearman rank correlation of two equal-length sequences (average ranks for ties;
     scipy.stats.spearmanr)."""
-    from scipy import stats
 
     a, b = np.asarray(a, float), np.asarray(b, float)
     if a.shape != b.shape or a.ndim != 1 or len(a) < 3:
@@ -490,7 +494,6 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
     that time-dependent measures (:func:`covariance_observability`) compare equal durations.
     Returns ``{name: Maneuver}`` in the order of :data:`CHEN2019_MANEUVERS`.
     """
-    from . import trajectory as tr
 
     for nm, v in (("straight", straight), ("u_turn", u_turn), ("figure_eight", figure_eight), ("s_turn", s_turn)):
         if not (v > 0 and math.isfinite(v)):
@@ -518,9 +521,6 @@ def unbanked(traj):
     A kinematic variant for the sensitivity study of the observability degrees (chen2019 does
     not say how its Fig. 2-3 maneuvers were flown); the increments ``dtheta``/``dv`` are the
     trapezoid of the new rates (not meant for strapdown accuracy tests)."""
-    from . import earth
-    from .rotations import body_rate_from_euler_rates, euler_to_dcm
-    from .trajectory import Trajectory
 
     t = np.asarray(traj.t, float)
     hpr = np.array(traj.hpr, float)
@@ -547,7 +547,6 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
     digits are rounding noise — are reported as 0.  ``df.attrs["rank_tol"]`` holds each
     scenario's tolerance, ``df.attrs["ambiguity"]`` (scenario → state → ratio) each
     state's ``ambiguity`` (:class:`ObservabilityDegrees`)."""
-    import pandas as pd
 
     cols, tols, amb = {}, {}, {}
     for name, mv in maneuvers.items():
@@ -564,7 +563,6 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
 def covariance_table(model, maneuvers: dict, R, *, states, update_interval: float = 2.0, P0=None):
     """√(P0/P) (:func:`covariance_observability`) over each scenario's whole trajectory, as a
     DataFrame (rows: states, columns: scenarios)."""
-    import pandas as pd
 
     cols = {}
     for name, mv in maneuvers.items():
@@ -578,7 +576,6 @@ def rank_metrics(reference, reproduced, *, reference_threshold: float, reproduce
     Spearman rank correlation, the number of states whose verdict (observable: degree above the
     column's threshold) agrees, and the counts of unobservable states.  ``reproduced_threshold``
     is a number or a {column: threshold} mapping.  Returns a DataFrame indexed by column."""
-    import pandas as pd
 
     if list(reference.columns) != list(reproduced.columns) or list(reference.index) != list(reproduced.index):
         raise ValueError("the two tables must have the same states (rows) and scenarios (columns) in the same order")
@@ -610,7 +607,6 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
     :func:`degrees_table` plus optional ``model``, ``maneuvers`` and ``states`` overrides.
     Returns one row per variant: Spearman ρ per scenario, total verdict agreement (of
     states × scenarios) and the scenario winning most states."""
-    import pandas as pd
 
     rows = []
     for name, spec in variants.items():

@@ -34,6 +34,7 @@ from . import earth
 from . import rotations
 from . import units
 from . import _polar_kernels as _k
+import pandas as pd
 
 OMEGA = earth.OMEGA_IE
 
@@ -936,7 +937,6 @@ def p_equation_check(lats, lons, radius):
     N (row-scaled), relative error of the printed N₂₂, max relative error of the printed M against
     N_num · C_num, and of C_OEPQ^G (16) against the axis definitions.
     """
-    import pandas as pd
 
     rows = []
     for lat, lon in zip(np.atleast_1d(lats), np.atleast_1d(lons)):
@@ -958,7 +958,6 @@ def sensitivity(case, variants, *, n_runs=4, seed=None):
     """Drift-estimate summaries (°/h) of short runs (to the second fix) for scenario ``variants``
     (name → dict of scenario overrides, plus optionally ``heading_observation``); one row per
     variant and estimator."""
-    import pandas as pd
 
     rows = []
     for name, changes in variants.items():

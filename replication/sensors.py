@@ -31,6 +31,8 @@ import numpy as np
 from . import earth
 from .rotations import euler_to_dcm
 from .units import DEG_PER_H, MICRO_G, PPM, ARCSEC, deg_per_h2
+from scipy.signal import lfilter
+from .strapdown import validate_increments, validate_time
 
 __all__ = ["TriadErrors", "ImuErrors", "misalignment_matrix", "apply_imu_errors", "draw_imu_errors",
            "markov_sigma_from_driving_psd", "GnssMeasurements", "gnss_measurements", "barometric_height",
@@ -127,7 +129,6 @@ def _markov_path(n, T, sigma, tau, rng, x0=None):
     xk = sigma * rng.standard_normal(3) if x0 is None else np.asarray(x0, float)
     w = rng.standard_normal((n, 3)) * s
     # vectorised AR(1) recursion via scipy.signal.lfilter per axis
-    from scipy.signal import lfilter
 
     for i in range(3):
         x[:, i], _ = lfilter([1.0], [1.0, -a], w[:, i], zi=[a * xk[i]])
@@ -139,7 +140,6 @@ def apply_imu_errors(t, dtheta, dv, errors: ImuErrors, rng=None):
 
     ``info`` holds the realised Markov paths (``gyro_markov``, ``accel_markov``, per interval).
     """
-    from .strapdown import validate_increments, validate_time
 
     dtheta, dv = validate_increments(dtheta, dv)
     t = validate_time(t, len(dtheta))

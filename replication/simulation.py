@@ -58,6 +58,8 @@ from . import closedloop as CL
 from .rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from .sensors import lever_arm_offset, misalignment_matrix
 from .units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MGAL, MICRO_G
+from .trajectory import chen2019_flight, generate
+import pandas as pd
 
 __all__ = ["SimulationSetup", "table_4_41_setup", "MISALIGNMENT_UNITS", "MARKOV_READINGS",
            "simulated_flight", "segment_summary", "filter_model", "BatchResult", "run_batch",
@@ -215,7 +217,6 @@ def table_4_41_setup(paper, *, misalignment_unit: str = "arcsec", markov_reading
 
 @lru_cache(maxsize=4)
 def _flight_cached(dt, s_swing, s_cycles, lat0, lon0, h0, heading, speed):
-    from .trajectory import chen2019_flight, generate
 
     segs, init = chen2019_flight(s_swing=s_swing, s_cycles=s_cycles)
     init = dict(init, lat0=lat0, lon0=lon0, h0=h0, heading=heading, speed=speed)
@@ -245,7 +246,6 @@ def simulated_flight(paper=None, *, imu_rate_hz: float = 100.0, s_swing: float =
 def segment_summary(traj):
     """Per segment of ``traj``: label, start, end (s), heading change (°, clockwise positive,
     unwrapped), largest |roll| (°), speed and height change (m/s, m) — the quantities of Table 4-42."""
-    import pandas as pd
 
     rows = []
     t = traj.t

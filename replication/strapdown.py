@@ -26,6 +26,7 @@ import numpy as np
 from . import earth
 from . import _kernels as K
 from .rotations import (dcm_to_euler, dcm_to_quat, euler_to_dcm, quat_to_dcm, skew, vee, _mat3)
+from .rotations import attitude_error
 
 __all__ = ["NavState", "NavSolution", "mechanize", "navigation_rates", "vertical_damping_gains",
            "validate_time", "validate_increments", "VERTICAL_MODES"]
@@ -86,7 +87,6 @@ class NavSolution:
 
         Returns a dict: ``east``, ``north``, ``up`` (m), ``v`` (m/s, ENU), ``phi`` (rad, n-frame
         misalignment with Ĉ = exp(-φ×) C)."""
-        from .rotations import attitude_error
 
         if len(truth.t) != len(self.t):
             raise ValueError(f"truth has {len(truth.t)} samples, the solution {len(self.t)}")

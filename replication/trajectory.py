@@ -32,6 +32,7 @@ from scipy.integrate import solve_ivp
 from . import earth
 from .rotations import body_rate_from_euler_rates, euler_to_dcm, dcm_to_quat
 from .units import DEG, G0
+from .strapdown import NavState
 
 __all__ = [
     "Segment", "Straight", "Turn", "UTurn", "STurn", "FigureEight", "Climb", "Accelerate",
@@ -333,7 +334,6 @@ class Trajectory:
 
     def initial_state(self, index: int = 0):
         """The true navigation state at sample ``index`` (a :class:`replication.strapdown.NavState`)."""
-        from .strapdown import NavState
 
         return NavState(lat=float(self.lat[index]), lon=float(self.lon[index]), h=float(self.h[index]),
                         v_enu=self.v_enu[index].copy(), C_bn=euler_to_dcm(*self.hpr[index]))

@@ -42,6 +42,10 @@ from scipy.optimize import brentq
 
 from . import earth
 from .units import DEG, DEG_PER_H, DEG_PER_SQRT_H, HOUR, MICRO_G, UG_PER_SQRT_HZ
+import mpmath
+import re
+from scipy.signal import dlsim
+from .kalman import predict, update, van_loan
 
 STATES = ("phi_E", "phi_N", "phi_U", "dV_E", "dV_N", "dL", "dlambda")
 """State names of the 7-state model, an2021 eq. (1)."""
@@ -457,7 +461,6 @@ def evaluate_at(expr, lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None
     mpmath with ``digits`` digits, so that the cancellations inside the printed forms do not lose
     precision; R and g from :func:`earth_parameters`.
     """
-    import mpmath
 
     lat, v_east, v_north = _check_motion(lat, v_east, v_north)
     r, g = earth_parameters(lat, radius, gravity)
@@ -492,7 +495,6 @@ def coefficient_location(name, motion):
     the power of s.
     """
     _check_motion_name(motion)
-    import re
 
     m = re.fullmatch(r"([nd])_(\d+)", name)
     if not m:
@@ -997,10 +999,7 @@ def time_domain_response(lat, v_east, v_north, noise: NoiseSettings, omegas, *, 
     constants of the slowest damped mode.
     Returns a DataFrame (omega, gain, phase_deg) with gain in rad/(m/s²).
     """
-    import pandas as pd
-    from scipy.signal import dlsim
 
-    from .kalman import predict, update, van_loan
 
     _check_pair(pair)
     out_i, in_i = _PAIR_INDEX[pair]
