@@ -1290,27 +1290,6 @@ def claim_checks(mc: MonteCarlo):
     return out
 
 
-def plot_error_histories(mc: MonteCarlo, quantity: str, *, scale=1.0, unit="", axes_labels=("E", "N", "U")):
-    """Figs. 3-5 analog: per axis, the run-mean of each system with a ±1σ band (one panel per axis)."""
-    import matplotlib.pyplot as plt
-
-    if quantity not in ("phi", "v", "enu"):
-        raise ValueError("quantity must be 'phi', 'v' or 'enu'")
-    fig, axs = plt.subplots(3, 1, figsize=(7, 6.5), sharex=True)
-    for ax, i, lab in zip(axs, range(3), axes_labels):
-        for sys_, c in zip(SYSTEMS, ("C0", "C1", "C2")):
-            a = mc.errors[sys_][quantity][:, :, i] * scale
-            m, sd = np.nanmean(a, 0), np.nanstd(a, 0)
-            ax.plot(mc.t / 60, m, color=c, lw=1, label=sys_)
-            ax.fill_between(mc.t / 60, m - sd, m + sd, color=c, alpha=0.2, lw=0)
-        ax.set_ylabel(f"{lab} ({unit})")
-        ax.set_yscale("symlog", linthresh=abs(np.nanmedian(np.abs(mc.errors['proposed SINS/ADS'][quantity][:, :, i] * scale))) + 1e-12)
-    axs[0].legend(fontsize=7, loc="upper left")
-    axs[-1].set_xlabel("time (min)")
-    fig.tight_layout()
-    return fig
-
-
 def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7):
     """Sensitivity of the proposed method: one Monte Carlo per dict of ``changes`` to ``setup``.
 

@@ -870,64 +870,6 @@ def drift_summary(result, estimator="printed"):
     return {axis: (float(est[:, j].mean()), float(est[:, j].std(ddof=ddof))) for j, axis in enumerate("XYZ")}
 
 
-# =============================================================================== figures
-
-_PANELS = {
-    "attitude": ((0, 1, 2), ("grid east φ_E", "grid north φ_N", "grid azimuth φ_U"), units.ARCSEC, "″"),
-    "velocity": ((3, 4), ("grid east δV_E", "grid north δV_N"), 1.0, "m/s"),
-    "position": ((5, 6, 7), ("ECEF δx", "ECEF δy", "ECEF δz"), 1000.0, "km"),
-}
-
-
-def plot_error_histories(result, kind, *, run=0, title=None):
-    """Figs. 4-6 / 8-10 equivalents: error histories of one run, calibrated (solid) and reset
-    only (dashed), with the fix times marked.  ``kind``: "attitude", "velocity" or "position"."""
-    import matplotlib.pyplot as plt
-
-    if kind not in _PANELS:
-        raise ValueError(f"kind must be one of {sorted(_PANELS)}")
-    if result.errors_reset_only.shape[0] <= run:
-        raise ValueError(f"run {run} has no reset-only continuation; simulate with reset_only_runs > {run}")
-    cols, labels, scale, unit = _PANELS[kind]
-    fig, axes = plt.subplots(len(cols), 1, figsize=(7.5, 1.9 * len(cols) + 0.6), sharex=True)
-    th = result.t / units.HOUR
-    for ax, c, lab in zip(axes, cols, labels):
-        ax.plot(th, result.errors_reset_only[run, :, c] / scale, "C0--", lw=1.0, label="reset only")
-        ax.plot(th, result.errors[run, :, c] / scale, "C3-", lw=1.0, label="two-point calibration")
-        for tf in result.scenario.fix_times:
-            ax.axvline(tf / units.HOUR, color="0.6", lw=0.8, ls=":")
-        ax.set_ylabel(f"{lab} ({unit})")
-        ax.grid(alpha=0.3)
-    axes[0].legend(loc="best", fontsize=8)
-    axes[-1].set_xlabel("time (h)")
-    if title:
-        axes[0].set_title(title)
-    fig.tight_layout()
-    return fig
-
-
-def plot_drift_estimates(result, *, axis="X", paper_mean=None, estimators=ESTIMATORS):
-    """Fig. 7 equivalent: the per-run drift estimates of one body axis (°/h), with the true drift
-    and, if given, the paper's mean."""
-    import matplotlib.pyplot as plt
-
-    j = "XYZ".index(axis)
-    fig, ax = plt.subplots(figsize=(7.0, 3.2))
-    n = result.estimates[estimators[0]].shape[0]
-    for k, name in enumerate(estimators):
-        ax.plot(np.arange(1, n + 1), result.estimates[name][:, j] / units.DEG_PER_H, "os^"[k % 3],
-                ms=4, label=f"estimate ({name})")
-    ax.axhline(result.scenario.gyro_drift[j] / units.DEG_PER_H, color="k", lw=1, label="true drift")
-    if paper_mean is not None:
-        ax.axhline(paper_mean, color="C2", ls="--", lw=1, label="paper mean")
-    ax.set_xlabel("run")
-    ax.set_ylabel(f"{axis}-axis drift estimate (°/h)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
-
-
 # =============================================================================== checks for the book
 
 def p_equation_check(lats, lons, radius):

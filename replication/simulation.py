@@ -65,8 +65,7 @@ __all__ = ["SimulationSetup", "table_4_41_setup", "MISALIGNMENT_UNITS", "MARKOV_
            "simulated_flight", "segment_summary", "filter_model", "BatchResult", "run_batch",
            "truth_parameters", "observable_nees", "fraction_in_band", "attitude_errors",
            "segment_mask", "survey_line_mask", "rms_with_ci", "improvement_percent",
-           "improvement_with_ci", "printed_improvements", "total_bias_estimates", "display_scales",
-           "plot_state_estimates"]
+           "improvement_with_ci", "printed_improvements", "total_bias_estimates", "display_scales"]
 
 MISALIGNMENT_UNITS = {"arcsec": ARCSEC, "arcmin": ARCMIN, "mrad": 1e-3}
 """Candidate units of Table 4-41's misalignment angle "1.5" (printed without a unit)."""
@@ -793,46 +792,3 @@ def display_scales(model: E.ErrorModel, lat: float, h: float):
     for b in model.blocks:
         units += [_UNITS.get(b.name, (1.0, ""))] * b.size
     return [(s, u[0], u[1]) for s, u in zip(M.state_symbols(model), units)]
-
-
-def plot_state_estimates(result: BatchResult, run: int = 0, *, ncols: int = 5, every: int = 10):
-    """chen2019 Fig. 4-14 analog: every state of ``result.model`` for one run — navigation
-    states: the error of the filtered solution with its ±3σ band; sensor states: the filtered
-    and smoothed estimates, the true value, and ±3σ of the filter around the true value.
-    Returns the matplotlib figure."""
-    import matplotlib.pyplot as plt
-
-    if not isinstance(result, BatchResult):
-        raise TypeError("result must be a BatchResult from run_batch")
-    if not 0 <= run < result.n_runs:
-        raise ValueError(f"run must lie in 0..{result.n_runs - 1}")
-    m = result.model
-    scales = display_scales(m, result.lat0, result.h0)
-    n = m.n
-    nrows = int(math.ceil(n / ncols))
-    fig, axs = plt.subplots(nrows, ncols, figsize=(2.3 * ncols, 1.35 * nrows), sharex=True)
-    t = result.t[::every] / 60.0
-    sig = result.sigma()[::every]
-    e = result.errors()[run, ::every]
-    smooth = result.ds is not None
-    for i, ax in enumerate(axs.flat):
-        if i >= n:
-            ax.axis("off")
-            continue
-        sym, sc, unit = scales[i]
-        if i < 9:
-            ax.plot(t, e[:, i] / sc, lw=0.6, color="C0")
-            ax.fill_between(t, -3 * sig[:, i] / sc, 3 * sig[:, i] / sc, color="0.85", lw=0)
-        else:
-            tru = result.p_true[run, ::every, i - 9] / sc
-            ax.fill_between(t, tru - 3 * sig[:, i] / sc, tru + 3 * sig[:, i] / sc, color="0.85", lw=0)
-            ax.plot(t, tru, lw=0.8, color="k")
-            ax.plot(t, result.p_hat[run, ::every, i - 9] / sc, lw=0.6, color="C0")
-            if smooth:
-                ax.plot(t, result.estimates(True)[run, ::every, i - 9] / sc, lw=0.6, color="C3")
-        ax.set_title(f"{sym} ({unit})", fontsize=7, pad=2)
-        ax.tick_params(labelsize=6)
-    for ax in axs[-1]:
-        ax.set_xlabel("min", fontsize=6)
-    fig.tight_layout(pad=0.3, h_pad=0.2, w_pad=0.2)
-    return fig
