@@ -52,7 +52,7 @@ __all__ = [
     "ar_companion", "ar_state_space", "GravityAugmentation", "gravity_augmentation",
     "augment_transition", "specific_force_measurement", "gauss_markov", "analog_direct_difference",
     "survey_flight", "local_east_north", "disturbed_increments", "direct_difference_from_filter",
-    "compensated_increments", "attitude_position_errors", "photo_epochs", "compensation_run",
+    "compensated_increments", "attitude_position_errors", "photo_epochs", "compensation_run", "compensation_first_pass",
     "consistent_kinematics", "ar_continuous", "ar_gravity_block", "slope_weights", "augmented_filter",
 ]
 
@@ -634,10 +634,32 @@ def photo_epochs(traj, n_photos: int, *, margin: float = 60.0) -> np.ndarray:
     return k[np.linspace(0, k.size - 1, int(n_photos)).astype(int)]
 
 
+def compensation_first_pass(traj, field_: PlanarGravityField, *, seed: int, origin, offset, imu: dict, gnss_kw: dict,
+                            model_kw: dict) -> dict:
+    """The part of :func:`compensation_run` that does not depend on the compensation settings:
+    the truth through ``field_`` (IMU errors, GNSS) drawn from ``seed`` and the 15-state
+    closed-loop filter with normal gravity (chen2019 §4.3, step 0)."""
+    rng = np.random.default_rng(seed)
+    lat0, lon0, h0 = origin
+    e, n = local_east_north(traj.lat, traj.lon, lat0, lon0, h0)
+    dg = field_.sample(e + offset[0], n + offset[1])
+    errs = se.ImuErrors(
+        gyro=se.TriadErrors(bias=imu["gyro_bias_sd"] * rng.standard_normal(3), white_psd=imu["gyro_psd"]),
+        accel=se.TriadErrors(bias=imu["accel_bias_sd"] * rng.standard_normal(3), white_psd=imu["accel_psd"]))
+    dth, dvm, _ = se.apply_imu_errors(traj.t, traj.dtheta, disturbed_increments(traj, dg), errs, rng)
+    gnss = se.gnss_measurements(traj, rng=rng, **gnss_kw)
+    m15 = er.model_15(accel_bias_sd=imu["accel_bias_sd"], gyro_bias_sd=imu["gyro_bias_sd"], accel_psd=imu["accel_psd"],
+                      gyro_psd=imu["gyro_psd"], lat=lat0, h=h0, **model_kw)
+    init = kf.perturb_state(traj.initial_state(), m15, rng)
+    r1 = kf.closed_loop(traj.t, dth, dvm, init, gnss, m15)
+    return dict(key=(seed, id(field_), tuple(offset)), dth=dth, dvm=dvm, gnss=gnss, m15=m15, init=init, r1=r1, dg=dg)
+
+
 def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, offset, photos, imu: dict, gnss_kw: dict,
                      model_kw: dict, cutoff_period: float = 100.0, ar_interval: float | None = None,
                      true_model: tuple | None = None, specific_force: bool = True,
-                     gauss_markov_reference: bool = False, methods=("normal", "direct", "state")) -> dict:
+                     gauss_markov_reference: bool = False, methods=("normal", "direct", "state"),
+                     first_pass: dict | None = None) -> dict:
     """One Monte-Carlo run of the three compensation methods of chen2019 §4.3 (Table 4-50 analog).
 
     The truth flies through ``field_`` (sampled at the planar offsets of the track from
@@ -665,27 +687,21 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
       ``specific_force``).
 
     ``methods`` selects which of ``normal``/``direct`` are returned (``normal`` is always run:
-    step 1 needs it).
+    step 1 needs it).  ``first_pass`` (from :func:`compensation_first_pass` with the same seed,
+    field and offset) reuses the truth and the normal-gravity filter of an earlier call — they do
+    not depend on the cut-off, the AR interval or the methods.
 
     Returns {method: {component: error array at ``photos``}} plus ``ar`` (per axis: phi, sigma2,
     the model checks and the inversion test) and
     ``dd`` (direct difference and true disturbance at the GNSS epochs).
     """
 
-    rng = np.random.default_rng(seed)
-    lat0, lon0, h0 = origin
-    e, n = local_east_north(traj.lat, traj.lon, lat0, lon0, h0)
-    dg = field_.sample(e + offset[0], n + offset[1])
-    errs = se.ImuErrors(
-        gyro=se.TriadErrors(bias=imu["gyro_bias_sd"] * rng.standard_normal(3), white_psd=imu["gyro_psd"]),
-        accel=se.TriadErrors(bias=imu["accel_bias_sd"] * rng.standard_normal(3), white_psd=imu["accel_psd"]))
-    dth, dvm, _ = se.apply_imu_errors(traj.t, traj.dtheta, disturbed_increments(traj, dg), errs, rng)
-    gnss = se.gnss_measurements(traj, rng=rng, **gnss_kw)
-    m15 = er.model_15(accel_bias_sd=imu["accel_bias_sd"], gyro_bias_sd=imu["gyro_bias_sd"], accel_psd=imu["accel_psd"],
-                      gyro_psd=imu["gyro_psd"], lat=lat0, h=h0, **model_kw)
-    init = kf.perturb_state(traj.initial_state(), m15, rng)
+    fp = compensation_first_pass(traj, field_, seed=seed, origin=origin, offset=offset, imu=imu, gnss_kw=gnss_kw,
+                                 model_kw=model_kw) if first_pass is None else first_pass
+    if fp.get("key") != (seed, id(field_), tuple(offset)):
+        raise ValueError("first_pass was computed for another seed, field or offset")
+    dth, dvm, gnss, m15, init, r1, dg = (fp[k] for k in ("dth", "dvm", "gnss", "m15", "init", "r1", "dg"))
     out = {}
-    r1 = kf.closed_loop(traj.t, dth, dvm, init, gnss, m15)
     if "normal" in methods:
         out["normal"] = attitude_position_errors(r1.solution, traj, photos)
     dd = direct_difference_from_filter(r1, dvm, traj.t, gnss, cutoff_period=cutoff_period)
