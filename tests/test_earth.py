@@ -357,3 +357,18 @@ def test_inputs_that_are_not_numbers_or_heights_are_refused():
     with _pytest.raises(ValueError, match="metres"):
         earth.normal_gravity(0.5, 2.0e6)
     assert earth.normal_gravity(0.5, 100.0) > 9.7
+
+
+def test_compiled_somigliana_forms_equal_the_earth_model():
+    """The two compiled copies of Somigliana's formula (the strapdown's with its height terms and
+    the polar grid INS's on the ellipsoid), written on scalars for numba, equal
+    :func:`replication.earth.normal_gravity_ellipsoid` / :func:`~replication.earth.normal_gravity`
+    to rounding (1e-15 relative) from the equator to the pole."""
+    from replication import _kernels as K, _polar_kernels as PK
+
+    lat = np.radians(np.linspace(0.0, 90.0, 19))
+    ref0 = earth.normal_gravity_ellipsoid(lat)
+    assert np.allclose([PK.gravity_surface(np.sin(x)) for x in lat], ref0, rtol=1e-15, atol=0)
+    assert np.allclose([K.gamma_s(x, 0.0) for x in lat], ref0, rtol=1e-15, atol=0)
+    ref = earth.normal_gravity(lat, 3000.0)
+    assert np.allclose([K.gamma_s(x, 3000.0) for x in lat], ref, rtol=1e-14, atol=0)
