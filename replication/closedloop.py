@@ -2,13 +2,13 @@
 chapter, batched over Monte-Carlo runs.
 
 One IMU step of every run: the accumulated sensor-error estimates are removed from the
-increments (chen2019 eq. (2-10)) and the strapdown of :func:`replication._kernels.sd_step`
+increments (chen2019 eq. (2-10)) and the strapdown of ``replication._kernels.sd_step``
 (chen2019 eq. (3-2)) advances the run.  One GNSS epoch: the error-state F of
-:func:`replication._kernels.build_F_core` plus the sensor-block couplings C_b^n B(u) — both
+``replication._kernels.build_F_core`` plus the sensor-block couplings C_b^n B(u) — both
 averaged over the interval's IMU steps (F is affine in them, so this is the interval mean of F)
 — gives (Φ, Q_d) by the Van Loan series; P⁻ = Φ P Φᵀ + Q_d; the measurement rows are written
-once, in :func:`replication._kernels.gnss_rows` (antenna position and velocity with the lever arm,
-chen2019 eq. (2-13)) and :func:`_specific_force_rows` (chen2019 eq. (3-18)); the update is the
+once, in ``replication._kernels.gnss_rows`` (antenna position and velocity with the lever arm,
+chen2019 eq. (2-13)) and ``_specific_force_rows`` (chen2019 eq. (3-18)); the update is the
 Joseph form one (independent) measurement at a time; then the navigation errors are fed back and
 the sensor-error estimates accumulated.  Optional: a vertical channel held or damped
 (:mod:`replication.strapdown`), discrete AR transitions of a gravity block at chosen epochs, the
@@ -45,14 +45,15 @@ from numba import njit
 from . import _kernels as K
 from .errors import ErrorModel
 
-__all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "initial_batch_state", "Records", "run"]
+__all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state",
+           "Records", "run", "filter_chunk", "rts_chunk", "no_windows"]
 
 _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 _MMAX = 9   # at most 9 measurement rows: position, velocity, specific force
 
 #: Configuration of the filter (numba-compatible bundle).  ``fconst``/``qc`` are the model's
 #: constant F and process-noise parts, ``tg/kd/bs/bz`` its block encoding
-#: (:meth:`replication.errors.ErrorModel._encoding`), ``dyn_rows`` the augmented states with
+#: (``ErrorModel._encoding``), ``dyn_rows`` the augmented states with
 #: dynamics, ``ar_T``/``ar_Q`` the discrete AR transition applied at ``ar_tick`` epochs,
 #: ``sf_H`` the gravity columns of the specific-force rows.
 Spec = namedtuple("Spec", ["fconst", "qc", "q_accel", "q_gyro", "tg", "kd", "bs", "bz", "order", "dyn_rows",
@@ -151,7 +152,7 @@ def _body_rate(dth, T, c, st, w_ie, w_en):
 
 @njit(**_NJ)
 def _innovations(st, c, lever, wx, wy, wz, gpos, gvel, use_pos, use_vel, z):
-    """GNSS innovations INS − GNSS at the antenna (rows as in :func:`replication._kernels.gnss_rows`);
+    """GNSS innovations INS − GNSS at the antenna (rows as in ``replication._kernels.gnss_rows``);
     returns the number of rows written."""
     rm, rn = K.radii_s(st[0])
     h = st[2]
@@ -212,7 +213,7 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cp
 @njit(**_NJ)
 def _lead_gains(P, H, m, Rd, gK, gs, bvec):
     """Sequential Joseph update of P for rows 0..m-1 of H (variances ``Rd``): gains ``gK[a]`` and
-    innovation variances ``gs[a]`` (see :func:`replication._kernels.joseph_update`)."""
+    innovation variances ``gs[a]`` (see the Joseph form of :func:`replication.kalman.update`)."""
     n = P.shape[0]
     for a in range(m):
         for i in range(n):
@@ -704,7 +705,7 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     n_steps : int
         Number of IMU steps.
     inputs : callable
-        ``inputs(chunk, k0, k1, ep_samples_of_chunk)`` → :data:`ChunkInputs` for steps k0..k1-1
+        ``inputs(chunk, k0, k1, ep_samples_of_chunk)`` → :class:`ChunkInputs` for steps k0..k1-1
         (deterministic: the smoother replays chunks).
     record_every : int
         Record every ``record_every``-th epoch (the P's and the per-run records).
@@ -895,7 +896,7 @@ def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, wi
 
 
 def no_windows(n_steps: int, n_epochs: int, n_runs: int, n_aug: int):
-    """The specific-force, AR and truth fields of :data:`ChunkInputs` when unused."""
+    """The specific-force, AR and truth fields of :class:`ChunkInputs` when unused."""
     return dict(sf_w=np.zeros(n_steps), sf_win=np.full(n_steps, -1, np.int64),
                 sf_end=np.full(n_epochs, -1, np.int64), sf_a=np.zeros((1, 3)), sf_R=np.ones((1, 3)),
                 ar_tick=np.zeros(n_epochs, np.int64), truth_st=np.zeros((n_epochs, 6)),

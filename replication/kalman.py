@@ -291,7 +291,7 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
 
 
 def _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp):
-    """The :data:`replication.closedloop.ChunkInputs` of one recorded run, chunk by chunk."""
+    """The :class:`replication.closedloop.ChunkInputs` of one recorded run, chunk by chunk."""
     gpos = np.ascontiguousarray(gnss.position, dtype=float)[None]
     gvel = np.ascontiguousarray(gnss.v_enu, dtype=float)[None]
     dt = np.diff(t)

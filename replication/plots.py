@@ -4,7 +4,7 @@ Each function takes the result of a chapter's computation and returns a matplotl
 nothing here computes a number that a table or a test uses.
 
 * :func:`state_estimates` — chen2019 Fig. 4-14 analog (:func:`replication.simulation.run_batch`);
-* :func:`airdata_error_histories` — duan2023 Figs. 3-5 analog (:func:`replication.airdata.simulate`);
+* :func:`airdata_error_histories` — duan2023 Figs. 3-5 analog (``replication.airdata.simulate``);
 * :func:`polar_error_histories`, :func:`polar_drift_estimates` — fang2020 Figs. 4-10
   (:func:`replication.polar.simulate`).
 """
@@ -63,7 +63,7 @@ def state_estimates(result: sim.BatchResult, run: int = 0, *, ncols: int = 5, ev
 
 
 def airdata_error_histories(mc: ad.MonteCarlo, quantity: str, *, scale=1.0, unit="", axes_labels=("E", "N", "U")):
-    """duan2023 Figs. 3-5 analog (:func:`replication.airdata.simulate`): per axis, the run-mean of each system with a ±1σ band (one panel per axis)."""
+    """duan2023 Figs. 3-5 analog (``replication.airdata.simulate``): per axis, the run-mean of each system with a ±1σ band (one panel per axis)."""
     if quantity not in ("phi", "v", "enu"):
         raise ValueError("quantity must be 'phi', 'v' or 'enu'")
     fig, axs = plt.subplots(3, 1, figsize=(7, 6.5), sharex=True)

@@ -1041,4 +1041,4 @@ def time_domain_response(lat, v_east, v_north, noise: NoiseSettings, omegas, *, 
 
 __all__ = [n for n in dir() if not n.startswith("_") and n not in (
     "annotations", "functools", "math", "dataclass", "replace", "ct", "np", "pd", "sla", "sp", "brentq", "earth",
-    "DEG", "DEG_PER_H", "DEG_PER_SQRT_H", "HOUR", "MICRO_G", "UG_PER_SQRT_HZ")]
+    "DEG", "DEG_PER_H", "DEG_PER_SQRT_H", "HOUR", "MICRO_G", "UG_PER_SQRT_HZ", "dlsim")]
