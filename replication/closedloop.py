@@ -301,6 +301,9 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     updated from it and the gains are written to ``gains`` for every epoch; otherwise the runs
     follow ``gains`` written by the lead's pass over the same chunk.  The runs advance one GNSS
     interval at a time.  Returns the number of GNSS epochs processed.
+
+    The epoch is written inline rather than as a function: a compiled call carrying the
+    configuration bundles cost about 4 µs per epoch, a fifth of a 15-state single run.
     """
     R = inp.dth.shape[0]
     n_steps = inp.dt.shape[0]
