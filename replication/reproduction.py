@@ -30,6 +30,7 @@ import math
 import os
 import re
 import subprocess
+import unicodedata
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
@@ -560,8 +561,59 @@ _TEX_SPECIAL = {"&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{":
                 "~": r"\textasciitilde{}", "^": r"\textasciicircum{}", "\\": r"\textbackslash{}"}
 
 
+_TEX_UNICODE = {
+    "°": r"\textdegree{}", "±": r"\ensuremath{\pm}", "×": r"\ensuremath{\times}", "²": r"\ensuremath{^2}",
+    "³": r"\ensuremath{^3}", "√": r"\ensuremath{\surd}", "″": r"\ensuremath{''}", "′": r"\ensuremath{'}",
+    "∇": r"\ensuremath{\nabla}", "∂": r"\ensuremath{\partial}", "→": r"\ensuremath{\rightarrow}",
+    "≥": r"\ensuremath{\geq}", "≤": r"\ensuremath{\leq}", "≠": r"\ensuremath{\neq}", "≈": r"\ensuremath{\approx}",
+    "∈": r"\ensuremath{\in}", "−": "-", "–": "--", "—": "---", "…": r"\ldots{}", "·": r"\ensuremath{\cdot}",
+    "Ā": r"\=A", "ā": r"\=a", "μ": r"\ensuremath{\mu}", "µ": r"\ensuremath{\mu}", "φ": r"\ensuremath{\varphi}",
+    "ε": r"\ensuremath{\varepsilon}", "Δ": r"\ensuremath{\Delta}", "Ω": r"\ensuremath{\Omega}",
+    "Φ": r"\ensuremath{\Phi}", "Σ": r"\ensuremath{\Sigma}",
+    **{g: rf"\ensuremath{{\{n}}}" for g, n in zip("αβγδζηθικλνξπρστυχψω",
+                                                  ("alpha", "beta", "gamma", "delta", "zeta", "eta", "theta", "iota",
+                                                   "kappa", "lambda", "nu", "xi", "pi", "rho", "sigma", "tau",
+                                                   "upsilon", "chi", "psi", "omega"))},
+}
+r"""Unicode of the tables in LaTeX that pdflatex compiles without extra packages (Greek and the
+mathematical signs in ``\ensuremath``)."""
+
+_TEX_ACCENTS = {"\u0304": "bar", "\u0302": "hat", "\u0307": "dot"}
+_CJK_NOTE = "[Chinese text: see the CSV]"
+
+
+def _is_cjk(ch: str) -> bool:
+    o = ord(ch)
+    return 0x3000 <= o <= 0x303F or 0x3400 <= o <= 0x9FFF or 0xFF00 <= o <= 0xFFEF
+
+
 def _tex_escape(s: str) -> str:
-    return "".join(_TEX_SPECIAL.get(ch, ch) for ch in s)
+    """Text of a cell in LaTeX that compiles with pdflatex in a plain article: TeX specials
+    escaped, Greek letters and mathematical signs as macros (:data:`_TEX_UNICODE`), a combining
+    accent over the preceding letter, a run of Chinese characters replaced by a pointer to the CSV
+    (which keeps them), any other non-ASCII character by its Unicode name."""
+    out: list[str] = []
+    cjk = False
+    for ch in s:
+        if _is_cjk(ch):
+            if not cjk:
+                out.append(_CJK_NOTE)
+            cjk = True
+            continue
+        cjk = False
+        if ch in _TEX_ACCENTS and out:
+            prev = out.pop()
+            inner = prev[len(r"\ensuremath{"):-1] if prev.startswith(r"\ensuremath{") else prev
+            out.append(rf"\ensuremath{{\{_TEX_ACCENTS[ch]}{{{inner}}}}}")
+        elif ch in _TEX_SPECIAL:
+            out.append(_TEX_SPECIAL[ch])
+        elif ord(ch) < 128:
+            out.append(ch)
+        elif ch in _TEX_UNICODE:
+            out.append(_TEX_UNICODE[ch])
+        else:
+            out.append(f"[{unicodedata.name(ch, hex(ord(ch)))}]")
+    return "".join(out)
 
 
 def _latex(df: pd.DataFrame, title: str, table_id: str) -> str:
@@ -661,6 +713,25 @@ def compare(
             p.write_text(content, encoding="utf-8")
     df.attrs.update(table_id=table_id, notebook=notebook)
     return df
+
+
+def refresh_exports(table_ids: Iterable[str] | None = None) -> list[str]:
+    """Rewrite the ``.md`` and ``.tex`` exports of tables from their stored CSV and sidecar title,
+    without recomputing anything (after a change of the export format).  Returns the ids whose
+    files changed; the CSV and the sidecar are left as they are."""
+    changed = []
+    for tid in list_tables() if table_ids is None else list(table_ids):
+        df = read_table(tid)
+        title = json.loads((tables_dir() / f"{tid}.json").read_text(encoding="utf-8"))["title"]
+        touched = False
+        for ext, content in ((".md", _markdown(df, title)), (".tex", _latex(df, title, tid))):
+            p = tables_dir() / f"{tid}{ext}"
+            if not p.exists() or p.read_text(encoding="utf-8") != content:
+                p.write_text(content, encoding="utf-8")
+                touched = True
+        if touched:
+            changed.append(tid)
+    return changed
 
 
 def read_table(table_id: str) -> pd.DataFrame:
