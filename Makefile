@@ -32,14 +32,17 @@ help:
 # ---------------------------------------------------------------- environment
 env: $(STAMP)
 
-$(STAMP): requirements.lock pyproject.toml
+# the locked packages are installed by uv (itself hash-pinned in requirements-tools.lock): the same
+# hash-checked wheels as pip would install, in seconds instead of a minute
+$(STAMP): requirements.lock requirements-tools.lock pyproject.toml
 	@test -x $(PY) || $(PY_BOOT) -m venv $(VENV)
-	$(PY) -m pip install --quiet --require-hashes --no-deps -r requirements.lock 2> >(grep -v "is ignored: it is neither a file nor a directory" >&2)
+	$(PY) -m pip install --quiet --require-hashes --no-deps -r requirements-tools.lock
+	$(PY) -m uv pip install --quiet --python $(PY) --require-hashes --no-deps -r requirements.lock
 	$(PY) -m pip install --quiet --no-deps --no-build-isolation -e . 2> >(grep -v "is ignored: it is neither a file nor a directory" >&2)
 	@touch $(STAMP)
 
 lock:
-	$(PY_BOOT) -m pip install --quiet uv
+	$(PY_BOOT) -m pip install --quiet --require-hashes --no-deps -r requirements-tools.lock
 	$(PY_BOOT) -m uv pip compile requirements.in --generate-hashes --python-version 3.11 \
 	    --python-platform x86_64-manylinux_2_28 -o requirements.lock
 

@@ -721,7 +721,7 @@ def initial_state(sc, n_runs, seed):
 
 
 def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimator="printed",
-             heading_observation="misalignment"):
+             heading_observation="misalignment", continued_runs=None):
     """Run fang2020 §3: damped grid INS, fixes at ``sc.fix_times``, two-point calibration.
 
     ``n_runs`` Monte Carlo runs (random rocking phases, white noise, ``seed``); the first fix resets
@@ -732,6 +732,9 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     runs are continued a second time without compensation (the paper's dashed curves).
     ``heading_observation``: ``"misalignment"`` observes the platform azimuth misalignment φ_z of
     the P equation, ``"euler"`` the difference of grid-heading Euler angles (:data:`HEADING_OBSERVATIONS`).
+    ``continued_runs``: how many runs (the first ones) are integrated past the second fix (default:
+    all); the records of the others are NaN from it on.  Every run has its own random stream, so
+    the continued runs are the same whatever this number.
     """
     if heading_observation not in HEADING_OBSERVATIONS:
         raise ValueError(f"heading_observation must be one of {HEADING_OBSERVATIONS}")
@@ -741,6 +744,9 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
         raise ValueError(f"estimator must be one of {ESTIMATORS}")
     if not 0 <= reset_only_runs <= n_runs:
         raise ValueError("reset_only_runs must lie in [0, n_runs]")
+    n_cont = n_runs if continued_runs is None else continued_runs
+    if not isinstance(n_cont, (int, np.integer)) or not 0 <= n_cont <= n_runs:
+        raise ValueError("continued_runs must be an integer in [0, n_runs] (or None: every run)")
     dt = sc.dt
     rec_every_k = sc.steps(_positive(record_every, "record_every (s)"))
     k_end = sc.steps(sc.duration)
@@ -778,7 +784,10 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     st = [x[:m].copy() for x in (cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens)]
     rec_reset = rec[:m].copy()
     comp[:] = est[estimator]
-    seg(k2, k_end, cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens, rec)
+    rec[n_cont:, k2 // rec_every_k:] = np.nan
+    if n_cont:
+        c = slice(0, n_cont)
+        seg(k2, k_end, cbp[c], vg[c], r[c], damp[c], comp[c], seeds[c], acc_e[c], acc_i[c], traj[c], sens[c], rec[c])
     if m:
         seg(k2, k_end, *st, rec_reset)
     t = np.arange(n_rec) * rec_every_k * dt
@@ -849,16 +858,17 @@ damped velocity, one rocking-phase set shared by all runs that leaves the ship l
 fixes; eq. (27) with the attitude at the second fix (``estimator="printed"``)."""
 
 
-def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, **changes):
+def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, continued_runs=None, **changes):
     """The 20-run Monte Carlo of fang2020 §3 for case 1 (Table 1) or case 2 (Table 2).
 
     Full fidelity: 10 h at 100 Hz, fixes at 2 h and 3.5 h, under :data:`FANG2020_READING`;
     ``changes`` override scenario fields (for sensitivity checks).  Returns a
-    :class:`SimulationResult`.
+    :class:`SimulationResult`.  ``continued_runs``: runs integrated past the second fix (default:
+    every run; see :func:`simulate`).
     """
     sc = fang2020_scenario(case, **{**FANG2020_READING, **changes})
     return simulate(sc, n_runs, FANG2020_SEEDS[case] if seed is None else seed,
-                    reset_only_runs=reset_only_runs)
+                    reset_only_runs=reset_only_runs, continued_runs=continued_runs)
 
 
 def drift_summary(result, estimator="printed"):

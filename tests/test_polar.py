@@ -333,6 +333,23 @@ def test_simulation_across_the_pole_is_finite():
     assert np.allclose(res.errors[:, j, 5:7], 5.0, atol=0.05) and np.all(np.abs(res.errors[:, j, 7]) < 0.05)
 
 
+def test_continuing_fewer_runs_past_the_second_fix_leaves_them_unchanged():
+    """Each run draws from its own random stream: integrating only the first run past the second
+    fix gives that run bit for bit, the estimates of every run, and NaN records for the others."""
+    sc = polar.fang2020_scenario(1, duration=900.0, fix_times=(300.0, 600.0))
+    full = polar.simulate(sc, 3, 7, record_every=10.0)
+    part = polar.simulate(sc, 3, 7, record_every=10.0, continued_runs=1)
+    after = full.t >= 600.0
+    np.testing.assert_array_equal(part.errors[0], full.errors[0])
+    np.testing.assert_array_equal(part.errors[1:, ~after], full.errors[1:, ~after])
+    assert np.all(np.isnan(part.errors[1:, after]))
+    np.testing.assert_array_equal(part.errors_reset_only, full.errors_reset_only)
+    for name in polar.ESTIMATORS:
+        np.testing.assert_array_equal(part.estimates[name], full.estimates[name])
+    with pytest.raises(ValueError, match="continued_runs"):
+        polar.simulate(sc, 3, 7, continued_runs=4)
+
+
 # ----------------------------------------------------------------------------- bad inputs
 
 def test_bad_inputs_are_refused_with_messages():
