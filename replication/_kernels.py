@@ -443,18 +443,51 @@ def build_F_core(lat, h, ve, vn, vu, fn0, fn1, fn2, fconst, F):
 # ----------------------------------------------------------------------------- dense helpers
 
 @njit(**_NJ)
-def _matmul_sp(a, b, out):
-    """out = a @ b, skipping zeros of a (a is usually sparse: F, Φ)."""
+def _csr(a, ptr, col, val):
+    """The non-zeros of ``a`` row by row, columns ascending (compressed sparse rows)."""
     n, m = a.shape
-    p = b.shape[1]
+    c = 0
+    for i in range(n):
+        ptr[i] = c
+        for k in range(m):
+            v = a[i, k]
+            if v != 0.0:
+                col[c] = k
+                val[c] = v
+                c += 1
+    ptr[n] = c
+
+
+@njit(**_NJ)
+def _row_nonzeros(b, nzc, cnt):
+    """Per row of ``b``: the columns of its non-zeros (``nzc[k, :cnt[k]]``)."""
+    n, p = b.shape
+    for k in range(n):
+        c = 0
+        for j in range(p):
+            if b[k, j] != 0.0:
+                nzc[k, c] = j
+                c += 1
+        cnt[k] = c
+
+
+@njit(**_NJ)
+def _csr_matmul(ptr, col, val, b, nzc, cnt, out):
+    """out = A @ b for A in compressed rows and b's non-zero columns per row.
+
+    Each out[i, j] sums a_ik b_kj over ascending k, as the dense product does; the terms left out
+    are exact zeros, which leave a sum that starts at +0.0 unchanged, so the result is the dense
+    product's bit for bit."""
+    n, p = out.shape
     for i in range(n):
         for j in range(p):
             out[i, j] = 0.0
-        for k in range(m):
-            aik = a[i, k]
-            if aik != 0.0:
-                for j in range(p):
-                    out[i, j] += aik * b[k, j]
+        for t in range(ptr[i], ptr[i + 1]):
+            k = col[t]
+            aik = val[t]
+            for u in range(cnt[k]):
+                j = nzc[k, u]
+                out[i, j] += aik * b[k, j]
 
 
 @njit(**_NJ)
@@ -462,38 +495,64 @@ def discretize_series(F, Qc, T, order, Phi, Qd, w1, w2):
     """Φ = exp(F T) and Q_d = ∫_0^T e^{Fs} Q_c e^{F^T s} ds by their Taylor series to ``order``.
 
     The series of Van Loan's block exponential: Q_d = Σ_k T^{k+1}/(k+1)! M_k with M_0 = Q_c,
-    M_k = F M_{k-1} + (F M_{k-1})^T.  Checked against scipy.linalg.expm in the tests.
+    M_k = F M_{k-1} + (F M_{k-1})^T.  Checked against scipy.linalg.expm in the tests.  The
+    products use the sparsity of F and of the running terms (an INS error model's sensor rows
+    have one non-zero or none); the arithmetic is that of the dense products.
     """
     n = F.shape[0]
-    # Φ
+    ptr = np.empty(n + 1, np.int64)
+    col = np.empty(n * n, np.int64)
+    val = np.empty(n * n)
+    _csr(F, ptr, col, val)
+    nzc = np.empty((n, n), np.int64)
+    cnt = np.empty(n, np.int64)
+    # Φ: running term w1 = (F T)^k / k!
     for i in range(n):
         for j in range(n):
             Phi[i, j] = 1.0 if i == j else 0.0
-            w1[i, j] = 1.0 if i == j else 0.0  # running term (F T)^k / k!
+            w1[i, j] = 1.0 if i == j else 0.0
+        nzc[i, 0] = i
+        cnt[i] = 1
     for k in range(1, order + 1):
-        _matmul_sp(F, w1, w2)
+        _csr_matmul(ptr, col, val, w1, nzc, cnt, w2)
         fac = T / k
         for i in range(n):
+            c = 0
             for j in range(n):
-                w1[i, j] = w2[i, j] * fac
-                Phi[i, j] += w1[i, j]
-    # Q_d
+                v = w2[i, j]
+                if v != 0.0:
+                    w1[i, j] = v * fac
+                    Phi[i, j] += w1[i, j]
+                    nzc[i, c] = j
+                    c += 1
+                else:
+                    w1[i, j] = 0.0
+            cnt[i] = c
+    # Q_d: running term w1 = M_k
     for i in range(n):
         for j in range(n):
             w1[i, j] = Qc[i, j]
             Qd[i, j] = Qc[i, j] * T
+    _row_nonzeros(w1, nzc, cnt)
     coef = T
     for k in range(1, order + 1):
-        _matmul_sp(F, w1, w2)
+        _csr_matmul(ptr, col, val, w1, nzc, cnt, w2)
         coef = coef * T / (k + 1)
+        for i in range(n):
+            cnt[i] = 0
         for i in range(n):
             for j in range(i, n):
                 v = w2[i, j] + w2[j, i]
                 w1[i, j] = v
                 w1[j, i] = v
-        for i in range(n):
-            for j in range(n):
-                Qd[i, j] += coef * w1[i, j]
+                if v != 0.0:
+                    Qd[i, j] += coef * v
+                    nzc[i, cnt[i]] = j
+                    cnt[i] += 1
+                    if j != i:
+                        Qd[j, i] += coef * v
+                        nzc[j, cnt[j]] = i
+                        cnt[j] += 1
 
 
 @njit(**_NJ)
