@@ -65,7 +65,7 @@ __all__ = ["SimulationSetup", "table_4_41_setup", "MISALIGNMENT_UNITS", "MARKOV_
            "simulated_flight", "segment_summary", "filter_model", "BatchResult", "run_batch",
            "truth_parameters", "observable_nees", "fraction_in_band", "attitude_errors",
            "segment_mask", "survey_line_mask", "rms_with_ci", "improvement_percent",
-           "improvement_with_ci", "printed_improvements", "total_bias_estimates", "display_scales"]
+           "improvement_with_ci", "paired_improvement", "printed_improvements", "total_bias_estimates", "display_scales"]
 
 MISALIGNMENT_UNITS = {"arcsec": ARCSEC, "arcmin": ARCMIN, "mrad": 1e-3}
 """Candidate units of Table 4-41's misalignment angle "1.5" (printed without a unit)."""
@@ -743,6 +743,25 @@ def improvement_with_ci(per_other, per_new, prob: float = 0.95, n_boot: int = 20
     boot = improvement_percent(a[idx].mean(1), b[idx].mean(1))
     lo, hi = np.quantile(boot, [(1 - prob) / 2, (1 + prob) / 2], axis=0)
     return val, lo, hi
+
+
+def paired_improvement(per_other, per_new, prob: float = 0.95):
+    """Per-run improvement 100 (other − new)/other (%) of paired runs (``per_*`` runs ×
+    components, the same truths and sensor errors), its mean and the two-sided ``prob``
+    Student-t interval of the mean (the runs' differences, not their levels, set its width).
+    Returns (per_run, mean, lo, hi); lo and hi are NaN with fewer than two runs."""
+    a = np.asarray(per_other, float)
+    b = np.asarray(per_new, float)
+    if a.shape != b.shape or a.ndim != 2:
+        raise ValueError("per_other and per_new need the same runs × components shape (paired runs)")
+    if not 0 < prob < 1:
+        raise ValueError("prob must lie in (0, 1)")
+    d = improvement_percent(a, b)
+    mean = d.mean(0)
+    if d.shape[0] < 2:
+        return d, mean, mean * np.nan, mean * np.nan
+    half = stats.t.ppf(0.5 + prob / 2, d.shape[0] - 1) * d.std(0, ddof=1) / math.sqrt(d.shape[0])
+    return d, mean, mean - half, mean + half
 
 
 def printed_improvements(table):

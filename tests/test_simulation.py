@@ -239,6 +239,24 @@ def test_rms_ci_and_paired_bootstrap():
         sim.rms_with_ci(err, np.zeros(500, bool))
 
 
+
+def test_paired_improvement_interval_covers_the_true_mean():
+    """Paired runs whose per-run improvement is 20 % ± 10 % (normal): the t interval of 400
+    such batches of 8 runs covers 20 % in 95 % of them, within the binomial spread (±3 %)."""
+    rng = np.random.default_rng(3)
+    cover = 0
+    for _ in range(400):
+        other = rng.uniform(1.0, 2.0, size=(8, 2))
+        new = other * (1.0 - (0.2 + 0.1 * rng.normal(size=(8, 2))))
+        d, mean, lo, hi = sim.paired_improvement(other, new)
+        assert d.shape == (8, 2) and np.all(lo < mean) and np.all(mean < hi)
+        cover += int(lo[0] < 20.0 < hi[0])
+    assert abs(cover / 400 - 0.95) < 0.03
+    d, mean, lo, hi = sim.paired_improvement([[2.0]], [[1.0]])
+    assert mean[0] == pytest.approx(50.0) and np.isnan(lo[0]) and np.isnan(hi[0])
+    with pytest.raises(ValueError, match="paired runs"):
+        sim.paired_improvement(np.ones((3, 2)), np.ones((2, 2)))
+
 def test_truth_parameters_layouts(t441):
     s = sim.table_4_41_setup(t441)
     const = {k: np.full((2, n), v) for k, n, v in (("gyro_bias", 3, 1.0), ("accel_bias", 3, 2.0), ("gyro_scale", 3, 3.0),
