@@ -76,8 +76,8 @@ units: env
 unit-portable: env
 	$(PY) scripts/portability.py unit tests -m "not browser and not slow"
 
-# the unit tests, the perturbed notebooks, the strict book build and the browser check as one
-# queue of jobs on every core, slowest first (what `make test` runs)
+# the unit tests and the perturbed notebooks as one queue of jobs on every core, slowest first,
+# with the strict book build and the browser check beside them (what `make test` runs)
 suite: env
 	$(PY) scripts/portability.py suite --book $(NOTEBOOKS)
 

@@ -168,26 +168,28 @@ SMALL_NOTEBOOK_S = 12.0
 (a pytest process and its start-up per notebook would cost more than the notebook)."""
 
 
+def _timed(cmd: list[str]) -> tuple[subprocess.CompletedProcess, float]:
+    t0 = time.perf_counter()
+    r = subprocess.run(cmd, cwd=ROOT, env={**os.environ, **COMMON}, capture_output=True, text=True)
+    return r, time.perf_counter() - t0
+
+
 def _pytest_nbval(paths: list[Path]) -> list[str]:
     return [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--nbval", "--nbval-current-env",
             *map(str, paths), "--nbval-sanitize-with", str(ROOT / "book" / "sanitize.cfg"),
             "--nbval-cell-timeout=900", "-o", "testpaths=", "-o", "addopts="]
 
 
-def suite_jobs(paths: list[Path], configs: list[str], book: bool = False) -> list[tuple[str, list[str], dict | None, float]]:
-    """Every job of ``make test`` but the index checks: the unit tests natively and under the
-    first configuration, each notebook under each configuration (small ones grouped) and, with
-    ``book``, the strict book build followed by the browser check; as (label, command,
-    environment, estimated seconds), slowest first."""
+def suite_jobs(paths: list[Path], configs: list[str]) -> list[tuple[str, list[str], dict | None, float]]:
+    """The queued jobs of ``make test``: the unit tests natively and under the first
+    configuration and each notebook under each configuration (small ones grouped); as (label,
+    command, environment, estimated seconds), slowest first."""
     first = next(iter(CONFIGS))
     jobs: list[tuple[str, list[str], dict | None, float]] = [
         ("unit tests natively", [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests", "-m",
                                  "not browser"], None, 100.0),
         (f"unit tests under '{first}'", [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests",
                                          "-m", "not browser and not slow"], environment(first), 50.0)]
-    if book:  # the strict book build and the browser check read only stored files: any time will do
-        jobs.append(("strict book build and browser check",
-                     ["make", "--no-print-directory", "html-strict", "browser"], None, 110.0))
     for name in configs:
         env = environment(name)
         small = [p for p in paths if cost(p) < SMALL_NOTEBOOK_S]
@@ -221,12 +223,19 @@ def _interleave(jobs: list) -> list:
     return out
 
 
+BOOK_JOB = ("strict book build and browser check", ["make", "--no-print-directory", "html-strict", "browser"])
+"""The side job of :func:`suite`: it reads only stored files, and the browser check spends most of
+its time waiting for pages to go network-idle (about 30 s of CPU in 80 s), so it runs beside the
+workers instead of occupying one."""
+
+
 def suite(paths: list[Path], jobs: int, configs: list[str], book: bool = False) -> int:
     """The unit tests and the perturbed re-execution of every notebook as one queue of jobs on
     ``jobs`` workers, slowest first, each worker taking the next job as it finishes (so that no
-    core idles while work is left); then ``tables/`` and ``book/`` must be unchanged."""
+    core idles while work is left), with ``book``: the strict book build and the browser check
+    beside them (:data:`BOOK_JOB`); then ``tables/`` and ``book/`` must be unchanged."""
     before = _git_state()
-    todo = suite_jobs(paths, configs, book)
+    todo = suite_jobs(paths, configs)
     for name in configs:
         print(f"== {name}: " + " ".join(f"{k}={v}" for k, v in CONFIGS[name].items()), flush=True)
     t_start = time.perf_counter()
@@ -238,6 +247,8 @@ def suite(paths: list[Path], jobs: int, configs: list[str], book: bool = False) 
         return label, r, time.perf_counter() - t0
 
     failed = []
+    side = ThreadPoolExecutor(1)
+    book_future = side.submit(lambda: (BOOK_JOB[0], *_timed(BOOK_JOB[1]))) if book else None
     with ThreadPoolExecutor(jobs) as pool:
         for label, r, dt in pool.map(run, enumerate(todo)):
             print(f"== {label}: {'ok' if r.returncode == 0 else 'FAILED'} in {dt:.0f} s", flush=True)
@@ -247,7 +258,18 @@ def suite(paths: list[Path], jobs: int, configs: list[str], book: bool = False) 
                 sys.stderr.write(r.stderr)
             else:
                 sys.stdout.write(r.stdout.strip().splitlines()[-1] + "\n" if r.stdout.strip() else "")
-    print(f"== {len(todo)} jobs on {jobs} workers in {time.perf_counter() - t_start:.0f} s", flush=True)
+    if book_future is not None:
+        label, r, dt = book_future.result()
+        print(f"== {label} (beside the workers): {'ok' if r.returncode == 0 else 'FAILED'} in {dt:.0f} s", flush=True)
+        if r.returncode != 0:
+            failed.append(label)
+            sys.stdout.write(r.stdout)
+            sys.stderr.write(r.stderr)
+        else:
+            sys.stdout.write(r.stdout.strip().splitlines()[-1] + "\n" if r.stdout.strip() else "")
+    side.shutdown()
+    print(f"== {len(todo)} jobs on {jobs} workers{' and the book beside them' if book else ''} in "
+          f"{time.perf_counter() - t_start:.0f} s", flush=True)
     if failed:
         print("failed: " + "; ".join(failed), file=sys.stderr)
         return 1
