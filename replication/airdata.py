@@ -72,6 +72,7 @@ __all__ = [
     "position_correction", "correction_vector", "exact_correction",
     "STATE_NAMES", "reference_state", "derived_coefficients", "printed_elements",
     "check_elements", "manifold_residuals", "consistency_count",
+    "LEDGER_ID", "LEDGER_TOLERANCE", "readings_ledger_rows",
 ]
 
 
@@ -1231,11 +1232,13 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
         if r["system"] == "proposed SINS/ADS" and r["lo"] > 10 * p:
             e = early[(r["system"], q)]
             row.update(status="not-reproduced", note=f"{PROPOSED_REASON}; {ci}; max before the final deceleration "
-                                                     f"(t <= {until:.0f} s): {e['mean']:.3g} (CI {e['lo']:.3g}..{e['hi']:.3g})")
+                                                     f"(t <= {until:.0f} s): {e['mean']:.3g} (CI {e['lo']:.3g}..{e['hi']:.3g}); "
+                                                     f"readings ledger: {LEDGER_ID}")
         elif r["system"] == "SINS" and q == "misalignment":
             row.update(status="not-reproduced", note=f"no reading reaches the print: with the printed sensor errors {ci}; "
                                                      f"ideal sensors (initial errors only) {ideal[q]:.2g}; the linear "
-                                                     "error model of the second computation stays near 0.1 deg too")
+                                                     "error model of the second computation stays near 0.1 deg too; "
+                                                     f"readings ledger: {LEDGER_ID}")
         elif r["system"] == "SINS" and abs(ideal[q] / p - 1) < 0.05 and m > 2 * p:
             row.update(reproduced=round(ideal[q], 4), status="inconsistent",
                        note=f"the print is the pure SINS driven by the printed initial errors alone ({ideal[q]:.4g}, "
@@ -1309,6 +1312,56 @@ def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7)
                      "final position error (km)": fi["position error"].mean(),
                      "gated per run": float(np.mean([sum(i["gated"] for i in r) for r in mc.infos]))})
     return pd.DataFrame(rows)
+
+
+
+LEDGER_ID = "duan2023-check-table-1-readings"
+"""The exported readings ledger of duan2023 Table 1 (written by the chapter)."""
+
+LEDGER_TOLERANCE = 0.5
+"""Relative tolerance of the Table 1 readings ledger (:func:`readings_ledger_rows`): a reading
+reaches a printed value when it lies within 50 % of it.  The printed values and the analog
+differ by factors of 5 to 100; the two runs per setting of :func:`sweep` scatter by tens of
+percent, and the rule is fixed before the comparison."""
+
+LEDGER_QUANTITIES = {"misalignment": "max misalignment (deg)", "velocity error": "max velocity error (m/s)",
+                     "position error": "max position error (km)"}
+
+
+def readings_ledger_rows(readings, table1, system="proposed SINS/ADS", *, runs=None):
+    """Rows of duan2023 Table 1's readings ledger for :func:`replication.reproduction.compare`.
+
+    Parameters
+    ----------
+    readings : dict
+        Reading label → mapping with the keys of :data:`LEDGER_QUANTITIES` (or its values, the
+        column names of :func:`sweep`): the flight maxima (°, m/s, km) under that reading.
+    table1 : PaperTable
+        ``rp.load_paper("duan2023-table-1")``.
+    system : str
+        The Table 1 column compared ("SINS", "literature SINS/ADS", "proposed SINS/ADS").
+    runs : int, optional
+        Runs behind each reading (stated in the notes).
+
+    Returns
+    -------
+    list of dict
+        One row per reading and quantity, ``quantity`` = "<reading> | <system> / <quantity>",
+        tolerance :data:`LEDGER_TOLERANCE` (relative).
+    """
+    if not isinstance(readings, dict) or not readings:
+        raise ValueError("readings must be a non-empty dict: reading label -> flight maxima")
+    rows = []
+    for label, vals in readings.items():
+        for q, col in LEDGER_QUANTITIES.items():
+            v = vals.get(q, vals.get(col)) if hasattr(vals, "get") else None
+            if v is None or not np.isfinite(float(v)):
+                raise ValueError(f"reading {label!r} has no finite {q!r}")
+            note = f"mean of {runs} runs" if runs else ""
+            rows.append(dict(quantity=f"{label} | {system} / {q}", unit=table1.unit(f"{system} / {q}"),
+                             paper=table1.value(f"{system} / {q}"), reproduced=float(f"{float(v):.3g}"), digits=3,
+                             tolerance=LEDGER_TOLERANCE, tolerance_kind="rel", note=note))
+    return rows
 
 
 _EVID = "book/duan2023/01_sins_ads_error_correction.ipynb; tests/test_airdata.py::"

@@ -1,6 +1,7 @@
 """Tests of replication.airdata: duan2023 correction geometry, derivation checks, simulation."""
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from replication import airdata as ad
@@ -348,3 +349,16 @@ def test_bias_experiment_tilt_grows_linearly(sign):
     assert abs(r["tilt_step"]) == pytest.approx(b * 30.0 / 200.0, rel=1e-12)
     with pytest.raises(ValueError, match="n_intervals"):
         ad.bias_experiment(b, n_intervals=1)
+
+
+def test_readings_ledger_rows_reach_the_print_only_within_the_stated_tolerance():
+    t1 = rp.load_paper("duan2023-table-1")
+    p = {q: t1.value(f"proposed SINS/ADS / {q}") for q in ad.LEDGER_QUANTITIES}
+    readings = {"at the print": {q: 1.2 * v for q, v in p.items()},
+                "far": pd.Series({col: 10.0 * p[q] for q, col in ad.LEDGER_QUANTITIES.items()})}
+    rows = ad.readings_ledger_rows(readings, t1, runs=2)
+    assert len(rows) == 6 and rows[0]["quantity"] == "at the print | proposed SINS/ADS / misalignment"
+    st = list(rp.comparison_frame(rows)["status"])
+    assert st[:3] == ["reproduced"] * 3 and st[3:] == ["not-reproduced"] * 3
+    with pytest.raises(ValueError, match="no finite"):
+        ad.readings_ledger_rows({"x": {"misalignment": 1.0}}, t1)
