@@ -1321,7 +1321,7 @@ LEDGER_ID = "duan2023-check-table-1-readings"
 LEDGER_TOLERANCE = 0.5
 """Relative tolerance of the Table 1 readings ledger (:func:`readings_ledger_rows`): a reading
 reaches a printed value when it lies within 50 % of it.  The printed values and the analog
-differ by factors of 5 to 100; the two runs per setting of :func:`sweep` scatter by tens of
+differ by factors of 5 to 100; the two runs per setting of ``sweep`` scatter by tens of
 percent, and the rule is fixed before the comparison."""
 
 LEDGER_QUANTITIES = {"misalignment": "max misalignment (deg)", "velocity error": "max velocity error (m/s)",
@@ -1334,8 +1334,8 @@ def readings_ledger_rows(readings, table1, system="proposed SINS/ADS", *, runs=N
     Parameters
     ----------
     readings : dict
-        Reading label → mapping with the keys of :data:`LEDGER_QUANTITIES` (or its values, the
-        column names of :func:`sweep`): the flight maxima (°, m/s, km) under that reading.
+        Reading label → mapping with the keys of ``LEDGER_QUANTITIES`` (or its values, the
+        column names of ``sweep``): the flight maxima (°, m/s, km) under that reading.
     table1 : PaperTable
         ``rp.load_paper("duan2023-table-1")``.
     system : str
