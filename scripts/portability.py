@@ -232,6 +232,18 @@ its time waiting for pages to go network-idle (about 30 s of CPU in 80 s), so it
 workers instead of occupying one."""
 
 
+def _report(label: str, r: subprocess.CompletedProcess, dt: float, failed: list[str]) -> None:
+    """One finished job: its verdict and time; the whole log if it failed (appended to
+    ``failed``), else its last line."""
+    print(f"== {label}: {'ok' if r.returncode == 0 else 'FAILED'} in {dt:.0f} s", flush=True)
+    if r.returncode != 0:
+        failed.append(label)
+        sys.stdout.write(r.stdout)
+        sys.stderr.write(r.stderr)
+    else:
+        sys.stdout.write(r.stdout.strip().splitlines()[-1] + "\n" if r.stdout.strip() else "")
+
+
 def suite(paths: list[Path], jobs: int, configs: list[str], book: bool = False) -> int:
     """The unit tests and the perturbed re-execution of every notebook as one queue of jobs on
     ``jobs`` workers, slowest first, each worker taking the next job as it finishes (so that no
@@ -254,22 +266,10 @@ def suite(paths: list[Path], jobs: int, configs: list[str], book: bool = False) 
     book_future = side.submit(lambda: (BOOK_JOB[0], *_timed(BOOK_JOB[1]))) if book else None
     with ThreadPoolExecutor(jobs) as pool:
         for label, r, dt in pool.map(run, enumerate(todo)):
-            print(f"== {label}: {'ok' if r.returncode == 0 else 'FAILED'} in {dt:.0f} s", flush=True)
-            if r.returncode != 0:
-                failed.append(label)
-                sys.stdout.write(r.stdout)
-                sys.stderr.write(r.stderr)
-            else:
-                sys.stdout.write(r.stdout.strip().splitlines()[-1] + "\n" if r.stdout.strip() else "")
+            _report(label, r, dt, failed)
     if book_future is not None:
         label, r, dt = book_future.result()
-        print(f"== {label} (beside the workers): {'ok' if r.returncode == 0 else 'FAILED'} in {dt:.0f} s", flush=True)
-        if r.returncode != 0:
-            failed.append(label)
-            sys.stdout.write(r.stdout)
-            sys.stderr.write(r.stderr)
-        else:
-            sys.stdout.write(r.stdout.strip().splitlines()[-1] + "\n" if r.stdout.strip() else "")
+        _report(f"{label} (beside the workers)", r, dt, failed)
     side.shutdown()
     print(f"== {len(todo)} jobs on {jobs} workers{' and the book beside them' if book else ''} in "
           f"{time.perf_counter() - t_start:.0f} s", flush=True)
