@@ -40,8 +40,9 @@ from __future__ import annotations
 import argparse
 import os
 import subprocess
-import time
 import sys
+import tempfile
+import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -98,16 +99,30 @@ def _shards(paths: list[Path], n: int) -> list[list[Path]]:
 KERNEL_START_FAILURE = "Kernel died before replying to kernel_info"
 
 
+def _run(cmd: list[str], env: dict[str, str]) -> subprocess.CompletedProcess:
+    """Run ``cmd`` with its output captured; the CPU seconds (user + system) of the process and
+    of every process it waited for (the notebook kernels) are in the result's ``cpu``."""
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=out, stderr=err, text=True)
+        _, status, usage = os.wait4(proc.pid, 0)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        err.seek(0)
+        r = subprocess.CompletedProcess(cmd, proc.returncode, out.read(), err.read())
+    r.cpu = usage.ru_utime + usage.ru_stime
+    return r
+
+
 def _run_shard(cmd: list[str], env: dict[str, str], delay: float) -> subprocess.CompletedProcess:
     """Run one nbval shard.  Shards start a few seconds apart: kernels launched at the same
     instant by two processes can race for the same TCP ports, and the loser dies before replying.
     A shard whose kernel did not start is run once more (a start-up failure says nothing about
     the stored outputs); any other failure stands."""
     time.sleep(delay)
-    r = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True)
+    r = _run(cmd, env)
     if r.returncode != 0 and KERNEL_START_FAILURE in r.stdout:
         print("a kernel did not start; running that shard once more", flush=True)
-        r = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True)
+        r = _run(cmd, env)
     return r
 
 
@@ -170,7 +185,7 @@ SMALL_NOTEBOOK_S = 12.0
 
 def _timed(cmd: list[str]) -> tuple[subprocess.CompletedProcess, float]:
     t0 = time.perf_counter()
-    r = subprocess.run(cmd, cwd=ROOT, env={**os.environ, **COMMON}, capture_output=True, text=True)
+    r = _run(cmd, {**os.environ, **COMMON})
     return r, time.perf_counter() - t0
 
 
@@ -235,7 +250,7 @@ workers instead of occupying one."""
 def _report(label: str, r: subprocess.CompletedProcess, dt: float, failed: list[str]) -> None:
     """One finished job: its verdict and time; the whole log if it failed (appended to
     ``failed``), else its last line."""
-    print(f"== {label}: {'ok' if r.returncode == 0 else 'FAILED'} in {dt:.0f} s", flush=True)
+    print(f"== {label}: {'ok' if r.returncode == 0 else 'FAILED'} in {dt:.0f} s ({r.cpu:.0f} s of CPU)", flush=True)
     if r.returncode != 0:
         failed.append(label)
         sys.stdout.write(r.stdout)
@@ -264,15 +279,18 @@ def suite(paths: list[Path], jobs: int, configs: list[str], book: bool = False) 
     failed = []
     side = ThreadPoolExecutor(1)
     book_future = side.submit(lambda: (BOOK_JOB[0], *_timed(BOOK_JOB[1]))) if book else None
+    cpu = 0.0
     with ThreadPoolExecutor(jobs) as pool:
         for label, r, dt in pool.map(run, enumerate(todo)):
             _report(label, r, dt, failed)
+            cpu += r.cpu
     if book_future is not None:
         label, r, dt = book_future.result()
         _report(f"{label} (beside the workers)", r, dt, failed)
+        cpu += r.cpu
     side.shutdown()
     print(f"== {len(todo)} jobs on {jobs} workers{' and the book beside them' if book else ''} in "
-          f"{time.perf_counter() - t_start:.0f} s", flush=True)
+          f"{time.perf_counter() - t_start:.0f} s ({cpu:.0f} s of CPU)", flush=True)
     if failed:
         print("failed: " + "; ".join(failed), file=sys.stderr)
         return 1
