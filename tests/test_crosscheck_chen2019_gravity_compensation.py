@@ -1,0 +1,146 @@
+"""Second computation of the height rows of chen2019 Table 4-50 (the chapter's simulated analog).
+
+The stored rows ``height normal / direct / state`` of ``tables/chen2019-table-4-50.csv`` are the
+mean photo-epoch RMS of four simulated flights, with a 95 % half-width in the note.  The
+cross-check (replication.crosschecks.chen2019_gravity_compensation) predicts the same RMS by a
+linear covariance analysis of the vertical channel alone (chen2019 eqs. 3-14, 3-15, 3-17, 3-18),
+with the true error covariance of the closed-loop filter for the methods that leave the
+disturbance unmodelled.
+
+Tolerance, fixed before the comparison.  A stored row agrees when it lies in the band
+
+    [min_pred - hw - 0.10 * stored,  max_pred + hw + 0.10 * stored]
+
+where min_pred / max_pred span the predictions for the two shapes of the field's along-track
+spectrum (Gauss-Markov exp(-r/D) and the upward-continued exponential: the simulation's field is
+the latter, the 1-D reduction may be either), hw is the stored 95 % Monte-Carlo half-width, and
+10 % of the stored value covers what the 1-D vertical model neglects: tilt x horizontal specific
+force in the 60 s turns, the horizontal channels' coupling into the vertical (Coriolis, δL, δλ
+terms of eq. 3-15), the low-pass shape of the direct difference (first order here; the chapter
+states only "100 s"), and the chapter's method-3 filter running fitted AR(3) models rather than
+the field's Gauss-Markov law (its stored ``state-gm`` and ``true-model`` columns differ by 4 %).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from replication.crosschecks import chen2019_gravity_compensation as xc
+
+# a covariance analysis over the whole flight: run natively only (its agreement does not depend on
+# the numerical code path)
+pytestmark = pytest.mark.slow
+
+TABLE = Path(__file__).resolve().parents[1] / "tables" / "chen2019-table-4-50.csv"
+NEGLECTED = 0.10          # relative, see the module docstring
+
+
+def _stored():
+    table = pd.read_csv(TABLE)
+    out = {}
+    for m in xc.METHODS:
+        row = table.loc[table["quantity"] == f"height {m}"].iloc[0]
+        hw = float(re.search(r"\+-\s*([0-9.]+)", str(row["note"])).group(1))
+        out[m] = (float(row["reproduced"]), hw)
+    return out
+
+
+STORED = _stored()
+
+
+@pytest.fixture(scope="module")
+def predicted():
+    return xc.geometry_height_rms()
+
+
+def _band(pred, m):
+    stored, hw = STORED[m]
+    lo = min(pred[(m, s)]["rms"] for s in xc.SHAPES)
+    hi = max(pred[(m, s)]["rms"] for s in xc.SHAPES)
+    return lo - hw - NEGLECTED * stored, hi + hw + NEGLECTED * stored
+
+
+def test_field_variance_matches_the_printed_500_m_value():
+    # the chapter prints 26.0 mGal (vertical, 500 m) for σ₀ = 30 mGal, D = 10 km; tolerance:
+    # half a unit of the printed last digit
+    sigma = 30.0 * np.sqrt(xc.field_variance_ratio(10_000.0, 500.0))
+    assert abs(sigma - 26.0) <= 0.05
+
+
+def test_single_line_routes_agree():
+    # one line of independent ground: the adjoint route and the shaping-filter route are the same
+    # linear computation; they differ only by binning δg over 5 s (its time scale is ≥ 50 s)
+    p = xc.VerticalChannel(flight_time=1800.0, n_lines=1, n_photos=30)
+    a = xc.geometry_height_rms(p, shapes=("gauss-markov",))
+    b = xc.predicted_height_rms(p, shapes=("gauss-markov",))
+    for m in xc.METHODS:
+        assert a[(m, "gauss-markov")]["rms"] == pytest.approx(b[(m, "gauss-markov")]["rms"], rel=1e-3)
+
+
+def test_ordering_normal_direct_state(predicted):
+    for s in xc.SHAPES:
+        r = [predicted[(m, s)]["rms"] for m in xc.METHODS]
+        assert r[0] > r[1] > r[2], (s, r)
+    stored = [STORED[m][0] for m in xc.METHODS]
+    assert stored[0] > stored[1] > stored[2]
+
+
+@pytest.mark.parametrize("method", ["direct", "state"])
+def test_height_rms_agrees(predicted, method):
+    lo, hi = _band(predicted, method)
+    assert lo <= STORED[method][0] <= hi, (method, lo, STORED[method][0], hi)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "normal gravity: predicted 0.0643-0.0656 m (continued / Gauss-Markov field, strips re-flown; "
+    "0.0756-0.0763 m for one line of independent ground) against stored 0.0525 +- 0.0036 m; "
+    "band lower edge 0.0554 m. The model also predicts a run-to-run scatter of one flight's RMS "
+    "of 0.018-0.021 m (the field's few independent patches over 53 km at D = 10 km), eight to nine "
+    "times the scatter the stored 4-run interval implies (about 0.0023 m): the simulation's field "
+    "carries less large-scale power than the ensemble covariance exp(-r/D), or its filter tracks "
+    "slow disturbance that a random-constant bias cannot"))
+def test_height_rms_agrees_normal(predicted):
+    lo, hi = _band(predicted, "normal")
+    assert lo <= STORED["normal"][0] <= hi, ("normal", lo, STORED["normal"][0], hi)
+
+
+def test_filter_own_covariance_is_not_the_error():
+    # with the disturbance unmodelled the filter's own P understates the true error
+    r = xc.predicted_height_rms(xc.VerticalChannel(flight_time=1800.0, n_lines=1, n_photos=30),
+                                shapes=("gauss-markov",))
+    normal = r[("normal", "gauss-markov")]
+    state = r[("state", "gauss-markov")]
+    assert normal["rms"] > 3.0 * normal["filter_rms"]
+    assert state["rms"] == pytest.approx(state["filter_rms"], rel=0.01)
+
+
+@pytest.mark.parametrize("kwargs", [
+    {"speed": 0.0}, {"speed": float("nan")}, {"sigma_height": -0.1}, {"n_photos": 2.5},
+    {"speed": "30"}, {"turn_time": 3000.0}, {"lowpass_period": 0.5}, {"gravity_gradient": -1.0},
+])
+def test_setup_validation(kwargs):
+    with pytest.raises(ValueError):
+        xc.VerticalChannel(**kwargs)
+
+
+def test_argument_validation():
+    with pytest.raises(ValueError):
+        xc.truth_model("kalman")
+    with pytest.raises(ValueError):
+        xc.truth_model("normal", shape="white")
+    with pytest.raises(ValueError):
+        xc.filter_model("state", setup={"speed": 30})
+    with pytest.raises(ValueError):
+        xc.field_variance_ratio(-1.0, 500.0)
+    with pytest.raises(ValueError):
+        xc.along_track_correlation(-5.0, 10_000.0, 500.0)
+    with pytest.raises(ValueError):
+        xc.height_error_history([("normal",)])
+    with pytest.raises(ValueError):
+        xc.geometry_height_rms(bin_seconds=100.0)
+    with pytest.raises(ValueError):
+        xc.flight_positions([1e6])
