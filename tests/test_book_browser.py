@@ -244,3 +244,28 @@ def test_figures_are_present_and_decoded(seen):
     for rel, r in with_fig.items():
         assert r["widths"] and all(w > 0 for w in r["widths"]), f"{rel}: a figure failed to decode ({r['widths']})"
     assert (ROOT / "book" / "_build" / "screenshot.png").stat().st_size > 10_000
+
+
+CJK_RUN = re.compile(r"[\u4e00-\u9fff]{2,}")
+
+
+def test_chinese_terms_of_the_sources_are_searchable(server, browser):
+    """The book quotes the sources' Chinese terms (逆序检验, 截尾, 子午圈 …): the search index
+    holds each quoted run as a term, and the search page finds a chapter for one of them."""
+    import json
+
+    text = (HTML / "searchindex.js").read_text(encoding="utf-8")
+    terms = json.loads(text[text.index("(") + 1:text.rindex(")")])["terms"]
+    quoted = set()
+    for src in list((ROOT / "book").rglob("*.ipynb")) + list((ROOT / "book").rglob("*.md")):
+        if "_build" not in src.parts:
+            quoted |= set(CJK_RUN.findall(src.read_text(encoding="utf-8")))
+    assert len(quoted) >= 10, "the book quotes fewer Chinese terms than expected"
+    missing = sorted(q for q in quoted if not any(q in t for t in terms))
+    assert not missing, f"Chinese terms missing from the search index: {missing[:10]}"
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page.goto(f"{server}/search.html?q=逆序检验", wait_until="load", timeout=60_000)
+    page.wait_for_selector("ul.search li a", timeout=30_000)
+    hits = page.eval_on_selector_all("ul.search li a", "els => els.map(e => e.getAttribute('href'))")
+    page.close()
+    assert any("05_gravity_time_series" in h for h in hits), hits
