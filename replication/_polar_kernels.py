@@ -308,9 +308,63 @@ def ideal_increments(c0, c1, v0, v1, g0, g1, dt, dth, dvel):
 
 # ----------------------------------------------------------------------------- grid-frame INS
 
+TRUTH_STEP_FIELDS = 8
+"""Per-step columns of :func:`truth_table`: the ideal Δθ (3) and Δv (3) of the interval ending at
+the step and the true grid-east and grid-north velocity at it."""
+TRUTH_RECORD_FIELDS = 15
+"""Per-record columns of :func:`truth_table`: the true C_b^e (9, row-major), r^e (3) and ṙ^e (3)."""
+
+
+@njit(cache=True)
+def truth_table(k0, k1, dt, p, rec_every, tin, trec):
+    """The truth of one trajectory from step k0 to k1, for runs that share it (:func:`run_grid`
+    with ``shared`` = 1): row k - k0 of ``tin`` receives the ideal increments of the interval
+    ending at step k (k > k0) and the true grid velocity at it; row j of ``trec`` the true state
+    at the record step k0 + j·rec_every (steps with k % rec_every == 0, as in run_grid).  The same
+    calls in the same order as run_grid's own truth, so the runs' results are bit-identical."""
+    cbe = np.empty((3, 3))
+    cbi0 = np.empty((3, 3))
+    cbi1 = np.empty((3, 3))
+    vi0 = np.empty(3)
+    vi1 = np.empty(3)
+    gi0 = np.empty(3)
+    gi1 = np.empty(3)
+    re = np.empty(3)
+    rde = np.empty(3)
+    dth = np.empty(3)
+    dvl = np.empty(3)
+    tge = np.empty(3)
+    tgn = np.empty(3)
+    tu = np.empty(3)
+    truth_inertial(k0 * dt, p, cbi0, vi0, gi0, cbe, re, rde)
+    for k in range(k0, k1 + 1):
+        if k > k0:
+            truth_inertial(k * dt, p, cbi1, vi1, gi1, cbe, re, rde)
+            ideal_increments(cbi0, cbi1, vi0, vi1, gi0, gi1, dt, dth, dvl)
+            grid_axes(re, tge, tgn, tu)
+            row = tin[k - k0]
+            for a in range(3):
+                row[a] = dth[a]
+                row[3 + a] = dvl[a]
+            row[6] = rde[0] * tge[0] + rde[1] * tge[1] + rde[2] * tge[2]
+            row[7] = rde[0] * tgn[0] + rde[1] * tgn[1] + rde[2] * tgn[2]
+            for a in range(3):
+                cbi0[a, 0], cbi0[a, 1], cbi0[a, 2] = cbi1[a, 0], cbi1[a, 1], cbi1[a, 2]
+                vi0[a] = vi1[a]
+                gi0[a] = gi1[a]
+        if k % rec_every == 0:
+            j = (k - k0) // rec_every
+            if j < trec.shape[0]:
+                for a in range(3):
+                    for b in range(3):
+                        trec[j, 3 * a + b] = cbe[a, b]
+                    trec[j, 9 + a] = re[a]
+                    trec[j, 12 + a] = rde[a]
+
+
 @njit(cache=True, parallel=True)
 def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
-             coef, damping, pos_damped, rec, rec_every, acc_every):
+             coef, damping, pos_damped, rec, rec_every, acc_every, shared, tin, trec):
     """Integrate the damped grid-frame strapdown INS of every run from step k0 to k1.
 
     State per run (updated in place): platform attitude ``cbp`` = C_b^p (3×3), grid velocity
@@ -330,6 +384,9 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
     ``acc_every`` steps (for the interval-mean attitude of the calibration).
     ``rec`` (runs × records × 8) receives REC_FIELDS every ``rec_every`` steps (k % rec_every == 0,
     record index (k - k0) // rec_every, k0 included).
+    ``shared`` = 1: every run follows the same trajectory, whose truth :func:`truth_table` has
+    put in ``tin``/``trec`` once (computing it once instead of per run; the same numbers);
+    ``shared`` = 0: each run computes its own (``tin``, ``trec`` unused).
     """
     nrun = traj.shape[0]
     b0, b1, b2, a1, a2 = coef[0], coef[1], coef[2], coef[3], coef[4]
@@ -359,15 +416,22 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
         wv = np.empty(3)
         wc = np.empty(3)
         tmp = np.empty((3, 3))
-        truth_inertial(k0 * dt, p, cbi0, vi0, gi0, cbe, re, rde)
+        if shared == 0:
+            truth_inertial(k0 * dt, p, cbi0, vi0, gi0, cbe, re, rde)
         sgw = sens[i, 6] * dt
         saw = sens[i, 7] * dt
         noisy = sens[i, 6] > 0.0 or sens[i, 7] > 0.0
         for k in range(k0, k1 + 1):
             t = k * dt
             if k > k0:
-                truth_inertial(t, p, cbi1, vi1, gi1, cbe, re, rde)
-                ideal_increments(cbi0, cbi1, vi0, vi1, gi0, gi1, dt, dth, dvl)
+                if shared == 0:
+                    truth_inertial(t, p, cbi1, vi1, gi1, cbe, re, rde)
+                    ideal_increments(cbi0, cbi1, vi0, vi1, gi0, gi1, dt, dth, dvl)
+                else:
+                    row = tin[k - k0]
+                    for a in range(3):
+                        dth[a] = row[a]
+                        dvl[a] = row[3 + a]
                 for a in range(3):
                     dth[a] += (sens[i, a] - comp[i, a]) * dt
                     dvl[a] += sens[i, 3 + a] * dt
@@ -382,9 +446,13 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
                     dvl[1] += saw * n5
                     dvl[2] += saw * n6
                 # reference velocity: true velocity in the true grid frame
-                grid_axes(re, tge, tgn, tu)
-                vre = rde[0] * tge[0] + rde[1] * tge[1] + rde[2] * tge[2]
-                vrn = rde[0] * tgn[0] + rde[1] * tgn[1] + rde[2] * tgn[2]
+                if shared == 0:
+                    grid_axes(re, tge, tgn, tu)
+                    vre = rde[0] * tge[0] + rde[1] * tge[1] + rde[2] * tge[2]
+                    vrn = rde[0] * tgn[0] + rde[1] * tgn[1] + rde[2] * tgn[2]
+                else:
+                    vre = tin[k - k0, 6]
+                    vrn = tin[k - k0, 7]
                 # navigator frame quantities at the previous state
                 nq = grid_axes(pos, ge, gn, u)
                 for a in range(3):
@@ -439,10 +507,11 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
                 for a in range(3):
                     pos[a] += (vme * ge[a] + vmn * gn[a]) * dt
                 project_to_surface(pos)
-                for a in range(3):
-                    cbi0[a, 0], cbi0[a, 1], cbi0[a, 2] = cbi1[a, 0], cbi1[a, 1], cbi1[a, 2]
-                    vi0[a] = vi1[a]
-                    gi0[a] = gi1[a]
+                if shared == 0:
+                    for a in range(3):
+                        cbi0[a, 0], cbi0[a, 1], cbi0[a, 2] = cbi1[a, 0], cbi1[a, 1], cbi1[a, 2]
+                        vi0[a] = vi1[a]
+                        gi0[a] = gi1[a]
                 if k % acc_every == 0:
                     grid_axes(pos, ge, gn, u)
                     ca, sa = math.cos(OMEGA * t), math.sin(OMEGA * t)
@@ -460,6 +529,12 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
             if rec.shape[1] > 0 and k % rec_every == 0:
                 j = (k - k0) // rec_every
                 if j < rec.shape[1]:
+                    if shared != 0:
+                        for a in range(3):
+                            for b in range(3):
+                                cbe[a, b] = trec[j, 3 * a + b]
+                            re[a] = trec[j, 9 + a]
+                            rde[a] = trec[j, 12 + a]
                     _record(rec, i, j, c, v, pos, cbe, re, rde, tge, tgn, tu, tmp)
 
 

@@ -694,12 +694,28 @@ def true_psi(sc, t, phases, cbp, r):
     return np.einsum("nij,nj->ni", c_g_oepq, phi - theta), re
 
 
+def _run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i, coef, damping, pos_damped,
+              rec, rec_every, acc_every):
+    """:func:`_polar_kernels.run_grid` over steps k0..k1; runs that share one trajectory (every row
+    of ``traj`` equal: a rocking-phase set shared by all runs) get its truth computed once by
+    :func:`_polar_kernels.truth_table` (bit-identical to each run computing it)."""
+    shared = traj.shape[0] > 1 and bool(np.all(traj == traj[0]))
+    if shared:
+        tin = np.empty((k1 - k0 + 1, _k.TRUTH_STEP_FIELDS))
+        trec = np.empty((rec.shape[1], _k.TRUTH_RECORD_FIELDS))
+        _k.truth_table(k0, k1, dt, np.ascontiguousarray(traj[0]), rec_every, tin, trec)
+    else:
+        tin, trec = np.empty((0, _k.TRUTH_STEP_FIELDS)), np.empty((0, _k.TRUTH_RECORD_FIELDS))
+    _k.run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i, coef, damping, pos_damped,
+                rec, rec_every, acc_every, 1 if shared else 0, tin, trec)
+
+
 def run_segment(sc, k0, k1, traj, sens, state, *, record_every_steps=None):
     """Advance the grid INS ``state`` (dict from :func:`initial_state`) from step k0 to k1."""
     rec = np.zeros((traj.shape[0], 0, _k.N_REC))
-    _k.run_grid(k0, k1, sc.dt, traj, sens, state["cbp"], state["vg"], state["r"], state["damp"],
-                state["comp"], state["rng"], state["acc_e"], state["acc_i"], discretize_damping(sc.dt),
-                1 if sc.damping else 0, _pos_flag(sc), rec, record_every_steps or max(k1 - k0, 1), 10)
+    _run_grid(k0, k1, sc.dt, traj, sens, state["cbp"], state["vg"], state["r"], state["damp"],
+              state["comp"], state["rng"], state["acc_e"], state["acc_i"], discretize_damping(sc.dt),
+              1 if sc.damping else 0, _pos_flag(sc), rec, record_every_steps or max(k1 - k0, 1), 10)
     return state
 
 
@@ -766,8 +782,8 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     def seg(ka, kb, cbp_, vg_, r_, damp_, comp_, rng_, acc_e_, acc_i_, traj_, sens_, rec_):
         j0 = ka // rec_every_k
         sub = np.zeros((traj_.shape[0], (kb - ka) // rec_every_k + 1, _k.N_REC))
-        _k.run_grid(ka, kb, dt, traj_, sens_, cbp_, vg_, r_, damp_, comp_, rng_, acc_e_, acc_i_,
-                    coef, flag, _pos_flag(sc), sub, rec_every_k, acc_every)
+        _run_grid(ka, kb, dt, traj_, sens_, cbp_, vg_, r_, damp_, comp_, rng_, acc_e_, acc_i_,
+                  coef, flag, _pos_flag(sc), sub, rec_every_k, acc_every)
         rec_[:, j0:j0 + sub.shape[1]] = sub
 
     seg(0, k1, cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens, rec)
@@ -829,8 +845,8 @@ def ecef_reference_comparison(sc, duration, *, seed=0, record_every=60.0):
     rng_g = seeds.copy()
     empty = np.zeros((1, 0, _k.N_REC))
     for j in range(1, n_rec):
-        _k.run_grid((j - 1) * rec_k, j * rec_k, dt, traj, sens, cbp, vg, r, np.zeros((1, 2, 2)),
-                    np.zeros((1, 3)), rng_g, np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), coef, 0, 0, empty, rec_k, 10)
+        _run_grid((j - 1) * rec_k, j * rec_k, dt, traj, sens, cbp, vg, r, np.zeros((1, 2, 2)),
+                  np.zeros((1, 3)), rng_g, np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), coef, 0, 0, empty, rec_k, 10)
         c = grid_frame(r[0])
         pos_grid.append(r[0].copy())
         vel_grid.append(c.T @ vg[0])
