@@ -40,12 +40,13 @@ random-constant bias state keeps converging over the flight).
 
 Two routes evaluate the same closed loop:
 
-:func:`predicted_height_rms`  the disturbance as a stationary process in time (shaping-filter
-                              states), i.e. one long line of independent ground;
-:func:`geometry_height_rms`   the disturbance given by its spatial covariance along the actual
-                              flight plan: four strips 500 m apart re-fly the same 53 km of ground
-                              (D = 10 km), so much of the field is seen four times; the height
-                              error's response to δg_U comes from an adjoint recursion.
+* :func:`predicted_height_rms`: the disturbance as a stationary process in time (shaping-filter
+  states), i.e. one long line of independent ground;
+* :func:`geometry_height_rms`: the disturbance given by its spatial covariance along the actual
+  flight plan: four strips 500 m apart re-fly the same 53 km of ground (D = 10 km), so much of
+  the field is seen four times; the height error's response to δg_U comes from an adjoint
+  recursion.
+
 For a single line both give the same numbers (tested), which checks the adjoint.
 
 Units: SI (m, m/s, m/s², s) unless a name says otherwise.
