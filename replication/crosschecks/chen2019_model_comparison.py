@@ -400,83 +400,98 @@ def analyse(model: str, *, dt: float = 1.0, settings: Settings = Settings(),
         raise TypeError("settings must be a Settings instance")
     model_indices(model)
     model_indices(truth)
+    return _results((model,), dt, settings, truth)[model]
+
+
+def _results(models, dt, settings, truth):
     t0 = time.process_time()
-    true_sig, own_sig = _recursion(model, dt, settings, truth)
+    out = _recursion(models, dt, settings, truth)
     names = ("heading", "pitch", "roll")
-    return Result(model,
-                  dict(zip(names, map(float, true_sig))),
-                  dict(zip(names, map(float, own_sig))),
-                  time.process_time() - t0)
+    seconds = (time.process_time() - t0) / len(models)
+    return {m: Result(m, dict(zip(names, map(float, true_sig))), dict(zip(names, map(float, own_sig))), seconds)
+            for m, (true_sig, own_sig) in out.items()}
 
 
-def _recursion(model, dt, settings, truth):
-    fi = model_indices(model)
+def _recursion(models, dt, settings, truth):
+    """The recursions of :func:`analyse` for several ``models`` in one pass over the flight: the
+    superset transition and measurement matrices of a step are computed once and shared (each
+    model's arithmetic is unchanged).  Returns {model: (true σ, own σ)} in degrees."""
     ti = model_indices(truth)
-    # The filter may carry states the truth lacks (the random walks of the 36-state model):
-    # they are then estimates of zero.  Only the navigation states are compared.
-    nf, nt = fi.size, ti.size
-    qf = process_psd(model, settings)
+    nt = ti.size
     qt = process_psd(truth, settings)
     r = np.diag(np.concatenate([np.asarray(settings.gnss_pos_sigma, float) ** 2,
                                 np.full(3, settings.gnss_vel_sigma**2)]))
     r = r * (GNSS_INTERVAL / dt)
-    pf = initial_covariance(model, settings)
-    y = np.zeros((nt + nf, nt + nf))
-    y[:nt, :nt] = initial_covariance(truth, settings)
     att_t = np.arange(nt)[np.isin(ti, np.arange(N_SUPER)[_SL["att"]])]
-    att_f = np.arange(nf)[np.isin(fi, np.arange(N_SUPER)[_SL["att"]])]
-    e = np.zeros((3, nt + nf))
-    e[np.arange(3), att_t] = 1.0
-    e[np.arange(3), nt + att_f] = -1.0
+    st = {}
+    for model in models:
+        # The filter may carry states the truth lacks (the random walks of the 36-state model):
+        # they are then estimates of zero.  Only the navigation states are compared.
+        fi = model_indices(model)
+        nf = fi.size
+        y = np.zeros((nt + nf, nt + nf))
+        y[:nt, :nt] = initial_covariance(truth, settings)
+        att_f = np.arange(nf)[np.isin(fi, np.arange(N_SUPER)[_SL["att"]])]
+        e = np.zeros((3, nt + nf))
+        e[np.arange(3), att_t] = 1.0
+        e[np.arange(3), nt + att_f] = -1.0
+        st[model] = dict(fi=fi, nf=nf, qf=process_psd(model, settings), pf=initial_covariance(model, settings),
+                         y=y, att_f=att_f, e=e, acc_true=np.zeros(3), acc_own=np.zeros(3))
     pts = flight(dt)
-    acc_true = np.zeros(3)
-    acc_own = np.zeros(3)
     count = 0
     for k in range(1, len(pts)):
         t_prev, p_prev = pts[k - 1]
         t, p = pts[k]
         phi = expm(system_matrix(p_prev, settings) * dt)
+        h = measurement_matrix(p, settings)
+        on_line = any(lo < t <= hi for lo, hi in SURVEY_LINES)
+        psi = heading_profile(t)[0].item() if on_line else 0.0
+        count += on_line
         # Sources never depend on the navigation states, so the model transition matrices are
         # exact sub-blocks of the superset one.
-        phi_f = phi[np.ix_(fi, fi)]
         phi_t = phi[np.ix_(ti, ti)]
-        qdf = 0.5 * (phi_f @ qf @ phi_f.T + qf) * dt
         qdt = 0.5 * (phi_t @ qt @ phi_t.T + qt) * dt
-        pf = phi_f @ pf @ phi_f.T + qdf
-        a = np.zeros_like(y)
-        a[:nt, :nt] = phi_t
-        a[nt:, nt:] = phi_f
-        y = a @ y @ a.T
-        y[:nt, :nt] += qdt
-        h = measurement_matrix(p, settings)
-        hf = h[:, fi]
         ht = h[:, ti]
-        s_mat = hf @ pf @ hf.T + r
-        gain = np.linalg.solve(s_mat, hf @ pf).T
-        ikh = np.eye(nf) - gain @ hf
-        pf = ikh @ pf @ ikh.T + gain @ r @ gain.T
-        pf = 0.5 * (pf + pf.T)
-        b = np.eye(nt + nf)
-        b[nt:, :nt] = gain @ ht
-        b[nt:, nt:] = ikh
-        kk = np.zeros((nt + nf, 6))
-        kk[nt:] = gain
-        y = b @ y @ b.T + kk @ r @ kk.T
-        y = 0.5 * (y + y.T)
-        if any(lo < t <= hi for lo, hi in SURVEY_LINES):
-            psi = heading_profile(t)[0].item()
-            acc_true += _euler_variances(e @ y @ e.T, psi)
-            acc_own += _euler_variances(pf[np.ix_(att_f, att_f)], psi)
-            count += 1
-    return np.sqrt(acc_true / count) / DEG, np.sqrt(acc_own / count) / DEG
+        for s_ in st.values():
+            fi, nf, qf, pf, y = s_["fi"], s_["nf"], s_["qf"], s_["pf"], s_["y"]
+            phi_f = phi[np.ix_(fi, fi)]
+            qdf = 0.5 * (phi_f @ qf @ phi_f.T + qf) * dt
+            pf = phi_f @ pf @ phi_f.T + qdf
+            a = np.zeros_like(y)
+            a[:nt, :nt] = phi_t
+            a[nt:, nt:] = phi_f
+            y = a @ y @ a.T
+            y[:nt, :nt] += qdt
+            hf = h[:, fi]
+            s_mat = hf @ pf @ hf.T + r
+            gain = np.linalg.solve(s_mat, hf @ pf).T
+            ikh = np.eye(nf) - gain @ hf
+            pf = ikh @ pf @ ikh.T + gain @ r @ gain.T
+            pf = 0.5 * (pf + pf.T)
+            b = np.eye(nt + nf)
+            b[nt:, :nt] = gain @ ht
+            b[nt:, nt:] = ikh
+            kk = np.zeros((nt + nf, 6))
+            kk[nt:] = gain
+            y = b @ y @ b.T + kk @ r @ kk.T
+            y = 0.5 * (y + y.T)
+            s_["pf"], s_["y"] = pf, y
+            if on_line:
+                s_["acc_true"] += _euler_variances(s_["e"] @ y @ s_["e"].T, psi)
+                s_["acc_own"] += _euler_variances(pf[np.ix_(s_["att_f"], s_["att_f"])], psi)
+    return {m: (np.sqrt(s_["acc_true"] / count) / DEG, np.sqrt(s_["acc_own"] / count) / DEG)
+            for m, s_ in st.items()}
 
 
 def compare(models=("15", "36", "45"), *, dt: float = 1.0) -> dict:
-    """Run :func:`analyse` for each model; returns {model: Result}."""
+    """:func:`analyse` for each model, in one pass over the flight; returns {model: Result}."""
     models = tuple(models)
     if not models:
         raise ValueError("models must not be empty")
-    return {m: analyse(m, dt=dt) for m in models}
+    dt = _check_dt(dt)
+    for m in models:
+        model_indices(m)
+    return _results(models, dt, Settings(), TRUTH_MODEL)
 
 
 if __name__ == "__main__":
