@@ -12,6 +12,10 @@ export MKL_NUM_THREADS := 1
 export MPLBACKEND := module://matplotlib_inline.backend_inline
 export REPLICATION_ROOT := $(CURDIR)
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
+# bytecode is compiled on first import and kept in .venv (and replication/__pycache__, beside numba's
+# cache): a PYTHONDONTWRITEBYTECODE inherited from the shell would make every notebook kernel and
+# test process recompile every module it imports
+unexport PYTHONDONTWRITEBYTECODE
 
 NOTEBOOKS := $(shell find book -name '*.ipynb' -not -path '*/_build/*' -not -path '*/.ipynb_checkpoints/*' | sort)
 
