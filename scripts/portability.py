@@ -243,8 +243,8 @@ def _interleave(jobs: list) -> list:
 
 BOOK_JOB = ("strict book build and browser check", ["make", "--no-print-directory", "html-strict", "browser"])
 """The side job of :func:`suite`: it reads only stored files, and the browser check spends most of
-its time waiting for pages to go network-idle (about 30 s of CPU in 80 s), so it runs beside the
-workers instead of occupying one."""
+its time waiting for pages to go network-idle (one tab visits every page: about 30 s of CPU,
+Chromium's renderer included, in 45 s), so it runs beside the workers instead of occupying one."""
 
 
 def _report(label: str, r: subprocess.CompletedProcess, dt: float, failed: list[str]) -> None:

@@ -72,27 +72,32 @@ def browser():
         b.close()
 
 
-def _visit(browser, url: str, errors: list | None = None):
-    """Load ``url``; return (page, external requests, failed requests); JavaScript errors of the
-    page are appended to ``errors``."""
-    page = browser.new_page(viewport={"width": 1280, "height": 900})
-    external, failed = [], []
-    if errors is not None:
-        page.on("pageerror", lambda exc: errors.append(str(exc)))
-        page.on("console", lambda msg: errors.append(msg.text) if msg.type == "error" else None)
+class _Visitor:
+    """One tab that visits page after page (one renderer process instead of one per page),
+    recording per visit the requests that leave the machine, the failed requests and the
+    JavaScript errors."""
 
-    def on_request(req):
-        host = urlparse(req.url).hostname
+    def __init__(self, browser):
+        self.page = browser.new_page(viewport={"width": 1280, "height": 900})
+        self.external, self.failed, self.errors = [], [], []
+        self.page.on("pageerror", lambda exc: self.errors.append(str(exc)))
+        self.page.on("console", lambda msg: self.errors.append(msg.text) if msg.type == "error" else None)
+        self.page.on("request", self._on_request)
+        self.page.on("requestfailed", lambda req: self.failed.append(f"{req.url} ({req.failure})"))
+        self.page.on("response", lambda resp: self.failed.append(f"{resp.url} (HTTP {resp.status})")
+                     if resp.status >= 400 else None)
+
+    def _on_request(self, req):
         if req.url.startswith(("data:", "blob:", "about:")):
             return
-        if host not in ("127.0.0.1", "localhost"):
-            external.append(req.url)
+        if urlparse(req.url).hostname not in ("127.0.0.1", "localhost"):
+            self.external.append(req.url)
 
-    page.on("request", on_request)
-    page.on("requestfailed", lambda req: failed.append(f"{req.url} ({req.failure})"))
-    page.on("response", lambda resp: failed.append(f"{resp.url} (HTTP {resp.status})") if resp.status >= 400 else None)
-    page.goto(url, wait_until="networkidle", timeout=60_000)
-    return page, external, failed
+    def visit(self, url: str):
+        """Load ``url`` until the network is idle; returns the page (the same tab every time)."""
+        self.external, self.failed, self.errors = [], [], []
+        self.page.goto(url, wait_until="networkidle", timeout=60_000)
+        return self.page
 
 
 RAW_TEX = re.compile(r"\$|\\(frac|mathrm|mathbf|left|right|begin|end|sqrt|delta|phi|omega)\b")
@@ -161,13 +166,13 @@ def seen(server, browser):
     wide = set(OVERVIEW + _chapter_of_each_paper())
     out = {}
     shot = False
+    tab = _Visitor(browser)
     for p in _pages():
         rel = p.relative_to(HTML).as_posix()
         text = p.read_text(encoding="utf-8")
-        js_errors: list[str] = []
-        page, external, failed = _visit(browser, f"{server}/{rel}", js_errors)
+        page = tab.visit(f"{server}/{rel}")
         page.evaluate(WAIT_MATH_JS)
-        r = dict(external=external, failed=failed, js_errors=js_errors,
+        r = dict(external=tab.external, failed=tab.failed, js_errors=tab.errors,
                  raw=sorted(set(m.group(0) for m in RAW_TEX.finditer(page.evaluate(VISIBLE_TEXT_JS)))),
                  imgs=page.evaluate("Array.from(document.images).map(i => i.getAttribute('src'))"
                                     ".filter(s => s && s.includes('_images/'))"),
@@ -186,8 +191,8 @@ def seen(server, browser):
                      findings=page.locator(FINDINGS).count())
             if rel == "status.html":
                 page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot-status.png"), full_page=False)
-        page.close()
         out[rel] = r
+    tab.page.close()
     return out
 
 
