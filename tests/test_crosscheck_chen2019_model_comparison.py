@@ -111,7 +111,7 @@ def test_inputs_are_validated():
 
 
 def test_disturbance_decides_45_against_36():
-    """Referee point C7: whether the 45-state filter beats the 36-state one with the misalignment
+    """Whether the 45-state filter beats the 36-state one with the misalignment
     read as 1.5″ depends on the gravity disturbance in the truth.  Expectations fixed before
     running: without disturbance the two tie (their extra states, 1.5″ misalignments, are
     unobservable at this size): level-attitude improvement within ±5 %; at 60 mGal the 45-state
