@@ -95,17 +95,22 @@ def test_height_rms_agrees(predicted, method):
     assert lo <= STORED[method][0] <= hi, (method, lo, STORED[method][0], hi)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "normal gravity: predicted 0.0643-0.0656 m (continued / Gauss-Markov field, strips re-flown; "
-    "0.0756-0.0763 m for one line of independent ground) against stored 0.0525 +- 0.0036 m; "
-    "band lower edge 0.0554 m. The model also predicts a run-to-run scatter of one flight's RMS "
-    "of 0.018-0.021 m (the field's few independent patches over 53 km at D = 10 km), eight to nine "
-    "times the scatter the stored 4-run interval implies (about 0.0023 m): the simulation's field "
-    "carries less large-scale power than the ensemble covariance exp(-r/D), or its filter tracks "
-    "slow disturbance that a random-constant bias cannot"))
-def test_height_rms_agrees_normal(predicted):
+def test_normal_row_differs_as_recorded(predicted):
+    """The normal-gravity row is the one open difference between the two computations of the
+    analog (stated in the chapter, not blamed on the paper): the linear model predicts 0.064-0.066 m
+    along the re-flown strips against the analog's 0.0525 +- 0.0036 m, above the agreement band,
+    and a run-to-run scatter of one flight's RMS several times what the analog's 4 runs show
+    (the field's few independent patches over 53 km at D = 10 km).  Asserted as recorded, so that
+    a change on either side (the field synthesis, the filter, this model) brings it back for review:
+    the stored row lies below the band, the prediction's lower edge 10-40 % above it, and the
+    predicted scatter more than 3 times the analog's per-run scatter."""
     lo, hi = _band(predicted, "normal")
-    assert lo <= STORED["normal"][0] <= hi, ("normal", lo, STORED["normal"][0], hi)
+    stored, hw = STORED["normal"]
+    assert stored < lo, ("normal", lo, stored, hi)
+    low_pred = min(predicted[("normal", s)]["rms"] for s in xc.SHAPES)
+    assert 0.10 < low_pred / stored - 1.0 < 0.40, (low_pred, stored)
+    per_run_sd = hw * 4 ** 0.5 / 3.182  # the 95 % half-width of 4 runs, t(0.975, 3) = 3.182
+    assert min(predicted[("normal", s)]["run_sd"] for s in xc.SHAPES) > 3.0 * per_run_sd
 
 
 def test_filter_own_covariance_is_not_the_error():
