@@ -308,6 +308,23 @@ def ideal_increments(c0, c1, v0, v1, g0, g1, dt, dth, dvel):
 
 # ----------------------------------------------------------------------------- grid-frame INS
 
+@njit(cache=True)
+def truth_step(t, p, cbi0, cbi1, vi0, vi1, gi0, gi1, dt, cbe, re, rde, dth, dvl, tge, tgn, tu):
+    """One step of the truth: the true state at ``t`` (C_b^e, r^e, ṙ^e into ``cbe``, ``re``,
+    ``rde``), the ideal increments of the interval ending at ``t`` from the previous state
+    (``cbi0``, ``vi0``, ``gi0``) into ``dth``, ``dvl``, which then becomes the state at ``t``;
+    returns the true grid-east and grid-north velocity (the damping reference)."""
+    truth_inertial(t, p, cbi1, vi1, gi1, cbe, re, rde)
+    ideal_increments(cbi0, cbi1, vi0, vi1, gi0, gi1, dt, dth, dvl)
+    for a in range(3):
+        cbi0[a, 0], cbi0[a, 1], cbi0[a, 2] = cbi1[a, 0], cbi1[a, 1], cbi1[a, 2]
+        vi0[a] = vi1[a]
+        gi0[a] = gi1[a]
+    grid_axes(re, tge, tgn, tu)
+    return (rde[0] * tge[0] + rde[1] * tge[1] + rde[2] * tge[2],
+            rde[0] * tgn[0] + rde[1] * tgn[1] + rde[2] * tgn[2])
+
+
 TRUTH_STEP_FIELDS = 8
 """Per-step columns of :func:`truth_table`: the ideal Δθ (3) and Δv (3) of the interval ending at
 the step and the true grid-east and grid-north velocity at it."""
@@ -339,19 +356,12 @@ def truth_table(k0, k1, dt, p, rec_every, tin, trec):
     truth_inertial(k0 * dt, p, cbi0, vi0, gi0, cbe, re, rde)
     for k in range(k0, k1 + 1):
         if k > k0:
-            truth_inertial(k * dt, p, cbi1, vi1, gi1, cbe, re, rde)
-            ideal_increments(cbi0, cbi1, vi0, vi1, gi0, gi1, dt, dth, dvl)
-            grid_axes(re, tge, tgn, tu)
             row = tin[k - k0]
+            row[6], row[7] = truth_step(k * dt, p, cbi0, cbi1, vi0, vi1, gi0, gi1, dt, cbe, re, rde, dth, dvl,
+                                        tge, tgn, tu)
             for a in range(3):
                 row[a] = dth[a]
                 row[3 + a] = dvl[a]
-            row[6] = rde[0] * tge[0] + rde[1] * tge[1] + rde[2] * tge[2]
-            row[7] = rde[0] * tgn[0] + rde[1] * tgn[1] + rde[2] * tgn[2]
-            for a in range(3):
-                cbi0[a, 0], cbi0[a, 1], cbi0[a, 2] = cbi1[a, 0], cbi1[a, 1], cbi1[a, 2]
-                vi0[a] = vi1[a]
-                gi0[a] = gi1[a]
         if k % rec_every == 0:
             j = (k - k0) // rec_every
             if j < trec.shape[0]:
@@ -425,13 +435,15 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
             t = k * dt
             if k > k0:
                 if shared == 0:
-                    truth_inertial(t, p, cbi1, vi1, gi1, cbe, re, rde)
-                    ideal_increments(cbi0, cbi1, vi0, vi1, gi0, gi1, dt, dth, dvl)
+                    vre, vrn = truth_step(t, p, cbi0, cbi1, vi0, vi1, gi0, gi1, dt, cbe, re, rde, dth, dvl,
+                                          tge, tgn, tu)
                 else:
                     row = tin[k - k0]
                     for a in range(3):
                         dth[a] = row[a]
                         dvl[a] = row[3 + a]
+                    vre = row[6]
+                    vrn = row[7]
                 for a in range(3):
                     dth[a] += (sens[i, a] - comp[i, a]) * dt
                     dvl[a] += sens[i, 3 + a] * dt
@@ -445,14 +457,6 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
                     dvl[0] += saw * n4
                     dvl[1] += saw * n5
                     dvl[2] += saw * n6
-                # reference velocity: true velocity in the true grid frame
-                if shared == 0:
-                    grid_axes(re, tge, tgn, tu)
-                    vre = rde[0] * tge[0] + rde[1] * tge[1] + rde[2] * tge[2]
-                    vrn = rde[0] * tgn[0] + rde[1] * tgn[1] + rde[2] * tgn[2]
-                else:
-                    vre = tin[k - k0, 6]
-                    vrn = tin[k - k0, 7]
                 # navigator frame quantities at the previous state
                 nq = grid_axes(pos, ge, gn, u)
                 for a in range(3):
@@ -507,11 +511,6 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
                 for a in range(3):
                     pos[a] += (vme * ge[a] + vmn * gn[a]) * dt
                 project_to_surface(pos)
-                if shared == 0:
-                    for a in range(3):
-                        cbi0[a, 0], cbi0[a, 1], cbi0[a, 2] = cbi1[a, 0], cbi1[a, 1], cbi1[a, 2]
-                        vi0[a] = vi1[a]
-                        gi0[a] = gi1[a]
                 if k % acc_every == 0:
                     grid_axes(pos, ge, gn, u)
                     ca, sa = math.cos(OMEGA * t), math.sin(OMEGA * t)
