@@ -1374,20 +1374,26 @@ _ERRATA = {
     "eq. (12) dV_U^c per phi^c": ("turning V by phi^c changes its up component by phi^c V cos(theta_2); eq. (13) contains "
                                   "the cos(theta_2) = S/sqrt(S^2+h^2) that eq. (12) omits (relative O(h^2/S^2))",
                                   "test_erratum_eq6_half_and_eq12_cos", "phi^c V S/sqrt(S^2+h^2)"),
-    "eq. (16) dS_x^c per dS^c": ("with beta the heading from north (reading B, under which eq. (21) is right) the east "
-                                 "component is sin(beta): cos and sin exchanged", "test_reading_b_is_the_economical_one",
-                                 "sin(beta)"),
-    "eq. (16) dS_y^c per dS^c": ("cos and sin exchanged (reading B)", "test_reading_b_is_the_economical_one", "cos(beta)"),
-    "eq. (19) dS_x^c per dh^c": ("cos and sin exchanged (reading B)", "test_reading_b_is_the_economical_one",
-                                 "-sin(beta) h/S"),
-    "eq. (19) dS_y^c per dh^c": ("cos and sin exchanged (reading B)", "test_reading_b_is_the_economical_one",
-                                 "-cos(beta) h/S"),
     "text below (19) dL-dot^c per dV_N^c": ("metric factors exchanged: the latitude rate is dV_N/R_Mh",
                                             "test_reading_b_is_the_economical_one", "1/R_Mh"),
     "text below (19) dlambda-dot^c per dV_E^c": ("metric factors exchanged: the longitude rate is dV_E/(R_Nh cos L)",
                                                  "test_reading_b_is_the_economical_one", "1/(R_Nh cos L)"),
     "eq. (20) [dL; dV_U]": ("R_Mh printed where R_Nh is needed (eq. (21) prints R_Nh for the same element)",
                             "test_reading_b_is_the_economical_one", "-h sin(beta)/(S R_Nh cos L)"),
+}
+
+
+#: Printed elements that follow another convention for β than eqs. (20)-(21): eq. (16) takes the
+#: east component as cos β (β from east), while the text names β the yaw angle (偏航角, from
+#: north) and eq. (21) is right with β from north (reading B).  Two printed parts disagree; neither
+#: is blamed (status ``inconsistent``).
+_INCONSISTENT = {
+    "eq. (16) dS_x^c per dS^c": "eq. (16) gives the east component as cos(beta), i.e. beta from east; the text names beta the "
+                                "yaw angle (from north) and eq. (21) is right with beta from north (reading B): the two "
+                                "printed parts use different references for beta",
+    "eq. (16) dS_y^c per dS^c": "sin(beta) for the north component: beta from east, as for dS_x^c; eq. (21) reads it from north",
+    "eq. (19) dS_x^c per dh^c": "cos(beta) for the east component (beta from east, as eq. (16)); eq. (21) reads it from north",
+    "eq. (19) dS_y^c per dh^c": "sin(beta) for the north component (beta from east, as eq. (16)); eq. (21) reads it from north",
 }
 
 
@@ -1405,6 +1411,8 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
         if not r["match"] and r["quantity"] in _ERRATA:
             note, test, corr = _ERRATA[r["quantity"]]
             row.update(status="erratum", note=note, evidence=_EVID + test, corrected=corr)
+        elif not r["match"] and r["quantity"] in _INCONSISTENT:
+            row.update(status="inconsistent", note=_INCONSISTENT[r["quantity"]])
         rows.append(row)
     m = manifold_residuals(paper, reading, states=(state,), conventions=("C1",))
     notes = {"14": "right only if dh^c is held constant over the interval and the flight is level; with "

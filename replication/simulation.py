@@ -65,7 +65,9 @@ __all__ = ["SimulationSetup", "table_4_41_setup", "MISALIGNMENT_UNITS", "MARKOV_
            "simulated_flight", "segment_summary", "filter_model", "BatchResult", "run_batch",
            "truth_parameters", "observable_nees", "fraction_in_band", "attitude_errors",
            "segment_mask", "survey_line_mask", "rms_with_ci", "improvement_percent",
-           "improvement_with_ci", "paired_improvement", "printed_improvements", "total_bias_estimates", "display_scales"]
+           "improvement_with_ci", "paired_improvement", "single_flight_interval", "printed_improvements",
+           "total_bias_estimates", "FIGURE_4_14_QUANTITIES", "figure_4_14_estimates", "figure_4_14_ledger",
+           "figure_4_14_retained_sigma", "display_scales"]
 
 MISALIGNMENT_UNITS = {"arcsec": ARCSEC, "arcmin": ARCMIN, "mrad": 1e-3}
 """Candidate units of Table 4-41's misalignment angle "1.5" (printed without a unit)."""
@@ -704,14 +706,19 @@ def survey_line_mask(t, traj):
     return segment_mask(t, traj, ("Straight",), after=sturn[0] if sturn else 0.0)
 
 
-def rms_with_ci(err, mask, prob: float = 0.95):
+def rms_with_ci(err, mask, prob: float = 0.95, remove_mean: bool = False):
     """Per-run RMS over ``mask`` epochs (runs × components), their mean and the two-sided
-    ``prob`` Student-t confidence interval of the mean.  Returns (per_run, mean, lo, hi)."""
+    ``prob`` Student-t confidence interval of the mean.  ``remove_mean`` removes each run's
+    mean over the mask first (the error after a boresight calibration, which absorbs a constant
+    attitude offset; the per-run standard deviation).  Returns (per_run, mean, lo, hi)."""
     err = np.asarray(err, float)
     mask = np.asarray(mask, bool)
     if not mask.any():
         raise ValueError("the mask selects no epoch")
-    per = np.sqrt(np.mean(err[:, mask] ** 2, axis=1))
+    sel = err[:, mask]
+    if remove_mean:
+        sel = sel - sel.mean(axis=1, keepdims=True)
+    per = np.sqrt(np.mean(sel ** 2, axis=1))
     R_ = per.shape[0]
     mean = per.mean(0)
     if R_ < 2:
@@ -764,6 +771,31 @@ def paired_improvement(per_other, per_new, prob: float = 0.95):
     return d, mean, mean - half, mean + half
 
 
+def single_flight_interval(per_other, per_new, prob: float = 0.95):
+    """Where one more flight's improvement 100 (other − new)/other (%) falls: the two-sided
+    ``prob`` Student-t prediction interval  m ± t s √(1 + 1/n)  of the per-run log error ratios
+    ln(new/other) of paired runs (``per_*`` runs × components, positive), mapped back to
+    percent.  On the log scale a ratio of RMS values is closer to normal than the percentage, and
+    the interval stays below 100 %.  A printed single-flight percentage is read against this
+    interval, not against the confidence interval of the mean over the runs.  Returns (lo, hi)
+    per component."""
+    a = np.asarray(per_other, float)
+    b = np.asarray(per_new, float)
+    if a.shape != b.shape or a.ndim != 2:
+        raise ValueError("per_other and per_new need the same runs × components shape (paired runs)")
+    if np.any(a <= 0) or np.any(b <= 0):
+        raise ValueError("accuracies must be positive")
+    if not 0 < prob < 1:
+        raise ValueError("prob must lie in (0, 1)")
+    n = a.shape[0]
+    if n < 2:
+        raise ValueError("a prediction interval needs at least two paired runs")
+    d = np.log(b / a)
+    half = stats.t.ppf(0.5 + prob / 2, n - 1) * d.std(0, ddof=1) * math.sqrt(1.0 + 1.0 / n)
+    m = d.mean(0)
+    return 100.0 * (1.0 - np.exp(m + half)), 100.0 * (1.0 - np.exp(m - half))
+
+
 def printed_improvements(table):
     """The improvement percentages recomputed from chen2019 Table 4-44 itself
     (``rp.load_paper("chen2019-table-4-44")``): 45-state vs 15-state and vs 36-state, for
@@ -791,6 +823,127 @@ def total_bias_estimates(result: BatchResult, smoothed: bool = False):
     g = blk("gyro_bias") + (blk("gyro_markov") if "gyro_markov" in names else 0.0)
     a = blk("accel_bias") + (blk("accel_markov") if "accel_markov" in names else 0.0)
     return g, a
+
+
+#: The ranges chen2019 states after Fig. 4-14 (data/paper/chen2019/chen2019-claim-figure-4-14-ranges.csv):
+#: quantity -> (blocks summed per axis, display unit name).  "Total" drift/bias is constant + Markov.
+FIGURE_4_14_QUANTITIES = {
+    "gyro total drift estimate range": (("gyro_bias", "gyro_markov"),),
+    "accelerometer total bias estimate range": (("accel_bias", "accel_markov"),),
+    "scale-factor estimate bound": (("gyro_scale",), ("accel_scale",)),
+    "misalignment estimate range": (("gyro_misalignment",), ("accel_misalignment",)),
+}
+
+
+def _figure_4_14_scales(misalignment_unit: float):
+    return {"gyro total drift estimate range": DEG_PER_H, "accelerometer total bias estimate range": MICRO_G,
+            "scale-factor estimate bound": 1.0, "misalignment estimate range": misalignment_unit}
+
+
+def figure_4_14_estimates(result: BatchResult, *, smoothed: bool = False, window: float = 1000.0,
+                          misalignment_unit: float = ARCSEC, truth: bool = False) -> dict:
+    """The estimates the text after chen2019 Fig. 4-14 states ranges for, per run and axis.
+
+    Parameters
+    ----------
+    result : BatchResult
+        A 45-state run (:func:`run_batch`; ``smoothed`` needs ``smoother=True``).
+    smoothed : bool
+        RTS-smoothed instead of filtered estimates.
+    window : float
+        Seconds at the end of the flight over which |estimate| is averaged.
+    misalignment_unit : float
+        Display unit of the misalignments (rad), e.g. ``units.ARCSEC``.
+    truth : bool
+        The simulated true values instead of the estimates (same averaging).
+
+    Returns
+    -------
+    dict
+        quantity of :data:`FIGURE_4_14_QUANTITIES` -> runs × axes array of the mean |estimate|
+        over the window, in the text's units (°/h, μg, 1, ``misalignment_unit``); the total gyro
+        drift and accelerometer bias are constant + Markov.
+    """
+    if not isinstance(result, BatchResult):
+        raise ValueError("result must be the BatchResult of simulation.run_batch")
+    if not (math.isfinite(window) and window > 0):
+        raise ValueError("window must be a positive number of seconds")
+    m = result.model
+    names = {b.name for b in m.blocks}
+    missing = {n for groups in FIGURE_4_14_QUANTITIES.values() for g in groups for n in g} - names
+    if missing:
+        raise ValueError(f"the result's model lacks the blocks {sorted(missing)}: use the 45-state model")
+    est = result.p_true if truth else result.estimates(smoothed)
+    last = result.t >= result.t[-1] - window
+    scales = _figure_4_14_scales(misalignment_unit)
+    out = {}
+    for q, groups in FIGURE_4_14_QUANTITIES.items():
+        parts = []
+        for g in groups:
+            x = sum(est[..., m.slices[n].start - 9:m.slices[n].stop - 9] for n in g)
+            parts.append(np.abs(x[:, last]).mean(1) / scales[q])
+        out[q] = np.concatenate(parts, axis=-1)
+    return out
+
+
+def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1000.0):
+    """Readings ledger of the ranges stated after chen2019 Fig. 4-14.
+
+    ``readings`` maps a label to ``(result, smoothed, misalignment_unit)``; ``claim`` is the
+    printed ranges (``chen2019-claim-figure-4-14-ranges``, indexed by quantity, columns
+    ``value, unit, lower, upper``).  A run matches a range when the window-mean |estimate| of every
+    axis lies inside it; a reading reaches the print when at least half of its runs match (fixed
+    before looking: one flight is one realisation, so the print is matched by a typical run, not
+    by a lucky one).  Returns (rows for :func:`replication.reproduction.compare`, {(label,
+    quantity): True when reached}).
+    """
+    if not isinstance(readings, dict) or not readings:
+        raise ValueError("readings must map a label to (result, smoothed, misalignment_unit)")
+    rows, reached = [], {}
+    for label, spec in readings.items():
+        if not (isinstance(spec, tuple) and len(spec) == 3):
+            raise ValueError(f"reading {label!r} must be (result, smoothed, misalignment_unit)")
+        result, smoothed, unit = spec
+        est = figure_4_14_estimates(result, smoothed=smoothed, window=window, misalignment_unit=unit)
+        for q, v in est.items():
+            lo, hi = float(claim.loc[q, "lower"]), float(claim.loc[q, "upper"])
+            inside = np.all((v >= lo) & (v <= hi), axis=1)
+            ok = bool(inside.mean() >= 0.5)
+            reached[(label, q)] = ok
+            rows.append(dict(quantity=f"{label} | {q}", unit=claim.loc[q, "unit"], paper=claim.loc[q, "value"],
+                             reproduced=f"{v.min():.2g}~{v.max():.2g}", status="analog" if ok else "not-reproduced",
+                             note=f"runs with every axis inside: {int(inside.sum())} of {inside.size}"))
+    return rows, reached
+
+
+def figure_4_14_retained_sigma(result: BatchResult, *, misalignment_unit: float = ARCSEC) -> pd.DataFrame:
+    """How much of its initial uncertainty each Fig. 4-14 quantity keeps over the flight.
+
+    Per quantity of :data:`FIGURE_4_14_QUANTITIES`: the smallest and largest over axes of the
+    standard deviation at the last epoch (RTS-smoothed if the run has the smoothed covariance,
+    else filtered) and at the first epoch, in the text's units, and their ratio.  For the totals
+    the variance is that of the sum, var(b) + var(m) + 2 cov(b, m).  A ratio near 1 means the
+    flight leaves the quantity unobserved: its estimate stays near the prior mean whatever the
+    truth.
+    """
+    if not isinstance(result, BatchResult):
+        raise ValueError("result must be the BatchResult of simulation.run_batch")
+    m = result.model
+    P_end = result.P_s[-1] if result.P_s is not None else result.P[-1]
+    P_0 = result.P[0]
+    scales = _figure_4_14_scales(misalignment_unit)
+    rows = {}
+    for q, groups in FIGURE_4_14_QUANTITIES.items():
+        s0, s1 = [], []
+        for g in groups:
+            for i in range(m.slices[g[0]].stop - m.slices[g[0]].start):
+                idx = [m.slices[n].start + i for n in g]
+                s0.append(math.sqrt(P_0[np.ix_(idx, idx)].sum()) / scales[q])
+                s1.append(math.sqrt(max(P_end[np.ix_(idx, idx)].sum(), 0.0)) / scales[q])
+        s0, s1 = np.array(s0), np.array(s1)
+        rows[q] = {"sigma_start_lo": s0.min(), "sigma_start_hi": s0.max(), "sigma_end_lo": s1.min(),
+                   "sigma_end_hi": s1.max(), "retained_lo": (s1 / s0).min(), "retained_hi": (s1 / s0).max()}
+    return pd.DataFrame(rows).T
 
 
 # ----------------------------------------------------------------------------- display helpers

@@ -128,3 +128,21 @@ def test_disturbance_sweep_validates():
         xc.disturbance_sweep((-1.0,))
     with pytest.raises(ValueError):
         xc.disturbance_sweep((10.0,), models=())
+
+
+def test_tuning_sweep_unit_factor_is_the_filter_as_specified():
+    # factor 1 is the specified 15-state filter: the same arithmetic as compare() at the same step
+    sweep = xc.tuning_sweep((1.0, 100.0))
+    ref = xc.compare(("15", "45"), dt=5.0)
+    for a in ANGLES:
+        assert sweep[1.0].true_sigma_deg[a] == pytest.approx(ref["15"].true_sigma_deg[a], rel=1e-9)
+        assert sweep["reference"].true_sigma_deg[a] == pytest.approx(ref["45"].true_sigma_deg[a], rel=1e-9)
+    # more process noise: the filter claims a larger σ of its own (it trusts its model less)
+    assert all(sweep[100.0].own_sigma_deg[a] > sweep[1.0].own_sigma_deg[a] for a in ANGLES)
+
+
+def test_tuning_sweep_validates():
+    with pytest.raises(ValueError):
+        xc.tuning_sweep((0.0,))
+    with pytest.raises(ValueError):
+        xc.tuning_sweep((1.0,), model="16")

@@ -567,6 +567,174 @@ def geometry_height_rms(setup: VerticalChannel | None = None, shapes=SHAPES, bin
     return out
 
 
+
+# --- level attitude: where the printed pitch/roll gains of method 3 become reachable -----------
+
+@dataclass(frozen=True)
+class LevelChannel:
+    """Settings of the level-attitude covariance analysis (one horizontal channel).
+
+    Printed in chen2019: GNSS 10 Hz, 0.1 m and 0.03 m/s, gyro bias 0.01 °/h, accelerometer bias
+    50 μg (Table 4-46), 2 h over four strips (Table 4-47), 135 photos.  The analog's stated
+    assumptions: 30 m/s, 60 s turns, white noise 0.003 °/√h and 10 μg/√Hz, initial tilt 1e-4 rad
+    (the chapter's attitude_sd), GNSS initial accuracies.  ``step``: the analysis steps at 1 s and
+    processes the ten fixes of a step as one with R/10 (the same information per unit time; the
+    fastest dynamics are the field's correlation time D/v ≥ 60 s).
+    """
+
+    flight_time: float = 7200.0
+    n_lines: int = 4
+    turn_time: float = 60.0
+    speed: float = 30.0
+    n_photos: int = 135
+    gnss_interval: float = 0.1
+    sigma_position: float = 0.1
+    sigma_velocity: float = 0.03
+    accel_noise: float = 10.0 * UG_PER_SQRT_HZ
+    gyro_noise: float = 0.003 * math.pi / 180.0 / 60.0          # rad/√s (0.003 °/√h)
+    accel_bias: float = 50.0 * MICRO_G
+    gyro_bias: float = 0.01 * math.pi / 180.0 / 3600.0         # rad/s
+    initial_tilt: float = 1e-4
+    gravity: float = GAMMA_E
+    earth_radius: float = EARTH_A
+    step: float = 1.0
+
+    def __post_init__(self):
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                    or value <= 0.0:
+                raise ValueError(f"{f.name} must be a finite number > 0, got {value!r}")
+        for name in ("n_photos", "n_lines"):
+            if int(getattr(self, name)) != getattr(self, name):
+                raise ValueError(f"{name} must be an integer")
+        if self.step < self.gnss_interval or self.step > 10.0:
+            raise ValueError("step must lie between one GNSS interval and 10 s")
+
+
+def _level_matrices(sign: float, sigma_h: float, tau: float, p: LevelChannel):
+    """Continuous F and noise intensity of [δp, δv, φ, ∇, ε, δg] along track (chen2019 eq. (3-15)
+    level rows with f^n = (0, 0, g), Schuler coupling φ̇ = δv/R, no Earth rate):
+    δv̇ = -g φ + s ∇ + δg + w_a,  φ̇ = δv/R - s ε + w_g,  δġ = -δg/τ + w (2σ²/τ);  s = ±1 is
+    the heading of the strip (east or west), which flips the body-fixed biases in the frame."""
+    F = np.zeros((6, 6))
+    F[0, 1] = 1.0
+    F[1, 2] = -p.gravity
+    F[1, 3] = sign
+    F[1, 5] = 1.0
+    F[2, 1] = 1.0 / p.earth_radius
+    F[2, 4] = -sign
+    F[5, 5] = -1.0 / tau
+    q = np.array([0.0, p.accel_noise ** 2, p.gyro_noise ** 2, 0.0, 0.0, 2.0 * sigma_h ** 2 / tau])
+    return F, np.diag(q)
+
+
+def level_attitude_rms(sigmas_h, correlation_lengths, setup: LevelChannel | None = None) -> dict:
+    """Expected photo-epoch RMS of the level attitude (pitch along track, roll across: the same
+    law) for the normal-gravity filter and for a filter given the field's true statistics.
+
+    Truth: :func:`_level_matrices` with the horizontal disturbance a first-order Gauss-Markov
+    process of σ ``sigma_h`` (m/s², at flight height) and correlation time D/v.  Filters
+    (closed loop, chen2019 eq. (3-18) position and velocity rows): ``"normal"`` leaves δg out
+    (eq. (3-1) gravity only, the 15-state filter); ``"informed"`` carries δg with the truth's
+    own law, the best any method-3 filter can do in this model (its P is the true error
+    covariance).  The true covariance of each closed loop follows Gelb (1974) §7.2 as in
+    :func:`height_error_history`.  All cases run in one batched recursion.
+
+    Returns ``{(sigma_h, D): {"normal": rms_rad, "informed": rms_rad}}``.
+    """
+    p = setup if setup is not None else LevelChannel()
+    if not isinstance(p, LevelChannel):
+        raise ValueError("setup must be a LevelChannel")
+    sig = [_positive(x, "sigma_h") for x in np.atleast_1d(sigmas_h)]
+    ds = [_positive(x, "correlation length") for x in np.atleast_1d(correlation_lengths)]
+    cases = [(sg, d) for sg in sig for d in ds]
+    dt = p.step
+    R = np.diag([p.sigma_position ** 2, p.sigma_velocity ** 2]) * (p.gnss_interval / dt)
+    H = np.zeros((2, 6))
+    H[0, 0] = H[1, 1] = 1.0
+    P0 = np.diag([p.sigma_position ** 2, p.sigma_velocity ** 2, p.initial_tilt ** 2, p.accel_bias ** 2,
+                  p.gyro_bias ** 2, 0.0])
+    # per case and sign: truth (Φ, Q); filters 0 = normal (δg column and state removed), 1 = informed
+    Phi_t = np.empty((len(cases), 2, 6, 6))
+    Q_t = np.empty_like(Phi_t)
+    Phi_f = np.empty((len(cases), 2, 2, 6, 6))
+    Q_f = np.empty_like(Phi_f)
+    P = np.empty((len(cases), 2, 6, 6))      # true error covariance of each closed loop
+    Pf = np.empty_like(P)                    # each filter's own covariance
+    for c, (sg, d) in enumerate(cases):
+        tau = d / p.speed
+        for j, sign in enumerate((1.0, -1.0)):
+            F, Qc = _level_matrices(sign, sg, tau, p)
+            Phi_t[c, j], Q_t[c, j] = _van_loan(F, Qc, dt)
+            Fn, Qn = F.copy(), Qc.copy()
+            Fn[:, 5] = 0.0
+            Fn[5, 5] = 0.0
+            Qn[5, 5] = 0.0
+            Phi_f[c, 0, j], Q_f[c, 0, j] = _van_loan(Fn, Qn, dt)
+            Phi_f[c, 1, j], Q_f[c, 1, j] = Phi_t[c, j], Q_t[c, j]
+        P0c = P0.copy()
+        P0c[5, 5] = sg ** 2
+        P[c] = P0c
+        Pf[c, 0], Pf[c, 1] = P0, P0c
+    t_photo = _level_photo_times(p)
+    steps = int(round(p.flight_time / dt))
+    k_photo = np.clip(np.round(t_photo / dt).astype(int) - 1, 0, steps - 1)
+    acc = np.zeros((len(cases), 2))
+    I6 = np.eye(6)
+    line_t = (p.flight_time - (p.n_lines - 1) * p.turn_time) / p.n_lines
+    for k in range(steps):
+        t_mid = (k + 0.5) * dt
+        j = int(t_mid // (line_t + p.turn_time) + ((t_mid % (line_t + p.turn_time)) > line_t + p.turn_time / 2)) % 2
+        Pf = Phi_f[:, :, j] @ Pf @ Phi_f[:, :, j].transpose(0, 1, 3, 2) + Q_f[:, :, j]
+        S = H @ Pf @ H.T + R
+        K = Pf @ H.T @ np.linalg.inv(S)
+        A = I6 - K @ H
+        Pf = A @ Pf @ A.transpose(0, 1, 3, 2) + K @ R @ K.transpose(0, 1, 3, 2)
+        P = Phi_t[:, None, j] @ P @ Phi_t[:, None, j].transpose(0, 1, 3, 2) + Q_t[:, None, j]
+        P = A @ P @ A.transpose(0, 1, 3, 2) + K @ R @ K.transpose(0, 1, 3, 2)
+        n = int(np.count_nonzero(k_photo == k))
+        if n:
+            acc += n * P[:, :, 2, 2]
+    rms = np.sqrt(acc / t_photo.size)
+    return {case: {"normal": float(rms[c, 0]), "informed": float(rms[c, 1])} for c, case in enumerate(cases)}
+
+
+
+def required_disturbance(gains_percent, correlation_lengths, setup: LevelChannel | None = None,
+                         sigmas_h=None) -> dict:
+    """Horizontal disturbance σ (m/s², at flight height) at which the informed filter of
+    :func:`level_attitude_rms` improves the level attitude over the normal-gravity filter by each
+    of ``gains_percent``, for each correlation length: the smallest field for which a printed
+    method-3 gain becomes reachable in this model.  The gain 100 (1 - informed/normal) is
+    evaluated on ``sigmas_h`` (default 5-640 mGal, log-spaced) and interpolated in log σ.
+
+    Returns ``{D: {"sigma_h": {gain: σ or nan if not reached}, "grid": [(σ, normal, informed)]}}``.
+    """
+    gains = [float(g) for g in np.atleast_1d(gains_percent)]
+    if any(not (0.0 < g < 100.0) for g in gains):
+        raise ValueError("gains_percent must lie strictly between 0 and 100")
+    grid = np.geomspace(5.0, 640.0, 15) * MGAL if sigmas_h is None else np.sort(np.atleast_1d(sigmas_h))
+    ds = [float(d) for d in np.atleast_1d(correlation_lengths)]
+    res = level_attitude_rms(grid, ds, setup)
+    out = {}
+    for d in ds:
+        rows = [(float(sg), res[(float(sg), d)]["normal"], res[(float(sg), d)]["informed"]) for sg in grid]
+        gain = np.array([100.0 * (1.0 - i / n) for _, n, i in rows])
+        if np.any(np.diff(gain) < 0.0):
+            raise RuntimeError("the gain is not monotonic in σ on this grid; refine sigmas_h")
+        need = {}
+        for g in gains:
+            need[g] = float(np.exp(np.interp(g, gain, np.log(grid)))) if gain[0] < g <= gain[-1] else float("nan")
+        out[d] = {"sigma_h": need, "grid": rows}
+    return out
+
+def _level_photo_times(p: LevelChannel) -> np.ndarray:
+    tl = (p.flight_time - (p.n_lines - 1) * p.turn_time) / p.n_lines
+    s = (np.arange(p.n_photos) + 0.5) * p.n_lines * tl / p.n_photos
+    line = np.minimum((s // tl).astype(int), p.n_lines - 1)
+    return s + line * p.turn_time
+
 def _positive(x, name):
     if isinstance(x, bool) or not isinstance(x, (int, float, np.floating, np.integer)):
         raise ValueError(f"{name} must be a number")
@@ -587,4 +755,5 @@ def _nonnegative(x, name):
 
 __all__ = ["METHODS", "SHAPES", "VerticalChannel", "field_variance_ratio", "along_track_correlation",
            "fit_continued_shape", "filter_model", "truth_model", "height_error_history", "photo_rms",
-           "predicted_height_rms", "photo_times", "flight_positions", "geometry_height_rms"]
+           "predicted_height_rms", "photo_times", "flight_positions", "geometry_height_rms",
+           "LevelChannel", "level_attitude_rms", "required_disturbance"]
