@@ -46,6 +46,8 @@ from numpy.polynomial import Polynomial
 from scipy.optimize import brentq
 from scipy.signal import ss2tf
 
+from replication._validate import choice
+
 __all__ = [
     "OMEGA_IE",
     "R_MEAN",
@@ -82,8 +84,7 @@ def normal_gravity(lat_deg):
 
 
 def _check(motion, lat_deg, speed_mps, n13):
-    if motion not in MOTIONS:
-        raise ValueError(f"motion must be one of {MOTIONS}, got {motion!r}")
+    choice(motion, MOTIONS, "motion")
     lat_deg, speed_mps = float(lat_deg), float(speed_mps)
     if not np.isfinite(lat_deg) or abs(lat_deg) >= 89.0:
         raise ValueError(f"lat_deg must be finite with |lat_deg| < 89 (tan L, sec L), got {lat_deg!r}")
