@@ -38,8 +38,8 @@ import numpy as np
 
 from . import earth
 from ._validate import vector3
+from .timeseries import gauss_markov
 from .units import ARCSEC, DEG, DEG_PER_H, G0
-from scipy.signal import lfilter
 
 AXES = ("x", "y", "z")
 POSITIONS = ("X+", "X-", "Y+", "Y-", "Z+", "Z-")
@@ -1033,10 +1033,7 @@ def simulate_static_sensor(duration: float, sample_rate: float, *, constant: flo
     if white_density > 0:
         y += rng.standard_normal(n) * white_density * math.sqrt(sample_rate)
     if gm_sigma > 0:
-        phi = math.exp(-dt / gm_tau)
-        drive = rng.standard_normal(n) * gm_sigma * math.sqrt(1 - phi**2)
-        drive[0] = rng.standard_normal() * gm_sigma                       # stationary start
-        y += lfilter([1.0], [1.0, -phi], drive)
+        y += gauss_markov(n, dt, gm_sigma, gm_tau, rng)[:, 0]         # stationary start
     return y
 
 
