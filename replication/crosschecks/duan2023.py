@@ -55,6 +55,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from replication._validate import choice, finite, nonnegative, positive
+from replication.earth import somigliana
 
 __all__ = [
     "PAPER",
@@ -131,7 +132,7 @@ def _earth(lat, h):
     w = np.sqrt(1.0 - _E2 * s2)
     rm = _A * (1.0 - _E2) / w**3
     rn = _A / w
-    gamma = _GAMMA_E * (1.0 + _K_SOMIGLIANA * s2) / w
+    gamma = somigliana(s2, gamma_e=_GAMMA_E, k=_K_SOMIGLIANA, e2=_E2)
     rmh, rnh = rm + h, rn + h
     # free-air gradient 2 g / R with the Gaussian mean radius
     g_h = 2.0 * gamma / (np.sqrt(rm * rn) + h)
