@@ -15,6 +15,14 @@ import numpy as np
 __all__ = ["positive", "nonnegative", "finite", "vector3", "components", "choice"]
 
 
+def _number(value, name: str, what: str, ok) -> float:
+    """``float(value)`` if it is finite and ``ok(value)``; else ``ValueError`` saying ``what`` it must be."""
+    value = float(value)
+    if not (np.isfinite(value) and ok(value)):
+        raise ValueError(f"{name} must be {what}, got {value!r}")
+    return value
+
+
 def positive(value, name: str) -> float:
     """A positive finite number.
 
@@ -28,69 +36,19 @@ def positive(value, name: str) -> float:
     Returns
     -------
     float
-        ``float(value)``.
-
-    Raises
-    ------
-    ValueError
-        If ``value`` is not finite or not > 0.
+        ``float(value)``; ``ValueError`` if it is not finite or not > 0.
     """
-    value = float(value)
-    if not np.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
-    return value
+    return _number(value, name, "a positive finite number", lambda v: v > 0.0)
 
 
 def nonnegative(value, name: str) -> float:
-    """A finite number >= 0.
-
-    Parameters
-    ----------
-    value : float-like
-        The argument.
-    name : str
-        Its name for the error message.
-
-    Returns
-    -------
-    float
-        ``float(value)``.
-
-    Raises
-    ------
-    ValueError
-        If ``value`` is not finite or is negative.
-    """
-    value = float(value)
-    if not np.isfinite(value) or value < 0.0:
-        raise ValueError(f"{name} must be a non-negative finite number, got {value!r}")
-    return value
+    """A finite number >= 0 (arguments and return as :func:`positive`; ``ValueError`` if negative)."""
+    return _number(value, name, "a non-negative finite number", lambda v: v >= 0.0)
 
 
 def finite(value, name: str) -> float:
-    """A finite number.
-
-    Parameters
-    ----------
-    value : float-like
-        The argument.
-    name : str
-        Its name for the error message.
-
-    Returns
-    -------
-    float
-        ``float(value)``.
-
-    Raises
-    ------
-    ValueError
-        If ``value`` is NaN or infinite.
-    """
-    value = float(value)
-    if not np.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return value
+    """A finite number (arguments and return as :func:`positive`; ``ValueError`` if NaN or infinite)."""
+    return _number(value, name, "a finite number", lambda v: True)
 
 
 def vector3(value, name: str) -> np.ndarray:
