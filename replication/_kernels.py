@@ -46,9 +46,16 @@ def radii_deriv_s(lat):
 
 
 @njit(**_NJ)
+def somigliana_s(s2):
+    """Somigliana's normal gravity on the ellipsoid from s2 = sin²L: the scalar kernel of
+    ``earth.somigliana`` (the same operations in the same order)."""
+    return GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / math.sqrt(1.0 - E2 * s2)
+
+
+@njit(**_NJ)
 def gamma_s(lat, h):
     s2 = math.sin(lat) ** 2
-    g0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / math.sqrt(1.0 - E2 * s2)
+    g0 = somigliana_s(s2)
     return g0 * (1.0 - 2.0 / A * (1.0 + FLAT + M_RATIO - 2.0 * FLAT * s2) * h + 3.0 * h * h / (A * A))
 
 
@@ -59,7 +66,7 @@ def gamma_grad_s(lat, h):
     s2 = s * s
     w2 = 1.0 - E2 * s2
     w = math.sqrt(w2)
-    g0 = GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / w
+    g0 = somigliana_s(s2)
     dg0 = GAMMA_E * (2.0 * K_SOMIGLIANA * s * c / w + (1.0 + K_SOMIGLIANA * s2) * E2 * s * c / (w2 * w))
     fac = 1.0 - 2.0 / A * (1.0 + FLAT + M_RATIO - 2.0 * FLAT * s2) * h + 3.0 * h * h / (A * A)
     dfac_dl = 8.0 * FLAT * h * s * c / A

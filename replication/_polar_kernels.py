@@ -24,13 +24,12 @@ import numpy as np
 from numba import njit, prange
 
 from . import earth
+from ._kernels import somigliana_s
 
 A = earth.A
 B = earth.B
 E2 = earth.E2
 OMEGA = earth.OMEGA_IE
-GAMMA_E = earth.GAMMA_E
-K_SOM = earth.K_SOMIGLIANA
 INV_A2 = 1.0 / (A * A)
 INV_B2 = 1.0 / (B * B)
 
@@ -49,8 +48,7 @@ N_REC = len(REC_FIELDS)
 @njit(cache=True, inline="always")
 def gravity_surface(sin_lat):
     """Somigliana normal gravity on the ellipsoid (earth.normal_gravity_ellipsoid), h = 0."""
-    s2 = sin_lat * sin_lat
-    return GAMMA_E * (1.0 + K_SOM * s2) / math.sqrt(1.0 - E2 * s2)
+    return somigliana_s(sin_lat * sin_lat)
 
 
 @njit(cache=True)

@@ -46,6 +46,7 @@ from functools import lru_cache
 import numpy as np
 
 from . import earth
+from ._validate import choice
 import pandas as pd
 from .errors import NavPoint, model_15
 from . import trajectory as tr
@@ -115,8 +116,7 @@ def pitch_correction(s, h, dh, *, form: str = "printed"):
     The printed form is the first-order term of ``"fixed-S"``; it differs from the first-order
     term of ``"equal-length"`` by the factor cos²θ_2 = S²/(S²+h²) (a relative O(h²/S²) term).
     """
-    if form not in PITCH_FORMS:
-        raise ValueError(f"form must be one of {PITCH_FORMS}, got {form!r}")
+    choice(form, PITCH_FORMS, "form")
     s, h, dh = _arr(s, "S"), _arr(h, "h"), _arr(dh, "dh")
     if np.any(s <= 0):
         raise ValueError("S (horizontal displacement) must be positive")
@@ -830,8 +830,7 @@ def correction_experiment_flight(kind: str = "cruise", *, dt: float = 0.02):
     first 30 s).  Returns a :class:`replication.trajectory.Trajectory`.
     """
 
-    if kind not in EXPERIMENT_KINDS:
-        raise ValueError(f"kind must be one of {EXPERIMENT_KINDS}, got {kind!r}")
+    choice(kind, EXPERIMENT_KINDS, "kind")
     speed, change = {"cruise": (200.0, 0.0), "accelerate": (100.0, 60.0), "decelerate": (160.0, -60.0)}[kind]
     seg = tr.Straight(60.0) if change == 0 else tr.Accelerate(60.0, speed_change=change)
     return tr.generate([seg], 45 * DEG, 110 * DEG, 3000.0, dt=dt, heading=0.5, speed=speed)

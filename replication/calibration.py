@@ -37,8 +37,9 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 
 from . import earth
+from ._validate import vector3
+from .timeseries import gauss_markov
 from .units import ARCSEC, DEG, DEG_PER_H, G0
-from scipy.signal import lfilter
 
 AXES = ("x", "y", "z")
 POSITIONS = ("X+", "X-", "Y+", "Y-", "Z+", "Z-")
@@ -60,15 +61,6 @@ class TemperatureOutOfRangeError(ValueError):
 # =============================================================================================
 # IMU error model, chen2019 ch. 2 §2
 # =============================================================================================
-
-def _as_vec3(v, name: str) -> np.ndarray:
-    a = np.asarray(v, dtype=float)
-    if a.shape[-1:] != (3,):
-        raise ValueError(f"{name} must have a last axis of length 3 (x, y, z); got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} must be finite")
-    return a
-
 
 def _as_mat3(m, name: str) -> np.ndarray:
     a = np.asarray(m, dtype=float)
@@ -140,8 +132,8 @@ def full_model_output(u, scale, bias, cross1, cross2, coupling1, coupling2, seco
     ``coupling2`` the cross-coupling coefficients B3, B4, ``second_order`` B5.  The same
     function serves gyros (G) and accelerometers (A).
     """
-    u = _as_vec3(u, "u")
-    co = [_as_vec3(c, n) for c, n in ((scale, "scale"), (bias, "bias"), (cross1, "cross1"), (cross2, "cross2"),
+    u = vector3(u, "u")
+    co = [vector3(c, n) for c, n in ((scale, "scale"), (bias, "bias"), (cross1, "cross1"), (cross2, "cross2"),
                                      (coupling1, "coupling1"), (coupling2, "coupling2"),
                                      (second_order, "second_order"))]
     k, b0, b1, b2, b3, b4, b5 = co
@@ -164,15 +156,15 @@ def imu_error(omega_ib, f_b, *, gyro_bias, accel_bias, gyro_scale_error=(0, 0, 0
     the diagonals of δK (2-6); the misalignment matrices are the 3x3 δG, δA of (2-9) (build them
     with :func:`misalignment_matrix`).  Returns (δω, δf) with the shapes of the inputs.
     """
-    w = _as_vec3(omega_ib, "omega_ib")
-    f = _as_vec3(f_b, "f_b")
+    w = vector3(omega_ib, "omega_ib")
+    f = vector3(f_b, "f_b")
     dg = np.zeros((3, 3)) if gyro_misalignment is None else _as_mat3(gyro_misalignment, "gyro_misalignment")
     da = np.zeros((3, 3)) if accel_misalignment is None else _as_mat3(accel_misalignment, "accel_misalignment")
     if np.any(np.diag(dg) != 0) or np.any(np.diag(da) != 0):
         raise ValueError("the misalignment matrices of (2-9) have a zero diagonal: put scale-factor errors "
                          "in gyro_scale_error / accel_scale_error")
-    tg = np.diag(_as_vec3(gyro_scale_error, "gyro_scale_error")) + dg
-    ta = np.diag(_as_vec3(accel_scale_error, "accel_scale_error")) + da
+    tg = np.diag(vector3(gyro_scale_error, "gyro_scale_error")) + dg
+    ta = np.diag(vector3(accel_scale_error, "accel_scale_error")) + da
     dw = np.asarray(gyro_bias, dtype=float) + w @ tg.T
     dfb = np.asarray(accel_bias, dtype=float) + f @ ta.T
     return dw, dfb
@@ -197,8 +189,8 @@ class SensorTriad:
     axes: np.ndarray
 
     def __post_init__(self):
-        b = _as_vec3(self.bias, "bias")
-        k = _as_vec3(self.scale, "scale")
+        b = vector3(self.bias, "bias")
+        k = vector3(self.scale, "scale")
         c = _as_mat3(self.axes, "axes")
         if np.any(k <= 0):
             raise ValueError("scale factors are positive (input units per pulse); a reversed axis is a "
@@ -219,11 +211,11 @@ class SensorTriad:
 
     def output(self, u) -> np.ndarray:
         """Noise-free pulse rate N = N0 + M u for inputs ``u`` (..., 3), chen2019 eq. (4-1)/(4-2)."""
-        return self.null_output + _as_vec3(u, "u") @ self.matrix.T
+        return self.null_output + vector3(u, "u") @ self.matrix.T
 
     def compensate(self, n) -> np.ndarray:
         """Input estimate û = M⁻¹ (N - N0) from pulse rates (..., 3): the compensation of §1.4 step 8."""
-        return (_as_vec3(n, "pulse rate") - self.null_output) @ np.linalg.inv(self.matrix).T
+        return (vector3(n, "pulse rate") - self.null_output) @ np.linalg.inv(self.matrix).T
 
     @classmethod
     def from_model(cls, null_output, matrix) -> "SensorTriad":
@@ -233,7 +225,7 @@ class SensorTriad:
         tables are normalized: every printed row has unit norm to 1e-15.
         """
         m = _as_mat3(matrix, "matrix")
-        n0 = _as_vec3(null_output, "null_output")
+        n0 = vector3(null_output, "null_output")
         norms = np.linalg.norm(m, axis=1)
         if np.any(norms == 0):
             raise CalibrationError("a row of M is zero: that sensor does not respond to any input")
@@ -799,8 +791,8 @@ def latitude_from_static(omega_mean, f_mean) -> float:
     At rest the gyro triad senses the Earth rate and the accelerometer triad the local vertical,
     whatever the attitude: sin φ = ω·f / (‖ω‖ ‖f‖).  Any common scale of either vector cancels.
     """
-    w = _as_vec3(omega_mean, "omega_mean")
-    f = _as_vec3(f_mean, "f_mean")
+    w = vector3(omega_mean, "omega_mean")
+    f = vector3(f_mean, "f_mean")
     nw, nf = np.linalg.norm(w), np.linalg.norm(f)
     if nw == 0 or nf == 0:
         raise ValueError("the mean vectors must be non-zero")
@@ -1041,10 +1033,7 @@ def simulate_static_sensor(duration: float, sample_rate: float, *, constant: flo
     if white_density > 0:
         y += rng.standard_normal(n) * white_density * math.sqrt(sample_rate)
     if gm_sigma > 0:
-        phi = math.exp(-dt / gm_tau)
-        drive = rng.standard_normal(n) * gm_sigma * math.sqrt(1 - phi**2)
-        drive[0] = rng.standard_normal() * gm_sigma                       # stationary start
-        y += lfilter([1.0], [1.0, -phi], drive)
+        y += gauss_markov(n, dt, gm_sigma, gm_tau, rng)[:, 0]         # stationary start
     return y
 
 

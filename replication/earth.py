@@ -129,14 +129,38 @@ def transport_rate_enu(lat, h, v_enu, *, polar_limit_deg: float = POLAR_LIMIT_DE
     return np.stack([-vn / (rm + h), ve / (rn + h), ve * np.tan(lat) / (rn + h)], axis=-1)
 
 
+def somigliana(sin2_lat, *, gamma_e: float = GAMMA_E, k: float = K_SOMIGLIANA, e2: float = E2):
+    """Somigliana's closed form of normal gravity on a level ellipsoid (m/s^2).
+
+    γ_0 = γ_e (1 + k sin²L) / sqrt(1 - e² sin²L)   (NIMA TR8350.2 eq. 4-1), evaluated as written,
+    for the WGS-84 constants of this module or for another set of them (a paper's printed ones).
+
+    Parameters
+    ----------
+    sin2_lat : float or array_like
+        sin²L of the geodetic latitude L (not validated: callers check their latitudes).
+    gamma_e : float, optional
+        Normal gravity at the equator γ_e (m/s^2), default :data:`GAMMA_E`.
+    k : float, optional
+        Somigliana's constant k = b γ_p / (a γ_e) - 1, default :data:`K_SOMIGLIANA`.
+    e2 : float, optional
+        First eccentricity squared e², default :data:`E2`.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        γ_0 in m/s^2, shaped as ``sin2_lat``.
+    """
+    return gamma_e * (1.0 + k * sin2_lat) / np.sqrt(1.0 - e2 * sin2_lat)
+
+
 def normal_gravity_ellipsoid(lat):
     """Somigliana's closed-form normal gravity on the WGS-84 ellipsoid (m/s^2).
 
-    γ_0 = γ_e (1 + k sin²L) / sqrt(1 - e² sin²L)   (NIMA TR8350.2 eq. 4-1).
+    γ_0 = γ_e (1 + k sin²L) / sqrt(1 - e² sin²L)   (NIMA TR8350.2 eq. 4-1; :func:`somigliana`).
     """
     lat = check_latitude(lat)
-    s2 = np.sin(lat) ** 2
-    return GAMMA_E * (1.0 + K_SOMIGLIANA * s2) / np.sqrt(1.0 - E2 * s2)
+    return somigliana(np.sin(lat) ** 2)
 
 
 def normal_gravity(lat, h=0.0):

@@ -42,6 +42,7 @@ import numpy as np
 
 from . import earth
 from . import _kernels as K
+from ._validate import choice
 from .rotations import euler_to_dcm, rotvec_to_dcm
 from .strapdown import navigation_rates
 
@@ -388,8 +389,7 @@ def gyro_scale(sd=0.0, *, name="gyro_scale"):
 
 
 def _coupling_kind(coupling):
-    if coupling not in MISALIGNMENT_COUPLINGS:
-        raise ValueError(f"coupling must be one of {sorted(MISALIGNMENT_COUPLINGS)}, got {coupling!r}")
+    choice(coupling, sorted(MISALIGNMENT_COUPLINGS), "coupling")
     return MISALIGNMENT_COUPLINGS[coupling]
 
 

@@ -30,7 +30,7 @@ from scipy import integrate, interpolate, signal
 
 from . import earth
 from . import closedloop as CL
-from .timeseries import ar_coefficients, ar_poles, is_stationary
+from .timeseries import ar_coefficients, ar_poles, gauss_markov, is_stationary
 from .units import MGAL
 from scipy.linalg import block_diag
 from . import trajectory as tj
@@ -478,16 +478,6 @@ def specific_force_measurement(f_n, v_gnss, a_gnss, lat, h) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- analog series
-
-def gauss_markov(n: int, dt: float, std: float, tau: float, rng: np.random.Generator, *, size: int = 1) -> np.ndarray:
-    """Stationary first-order Gauss-Markov sequences, shape (n, size): x_{k+1} = e^{-dt/tau} x_k + w_k."""
-    if not (n >= 1 and dt > 0 and std >= 0 and tau > 0):
-        raise ValueError("need n >= 1, dt > 0, std >= 0 and tau > 0")
-    a = math.exp(-dt / tau)
-    w = rng.standard_normal((n, size)) * std * math.sqrt(1 - a * a)
-    w[0] = rng.standard_normal(size) * std
-    return signal.lfilter([1.0], [1.0, -a], w, axis=0)
-
 
 def analog_direct_difference(field_: PlanarGravityField, *, n_lines: int, line_length: float, spacing: float,
                              speed: float, seed: int, gnss_dt: float = 0.1, sigma_v: float = 0.03,

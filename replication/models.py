@@ -69,7 +69,7 @@ import numpy as np
 from . import earth
 from . import errors as E
 from .rotations import rotvec_to_dcm, skew
-from .sensors import _vec
+from ._validate import components
 from replication import models, errors
 from .rotations import euler_to_dcm
 from ._kernels import KIND_MISALIGN, coupling_matrix
@@ -117,7 +117,7 @@ _BLOCK_SYMBOLS = {
 # ----------------------------------------------------------------------------- helpers
 
 def _nonneg(x, name, n=3):
-    a = _vec(x, name, n)
+    a = components(x, name, n)
     if np.any(a < 0):
         raise ValueError(f"{name} must be finite and non-negative (SI units), got {a}")
     return a

@@ -34,6 +34,7 @@ from . import earth
 from . import rotations
 from . import units
 from . import _polar_kernels as _k
+from ._validate import choice, positive, vector3
 import pandas as pd
 
 OMEGA = earth.OMEGA_IE
@@ -47,15 +48,6 @@ DAMPING_POLES = (-8.0e-3, -1.0e-2)
 
 # =============================================================================== validation
 
-def _vec3(r, name):
-    r = np.asarray(r, dtype=float)
-    if r.ndim == 0 or r.shape[-1] != 3:
-        raise ValueError(f"{name} must have a last axis of length 3 (x, y, z), got shape {r.shape}")
-    if not np.all(np.isfinite(r)):
-        raise ValueError(f"{name} must be finite")
-    return r
-
-
 def _angle(a, name, limit=None):
     a = np.asarray(a, dtype=float)
     if not np.all(np.isfinite(a)):
@@ -64,13 +56,6 @@ def _angle(a, name, limit=None):
         raise ValueError(f"{name} exceeds {np.degrees(limit):.0f}° in magnitude: angles are radians "
                          f"(convert degrees with np.radians)")
     return a
-
-
-def _positive(x, name):
-    x = float(x)
-    if not np.isfinite(x) or x <= 0:
-        raise ValueError(f"{name} must be a positive finite number, got {x}")
-    return x
 
 
 # =============================================================================== frames (§2.1)
@@ -84,14 +69,14 @@ def grid_frame(r):
     parallel to the prime-meridian plane, G_N ∝ G_U × e_y; G_E = G_N × G_U.  Regular at the poles;
     undefined only where G_U = ±e_y (λ = ±90° on the equator).
     """
-    r = _vec3(r, "r (ECEF position, m)")
+    r = vector3(r, "r (ECEF position, m)")
     q = r / np.array([earth.A**2, earth.A**2, earth.B**2])
     return _frame_from_normal(q / np.linalg.norm(q, axis=-1, keepdims=True))
 
 
 def grid_frame_sphere(r):
     """C_e^G of the spherical Earth used in fang2020 §2.2 (normal r/‖r‖)."""
-    r = _vec3(r, "r (position on the sphere, m)")
+    r = vector3(r, "r (position on the sphere, m)")
     return _frame_from_normal(r / np.linalg.norm(r, axis=-1, keepdims=True))
 
 
@@ -158,7 +143,7 @@ def sphere_point(lat, lon, radius):
     """(x, y, z) = R (cos L cos λ, cos L sin λ, sin L) — the spherical Earth of fang2020 eq. (6)."""
     lat = earth.check_latitude(lat)
     lon = _angle(lon, "lon")
-    radius = _positive(radius, "radius")
+    radius = positive(radius, "radius")
     return radius * np.stack(np.broadcast_arrays(np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon),
                                                  np.sin(lat)), -1)
 
@@ -199,9 +184,9 @@ def n_matrix(r, radius=None, *, printed=False):
     ``printed=False`` (default) returns the corrected N with N₂₂ = -√(x²+z²), ``printed=True``
     the matrix as printed.
     """
-    r = _vec3(r, "r (sphere point, m)")
+    r = vector3(r, "r (sphere point, m)")
     x, y, z = r[..., 0], r[..., 1], r[..., 2]
-    rad = np.linalg.norm(r, axis=-1) if radius is None else _positive(radius, "radius")
+    rad = np.linalg.norm(r, axis=-1) if radius is None else positive(radius, "radius")
     rxz = np.sqrt(x**2 + z**2)
     if np.any(np.abs(z) < 1e-9 * np.maximum(rxz, 1.0)):
         raise ValueError("N is singular on the equator (z = 0): the P equation needs z ≠ 0")
@@ -217,9 +202,9 @@ def m_matrix(r, radius=None):
 
     ``r`` on the sphere of radius ``radius`` (default ‖r‖).  Equals (corrected N) · C_OEPQ^G.
     """
-    r = _vec3(r, "r (sphere point, m)")
+    r = vector3(r, "r (sphere point, m)")
     x, y, z = r[..., 0], r[..., 1], r[..., 2]
-    rad = np.linalg.norm(r, axis=-1) if radius is None else _positive(radius, "radius")
+    rad = np.linalg.norm(r, axis=-1) if radius is None else positive(radius, "radius")
     rxy = np.sqrt(x**2 + y**2)
     rxz2 = x**2 + z**2
     if np.any(rxy < 1e-12 * rad):
@@ -259,9 +244,9 @@ def p_equation_numeric(lat, lon, radius, step=None):
     """
     lat = float(earth.check_latitude(lat))
     lon = float(_angle(lon, "lon"))
-    radius = _positive(radius, "radius")
+    radius = positive(radius, "radius")
     r0 = sphere_point(lat, lon, radius)
-    step = p_equation_step(r0[2], radius) if step is None else _positive(step, "step")
+    step = p_equation_step(r0[2], radius) if step is None else positive(step, "step")
     g0 = grid_frame_sphere(r0)
 
     def theta(dx, dy):
@@ -285,7 +270,7 @@ def p_equation_numeric(lat, lon, radius, step=None):
 
 def psi_from_p(p, r, radius=None):
     """ψ_OEPQ = M⁻¹ P (fang2020 eq. (17) inverted)."""
-    p = _vec3(p, "P = (δx, δy, φ_z)")
+    p = vector3(p, "P = (δx, δy, φ_z)")
     m = m_matrix(r, radius)
     return np.linalg.solve(m, p[..., None])[..., 0]
 
@@ -316,9 +301,9 @@ def input_u(a):
 
 def propagate_psi(psi0, eps, tau, omega=OMEGA):
     """Exact solution of eq. (24): ψ(τ) = T ψ(0) + U ε / Ω for a constant platform drift ε."""
-    psi0 = _vec3(psi0, "psi0")
-    eps = _vec3(eps, "eps")
-    tau = _positive(tau, "tau (s)")
+    psi0 = vector3(psi0, "psi0")
+    eps = vector3(eps, "eps")
+    tau = positive(tau, "tau (s)")
     a = omega * tau
     return psi0 @ transition_t(a).T + eps @ input_u(a).T / omega
 
@@ -344,8 +329,7 @@ def b_matrix(lat, sigma, convention="gyro-error"):
         ``convention="gyro-error"``: B = -C_OEPQ^G   (ε_b = gyro output minus true rate),
         ``convention="platform-drift"``: B = +C_OEPQ^G (ε_b = platform drift rate, gimballed).
     """
-    if convention not in DRIFT_CONVENTIONS:
-        raise ValueError(f"convention must be one of {DRIFT_CONVENTIONS}, got {convention!r}")
+    choice(convention, DRIFT_CONVENTIONS, "convention")
     c = oepq_to_grid(lat, sigma)
     return -c if convention == "gyro-error" else c
 
@@ -368,22 +352,21 @@ def two_point_drift(p2, r2, c_b_g, tau, *, p1=None, r1=None, mean_c_b_e=None,
     ε_b = s ⟨C_b^OEPQ⟩⁻¹ Ω U⁻¹[...] (s = -1 for gyro errors), which equals eq. (27) for a ship
     holding a constant attitude.  Works on batches (leading axes).  Returns ε_b (rad/s).
     """
-    p2 = _vec3(p2, "p2")
-    r2 = _vec3(r2, "r2 (ECEF, m)")
-    tau = _positive(tau, "tau (s)")
-    if convention not in DRIFT_CONVENTIONS:
-        raise ValueError(f"convention must be one of {DRIFT_CONVENTIONS}, got {convention!r}")
+    p2 = vector3(p2, "p2")
+    r2 = vector3(r2, "r2 (ECEF, m)")
+    tau = positive(tau, "tau (s)")
+    choice(convention, DRIFT_CONVENTIONS, "convention")
     if (p1 is None) != (r1 is None):
         raise ValueError("give both p1 and r1 (eq. (26)) or neither (eq. (27), P(t_n+) = 0)")
     lat2, lon2, _ = earth.ecef_to_geodetic(r2)
-    rad2 = gaussian_radius(lat2) if radius is None else np.broadcast_to(_positive(radius, "radius"), lat2.shape)
+    rad2 = gaussian_radius(lat2) if radius is None else np.broadcast_to(positive(radius, "radius"), lat2.shape)
     psi2 = _psi_at(p2, lat2, lon2, rad2)
     a = OMEGA * tau
     t_mat, u_mat = transition_t(a), input_u(a)
     rhs = psi2
     if p1 is not None:
-        p1 = _vec3(p1, "p1")
-        lat1, lon1, _ = earth.ecef_to_geodetic(_vec3(r1, "r1 (ECEF, m)"))
+        p1 = vector3(p1, "p1")
+        lat1, lon1, _ = earth.ecef_to_geodetic(vector3(r1, "r1 (ECEF, m)"))
         rad1 = gaussian_radius(lat1) if radius is None else np.broadcast_to(float(radius), lat1.shape)
         # ψ(t_n) is expressed in OEPQ at the first fix; rotate it into OEPQ of the second (about P)
         psi1 = _psi_at(p1, lat1, lon1, rad1)
@@ -395,10 +378,9 @@ def two_point_drift(p2, r2, c_b_g, tau, *, p1=None, r1=None, mean_c_b_e=None,
 def drift_from_psi(dpsi, lat, lon, c_b_g, tau, *, mean_c_b_e=None, convention="gyro-error"):
     """ε_b = C_G^b B Ω U⁻¹ Δψ, fang2020 eq. (25), with Δψ = ψ(t_{n+1}) - T ψ(t_n) in OEPQ
     components at (``lat``, ``lon``) of the second fix; see :func:`two_point_drift`."""
-    rhs = _vec3(dpsi, "dpsi")
-    tau = _positive(tau, "tau (s)")
-    if convention not in DRIFT_CONVENTIONS:
-        raise ValueError(f"convention must be one of {DRIFT_CONVENTIONS}, got {convention!r}")
+    rhs = vector3(dpsi, "dpsi")
+    tau = positive(tau, "tau (s)")
+    choice(convention, DRIFT_CONVENTIONS, "convention")
     lat2 = earth.check_latitude(lat)
     lon2 = _angle(lon, "lon")
     u_mat = input_u(OMEGA * tau)
@@ -442,8 +424,8 @@ def schuler_loop(damped=True, *, radius=None, gravity=None):
     """
     import control as ct
 
-    radius = earth.A if radius is None else _positive(radius, "radius")
-    gravity = float(earth.normal_gravity(np.radians(85.0))) if gravity is None else _positive(gravity, "gravity")
+    radius = earth.A if radius is None else positive(radius, "radius")
+    gravity = float(earth.normal_gravity(np.radians(85.0))) if gravity is None else positive(gravity, "gravity")
     s = ct.tf("s")
     h = damping_network() if damped else ct.tf([1.0], [1.0])
     ws2 = gravity / radius
@@ -483,7 +465,7 @@ def discretize_damping(dt):
     """Tustin (bilinear) discretization of H_y at step ``dt`` (s): (b0, b1, b2, a1, a2), a0 = 1."""
     import control as ct
 
-    dt = _positive(dt, "dt (s)")
+    dt = positive(dt, "dt (s)")
     hd = ct.sample_system(damping_network(), dt, method="tustin")
     num = np.atleast_1d(np.squeeze(hd.num[0][0]))
     den = np.atleast_1d(np.squeeze(hd.den[0][0]))
@@ -764,7 +746,7 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     if not isinstance(n_cont, (int, np.integer)) or not 0 <= n_cont <= n_runs:
         raise ValueError("continued_runs must be an integer in [0, n_runs] (or None: every run)")
     dt = sc.dt
-    rec_every_k = sc.steps(_positive(record_every, "record_every (s)"))
+    rec_every_k = sc.steps(positive(record_every, "record_every (s)"))
     k_end = sc.steps(sc.duration)
     k1, k2 = sc.steps(sc.fix_times[0]), sc.steps(sc.fix_times[1])
     if k1 % rec_every_k or k2 % rec_every_k:
@@ -820,11 +802,11 @@ def ecef_reference_comparison(sc, duration, *, seed=0, record_every=60.0):
     Returns a dict of time (s), ECEF positions of both (runs × records × 3), ECEF velocities and
     the angle between their attitudes (rad), plus the true positions.
     """
-    duration = _positive(duration, "duration (s)")
+    duration = positive(duration, "duration (s)")
     sc = replace(sc, damping=False)
     dt = sc.dt
     k_end = sc.steps(duration)
-    rec_k = sc.steps(_positive(record_every, "record_every (s)"))
+    rec_k = sc.steps(positive(record_every, "record_every (s)"))
     rng = np.random.default_rng(seed)
     phases = rng.uniform(0, 2 * np.pi, (1, 3))
     seeds = rng.integers(1, 2**63 - 1, size=1, dtype=np.int64).astype(np.uint64)

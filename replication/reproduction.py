@@ -34,7 +34,7 @@ import unicodedata
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -548,13 +548,44 @@ def _notebook_digest(root: Path, notebook: str | None) -> str | None:
     return _sha256(src.encode())
 
 
+def _md_table(columns: Sequence[str], rows: Iterable[Sequence[str]]) -> list[str]:
+    """Lines of a Markdown pipe table: the header, the ``|---|`` rule and one line per row.
+
+    Every table that the package writes in Markdown (the exports ``tables/<id>.md``, the status
+    page, the part summaries, the errata register and the tables shown in the notebooks) is
+    rendered here.
+
+    Parameters
+    ----------
+    columns : sequence of str
+        Header cells.  An empty one (the corner above a column of row labels) is written ``| |``.
+    rows : iterable of sequences of str
+        Body cells as text, as many per row as ``columns``.  A ``|`` in a cell is escaped as
+        ``\\|`` and a line break becomes a blank, so that each row stays one table row; an empty
+        body cell is written ``|  |``.
+
+    Returns
+    -------
+    list of str
+        The lines of the table, without line ends.
+    """
+    lines = ["|" + "|".join(f" {c} " if c else " " for c in columns) + "|", "|" + "---|" * len(columns)]
+    for cells in rows:
+        lines.append("| " + " | ".join(str(c).replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
+    return lines
+
+
+def _md_comparison(df: pd.DataFrame, cols: Sequence[str], headings: Mapping[str, str] | None = None) -> list[str]:
+    """The columns ``cols`` of a comparison table as a Markdown table (cells as :func:`display_cell`
+    shows them; header cells renamed by ``headings``)."""
+    headings = headings or {}
+    return _md_table([headings.get(c, c) for c in cols],
+                     ([display_cell(r, c) for c in cols] for _, r in df.iterrows()))
+
+
 def _markdown(df: pd.DataFrame, title: str) -> str:
     cols = ["quantity", "unit", "paper", "reproduced", "abs_error", "rel_error", "tolerance", "status", "note"]
-    lines = [f"**{title}**", "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    for _, r in df.iterrows():
-        cells = [display_cell(r, c).replace("|", "\\|").replace("\n", " ") for c in cols]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
+    return "\n".join([f"**{title}**", "", *_md_comparison(df, cols)]) + "\n"
 
 
 _TEX_SPECIAL = {"&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}",
@@ -757,14 +788,6 @@ and its reason (the ``note``); the long format is one click away (:func:`display
 _HEADINGS = {"note": "reason", "abs_error": "abs. error", "rel_error": "rel. error"}
 
 
-def _md_rows(df: pd.DataFrame, cols: list[str]) -> list[str]:
-    head = "| " + " | ".join(_HEADINGS.get(c, c) for c in cols) + " |"
-    lines = [head, "|" + "---|" * len(cols)]
-    for _, r in df.iterrows():
-        lines.append("| " + " | ".join(display_cell(r, c).replace("|", "\\|").replace("\n", " ") for c in cols) + " |")
-    return lines
-
-
 def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterable[str] | None = None):
     """A numbered, cross-referenceable MyST table of a comparison (for notebook output).
 
@@ -784,7 +807,7 @@ def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterabl
         raise RegistryError(f"display_table: columns {missing} not in the table")
     if not re.match(r"^[a-z0-9][a-z0-9-]*$", name):
         raise RegistryError(f"display_table: name {name!r} must be lower-case letters, digits and '-'")
-    lines = [f"```{{table}} {caption}", f":name: {name}", "", *_md_rows(df, cols), "```"]
+    lines = [f"```{{table}} {caption}", f":name: {name}", "", *_md_comparison(df, cols, _HEADINGS), "```"]
     table_id, notebook = df.attrs.get("table_id"), df.attrs.get("notebook")
     if table_id:  # a target named by the table id: the findings box and the part pages link to it
         lines = [f"({table_id})=", "", *lines]
@@ -794,7 +817,7 @@ def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterabl
                 and (df[c].astype(str) != "").any()]
         lines += ["", f"Download: {{download}}`{table_id}.csv <{up}tables/{table_id}.csv>` (long format, with "
                   f"provenance in {{download}}`{table_id}.json <{up}tables/{table_id}.json>`)", "",
-                  f":::{{dropdown}} All columns of {table_id}", *_md_rows(df, full), ":::"]
+                  f":::{{dropdown}} All columns of {table_id}", *_md_comparison(df, full, _HEADINGS), ":::"]
     return Markdown("\n".join(lines))
 
 
@@ -1090,11 +1113,9 @@ def _paper_summary_markdown(status: pd.DataFrame, source: str) -> str:
             continue
         tally = status_tally(sub)[kind]
         lines += [f"**{title}** — {tally}.", "", status_bar_html(sub["status"].value_counts().to_dict()), "",
-                  "| id | artifact | status | rows | tables |", "|---|---|---|---|---|"]
-        for _, r in sub.iterrows():
-            lines.append(f"| {_chapter_link(r)} | {r['artifact']} | **{status_label(r)}** | {_row_split(r)} | "
-                         f"{_table_links(r, root, '../../')} |")
-        lines.append("")
+                  *_md_table(["id", "artifact", "status", "rows", "tables"],
+                             ([_chapter_link(r), r["artifact"], f"**{status_label(r)}**", _row_split(r),
+                               _table_links(r, root, "../../")] for _, r in sub.iterrows())), ""]
     lines.append("Statuses are defined on the {doc}`status page </status>`; the errata of every document "
                  "are collected in the {doc}`errata register </errata>`.")
     return "\n".join(lines) + "\n"
@@ -1170,23 +1191,22 @@ def _status_markdown(status: pd.DataFrame) -> str:
     by = {src: paper[paper["source"] == src] for src in SOURCE_KEYS}
     lines = ["**At a glance** — the artifacts of each document by status, and the errata and "
              "inconsistencies their rows record:", "",
-             "| | " + " | ".join(SOURCE_KEYS) + " |", "|---|" + "---|" * len(SOURCE_KEYS),
-             "| artifacts | " + " | ".join(str(len(by[k])) for k in SOURCE_KEYS) + " |"]
-    lines += [f"| {c} | " + " | ".join(str(int((by[k]["status"] == c).sum())) for k in SOURCE_KEYS) + " |" for c in cols]
-    lines += [f"| {name} | " + " | ".join(str(int(by[k][col].sum())) for k in SOURCE_KEYS) + " |"
-              for name, col in (("errata", "erratum"), ("inconsistencies", "inconsistent"))]
-    lines.append("")
+             *_md_table(["", *SOURCE_KEYS],
+                        [["artifacts", *(len(by[k]) for k in SOURCE_KEYS)],
+                         *([c, *(int((by[k]["status"] == c).sum()) for k in SOURCE_KEYS)] for c in cols),
+                         *([name, *(int(by[k][col].sum()) for k in SOURCE_KEYS)]
+                           for name, col in (("errata", "erratum"), ("inconsistencies", "inconsistent")))]),
+             ""]
     for k in SOURCE_KEYS:
         if len(by[k]):
             lines += [f"**{k}** ({{doc}}`its part </{k}/index>`)", "",
                       status_bar_html(by[k]["status"].value_counts().to_dict()), ""]
     for kind, title in (("paper", "Artifacts of the four documents"), ("supplementary", "Supplementary checks")):
         lines += [f"**{title}** — {tally[kind]}.", "",
-                  "| id | artifact | status | rows | description | tables |", "|---|---|---|---|---|---|"]
-        for _, r in status[status["kind"] == kind].iterrows():
-            lines.append(f"| {_chapter_link(r)} | {r['artifact']} | **{status_label(r)}** | {_row_split(r)} | "
-                         f"{str(r['description']).replace('|', '/')} | {_table_links(r, project_root(), '../')} |")
-        lines.append("")
+                  *_md_table(["id", "artifact", "status", "rows", "description", "tables"],
+                             ([_chapter_link(r), r["artifact"], f"**{status_label(r)}**", _row_split(r),
+                               str(r["description"]).replace("|", "/"), _table_links(r, project_root(), "../")]
+                              for _, r in status[status["kind"] == kind].iterrows())), ""]
     return "\n".join(lines)
 
 
@@ -1203,13 +1223,11 @@ def _errata_markdown(errata: pd.DataFrame) -> str:
     for source in [k for k in SOURCE_KEYS if k in set(errata["source"])] + \
             sorted(set(errata["source"]) - set(SOURCE_KEYS)):
         part = errata[errata["source"] == source]
+        rows = ([r["location"], r["printed"], _formula(r["corrected"]),
+                 re.sub(r"book/([\w/.-]+?)\.ipynb", r"{doc}`/\1`", str(r["evidence"]))]  # link the chapter
+                for _, r in part.iterrows())
         lines += [f"## {source} ({len(part)} {'erratum' if len(part) == 1 else 'errata'})", "",
-                  "| location | printed | corrected | evidence |", "|---|---|---|---|"]
-        for _, r in part.iterrows():
-            evidence = re.sub(r"book/([\w/.-]+?)\.ipynb", r"{doc}`/\1`", str(r["evidence"]))  # link the chapter
-            cells = [str(r["location"]), str(r["printed"]), _formula(r["corrected"]), evidence]
-            lines.append("| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
-        lines.append("")
+                  *_md_table(["location", "printed", "corrected", "evidence"], rows), ""]
     return "\n".join(lines)
 
 

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import earth
+from ._validate import components
 from .rotations import euler_to_dcm
 from .units import DEG_PER_H, MICRO_G, PPM, ARCSEC, deg_per_h2
 from scipy.signal import lfilter
@@ -39,20 +40,9 @@ __all__ = ["TriadErrors", "ImuErrors", "misalignment_matrix", "apply_imu_errors"
            "lever_arm_offset"]
 
 
-def _vec(x, name, n=3):
-    a = np.asarray(x, float)
-    if a.ndim == 0:
-        a = np.full(n, float(a))
-    if a.shape != (n,):
-        raise ValueError(f"{name} must be a scalar or have {n} components, got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} must be finite")
-    return a
-
-
 def misalignment_matrix(theta):
     """δC_m^s of chen2019 eq. (2-8) from [θ_xy, θ_yx, θ_xz, θ_zx, θ_yz, θ_zy] (rad)."""
-    xy, yx, xz, zx, yz, zy = _vec(theta, "misalignment", 6)
+    xy, yx, xz, zx, yz, zy = components(theta, "misalignment", 6)
     return np.array([[0.0, -yz, zy], [xz, 0.0, -zx], [-xy, yx, 0.0]])
 
 
@@ -75,13 +65,13 @@ class TriadErrors:
     misalignment: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
     def __post_init__(self):
-        self.bias = _vec(self.bias, "bias")
-        self.markov_sigma = _vec(self.markov_sigma, "markov_sigma")
-        self.white_psd = _vec(self.white_psd, "white_psd")
+        self.bias = components(self.bias, "bias")
+        self.markov_sigma = components(self.markov_sigma, "markov_sigma")
+        self.white_psd = components(self.white_psd, "white_psd")
         if np.any(self.white_psd < 0) or np.any(self.markov_sigma < 0):
             raise ValueError("white_psd and markov_sigma cannot be negative")
-        self.scale = _vec(self.scale, "scale")
-        self.misalignment = _vec(self.misalignment, "misalignment", 6)
+        self.scale = components(self.scale, "scale")
+        self.misalignment = components(self.misalignment, "misalignment", 6)
         if not self.markov_tau > 0:
             raise ValueError("markov_tau must be positive (seconds; np.inf for none)")
 
@@ -201,7 +191,7 @@ def lever_arm_offset(lat, h, C_bn, lever_arm_b, w_eb_b=None):
     writes C_b^n ω_nb^n P^b; ω_eb^b = ω_ib^b - C_n^b ω_ie^n is the exact rate).
     """
     lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
-    l = _vec(lever_arm_b, "lever_arm_b")
+    l = components(lever_arm_b, "lever_arm_b")
     d = np.einsum("...ij,j->...i", C_bn, l)
     rm, rn = earth.radii(lat)
     dpos = np.stack([d[..., 1] / (rm + h), d[..., 0] / ((rn + h) * np.cos(lat)), d[..., 2]], -1)
@@ -226,9 +216,9 @@ def gnss_measurements(traj, *, rate_hz: float = 10.0, sigma_pos=(0.03, 0.03, 0.1
     step = int(round(step))
     idx = np.arange(step, len(traj.t), step)
     rng = np.random.default_rng(rng)
-    sp = _vec(sigma_pos, "sigma_pos")
-    sv = _vec(sigma_vel, "sigma_vel")
-    l = _vec(lever_arm_b, "lever_arm_b")
+    sp = components(sigma_pos, "sigma_pos")
+    sv = components(sigma_vel, "sigma_vel")
+    l = components(lever_arm_b, "lever_arm_b")
     C = euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2])
     w_ie = earth.earth_rate_enu(traj.lat[idx])
     w_eb = traj.w_ib_b[idx] - np.einsum("kji,kj->ki", C, w_ie)

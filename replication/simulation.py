@@ -55,6 +55,7 @@ from . import earth
 from . import errors as E
 from . import models as M
 from . import closedloop as CL
+from ._validate import choice
 from .rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from .sensors import lever_arm_offset, misalignment_matrix
 from .units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MGAL, MICRO_G
@@ -178,10 +179,8 @@ def table_4_41_setup(paper, *, misalignment_unit: str = "arcsec", markov_reading
 
     ``choices`` override the parameters the report does not print (see :class:`SimulationSetup`).
     """
-    if misalignment_unit not in MISALIGNMENT_UNITS:
-        raise ValueError(f"misalignment_unit must be one of {sorted(MISALIGNMENT_UNITS)}, got {misalignment_unit!r}")
-    if markov_reading not in MARKOV_READINGS:
-        raise ValueError(f"markov_reading must be one of {MARKOV_READINGS}, got {markov_reading!r}")
+    choice(misalignment_unit, sorted(MISALIGNMENT_UNITS), "misalignment_unit")
+    choice(markov_reading, MARKOV_READINGS, "markov_reading")
     for q in ("gyro_markov_sigma", "accel_markov_sigma"):
         if q in choices:
             raise ValueError(f"{q} comes from Table 4-41 (use markov_reading), not from a keyword")

@@ -25,6 +25,7 @@ import numpy as np
 
 from . import earth
 from . import _kernels as K
+from ._validate import choice
 from .rotations import (dcm_to_euler, dcm_to_quat, euler_to_dcm, quat_to_dcm, skew, vee, _mat3)
 from .rotations import attitude_error
 
@@ -168,8 +169,7 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
     t = validate_time(t, n)
     if not isinstance(initial, NavState):
         raise TypeError("initial must be a NavState (e.g. Trajectory.initial_state())")
-    if vertical not in VERTICAL_MODES:
-        raise ValueError(f"vertical must be one of {sorted(VERTICAL_MODES)}, got {vertical!r}")
+    choice(vertical, sorted(VERTICAL_MODES), "vertical")
     earth.check_latitude(initial.lat, polar_limit_deg=polar_limit_deg, name="initial latitude")
     if vertical in ("hold", "damped"):
         if h_ref is None:

@@ -36,7 +36,7 @@ __all__ = [
     "correlogram", "cutoff_lag", "Identification", "identify_model", "ar_design",
     "ar_least_squares", "require_stationary_series", "fit_ar", "order_cap", "aic_by_order", "select_order",
     "aic_increment_bound", "ar_poles", "is_stationary", "ar_autocorrelation", "ar_variance",
-    "check_ar_model", "simulate_ar", "aic_batch", "order_recovery",
+    "check_ar_model", "simulate_ar", "gauss_markov", "aic_batch", "order_recovery",
 ]
 
 
@@ -636,6 +636,40 @@ def simulate_ar(phi, sigma2: float, n: int, n_series: int, rng: np.random.Genera
         burn = int(max(100, 10 * -1.0 / math.log(np.max(np.abs(ar_poles(phi))) + 1e-300)))
     e = rng.standard_normal((n_series, n + burn)) * math.sqrt(sigma2)
     return signal.lfilter([1.0], np.r_[1.0, -phi], e, axis=1)[:, burn:]
+
+
+def gauss_markov(n: int, dt: float, std: float, tau: float, rng: np.random.Generator, *, size: int = 1) -> np.ndarray:
+    """Stationary first-order Gauss-Markov sequences, sampled exactly.
+
+    x_{k+1} = a x_k + w_k with a = e^{-dt/tau} and w_k ~ N(0, std²(1 - a²)); x_0 ~ N(0, std²), so
+    every sample has the standard deviation ``std``.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples (>= 1).
+    dt : float
+        Sample interval (> 0), in the unit of ``tau``.
+    std : float
+        Stationary standard deviation (>= 0).
+    tau : float
+        Correlation time (> 0).
+    rng : numpy.random.Generator
+        Source of the draws: first the n × size driving draws, then the ``size`` initial values.
+    size : int, optional
+        Number of independent sequences (columns), default 1.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n, size).
+    """
+    if not (n >= 1 and dt > 0 and std >= 0 and tau > 0):
+        raise ValueError("need n >= 1, dt > 0, std >= 0 and tau > 0")
+    a = math.exp(-dt / tau)
+    w = rng.standard_normal((n, size)) * std * math.sqrt(1 - a * a)
+    w[0] = rng.standard_normal(size) * std
+    return signal.lfilter([1.0], [1.0, -a], w, axis=0)
 
 
 def aic_batch(Y, max_order: int, *, chunk: int = 16) -> np.ndarray:

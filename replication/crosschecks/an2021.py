@@ -46,6 +46,9 @@ from numpy.polynomial import Polynomial
 from scipy.optimize import brentq
 from scipy.signal import ss2tf
 
+from replication._validate import choice
+from replication.earth import somigliana
+
 __all__ = [
     "OMEGA_IE",
     "R_MEAN",
@@ -77,13 +80,12 @@ def normal_gravity(lat_deg):
     float
         Normal gravity, m/s² (the ``g`` of eqs. (1) and (4)-(7), which the paper does not print).
     """
-    s2 = np.sin(np.radians(lat_deg)) ** 2
-    return 9.7803253359 * (1.0 + 0.00193185265241 * s2) / np.sqrt(1.0 - 6.69437999014e-3 * s2)
+    # the printed TR8350.2 constants γ_e, k, e² (the derived ones of replication.earth differ by < 1e-10 m/s²)
+    return somigliana(np.sin(np.radians(lat_deg)) ** 2, gamma_e=9.7803253359, k=0.00193185265241, e2=6.69437999014e-3)
 
 
 def _check(motion, lat_deg, speed_mps, n13):
-    if motion not in MOTIONS:
-        raise ValueError(f"motion must be one of {MOTIONS}, got {motion!r}")
+    choice(motion, MOTIONS, "motion")
     lat_deg, speed_mps = float(lat_deg), float(speed_mps)
     if not np.isfinite(lat_deg) or abs(lat_deg) >= 89.0:
         raise ValueError(f"lat_deg must be finite with |lat_deg| < 89 (tan L, sec L), got {lat_deg!r}")

@@ -62,6 +62,7 @@ from scipy.linalg import expm
 from scipy.optimize import least_squares
 from scipy.special import j0
 
+from replication._validate import choice
 from replication.earth import A as EARTH_A, GAMMA_E
 from replication.units import MGAL, MICRO_G, UG_PER_SQRT_HZ
 
@@ -130,12 +131,6 @@ def _check_setup(setup) -> VerticalChannel:
     if not isinstance(setup, VerticalChannel):
         raise ValueError(f"setup must be a VerticalChannel, not {type(setup).__name__}")
     return setup
-
-
-def _check_choice(value, allowed, name):
-    if value not in allowed:
-        raise ValueError(f"{name} must be one of {allowed}, got {value!r}")
-    return value
 
 
 # --- the disturbance field along the flight ---------------------------------------------------
@@ -247,7 +242,7 @@ def filter_model(method: str, setup: VerticalChannel | None = None) -> dict:
     The filter's F is the printed one (no 2γ/R term); ∇_bz is a random constant; δg_U, when
     augmented, is a first-order Gauss-Markov process with the field's variance and τ = D/v.
     """
-    _check_choice(method, METHODS, "method")
+    choice(method, METHODS, "method")
     p = _check_setup(setup)
     n = 4 if method == "state" else 3
     F = np.zeros((n, n))
@@ -284,9 +279,9 @@ def truth_model(method: str, shape: str = "gauss-markov", setup: VerticalChannel
     vector of a δg_U held over one GNSS interval, for a disturbance given by its covariance along
     the actual flight lines (:func:`geometry_height_rms`).
     """
-    _check_choice(method, METHODS, "method")
-    _check_choice(shape, SHAPES, "shape")
-    _check_choice(disturbance, ("state", "input"), "disturbance")
+    choice(method, METHODS, "method")
+    choice(shape, SHAPES, "shape")
+    choice(disturbance, ("state", "input"), "disturbance")
     p = _check_setup(setup)
     if disturbance == "state":
         Fd, qd, idd, Pd = _disturbance_block(shape, p)
@@ -389,8 +384,8 @@ def height_error_history(cases, setup: VerticalChannel | None = None, disturbanc
     for c in cases:
         if not (isinstance(c, tuple) and len(c) == 2):
             raise ValueError(f"each case must be a (method, shape) tuple, got {c!r}")
-        _check_choice(c[0], METHODS, "method")
-        _check_choice(c[1], SHAPES, "shape")
+        choice(c[0], METHODS, "method")
+        choice(c[1], SHAPES, "shape")
     tm = [truth_model(m, s, p, disturbance) for m, s in cases]
     fm = [filter_model(m, p) for m, _ in cases]
     nt = max(t["Phi"].shape[0] for t in tm)
@@ -454,7 +449,7 @@ def predicted_height_rms(setup: VerticalChannel | None = None, shapes=SHAPES) ->
     p = _check_setup(setup)
     shapes = tuple(shapes)
     for s in shapes:
-        _check_choice(s, SHAPES, "shape")
+        choice(s, SHAPES, "shape")
     cases = [(m, s) for s in shapes for m in METHODS]
     hist = height_error_history(cases, p)
     rms = photo_rms(hist, p)
@@ -517,7 +512,7 @@ def geometry_height_rms(setup: VerticalChannel | None = None, shapes=SHAPES, bin
     p = _check_setup(setup)
     shapes = tuple(shapes)
     for sh in shapes:
-        _check_choice(sh, SHAPES, "shape")
+        choice(sh, SHAPES, "shape")
     bin_seconds = _positive(bin_seconds, "bin_seconds")
     per_bin = int(round(bin_seconds / p.gnss_interval))
     if per_bin < 1 or bin_seconds > 30.0:

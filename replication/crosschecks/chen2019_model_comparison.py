@@ -67,6 +67,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.linalg import expm
 
+from replication._validate import choice
 from replication.earth import OMEGA_IE, normal_gravity, radii
 from replication.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MGAL, MICRO_G
 
@@ -140,8 +141,7 @@ TRUTH_MODEL = "45"
 
 def model_indices(model: str) -> np.ndarray:
     """Indices of ``model``'s states in the superset layout (chen2019 eq. (2-14) order)."""
-    if model not in MODEL_BLOCKS:
-        raise ValueError(f"model must be one of {sorted(MODEL_BLOCKS)}, got {model!r}")
+    choice(model, sorted(MODEL_BLOCKS), "model")
     return np.concatenate([np.arange(N_SUPER)[_SL[b]] for b in MODEL_BLOCKS[model]])
 
 

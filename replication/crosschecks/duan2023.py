@@ -54,6 +54,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import expm
 
+from replication._validate import choice, finite, nonnegative, positive
+from replication.earth import somigliana
+
 __all__ = [
     "PAPER",
     "sins_error_matrix",
@@ -98,27 +101,6 @@ _DPH = _DEG / 3600.0
 
 
 # --------------------------------------------------------------------------- validation helpers
-def _positive(name, value):
-    value = float(value)
-    if not np.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
-    return value
-
-
-def _finite(name, value):
-    value = float(value)
-    if not np.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return value
-
-
-def _nonnegative(name, value):
-    value = float(value)
-    if not np.isfinite(value) or value < 0.0:
-        raise ValueError(f"{name} must be a non-negative finite number, got {value!r}")
-    return value
-
-
 def _axes(name, value):
     arr = np.asarray(value, dtype=float)
     if arr.ndim == 0:
@@ -129,7 +111,7 @@ def _axes(name, value):
 
 
 def _latitude(lat_deg):
-    lat_deg = _finite("lat0_deg", lat_deg)
+    lat_deg = finite(lat_deg, "lat0_deg")
     if abs(lat_deg) >= 89.0:
         raise ValueError(
             f"lat0_deg = {lat_deg} is too close to a pole for the latitude-longitude error model "
@@ -139,7 +121,7 @@ def _latitude(lat_deg):
 
 
 def _height(height_m):
-    height_m = _finite("height_m", height_m)
+    height_m = finite(height_m, "height_m")
     if not -500.0 <= height_m <= 30000.0:
         raise ValueError(f"height_m = {height_m} outside the airborne range [-500, 30000] m")
     return height_m
@@ -150,7 +132,7 @@ def _earth(lat, h):
     w = np.sqrt(1.0 - _E2 * s2)
     rm = _A * (1.0 - _E2) / w**3
     rn = _A / w
-    gamma = _GAMMA_E * (1.0 + _K_SOMIGLIANA * s2) / w
+    gamma = somigliana(s2, gamma_e=_GAMMA_E, k=_K_SOMIGLIANA, e2=_E2)
     rmh, rnh = rm + h, rn + h
     # free-air gradient 2 g / R with the Gaussian mean radius
     g_h = 2.0 * gamma / (np.sqrt(rm * rn) + h)
@@ -268,10 +250,10 @@ def vertical_channel_closed_form(
         of each (``dh_from``/``dv_from`` dicts keyed ``initial_height``, ``initial_velocity``,
         ``accel_bias``).
     """
-    t = _positive("duration_s", duration_s)
-    dh0 = _finite("dh0_m", dh0_m)
-    dv0 = _finite("dv0_mps", dv0_mps)
-    b = _finite("accel_bias_ug", accel_bias_ug) * 1e-6 * _G_UNIT
+    t = positive(duration_s, "duration_s")
+    dh0 = finite(dh0_m, "dh0_m")
+    dv0 = finite(dv0_mps, "dv0_mps")
+    b = finite(accel_bias_ug, "accel_bias_ug") * 1e-6 * _G_UNIT
     lat = _latitude(lat0_deg)
     h = _height(height_m)
     _, _, _, g_h = _earth(lat, h)
@@ -298,9 +280,9 @@ def vertical_channel_closed_form(
 
 def _check_common(duration_s, speed_mps, heading_deg, lat0_deg, height_m):
     return (
-        _positive("duration_s", duration_s),
-        _positive("speed_mps", speed_mps),
-        _finite("heading_deg", heading_deg) * _DEG,
+        positive(duration_s, "duration_s"),
+        positive(speed_mps, "speed_mps"),
+        finite(heading_deg, "heading_deg") * _DEG,
         _latitude(lat0_deg),
         _height(height_m),
     )
@@ -405,8 +387,8 @@ def pure_sins_linear_propagation(
         φ), ``velocity_mps`` (norm of δv), ``position_km`` (norm of the E, N, U position
         error) and ``tilt_deg`` (norm of φ_E, φ_N).
     """
-    step = _positive("step_s", step_s)
-    x0 = _initial_state(_latitude(lat0_deg), _height(height_m), _finite("dv0_mps", dv0_mps), _finite("dp0_m", dp0_m))
+    step = positive(step_s, "step_s")
+    x0 = _initial_state(_latitude(lat0_deg), _height(height_m), finite(dv0_mps, "dv0_mps"), finite(dp0_m, "dp0_m"))
     g = _axes("gyro_drift_dph", gyro_drift_dph)
     a = _axes("accel_bias_ug", accel_bias_ug)
     _, hist, _ = _propagate(duration_s, speed_mps, heading_deg, lat0_deg, height_m, x0, g, a, step)
@@ -499,12 +481,12 @@ def vertical_reset_sequence(
     n = int(n_intervals)
     if n < 1 or n != n_intervals:
         raise ValueError(f"n_intervals must be a positive integer, got {n_intervals!r}")
-    T = _positive("interval_s", interval_s)
-    b = _finite("accel_bias_ug", accel_bias_ug) * 1e-6 * _G_UNIT
+    T = positive(interval_s, "interval_s")
+    b = finite(accel_bias_ug, "accel_bias_ug") * 1e-6 * _G_UNIT
     noise = np.zeros(n) if ads_errors_m is None else np.asarray(ads_errors_m, dtype=float)
     if noise.shape != (n,) or not np.all(np.isfinite(noise)):
         raise ValueError(f"ads_errors_m must hold {n} finite values (one per correction), got shape {noise.shape}")
-    dh, dv = _finite("dh0_m", dh0_m), _finite("dv0_mps", dv0_mps)
+    dh, dv = finite(dh0_m, "dh0_m"), finite(dv0_mps, "dv0_mps")
     out = np.empty(n)
     for k in range(n):
         dh, dv = dh + dv * T + 0.5 * b * T**2, dv + b * T
@@ -578,14 +560,13 @@ def proposed_closed_form(
         ``kappa`` (1/s²), ``stable`` (``κ > 0``), and ``final`` / ``max`` dicts of along-track
         ``tilt_deg``, ``velocity_mps``, ``position_km``.
     """
-    t_end = _positive("duration_s", duration_s)
-    T = _positive("interval_s", interval_s)
-    V = _positive("speed_mps", speed_mps)
-    psi = _finite("heading_deg", heading_deg) * _DEG
-    c = _positive("eq6_factor", eq6_factor)
+    t_end = positive(duration_s, "duration_s")
+    T = positive(interval_s, "interval_s")
+    V = positive(speed_mps, "speed_mps")
+    psi = finite(heading_deg, "heading_deg") * _DEG
+    c = positive(eq6_factor, "eq6_factor")
     signs = {"literal": -1.0, "geometric": 1.0, "open": 1.0}
-    if reading not in signs:
-        raise ValueError(f"reading must be one of {sorted(signs)}, got {reading!r}")
+    choice(reading, sorted(signs), "reading")
     if T >= t_end:
         raise ValueError(f"interval_s ({T}) must be shorter than duration_s ({t_end})")
     lat = _latitude(lat0_deg)
@@ -594,9 +575,9 @@ def proposed_closed_form(
     R = np.sqrt(rmh * rnh)
     sigma = signs[reading]
     k = 0.0 if reading == "open" else 2.0 * V / R + 2.0 * _OMEGA_IE * np.cos(lat) * np.sin(psi)
-    b = _finite("accel_bias_ug", accel_bias_ug) * 1e-6 * _G_UNIT
-    dv0 = _finite("dv0_mps", dv0_mps)
-    dh0 = _finite("dh0_m", dh0_m)
+    b = finite(accel_bias_ug, "accel_bias_ug") * 1e-6 * _G_UNIT
+    dv0 = finite(dv0_mps, "dv0_mps")
+    dh0 = finite(dh0_m, "dh0_m")
     kappa = g * (1.0 / R - sigma * c * k / V)
     forcing = sigma * c * g * b / V
     phi0 = sigma * c * dv0 / V
@@ -689,18 +670,18 @@ def proposed_linear_propagation(
     dict
         ``final`` and ``max`` dicts as in ``pure_sins_linear_propagation``.
     """
-    T = _positive("interval_s", interval_s)
-    step = _positive("step_s", step_s)
+    T = positive(interval_s, "interval_s")
+    step = positive(step_s, "step_s")
     if abs(T / step - round(T / step)) > 1e-9:
         raise ValueError(f"step_s ({step}) must divide interval_s ({T}) into whole steps")
-    sigma = _nonnegative("ads_sigma_m", ads_sigma_m)
-    c = _positive("eq6_factor", eq6_factor)
+    sigma = nonnegative(ads_sigma_m, "ads_sigma_m")
+    c = positive(eq6_factor, "eq6_factor")
     if tilt_sign not in (1, -1, 1.0, -1.0):
         raise ValueError(f"tilt_sign must be +1 or -1, got {tilt_sign!r}")
-    t_end = _positive("duration_s", duration_s)
+    t_end = positive(duration_s, "duration_s")
     rng = np.random.default_rng(seed)
     noise = sigma * rng.standard_normal(int(t_end // T) + 2)
-    state = {"h_prev": float(_finite("dp0_m", dp0_m))}
+    state = {"h_prev": float(finite(dp0_m, "dp0_m"))}
 
     def correct(x, lat, h, v_enu, k):
         rmh, rnh, _, _ = _earth(lat, h)
@@ -726,7 +707,7 @@ def proposed_linear_propagation(
         state["h_prev"] = x[8]
         return x
 
-    x0 = _initial_state(_latitude(lat0_deg), _height(height_m), _finite("dv0_mps", dv0_mps), _finite("dp0_m", dp0_m))
+    x0 = _initial_state(_latitude(lat0_deg), _height(height_m), finite(dv0_mps, "dv0_mps"), finite(dp0_m, "dp0_m"))
     g = _axes("gyro_drift_dph", gyro_drift_dph)
     a = _axes("accel_bias_ug", accel_bias_ug)
     _, hist, _ = _propagate(

@@ -79,6 +79,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from replication import earth, units
+from replication._validate import positive
 
 __all__ = [
     "PAPER",
@@ -287,13 +288,6 @@ def _rhs(t, y, traj, eps_b, bias_b, g, coeffs):
     return np.concatenate([dpsi, ddr, ddv, dw1, dw2])
 
 
-def _check_positive(name, value):
-    value = float(value)
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
-    return value
-
-
 def propagate(case, *, t1_h=2.0, t2_h=3.5, drift_deg_h=0.01, bias_g=1e-4,
               attitude_arcsec=(6.0, 6.0, 360.0), speed=10.0, reset="grid-attitude",
               drift_convention="gyro-output", rtol=1e-10):
@@ -311,11 +305,11 @@ def propagate(case, *, t1_h=2.0, t2_h=3.5, drift_deg_h=0.01, bias_g=1e-4,
     ``P(t2) = [δx, δy, φ_z]`` of fang2020 eq. (17)."""
     if case not in CASES:
         raise ValueError(f"case must be 1 or 2, got {case!r}")
-    t1_h = _check_positive("t1_h", t1_h)
-    t2_h = _check_positive("t2_h", t2_h)
+    t1_h = positive(t1_h, "t1_h")
+    t2_h = positive(t2_h, "t2_h")
     if t2_h <= t1_h:
         raise ValueError("t2_h must be later than t1_h")
-    speed = _check_positive("speed", speed)
+    speed = positive(speed, "speed")
     if drift_convention not in ("gyro-output", "platform"):
         raise ValueError(f"drift_convention must be 'gyro-output' or 'platform', got {drift_convention!r}")
     if reset not in ("grid-attitude", "ecef-attitude", "ideal"):

@@ -1,0 +1,138 @@
+"""Argument checks shared by the modules of the package (private).
+
+Each function returns the checked argument in the form the caller computes with (a float or a
+float array) and raises ``ValueError`` naming the argument, what it must be and what was given.
+The domain-specific checks stay with their modules (latitudes and heights in
+:mod:`replication.earth`, increments in :mod:`replication.strapdown`).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Collection
+
+import numpy as np
+
+__all__ = ["positive", "nonnegative", "finite", "vector3", "components", "choice"]
+
+
+def _number(value, name: str, what: str, ok) -> float:
+    """``float(value)`` if it is finite and ``ok(value)``; else ``ValueError`` saying ``what`` it must be."""
+    value = float(value)
+    if not (np.isfinite(value) and ok(value)):
+        raise ValueError(f"{name} must be {what}, got {value!r}")
+    return value
+
+
+def positive(value, name: str) -> float:
+    """A positive finite number.
+
+    Parameters
+    ----------
+    value : float-like
+        The argument.
+    name : str
+        Its name (with its unit where it helps) for the error message.
+
+    Returns
+    -------
+    float
+        ``float(value)``; ``ValueError`` if it is not finite or not > 0.
+    """
+    return _number(value, name, "a positive finite number", lambda v: v > 0.0)
+
+
+def nonnegative(value, name: str) -> float:
+    """A finite number >= 0 (arguments and return as :func:`positive`; ``ValueError`` if negative)."""
+    return _number(value, name, "a non-negative finite number", lambda v: v >= 0.0)
+
+
+def finite(value, name: str) -> float:
+    """A finite number (arguments and return as :func:`positive`; ``ValueError`` if NaN or infinite)."""
+    return _number(value, name, "a finite number", lambda v: True)
+
+
+def vector3(value, name: str) -> np.ndarray:
+    """A finite array of 3-vectors (last axis x, y, z; any leading axes).
+
+    Parameters
+    ----------
+    value : array_like
+        The argument, shape (..., 3).
+    name : str
+        Its name for the error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``value`` as a float array.
+
+    Raises
+    ------
+    ValueError
+        If the last axis is not of length 3 or an element is not finite.
+    """
+    a = np.asarray(value, dtype=float)
+    if a.shape[-1:] != (3,):
+        raise ValueError(f"{name} must have a last axis of length 3 (x, y, z), got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite")
+    return a
+
+
+def components(value, name: str, n: int = 3) -> np.ndarray:
+    """``n`` finite components, or one number standing for all of them.
+
+    Parameters
+    ----------
+    value : float or array_like
+        A scalar (repeated ``n`` times) or ``n`` numbers.
+    name : str
+        Its name for the error message.
+    n : int, optional
+        The number of components (default 3).
+
+    Returns
+    -------
+    numpy.ndarray
+        Float array of shape (n,).
+
+    Raises
+    ------
+    ValueError
+        If ``value`` has another shape or an element is not finite.
+    """
+    a = np.asarray(value, float)
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    if a.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or have {n} components, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite")
+    return a
+
+
+def choice(value: Any, allowed: Collection, name: str) -> Any:
+    """One of a fixed set of options.
+
+    Parameters
+    ----------
+    value : object
+        The argument.
+    allowed : collection
+        The options, shown in the error message as given (pass a sorted list for a set).
+    name : str
+        Its name for the error message.
+
+    Returns
+    -------
+    object
+        ``value`` unchanged.
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not among ``allowed``.
+    """
+    if value not in allowed:
+        raise ValueError(f"{name} must be one of {allowed}, got {value!r}")
+    return value
