@@ -606,7 +606,8 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
     the unspecified choices.  ``variants`` maps a name to keyword arguments of
     :func:`degrees_table` plus optional ``model``, ``maneuvers`` and ``states`` overrides.
     Returns one row per variant: Spearman ρ per scenario, total verdict agreement (of
-    states × scenarios) and the scenario winning most states."""
+    states × scenarios), the scenario winning most states and the number of states above the
+    rank tolerance per scenario ("observable <scenario>", the bar count of chen2019 Fig. 2-4)."""
 
     rows = []
     for name, spec in variants.items():
@@ -620,5 +621,6 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
         row.update({f"ρ {c}": met.loc[c, "spearman"] for c in reference.columns})
         row["verdicts agree"] = int(met["verdicts_agree"].sum())
         row["best maneuver"] = best_scenario_counts(table).idxmax()
+        row.update({f"observable {c}": int((table[c] > tol[c]).sum()) for c in reference.columns})
         rows.append(row)
     return pd.DataFrame(rows).set_index("variant")
