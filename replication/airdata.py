@@ -1427,6 +1427,27 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
     return rows
 
 
+def eq22_readings_rows(paper, state: str = "climb"):
+    """Readings ledger of the blamed elements of duan2023 eqs. (4)-(21): every element that the
+    adopted reading B flags (erratum or inconsistency), compared with the re-derivation under
+    both readings of the position rows (A: β from east, δp = latitude, longitude, height; B: β
+    the heading from north, δp = longitude, latitude, height), relative tolerance 1e-9 (symbolic
+    expressions: only round-off separates them).  An element reproduced under reading A is a
+    matter of convention, not a misprint."""
+    da = check_elements(paper, "A", state).set_index("quantity")
+    db = check_elements(paper, "B", state).set_index("quantity")
+    blamed = [q for q in db.index if db.loc[q, "comparable"] and not db.loc[q, "match"]]
+    rows = []
+    for q in blamed:
+        for label, d in (("reading A", da), ("reading B", db)):
+            rows.append({"quantity": f"{label} | {q}", "unit": d.loc[q, "unit"], "paper": d.loc[q, "paper"],
+                         "reproduced": d.loc[q, "derived"], "tolerance": 1e-9, "tolerance_kind": "rel",
+                         "note": "erratum under both readings" if q in _ERRATA and not da.loc[q, "match"] else
+                                 ("reproduced under reading A: a convention, recorded as an inconsistency"
+                                  if da.loc[q, "match"] else "")})
+    return rows
+
+
 def eq1_checks(point):
     """Structure of duan2023 eq. (1) from the navigation core: largest |M_pφ|, the scalar k with
     G_gyro = k C_b^n (attitude rows), G_accel = k C_b^n (velocity rows), largest position forcing,
