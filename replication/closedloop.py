@@ -339,7 +339,8 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     tmp = np.empty(max(n_dyn, n))
     Ta = np.ascontiguousarray(spec.ar_T[9:, 9:])
     store_nav = out.nav_st.shape[1] > 0
-    record = out.rec_x.shape[1] > 0
+    record = out.rec_Phi.shape[0] > 0
+    record_x = out.rec_x.shape[1] > 0
     if store_nav:
         for r in range(R):
             out.nav_st[r, 0, :] = bs_.st[r]
@@ -371,9 +372,6 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                 for t in range(n_dyn):
                     for jj in range(n_aug):
                         gains.Phid[j, t, jj] = Phi[9 + spec.dyn_rows[t], 9 + jj]
-                if record:
-                    out.rec_Phi[j] = Phi
-                    out.rec_Pp[j] = lead.P
             # sensor-error estimates with dynamics (Markov, gravity) follow Φ
             for r in range(R):
                 for t in range(n_dyn):
@@ -391,6 +389,14 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                         lead.Pbar[:, :] = spec.ar_T @ lead.Pbar @ spec.ar_T.T + spec.ar_Q
                 for r in range(R):
                     bs_.p_hat[r, :] = Ta @ bs_.p_hat[r]
+            if is_lead and record:
+                # the transition from the last epoch's P⁺ to this epoch's P⁻ (T Φ at an AR epoch)
+                if inp.ar_tick[j]:
+                    out.rec_Phi[j] = spec.ar_T @ Phi
+                else:
+                    out.rec_Phi[j] = Phi
+                if out.rec_Pp.shape[0] > 0:
+                    out.rec_Pp[j] = lead.P
             # ---------------- measurement rows and gains (lead)
             if is_lead:
                 K._q2c(bs_.q[0], c)
@@ -450,7 +456,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                 out.nis[r, j] = nis
                 for a in range(m):
                     out.innov[r, j, a] = z[a]
-                if record:
+                if record_x:
                     out.rec_x[r, j, :] = xk
                 K._feedback_nav(xk, st_r, bs_.st_prev[r], q_r, ph_r, qtmp, e)
                 K._feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, bs_.g_extra[r])
@@ -470,12 +476,12 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
             if is_lead:
                 for i in range(n):
                     out.pdiag[j, i] = lead.P[i, i]
-                if record:
+                if record and out.rec_Pf.shape[0] > 0:
                     out.rec_Pf[j] = lead.P
                 f = out.flag[j]
                 if f >= 0 and out.P.shape[0] > 0:
                     out.P[f] = lead.P
-                    if spec.use_pbar:
+                    if spec.use_pbar and out.Pbar.shape[0] > 0:
                         out.Pbar[f] = lead.Pbar
             K._reset_interval(Cpl, fsum, Csum, navsum)
             sums[0] = 0.0
@@ -569,6 +575,161 @@ def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, o
                     for k in range(n):
                         out_Ps[f, i, k] = Ps[i, k]
 
+
+@njit(**_NJ)
+def _column_nonzeros(Phi, nzc, nzv, cnt):
+    """Row indices ``nzc[i, :cnt[i]]`` and values ``nzv`` of the non-zeros of Φ's column i."""
+    n = Phi.shape[0]
+    for i in range(n):
+        cnt[i] = 0
+    for k in range(n):
+        for i in range(n):
+            v = Phi[k, i]
+            if v != 0.0:
+                c = cnt[i]
+                nzc[i, c] = k
+                nzv[i, c] = v
+                cnt[i] = c + 1
+
+
+@njit(**_NJ)
+def _congruence_transposed(L, W, nzc, nzv, cnt):
+    """L ← Φᵀ L Φ for a symmetric L, from the non-zeros of Φ's columns (``_column_nonzeros``; Φ of
+    an INS error model is sparse)."""
+    n = L.shape[0]
+    # W = Φᵀ L (row i: Σ_k Φ_ki L[k, :]), then (Φᵀ L Φ)_ij = Σ_k W[i, k] Φ_kj
+    for i in range(n):
+        for j in range(n):
+            W[i, j] = 0.0
+        for t in range(cnt[i]):
+            k = nzc[i, t]
+            v = nzv[i, t]
+            for j in range(n):
+                W[i, j] += v * L[k, j]
+    for i in range(n):
+        for j in range(i, n):
+            acc = 0.0
+            for t in range(cnt[j]):
+                acc += W[i, nzc[j, t]] * nzv[j, t]
+            L[i, j] = acc
+            L[j, i] = acc
+
+
+@njit(**_NJ)
+def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov, transition_first):
+    """Backward pass over one chunk of the closed-loop filter in the modified Bryson-Frazier form
+    of the fixed-interval smoother (Bierman 1977, ch. X): the same smoothed error and covariance as
+    the Rauch-Tung-Striebel recursion of :func:`rts_chunk`, without inverting P⁻ and with the
+    O(n³) products only at the epochs kept.
+
+    With the adjoint λ_k (and its covariance Λ_k) of the epoch after its update, the smoothed error
+    of the solution after feedback is d_k = −P_k⁺ λ_k and P^s_k = P_k⁺ − P_k⁺ Λ_k P_k⁺.  Going back
+    through the scalar updates a = m−1 … 0 of epoch k (rows h_a, gains K_a, innovation variances
+    s_a, innovations ν_a of the sequential update):
+
+        λ ← λ − h_a (K_aᵀ λ + ν_a / s_a),
+        Λ ← (I − K_a h_aᵀ)ᵀ Λ (I − K_a h_aᵀ) + h_a h_aᵀ / s_a,
+
+    then λ_{k−1} = Φ_kᵀ λ, Λ_{k−1} = Φ_kᵀ Λ Φ_k; λ = 0, Λ = 0 after the last epoch.  The innovations
+    are recomputed from the raw ones ``z`` (runs × epochs × rows, INS − GNSS) as the filter formed
+    them (the same numbers).  ``Phi``, ``m``, ``H``, ``Kg``, ``s`` per epoch of the chunk (the
+    lead's pass), ``Pf`` the P⁺ of the flagged epochs (``flag`` ≥ 0, their index in
+    ``out_ds``/``out_Ps``).  ``lam`` (runs × n) and ``Lam`` hold λ, Λ of the last epoch of the
+    chunk on entry and of the epoch before the chunk on return (the transition of the chunk's first
+    epoch is applied only when ``transition_first``).  Without ``with_cov`` only λ is propagated."""
+    E_ = Phi.shape[0]
+    R = lam.shape[0]
+    n = Phi.shape[1]
+    nu = np.empty(_MMAX)
+    x = np.empty(n)
+    u = np.empty(n)
+    tmp = np.empty(n)
+    hz = np.empty((_MMAX, n), np.int64)
+    nh = np.empty(_MMAX, np.int64)
+    W = np.empty((n, n))
+    nzc = np.empty((n, n), np.int64)
+    nzv = np.empty((n, n))
+    cnt = np.empty(n, np.int64)
+    for jj in range(E_ - 1, -1, -1):
+        f = flag[jj]
+        if f >= 0:
+            P = Pf[f]
+            for r in range(R):
+                for i in range(n):
+                    acc = 0.0
+                    for k in range(n):
+                        acc += P[i, k] * lam[r, k]
+                    out_ds[r, f, i] = -acc
+            if with_cov:
+                G = P @ (Lam @ P)
+                for i in range(n):
+                    for k in range(i, n):
+                        v = P[i, k] - 0.5 * (G[i, k] + G[k, i])
+                        out_Ps[f, i, k] = v
+                        out_Ps[f, k, i] = v
+        mj = m[jj]
+        for a in range(mj):
+            c = 0
+            for k in range(n):
+                if H[jj, a, k] != 0.0:
+                    hz[a, c] = k
+                    c += 1
+            nh[a] = c
+        # ---------------- the epoch's scalar updates, last first
+        for r in range(R):
+            # the innovations of the sequential update (the zero entries of H skipped: the same sums)
+            for i in range(n):
+                x[i] = 0.0
+            for a in range(mj):
+                v = z[r, jj, a]
+                for t in range(nh[a]):
+                    k = hz[a, t]
+                    v -= H[jj, a, k] * x[k]
+                for i in range(n):
+                    x[i] += Kg[jj, a, i] * v
+                nu[a] = v
+            for a in range(mj - 1, -1, -1):
+                g = nu[a] / s[jj, a]
+                for k in range(n):
+                    g += Kg[jj, a, k] * lam[r, k]
+                for t in range(nh[a]):
+                    k = hz[a, t]
+                    lam[r, k] -= H[jj, a, k] * g
+        if with_cov:
+            for a in range(mj - 1, -1, -1):
+                c = 0.0
+                for i in range(n):
+                    acc = 0.0
+                    for k in range(n):
+                        acc += Lam[i, k] * Kg[jj, a, k]
+                    u[i] = acc
+                    c += Kg[jj, a, i] * acc
+                c += 1.0 / s[jj, a]
+                # Λ + c h hᵀ − (h uᵀ + u hᵀ): only the rows and columns of h's non-zeros change; each
+                # pair (i, k) once, the increment symmetric in (i, k) to the last bit
+                for t in range(nh[a]):
+                    i = hz[a, t]
+                    hi = H[jj, a, i]
+                    for k in range(n):
+                        hk = H[jj, a, k]
+                        if hk != 0.0 and k < i:
+                            continue
+                        v = Lam[i, k] + (c * (hi * hk) - (hi * u[k] + u[i] * hk))
+                        Lam[i, k] = v
+                        Lam[k, i] = v
+        # ---------------- back through the transition into the previous epoch
+        if jj > 0 or transition_first:
+            _column_nonzeros(Phi[jj], nzc, nzv, cnt)
+            for r in range(R):
+                for i in range(n):
+                    acc = 0.0
+                    for t in range(cnt[i]):
+                        acc += nzv[i, t] * lam[r, nzc[i, t]]
+                    tmp[i] = acc
+                for i in range(n):
+                    lam[r, i] = tmp[i]
+            if with_cov:
+                _congruence_transposed(Lam, W, nzc, nzv, cnt)
 
 # ----------------------------------------------------------------------------- configuration
 
@@ -692,7 +853,7 @@ def _empty_gains(E_, n, n_dyn, n_aug, with_P):
 def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *, record_every: int = 1,
         chunk_epochs: int = 2000, smoother: bool = False, smoother_covariance: bool = True,
-        store_nav: bool = False, store_P: bool = True, workers: int = 2) -> Records:
+        smoother_form: str = "mbf", store_nav: bool = False, store_P: bool = True, workers: int = 2) -> Records:
     """Run the closed-loop filter of ``spec`` over ``n_steps`` IMU steps for the runs of ``state``.
 
     Parameters
@@ -715,7 +876,13 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     chunk_epochs : int
         Epochs per chunk (memory of the gains and of the smoother's records).
     smoother, smoother_covariance : bool
-        Add the RTS pass (replaying the forward pass chunk by chunk), with or without P^s.
+        Add the fixed-interval smoother pass (replaying the forward pass chunk by chunk), with or
+        without P^s.
+    smoother_form : {"mbf", "rts"}
+        The smoother's backward recursion: the modified Bryson-Frazier form (:func:`mbf_chunk`,
+        the default) or the Rauch-Tung-Striebel covariance form (:func:`rts_chunk`); the two give
+        the same smoothed error and covariance (to rounding).  The MBF form inverts nothing and
+        forms the O(n³) products only at the recorded epochs.
     store_nav : bool
         Keep the IMU-rate solution.
     store_P : bool
@@ -734,6 +901,9 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         raise ValueError(f"ep_samples must be strictly increasing sample indices in 1..{n_steps}")
     if int(record_every) < 1 or int(chunk_epochs) < 2 or int(workers) < 1:
         raise ValueError("record_every ≥ 1, chunk_epochs ≥ 2 and workers ≥ 1 are required")
+    if smoother_form not in ("mbf", "rts"):
+        raise ValueError('smoother_form must be "mbf" or "rts"')
+    rts = smoother_form == "rts"
     P0 = np.array(P0, dtype=float)
     if P0.shape != (n, n):
         raise ValueError(f"P0 must be {n}×{n}")
@@ -771,13 +941,16 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         n_f = int(np.sum(flag >= 0))
         nav = (k1 - k0 + 1) if store_nav else 0
         e3 = np.empty((0, n, n))
+        # the smoother's replay (``record``) keeps Φ per epoch and P⁺ at the recorded epochs; the RTS
+        # form also P⁺, P⁻ and the estimates x̂ per epoch
         return ChunkOut(np.empty((R, E_, 6)), np.empty((R, E_, 4)), np.empty((R, E_, n_aug)), np.empty((R, E_)),
                         np.zeros((R, E_, _MMAX)), np.full((R, E_), np.nan) if spec.nees else np.empty((R, 0)),
                         np.empty((R, nav, 6)), np.empty((R, nav, 4)), np.empty((E_, n)), flag,
-                        np.empty((n_f, n, n)) if store_P else e3, np.empty((n_f, n, n)) if spec.use_pbar and store_P else e3,
-                        np.empty((E_, n, n)) if record else e3, np.empty((E_, n, n)) if record else e3,
+                        np.empty((n_f, n, n)) if store_P or record else e3,
+                        np.empty((n_f, n, n)) if spec.use_pbar and store_P else e3,
+                        np.empty((E_, n, n)) if record and rts else e3, np.empty((E_, n, n)) if record and rts else e3,
                         np.empty((E_, n, n)) if record else e3,
-                        np.empty((R, E_, n)) if record else np.empty((R, 0, n)))
+                        np.empty((R, E_, n)) if record and rts else np.empty((R, 0, n)))
 
     def view(o: ChunkOut, sl) -> ChunkOut:
         per_run = {"st", "q", "phat", "nis", "innov", "nees", "nav_st", "nav_q", "rec_x"}
@@ -810,7 +983,7 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         lead_pass(st_, lead_, x, g, o)
         for t in start_followers(st_, lead_, x, g, o):
             t.join()
-        return j0, j1, o
+        return j0, j1, o, g
 
     # forward pass, pipelined: the lead runs chunk c while the followers finish chunk c − 1
     checkpoints = []
@@ -834,7 +1007,7 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
             checkpoints.append((ck, row0[1]))
         pending = (start_followers(state, lead, x, g, o), j0, j1, o, bounds(ci)[2] if store_nav else None)
     if smoother:
-        _smooth(res, chunks, checkpoints, forward, rec_pos, R, n, m_rec, smoother_covariance)
+        _smooth(res, chunks, checkpoints, forward, rec_pos, R, n, m_rec, smoother_covariance, rts)
     return res
 
 
@@ -860,9 +1033,10 @@ def _collect(res: Records, j0, j1, o, rec_pos, spec, k0):
         res.nav_q[:, k0:k0 + o.nav_q.shape[1]] = o.nav_q
 
 
-def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, with_cov):
-    """RTS pass: chunks replayed from their checkpoints (newest first) on a second thread while
-    the backward recursion runs over the chunk replayed before."""
+def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, with_cov, rts):
+    """Smoother pass: chunks replayed from their checkpoints (newest first) on a second thread
+    while the backward recursion (:func:`mbf_chunk`, or :func:`rts_chunk` when ``rts``) runs over
+    the chunk replayed before."""
     res.ds = np.empty((R, m_rec, n))
     res.P_s = np.empty((m_rec, n, n)) if with_cov else None
     ds = np.zeros((R, n))
@@ -877,7 +1051,7 @@ def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, wi
     with ThreadPoolExecutor(max_workers=1) as ex:
         fut = ex.submit(replay, len(chunks) - 1)
         for ci in range(len(chunks) - 1, -1, -1):
-            j0, j1, o = fut.result()
+            j0, j1, o, g = fut.result()
             if ci > 0:
                 fut = ex.submit(replay, ci - 1)
             E_ = j1 - j0
@@ -885,13 +1059,17 @@ def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, wi
             o_ds = np.empty((R, n_f, n))
             o_Ps = np.empty((n_f if with_cov else 0, n, n))
             o_pd = np.empty((E_, n))
-            if nxt is None:
+            if not rts:
+                # ds, Ps: the adjoint λ (runs × n) and its covariance Λ
+                mbf_chunk(o.rec_Phi, g.m, g.H, g.Kg, g.s, o.innov, o.P, o.flag, ds, Ps, o_ds, o_Ps, with_cov, ci > 0)
+            elif nxt is None:
                 rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, False, o.rec_Pp[0], o.rec_Phi[0],
                           np.ascontiguousarray(o.rec_x[:, 0, :]), ds, Ps, o.flag, o_ds, o_Ps, o_pd, with_cov)
             else:
                 rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, True, nxt[0], nxt[1], nxt[2], ds, Ps, o.flag,
                           o_ds, o_Ps, o_pd, with_cov)
-            nxt = (o.rec_Pp[0].copy(), o.rec_Phi[0].copy(), np.ascontiguousarray(o.rec_x[:, 0, :]))
+            if rts:
+                nxt = (o.rec_Pp[0].copy(), o.rec_Phi[0].copy(), np.ascontiguousarray(o.rec_x[:, 0, :]))
             pos = rec_pos[j0:j1][o.flag >= 0]
             res.ds[:, pos] = o_ds
             if with_cov:

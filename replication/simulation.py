@@ -518,7 +518,8 @@ def _check_traj(traj, setup):
 def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int = 20, seed: int = 0,
               chunk_epochs: int = 1000, record_every: int = 20, smoother: bool = False,
               smoother_covariance: bool = True, prior_covariance: bool = False, first_run: int = 0,
-              fixed_constants: bool = False, series_order: int = 4, workers: int = 2) -> BatchResult:
+              fixed_constants: bool = False, series_order: int = 4, workers: int = 2,
+              smoother_form: str = "mbf") -> BatchResult:
     """Monte Carlo of the closed-loop INS/GNSS filter of ``model`` on ``traj`` with the truth of
     ``setup`` (chen2019 eq. (2-10) sensor errors, eq. (2-12) gravity disturbance, eq. (2-13)
     lever arm, Table 4-41 noise), batched across ``n_runs`` runs (see the module docstring).
@@ -526,7 +527,9 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
     ``record_every`` GNSS epochs are recorded (20 → 1 Hz at 20-Hz GNSS); ``smoother`` adds the
     RTS pass (replaying the forward pass chunk by chunk, ``chunk_epochs`` epochs each);
     ``smoother_covariance=False`` skips the smoothed covariance (P^s) and keeps only the smoothed
-    states (about a third faster); ``prior_covariance`` propagates the covariance without
+    states; ``smoother_form`` picks the backward recursion (:func:`replication.closedloop.run`: the
+    modified Bryson-Frazier form or the Rauch-Tung-Striebel covariance form, the same results to
+    rounding); ``prior_covariance`` propagates the covariance without
     measurements as well (for :func:`observable_nees`).  Runs are numbered ``first_run`` ..
     ``first_run + n_runs - 1``; run r's truth depends only on (``seed``, r), so run r processed
     alone (``first_run=r, n_runs=1``) is an exact extended filter of the same truth.
@@ -587,7 +590,7 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
 
     rec = CL.run(spec, CL.initial_batch_state(st, q, lever0), model.P0(), ep_samples, N, inputs,
                  record_every=record_every, chunk_epochs=chunk_epochs, smoother=smoother,
-                 smoother_covariance=smoother_covariance, workers=workers)
+                 smoother_covariance=smoother_covariance, smoother_form=smoother_form, workers=workers)
     nav_err = navigation_errors(rec.st, rec.q, truth_st[rec_ep], truth_q[rec_ep])
     p_true = truth_parameters(model, truth.const, procs_rec)
     return BatchResult(model=model, setup=setup, t=traj.t[ep_samples[rec_ep]], epoch_index=ep_samples[rec_ep],
