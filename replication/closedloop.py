@@ -851,7 +851,8 @@ def _empty_gains(E_, n, n_dyn, n_aug, with_P):
 
 
 def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
-        inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *, record_every: int = 1,
+        inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *,
+        lead_inputs: Callable[[int, int, int, np.ndarray], ChunkInputs] | None = None, record_every: int = 1,
         chunk_epochs: int = 2000, smoother: bool = False, smoother_covariance: bool = True,
         smoother_form: str = "mbf", store_nav: bool = False, store_P: bool = True, workers: int = 2) -> Records:
     """Run the closed-loop filter of ``spec`` over ``n_steps`` IMU steps for the runs of ``state``.
@@ -871,6 +872,9 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     inputs : callable
         ``inputs(chunk, k0, k1, ep_samples_of_chunk)`` → :class:`ChunkInputs` for steps k0..k1-1
         (deterministic: the smoother replays chunks).
+    lead_inputs : callable, optional
+        The same for run 0 alone (arrays of one run), for the smoother's replay of the lead;
+        by default run 0's slice of ``inputs``.
     record_every : int
         Record every ``record_every``-th epoch (the P's and the per-run records).
     chunk_epochs : int
@@ -882,7 +886,10 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         The smoother's backward recursion: the modified Bryson-Frazier form (:func:`mbf_chunk`,
         the default) or the Rauch-Tung-Striebel covariance form (:func:`rts_chunk`); the two give
         the same smoothed error and covariance (to rounding).  The MBF form inverts nothing and
-        forms the O(n³) products only at the recorded epochs.
+        forms the O(n³) products only at the recorded epochs; it needs per epoch the lead's Φ,
+        rows and gains and every run's innovations, so the forward pass keeps the innovations
+        (runs × epochs × rows) and the replay re-runs the lead alone.  The RTS form needs every
+        run's estimates and replays the whole batch.
     store_nav : bool
         Keep the IMU-rate solution.
     store_P : bool
@@ -934,7 +941,7 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         k1 = n_steps if ci == len(chunks) - 1 else int(ep[j1 - 1])
         return j0, j1, k0, k1
 
-    def chunk_out(ci, j0, j1, k0, k1, record):
+    def chunk_out(ci, j0, j1, k0, k1, record, R=R, store_nav=store_nav):
         E_ = j1 - j0
         flag = rec_pos[j0:j1] - (rec_pos[j0:j1][rec_pos[j0:j1] >= 0].min() if np.any(rec_pos[j0:j1] >= 0) else 0)
         flag = np.where(rec_pos[j0:j1] >= 0, flag, -1).astype(np.int64)
@@ -985,29 +992,60 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
             t.join()
         return j0, j1, o, g
 
-    # forward pass, pipelined: the lead runs chunk c while the followers finish chunk c − 1
+    # the lead's replay for the smoother: neither the covariance without measurements nor the NEES
+    spec_replay = spec._replace(use_pbar=False, nees=False)
+
+    def replay_lead(ci, st0, lead_):
+        """The lead alone over chunk ``ci`` from its checkpoint, recording for the smoother."""
+        j0, j1, k0, k1 = bounds(ci)
+        x = (lead_inputs(ci, k0, k1, ep[j0:j1]) if lead_inputs is not None
+             else inp_view(inputs(ci, k0, k1, ep[j0:j1]), slice(0, 1)))
+        o = chunk_out(ci, j0, j1, k0, k1, True, R=1, store_nav=False)
+        g = _empty_gains(j1 - j0, n, n_dyn, n_aug, False)
+        filter_chunk(spec_replay, x, st0, lead_, g, o, True)
+        return j0, j1, o, g
+
+    # forward pass, pipelined: the lead runs chunk c while the followers finish chunk c − 1 and the
+    # inputs of chunk c + 1 are prepared (``inputs`` is called in chunk order, from one thread)
     checkpoints = []
+    innov = [None] * len(chunks)
     pending = None
+    prep = ThreadPoolExecutor(max_workers=1)
+    nxt_prep = prep.submit(prepare, 0, False)
     for ci in range(len(chunks) + 1):
         if ci < len(chunks):
-            j0, j1, x, o, g = prepare(ci, False)
+            j0, j1, x, o, g = nxt_prep.result()
+            if ci + 1 < len(chunks):
+                nxt_prep = prep.submit(prepare, ci + 1, False)
             row0 = (BatchState(*(v[:1].copy() for v in state)), LeadState(*(v.copy() for v in lead)))
             lead_pass(state, lead, x, g, o)
         if pending is not None:
             for t in pending[0]:
                 t.join()
             _collect(res, pending[1], pending[2], pending[3], rec_pos, spec, pending[4])
+            if smoother and not rts:
+                # every run's innovations, for the smoother (the rows in use)
+                innov[ci - 1] = np.ascontiguousarray(pending[3].innov[:, :, :int(pending[5].m.max())])
             pending = None
         if ci == len(chunks):
             break
-        if smoother:
+        if smoother and rts:
             ck = BatchState(*(v.copy() for v in state))
             for v, v0 in zip(ck, row0[0]):
                 v[:1] = v0
             checkpoints.append((ck, row0[1]))
-        pending = (start_followers(state, lead, x, g, o), j0, j1, o, bounds(ci)[2] if store_nav else None)
+        elif smoother:
+            checkpoints.append(row0)
+        pending = (start_followers(state, lead, x, g, o), j0, j1, o, bounds(ci)[2] if store_nav else None, g)
+    prep.shutdown()
+
+    def replay(ci):
+        st_c, lead_c = checkpoints[ci]
+        checkpoints[ci] = None
+        return forward(ci, st_c, lead_c, True) if rts else replay_lead(ci, st_c, lead_c)
+
     if smoother:
-        _smooth(res, chunks, checkpoints, forward, rec_pos, R, n, m_rec, smoother_covariance, rts)
+        _smooth(res, chunks, replay, innov, rec_pos, R, n, m_rec, smoother_covariance, rts)
     return res
 
 
@@ -1033,27 +1071,24 @@ def _collect(res: Records, j0, j1, o, rec_pos, spec, k0):
         res.nav_q[:, k0:k0 + o.nav_q.shape[1]] = o.nav_q
 
 
-def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, with_cov, rts):
-    """Smoother pass: chunks replayed from their checkpoints (newest first) on a second thread
-    while the backward recursion (:func:`mbf_chunk`, or :func:`rts_chunk` when ``rts``) runs over
-    the chunk replayed before."""
+def _smooth(res: Records, chunks, replay, innov, rec_pos, R, n, m_rec, with_cov, rts):
+    """Smoother pass: chunks replayed (``replay(chunk)``, newest first) ahead on other threads
+    while the backward recursion runs over the chunk replayed before: :func:`mbf_chunk` on the
+    lead's records and the forward pass's innovations ``innov`` (per chunk; the lead's replays
+    start from independent checkpoints, two run at once), or :func:`rts_chunk` when ``rts`` (one
+    replay of the whole batch at a time)."""
     res.ds = np.empty((R, m_rec, n))
     res.P_s = np.empty((m_rec, n, n)) if with_cov else None
     ds = np.zeros((R, n))
     Ps = np.zeros((n, n))
     nxt = None
-
-    def replay(ci):
-        st_c, lead_c = checkpoints[ci]
-        checkpoints[ci] = None
-        return forward(ci, st_c, lead_c, True)
-
-    with ThreadPoolExecutor(max_workers=1) as ex:
-        fut = ex.submit(replay, len(chunks) - 1)
+    ahead = 1 if rts else 2
+    with ThreadPoolExecutor(max_workers=ahead) as ex:
+        futs = {c: ex.submit(replay, c) for c in range(len(chunks) - 1, max(len(chunks) - 1 - ahead, -1), -1)}
         for ci in range(len(chunks) - 1, -1, -1):
-            j0, j1, o, g = fut.result()
-            if ci > 0:
-                fut = ex.submit(replay, ci - 1)
+            j0, j1, o, g = futs.pop(ci).result()
+            if ci - ahead >= 0:
+                futs[ci - ahead] = ex.submit(replay, ci - ahead)
             E_ = j1 - j0
             n_f = int(np.sum(o.flag >= 0))
             o_ds = np.empty((R, n_f, n))
@@ -1061,7 +1096,9 @@ def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, wi
             o_pd = np.empty((E_, n))
             if not rts:
                 # ds, Ps: the adjoint λ (runs × n) and its covariance Λ
-                mbf_chunk(o.rec_Phi, g.m, g.H, g.Kg, g.s, o.innov, o.P, o.flag, ds, Ps, o_ds, o_Ps, with_cov, ci > 0)
+                mbf_chunk(o.rec_Phi, g.m, g.H, g.Kg, g.s, innov[ci], o.P, o.flag, ds, Ps, o_ds, o_Ps, with_cov,
+                          ci > 0)
+                innov[ci] = None
             elif nxt is None:
                 rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, False, o.rec_Pp[0], o.rec_Phi[0],
                           np.ascontiguousarray(o.rec_x[:, 0, :]), ds, Ps, o.flag, o_ds, o_Ps, o_pd, with_cov)

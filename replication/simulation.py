@@ -362,11 +362,13 @@ class _Truth:
             q[r] = dcm_to_quat(rotvec_to_dcm(-d[6:9]) @ C)
         return st, q
 
-    def chunk(self, c: int, k0: int, k1: int, ep_samples, state):
+    def chunk(self, c: int, k0: int, k1: int, ep_samples, state, runs: int | None = None):
         """Corrupted increments (R, k1-k0, 3) of steps k0..k1-1 and GNSS fixes at ``ep_samples``;
         ``state`` carries the AR(1) values (updated in place).  Returns also the process values at
-        the epochs (value of the interval ending at the epoch)."""
-        s, tr, R = self.setup, self.traj, self.R
+        the epochs (value of the interval ending at the epoch).  ``runs``: only the first ``runs``
+        runs (each run's numbers do not depend on the others)."""
+        s, tr = self.setup, self.traj
+        R = self.R if runs is None else int(runs)
         Kn = k1 - k0
         T = tr.t[k0 + 1:k1 + 1] - tr.t[k0:k1]
         Tm = float(np.median(T))
@@ -573,22 +575,23 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
     procs_rec = {k: np.empty((n_runs, len(rec_ep), 3)) for k in ("gyro_markov", "accel_markov", "gravity")}
     ar_start = {0: {k: v.copy() for k, v in truth.x0.items()}}
 
-    def inputs(ci, k0, k1, eps):
+    def inputs(ci, k0, k1, eps, runs=None):
         # the AR(1) state at the chunk's start is kept, so that a replay draws the same inputs
         ar_ = {k: v.copy() for k, v in ar_start[ci].items()}
-        dth, dvv, gpos, gvel, procs = truth.chunk(ci, k0, k1, eps, ar_)
-        if ci + 1 not in ar_start:
+        dth, dvv, gpos, gvel, procs = truth.chunk(ci, k0, k1, eps, ar_, runs=runs)
+        if runs is None and ci + 1 not in ar_start:
             ar_start[ci + 1] = ar_
             j0 = int(np.searchsorted(ep_samples, eps[0]))
             pos = rec_pos[j0:j0 + len(eps)]
             for k in procs_rec:
                 procs_rec[k][:, pos[pos >= 0]] = procs[k][:, pos >= 0]
-        extra = CL.no_windows(k1 - k0, len(eps), n_runs, n_aug)
+        extra = CL.no_windows(k1 - k0, len(eps), n_runs if runs is None else runs, n_aug)
         return CL.ChunkInputs(dt=np.ascontiguousarray(dtv[k0:k1]), dth=dth, dvv=dvv, h_ref=np.zeros(k1 - k0 + 1),
                               vu_ref=np.zeros(k1 - k0 + 1), ep_step=(np.asarray(eps) - 1 - k0).astype(np.int64),
                               gpos=gpos, gvel=gvel, **extra)
 
     rec = CL.run(spec, CL.initial_batch_state(st, q, lever0), model.P0(), ep_samples, N, inputs,
+                 lead_inputs=lambda ci, k0, k1, eps: inputs(ci, k0, k1, eps, runs=1),
                  record_every=record_every, chunk_epochs=chunk_epochs, smoother=smoother,
                  smoother_covariance=smoother_covariance, smoother_form=smoother_form, workers=workers)
     nav_err = navigation_errors(rec.st, rec.q, truth_st[rec_ep], truth_q[rec_ep])
