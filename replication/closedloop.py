@@ -76,8 +76,9 @@ BatchState = namedtuple("BatchState", ["st", "st_prev", "q", "p_hat", "lever", "
 #: without measurements), window sums of f^n and of the accelerometer couplings.
 LeadState = namedtuple("LeadState", ["P", "Pbar", "facc", "Cw"])
 
-#: What the lead leaves, per epoch, for the runs that follow it.
-Gains = namedtuple("Gains", ["m", "H", "Kg", "s", "Phid", "P"])
+#: What the lead leaves, per epoch, for the runs that follow it (with the NEES: the standard
+#: deviations of P⁺ and the Cholesky factor of P⁺ scaled to a correlation matrix).
+Gains = namedtuple("Gains", ["m", "H", "Kg", "s", "Phid", "nees_sd", "nees_L"])
 
 #: Outputs of one chunk (per run and epoch unless noted).
 ChunkOut = namedtuple("ChunkOut", ["st", "q", "phat", "nis", "innov", "nees", "nav_st", "nav_q", "pdiag",
@@ -420,8 +421,8 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                 _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j], tmp)
                 for a in range(m):
                     gains.H[j, a, :] = H[a]
-                if gains.P.shape[0] > 0:
-                    gains.P[j] = lead.P
+                if gains.nees_L.shape[0] > 0:
+                    K._chol_scaled(lead.P, gains.nees_sd[j], gains.nees_L[j])
                 if sf >= 0:
                     lead.facc[:] = 0.0
                     lead.Cw[:, :] = 0.0
@@ -472,7 +473,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                     _attitude_error(q_r, inp.truth_q[j], e)
                     for i in range(n_aug):
                         e[9 + i] = inp.truth_p[r, j, i] - ph_r[i]
-                    out.nees[r, j] = K._chol_solve_scaled(gains.P[j], e)
+                    out.nees[r, j] = K._solve_scaled(gains.nees_L[j], gains.nees_sd[j], e)
             if is_lead:
                 for i in range(n):
                     out.pdiag[j, i] = lead.P[i, i]
@@ -577,27 +578,34 @@ def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, o
 
 
 @njit(**_NJ)
-def _column_nonzeros(Phi, nzc, nzv, cnt):
-    """Row indices ``nzc[i, :cnt[i]]`` and values ``nzv`` of the non-zeros of Φ's column i."""
+def _nonzeros(Phi, nzc, nzv, cnt, rzc, rzv, rcnt):
+    """The non-zeros of Φ by column (row indices ``nzc[i, :cnt[i]]``, values ``nzv``) and by row
+    (column indices ``rzc[k, :rcnt[k]]``, values ``rzv``)."""
     n = Phi.shape[0]
     for i in range(n):
         cnt[i] = 0
     for k in range(n):
+        c = 0
         for i in range(n):
             v = Phi[k, i]
             if v != 0.0:
-                c = cnt[i]
-                nzc[i, c] = k
-                nzv[i, c] = v
-                cnt[i] = c + 1
+                rzc[k, c] = i
+                rzv[k, c] = v
+                c += 1
+                ci = cnt[i]
+                nzc[i, ci] = k
+                nzv[i, ci] = v
+                cnt[i] = ci + 1
+        rcnt[k] = c
 
 
 @njit(**_NJ)
-def _congruence_transposed(L, W, nzc, nzv, cnt):
-    """L ← Φᵀ L Φ for a symmetric L, from the non-zeros of Φ's columns (``_column_nonzeros``; Φ of
-    an INS error model is sparse)."""
+def _congruence_transposed(Phi, L, W, row, nzc, nzv, cnt, rzc, rzv, rcnt):
+    """L ← Φᵀ L Φ for a symmetric L, from the non-zeros of Φ (``_nonzeros``; Φ of an INS error
+    model is sparse: dense navigation rows, sensor rows with one non-zero or two): W = Φᵀ L row by
+    row (row i: Σ_k Φ_ki L[k, :]), then row i of W Φ as Σ_k W[i, k] Φ[k, :] (a dense row of Φ
+    whole, a sparse one by its non-zeros); the upper triangle is kept and mirrored."""
     n = L.shape[0]
-    # W = Φᵀ L (row i: Σ_k Φ_ki L[k, :]), then (Φᵀ L Φ)_ij = Σ_k W[i, k] Φ_kj
     for i in range(n):
         for j in range(n):
             W[i, j] = 0.0
@@ -606,13 +614,23 @@ def _congruence_transposed(L, W, nzc, nzv, cnt):
             v = nzv[i, t]
             for j in range(n):
                 W[i, j] += v * L[k, j]
+    dense = n // 4
     for i in range(n):
+        for j in range(n):
+            row[j] = 0.0
+        for k in range(n):
+            w = W[i, k]
+            if w == 0.0:
+                continue
+            if rcnt[k] > dense:
+                for j in range(n):
+                    row[j] += w * Phi[k, j]
+            else:
+                for t in range(rcnt[k]):
+                    row[rzc[k, t]] += w * rzv[k, t]
         for j in range(i, n):
-            acc = 0.0
-            for t in range(cnt[j]):
-                acc += W[i, nzc[j, t]] * nzv[j, t]
-            L[i, j] = acc
-            L[j, i] = acc
+            L[i, j] = row[j]
+            L[j, i] = row[j]
 
 
 @njit(**_NJ)
@@ -636,30 +654,41 @@ def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov,
     lead's pass), ``Pf`` the P⁺ of the flagged epochs (``flag`` ≥ 0, their index in
     ``out_ds``/``out_Ps``).  ``lam`` (runs × n) and ``Lam`` hold λ, Λ of the last epoch of the
     chunk on entry and of the epoch before the chunk on return (the transition of the chunk's first
-    epoch is applied only when ``transition_first``).  Without ``with_cov`` only λ is propagated."""
+    epoch is applied only when ``transition_first``).  Without ``with_cov`` only λ is propagated.
+    The runs are processed side by side (λ as n × runs)."""
     E_ = Phi.shape[0]
     R = lam.shape[0]
     n = Phi.shape[1]
-    nu = np.empty(_MMAX)
-    x = np.empty(n)
+    L = np.ascontiguousarray(lam.T)
+    L2 = np.empty((n, R))
+    X = np.zeros((n, R))
+    Nu = np.empty((_MMAX, R))
+    acc = np.empty(R)
     u = np.empty(n)
-    tmp = np.empty(n)
+    row = np.empty(n)
     hz = np.empty((_MMAX, n), np.int64)
     nh = np.empty(_MMAX, np.int64)
+    used = np.empty(n, np.int64)
     W = np.empty((n, n))
     nzc = np.empty((n, n), np.int64)
     nzv = np.empty((n, n))
     cnt = np.empty(n, np.int64)
+    rzc = np.empty((n, n), np.int64)
+    rzv = np.empty((n, n))
+    rcnt = np.empty(n, np.int64)
     for jj in range(E_ - 1, -1, -1):
         f = flag[jj]
         if f >= 0:
             P = Pf[f]
-            for r in range(R):
-                for i in range(n):
-                    acc = 0.0
-                    for k in range(n):
-                        acc += P[i, k] * lam[r, k]
-                    out_ds[r, f, i] = -acc
+            for i in range(n):
+                for r in range(R):
+                    acc[r] = 0.0
+                for k in range(n):
+                    p = P[i, k]
+                    for r in range(R):
+                        acc[r] += p * L[k, r]
+                for r in range(R):
+                    out_ds[r, f, i] = -acc[r]
             if with_cov:
                 G = P @ (Lam @ P)
                 for i in range(n):
@@ -668,43 +697,63 @@ def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov,
                         out_Ps[f, i, k] = v
                         out_Ps[f, k, i] = v
         mj = m[jj]
+        # the non-zeros of the epoch's rows, and the columns any row uses
+        for k in range(n):
+            used[k] = 0
         for a in range(mj):
             c = 0
             for k in range(n):
                 if H[jj, a, k] != 0.0:
                     hz[a, c] = k
+                    used[k] = 1
                     c += 1
             nh[a] = c
-        # ---------------- the epoch's scalar updates, last first
-        for r in range(R):
-            # the innovations of the sequential update (the zero entries of H skipped: the same sums)
-            for i in range(n):
-                x[i] = 0.0
-            for a in range(mj):
-                v = z[r, jj, a]
-                for t in range(nh[a]):
-                    k = hz[a, t]
-                    v -= H[jj, a, k] * x[k]
-                for i in range(n):
-                    x[i] += Kg[jj, a, i] * v
-                nu[a] = v
-            for a in range(mj - 1, -1, -1):
-                g = nu[a] / s[jj, a]
-                for k in range(n):
-                    g += Kg[jj, a, k] * lam[r, k]
-                for t in range(nh[a]):
-                    k = hz[a, t]
-                    lam[r, k] -= H[jj, a, k] * g
+        # ---------------- the innovations of the sequential update (H's zero entries skipped: the
+        # filter's sums), then back through the scalar updates, last first
+        for k in range(n):
+            if used[k]:
+                for r in range(R):
+                    X[k, r] = 0.0
+        for a in range(mj):
+            for r in range(R):
+                acc[r] = z[r, jj, a]
+            for t in range(nh[a]):
+                k = hz[a, t]
+                h = H[jj, a, k]
+                for r in range(R):
+                    acc[r] -= h * X[k, r]
+            for k in range(n):
+                if used[k]:
+                    g = Kg[jj, a, k]
+                    for r in range(R):
+                        X[k, r] += g * acc[r]
+            for r in range(R):
+                Nu[a, r] = acc[r]
+        for a in range(mj - 1, -1, -1):
+            sa = s[jj, a]
+            for r in range(R):
+                acc[r] = Nu[a, r] / sa
+            for k in range(n):
+                g = Kg[jj, a, k]
+                for r in range(R):
+                    acc[r] += g * L[k, r]
+            for t in range(nh[a]):
+                k = hz[a, t]
+                h = H[jj, a, k]
+                for r in range(R):
+                    L[k, r] -= h * acc[r]
         if with_cov:
             for a in range(mj - 1, -1, -1):
-                c = 0.0
                 for i in range(n):
-                    acc = 0.0
-                    for k in range(n):
-                        acc += Lam[i, k] * Kg[jj, a, k]
-                    u[i] = acc
-                    c += Kg[jj, a, i] * acc
-                c += 1.0 / s[jj, a]
+                    u[i] = 0.0
+                for k in range(n):
+                    g = Kg[jj, a, k]
+                    if g != 0.0:
+                        for i in range(n):
+                            u[i] += Lam[k, i] * g
+                c = 1.0 / s[jj, a]
+                for i in range(n):
+                    c += Kg[jj, a, i] * u[i]
                 # Λ + c h hᵀ − (h uᵀ + u hᵀ): only the rows and columns of h's non-zeros change; each
                 # pair (i, k) once, the increment symmetric in (i, k) to the last bit
                 for t in range(nh[a]):
@@ -719,17 +768,24 @@ def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov,
                         Lam[k, i] = v
         # ---------------- back through the transition into the previous epoch
         if jj > 0 or transition_first:
-            _column_nonzeros(Phi[jj], nzc, nzv, cnt)
-            for r in range(R):
-                for i in range(n):
-                    acc = 0.0
-                    for t in range(cnt[i]):
-                        acc += nzv[i, t] * lam[r, nzc[i, t]]
-                    tmp[i] = acc
-                for i in range(n):
-                    lam[r, i] = tmp[i]
+            Ph = Phi[jj]
+            _nonzeros(Ph, nzc, nzv, cnt, rzc, rzv, rcnt)
+            for i in range(n):
+                for r in range(R):
+                    acc[r] = 0.0
+                for t in range(cnt[i]):
+                    v = nzv[i, t]
+                    k = nzc[i, t]
+                    for r in range(R):
+                        acc[r] += v * L[k, r]
+                for r in range(R):
+                    L2[i, r] = acc[r]
+            L, L2 = L2, L
             if with_cov:
-                _congruence_transposed(Lam, W, nzc, nzv, cnt)
+                _congruence_transposed(Ph, Lam, W, row, nzc, nzv, cnt, rzc, rzv, rcnt)
+    for r in range(R):
+        for i in range(n):
+            lam[r, i] = L[i, r]
 
 # ----------------------------------------------------------------------------- configuration
 
@@ -844,10 +900,11 @@ class Records:
     P_s: np.ndarray | None = None
 
 
-def _empty_gains(E_, n, n_dyn, n_aug, with_P):
+def _empty_gains(E_, n, n_dyn, n_aug, with_nees):
+    E_n = E_ if with_nees else 0
     return Gains(np.zeros(E_, np.int64), np.zeros((E_, _MMAX, n)), np.zeros((E_, _MMAX, n)),
-                 np.ones((E_, _MMAX)), np.zeros((E_, max(n_dyn, 0), n_aug)),
-                 np.empty((E_ if with_P else 0, n, n)))
+                 np.ones((E_, _MMAX)), np.zeros((E_, max(n_dyn, 0), n_aug)), np.empty((E_n, n)),
+                 np.empty((E_n, n, n)))
 
 
 def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
