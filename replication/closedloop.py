@@ -12,7 +12,9 @@ chen2019 eq. (2-13)) and ``_specific_force_rows`` (chen2019 eq. (3-18)); the upd
 Joseph form one (independent) measurement at a time; then the navigation errors are fed back and
 the sensor-error estimates accumulated.  Optional: a vertical channel held or damped
 (:mod:`replication.strapdown`), discrete AR transitions of a gravity block at chosen epochs, the
-recording of (P⁺, P⁻, Φ, x̂) for the Rauch-Tung-Striebel smoother, NEES against a truth.
+recording of what the fixed-interval smoother needs (Φ, rows, gains and innovations for the
+modified Bryson-Frazier form :func:`mbf_chunk`; P⁺, P⁻, Φ, x̂ for the Rauch-Tung-Striebel form
+:func:`rts_chunk`), NEES against a truth.
 
 **Batches.** The covariance, the gains and the measurement matrix of a batch come from its
 first run (the *lead*); every run applies them to its own innovations, so run 0 is an exact
@@ -23,7 +25,7 @@ of one is the single-run filter.  The lead's pass records per epoch what the oth
 follow on other threads, chunk by chunk, while the lead goes on: the result does not depend on
 the number of threads.
 
-:func:`run` is the driver (chunks, threads, records, RTS); :func:`build_spec` bundles the
+:func:`run` is the driver (chunks, threads, records, smoother); :func:`build_spec` bundles the
 configuration of an :class:`replication.errors.ErrorModel`.  The public entry points are
 :func:`replication.kalman.closed_loop` (one run), :func:`replication.kalman.monte_carlo`,
 :func:`replication.simulation.run_batch` (chen2019 §4.2) and
@@ -928,10 +930,11 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         Number of IMU steps.
     inputs : callable
         ``inputs(chunk, k0, k1, ep_samples_of_chunk)`` → :class:`ChunkInputs` for steps k0..k1-1
-        (deterministic: the smoother replays chunks).
+        (deterministic: the smoother replays chunks).  The forward pass calls it in chunk order
+        from one helper thread (the next chunk's inputs are prepared while the lead runs).
     lead_inputs : callable, optional
-        The same for run 0 alone (arrays of one run), for the smoother's replay of the lead;
-        by default run 0's slice of ``inputs``.
+        The same for run 0 alone (arrays of one run), for the smoother's replay of the lead (two
+        chunks at once, from two threads); by default run 0's slice of ``inputs``.
     record_every : int
         Record every ``record_every``-th epoch (the P's and the per-run records).
     chunk_epochs : int
@@ -1068,33 +1071,35 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     innov = [None] * len(chunks)
     pending = None
     prep = ThreadPoolExecutor(max_workers=1)
-    nxt_prep = prep.submit(prepare, 0, False)
-    for ci in range(len(chunks) + 1):
-        if ci < len(chunks):
-            j0, j1, x, o, g = nxt_prep.result()
-            if ci + 1 < len(chunks):
-                nxt_prep = prep.submit(prepare, ci + 1, False)
-            row0 = (BatchState(*(v[:1].copy() for v in state)), LeadState(*(v.copy() for v in lead)))
-            lead_pass(state, lead, x, g, o)
-        if pending is not None:
-            for t in pending[0]:
-                t.join()
-            _collect(res, pending[1], pending[2], pending[3], rec_pos, spec, pending[4])
-            if smoother and not rts:
-                # every run's innovations, for the smoother (the rows in use)
-                innov[ci - 1] = np.ascontiguousarray(pending[3].innov[:, :, :int(pending[5].m.max())])
-            pending = None
-        if ci == len(chunks):
-            break
-        if smoother and rts:
-            ck = BatchState(*(v.copy() for v in state))
-            for v, v0 in zip(ck, row0[0]):
-                v[:1] = v0
-            checkpoints.append((ck, row0[1]))
-        elif smoother:
-            checkpoints.append(row0)
-        pending = (start_followers(state, lead, x, g, o), j0, j1, o, bounds(ci)[2] if store_nav else None, g)
-    prep.shutdown()
+    try:
+        nxt_prep = prep.submit(prepare, 0, False)
+        for ci in range(len(chunks) + 1):
+            if ci < len(chunks):
+                j0, j1, x, o, g = nxt_prep.result()
+                if ci + 1 < len(chunks):
+                    nxt_prep = prep.submit(prepare, ci + 1, False)
+                row0 = (BatchState(*(v[:1].copy() for v in state)), LeadState(*(v.copy() for v in lead)))
+                lead_pass(state, lead, x, g, o)
+            if pending is not None:
+                for t in pending[0]:
+                    t.join()
+                _collect(res, pending[1], pending[2], pending[3], rec_pos, spec, pending[4])
+                if smoother and not rts:
+                    # every run's innovations, for the smoother (the rows in use)
+                    innov[ci - 1] = np.ascontiguousarray(pending[3].innov[:, :, :int(pending[5].m.max())])
+                pending = None
+            if ci == len(chunks):
+                break
+            if smoother and rts:
+                ck = BatchState(*(v.copy() for v in state))
+                for v, v0 in zip(ck, row0[0]):
+                    v[:1] = v0
+                checkpoints.append((ck, row0[1]))
+            elif smoother:
+                checkpoints.append(row0)
+            pending = (start_followers(state, lead, x, g, o), j0, j1, o, bounds(ci)[2] if store_nav else None, g)
+    finally:
+        prep.shutdown()
 
     def replay(ci):
         st_c, lead_c = checkpoints[ci]

@@ -38,7 +38,12 @@ prediction of e_{k+1}⁻ is 0 with covariance P_{k+1}⁻ = Φ_k P_k⁺ Φ_kᵀ +
     P_k^s = P_k⁺ + C_k (P_{k+1}^s − P_{k+1}⁻) C_kᵀ,
 
 and the smoothed solution's error is e_k⁺ − ê_k^s.  This is :func:`replication.kalman.rts_smoother`
-with x_f = 0 and x_p[k+1] = −x_{k+1}; the test suite checks the two against each other.
+with x_f = 0 and x_p[k+1] = −x_{k+1}; the test suite checks the two against each other.  The
+default backward pass is the same smoother in the modified Bryson-Frazier form
+(:func:`replication.closedloop.mbf_chunk`): ê_k^s = −P_k⁺ λ_k and P_k^s = P_k⁺ − P_k⁺ Λ_k P_k⁺ with
+the adjoint λ_k and its covariance Λ_k carried back through the updates' rows, gains and
+innovations and through Φ — no inverse of P_{k+1}⁻, and the O(n³) products only at the recorded
+epochs; the test suite checks it against the RTS form.
 """
 
 from __future__ import annotations
@@ -527,7 +532,8 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
     lever arm, Table 4-41 noise), batched across ``n_runs`` runs (see the module docstring).
 
     ``record_every`` GNSS epochs are recorded (20 → 1 Hz at 20-Hz GNSS); ``smoother`` adds the
-    RTS pass (replaying the forward pass chunk by chunk, ``chunk_epochs`` epochs each);
+    fixed-interval smoother pass (replaying the lead's forward pass chunk by chunk, ``chunk_epochs``
+    epochs each);
     ``smoother_covariance=False`` skips the smoothed covariance (P^s) and keeps only the smoothed
     states; ``smoother_form`` picks the backward recursion (:func:`replication.closedloop.run`: the
     modified Bryson-Frazier form or the Rauch-Tung-Striebel covariance form, the same results to
