@@ -563,17 +563,23 @@ def discretize_series(F, Qc, T, order, Phi, Qd, w1, w2):
 
 
 @njit(**_NJ)
-def _chol_solve_scaled(P, e):
-    """eᵀ P⁻¹ e with P scaled to a correlation matrix first (P may span many decades)."""
+def _chol_scaled(P, d, Lc):
+    """The standard deviations ``d`` of P and the Cholesky factor ``Lc`` of P scaled to a
+    correlation matrix (P may span many decades): the factorization of :func:`_chol_solve_scaled`."""
     n = P.shape[0]
-    d = np.empty(n)
     for i in range(n):
         d[i] = math.sqrt(P[i, i])
     R = np.empty((n, n))
     for i in range(n):
         for j in range(n):
             R[i, j] = P[i, j] / (d[i] * d[j])
-    Lc = np.linalg.cholesky(R)
+    Lc[:, :] = np.linalg.cholesky(R)
+
+
+@njit(**_NJ)
+def _solve_scaled(Lc, d, e):
+    """eᵀ P⁻¹ e from the factorization ``_chol_scaled`` of P."""
+    n = Lc.shape[0]
     y = np.empty(n)
     for i in range(n):
         acc = e[i] / d[i]
@@ -584,6 +590,16 @@ def _chol_solve_scaled(P, e):
     for i in range(n):
         s += y[i] * y[i]
     return s
+
+
+@njit(**_NJ)
+def _chol_solve_scaled(P, e):
+    """eᵀ P⁻¹ e with P scaled to a correlation matrix first (P may span many decades)."""
+    n = P.shape[0]
+    d = np.empty(n)
+    Lc = np.empty((n, n))
+    _chol_scaled(P, d, Lc)
+    return _solve_scaled(Lc, d, e)
 
 
 # ----------------------------------------------------------------------------- closed loop

@@ -12,7 +12,9 @@ chen2019 eq. (2-13)) and ``_specific_force_rows`` (chen2019 eq. (3-18)); the upd
 Joseph form one (independent) measurement at a time; then the navigation errors are fed back and
 the sensor-error estimates accumulated.  Optional: a vertical channel held or damped
 (:mod:`replication.strapdown`), discrete AR transitions of a gravity block at chosen epochs, the
-recording of (P⁺, P⁻, Φ, x̂) for the Rauch-Tung-Striebel smoother, NEES against a truth.
+recording of what the fixed-interval smoother needs (Φ, rows, gains and innovations for the
+modified Bryson-Frazier form :func:`mbf_chunk`; P⁺, P⁻, Φ, x̂ for the Rauch-Tung-Striebel form
+:func:`rts_chunk`), NEES against a truth.
 
 **Batches.** The covariance, the gains and the measurement matrix of a batch come from its
 first run (the *lead*); every run applies them to its own innovations, so run 0 is an exact
@@ -23,7 +25,7 @@ of one is the single-run filter.  The lead's pass records per epoch what the oth
 follow on other threads, chunk by chunk, while the lead goes on: the result does not depend on
 the number of threads.
 
-:func:`run` is the driver (chunks, threads, records, RTS); :func:`build_spec` bundles the
+:func:`run` is the driver (chunks, threads, records, smoother); :func:`build_spec` bundles the
 configuration of an :class:`replication.errors.ErrorModel`.  The public entry points are
 :func:`replication.kalman.closed_loop` (one run), :func:`replication.kalman.monte_carlo`,
 :func:`replication.simulation.run_batch` (chen2019 §4.2) and
@@ -76,8 +78,9 @@ BatchState = namedtuple("BatchState", ["st", "st_prev", "q", "p_hat", "lever", "
 #: without measurements), window sums of f^n and of the accelerometer couplings.
 LeadState = namedtuple("LeadState", ["P", "Pbar", "facc", "Cw"])
 
-#: What the lead leaves, per epoch, for the runs that follow it.
-Gains = namedtuple("Gains", ["m", "H", "Kg", "s", "Phid", "P"])
+#: What the lead leaves, per epoch, for the runs that follow it (with the NEES: the standard
+#: deviations of P⁺ and the Cholesky factor of P⁺ scaled to a correlation matrix).
+Gains = namedtuple("Gains", ["m", "H", "Kg", "s", "Phid", "nees_sd", "nees_L"])
 
 #: Outputs of one chunk (per run and epoch unless noted).
 ChunkOut = namedtuple("ChunkOut", ["st", "q", "phat", "nis", "innov", "nees", "nav_st", "nav_q", "pdiag",
@@ -339,7 +342,8 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     tmp = np.empty(max(n_dyn, n))
     Ta = np.ascontiguousarray(spec.ar_T[9:, 9:])
     store_nav = out.nav_st.shape[1] > 0
-    record = out.rec_x.shape[1] > 0
+    record = out.rec_Phi.shape[0] > 0
+    record_x = out.rec_x.shape[1] > 0
     if store_nav:
         for r in range(R):
             out.nav_st[r, 0, :] = bs_.st[r]
@@ -371,9 +375,6 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                 for t in range(n_dyn):
                     for jj in range(n_aug):
                         gains.Phid[j, t, jj] = Phi[9 + spec.dyn_rows[t], 9 + jj]
-                if record:
-                    out.rec_Phi[j] = Phi
-                    out.rec_Pp[j] = lead.P
             # sensor-error estimates with dynamics (Markov, gravity) follow Φ
             for r in range(R):
                 for t in range(n_dyn):
@@ -391,6 +392,14 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                         lead.Pbar[:, :] = spec.ar_T @ lead.Pbar @ spec.ar_T.T + spec.ar_Q
                 for r in range(R):
                     bs_.p_hat[r, :] = Ta @ bs_.p_hat[r]
+            if is_lead and record:
+                # the transition from the last epoch's P⁺ to this epoch's P⁻ (T Φ at an AR epoch)
+                if inp.ar_tick[j]:
+                    out.rec_Phi[j] = spec.ar_T @ Phi
+                else:
+                    out.rec_Phi[j] = Phi
+                if out.rec_Pp.shape[0] > 0:
+                    out.rec_Pp[j] = lead.P
             # ---------------- measurement rows and gains (lead)
             if is_lead:
                 K._q2c(bs_.q[0], c)
@@ -414,8 +423,8 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                 _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j], tmp)
                 for a in range(m):
                     gains.H[j, a, :] = H[a]
-                if gains.P.shape[0] > 0:
-                    gains.P[j] = lead.P
+                if gains.nees_L.shape[0] > 0:
+                    K._chol_scaled(lead.P, gains.nees_sd[j], gains.nees_L[j])
                 if sf >= 0:
                     lead.facc[:] = 0.0
                     lead.Cw[:, :] = 0.0
@@ -450,7 +459,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                 out.nis[r, j] = nis
                 for a in range(m):
                     out.innov[r, j, a] = z[a]
-                if record:
+                if record_x:
                     out.rec_x[r, j, :] = xk
                 K._feedback_nav(xk, st_r, bs_.st_prev[r], q_r, ph_r, qtmp, e)
                 K._feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, bs_.g_extra[r])
@@ -466,16 +475,16 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                     _attitude_error(q_r, inp.truth_q[j], e)
                     for i in range(n_aug):
                         e[9 + i] = inp.truth_p[r, j, i] - ph_r[i]
-                    out.nees[r, j] = K._chol_solve_scaled(gains.P[j], e)
+                    out.nees[r, j] = K._solve_scaled(gains.nees_L[j], gains.nees_sd[j], e)
             if is_lead:
                 for i in range(n):
                     out.pdiag[j, i] = lead.P[i, i]
-                if record:
+                if record and out.rec_Pf.shape[0] > 0:
                     out.rec_Pf[j] = lead.P
                 f = out.flag[j]
                 if f >= 0 and out.P.shape[0] > 0:
                     out.P[f] = lead.P
-                    if spec.use_pbar:
+                    if spec.use_pbar and out.Pbar.shape[0] > 0:
                         out.Pbar[f] = lead.Pbar
             K._reset_interval(Cpl, fsum, Csum, navsum)
             sums[0] = 0.0
@@ -569,6 +578,216 @@ def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, o
                     for k in range(n):
                         out_Ps[f, i, k] = Ps[i, k]
 
+
+@njit(**_NJ)
+def _nonzeros(Phi, nzc, nzv, cnt, rzc, rzv, rcnt):
+    """The non-zeros of Φ by column (row indices ``nzc[i, :cnt[i]]``, values ``nzv``) and by row
+    (column indices ``rzc[k, :rcnt[k]]``, values ``rzv``)."""
+    n = Phi.shape[0]
+    for i in range(n):
+        cnt[i] = 0
+    for k in range(n):
+        c = 0
+        for i in range(n):
+            v = Phi[k, i]
+            if v != 0.0:
+                rzc[k, c] = i
+                rzv[k, c] = v
+                c += 1
+                ci = cnt[i]
+                nzc[i, ci] = k
+                nzv[i, ci] = v
+                cnt[i] = ci + 1
+        rcnt[k] = c
+
+
+@njit(**_NJ)
+def _congruence_transposed(Phi, L, W, row, nzc, nzv, cnt, rzc, rzv, rcnt):
+    """L ← Φᵀ L Φ for a symmetric L, from the non-zeros of Φ (``_nonzeros``; Φ of an INS error
+    model is sparse: dense navigation rows, sensor rows with one non-zero or two): W = Φᵀ L row by
+    row (row i: Σ_k Φ_ki L[k, :]), then row i of W Φ as Σ_k W[i, k] Φ[k, :] (a dense row of Φ
+    whole, a sparse one by its non-zeros); the upper triangle is kept and mirrored."""
+    n = L.shape[0]
+    for i in range(n):
+        for j in range(n):
+            W[i, j] = 0.0
+        for t in range(cnt[i]):
+            k = nzc[i, t]
+            v = nzv[i, t]
+            for j in range(n):
+                W[i, j] += v * L[k, j]
+    dense = n // 4
+    for i in range(n):
+        for j in range(n):
+            row[j] = 0.0
+        for k in range(n):
+            w = W[i, k]
+            if w == 0.0:
+                continue
+            if rcnt[k] > dense:
+                for j in range(n):
+                    row[j] += w * Phi[k, j]
+            else:
+                for t in range(rcnt[k]):
+                    row[rzc[k, t]] += w * rzv[k, t]
+        for j in range(i, n):
+            L[i, j] = row[j]
+            L[j, i] = row[j]
+
+
+@njit(**_NJ)
+def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov, transition_first):
+    """Backward pass over one chunk of the closed-loop filter in the modified Bryson-Frazier form
+    of the fixed-interval smoother (Bierman 1977, ch. X): the same smoothed error and covariance as
+    the Rauch-Tung-Striebel recursion of :func:`rts_chunk`, without inverting P⁻ and with the
+    O(n³) products only at the epochs kept.
+
+    With the adjoint λ_k (and its covariance Λ_k) of the epoch after its update, the smoothed error
+    of the solution after feedback is d_k = −P_k⁺ λ_k and P^s_k = P_k⁺ − P_k⁺ Λ_k P_k⁺.  Going back
+    through the scalar updates a = m−1 … 0 of epoch k (rows h_a, gains K_a, innovation variances
+    s_a, innovations ν_a of the sequential update):
+
+        λ ← λ − h_a (K_aᵀ λ + ν_a / s_a),
+        Λ ← (I − K_a h_aᵀ)ᵀ Λ (I − K_a h_aᵀ) + h_a h_aᵀ / s_a,
+
+    then λ_{k−1} = Φ_kᵀ λ, Λ_{k−1} = Φ_kᵀ Λ Φ_k; λ = 0, Λ = 0 after the last epoch.  The innovations
+    are recomputed from the raw ones ``z`` (runs × epochs × rows, INS − GNSS) as the filter formed
+    them (the same numbers).  ``Phi``, ``m``, ``H``, ``Kg``, ``s`` per epoch of the chunk (the
+    lead's pass), ``Pf`` the P⁺ of the flagged epochs (``flag`` ≥ 0, their index in
+    ``out_ds``/``out_Ps``).  ``lam`` (runs × n) and ``Lam`` hold λ, Λ of the last epoch of the
+    chunk on entry and of the epoch before the chunk on return (the transition of the chunk's first
+    epoch is applied only when ``transition_first``).  Without ``with_cov`` only λ is propagated.
+    The runs are processed side by side (λ as n × runs)."""
+    E_ = Phi.shape[0]
+    R = lam.shape[0]
+    n = Phi.shape[1]
+    L = np.ascontiguousarray(lam.T)
+    L2 = np.empty((n, R))
+    X = np.zeros((n, R))
+    Nu = np.empty((_MMAX, R))
+    acc = np.empty(R)
+    u = np.empty(n)
+    row = np.empty(n)
+    hz = np.empty((_MMAX, n), np.int64)
+    nh = np.empty(_MMAX, np.int64)
+    used = np.empty(n, np.int64)
+    W = np.empty((n, n))
+    nzc = np.empty((n, n), np.int64)
+    nzv = np.empty((n, n))
+    cnt = np.empty(n, np.int64)
+    rzc = np.empty((n, n), np.int64)
+    rzv = np.empty((n, n))
+    rcnt = np.empty(n, np.int64)
+    for jj in range(E_ - 1, -1, -1):
+        f = flag[jj]
+        if f >= 0:
+            P = Pf[f]
+            for i in range(n):
+                for r in range(R):
+                    acc[r] = 0.0
+                for k in range(n):
+                    p = P[i, k]
+                    for r in range(R):
+                        acc[r] += p * L[k, r]
+                for r in range(R):
+                    out_ds[r, f, i] = -acc[r]
+            if with_cov:
+                G = P @ (Lam @ P)
+                for i in range(n):
+                    for k in range(i, n):
+                        v = P[i, k] - 0.5 * (G[i, k] + G[k, i])
+                        out_Ps[f, i, k] = v
+                        out_Ps[f, k, i] = v
+        mj = m[jj]
+        # the non-zeros of the epoch's rows, and the columns any row uses
+        for k in range(n):
+            used[k] = 0
+        for a in range(mj):
+            c = 0
+            for k in range(n):
+                if H[jj, a, k] != 0.0:
+                    hz[a, c] = k
+                    used[k] = 1
+                    c += 1
+            nh[a] = c
+        # ---------------- the innovations of the sequential update (H's zero entries skipped: the
+        # filter's sums), then back through the scalar updates, last first
+        for k in range(n):
+            if used[k]:
+                for r in range(R):
+                    X[k, r] = 0.0
+        for a in range(mj):
+            for r in range(R):
+                acc[r] = z[r, jj, a]
+            for t in range(nh[a]):
+                k = hz[a, t]
+                h = H[jj, a, k]
+                for r in range(R):
+                    acc[r] -= h * X[k, r]
+            for k in range(n):
+                if used[k]:
+                    g = Kg[jj, a, k]
+                    for r in range(R):
+                        X[k, r] += g * acc[r]
+            for r in range(R):
+                Nu[a, r] = acc[r]
+        for a in range(mj - 1, -1, -1):
+            sa = s[jj, a]
+            for r in range(R):
+                acc[r] = Nu[a, r] / sa
+            for k in range(n):
+                g = Kg[jj, a, k]
+                for r in range(R):
+                    acc[r] += g * L[k, r]
+            for t in range(nh[a]):
+                k = hz[a, t]
+                h = H[jj, a, k]
+                for r in range(R):
+                    L[k, r] -= h * acc[r]
+        if with_cov:
+            for a in range(mj - 1, -1, -1):
+                for i in range(n):
+                    u[i] = 0.0
+                for k in range(n):
+                    g = Kg[jj, a, k]
+                    if g != 0.0:
+                        for i in range(n):
+                            u[i] += Lam[k, i] * g
+                c = 1.0 / s[jj, a]
+                for i in range(n):
+                    c += Kg[jj, a, i] * u[i]
+                # Λ + c h hᵀ − (h uᵀ + u hᵀ): only the rows and columns of h's non-zeros change; each
+                # pair (i, k) once, the increment symmetric in (i, k) to the last bit
+                for t in range(nh[a]):
+                    i = hz[a, t]
+                    hi = H[jj, a, i]
+                    for k in range(n):
+                        hk = H[jj, a, k]
+                        if hk != 0.0 and k < i:
+                            continue
+                        v = Lam[i, k] + (c * (hi * hk) - (hi * u[k] + u[i] * hk))
+                        Lam[i, k] = v
+                        Lam[k, i] = v
+        # ---------------- back through the transition into the previous epoch
+        if jj > 0 or transition_first:
+            Ph = Phi[jj]
+            _nonzeros(Ph, nzc, nzv, cnt, rzc, rzv, rcnt)
+            for i in range(n):
+                for r in range(R):
+                    acc[r] = 0.0
+                for t in range(cnt[i]):
+                    v = nzv[i, t]
+                    k = nzc[i, t]
+                    for r in range(R):
+                        acc[r] += v * L[k, r]
+                for r in range(R):
+                    L2[i, r] = acc[r]
+            L, L2 = L2, L
+            if with_cov:
+                _congruence_transposed(Ph, Lam, W, row, nzc, nzv, cnt, rzc, rzv, rcnt)
+    for r in range(R):
+        for i in range(n):
+            lam[r, i] = L[i, r]
 
 # ----------------------------------------------------------------------------- configuration
 
@@ -683,16 +902,18 @@ class Records:
     P_s: np.ndarray | None = None
 
 
-def _empty_gains(E_, n, n_dyn, n_aug, with_P):
+def _empty_gains(E_, n, n_dyn, n_aug, with_nees):
+    E_n = E_ if with_nees else 0
     return Gains(np.zeros(E_, np.int64), np.zeros((E_, _MMAX, n)), np.zeros((E_, _MMAX, n)),
-                 np.ones((E_, _MMAX)), np.zeros((E_, max(n_dyn, 0), n_aug)),
-                 np.empty((E_ if with_P else 0, n, n)))
+                 np.ones((E_, _MMAX)), np.zeros((E_, max(n_dyn, 0), n_aug)), np.empty((E_n, n)),
+                 np.empty((E_n, n, n)))
 
 
 def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
-        inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *, record_every: int = 1,
+        inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *,
+        lead_inputs: Callable[[int, int, int, np.ndarray], ChunkInputs] | None = None, record_every: int = 1,
         chunk_epochs: int = 2000, smoother: bool = False, smoother_covariance: bool = True,
-        store_nav: bool = False, store_P: bool = True, workers: int = 2) -> Records:
+        smoother_form: str = "mbf", store_nav: bool = False, store_P: bool = True, workers: int = 2) -> Records:
     """Run the closed-loop filter of ``spec`` over ``n_steps`` IMU steps for the runs of ``state``.
 
     Parameters
@@ -709,13 +930,26 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         Number of IMU steps.
     inputs : callable
         ``inputs(chunk, k0, k1, ep_samples_of_chunk)`` → :class:`ChunkInputs` for steps k0..k1-1
-        (deterministic: the smoother replays chunks).
+        (deterministic: the smoother replays chunks).  The forward pass calls it in chunk order
+        from one helper thread (the next chunk's inputs are prepared while the lead runs).
+    lead_inputs : callable, optional
+        The same for run 0 alone (arrays of one run), for the smoother's replay of the lead (two
+        chunks at once, from two threads); by default run 0's slice of ``inputs``.
     record_every : int
         Record every ``record_every``-th epoch (the P's and the per-run records).
     chunk_epochs : int
         Epochs per chunk (memory of the gains and of the smoother's records).
     smoother, smoother_covariance : bool
-        Add the RTS pass (replaying the forward pass chunk by chunk), with or without P^s.
+        Add the fixed-interval smoother pass (replaying the forward pass chunk by chunk), with or
+        without P^s.
+    smoother_form : {"mbf", "rts"}
+        The smoother's backward recursion: the modified Bryson-Frazier form (:func:`mbf_chunk`,
+        the default) or the Rauch-Tung-Striebel covariance form (:func:`rts_chunk`); the two give
+        the same smoothed error and covariance (to rounding).  The MBF form inverts nothing and
+        forms the O(n³) products only at the recorded epochs; it needs per epoch the lead's Φ,
+        rows and gains and every run's innovations, so the forward pass keeps the innovations
+        (runs × epochs × rows) and the replay re-runs the lead alone.  The RTS form needs every
+        run's estimates and replays the whole batch.
     store_nav : bool
         Keep the IMU-rate solution.
     store_P : bool
@@ -734,6 +968,9 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         raise ValueError(f"ep_samples must be strictly increasing sample indices in 1..{n_steps}")
     if int(record_every) < 1 or int(chunk_epochs) < 2 or int(workers) < 1:
         raise ValueError("record_every ≥ 1, chunk_epochs ≥ 2 and workers ≥ 1 are required")
+    if smoother_form not in ("mbf", "rts"):
+        raise ValueError('smoother_form must be "mbf" or "rts"')
+    rts = smoother_form == "rts"
     P0 = np.array(P0, dtype=float)
     if P0.shape != (n, n):
         raise ValueError(f"P0 must be {n}×{n}")
@@ -764,20 +1001,23 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         k1 = n_steps if ci == len(chunks) - 1 else int(ep[j1 - 1])
         return j0, j1, k0, k1
 
-    def chunk_out(ci, j0, j1, k0, k1, record):
+    def chunk_out(ci, j0, j1, k0, k1, record, R=R, store_nav=store_nav):
         E_ = j1 - j0
         flag = rec_pos[j0:j1] - (rec_pos[j0:j1][rec_pos[j0:j1] >= 0].min() if np.any(rec_pos[j0:j1] >= 0) else 0)
         flag = np.where(rec_pos[j0:j1] >= 0, flag, -1).astype(np.int64)
         n_f = int(np.sum(flag >= 0))
         nav = (k1 - k0 + 1) if store_nav else 0
         e3 = np.empty((0, n, n))
+        # the smoother's replay (``record``) keeps Φ per epoch and P⁺ at the recorded epochs; the RTS
+        # form also P⁺, P⁻ and the estimates x̂ per epoch
         return ChunkOut(np.empty((R, E_, 6)), np.empty((R, E_, 4)), np.empty((R, E_, n_aug)), np.empty((R, E_)),
                         np.zeros((R, E_, _MMAX)), np.full((R, E_), np.nan) if spec.nees else np.empty((R, 0)),
                         np.empty((R, nav, 6)), np.empty((R, nav, 4)), np.empty((E_, n)), flag,
-                        np.empty((n_f, n, n)) if store_P else e3, np.empty((n_f, n, n)) if spec.use_pbar and store_P else e3,
-                        np.empty((E_, n, n)) if record else e3, np.empty((E_, n, n)) if record else e3,
+                        np.empty((n_f, n, n)) if store_P or record else e3,
+                        np.empty((n_f, n, n)) if spec.use_pbar and store_P else e3,
+                        np.empty((E_, n, n)) if record and rts else e3, np.empty((E_, n, n)) if record and rts else e3,
                         np.empty((E_, n, n)) if record else e3,
-                        np.empty((R, E_, n)) if record else np.empty((R, 0, n)))
+                        np.empty((R, E_, n)) if record and rts else np.empty((R, 0, n)))
 
     def view(o: ChunkOut, sl) -> ChunkOut:
         per_run = {"st", "q", "phat", "nis", "innov", "nees", "nav_st", "nav_q", "rec_x"}
@@ -810,31 +1050,64 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         lead_pass(st_, lead_, x, g, o)
         for t in start_followers(st_, lead_, x, g, o):
             t.join()
-        return j0, j1, o
+        return j0, j1, o, g
 
-    # forward pass, pipelined: the lead runs chunk c while the followers finish chunk c − 1
+    # the lead's replay for the smoother: neither the covariance without measurements nor the NEES
+    spec_replay = spec._replace(use_pbar=False, nees=False)
+
+    def replay_lead(ci, st0, lead_):
+        """The lead alone over chunk ``ci`` from its checkpoint, recording for the smoother."""
+        j0, j1, k0, k1 = bounds(ci)
+        x = (lead_inputs(ci, k0, k1, ep[j0:j1]) if lead_inputs is not None
+             else inp_view(inputs(ci, k0, k1, ep[j0:j1]), slice(0, 1)))
+        o = chunk_out(ci, j0, j1, k0, k1, True, R=1, store_nav=False)
+        g = _empty_gains(j1 - j0, n, n_dyn, n_aug, False)
+        filter_chunk(spec_replay, x, st0, lead_, g, o, True)
+        return j0, j1, o, g
+
+    # forward pass, pipelined: the lead runs chunk c while the followers finish chunk c − 1 and the
+    # inputs of chunk c + 1 are prepared (``inputs`` is called in chunk order, from one thread)
     checkpoints = []
+    innov = [None] * len(chunks)
     pending = None
-    for ci in range(len(chunks) + 1):
-        if ci < len(chunks):
-            j0, j1, x, o, g = prepare(ci, False)
-            row0 = (BatchState(*(v[:1].copy() for v in state)), LeadState(*(v.copy() for v in lead)))
-            lead_pass(state, lead, x, g, o)
-        if pending is not None:
-            for t in pending[0]:
-                t.join()
-            _collect(res, pending[1], pending[2], pending[3], rec_pos, spec, pending[4])
-            pending = None
-        if ci == len(chunks):
-            break
-        if smoother:
-            ck = BatchState(*(v.copy() for v in state))
-            for v, v0 in zip(ck, row0[0]):
-                v[:1] = v0
-            checkpoints.append((ck, row0[1]))
-        pending = (start_followers(state, lead, x, g, o), j0, j1, o, bounds(ci)[2] if store_nav else None)
+    prep = ThreadPoolExecutor(max_workers=1)
+    try:
+        nxt_prep = prep.submit(prepare, 0, False)
+        for ci in range(len(chunks) + 1):
+            if ci < len(chunks):
+                j0, j1, x, o, g = nxt_prep.result()
+                if ci + 1 < len(chunks):
+                    nxt_prep = prep.submit(prepare, ci + 1, False)
+                row0 = (BatchState(*(v[:1].copy() for v in state)), LeadState(*(v.copy() for v in lead)))
+                lead_pass(state, lead, x, g, o)
+            if pending is not None:
+                for t in pending[0]:
+                    t.join()
+                _collect(res, pending[1], pending[2], pending[3], rec_pos, spec, pending[4])
+                if smoother and not rts:
+                    # every run's innovations, for the smoother (the rows in use)
+                    innov[ci - 1] = np.ascontiguousarray(pending[3].innov[:, :, :int(pending[5].m.max())])
+                pending = None
+            if ci == len(chunks):
+                break
+            if smoother and rts:
+                ck = BatchState(*(v.copy() for v in state))
+                for v, v0 in zip(ck, row0[0]):
+                    v[:1] = v0
+                checkpoints.append((ck, row0[1]))
+            elif smoother:
+                checkpoints.append(row0)
+            pending = (start_followers(state, lead, x, g, o), j0, j1, o, bounds(ci)[2] if store_nav else None, g)
+    finally:
+        prep.shutdown()
+
+    def replay(ci):
+        st_c, lead_c = checkpoints[ci]
+        checkpoints[ci] = None
+        return forward(ci, st_c, lead_c, True) if rts else replay_lead(ci, st_c, lead_c)
+
     if smoother:
-        _smooth(res, chunks, checkpoints, forward, rec_pos, R, n, m_rec, smoother_covariance)
+        _smooth(res, chunks, replay, innov, rec_pos, R, n, m_rec, smoother_covariance, rts)
     return res
 
 
@@ -860,38 +1133,42 @@ def _collect(res: Records, j0, j1, o, rec_pos, spec, k0):
         res.nav_q[:, k0:k0 + o.nav_q.shape[1]] = o.nav_q
 
 
-def _smooth(res: Records, chunks, checkpoints, forward, rec_pos, R, n, m_rec, with_cov):
-    """RTS pass: chunks replayed from their checkpoints (newest first) on a second thread while
-    the backward recursion runs over the chunk replayed before."""
+def _smooth(res: Records, chunks, replay, innov, rec_pos, R, n, m_rec, with_cov, rts):
+    """Smoother pass: chunks replayed (``replay(chunk)``, newest first) ahead on other threads
+    while the backward recursion runs over the chunk replayed before: :func:`mbf_chunk` on the
+    lead's records and the forward pass's innovations ``innov`` (per chunk; the lead's replays
+    start from independent checkpoints, two run at once), or :func:`rts_chunk` when ``rts`` (one
+    replay of the whole batch at a time)."""
     res.ds = np.empty((R, m_rec, n))
     res.P_s = np.empty((m_rec, n, n)) if with_cov else None
     ds = np.zeros((R, n))
     Ps = np.zeros((n, n))
     nxt = None
-
-    def replay(ci):
-        st_c, lead_c = checkpoints[ci]
-        checkpoints[ci] = None
-        return forward(ci, st_c, lead_c, True)
-
-    with ThreadPoolExecutor(max_workers=1) as ex:
-        fut = ex.submit(replay, len(chunks) - 1)
+    ahead = 1 if rts else 2
+    with ThreadPoolExecutor(max_workers=ahead) as ex:
+        futs = {c: ex.submit(replay, c) for c in range(len(chunks) - 1, max(len(chunks) - 1 - ahead, -1), -1)}
         for ci in range(len(chunks) - 1, -1, -1):
-            j0, j1, o = fut.result()
-            if ci > 0:
-                fut = ex.submit(replay, ci - 1)
+            j0, j1, o, g = futs.pop(ci).result()
+            if ci - ahead >= 0:
+                futs[ci - ahead] = ex.submit(replay, ci - ahead)
             E_ = j1 - j0
             n_f = int(np.sum(o.flag >= 0))
             o_ds = np.empty((R, n_f, n))
             o_Ps = np.empty((n_f if with_cov else 0, n, n))
             o_pd = np.empty((E_, n))
-            if nxt is None:
+            if not rts:
+                # ds, Ps: the adjoint λ (runs × n) and its covariance Λ
+                mbf_chunk(o.rec_Phi, g.m, g.H, g.Kg, g.s, innov[ci], o.P, o.flag, ds, Ps, o_ds, o_Ps, with_cov,
+                          ci > 0)
+                innov[ci] = None
+            elif nxt is None:
                 rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, False, o.rec_Pp[0], o.rec_Phi[0],
                           np.ascontiguousarray(o.rec_x[:, 0, :]), ds, Ps, o.flag, o_ds, o_Ps, o_pd, with_cov)
             else:
                 rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, True, nxt[0], nxt[1], nxt[2], ds, Ps, o.flag,
                           o_ds, o_Ps, o_pd, with_cov)
-            nxt = (o.rec_Pp[0].copy(), o.rec_Phi[0].copy(), np.ascontiguousarray(o.rec_x[:, 0, :]))
+            if rts:
+                nxt = (o.rec_Pp[0].copy(), o.rec_Phi[0].copy(), np.ascontiguousarray(o.rec_x[:, 0, :]))
             pos = rec_pos[j0:j1][o.flag >= 0]
             res.ds[:, pos] = o_ds
             if with_cov:

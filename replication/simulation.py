@@ -38,7 +38,12 @@ prediction of e_{k+1}⁻ is 0 with covariance P_{k+1}⁻ = Φ_k P_k⁺ Φ_kᵀ +
     P_k^s = P_k⁺ + C_k (P_{k+1}^s − P_{k+1}⁻) C_kᵀ,
 
 and the smoothed solution's error is e_k⁺ − ê_k^s.  This is :func:`replication.kalman.rts_smoother`
-with x_f = 0 and x_p[k+1] = −x_{k+1}; the test suite checks the two against each other.
+with x_f = 0 and x_p[k+1] = −x_{k+1}; the test suite checks the two against each other.  The
+default backward pass is the same smoother in the modified Bryson-Frazier form
+(:func:`replication.closedloop.mbf_chunk`): ê_k^s = −P_k⁺ λ_k and P_k^s = P_k⁺ − P_k⁺ Λ_k P_k⁺ with
+the adjoint λ_k and its covariance Λ_k carried back through the updates' rows, gains and
+innovations and through Φ — no inverse of P_{k+1}⁻, and the O(n³) products only at the recorded
+epochs; the test suite checks it against the RTS form.
 """
 
 from __future__ import annotations
@@ -363,11 +368,13 @@ class _Truth:
             q[r] = dcm_to_quat(rotvec_to_dcm(-d[6:9]) @ C)
         return st, q
 
-    def chunk(self, c: int, k0: int, k1: int, ep_samples, state):
+    def chunk(self, c: int, k0: int, k1: int, ep_samples, state, runs: int | None = None):
         """Corrupted increments (R, k1-k0, 3) of steps k0..k1-1 and GNSS fixes at ``ep_samples``;
         ``state`` carries the AR(1) values (updated in place).  Returns also the process values at
-        the epochs (value of the interval ending at the epoch)."""
-        s, tr, R = self.setup, self.traj, self.R
+        the epochs (value of the interval ending at the epoch).  ``runs``: only the first ``runs``
+        runs (each run's numbers do not depend on the others)."""
+        s, tr = self.setup, self.traj
+        R = self.R if runs is None else int(runs)
         Kn = k1 - k0
         T = tr.t[k0 + 1:k1 + 1] - tr.t[k0:k1]
         Tm = float(np.median(T))
@@ -519,15 +526,19 @@ def _check_traj(traj, setup):
 def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int = 20, seed: int = 0,
               chunk_epochs: int = 1000, record_every: int = 20, smoother: bool = False,
               smoother_covariance: bool = True, prior_covariance: bool = False, first_run: int = 0,
-              fixed_constants: bool = False, series_order: int = 4, workers: int = 2) -> BatchResult:
+              fixed_constants: bool = False, series_order: int = 4, workers: int = 2,
+              smoother_form: str = "mbf") -> BatchResult:
     """Monte Carlo of the closed-loop INS/GNSS filter of ``model`` on ``traj`` with the truth of
     ``setup`` (chen2019 eq. (2-10) sensor errors, eq. (2-12) gravity disturbance, eq. (2-13)
     lever arm, Table 4-41 noise), batched across ``n_runs`` runs (see the module docstring).
 
     ``record_every`` GNSS epochs are recorded (20 → 1 Hz at 20-Hz GNSS); ``smoother`` adds the
-    RTS pass (replaying the forward pass chunk by chunk, ``chunk_epochs`` epochs each);
+    fixed-interval smoother pass (replaying the lead's forward pass chunk by chunk, ``chunk_epochs``
+    epochs each);
     ``smoother_covariance=False`` skips the smoothed covariance (P^s) and keeps only the smoothed
-    states (about a third faster); ``prior_covariance`` propagates the covariance without
+    states; ``smoother_form`` picks the backward recursion (:func:`replication.closedloop.run`: the
+    modified Bryson-Frazier form or the Rauch-Tung-Striebel covariance form, the same results to
+    rounding); ``prior_covariance`` propagates the covariance without
     measurements as well (for :func:`observable_nees`).  Runs are numbered ``first_run`` ..
     ``first_run + n_runs - 1``; run r's truth depends only on (``seed``, r), so run r processed
     alone (``first_run=r, n_runs=1``) is an exact extended filter of the same truth.
@@ -571,24 +582,25 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
     procs_rec = {k: np.empty((n_runs, len(rec_ep), 3)) for k in ("gyro_markov", "accel_markov", "gravity")}
     ar_start = {0: {k: v.copy() for k, v in truth.x0.items()}}
 
-    def inputs(ci, k0, k1, eps):
+    def inputs(ci, k0, k1, eps, runs=None):
         # the AR(1) state at the chunk's start is kept, so that a replay draws the same inputs
         ar_ = {k: v.copy() for k, v in ar_start[ci].items()}
-        dth, dvv, gpos, gvel, procs = truth.chunk(ci, k0, k1, eps, ar_)
-        if ci + 1 not in ar_start:
+        dth, dvv, gpos, gvel, procs = truth.chunk(ci, k0, k1, eps, ar_, runs=runs)
+        if runs is None and ci + 1 not in ar_start:
             ar_start[ci + 1] = ar_
             j0 = int(np.searchsorted(ep_samples, eps[0]))
             pos = rec_pos[j0:j0 + len(eps)]
             for k in procs_rec:
                 procs_rec[k][:, pos[pos >= 0]] = procs[k][:, pos >= 0]
-        extra = CL.no_windows(k1 - k0, len(eps), n_runs, n_aug)
+        extra = CL.no_windows(k1 - k0, len(eps), n_runs if runs is None else runs, n_aug)
         return CL.ChunkInputs(dt=np.ascontiguousarray(dtv[k0:k1]), dth=dth, dvv=dvv, h_ref=np.zeros(k1 - k0 + 1),
                               vu_ref=np.zeros(k1 - k0 + 1), ep_step=(np.asarray(eps) - 1 - k0).astype(np.int64),
                               gpos=gpos, gvel=gvel, **extra)
 
     rec = CL.run(spec, CL.initial_batch_state(st, q, lever0), model.P0(), ep_samples, N, inputs,
+                 lead_inputs=lambda ci, k0, k1, eps: inputs(ci, k0, k1, eps, runs=1),
                  record_every=record_every, chunk_epochs=chunk_epochs, smoother=smoother,
-                 smoother_covariance=smoother_covariance, workers=workers)
+                 smoother_covariance=smoother_covariance, smoother_form=smoother_form, workers=workers)
     nav_err = navigation_errors(rec.st, rec.q, truth_st[rec_ep], truth_q[rec_ep])
     p_true = truth_parameters(model, truth.const, procs_rec)
     return BatchResult(model=model, setup=setup, t=traj.t[ep_samples[rec_ep]], epoch_index=ep_samples[rec_ep],

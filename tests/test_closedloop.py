@@ -150,3 +150,37 @@ def test_bad_configuration_is_refused():
         cl.build_spec("15", R_pos=np.eye(3), R_vel=np.eye(3))
     with pytest.raises(ValueError, match="R×6"):
         cl.initial_batch_state(np.zeros(6), np.zeros(4), np.zeros(3))
+
+
+# ----------------------------------------------------------------------------- smoother
+
+@pytest.mark.parametrize("model", ["15", "45"])
+def test_mbf_smoother_equals_the_rts_smoother(short_flight, model):
+    """The modified Bryson-Frazier backward pass (the default) against the Rauch-Tung-Striebel
+    covariance form over several chunks: the same forward pass exactly, the same smoothed errors
+    and covariances to rounding.  Tolerance: the MBF form gets P^s as P⁺ − P⁺ Λ P⁺, whose terms
+    are of the size σ⁺_i σ⁺_j of the filter's covariance (the smoothed heading variance is up to
+    2·10⁴ times smaller than the filtered one here), and the RTS form solves with P⁻ scaled to a
+    correlation matrix; the two differ by about 1e-13 σ⁺_i σ⁺_j in P^s and 1e-12 σ^s in d, so 1e-9
+    leaves three decades for other machines' arithmetic."""
+    s = _setup()
+    m = sim.filter_model(model, s, short_flight.lat[0], short_flight.h[0])
+    kw = dict(n_runs=4, seed=4, record_every=3, chunk_epochs=150, smoother=True)
+    a = sim.run_batch(short_flight, s, m, **kw)
+    b = sim.run_batch(short_flight, s, m, smoother_form="rts", **kw)
+    assert np.array_equal(a.errors(), b.errors()) and np.array_equal(a.P, b.P)
+    sd_f = np.sqrt(np.einsum("kii->ki", b.P))
+    sd_s = np.sqrt(np.einsum("kii->ki", b.P_s))
+    assert np.all(np.abs(a.P_s - b.P_s) <= 1e-9 * sd_f[:, :, None] * sd_f[:, None, :])
+    assert np.all(np.abs(a.ds - b.ds) <= 1e-9 * sd_s[None])        # exact where σ^s = 0 (states without prior)
+    assert np.ptp(b.ds) > 0 and np.all(sd_s <= sd_f * (1 + 1e-9))
+
+
+def test_smoother_does_not_depend_on_the_thread_count(short_flight):
+    s = _setup()
+    m = sim.filter_model("45", s, short_flight.lat[0], short_flight.h[0])
+    a = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, record_every=5, chunk_epochs=300, smoother=True,
+                      workers=1)
+    b = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, record_every=5, chunk_epochs=300, smoother=True,
+                      workers=3)
+    assert np.array_equal(a.ds, b.ds) and np.array_equal(a.P_s, b.P_s)
