@@ -48,7 +48,7 @@ from . import _kernels as K
 from .errors import ErrorModel
 
 __all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state",
-           "Records", "run", "filter_chunk", "rts_chunk", "no_windows"]
+           "Records", "run", "filter_chunk", "rts_chunk", "mbf_chunk", "no_windows"]
 
 _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 _MMAX = 9   # at most 9 measurement rows: position, velocity, specific force

@@ -628,7 +628,7 @@ def level_attitude_rms(sigmas_h, correlation_lengths, setup: LevelChannel | None
     """Expected photo-epoch RMS of the level attitude (pitch along track, roll across: the same
     law) for the normal-gravity filter and for a filter given the field's true statistics.
 
-    Truth: :func:`_level_matrices` with the horizontal disturbance a first-order Gauss-Markov
+    Truth: the equations of ``_level_matrices`` with the horizontal disturbance a first-order Gauss-Markov
     process of σ ``sigma_h`` (m/s², at flight height) and correlation time D/v.  Filters
     (closed loop, chen2019 eq. (3-18) position and velocity rows): ``"normal"`` leaves δg out
     (eq. (3-1) gravity only, the 15-state filter); ``"informed"`` carries δg with the truth's
