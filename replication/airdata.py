@@ -64,6 +64,7 @@ from .errors import NavPoint
 from .kalman import update, van_loan
 from .rotations import quat_to_dcm, rotvec_to_dcm
 from scipy import stats
+from scipy.integrate import solve_ivp
 from dataclasses import replace
 from .errors import model_15
 
@@ -73,6 +74,7 @@ __all__ = [
     "position_correction", "correction_vector", "exact_correction",
     "STATE_NAMES", "reference_state", "derived_coefficients", "printed_elements",
     "check_elements", "manifold_residuals", "consistency_count",
+    "interval_motion", "integrate_eq21", "EQ21_ROWS", "EQ21_STARTS",
     "LEDGER_ID", "LEDGER_TOLERANCE", "readings_ledger_rows",
 ]
 
@@ -540,6 +542,169 @@ def consistency_count(paper, state: str = "climb"):
     for rd in READINGS:
         df = check_elements(paper, rd, state)
         out[rd] = int((~df["match"] & df["comparable"]).sum())
+    return out
+
+
+def interval_motion(state: str = "climb", interval: float = 30.0):
+    """Kinematics along one correction interval, as a function of the time τ since its start.
+
+    duan2023 §2 puts the origin at the SINS position at the start of the interval, so
+    d(0) = [S_x, S_y, h](0) = 0 and S(0) = 0.  The flight is the straight, constant-acceleration
+    motion of :func:`reference_state` ``state`` (direction e, along-track acceleration a): speed
+    v(τ) = v̄ + a (τ - T/2) with the reference speed v̄ as mean speed, d(τ) = (v̄ - aT/2) τ e + a τ²/2 e.
+    At T = 30 s the displacement is the reference one (5.4 km); the end speed is v̄ + aT/2 (the
+    reference state's speed × 30 s ignores its acceleration).  L, R_Mh, R_Nh are held, as in
+    :func:`_ddt`.  Returns ``f(tau) -> dict`` over the kinematic symbols.
+    """
+    if not interval > 0:
+        raise ValueError("interval must be positive (seconds)")
+    ref = reference_state(state)
+    vref = np.array([ref["VE"], ref["VN"], ref["VU"]])
+    vbar = float(np.linalg.norm(vref))
+    e = vref / vbar
+    acc = float(np.linalg.norm([ref["AE"], ref["AN"], ref["AU"]]))
+    v0 = vbar - acc * interval / 2
+
+    def at(tau):
+        tau = float(tau)
+        st = dict(zip(("Sx", "Sy", "h"), (v0 * tau + acc * tau**2 / 2) * e))
+        st.update(zip(("VE", "VN", "VU"), (v0 + acc * tau) * e))
+        st.update(zip(("AE", "AN", "AU"), acc * e))
+        st.update(L=ref["L"], RMh=ref["RMh"], RNh=ref["RNh"])
+        return st
+
+    return at
+
+
+def _repaired_velocity_rows(dc):
+    """Velocity rows of eq. (21) re-derived in the pattern of eq. (7) (convention C1).
+
+    Eqs. (11) and (13) over the common denominator d = (S² + h²)^{3/2}: δV_i^c = (n_i/d) δh^c with
+    n_U = S² V, n_{E,N} = -S_{x,y} h V.  The quotient rule with δḣ^c = δV_U^c (eq. (20) row 3)
+    gives δV̇_i^c = -(ḋ/d) δV_i^c + (ṅ_i/d) δh^c + (n_i/d) δV_U^c, the split eq. (7) uses.
+    Returns {row: {col: expr}}.
+    """
+    import sympy as sp
+
+    _, k = _symbols()
+    r2 = k["Sx"] ** 2 + k["Sy"] ** 2 + k["h"] ** 2
+    d = r2 ** sp.Rational(3, 2)
+    out = {}
+    for row in ("dV_E", "dV_N", "dV_U"):
+        n = sp.simplify(dc[row] * d)
+        m = {row: sp.simplify(-_ddt(d) / d), "dh": sp.simplify(_ddt(n) / d)}
+        m["dV_U"] = m.get("dV_U", 0) + dc[row]
+        out[row] = m
+    return out
+
+
+_EQ21_CACHE: dict = {}
+
+
+def _eq21_functions(paper, reading: str, rows: str):
+    """Numeric M(state) of eq. (21) (8×8, order :data:`STATE_NAMES`) and the coefficient vector a(state).
+
+    Cached on the transcribed eq. (21) elements (the paper table itself is not hashable)."""
+    import sympy as sp
+
+    key = (tuple(paper.data.loc[paper.data["equation"].astype(str) == "21", ["row", "col", "value"]]
+                 .astype(str).itertuples(index=False, name=None)), reading, rows)
+    if key in _EQ21_CACHE:
+        return _EQ21_CACHE[key]
+    _, k = _symbols()
+    dc = derived_coefficients(reading)
+    m = sp.zeros(8, 8)
+    els = printed_elements(paper, reading)
+    for i, rname in enumerate(STATE_NAMES):
+        for col, expr in _row_of(els, "21", rname).items():
+            m[i, STATE_NAMES.index(col)] = expr
+    if rows == "repaired":
+        for rname, cols in _repaired_velocity_rows(dc).items():
+            i = STATE_NAMES.index(rname)
+            m[i, :] = sp.zeros(1, 8)
+            for col, expr in cols.items():
+                m[i, STATE_NAMES.index(col)] += expr
+    args = [k[n] for n in _KIN]
+    fm = sp.lambdify(args, m, "numpy")
+    fa = sp.lambdify(args, sp.Matrix([dc[n] for n in STATE_NAMES]), "numpy")
+    _EQ21_CACHE[key] = (lambda st: np.asarray(fm(*[st[n] for n in _KIN]), float),
+                        lambda st: np.asarray(fa(*[st[n] for n in _KIN]), float).ravel())
+    return _EQ21_CACHE[key]
+
+
+EQ21_ROWS = ("printed", "repaired")
+EQ21_STARTS = ("manifold", "height-only")
+
+
+def integrate_eq21(paper, *, reading: str = "B", state: str = "climb", interval: float = 30.0,
+                   t0: float = 1.0, dh: float = 1.0, rows: str = "printed", start: str = "manifold",
+                   rtol: float = 1e-11):
+    """Integrate the linear system of duan2023 eq. (21) over one correction interval.
+
+    x = [φ_E, φ_N, δV_E, δV_N, δV_U, δL, δλ, δh]^c (:data:`STATE_NAMES`) obeys ẋ = M(t) x along
+    :func:`interval_motion`.  S(0) = 0 at the interval's origin and M has 1/S and 1/(S²+h²)
+    entries, so the integration starts at t0 > 0.
+
+    Parameters
+    ----------
+    paper : PaperTable
+        ``duan2023-eq-22`` (the transcribed eq. (21) elements).
+    reading : {"B", "A"}
+        β and position-state order (:func:`derived_coefficients`).
+    state : {"climb", "level", "steep"}
+        Flight of :func:`reference_state` followed over the interval.
+    interval, t0 : float
+        End T and start t0 of the integration (s), 0 < t0 < T.
+    dh : float
+        δh^c (m) at t0.
+    rows : {"printed", "repaired"}
+        M as printed in eq. (21), or with its velocity rows (eqs. (14)-(15)) replaced by
+        :func:`_repaired_velocity_rows`.
+    start : {"manifold", "height-only"}
+        x(t0) = a(t0) δh^c, a the closed-form coefficients of eqs. (6) (without the misprinted
+        1/2), (11), (13), (19) (:func:`derived_coefficients`); or x(t0) = [0, ..., 0, δh^c].
+    rtol : float
+        ``solve_ivp`` (DOP853) relative tolerance; per-state atol = 1e-3 · rtol · |a(T) δh^c|.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Indexed by state: ``end`` x(T); ``closed`` a(T) δh^c (closed form with the given δh^c);
+        ``closed_end_height`` a(T) x_δh(T) (closed form with the height correction the system
+        carries to T); ``rel``, ``rel_end_height`` the relative differences of ``end`` from them.
+        ``attrs``: ``t0``, ``height_gain`` = x_δh(T)/δh^c, ``nfev``, ``rows``, ``start``.
+
+    Notes
+    -----
+    Row 3 of eq. (20), δḣ^c = δV_U^c, with eq. (13), δV_U^c = cos²γ (ṙ/r) δh^c on straight flight,
+    makes x_δh grow as r^{cos²γ} on the correction manifold: any consistent form of eq. (21) ends
+    at a(T) x_δh(T) with x_δh(T) = δh^c (r(T)/r(t0))^{cos²γ}, which diverges as t0 → 0.  The
+    printed velocity rows add a growing mode (diagonal +(2SṠ + 3hV_U)/(S²+h²) ≈ +2/t).
+    """
+    choice(rows, EQ21_ROWS, "rows")
+    choice(start, EQ21_STARTS, "start")
+    if not 0 < t0 < interval:
+        raise ValueError("t0 must lie in (0, interval): S = 0 at the start of the interval and eq. (21) divides by S")
+    motion = interval_motion(state, interval)
+    fm, fa = _eq21_functions(paper, reading, rows)
+    a0, a1 = fa(motion(t0)), fa(motion(interval))
+    x0 = a0 * dh if start == "manifold" else np.r_[np.zeros(7), dh]
+    scale = np.where(np.abs(a1 * dh) > 0, np.abs(a1 * dh), np.abs(dh))
+    sol = solve_ivp(lambda t, x: fm(motion(t)) @ x, (t0, interval), x0, method="DOP853",
+                    rtol=rtol, atol=1e-3 * rtol * scale)
+    if not sol.success:
+        raise RuntimeError(f"eq. (21) integration failed: {sol.message}")
+    end = sol.y[:, -1]
+    closed, closed_h = a1 * dh, a1 * end[-1]
+
+    def rel(x, y):
+        den = np.maximum(np.maximum(np.abs(x), np.abs(y)), 1e-300)
+        return np.where(np.maximum(np.abs(x), np.abs(y)) > 0, np.abs(x - y) / den, 0.0)
+
+    out = pd.DataFrame({"end": end, "closed": closed, "closed_end_height": closed_h,
+                        "rel": rel(end, closed), "rel_end_height": rel(end, closed_h)},
+                       index=pd.Index(STATE_NAMES, name="state"))
+    out.attrs.update(t0=t0, height_gain=end[-1] / dh, nfev=int(sol.nfev), rows=rows, start=start)
     return out
 
 

@@ -157,6 +157,78 @@ def test_manifold_rows(eq22):
     assert get("21", "dL", "climb", "C1") < 1e-9 and get("21", "dlambda", "climb", "C1") < 1e-9
 
 
+
+# --------------------------------------------------------------------------- eq. (21) integrated
+# Integration error: at rtol = 1e-11 (DOP853) the end states move by ≤ 2e-11 relative between
+# rtol = 1e-9 and 1e-12, so bounds of 1e-9 on quantities that are exact in exact arithmetic keep a
+# margin of ~50x over the solver and sit eight orders below the misses of the printed rows (0.1-1).
+
+def _radius(state, tau):
+    m = ad.interval_motion(state)(tau)
+    return np.linalg.norm([m["Sx"], m["Sy"], m["h"]])
+
+
+def test_eq21_printed_does_not_reach_closed_forms(eq22):
+    """Printed eq. (21) from the closed forms at t0 = 1 s (climb): the height correction grows
+    ~1e4-fold, every end state misses a(T) δh^c by > 99 %, and the velocity rows (eqs. (14)-(15))
+    leave the correction manifold even measured against the height the system carries (16 %, 66 %),
+    while the attitude and position rows (eqs. (7), (20)) stay on it.  The growth scales as t0^-3
+    (diagonal +(2SṠ+3hV_U)/(S²+h²) ≈ +2/t of the printed δV_U row), so the integral from S = 0 diverges."""
+    r = ad.integrate_eq21(eq22, rows="printed", t0=1.0)
+    assert r.attrs["height_gain"] > 1e3
+    assert (r["rel"] > 0.99).all()
+    assert r.loc["dV_U", "rel_end_height"] > 0.5 and r.loc[["dV_E", "dV_N"], "rel_end_height"].min() > 0.1
+    assert r.loc[["phi_E", "phi_N", "dL", "dlambda"], "rel_end_height"].max() < 1e-9
+    g01 = ad.integrate_eq21(eq22, rows="printed", t0=0.1).attrs["height_gain"]
+    assert 900 < g01 / r.attrs["height_gain"] < 1200
+
+
+def test_eq21_printed_level_height_gain_in_closed_form(eq22):
+    """Level flight: the printed δV_U row reduces to δV̇_U = (2Ṡ/S) δV_U (no δh term), so
+    δV_U = δV_U(t0) (S/S0)² and δh(T) = δh^c [1 + V(t0)/S0³ ∫ S² dt]; the integrator must agree."""
+    t0, T = 1.0, 30.0
+    m = ad.interval_motion("level")
+    s0, v0 = _radius("level", t0), np.linalg.norm([m(t0)[k] for k in ("VE", "VN", "VU")])
+    tau = np.linspace(t0, T, 20001)
+    s2 = np.array([_radius("level", t) for t in tau]) ** 2
+    expected = 1 + v0 / s0**3 * np.sum((s2[1:] + s2[:-1]) / 2 * np.diff(tau))  # S² quartic: trapezoid rel. err ~1e-8
+    got = ad.integrate_eq21(eq22, rows="printed", state="level", t0=t0).attrs["height_gain"]
+    assert abs(got / expected - 1) < 1e-6
+
+
+@pytest.mark.parametrize("state", ["climb", "level"])
+@pytest.mark.parametrize("t0", [0.1, 1.0, 3.0])
+def test_eq21_repaired_stays_on_manifold_but_height_grows(eq22, state, t0):
+    """Velocity rows re-derived (eq. (7)'s quotient rule on eqs. (11), (13)): from the closed
+    forms at t0 every end state equals a(T) x_δh(T) to 1e-9, but with δḣ^c = δV_U^c (eq. (20)
+    row 3) and δV_U^c = cos²γ (ṙ/r) δh^c (eq. (13)), x_δh grows as r^{cos²γ}:
+    x_δh(T)/δh^c = (r(T)/r(t0))^{cos²γ} (≈ 31 for t0 = 1 s), so a(T) δh^c with the starting δh^c is
+    not reached, and the gain diverges as 1/t0 at the interval start (S = 0)."""
+    r = ad.integrate_eq21(eq22, rows="repaired", state=state, t0=t0)
+    assert r["rel_end_height"].max() < 1e-9
+    gam = np.radians({"climb": 3.0, "level": 0.0}[state])
+    gain = (_radius(state, 30.0) / _radius(state, t0)) ** (np.cos(gam) ** 2)
+    assert abs(r.attrs["height_gain"] / gain - 1) < 1e-9
+    nonzero = r["closed"] != 0                   # level flight: δV_E, δV_N, δL, δλ are 0 throughout
+    assert nonzero.sum() >= 4
+    assert (r.loc[nonzero, "rel"] > 1 - 1.1 / gain).all()     # = 1 - 1/gain: a(T)·δh^c is missed
+
+
+def test_eq21_repaired_from_height_only_approaches_manifold(eq22):
+    """Started with only δh^c (other corrections 0) the repaired system is drawn onto the
+    manifold: the off-manifold part decays like (t0/T)², 1.5e-3 at t0 = 1 s, 1.5e-5 at 0.1 s."""
+    a = ad.integrate_eq21(eq22, rows="repaired", start="height-only", t0=1.0)
+    b = ad.integrate_eq21(eq22, rows="repaired", start="height-only", t0=0.1)
+    assert a["rel_end_height"].max() < 5e-3
+    assert b["rel_end_height"].max() < 0.02 * a["rel_end_height"].max()
+
+
+def test_eq21_rejects_start_at_origin(eq22):
+    with pytest.raises(ValueError, match="S = 0"):
+        ad.integrate_eq21(eq22, t0=0.0)
+    with pytest.raises(ValueError):
+        ad.integrate_eq21(eq22, rows="typeset")
+
 # --------------------------------------------------------------------------- eq. (1), ADS, simulation
 
 @pytest.fixture(scope="module")
