@@ -554,7 +554,7 @@ def interval_motion(state: str = "climb", interval: float = 30.0):
     v(τ) = v̄ + a (τ - T/2) with the reference speed v̄ as mean speed, d(τ) = (v̄ - aT/2) τ e + a τ²/2 e.
     At T = 30 s the displacement is the reference one (5.4 km); the end speed is v̄ + aT/2 (the
     reference state's speed × 30 s ignores its acceleration).  L, R_Mh, R_Nh are held, as in
-    :func:`_ddt`.  Returns ``f(tau) -> dict`` over the kinematic symbols.
+    ``_ddt``.  Returns ``f(tau) -> dict`` over the kinematic symbols.
     """
     if not interval > 0:
         raise ValueError("interval must be positive (seconds)")
@@ -659,7 +659,7 @@ def integrate_eq21(paper, *, reading: str = "B", state: str = "climb", interval:
         δh^c (m) at t0.
     rows : {"printed", "repaired"}
         M as printed in eq. (21), or with its velocity rows (eqs. (14)-(15)) replaced by
-        :func:`_repaired_velocity_rows`.
+        ``_repaired_velocity_rows``.
     start : {"manifold", "height-only"}
         x(t0) = a(t0) δh^c, a the closed-form coefficients of eqs. (6) (without the misprinted
         1/2), (11), (13), (19) (:func:`derived_coefficients`); or x(t0) = [0, ..., 0, δh^c].
