@@ -90,9 +90,9 @@ ChunkOut = namedtuple("ChunkOut", ["st", "q", "phat", "nis", "innov", "nees", "n
 # ----------------------------------------------------------------------------- compiled pieces
 
 @njit(**_NJ)
-def _propagate_sparse(Phi, P, Qd, W, nzc, nzv, cnt):
-    """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (Φ of an INS error model is sparse)."""
-    n = P.shape[0]
+def _row_nonzeros(Phi, nzc, nzv, cnt):
+    """The non-zeros of Φ by row: column indices ``nzc[i, :cnt[i]]`` (ascending), values ``nzv``."""
+    n = Phi.shape[0]
     for i in range(n):
         c = 0
         for k in range(n):
@@ -102,6 +102,13 @@ def _propagate_sparse(Phi, P, Qd, W, nzc, nzv, cnt):
                 nzv[i, c] = v
                 c += 1
         cnt[i] = c
+
+
+@njit(**_NJ)
+def _propagate_sparse(Phi, P, Qd, W, nzc, nzv, cnt):
+    """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (Φ of an INS error model is sparse)."""
+    n = P.shape[0]
+    _row_nonzeros(Phi, nzc, nzv, cnt)
     for i in range(n):
         for j in range(n):
             W[i, j] = 0.0
@@ -584,21 +591,16 @@ def _nonzeros(Phi, nzc, nzv, cnt, rzc, rzv, rcnt):
     """The non-zeros of Φ by column (row indices ``nzc[i, :cnt[i]]``, values ``nzv``) and by row
     (column indices ``rzc[k, :rcnt[k]]``, values ``rzv``)."""
     n = Phi.shape[0]
+    _row_nonzeros(Phi, rzc, rzv, rcnt)
     for i in range(n):
         cnt[i] = 0
     for k in range(n):
-        c = 0
-        for i in range(n):
-            v = Phi[k, i]
-            if v != 0.0:
-                rzc[k, c] = i
-                rzv[k, c] = v
-                c += 1
-                ci = cnt[i]
-                nzc[i, ci] = k
-                nzv[i, ci] = v
-                cnt[i] = ci + 1
-        rcnt[k] = c
+        for t in range(rcnt[k]):
+            i = rzc[k, t]
+            ci = cnt[i]
+            nzc[i, ci] = k
+            nzv[i, ci] = rzv[k, t]
+            cnt[i] = ci + 1
 
 
 @njit(**_NJ)
