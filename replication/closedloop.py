@@ -911,6 +911,201 @@ def _empty_gains(E_, n, n_dyn, n_aug, with_nees):
                  np.empty((E_n, n, n)))
 
 
+def _run_arguments(spec: Spec, P0, ep_samples, n_steps: int, record_every, chunk_epochs, workers, smoother_form):
+    """The checked epoch samples and initial covariance of :func:`run` (``ValueError`` otherwise)."""
+    ep = np.asarray(ep_samples, np.int64)
+    n = spec.fconst.shape[0]
+    if ep.ndim != 1 or len(ep) < 1 or np.any(np.diff(ep) <= 0) or ep[0] < 1 or ep[-1] > n_steps:
+        raise ValueError(f"ep_samples must be strictly increasing sample indices in 1..{n_steps}")
+    if int(record_every) < 1 or int(chunk_epochs) < 2 or int(workers) < 1:
+        raise ValueError("record_every ≥ 1, chunk_epochs ≥ 2 and workers ≥ 1 are required")
+    if smoother_form not in ("mbf", "rts"):
+        raise ValueError('smoother_form must be "mbf" or "rts"')
+    P0 = np.array(P0, dtype=float)
+    if P0.shape != (n, n):
+        raise ValueError(f"P0 must be {n}×{n}")
+    return ep, P0
+
+
+def _record_positions(n_ep: int, record_every: int):
+    """Indices of the recorded epochs and, per epoch, its place among them (−1: not recorded)."""
+    rec_mask = (np.arange(n_ep) + 1) % int(record_every) == 0
+    rec_ep = np.nonzero(rec_mask)[0]
+    rec_pos = np.full(n_ep, -1, np.int64)
+    rec_pos[rec_ep] = np.arange(len(rec_ep))
+    return rec_ep, rec_pos
+
+
+def _new_records(spec: Spec, rec_ep, R: int, n: int, n_ep: int, n_steps: int, store_P: bool,
+                 store_nav: bool) -> Records:
+    """Empty :class:`Records` for ``R`` runs of ``n`` states at the recorded epochs ``rec_ep``."""
+    n_aug = n - 9
+    m_rec = len(rec_ep)
+    return Records(epochs=rec_ep, st=np.empty((R, m_rec, 6)), q=np.empty((R, m_rec, 4)),
+                   p_hat=np.empty((R, m_rec, n_aug)), nis=np.empty((R, m_rec)), innov=np.zeros((R, m_rec, _MMAX)),
+                   nees=np.full((R, m_rec), np.nan) if spec.nees else None,
+                   P=np.empty((m_rec, n, n)) if store_P else None,
+                   P_bar=np.empty((m_rec, n, n)) if spec.use_pbar else None, pdiag_all=np.empty((n_ep, n)),
+                   nav_st=np.empty((R, n_steps + 1, 6)) if store_nav else None,
+                   nav_q=np.empty((R, n_steps + 1, 4)) if store_nav else None)
+
+
+def _follower_groups(R: int, workers: int) -> list:
+    """Slices of the runs 1..R−1 for at most ``workers`` follower threads (none for a single run)."""
+    n_groups = min(int(workers), R - 1) if R > 1 else 0
+    return [slice(1 + g * (R - 1) // n_groups, 1 + (g + 1) * (R - 1) // n_groups) for g in range(n_groups)]
+
+
+def _out_view(o: ChunkOut, sl) -> ChunkOut:
+    """The runs ``sl`` of a chunk's outputs (per-run fields sliced, shared fields as they are)."""
+    per_run = {"st", "q", "phat", "nis", "innov", "nees", "nav_st", "nav_q", "rec_x"}
+    return ChunkOut(*(v[sl] if k in per_run else v for k, v in zip(ChunkOut._fields, o)))
+
+
+def _inputs_view(x: ChunkInputs, sl) -> ChunkInputs:
+    """The runs ``sl`` of a chunk's inputs (per-run fields sliced, shared fields as they are)."""
+    per_run = {"dth", "dvv", "gpos", "gvel", "truth_p"}
+    return ChunkInputs(*(v[sl] if k in per_run else v for k, v in zip(ChunkInputs._fields, x)))
+
+
+class _ChunkPlan:
+    """The chunks of one call of :func:`run` and the filter's work on one chunk (lead, followers, replay)."""
+
+    def __init__(self, spec: Spec, ep, n_steps: int, chunk_epochs: int, rec_pos, R: int, groups, inputs,
+                 lead_inputs, store_nav: bool, store_P: bool, rts: bool):
+        n_ep = len(ep)
+        self.spec, self.ep, self.n_steps, self.rec_pos, self.R, self.groups = spec, ep, n_steps, rec_pos, R, groups
+        self.inputs, self.lead_inputs = inputs, lead_inputs
+        self.store_nav, self.store_P, self.rts = store_nav, store_P, rts
+        self.chunks = [(j0, min(j0 + int(chunk_epochs), n_ep)) for j0 in range(0, n_ep, int(chunk_epochs))]
+        self.n = spec.fconst.shape[0]
+        self.n_aug = self.n - 9
+        self.n_dyn = len(spec.dyn_rows)
+        # the lead's replay for the smoother: neither the covariance without measurements nor the NEES
+        self.spec_replay = spec._replace(use_pbar=False, nees=False)
+
+    def bounds(self, ci):
+        """Epochs j0..j1−1 and IMU steps k0..k1−1 of chunk ``ci``."""
+        j0, j1 = self.chunks[ci]
+        k0 = 0 if ci == 0 else int(self.ep[j0 - 1])
+        k1 = self.n_steps if ci == len(self.chunks) - 1 else int(self.ep[j1 - 1])
+        return j0, j1, k0, k1
+
+    def chunk_out(self, j0, j1, k0, k1, record, R=None, store_nav=None) -> ChunkOut:
+        """Output arrays of one chunk for ``R`` runs (all by default); ``record`` for the smoother's replay."""
+        R = self.R if R is None else R
+        store_nav = self.store_nav if store_nav is None else store_nav
+        n, rec_pos, spec, rts = self.n, self.rec_pos, self.spec, self.rts
+        E_ = j1 - j0
+        flag = rec_pos[j0:j1] - (rec_pos[j0:j1][rec_pos[j0:j1] >= 0].min() if np.any(rec_pos[j0:j1] >= 0) else 0)
+        flag = np.where(rec_pos[j0:j1] >= 0, flag, -1).astype(np.int64)
+        n_f = int(np.sum(flag >= 0))
+        nav = (k1 - k0 + 1) if store_nav else 0
+        e3 = np.empty((0, n, n))
+        # the smoother's replay (``record``) keeps Φ per epoch and P⁺ at the recorded epochs; the RTS
+        # form also P⁺, P⁻ and the estimates x̂ per epoch
+        return ChunkOut(np.empty((R, E_, 6)), np.empty((R, E_, 4)), np.empty((R, E_, self.n_aug)), np.empty((R, E_)),
+                        np.zeros((R, E_, _MMAX)), np.full((R, E_), np.nan) if spec.nees else np.empty((R, 0)),
+                        np.empty((R, nav, 6)), np.empty((R, nav, 4)), np.empty((E_, n)), flag,
+                        np.empty((n_f, n, n)) if self.store_P or record else e3,
+                        np.empty((n_f, n, n)) if spec.use_pbar and self.store_P else e3,
+                        np.empty((E_, n, n)) if record and rts else e3, np.empty((E_, n, n)) if record and rts else e3,
+                        np.empty((E_, n, n)) if record else e3,
+                        np.empty((R, E_, n)) if record and rts else np.empty((R, 0, n)))
+
+    def prepare(self, ci, record):
+        """Epochs, inputs, output arrays and empty gains of chunk ``ci`` for every run."""
+        j0, j1, k0, k1 = self.bounds(ci)
+        return (j0, j1, self.inputs(ci, k0, k1, self.ep[j0:j1]), self.chunk_out(j0, j1, k0, k1, record),
+                _empty_gains(j1 - j0, self.n, self.n_dyn, self.n_aug, self.spec.nees))
+
+    def lead_pass(self, st_, lead_, x, g, o):
+        """Run 0 over one chunk, leaving the gains ``g`` for the followers."""
+        filter_chunk(self.spec, _inputs_view(x, slice(0, 1)), _split(st_, slice(0, 1)), lead_, g,
+                     _out_view(o, slice(0, 1)), True)
+
+    def start_followers(self, st_, lead_, x, g, o):
+        """Threads running the followers of one chunk (their state views are taken now)."""
+        threads = [threading.Thread(target=filter_chunk, args=(self.spec, _inputs_view(x, sl), _split(st_, sl), lead_,
+                                                               g, _out_view(o, sl), False)) for sl in self.groups]
+        for t in threads:
+            t.start()
+        st_.first[0] = 0
+        return threads
+
+    def forward(self, ci, st_, lead_, record):
+        """Lead over the chunk, then its followers, joined before return."""
+        j0, j1, x, o, g = self.prepare(ci, record)
+        self.lead_pass(st_, lead_, x, g, o)
+        for t in self.start_followers(st_, lead_, x, g, o):
+            t.join()
+        return j0, j1, o, g
+
+    def replay_lead(self, ci, st0, lead_):
+        """The lead alone over chunk ``ci`` from its checkpoint, recording for the smoother."""
+        j0, j1, k0, k1 = self.bounds(ci)
+        x = (self.lead_inputs(ci, k0, k1, self.ep[j0:j1]) if self.lead_inputs is not None
+             else _inputs_view(self.inputs(ci, k0, k1, self.ep[j0:j1]), slice(0, 1)))
+        o = self.chunk_out(j0, j1, k0, k1, True, R=1, store_nav=False)
+        g = _empty_gains(j1 - j0, self.n, self.n_dyn, self.n_aug, False)
+        filter_chunk(self.spec_replay, x, st0, lead_, g, o, True)
+        return j0, j1, o, g
+
+    def replay(self, checkpoints, ci):
+        """Chunk ``ci`` replayed from its checkpoint (released) for the smoother."""
+        st_c, lead_c = checkpoints[ci]
+        checkpoints[ci] = None
+        return self.forward(ci, st_c, lead_c, True) if self.rts else self.replay_lead(ci, st_c, lead_c)
+
+
+def _checkpoint(plan: _ChunkPlan, state: BatchState, row0):
+    """What the smoother's replay of a chunk starts from: every run (RTS form) or the lead alone (MBF form)."""
+    if not plan.rts:
+        return row0
+    ck = BatchState(*(v.copy() for v in state))
+    for v, v0 in zip(ck, row0[0]):
+        v[:1] = v0
+    return ck, row0[1]
+
+
+def _forward_pass(plan: _ChunkPlan, state: BatchState, lead: LeadState, res: Records, smoother: bool):
+    """The filter over every chunk, pipelined, into ``res``; returns the smoother's checkpoints and innovations.
+
+    The lead runs chunk c while the followers finish chunk c − 1 and the inputs of chunk c + 1 are
+    prepared (``inputs`` is called in chunk order, from one thread)."""
+    chunks, rts = plan.chunks, plan.rts
+    checkpoints = []
+    innov = [None] * len(chunks)
+    pending = None
+    prep = ThreadPoolExecutor(max_workers=1)
+    try:
+        nxt_prep = prep.submit(plan.prepare, 0, False)
+        for ci in range(len(chunks) + 1):
+            if ci < len(chunks):
+                j0, j1, x, o, g = nxt_prep.result()
+                if ci + 1 < len(chunks):
+                    nxt_prep = prep.submit(plan.prepare, ci + 1, False)
+                row0 = (BatchState(*(v[:1].copy() for v in state)), LeadState(*(v.copy() for v in lead)))
+                plan.lead_pass(state, lead, x, g, o)
+            if pending is not None:
+                for t in pending[0]:
+                    t.join()
+                _collect(res, pending[1], pending[2], pending[3], plan.rec_pos, plan.spec, pending[4])
+                if smoother and not rts:
+                    # every run's innovations, for the smoother (the rows in use)
+                    innov[ci - 1] = np.ascontiguousarray(pending[3].innov[:, :, :int(pending[5].m.max())])
+                pending = None
+            if ci == len(chunks):
+                break
+            if smoother:
+                checkpoints.append(_checkpoint(plan, state, row0))
+            pending = (plan.start_followers(state, lead, x, g, o), j0, j1, o,
+                       plan.bounds(ci)[2] if plan.store_nav else None, g)
+    finally:
+        prep.shutdown()
+    return checkpoints, innov
+
+
 def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *,
         lead_inputs: Callable[[int, int, int, np.ndarray], ChunkInputs] | None = None, record_every: int = 1,
@@ -963,153 +1158,19 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     -------
     Records
     """
-    ep = np.asarray(ep_samples, np.int64)
+    ep, P0 = _run_arguments(spec, P0, ep_samples, n_steps, record_every, chunk_epochs, workers, smoother_form)
     n = spec.fconst.shape[0]
-    n_aug = n - 9
-    if ep.ndim != 1 or len(ep) < 1 or np.any(np.diff(ep) <= 0) or ep[0] < 1 or ep[-1] > n_steps:
-        raise ValueError(f"ep_samples must be strictly increasing sample indices in 1..{n_steps}")
-    if int(record_every) < 1 or int(chunk_epochs) < 2 or int(workers) < 1:
-        raise ValueError("record_every ≥ 1, chunk_epochs ≥ 2 and workers ≥ 1 are required")
-    if smoother_form not in ("mbf", "rts"):
-        raise ValueError('smoother_form must be "mbf" or "rts"')
-    rts = smoother_form == "rts"
-    P0 = np.array(P0, dtype=float)
-    if P0.shape != (n, n):
-        raise ValueError(f"P0 must be {n}×{n}")
-    state = _with_phat(state, n_aug)
+    state = _with_phat(state, n - 9)
     R = state.st.shape[0]
-    n_ep = len(ep)
-    chunks = [(j0, min(j0 + int(chunk_epochs), n_ep)) for j0 in range(0, n_ep, int(chunk_epochs))]
-    rec_mask = (np.arange(n_ep) + 1) % int(record_every) == 0
-    rec_ep = np.nonzero(rec_mask)[0]
-    m_rec = len(rec_ep)
-    rec_pos = np.full(n_ep, -1, np.int64)
-    rec_pos[rec_ep] = np.arange(m_rec)
-    res = Records(epochs=rec_ep, st=np.empty((R, m_rec, 6)), q=np.empty((R, m_rec, 4)),
-                  p_hat=np.empty((R, m_rec, n_aug)), nis=np.empty((R, m_rec)), innov=np.zeros((R, m_rec, _MMAX)),
-                  nees=np.full((R, m_rec), np.nan) if spec.nees else None,
-                  P=np.empty((m_rec, n, n)) if store_P else None,
-                  P_bar=np.empty((m_rec, n, n)) if spec.use_pbar else None, pdiag_all=np.empty((n_ep, n)),
-                  nav_st=np.empty((R, n_steps + 1, 6)) if store_nav else None,
-                  nav_q=np.empty((R, n_steps + 1, 4)) if store_nav else None)
+    rec_ep, rec_pos = _record_positions(len(ep), record_every)
+    res = _new_records(spec, rec_ep, R, n, len(ep), n_steps, store_P, store_nav)
     lead = LeadState(P0.copy(), P0.copy(), np.zeros(3), np.zeros((6, n)))
-    n_dyn = len(spec.dyn_rows)
-    n_groups = min(int(workers), R - 1) if R > 1 else 0
-    groups = [slice(1 + g * (R - 1) // n_groups, 1 + (g + 1) * (R - 1) // n_groups) for g in range(n_groups)]
-
-    def bounds(ci):
-        j0, j1 = chunks[ci]
-        k0 = 0 if ci == 0 else int(ep[j0 - 1])
-        k1 = n_steps if ci == len(chunks) - 1 else int(ep[j1 - 1])
-        return j0, j1, k0, k1
-
-    def chunk_out(ci, j0, j1, k0, k1, record, R=R, store_nav=store_nav):
-        E_ = j1 - j0
-        flag = rec_pos[j0:j1] - (rec_pos[j0:j1][rec_pos[j0:j1] >= 0].min() if np.any(rec_pos[j0:j1] >= 0) else 0)
-        flag = np.where(rec_pos[j0:j1] >= 0, flag, -1).astype(np.int64)
-        n_f = int(np.sum(flag >= 0))
-        nav = (k1 - k0 + 1) if store_nav else 0
-        e3 = np.empty((0, n, n))
-        # the smoother's replay (``record``) keeps Φ per epoch and P⁺ at the recorded epochs; the RTS
-        # form also P⁺, P⁻ and the estimates x̂ per epoch
-        return ChunkOut(np.empty((R, E_, 6)), np.empty((R, E_, 4)), np.empty((R, E_, n_aug)), np.empty((R, E_)),
-                        np.zeros((R, E_, _MMAX)), np.full((R, E_), np.nan) if spec.nees else np.empty((R, 0)),
-                        np.empty((R, nav, 6)), np.empty((R, nav, 4)), np.empty((E_, n)), flag,
-                        np.empty((n_f, n, n)) if store_P or record else e3,
-                        np.empty((n_f, n, n)) if spec.use_pbar and store_P else e3,
-                        np.empty((E_, n, n)) if record and rts else e3, np.empty((E_, n, n)) if record and rts else e3,
-                        np.empty((E_, n, n)) if record else e3,
-                        np.empty((R, E_, n)) if record and rts else np.empty((R, 0, n)))
-
-    def view(o: ChunkOut, sl) -> ChunkOut:
-        per_run = {"st", "q", "phat", "nis", "innov", "nees", "nav_st", "nav_q", "rec_x"}
-        return ChunkOut(*(v[sl] if k in per_run else v for k, v in zip(ChunkOut._fields, o)))
-
-    def inp_view(x: ChunkInputs, sl) -> ChunkInputs:
-        per_run = {"dth", "dvv", "gpos", "gvel", "truth_p"}
-        return ChunkInputs(*(v[sl] if k in per_run else v for k, v in zip(ChunkInputs._fields, x)))
-
-    def prepare(ci, record):
-        j0, j1, k0, k1 = bounds(ci)
-        return (j0, j1, inputs(ci, k0, k1, ep[j0:j1]), chunk_out(ci, j0, j1, k0, k1, record),
-                _empty_gains(j1 - j0, n, n_dyn, n_aug, spec.nees))
-
-    def lead_pass(st_, lead_, x, g, o):
-        filter_chunk(spec, inp_view(x, slice(0, 1)), _split(st_, slice(0, 1)), lead_, g, view(o, slice(0, 1)), True)
-
-    def start_followers(st_, lead_, x, g, o):
-        """Threads running the followers of one chunk (their state views are taken now)."""
-        threads = [threading.Thread(target=filter_chunk, args=(spec, inp_view(x, sl), _split(st_, sl), lead_, g,
-                                                               view(o, sl), False)) for sl in groups]
-        for t in threads:
-            t.start()
-        st_.first[0] = 0
-        return threads
-
-    def forward(ci, st_, lead_, record):
-        """Lead over the chunk, then its followers, joined before return."""
-        j0, j1, x, o, g = prepare(ci, record)
-        lead_pass(st_, lead_, x, g, o)
-        for t in start_followers(st_, lead_, x, g, o):
-            t.join()
-        return j0, j1, o, g
-
-    # the lead's replay for the smoother: neither the covariance without measurements nor the NEES
-    spec_replay = spec._replace(use_pbar=False, nees=False)
-
-    def replay_lead(ci, st0, lead_):
-        """The lead alone over chunk ``ci`` from its checkpoint, recording for the smoother."""
-        j0, j1, k0, k1 = bounds(ci)
-        x = (lead_inputs(ci, k0, k1, ep[j0:j1]) if lead_inputs is not None
-             else inp_view(inputs(ci, k0, k1, ep[j0:j1]), slice(0, 1)))
-        o = chunk_out(ci, j0, j1, k0, k1, True, R=1, store_nav=False)
-        g = _empty_gains(j1 - j0, n, n_dyn, n_aug, False)
-        filter_chunk(spec_replay, x, st0, lead_, g, o, True)
-        return j0, j1, o, g
-
-    # forward pass, pipelined: the lead runs chunk c while the followers finish chunk c − 1 and the
-    # inputs of chunk c + 1 are prepared (``inputs`` is called in chunk order, from one thread)
-    checkpoints = []
-    innov = [None] * len(chunks)
-    pending = None
-    prep = ThreadPoolExecutor(max_workers=1)
-    try:
-        nxt_prep = prep.submit(prepare, 0, False)
-        for ci in range(len(chunks) + 1):
-            if ci < len(chunks):
-                j0, j1, x, o, g = nxt_prep.result()
-                if ci + 1 < len(chunks):
-                    nxt_prep = prep.submit(prepare, ci + 1, False)
-                row0 = (BatchState(*(v[:1].copy() for v in state)), LeadState(*(v.copy() for v in lead)))
-                lead_pass(state, lead, x, g, o)
-            if pending is not None:
-                for t in pending[0]:
-                    t.join()
-                _collect(res, pending[1], pending[2], pending[3], rec_pos, spec, pending[4])
-                if smoother and not rts:
-                    # every run's innovations, for the smoother (the rows in use)
-                    innov[ci - 1] = np.ascontiguousarray(pending[3].innov[:, :, :int(pending[5].m.max())])
-                pending = None
-            if ci == len(chunks):
-                break
-            if smoother and rts:
-                ck = BatchState(*(v.copy() for v in state))
-                for v, v0 in zip(ck, row0[0]):
-                    v[:1] = v0
-                checkpoints.append((ck, row0[1]))
-            elif smoother:
-                checkpoints.append(row0)
-            pending = (start_followers(state, lead, x, g, o), j0, j1, o, bounds(ci)[2] if store_nav else None, g)
-    finally:
-        prep.shutdown()
-
-    def replay(ci):
-        st_c, lead_c = checkpoints[ci]
-        checkpoints[ci] = None
-        return forward(ci, st_c, lead_c, True) if rts else replay_lead(ci, st_c, lead_c)
-
+    plan = _ChunkPlan(spec, ep, n_steps, chunk_epochs, rec_pos, R, _follower_groups(R, workers), inputs, lead_inputs,
+                      store_nav, store_P, smoother_form == "rts")
+    checkpoints, innov = _forward_pass(plan, state, lead, res, smoother)
     if smoother:
-        _smooth(res, chunks, replay, innov, rec_pos, R, n, m_rec, smoother_covariance, rts)
+        _smooth(res, plan.chunks, lambda ci: plan.replay(checkpoints, ci), innov, rec_pos, R, n, len(rec_ep),
+                smoother_covariance, plan.rts)
     return res
 
 
