@@ -853,6 +853,99 @@ def slope_weights(t_gnss, t_imu) -> np.ndarray:
     return C[seg] * np.diff(ti)
 
 
+def _single_gravity_block(model):
+    """The one gravity block of ``model`` and its slice of the state (``ValueError`` unless exactly one)."""
+    names = [b.name for b in model.blocks if b.target == "gravity"]
+    if len(names) != 1:
+        raise ValueError("the model needs exactly one gravity block (errors.gravity_shaping or ar_gravity_block)")
+    return model.block(names[0]), model.slices[names[0]]
+
+
+def _specific_force_windows(t, idx, gnss, model, gblk, gs, sf_interval, discrete: bool):
+    """Windows of the specific-force rows of :func:`augmented_filter` and the rows' gravity columns.
+
+    Returns per IMU step the slope weight and window id (-1 outside), per GNSS epoch the id of
+    the window ending there (-1 elsewhere), per window the GNSS acceleration and the variance
+    R_f, the gravity columns ``Hg`` (3 × augmented states) and the window length in epochs
+    (None without ``sf_interval``).
+    """
+    n = len(t) - 1
+    n_aug = model.n - 9
+    wgt = np.zeros(n)
+    win = np.full(n, -1, np.int64)
+    win_end = np.full(len(idx), -1, np.int64)
+    Hg = np.zeros((3, n_aug))
+    a_g, R_sf = np.zeros((1, 3)), np.zeros((1, 3))
+    if sf_interval is None:
+        return wgt, win, win_end, a_g, R_sf, Hg, None
+    dtg = float(np.median(np.diff(gnss.t)))
+    m = int(round(sf_interval / dtg))
+    if m < 3 or abs(m * dtg - sf_interval) > 1e-6:
+        raise ValueError(f"sf_interval must be a multiple (>= 3) of the GNSS interval {dtg} s")
+    nw = len(idx) // m
+    a_g, R_sf = np.zeros((nw, 3)), np.zeros((nw, 3))
+    sv2 = np.broadcast_to(np.asarray(gnss.sigma_vel, float) ** 2, (3,))
+    lag = 0.0
+    for w in range(nw):
+        e = np.arange(w * m, (w + 1) * m)
+        te = gnss.t[e]
+        d = te - te.mean()
+        a_g[w] = (d / np.sum(d * d)) @ gnss.v_enu[e]
+        k0, k1 = idx[e[0]], idx[e[-1]]
+        ww = slope_weights(te, t[k0:k1 + 1])
+        wgt[k0:k1] = ww
+        win[k0:k1] = w
+        win_end[e[-1]] = w
+        T = np.diff(t[k0:k1 + 1])
+        R_sf[w] = sv2 / np.sum(d * d) + model.accel_psd * np.sum(ww**2 / T)
+        lag = te[-1] - np.sum(ww * 0.5 * (t[k0:k1] + t[k0 + 1:k1 + 1]))
+    Hg[:, gs.start - 9:gs.stop - 9] = -np.asarray(gblk.output, float) @ expm(
+        -np.asarray(gblk.dynamics) * (0.0 if discrete else lag))
+    return wgt, win, win_end, a_g, R_sf, Hg, m
+
+
+def _discrete_gravity_steps(model, gblk, gs, discrete, sf_interval, m, n_epochs: int):
+    """Transition and noise over the whole state of the discrete gravity model, and its step epochs."""
+    ar_tick = np.zeros(n_epochs, np.int64)
+    Tg = np.eye(model.n)
+    Qg = np.zeros((model.n, model.n))
+    if discrete is None:
+        return Tg, Qg, ar_tick
+    if sf_interval is None:
+        raise ValueError("a discrete gravity model needs sf_interval (its sampling interval)")
+    Ad, Qd = (np.asarray(x, float) for x in discrete)
+    if Ad.shape != (gblk.size, gblk.size) or Qd.shape != Ad.shape:
+        raise ValueError(f"discrete = (A_d, Q_d) must be {gblk.size}x{gblk.size} for block {gblk.name!r}")
+    if np.any(gblk.dynamics != 0) or np.any(gblk.noise_psd != 0):
+        raise ValueError("with a discrete gravity model the block's continuous dynamics and noise must be zero")
+    Tg[gs, gs] = Ad
+    Qg[gs, gs] = Qd
+    ar_tick[np.arange(m, n_epochs, m)] = 1
+    return Tg, Qg, ar_tick
+
+
+def _augmented_filter_inputs(t, dtheta, dv, idx, gnss, n_aug: int, windows, ar_tick):
+    """The :class:`replication.closedloop.ChunkInputs` of :func:`augmented_filter`, chunk by chunk."""
+    wgt, win, win_end, a_g, R_sf = windows
+    gpos = np.ascontiguousarray(gnss.position, dtype=float)[None]
+    gvel = np.ascontiguousarray(gnss.v_enu, dtype=float)[None]
+    dtv = np.diff(t)
+
+    def inputs(ci, k0, k1, eps):
+        j0 = int(np.searchsorted(idx, eps[0]))
+        j1 = j0 + len(eps)
+        none = CL.no_windows(k1 - k0, j1 - j0, 1, n_aug)
+        return CL.ChunkInputs(dt=np.ascontiguousarray(dtv[k0:k1]), dth=np.ascontiguousarray(dtheta[None, k0:k1]),
+                              dvv=np.ascontiguousarray(dv[None, k0:k1]), h_ref=np.zeros(k1 - k0 + 1),
+                              vu_ref=np.zeros(k1 - k0 + 1), ep_step=(np.asarray(eps, np.int64) - 1 - k0),
+                              gpos=np.ascontiguousarray(gpos[:, j0:j1]), gvel=np.ascontiguousarray(gvel[:, j0:j1]),
+                              sf_w=np.ascontiguousarray(wgt[k0:k1]), sf_win=np.ascontiguousarray(win[k0:k1]),
+                              sf_end=np.ascontiguousarray(win_end[j0:j1]), sf_a=np.ascontiguousarray(a_g),
+                              sf_R=np.ascontiguousarray(R_sf), ar_tick=np.ascontiguousarray(ar_tick[j0:j1]),
+                              truth_st=none["truth_st"], truth_q=none["truth_q"], truth_p=none["truth_p"])
+    return inputs
+
+
 def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float | None = None, P0=None,
                      discrete=None, use_specific_force: bool = True, series_order: int = 4):
     """Closed-loop INS/GNSS filter with the 9-dimensional measurement of chen2019 eq. (3-18).
@@ -884,89 +977,26 @@ def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float 
     keeps the windows (and the AR steps) but drops the specific-force rows.
     Returns a :class:`replication.strapdown.NavSolution`.
     """
-
-
     dtheta, dv = validate_increments(dtheta, dv)
     n = len(dtheta)
     t = validate_time(t, n)
     idx = np.asarray(gnss.index, np.int64)
     if np.any(np.asarray(gnss.lever_arm_b) != 0):
         raise ValueError("augmented_filter has no lever-arm correction; use GNSS at the IMU (lever_arm_b = 0)")
-    names = [b.name for b in model.blocks if b.target == "gravity"]
-    if len(names) != 1:
-        raise ValueError("the model needs exactly one gravity block (errors.gravity_shaping or ar_gravity_block)")
-    gblk = model.block(names[0])
-    gs = model.slices[names[0]]
+    gblk, gs = _single_gravity_block(model)
     P0 = model.P0() if P0 is None else np.asarray(P0, float)
     if P0.shape != (model.n, model.n):
         raise ValueError(f"P0 must be {model.n}x{model.n}")
-    n_aug = model.n - 9
-    wgt = np.zeros(n)
-    win = np.full(n, -1, np.int64)
-    win_end = np.full(len(idx), -1, np.int64)
-    Hg = np.zeros((3, n_aug))
-    a_g, R_sf = np.zeros((1, 3)), np.zeros((1, 3))
-    if sf_interval is not None:
-        dtg = float(np.median(np.diff(gnss.t)))
-        m = int(round(sf_interval / dtg))
-        if m < 3 or abs(m * dtg - sf_interval) > 1e-6:
-            raise ValueError(f"sf_interval must be a multiple (>= 3) of the GNSS interval {dtg} s")
-        nw = len(idx) // m
-        a_g, R_sf = np.zeros((nw, 3)), np.zeros((nw, 3))
-        sv2 = np.broadcast_to(np.asarray(gnss.sigma_vel, float) ** 2, (3,))
-        lag = 0.0
-        for w in range(nw):
-            e = np.arange(w * m, (w + 1) * m)
-            te = gnss.t[e]
-            d = te - te.mean()
-            a_g[w] = (d / np.sum(d * d)) @ gnss.v_enu[e]
-            k0, k1 = idx[e[0]], idx[e[-1]]
-            ww = slope_weights(te, t[k0:k1 + 1])
-            wgt[k0:k1] = ww
-            win[k0:k1] = w
-            win_end[e[-1]] = w
-            T = np.diff(t[k0:k1 + 1])
-            R_sf[w] = sv2 / np.sum(d * d) + model.accel_psd * np.sum(ww**2 / T)
-            lag = te[-1] - np.sum(ww * 0.5 * (t[k0:k1] + t[k0 + 1:k1 + 1]))
-        Hg[:, gs.start - 9:gs.stop - 9] = -np.asarray(gblk.output, float) @ expm(
-            -np.asarray(gblk.dynamics) * (0.0 if discrete is not None else lag))
-    ar_tick = np.zeros(len(idx), np.int64)
-    Tg = np.eye(model.n)
-    Qg = np.zeros((model.n, model.n))
-    if discrete is not None:
-        if sf_interval is None:
-            raise ValueError("a discrete gravity model needs sf_interval (its sampling interval)")
-        Ad, Qd = (np.asarray(x, float) for x in discrete)
-        if Ad.shape != (gblk.size, gblk.size) or Qd.shape != Ad.shape:
-            raise ValueError(f"discrete = (A_d, Q_d) must be {gblk.size}x{gblk.size} for block {gblk.name!r}")
-        if np.any(gblk.dynamics != 0) or np.any(gblk.noise_psd != 0):
-            raise ValueError("with a discrete gravity model the block's continuous dynamics and noise must be zero")
-        Tg[gs, gs] = Ad
-        Qg[gs, gs] = Qd
-        ar_tick[np.arange(m, len(idx), m)] = 1
+    wgt, win, win_end, a_g, R_sf, Hg, m = _specific_force_windows(t, idx, gnss, model, gblk, gs, sf_interval,
+                                                                  discrete is not None)
+    Tg, Qg, ar_tick = _discrete_gravity_steps(model, gblk, gs, discrete, sf_interval, m, len(idx))
     if not use_specific_force:
         win_end[:] = -1
     R_pos = np.diag(np.broadcast_to(np.asarray(gnss.sigma_pos, float), (3,)) ** 2)
     R_vel = np.diag(np.broadcast_to(np.asarray(gnss.sigma_vel, float), (3,)) ** 2)
     spec = CL.build_spec(model, R_pos=R_pos, R_vel=R_vel, series_order=series_order,
                          ar=(Tg, Qg) if discrete is not None else None, sf_H=Hg)
-    gpos = np.ascontiguousarray(gnss.position, dtype=float)[None]
-    gvel = np.ascontiguousarray(gnss.v_enu, dtype=float)[None]
-    dtv = np.diff(t)
-
-    def inputs(ci, k0, k1, eps):
-        j0 = int(np.searchsorted(idx, eps[0]))
-        j1 = j0 + len(eps)
-        none = CL.no_windows(k1 - k0, j1 - j0, 1, model.n - 9)
-        return CL.ChunkInputs(dt=np.ascontiguousarray(dtv[k0:k1]), dth=np.ascontiguousarray(dtheta[None, k0:k1]),
-                              dvv=np.ascontiguousarray(dv[None, k0:k1]), h_ref=np.zeros(k1 - k0 + 1),
-                              vu_ref=np.zeros(k1 - k0 + 1), ep_step=(np.asarray(eps, np.int64) - 1 - k0),
-                              gpos=np.ascontiguousarray(gpos[:, j0:j1]), gvel=np.ascontiguousarray(gvel[:, j0:j1]),
-                              sf_w=np.ascontiguousarray(wgt[k0:k1]), sf_win=np.ascontiguousarray(win[k0:k1]),
-                              sf_end=np.ascontiguousarray(win_end[j0:j1]), sf_a=np.ascontiguousarray(a_g),
-                              sf_R=np.ascontiguousarray(R_sf), ar_tick=np.ascontiguousarray(ar_tick[j0:j1]),
-                              truth_st=none["truth_st"], truth_q=none["truth_q"], truth_p=none["truth_p"])
-
+    inputs = _augmented_filter_inputs(t, dtheta, dv, idx, gnss, model.n - 9, (wgt, win, win_end, a_g, R_sf), ar_tick)
     state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], np.zeros(3))
     rec = CL.run(spec, state, P0, idx, n, inputs, store_nav=True, store_P=False, workers=1)
     return NavSolution(t, rec.nav_st[0, :, 0], rec.nav_st[0, :, 1], rec.nav_st[0, :, 2], rec.nav_st[0, :, 3:6],
