@@ -342,6 +342,68 @@ class MonteCarloResult:
         return float(np.mean((m >= lo) & (m <= hi)))
 
 
+def _draw_runs(traj, model: ErrorModel, n_runs: int, seed, gnss_rate_hz, sigma_pos, sigma_vel, workers):
+    """Every run's truth of :func:`monte_carlo`: augmented-state values, increments, GNSS and initial state.
+
+    Per run, from its own generator of ``SeedSequence(seed).spawn(n_runs)``, in this order: the
+    random constants (block by block), the gyro then the accelerometer white noise, the GNSS
+    fixes, the initial navigation errors.
+    """
+    n = traj.n
+    T = np.diff(traj.t)[:, None]
+    n_aug = model.n - 9
+    dth = np.empty((n_runs, n, 3))
+    dvv = np.empty((n_runs, n, 3))
+    p_true = np.zeros((n_runs, n_aug))
+    gn, st0, q0 = [None] * n_runs, np.empty((n_runs, 6)), np.empty((n_runs, 4))
+
+    def draw(r, ss):
+        # one run's truth from its own generator (numpy releases the GIL while filling the arrays)
+        rng = np.random.default_rng(ss)
+        for b in model.blocks:
+            sl = model.slices[b.name]
+            p_true[r, sl.start - 9:sl.stop - 9] = b.sd * rng.standard_normal(b.size)
+        gb = p_true[r, model.slices["gyro_bias"].start - 9:model.slices["gyro_bias"].stop - 9]
+        ab = p_true[r, model.slices["accel_bias"].start - 9:model.slices["accel_bias"].stop - 9]
+        dth[r] = traj.dtheta + gb * T + rng.standard_normal((n, 3)) * np.sqrt(model.gyro_psd * T)
+        dvv[r] = traj.dv + ab * T + rng.standard_normal((n, 3)) * np.sqrt(model.accel_psd * T)
+        gn[r] = gnss_measurements(traj, rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, rng=rng)
+        init = perturb_state(traj.initial_state(), model, rng)
+        st0[r] = init.vector()
+        q0[r] = dcm_to_quat(init.C_bn)
+
+    seeds = np.random.SeedSequence(seed).spawn(n_runs)
+    with ThreadPoolExecutor(max_workers=max(int(workers), 1)) as ex:
+        list(ex.map(draw, range(n_runs), seeds))
+    return p_true, dth, dvv, gn, st0, q0
+
+
+def _batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref):
+    """The :class:`replication.closedloop.ChunkInputs` of a batch of runs, chunk by chunk, with the NEES truth."""
+    n_runs, n_aug = p_true.shape
+    m_ep = len(idx)
+    gpos = np.stack([g.position for g in gn])
+    gvel = np.stack([np.asarray(g.v_enu, float) for g in gn])
+    tst = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
+    tq = dcm_to_quat(euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2]))
+    tp = np.ascontiguousarray(np.broadcast_to(p_true[:, None, :], (n_runs, m_ep, n_aug)))
+    dt = np.diff(traj.t)
+
+    def inputs(ci, k0, k1, eps):
+        j0 = int(np.searchsorted(idx, eps[0]))
+        j1 = j0 + len(eps)
+        extra = CL.no_windows(k1 - k0, j1 - j0, n_runs, n_aug)
+        extra.update(truth_st=np.ascontiguousarray(tst[j0:j1]), truth_q=np.ascontiguousarray(tq[j0:j1]),
+                     truth_p=np.ascontiguousarray(tp[:, j0:j1]))
+        return CL.ChunkInputs(dt=np.ascontiguousarray(dt[k0:k1]), dth=np.ascontiguousarray(dth[:, k0:k1]),
+                              dvv=np.ascontiguousarray(dvv[:, k0:k1]), h_ref=np.ascontiguousarray(href[k0:k1 + 1]),
+                              vu_ref=np.ascontiguousarray(vuref[k0:k1 + 1]),
+                              ep_step=(np.asarray(eps, np.int64) - 1 - k0),
+                              gpos=np.ascontiguousarray(gpos[:, j0:j1]), gvel=np.ascontiguousarray(gvel[:, j0:j1]),
+                              **extra)
+    return inputs
+
+
 def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gnss_rate_hz: float = 10.0,
                 sigma_pos=(0.03, 0.03, 0.1), sigma_vel=0.03, vertical: str = "free", workers: int = 2,
                 h_ref=None, vu_ref=None) -> MonteCarloResult:
@@ -372,7 +434,6 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     -------
     MonteCarloResult
     """
-
     if int(n_runs) < 1:
         raise ValueError("n_runs must be at least 1")
     if vertical not in VERTICAL_MODES:
@@ -381,39 +442,9 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
         model.block(need)
     n_runs = int(n_runs)
     n = traj.n
-    T = np.diff(traj.t)[:, None]
-    n_aug = model.n - 9
-    dth = np.empty((n_runs, n, 3))
-    dvv = np.empty((n_runs, n, 3))
-    p_true = np.zeros((n_runs, n_aug))
-    gn, st0, q0 = [None] * n_runs, np.empty((n_runs, 6)), np.empty((n_runs, 4))
-
-    def draw(r, ss):
-        # one run's truth from its own generator (numpy releases the GIL while filling the arrays)
-        rng = np.random.default_rng(ss)
-        for b in model.blocks:
-            sl = model.slices[b.name]
-            p_true[r, sl.start - 9:sl.stop - 9] = b.sd * rng.standard_normal(b.size)
-        gb = p_true[r, model.slices["gyro_bias"].start - 9:model.slices["gyro_bias"].stop - 9]
-        ab = p_true[r, model.slices["accel_bias"].start - 9:model.slices["accel_bias"].stop - 9]
-        dth[r] = traj.dtheta + gb * T + rng.standard_normal((n, 3)) * np.sqrt(model.gyro_psd * T)
-        dvv[r] = traj.dv + ab * T + rng.standard_normal((n, 3)) * np.sqrt(model.accel_psd * T)
-        gn[r] = gnss_measurements(traj, rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, rng=rng)
-        init = perturb_state(traj.initial_state(), model, rng)
-        st0[r] = init.vector()
-        q0[r] = dcm_to_quat(init.C_bn)
-
-    seeds = np.random.SeedSequence(seed).spawn(n_runs)
-    with ThreadPoolExecutor(max_workers=max(int(workers), 1)) as ex:
-        list(ex.map(draw, range(n_runs), seeds))
+    p_true, dth, dvv, gn, st0, q0 = _draw_runs(traj, model, n_runs, seed, gnss_rate_hz, sigma_pos, sigma_vel, workers)
     g0 = gn[0]
     idx = np.asarray(g0.index, np.int64)
-    m_ep = len(idx)
-    gpos = np.stack([g.position for g in gn])
-    gvel = np.stack([np.asarray(g.v_enu, float) for g in gn])
-    tst = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
-    tq = dcm_to_quat(euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2]))
-    tp = np.ascontiguousarray(np.broadcast_to(p_true[:, None, :], (n_runs, m_ep, n_aug)))
     href = np.zeros(n + 1) if h_ref is None else np.ascontiguousarray(np.broadcast_to(h_ref, (n + 1,)), float)
     vuref = np.zeros(n + 1) if vu_ref is None else np.ascontiguousarray(np.broadcast_to(vu_ref, (n + 1,)), float)
     if vertical != "free" and h_ref is None:
@@ -422,23 +453,8 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     spec = CL.build_spec(model, R_pos=np.diag(np.broadcast_to(np.asarray(sigma_pos, float), (3,)) ** 2),
                          R_vel=np.diag(np.broadcast_to(np.asarray(sigma_vel, float), (3,)) ** 2),
                          lever_arm_b=g0.lever_arm_b, vmode=VERTICAL_MODES[vertical], gains=gains, nees=True)
-    dt = np.diff(traj.t)
-
-    def inputs(ci, k0, k1, eps):
-        j0 = int(np.searchsorted(idx, eps[0]))
-        j1 = j0 + len(eps)
-        extra = CL.no_windows(k1 - k0, j1 - j0, n_runs, n_aug)
-        extra.update(truth_st=np.ascontiguousarray(tst[j0:j1]), truth_q=np.ascontiguousarray(tq[j0:j1]),
-                     truth_p=np.ascontiguousarray(tp[:, j0:j1]))
-        return CL.ChunkInputs(dt=np.ascontiguousarray(dt[k0:k1]), dth=np.ascontiguousarray(dth[:, k0:k1]),
-                              dvv=np.ascontiguousarray(dvv[:, k0:k1]), h_ref=np.ascontiguousarray(href[k0:k1 + 1]),
-                              vu_ref=np.ascontiguousarray(vuref[k0:k1 + 1]),
-                              ep_step=(np.asarray(eps, np.int64) - 1 - k0),
-                              gpos=np.ascontiguousarray(gpos[:, j0:j1]), gvel=np.ascontiguousarray(gvel[:, j0:j1]),
-                              **extra)
-
-    rec = CL.run(spec, CL.initial_batch_state(st0, q0, g0.lever_arm_b), model.P0(), idx, n, inputs,
-                 store_P=False, workers=workers)
+    rec = CL.run(spec, CL.initial_batch_state(st0, q0, g0.lever_arm_b), model.P0(), idx, n,
+                 _batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref), store_P=False, workers=workers)
     return MonteCarloResult(
         t_epoch=traj.t[idx],
         nees=rec.nees,
