@@ -496,6 +496,37 @@ def vertical_reset_sequence(
     return out
 
 
+def _closed_form_flight(duration_s, interval_s, speed_mps, heading_deg, reading, eq6_factor):
+    """Checked flight time, interval, speed, heading (rad), ``c`` and sign ``σ`` of ``proposed_closed_form``."""
+    t_end = positive(duration_s, "duration_s")
+    T = positive(interval_s, "interval_s")
+    V = positive(speed_mps, "speed_mps")
+    psi = finite(heading_deg, "heading_deg") * _DEG
+    c = positive(eq6_factor, "eq6_factor")
+    signs = {"literal": -1.0, "geometric": 1.0, "open": 1.0}
+    choice(reading, sorted(signs), "reading")
+    if T >= t_end:
+        raise ValueError(f"interval_s ({T}) must be shorter than duration_s ({t_end})")
+    return t_end, T, V, psi, c, signs[reading]
+
+
+def _tilt_loop_response(t, kappa, forcing, phi0, g):
+    """Tilt, velocity and position errors at ``t`` of δv'' = -κ δv + forcing from the tilt ``phi0``."""
+    if kappa > 0.0:
+        w = np.sqrt(kappa)
+        cs, sn = np.cos(w * t), np.sin(w * t)
+        dv = forcing / kappa * (1.0 - cs) + g * phi0 / w * sn
+        dx = forcing / kappa * (t - sn / w) + g * phi0 / kappa * (1.0 - cs)
+        phi = forcing / (g * w) * sn + phi0 * cs
+    else:
+        w = np.sqrt(-kappa)
+        ch, sh = np.cosh(w * t), np.sinh(w * t)
+        dv = forcing / w**2 * (ch - 1.0) + g * phi0 / w * sh
+        dx = forcing / w**2 * (sh / w - t) + g * phi0 / w**2 * (ch - 1.0)
+        phi = forcing / (g * w) * sh + phi0 * ch
+    return phi, dv, dx
+
+
 def proposed_closed_form(
     duration_s=PAPER["duration_s"],
     interval_s=PAPER["interval_s"],
@@ -560,20 +591,12 @@ def proposed_closed_form(
         ``kappa`` (1/s²), ``stable`` (``κ > 0``), and ``final`` / ``max`` dicts of along-track
         ``tilt_deg``, ``velocity_mps``, ``position_km``.
     """
-    t_end = positive(duration_s, "duration_s")
-    T = positive(interval_s, "interval_s")
-    V = positive(speed_mps, "speed_mps")
-    psi = finite(heading_deg, "heading_deg") * _DEG
-    c = positive(eq6_factor, "eq6_factor")
-    signs = {"literal": -1.0, "geometric": 1.0, "open": 1.0}
-    choice(reading, sorted(signs), "reading")
-    if T >= t_end:
-        raise ValueError(f"interval_s ({T}) must be shorter than duration_s ({t_end})")
+    t_end, T, V, psi, c, sigma = _closed_form_flight(duration_s, interval_s, speed_mps, heading_deg, reading,
+                                                     eq6_factor)
     lat = _latitude(lat0_deg)
     h = _height(height_m)
     rmh, rnh, g, _ = _earth(lat, h)
     R = np.sqrt(rmh * rnh)
-    sigma = signs[reading]
     k = 0.0 if reading == "open" else 2.0 * V / R + 2.0 * _OMEGA_IE * np.cos(lat) * np.sin(psi)
     b = finite(accel_bias_ug, "accel_bias_ug") * 1e-6 * _G_UNIT
     dv0 = finite(dv0_mps, "dv0_mps")
@@ -581,19 +604,7 @@ def proposed_closed_form(
     kappa = g * (1.0 / R - sigma * c * k / V)
     forcing = sigma * c * g * b / V
     phi0 = sigma * c * dv0 / V
-    t = np.linspace(0.0, t_end, 2001)
-    if kappa > 0.0:
-        w = np.sqrt(kappa)
-        cs, sn = np.cos(w * t), np.sin(w * t)
-        dv = forcing / kappa * (1.0 - cs) + g * phi0 / w * sn
-        dx = forcing / kappa * (t - sn / w) + g * phi0 / kappa * (1.0 - cs)
-        phi = forcing / (g * w) * sn + phi0 * cs
-    else:
-        w = np.sqrt(-kappa)
-        ch, sh = np.cosh(w * t), np.sinh(w * t)
-        dv = forcing / w**2 * (ch - 1.0) + g * phi0 / w * sh
-        dx = forcing / w**2 * (sh / w - t) + g * phi0 / w**2 * (ch - 1.0)
-        phi = forcing / (g * w) * sh + phi0 * ch
+    phi, dv, dx = _tilt_loop_response(np.linspace(0.0, t_end, 2001), kappa, forcing, phi0, g)
     dhc1 = vertical_reset_sequence(1, T, dh0, dv0, accel_bias_ug)[0]
     series = {"tilt_deg": np.abs(phi) / _DEG, "velocity_mps": np.abs(dv), "position_km": np.abs(dx) / 1e3}
     return {
@@ -606,6 +617,36 @@ def proposed_closed_form(
         "final": {key: float(s[-1]) for key, s in series.items()},
         "max": {key: float(s.max()) for key, s in series.items()},
     }
+
+
+def _ads_correction(T, c, tilt_sign, apply_tilt, noise, h0):
+    """The correction ``X ← X + X^C`` of eqs. (4)-(22) for ``_propagate``, with the ADS errors ``noise``."""
+    state = {"h_prev": h0}
+
+    def correct(x, lat, h, v_enu, k):
+        rmh, rnh, _, _ = _earth(lat, h)
+        sx, sy = v_enu[0] * T, v_enu[1] * T
+        S2 = sx**2 + sy**2
+        S = np.sqrt(S2)
+        hd = x[8] - state["h_prev"]  # SINS up displacement = true (0) + error growth
+        V = np.linalg.norm(v_enu)
+        dhc = -x[8] + noise[k]
+        xc = np.zeros_like(x)
+        if apply_tilt:
+            xc[0] = tilt_sign * c * sy / (S2 + hd**2) * dhc
+            xc[1] = -tilt_sign * c * sx / (S2 + hd**2) * dhc
+        dvu = S2 * V / (S2 + hd**2) ** 1.5 * dhc
+        xc[5] = dvu
+        xc[3] = -sx * hd / S2 * dvu
+        xc[4] = -sy * hd / S2 * dvu
+        ds = -hd / S * dhc
+        xc[6] = (sy / S) * ds / rmh
+        xc[7] = (sx / S) * ds / (rnh * np.cos(lat))
+        xc[8] = dhc
+        x = x + xc
+        state["h_prev"] = x[8]
+        return x
+    return correct
 
 
 def proposed_linear_propagation(
@@ -681,32 +722,7 @@ def proposed_linear_propagation(
     t_end = positive(duration_s, "duration_s")
     rng = np.random.default_rng(seed)
     noise = sigma * rng.standard_normal(int(t_end // T) + 2)
-    state = {"h_prev": float(finite(dp0_m, "dp0_m"))}
-
-    def correct(x, lat, h, v_enu, k):
-        rmh, rnh, _, _ = _earth(lat, h)
-        sx, sy = v_enu[0] * T, v_enu[1] * T
-        S2 = sx**2 + sy**2
-        S = np.sqrt(S2)
-        hd = x[8] - state["h_prev"]  # SINS up displacement = true (0) + error growth
-        V = np.linalg.norm(v_enu)
-        dhc = -x[8] + noise[k]
-        xc = np.zeros_like(x)
-        if apply_tilt:
-            xc[0] = tilt_sign * c * sy / (S2 + hd**2) * dhc
-            xc[1] = -tilt_sign * c * sx / (S2 + hd**2) * dhc
-        dvu = S2 * V / (S2 + hd**2) ** 1.5 * dhc
-        xc[5] = dvu
-        xc[3] = -sx * hd / S2 * dvu
-        xc[4] = -sy * hd / S2 * dvu
-        ds = -hd / S * dhc
-        xc[6] = (sy / S) * ds / rmh
-        xc[7] = (sx / S) * ds / (rnh * np.cos(lat))
-        xc[8] = dhc
-        x = x + xc
-        state["h_prev"] = x[8]
-        return x
-
+    correct = _ads_correction(T, c, tilt_sign, apply_tilt, noise, float(finite(dp0_m, "dp0_m")))
     x0 = _initial_state(_latitude(lat0_deg), _height(height_m), finite(dv0_mps, "dv0_mps"), finite(dp0_m, "dp0_m"))
     g = _axes("gyro_drift_dph", gyro_drift_dph)
     a = _axes("accel_bias_ug", accel_bias_ug)
