@@ -58,7 +58,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 from scipy.integrate import quad
-from scipy.linalg import expm
+from scipy.linalg import expm, solve_continuous_lyapunov
 from scipy.optimize import least_squares
 from scipy.special import j0
 
@@ -230,7 +230,6 @@ def _disturbance_block(shape, p: VerticalChannel):
     F = np.array([[-beta, 0.0], [1.0 / tc, -1.0 / tc]])
     q = np.array([2.0 * beta * var_g, 0.0])
     # stationary covariance of the block
-    from scipy.linalg import solve_continuous_lyapunov
     P = solve_continuous_lyapunov(F, -np.diag(q))
     return F, q, 1, P
 
