@@ -12,7 +12,7 @@ from typing import Any, Collection
 
 import numpy as np
 
-__all__ = ["positive", "nonnegative", "finite", "vector3", "components", "choice"]
+__all__ = ["positive", "nonnegative", "finite", "vector3", "matrix3", "components", "choice"]
 
 
 def _number(value, name: str, what: str, ok) -> float:
@@ -77,6 +77,34 @@ def vector3(value, name: str) -> np.ndarray:
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name} must be finite")
     return a
+
+
+def matrix3(value, name: str) -> np.ndarray:
+    """An array of 3×3 matrices (trailing shape (3, 3); any leading axes).
+
+    Only the shape is checked: a NaN element passes through to the result of the computation.
+
+    Parameters
+    ----------
+    value : array_like
+        The argument, shape (..., 3, 3).
+    name : str
+        Its name for the error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``value`` as a float array.
+
+    Raises
+    ------
+    ValueError
+        If the trailing shape is not (3, 3).
+    """
+    m = np.asarray(value, dtype=float)
+    if m.shape[-2:] != (3, 3):
+        raise ValueError(f"{name} must have trailing shape (3, 3), got shape {m.shape}")
+    return m
 
 
 def components(value, name: str, n: int = 3) -> np.ndarray:

@@ -29,6 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._validate import matrix3
+
 __all__ = [
     "skew", "vee", "euler_to_dcm", "dcm_to_euler", "rotvec_to_dcm", "dcm_to_rotvec",
     "quat_to_dcm", "dcm_to_quat", "quat_multiply", "quat_conjugate", "quat_normalize",
@@ -42,13 +44,6 @@ def _vec3(v, name):
     if v.shape[-1:] != (3,):
         raise ValueError(f"{name} must have a last axis of length 3, got shape {v.shape}")
     return v
-
-
-def _mat3(m, name):
-    m = np.asarray(m, dtype=float)
-    if m.shape[-2:] != (3, 3):
-        raise ValueError(f"{name} must have trailing shape (3, 3), got shape {m.shape}")
-    return m
 
 
 def _quat(q, name="q"):
@@ -72,7 +67,7 @@ def skew(v):
 
 def vee(m):
     """Inverse of :func:`skew` applied to the skew-symmetric part of ``m``."""
-    m = _mat3(m, "m")
+    m = matrix3(m, "m")
     return 0.5 * np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0],
                            m[..., 1, 0] - m[..., 0, 1]], -1)
 
@@ -103,7 +98,7 @@ def dcm_to_euler(c):
 
     Near pitch = ±90° heading and roll are not separable (gimbal lock); the sum is kept.
     """
-    c = _mat3(c, "C_bn")
+    c = matrix3(c, "C_bn")
     pitch = np.arcsin(np.clip(c[..., 2, 1], -1.0, 1.0))
     heading = np.mod(np.arctan2(c[..., 0, 1], c[..., 1, 1]), 2 * np.pi)
     roll = np.arctan2(-c[..., 2, 0], c[..., 2, 2])
@@ -148,7 +143,7 @@ def quat_to_dcm(q):
 
 def dcm_to_quat(c):
     """Scalar-first unit quaternion (q0 ≥ 0) of a DCM (Shepperd's method)."""
-    c = _mat3(c, "C")
+    c = matrix3(c, "C")
     tr = c[..., 0, 0] + c[..., 1, 1] + c[..., 2, 2]
     cand = np.stack([tr, c[..., 0, 0], c[..., 1, 1], c[..., 2, 2]], -1)
     i = np.argmax(cand, -1)
@@ -239,7 +234,7 @@ def quat_to_euler(q):
 
 def attitude_error(c_est, c_true):
     """Misalignment φ^n with Ĉ_b^n = exp(-φ×) C_b^n (≈ (I - φ×) C_b^n), chen2019 eq. (3-16) ψ^n."""
-    c_est, c_true = _mat3(c_est, "C_est"), _mat3(c_true, "C_true")
+    c_est, c_true = matrix3(c_est, "C_est"), matrix3(c_true, "C_true")
     e = c_est @ np.swapaxes(c_true, -1, -2)
     return -dcm_to_rotvec(e)
 
@@ -263,6 +258,6 @@ def body_rate_from_euler_rates(heading, pitch, roll, heading_rate, pitch_rate, r
 
 def orthonormalize(c):
     """Nearest rotation matrix (polar decomposition via SVD)."""
-    c = _mat3(c, "C")
+    c = matrix3(c, "C")
     u, _, vt = np.linalg.svd(c)
     return u @ vt

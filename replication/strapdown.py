@@ -25,8 +25,8 @@ import numpy as np
 
 from . import earth
 from . import _kernels as K
-from ._validate import choice
-from .rotations import (dcm_to_euler, dcm_to_quat, euler_to_dcm, quat_to_dcm, skew, vee, _mat3)
+from ._validate import choice, matrix3
+from .rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, quat_to_dcm, skew, vee
 from .rotations import attitude_error
 
 __all__ = ["NavState", "NavSolution", "mechanize", "navigation_rates", "vertical_damping_gains",
@@ -48,7 +48,7 @@ class NavState:
     def __post_init__(self):
         earth.check_latitude(self.lat, polar_limit_deg=earth.POLAR_LIMIT_DEG, name="NavState.lat")
         self.v_enu = np.asarray(self.v_enu, float).reshape(3)
-        self.C_bn = _mat3(self.C_bn, "C_bn").reshape(3, 3)
+        self.C_bn = matrix3(self.C_bn, "C_bn").reshape(3, 3)
         if not np.allclose(self.C_bn @ self.C_bn.T, np.eye(3), atol=1e-9):
             raise ValueError("C_bn is not a rotation matrix (C Cᵀ ≠ I); build it with rotations.euler_to_dcm")
 
@@ -206,7 +206,7 @@ def navigation_rates(lat, lon, h, v_enu, C_bn, w_ib_b, f_b, g_extra=None):
     """
     lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
     v = np.asarray(v_enu, float)
-    C = _mat3(C_bn, "C_bn")
+    C = matrix3(C_bn, "C_bn")
     rm, rn = earth.radii(lat)
     w_ie = earth.earth_rate_enu(lat)
     w_en = earth.transport_rate_enu(lat, h, v)
