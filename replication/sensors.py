@@ -24,6 +24,7 @@ Units as printed in the papers (°/h, μg, ppm, ″, (°/h)²) convert with :mod
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,7 +37,7 @@ from scipy.signal import lfilter
 from .strapdown import validate_increments, validate_time
 
 __all__ = ["TriadErrors", "ImuErrors", "misalignment_matrix", "apply_imu_errors", "draw_imu_errors",
-           "markov_sigma_from_driving_psd", "GnssMeasurements", "gnss_measurements", "barometric_height",
+           "markov_sigma_from_driving_psd", "gauss_markov_coefficients", "gauss_markov_recursion", "GnssMeasurements", "gnss_measurements", "barometric_height",
            "lever_arm_offset"]
 
 
@@ -109,20 +110,82 @@ class ImuErrors:
         return cls(gyro=g, accel=a)
 
 
+def gauss_markov_coefficients(dt, tau) -> tuple[float, float]:
+    """Coefficients of a first-order Gauss-Markov process sampled exactly at the interval ``dt``.
+
+    The process ẋ = -x/τ + w of stationary standard deviation σ (chen2019 eq. (2-5)) sampled
+    every ``dt`` is the AR(1) recursion x_k = a x_{k-1} + w_k with a = exp(-dt/τ) and
+    w_k ~ N(0, σ² (1 - a²)), which keeps the standard deviation σ at every sample
+    (:func:`gauss_markov_recursion` runs it).
+
+    Parameters
+    ----------
+    dt : float
+        Sample interval (> 0), in the unit of ``tau``.
+    tau : float
+        Correlation time (> 0; ``inf`` gives a = 1, a random constant).
+
+    Returns
+    -------
+    a : float
+        The transition coefficient exp(-dt/τ).
+    q : float
+        sqrt(1 - a²): the driving standard deviation per unit of σ.
+    """
+    if not dt > 0:
+        raise ValueError(f"dt must be a positive sample interval, got {dt!r}")
+    if not tau > 0:
+        raise ValueError(f"tau must be a positive correlation time (inf for a random constant), got {tau!r}")
+    a = math.exp(-dt / tau)
+    return a, math.sqrt(1 - a * a)
+
+
+def gauss_markov_recursion(w, a, x_prev=None) -> np.ndarray:
+    """The first-order Gauss-Markov (AR(1)) recursion x_k = a x_{k-1} + w_k along the first axis.
+
+    Computed by ``scipy.signal.lfilter``; the caller draws and scales the driving noise ``w``
+    (e.g. standard-normal draws times σ sqrt(1 - a²), see :func:`gauss_markov_coefficients`), so
+    the order of its draws and of its products is its own.
+
+    Parameters
+    ----------
+    w : array_like, shape (n, ...)
+        Driving noise w_0 .. w_{n-1}, n >= 1; the trailing axes are independent sequences.
+    a : float
+        Transition coefficient (|a| <= 1 for a process that does not grow).
+    x_prev : array_like, shape ``w.shape[1:]``, optional
+        The value x_{-1} before the first sample; by default the recursion starts at x_0 = w_0
+        (a stationary start draws x_0 ~ N(0, σ²) into ``w[0]``).
+
+    Returns
+    -------
+    numpy.ndarray
+        x_0 .. x_{n-1}, float, the shape of ``w``.
+    """
+    w = np.asarray(w, dtype=float)
+    if w.ndim < 1 or w.shape[0] < 1:
+        raise ValueError(f"w must have at least one sample along its first axis, got shape {w.shape}")
+    if np.ndim(a) != 0 or not np.isfinite(a):
+        raise ValueError(f"a must be a finite number, got {a!r}")
+    if x_prev is None:
+        return lfilter([1.0], [1.0, -a], w, axis=0)
+    x_prev = np.asarray(x_prev, dtype=float)
+    if x_prev.shape != w.shape[1:]:
+        raise ValueError(f"x_prev must have the shape {w.shape[1:]} of one sample of w, got {x_prev.shape}")
+    x, _ = lfilter([1.0], [1.0, -a], w, axis=0, zi=(a * x_prev)[None, ...])
+    return x
+
+
 def _markov_path(n, T, sigma, tau, rng, x0=None):
-    """Exact discretisation of a first-order Gauss-Markov process at the sample rate."""
-    x = np.zeros((n, 3))
+    """Exact discretisation of a first-order Gauss-Markov process at the sample rate (three axes)."""
     if not np.any(sigma > 0) or not np.isfinite(tau):
-        return x
+        return np.zeros((n, 3))
+    # numpy's exp and a**2, not the math.exp and a*a of gauss_markov_coefficients (they may differ in the
+    # last bit): a seed keeps giving the same realisation
     a = np.exp(-T / tau)
     s = sigma * np.sqrt(1 - a**2)
     xk = sigma * rng.standard_normal(3) if x0 is None else np.asarray(x0, float)
-    w = rng.standard_normal((n, 3)) * s
-    # vectorised AR(1) recursion via scipy.signal.lfilter per axis
-
-    for i in range(3):
-        x[:, i], _ = lfilter([1.0], [1.0, -a], w[:, i], zi=[a * xk[i]])
-    return x
+    return gauss_markov_recursion(rng.standard_normal((n, 3)) * s, a, xk)
 
 
 def apply_imu_errors(t, dtheta, dv, errors: ImuErrors, rng=None):

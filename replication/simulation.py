@@ -54,7 +54,6 @@ from functools import lru_cache
 
 import numpy as np
 from scipy import stats
-from scipy.signal import lfilter
 
 from . import earth
 from . import errors as E
@@ -62,7 +61,7 @@ from . import models as M
 from . import closedloop as CL
 from ._validate import choice
 from .rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
-from .sensors import lever_arm_offset, misalignment_matrix
+from .sensors import gauss_markov_coefficients, gauss_markov_recursion, lever_arm_offset, misalignment_matrix
 from .units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MGAL, MICRO_G
 from .trajectory import chen2019_flight, generate
 import pandas as pd
@@ -397,9 +396,8 @@ class _Truth:
             g = np.random.default_rng([self.seed, self.r0 + r, c + 1])
             paths = {}
             for name in ("gyro_markov", "accel_markov", "gravity"):
-                a = math.exp(-Tm / taus[name])
-                w = g.standard_normal((Kn, 3)) * (sigmas[name] * math.sqrt(1 - a * a))
-                x, _ = lfilter([1.0], [1.0, -a], w, axis=0, zi=(a * state[name][r])[None, :])
+                a, q = gauss_markov_coefficients(Tm, taus[name])
+                x = gauss_markov_recursion(g.standard_normal((Kn, 3)) * (sigmas[name] * q), a, state[name][r])
                 state[name][r] = x[-1]
                 paths[name] = x
                 procs[name][r] = x[eidx]

@@ -30,6 +30,8 @@ import numpy as np
 import pandas as pd
 from scipy import linalg, signal, stats
 
+from .sensors import gauss_markov_coefficients, gauss_markov_recursion
+
 __all__ = [
     "NonStationaryError", "ar_coefficients", "InversionTest", "inversion_count", "inversion_moments", "inversion_distribution", "inversion_test",
     "stationarity_report", "difference", "make_stationary", "acf_printed", "pacf_printed",
@@ -642,7 +644,8 @@ def gauss_markov(n: int, dt: float, std: float, tau: float, rng: np.random.Gener
     """Stationary first-order Gauss-Markov sequences, sampled exactly.
 
     x_{k+1} = a x_k + w_k with a = e^{-dt/tau} and w_k ~ N(0, std²(1 - a²)); x_0 ~ N(0, std²), so
-    every sample has the standard deviation ``std``.
+    every sample has the standard deviation ``std`` (:func:`replication.sensors.gauss_markov_coefficients`,
+    :func:`replication.sensors.gauss_markov_recursion`).
 
     Parameters
     ----------
@@ -666,10 +669,10 @@ def gauss_markov(n: int, dt: float, std: float, tau: float, rng: np.random.Gener
     """
     if not (n >= 1 and dt > 0 and std >= 0 and tau > 0):
         raise ValueError("need n >= 1, dt > 0, std >= 0 and tau > 0")
-    a = math.exp(-dt / tau)
-    w = rng.standard_normal((n, size)) * std * math.sqrt(1 - a * a)
+    a, q = gauss_markov_coefficients(dt, tau)
+    w = rng.standard_normal((n, size)) * std * q
     w[0] = rng.standard_normal(size) * std
-    return signal.lfilter([1.0], [1.0, -a], w, axis=0)
+    return gauss_markov_recursion(w, a)
 
 
 def aic_batch(Y, max_order: int, *, chunk: int = 16) -> np.ndarray:

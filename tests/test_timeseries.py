@@ -272,6 +272,24 @@ def test_simulated_variance_matches_theory():
     assert Y.var() == pytest.approx(ts.ar_variance(phi, 1.0), rel=0.05)
 
 
+def test_gauss_markov_is_the_recursion_of_its_draws():
+    """gauss_markov draws the n × size driving values, then the size initial values, and runs the
+    shared first-order recursion (replication.sensors.gauss_markov_recursion) from x_0 = w_0: the
+    same numbers exactly."""
+    from replication import sensors as se
+
+    n, dt, std, tau, size = 300, 0.2, 1.5, 4.0, 3
+    x = ts.gauss_markov(n, dt, std, tau, np.random.default_rng(5), size=size)
+    a, q = se.gauss_markov_coefficients(dt, tau)
+    rng = np.random.default_rng(5)
+    w = rng.standard_normal((n, size)) * std * q
+    w[0] = rng.standard_normal(size) * std
+    assert np.array_equal(x, se.gauss_markov_recursion(w, a))
+    np.testing.assert_allclose(x[1:], a * x[:-1] + w[1:], rtol=0, atol=1e-13 * np.abs(x).max())  # a few ε
+    with pytest.raises(ValueError, match="tau > 0"):
+        ts.gauss_markov(n, dt, std, 0.0, rng)
+
+
 def test_order_recovery_of_a_clear_ar1():
     f = ts.order_recovery([0.7], 1.0, 2000, n_series=200, max_order=10, seed=1)
     assert f.sum() == pytest.approx(1.0)
