@@ -1,7 +1,9 @@
 """Argument checks shared by the modules of the package (private).
 
 Each function returns the checked argument in the form the caller computes with (a float or a
-float array) and raises ``ValueError`` naming the argument, what it must be and what was given.
+float array) and raises ``ValueError`` naming the argument, what it must be and what was given;
+where a module words its message differently, ``message`` replaces the text (a ``str.format``
+template with the fields ``name`` and ``value``, for :func:`choice` also ``allowed``).
 The domain-specific checks stay with their modules (latitudes and heights in
 :mod:`replication.earth`, increments in :mod:`replication.strapdown`).
 """
@@ -15,15 +17,16 @@ import numpy as np
 __all__ = ["positive", "nonnegative", "finite", "vector3", "matrix3", "components", "choice"]
 
 
-def _number(value, name: str, what: str, ok) -> float:
+def _number(value, name: str, what: str, ok, message: str | None) -> float:
     """``float(value)`` if it is finite and ``ok(value)``; else ``ValueError`` saying ``what`` it must be."""
     value = float(value)
     if not (np.isfinite(value) and ok(value)):
-        raise ValueError(f"{name} must be {what}, got {value!r}")
+        text = f"{{name}} must be {what}, got {{value!r}}" if message is None else message
+        raise ValueError(text.format(name=name, value=value))
     return value
 
 
-def positive(value, name: str) -> float:
+def positive(value, name: str, message: str | None = None) -> float:
     """A positive finite number.
 
     Parameters
@@ -32,23 +35,26 @@ def positive(value, name: str) -> float:
         The argument.
     name : str
         Its name (with its unit where it helps) for the error message.
+    message : str, optional
+        The error message as a template with the fields ``name`` and ``value`` (``float(value)``);
+        by default "{name} must be a positive finite number, got {value!r}".
 
     Returns
     -------
     float
         ``float(value)``; ``ValueError`` if it is not finite or not > 0.
     """
-    return _number(value, name, "a positive finite number", lambda v: v > 0.0)
+    return _number(value, name, "a positive finite number", lambda v: v > 0.0, message)
 
 
-def nonnegative(value, name: str) -> float:
+def nonnegative(value, name: str, message: str | None = None) -> float:
     """A finite number >= 0 (arguments and return as :func:`positive`; ``ValueError`` if negative)."""
-    return _number(value, name, "a non-negative finite number", lambda v: v >= 0.0)
+    return _number(value, name, "a non-negative finite number", lambda v: v >= 0.0, message)
 
 
-def finite(value, name: str) -> float:
+def finite(value, name: str, message: str | None = None) -> float:
     """A finite number (arguments and return as :func:`positive`; ``ValueError`` if NaN or infinite)."""
-    return _number(value, name, "a finite number", lambda v: True)
+    return _number(value, name, "a finite number", lambda v: True, message)
 
 
 def vector3(value, name: str) -> np.ndarray:
@@ -139,7 +145,7 @@ def components(value, name: str, n: int = 3) -> np.ndarray:
     return a
 
 
-def choice(value: Any, allowed: Collection, name: str) -> Any:
+def choice(value: Any, allowed: Collection, name: str, message: str | None = None) -> Any:
     """One of a fixed set of options.
 
     Parameters
@@ -150,6 +156,9 @@ def choice(value: Any, allowed: Collection, name: str) -> Any:
         The options, shown in the error message as given (pass a sorted list for a set).
     name : str
         Its name for the error message.
+    message : str, optional
+        The error message as a template with the fields ``name``, ``allowed`` and ``value``; by
+        default "{name} must be one of {allowed}, got {value!r}".
 
     Returns
     -------
@@ -162,5 +171,6 @@ def choice(value: Any, allowed: Collection, name: str) -> Any:
         If ``value`` is not among ``allowed``.
     """
     if value not in allowed:
-        raise ValueError(f"{name} must be one of {allowed}, got {value!r}")
+        text = "{name} must be one of {allowed}, got {value!r}" if message is None else message
+        raise ValueError(text.format(name=name, allowed=allowed, value=value))
     return value

@@ -69,7 +69,7 @@ import numpy as np
 from . import earth
 from . import errors as E
 from .rotations import rotvec_to_dcm, skew
-from ._validate import components
+from ._validate import components, positive
 from replication import models, errors
 from .rotations import euler_to_dcm
 from ._kernels import KIND_MISALIGN, coupling_matrix
@@ -116,18 +116,14 @@ _BLOCK_SYMBOLS = {
 
 # ----------------------------------------------------------------------------- helpers
 
+_SECONDS = "{name} must be a positive number of seconds (or 1/s for beta), got {value}"
+
+
 def _nonneg(x, name, n=3):
     a = components(x, name, n)
     if np.any(a < 0):
         raise ValueError(f"{name} must be finite and non-negative (SI units), got {a}")
     return a
-
-
-def _positive(x, name):
-    x = float(x)
-    if not (x > 0 and math.isfinite(x)):
-        raise ValueError(f"{name} must be a positive number of seconds (or 1/s for beta), got {x}")
-    return x
 
 
 def _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h):
@@ -140,7 +136,7 @@ def _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h):
 
 def _markov_block(kind, sigma, tau, name):
     s = _nonneg(sigma, f"{name} sigma")
-    tau = _positive(tau, f"{name} correlation time tau")
+    tau = positive(tau, f"{name} correlation time tau", _SECONDS)
     return (E.accel_markov if kind == "accel" else E.gyro_markov)(s, tau, name=name)
 
 
@@ -174,7 +170,7 @@ def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
     before running a filter.  Returns an :class:`replication.errors.ErrorModel` (45 states).
     """
     nav_sd = _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h)
-    beta = _positive(gravity_beta, "gravity_beta")
+    beta = positive(gravity_beta, "gravity_beta", _SECONDS)
     blocks = (
         E.accel_bias(_nonneg(accel_bias_sd, "accel_bias_sd")),
         _markov_block("accel", accel_markov_sigma, accel_markov_tau, "accel_markov"),
@@ -562,8 +558,8 @@ def table_2_2_printed(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.0)
     B["F51"] = C * om[None, :]
     B["F52"] = np.column_stack([C[:, 0] * om[1], C[:, 1] * om[0], C[:, 0] * om[2]])
     B["F53"] = np.column_stack([C[:, 2] * om[0], C[:, 1] * om[2], C[:, 2] * om[1]])
-    B["F6"] = -np.eye(3) / _positive(accel_markov_tau, "accel_markov_tau")
-    B["F7"] = -np.eye(3) / _positive(gyro_markov_tau, "gyro_markov_tau")
+    B["F6"] = -np.eye(3) / positive(accel_markov_tau, "accel_markov_tau", _SECONDS)
+    B["F7"] = -np.eye(3) / positive(gyro_markov_tau, "gyro_markov_tau", _SECONDS)
     return B
 
 

@@ -41,6 +41,7 @@ import sympy as sp
 from scipy.optimize import brentq
 
 from . import earth
+from ._validate import choice
 from .units import DEG, DEG_PER_H, DEG_PER_SQRT_H, HOUR, MICRO_G, UG_PER_SQRT_HZ
 import mpmath
 import re
@@ -60,6 +61,7 @@ PAIRS = ("phiE/gdN", "phiN/gdE")
 MOTIONS = ("north-south", "east-west")
 
 _PAIR_INDEX = {"phiE/gdN": (0, 1), "phiN/gdE": (1, 0)}  # (output, input) of the (g_dE, g_dN) system
+_NOT_ONE_OF = "{name} must be one of {allowed}, not {value!r}"  # the refusal of an unknown pair or motion
 
 
 # --------------------------------------------------------------------------- validation
@@ -78,18 +80,6 @@ def _check_motion(lat, v_east, v_north):
     if not (math.isfinite(v_east) and math.isfinite(v_north)):
         raise ValueError("velocities must be finite numbers (m/s)")
     return lat, v_east, v_north
-
-
-def _check_pair(pair):
-    if pair not in PAIRS:
-        raise ValueError(f"pair must be one of {PAIRS}, not {pair!r}")
-    return pair
-
-
-def _check_motion_name(motion):
-    if motion not in MOTIONS:
-        raise ValueError(f"motion must be one of {MOTIONS}, not {motion!r}")
-    return motion
 
 
 def earth_parameters(lat, radius=None, gravity=None):
@@ -216,7 +206,7 @@ def _balanced(sys):
 
 def siso(sys, pair):
     """The SISO channel ``pair`` ('phiE/gdN' or 'phiN/gdE') of a (g_dE, g_dN) → (ϕ_E, ϕ_N) system."""
-    _check_pair(pair)
+    choice(pair, PAIRS, "pair", _NOT_ONE_OF)
     i, j = _PAIR_INDEX[pair]
     return ct.ss(np.asarray(sys.A), np.asarray(sys.B)[:, [j]], np.asarray(sys.C)[[i], :], np.asarray(sys.D)[[i]][:, [j]])
 
@@ -257,7 +247,7 @@ def transfer_function(lat, v_east=0.0, v_north=0.0, pair="phiE/gdN", *, radius=N
     otherwise the full 6th-order form is returned (the near-cancellation of north-south motion is
     kept, as in eqs. (4)-(5)).
     """
-    _check_pair(pair)
+    choice(pair, PAIRS, "pair", _NOT_ONE_OF)
     lat, v_east, v_north = _check_motion(lat, v_east, v_north)
     r, g = earth_parameters(lat, radius, gravity)
     w0 = math.sqrt(g / r)
@@ -393,7 +383,7 @@ def symbolic_transfer_functions(motion):
     ``num``, ``den`` sympy ``Poly`` in s (den monic, coefficients in R, g, omega_ie, L and the
     speed) and ``common`` the cancelled factor (1 when none).
     """
-    _check_motion_name(motion)
+    choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     s, L = SYMBOLS["s"], SYMBOLS["L"]
     a = symbolic_system_matrix(motion)[:6, :6]
     m = s * sp.eye(6) - a
@@ -476,7 +466,7 @@ def evaluate(expr, lat, speed, motion, *, radius=None, gravity=None, digits=30):
 
     ``speed`` is V_N for north-south motion and V_E for east-west motion (:func:`evaluate_at`).
     """
-    _check_motion_name(motion)
+    choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     ve, vn = (0.0, speed) if motion == "north-south" else (speed, 0.0)
     return evaluate_at(expr, lat, ve, vn, radius=radius, gravity=gravity, digits=digits)
 
@@ -494,7 +484,7 @@ def coefficient_location(name, motion):
     n_1k: numerator of ϕ_E/g_dN, n_2k: numerator of ϕ_N/g_dE, d_k: the shared denominator; k is
     the power of s.
     """
-    _check_motion_name(motion)
+    choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
 
     m = re.fullmatch(r"([nd])_(\d+)", name)
     if not m:
@@ -528,7 +518,7 @@ def printed_in_derived_normalization(name, printed, motion):
     would be vacuous) the printed leading ratio n_12/d_4 is returned, to be compared with the
     derived monic n_12 = 1/R (the δV_N → ϕ_E path).
     """
-    _check_motion_name(motion)
+    choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     expr = parse_printed(printed[name])
     if motion == "north-south":
         return expr
@@ -549,7 +539,7 @@ def coefficient_checks(printed, motion, points, *, radius=None, gravity=None):
     the first point.  For east-west motion the d_4 row compares n_12/d_4 (see
     :func:`printed_in_derived_normalization`).
     """
-    _check_motion_name(motion)
+    choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     if not points:
         raise ValueError("give at least one (lat, speed) point")
     rows = []
@@ -602,7 +592,7 @@ def pole_zero_grid(motion, lats_deg, speeds, *, radius=None, gravity=None):
     than ``ROOT_REAL_TOL`` |z| are that round-off and are returned as 0 (otherwise they change
     from one BLAS/SIMD code path to another).
     """
-    _check_motion_name(motion)
+    choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     rows = []
     for lat_deg in np.atleast_1d(lats_deg):
         for v in np.atleast_1d(speeds):
@@ -641,7 +631,7 @@ def cancellation_distance(lat, speed, motion, pair, *, radius=None, gravity=None
     calls cancellable.  Zero means exact cancellation (east-west motion, and north-south motion
     at rest); for north-south motion it grows with |V_N|.
     """
-    _check_motion_name(motion)
+    choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     ve, vn = (0.0, speed) if motion == "north-south" else (speed, 0.0)
     tf = transfer_function(lat, ve, vn, pair, radius=radius, gravity=gravity, minimal=False)
     p = min((z for z in tf.poles() if z.imag >= 0), key=abs)
@@ -1001,7 +991,7 @@ def time_domain_response(lat, v_east, v_north, noise: NoiseSettings, omegas, *, 
     """
 
 
-    _check_pair(pair)
+    choice(pair, PAIRS, "pair", _NOT_ONE_OF)
     out_i, in_i = _PAIR_INDEX[pair]
     if not isinstance(noise, NoiseSettings):
         raise TypeError("noise must be a NoiseSettings")
