@@ -28,7 +28,7 @@ _TWELFTH = 1.0 / 12.0
 
 # ----------------------------------------------------------------------------- Earth (scalar)
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def radii_s(lat):
     s = math.sin(lat)
     w2 = 1.0 - E2 * s * s
@@ -74,7 +74,7 @@ def gamma_grad_s(lat, h):
     return dg0 * fac + g0 * dfac_dl, g0 * dfac_dh
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def rates_s(lat, h, ve, vn, out_ie, out_en):
     """ω_ie^n and ω_en^n (ENU) into the given 3-vectors."""
     rm, rn = radii_s(lat)
@@ -124,7 +124,7 @@ def _rv2q(x, y, z, out):
     out[3] = k * z
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _q2c(q, c):
     a, b, cc, d = q[0], q[1], q[2], q[3]
     c[0, 0] = a * a + b * b - cc * cc - d * d
@@ -291,7 +291,7 @@ def strapdown_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains, out_s
 
 # ----------------------------------------------------------------------------- error model F
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def coupling_matrix(kind, u, out):
     """B(u) of a sensor-error block: δu = B(u) x (chen2019 eq. (2-10)); out is 3×k."""
     out[:, :] = 0.0
@@ -353,7 +353,7 @@ def build_F(lat, h, ve, vn, vu, c, f_b, w_b, fconst, blk_target, blk_kind, blk_s
                 F[row + i, k0 + j] += sgn * acc
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def build_F_core(lat, h, ve, vn, vu, fn0, fn1, fn2, fconst, F):
     """F without the sensor-block couplings: fconst + the navigation-error rows (f^n given)."""
     n = F.shape[0]
@@ -449,7 +449,7 @@ def build_F_core(lat, h, ve, vn, vu, fn0, fn1, fn2, fconst, F):
 
 # ----------------------------------------------------------------------------- dense helpers
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _csr(a, ptr, col, val):
     """The non-zeros of ``a`` row by row, columns ascending (compressed sparse rows)."""
     n, m = a.shape
@@ -466,25 +466,26 @@ def _csr(a, ptr, col, val):
 
 
 @njit(**_NJ)
-def _row_nonzeros(b, nzc, cnt):
-    """Per row of ``b``: the columns of its non-zeros (``nzc[k, :cnt[k]]``)."""
-    n, p = b.shape
-    for k in range(n):
-        c = 0
-        for j in range(p):
-            if b[k, j] != 0.0:
-                nzc[k, c] = j
-                c += 1
-        cnt[k] = c
+def discretize_series(F, Qc, T, order, Phi, Qd, w1, w2):
+    """Φ = exp(F T) and Q_d = ∫_0^T e^{Fs} Q_c e^{F^T s} ds by their Taylor series to ``order``.
+
+    The series of Van Loan's block exponential: Q_d = Σ_k T^{k+1}/(k+1)! M_k with M_0 = Q_c,
+    M_k = F M_{k-1} + (F M_{k-1})^T.  Checked against scipy.linalg.expm in the tests.  The
+    products skip the zeros of F (an INS error model's F is sparse); the terms left out are exact
+    zeros, so the arithmetic is that of the dense products, bit for bit.
+    """
+    n = F.shape[0]
+    ptr = np.empty(n + 1, np.int64)
+    col = np.empty(n * n, np.int64)
+    val = np.empty(n * n)
+    _series_into(F, Qc, T, order, Phi, Qd, w1, w2, ptr, col, val)
 
 
 @njit(**_NJ)
-def _csr_matmul(ptr, col, val, b, nzc, cnt, out):
-    """out = A @ b for A in compressed rows and b's non-zero columns per row.
-
-    Each out[i, j] sums a_ik b_kj over ascending k, as the dense product does; the terms left out
-    are exact zeros, which leave a sum that starts at +0.0 unchanged, so the result is the dense
-    product's bit for bit."""
+def _csr_matmul(ptr, col, val, b, out):
+    """out = A @ b for A in compressed rows: out[i] = Σ_t val[t] b[col[t], :] over ascending
+    columns, the order of the dense product (the terms left out are exact zeros, which leave a
+    sum that starts at +0.0 unchanged: the dense product's result bit for bit)."""
     n, p = out.shape
     for i in range(n):
         for j in range(p):
@@ -492,74 +493,56 @@ def _csr_matmul(ptr, col, val, b, nzc, cnt, out):
         for t in range(ptr[i], ptr[i + 1]):
             k = col[t]
             aik = val[t]
-            for u in range(cnt[k]):
-                j = nzc[k, u]
+            for j in range(p):
                 out[i, j] += aik * b[k, j]
 
 
 @njit(**_NJ)
-def discretize_series(F, Qc, T, order, Phi, Qd, w1, w2):
-    """Φ = exp(F T) and Q_d = ∫_0^T e^{Fs} Q_c e^{F^T s} ds by their Taylor series to ``order``.
-
-    The series of Van Loan's block exponential: Q_d = Σ_k T^{k+1}/(k+1)! M_k with M_0 = Q_c,
-    M_k = F M_{k-1} + (F M_{k-1})^T.  Checked against scipy.linalg.expm in the tests.  The
-    products use the sparsity of F and of the running terms (an INS error model's sensor rows
-    have one non-zero or none); the arithmetic is that of the dense products.
-    """
+def _series_into(F, Qc, T, order, Phi, Qd, w1, w2, ptr, col, val):
+    """``discretize_series`` with its scratch passed in (the closed-loop filter calls it every
+    GNSS epoch): ``ptr``, ``col``, ``val`` receive the compressed rows of F."""
     n = F.shape[0]
-    ptr = np.empty(n + 1, np.int64)
-    col = np.empty(n * n, np.int64)
-    val = np.empty(n * n)
     _csr(F, ptr, col, val)
-    nzc = np.empty((n, n), np.int64)
-    cnt = np.empty(n, np.int64)
-    # Φ: running term w1 = (F T)^k / k!
+    # Φ: running term w1 = (F T)^k / k!; the first term F·I / 1 is F T
+    t1 = T if order >= 1 else 0.0
     for i in range(n):
         for j in range(n):
-            Phi[i, j] = 1.0 if i == j else 0.0
-            w1[i, j] = 1.0 if i == j else 0.0
-        nzc[i, 0] = i
-        cnt[i] = 1
-    for k in range(1, order + 1):
-        _csr_matmul(ptr, col, val, w1, nzc, cnt, w2)
+            v = F[i, j] * t1
+            w1[i, j] = v
+            Phi[i, j] = (1.0 if i == j else 0.0) + v
+    for k in range(2, order + 1):
+        # row i of the next term, (F w1)[i] T / k, built in w2; then w1 <-> w2
         fac = T / k
         for i in range(n):
-            c = 0
             for j in range(n):
-                v = w2[i, j]
-                if v != 0.0:
-                    w1[i, j] = v * fac
-                    Phi[i, j] += w1[i, j]
-                    nzc[i, c] = j
-                    c += 1
-                else:
-                    w1[i, j] = 0.0
-            cnt[i] = c
+                w2[i, j] = 0.0
+            for t in range(ptr[i], ptr[i + 1]):
+                kk = col[t]
+                a = val[t]
+                for j in range(n):
+                    w2[i, j] += a * w1[kk, j]
+            for j in range(n):
+                v = w2[i, j] * fac
+                w2[i, j] = v
+                Phi[i, j] += v
+        w1, w2 = w2, w1
     # Q_d: running term w1 = M_k
     for i in range(n):
         for j in range(n):
             w1[i, j] = Qc[i, j]
             Qd[i, j] = Qc[i, j] * T
-    _row_nonzeros(w1, nzc, cnt)
     coef = T
     for k in range(1, order + 1):
-        _csr_matmul(ptr, col, val, w1, nzc, cnt, w2)
+        _csr_matmul(ptr, col, val, w1, w2)
         coef = coef * T / (k + 1)
-        for i in range(n):
-            cnt[i] = 0
         for i in range(n):
             for j in range(i, n):
                 v = w2[i, j] + w2[j, i]
                 w1[i, j] = v
                 w1[j, i] = v
-                if v != 0.0:
-                    Qd[i, j] += coef * v
-                    nzc[i, cnt[i]] = j
-                    cnt[i] += 1
-                    if j != i:
-                        Qd[j, i] += coef * v
-                        nzc[j, cnt[j]] = i
-                        cnt[j] += 1
+                Qd[i, j] += coef * v
+                if j != i:
+                    Qd[j, i] += coef * v
 
 
 @njit(**_NJ)
@@ -604,7 +587,7 @@ def _chol_solve_scaled(P, e):
 
 # ----------------------------------------------------------------------------- closed loop
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _apply_corrections(u, T, p_hat, blk_target, blk_kind, blk_start, blk_size, target, out, B):
     """out = u - Σ_blocks B(u) p̂ (bias-like blocks scaled by T for increments)."""
     out[0], out[1], out[2] = u[0], u[1], u[2]
@@ -613,21 +596,25 @@ def _apply_corrections(u, T, p_hat, blk_target, blk_kind, blk_start, blk_size, t
         if blk_target[b] != target:
             continue
         kind = blk_kind[b]
-        coupling_matrix(kind, u, B)
-        fac = T if kind == KIND_IDENTITY else 1.0
         k0, kk = blk_start[b], blk_size[b]
+        if kind == KIND_IDENTITY:
+            # B = I: the sum Σ_j B[i, j] p̂_j is p̂_i (the other terms are exact zeros)
+            for i in range(3):
+                out[i] -= T * p_hat[k0 + i - nav]
+            continue
+        coupling_matrix(kind, u, B)
         for i in range(3):
             acc = 0.0
             for j in range(kk):
                 acc += B[i, j] * p_hat[k0 + j - nav]
-            out[i] -= fac * acc
+            out[i] -= acc
 
 
 # ----------------------------------------------------------------------------- closed-loop steps
 # Steps of the closed-loop filter of replication.closedloop: interval sums, discretization,
 # feedback, resets.
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _accumulate_interval(c, fb, st, fsum, Csum, navsum):
     """Interval sums of the inputs of F at the start of an IMU step: f^n = C f^b, C_b^n and the
     navigation state (lat, h, vE, vN, vU)."""
@@ -639,7 +626,7 @@ def _accumulate_interval(c, fb, st, fsum, Csum, navsum):
         navsum[i] += st[0] if i == 0 else st[i + 1]
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _reset_interval(Cpl, fsum, Csum, navsum):
     """Zero the interval sums of ``_accumulate_interval`` and the block couplings."""
     for i in range(6):
@@ -653,7 +640,7 @@ def _reset_interval(Cpl, fsum, Csum, navsum):
         navsum[i] = 0.0
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _interval_discretize(F, qc_const, Cm, q_accel, q_gyro, T, order, Qc, Phi, Qd, w1, w2):
     """(Φ, Q_d) of one GNSS interval of length ``T``: Qc = ``qc_const`` plus the navigation white
     noise G diag(q) Gᵀ with G = [0; C; -C] (``Cm`` the interval-mean C_b^n, accelerometer and gyro
@@ -685,7 +672,7 @@ def _skew_rows(H, r, u0, u1, u2):
     H[r + 2, 7] = u0
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def gnss_rows(H, c, lever, wx, wy, wz, L, h, use_pos, use_vel, blk_target, blk_start):
     """GNSS measurement rows of the error state, chen2019 eqs. (3-17) and (2-13); returns the
     number of rows written (H must be zero on entry).
@@ -734,7 +721,7 @@ def gnss_rows(H, c, lever, wx, wy, wz, L, h, use_pos, use_vel, blk_target, blk_s
     return r
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def accumulate_coupling(c, fb, wb, blk_target, blk_kind, blk_start, blk_size, weight, Cpl, B):
     """Cpl[0:3] += weight · C_b^n B(f^b) for accelerometer blocks and Cpl[3:6] += weight · C_b^n B(ω^b)
     for gyro blocks, B of :func:`coupling_matrix` for the block's kind (chen2019 eq. (2-10)):
@@ -745,13 +732,19 @@ def accumulate_coupling(c, fb, wb, blk_target, blk_kind, blk_start, blk_size, we
             continue
         r0 = 0 if tg == TARGET_ACCEL else 3
         k0, kk = blk_start[b], blk_size[b]
+        if blk_kind[b] == KIND_IDENTITY:
+            # B = I: C_b^n B is C_b^n (the other terms of each sum are exact zeros)
+            for i in range(3):
+                for jj in range(3):
+                    Cpl[r0 + i, k0 + jj] += weight * c[i, jj]
+            continue
         coupling_matrix(blk_kind[b], fb if tg == TARGET_ACCEL else wb, B)
         for i in range(3):
             for jj in range(kk):
                 Cpl[r0 + i, k0 + jj] += weight * (c[i, 0] * B[0, jj] + c[i, 1] * B[1, jj] + c[i, 2] * B[2, jj])
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp, nq):
     """Feedback of the estimate ``xk``: δp, δv subtracted from ``st`` and ``st_prev``, the attitude
     corrected by q ← q(φ) ⊗ q (normalized), and p̂ += x̂[9:]."""
@@ -767,7 +760,7 @@ def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp, nq):
         p_hat[i] += xk[9 + i]
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _feedback_blocks(p_hat, blk_target, blk_start, blk_size, fconst, lever0, lever, g_extra):
     """Apply the accumulated estimates p̂ of the lever-arm block (lever = lever0 + δl) and of the
     gravity block (ĝ^n = output rows of ``fconst``, velocity rows with sign -, into ``g_extra``)."""

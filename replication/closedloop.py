@@ -89,7 +89,7 @@ ChunkOut = namedtuple("ChunkOut", ["st", "q", "phat", "nis", "innov", "nees", "n
 
 # ----------------------------------------------------------------------------- compiled pieces
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _row_nonzeros(Phi, nzc, nzv, cnt):
     """The non-zeros of Φ by row: column indices ``nzc[i, :cnt[i]]`` (ascending), values ``nzv``."""
     n = Phi.shape[0]
@@ -104,11 +104,13 @@ def _row_nonzeros(Phi, nzc, nzv, cnt):
         cnt[i] = c
 
 
-@njit(**_NJ)
-def _propagate_sparse(Phi, P, Qd, W, nzc, nzv, cnt):
-    """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (Φ of an INS error model is sparse)."""
+@njit(inline="always", **_NJ)
+def _propagate_sparse(Phi, P, Qd, W, Wt, U, nzc, nzv, cnt):
+    """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (``nzc``, ``nzv``, ``cnt`` of
+    :func:`_row_nonzeros`; Φ of an INS error model is sparse).  W = Φ P and U = Φ Wᵀ are built row
+    by row (contiguous inner loops); each element sums the same products in the same order as
+    Σ_k W[i, k] Φ[j, k] over Φ's non-zeros, ascending k."""
     n = P.shape[0]
-    _row_nonzeros(Phi, nzc, nzv, cnt)
     for i in range(n):
         for j in range(n):
             W[i, j] = 0.0
@@ -118,16 +120,24 @@ def _propagate_sparse(Phi, P, Qd, W, nzc, nzv, cnt):
             for j in range(n):
                 W[i, j] += v * P[k, j]
     for i in range(n):
+        for j in range(n):
+            Wt[j, i] = W[i, j]
+    for j in range(n):
+        for i in range(n):
+            U[j, i] = 0.0
+        for t in range(cnt[j]):
+            k = nzc[j, t]
+            v = nzv[j, t]
+            for i in range(n):
+                U[j, i] += v * Wt[k, i]
+    for i in range(n):
         for j in range(i, n):
-            acc = 0.0
-            for t in range(cnt[j]):
-                acc += W[i, nzc[j, t]] * nzv[j, t]
-            v = acc + 0.5 * (Qd[i, j] + Qd[j, i])
+            v = U[j, i] + 0.5 * (Qd[i, j] + Qd[j, i])
             P[i, j] = v
             P[j, i] = v
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _specific_force_rows(H, r, facc, Cw, sf_H, tg, bs, bz):
     """Rows r..r+2 of H for the specific-force measurement of chen2019 eq. (3-18): the window
     mean of C_b^n f^b minus the GNSS acceleration = f^n × φ + C_b^n ∇ − δg^n: attitude columns
@@ -150,7 +160,7 @@ def _specific_force_rows(H, r, facc, Cw, sf_H, tg, bs, bz):
                     H[r + i, bs[b] + jj] += Cw[i, bs[b] + jj]
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _body_rate(dth, T, c, st, w_ie, w_en):
     """ω_eb^b ≈ corrected gyro rate of the last step − C_b^nᵀ ω_ie^n (for the lever-arm rows)."""
     K.rates_s(st[0], st[2], st[3], st[4], w_ie, w_en)
@@ -160,7 +170,7 @@ def _body_rate(dth, T, c, st, w_ie, w_en):
     return wx, wy, wz
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _innovations(st, c, lever, wx, wy, wz, gpos, gvel, use_pos, use_vel, z):
     """GNSS innovations INS − GNSS at the antenna (rows as in ``replication._kernels.gnss_rows``);
     returns the number of rows written."""
@@ -197,9 +207,9 @@ def _attitude_error(q, tq, e):
     e[8] = -2.0 * sg * r[3]
 
 
-@njit(**_NJ)
+@njit(inline="always", **_NJ)
 def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd, w1,
-                      w2, nzc, nzv, cnt, P, Pbar, use_pbar):
+                      w2, w3, nzc, nzv, cnt, P, Pbar, use_pbar):
     """F as the interval mean (``build_F_core`` at the mean inputs plus the mean couplings ``Cpl``),
     (Φ, Q_d) by the Van Loan series with the navigation white noise at the mean C_b^n, then
     P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements)."""
@@ -215,23 +225,35 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cp
         for jj in range(3):
             Csum[i, jj] *= inv
     K._interval_discretize(F, qc, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2)
-    _propagate_sparse(Phi, P, Qd, w1, nzc, nzv, cnt)
+    _row_nonzeros(Phi, nzc, nzv, cnt)
+    _propagate_sparse(Phi, P, Qd, w1, w2, w3, nzc, nzv, cnt)
     if use_pbar:
-        _propagate_sparse(Phi, Pbar, Qd, w1, nzc, nzv, cnt)
+        _propagate_sparse(Phi, Pbar, Qd, w1, w2, w3, nzc, nzv, cnt)
 
 
 @njit(**_NJ)
-def _lead_gains(P, H, m, Rd, gK, gs, bvec):
+def _lead_gains(P, H, m, Rd, gK, gs, bvec, hz):
     """Sequential Joseph update of P for rows 0..m-1 of H (variances ``Rd``): gains ``gK[a]`` and
-    innovation variances ``gs[a]`` (see the Joseph form of :func:`replication.kalman.update`)."""
+    innovation variances ``gs[a]`` (see the Joseph form of :func:`replication.kalman.update`).
+
+    The updates write P's upper triangle (contiguous rows) and mirror it once at the end; the
+    rows after the first read P from the upper triangle, which is what the lower one would hold.
+    ``hz`` (n ints) receives the non-zero columns of each row of H."""
     n = P.shape[0]
     for a in range(m):
+        c = 0
+        for k in range(n):
+            if H[a, k] != 0.0:
+                hz[c] = k
+                c += 1
         for i in range(n):
             acc = 0.0
-            for k in range(n):
-                hk = H[a, k]
-                if hk != 0.0:
-                    acc += P[i, k] * hk
+            for t in range(c):
+                k = hz[t]
+                if a == 0 or i <= k:
+                    acc += P[i, k] * H[a, k]
+                else:
+                    acc += P[k, i] * H[a, k]
             gK[a, i] = acc
         sv = Rd[a]
         for k in range(n):
@@ -242,10 +264,15 @@ def _lead_gains(P, H, m, Rd, gK, gs, bvec):
             gK[a, i] = bvec[i] / sv
         gs[a] = sv
         for i in range(n):
+            ki = gK[a, i]
+            bi = bvec[i]
+            ski = sv * ki
             for j in range(i, n):
-                v = P[i, j] - gK[a, i] * bvec[j] - bvec[i] * gK[a, j] + sv * gK[a, i] * gK[a, j]
-                P[i, j] = v
-                P[j, i] = v
+                P[i, j] = P[i, j] - ki * bvec[j] - bi * gK[a, j] + ski * gK[a, j]
+    if m > 0:
+        for i in range(n):
+            for j in range(i + 1, n):
+                P[j, i] = P[i, j]
 
 
 @njit(inline="always", **_NJ)
@@ -333,6 +360,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     Qc = np.empty((n, n))
     w1 = np.empty((n, n))
     w2 = np.empty((n, n))
+    w3 = np.empty((n, n))
     nzc = np.empty((n, n), np.int64)
     nzv = np.empty((n, n))
     cnt = np.empty(n, np.int64)
@@ -347,6 +375,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     xk = np.empty(n)
     e = np.empty(n)
     tmp = np.empty(max(n_dyn, n))
+    hz = np.empty(n, np.int64)
     Ta = np.ascontiguousarray(spec.ar_T[9:, 9:])
     store_nav = out.nav_st.shape[1] > 0
     record = out.rec_Phi.shape[0] > 0
@@ -378,7 +407,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
             # ---------------- time update (lead)
             if is_lead:
                 _lead_time_update(spec.fconst, spec.qc, spec.q_accel, spec.q_gyro, spec.order, navsum, fsum, Csum, Cpl,
-                                  nsum, tsum, F, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt, lead.P, lead.Pbar, spec.use_pbar)
+                                  nsum, tsum, F, Qc, Phi, Qd, w1, w2, w3, nzc, nzv, cnt, lead.P, lead.Pbar, spec.use_pbar)
                 for t in range(n_dyn):
                     for jj in range(n_aug):
                         gains.Phid[j, t, jj] = Phi[9 + spec.dyn_rows[t], 9 + jj]
@@ -427,7 +456,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                         Rd[m + i] = inp.sf_R[sf, i]
                     m += 3
                 gains.m[j] = m
-                _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j], tmp)
+                _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j], tmp, hz)
                 for a in range(m):
                     gains.H[j, a, :] = H[a]
                 if gains.nees_L.shape[0] > 0:

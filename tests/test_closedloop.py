@@ -23,7 +23,8 @@ def test_sequential_gains_equal_the_joseph_update():
     z = rng.normal(size=m)
     gK, gs = np.empty((9, n)), np.empty(9)
     Pseq = P.copy()
-    cl._lead_gains(Pseq, np.vstack([H, np.zeros((9 - m, n))]), m, np.r_[Rd, np.ones(9 - m)], gK, gs, np.empty(n))
+    cl._lead_gains(Pseq, np.vstack([H, np.zeros((9 - m, n))]), m, np.r_[Rd, np.ones(9 - m)], gK, gs, np.empty(n),
+                   np.empty(n, np.int64))
     x = np.zeros(n)
     for a in range(m):
         x += gK[a] * (z[a] - H[a] @ x)
