@@ -846,11 +846,20 @@ def slope_weights(t_gnss, t_imu) -> np.ndarray:
     ti = np.asarray(t_imu, float)
     if tg.size < 3:
         raise ValueError("the window needs at least three GNSS epochs")
-    d = tg - tg.mean()
-    c = d / np.sum(d * d)
-    C = -np.cumsum(c)[:-1]
-    seg = np.searchsorted(tg, 0.5 * (ti[1:] + ti[:-1])) - 1
-    return C[seg] * np.diff(ti)
+    ks = np.arange(ti.size - 1)
+    return _window_weights(tg[None, :], tg, ti, ks, np.zeros(ks.size, np.int64))[0]
+
+
+def _window_weights(te, t_all, t, ks, wid):
+    """The weights of :func:`slope_weights` for many windows at once: GNSS epochs ``te`` (windows ×
+    epochs, consecutive rows of the sorted ``t_all``), IMU steps ``ks`` of the time grid ``t`` and
+    their window ids ``wid``.  Returns the weights of the steps and, per window, the centred epoch
+    times d and Σ d² (every sum is taken along one row, in the order of the one-window sums)."""
+    d = te - te.mean(axis=1)[:, None]
+    dd = np.sum(d * d, axis=1)
+    C = -np.cumsum(d / dd[:, None], axis=1)[:, :-1]
+    seg = np.searchsorted(t_all, 0.5 * (t[ks + 1] + t[ks])) - 1 - wid * te.shape[1]
+    return C[wid, seg] * (t[ks + 1] - t[ks]), d, dd
 
 
 def _single_gravity_block(model):
@@ -883,25 +892,37 @@ def _specific_force_windows(t, idx, gnss, model, gblk, gs, sf_interval, discrete
     if m < 3 or abs(m * dtg - sf_interval) > 1e-6:
         raise ValueError(f"sf_interval must be a multiple (>= 3) of the GNSS interval {dtg} s")
     nw = len(idx) // m
-    a_g, R_sf = np.zeros((nw, 3)), np.zeros((nw, 3))
-    sv2 = np.broadcast_to(np.asarray(gnss.sigma_vel, float) ** 2, (3,))
-    lag = 0.0
-    for w in range(nw):
-        e = np.arange(w * m, (w + 1) * m)
-        te = gnss.t[e]
-        d = te - te.mean()
-        a_g[w] = (d / np.sum(d * d)) @ gnss.v_enu[e]
-        k0, k1 = idx[e[0]], idx[e[-1]]
-        ww = slope_weights(te, t[k0:k1 + 1])
-        wgt[k0:k1] = ww
-        win[k0:k1] = w
-        win_end[e[-1]] = w
-        T = np.diff(t[k0:k1 + 1])
-        R_sf[w] = sv2 / np.sum(d * d) + model.accel_psd * np.sum(ww**2 / T)
-        lag = te[-1] - np.sum(ww * 0.5 * (t[k0:k1] + t[k0 + 1:k1 + 1]))
+    a_g, R_sf, lag = np.zeros((nw, 3)), np.zeros((nw, 3)), 0.0
+    if nw:
+        a_g, R_sf, lag = _fill_windows(t, idx, gnss, model, m, nw, wgt, win, win_end)
     Hg[:, gs.start - 9:gs.stop - 9] = -np.asarray(gblk.output, float) @ expm(
         -np.asarray(gblk.dynamics) * (0.0 if discrete else lag))
     return wgt, win, win_end, a_g, R_sf, Hg, m
+
+
+def _fill_windows(t, idx, gnss, model, m, nw, wgt, win, win_end):
+    """Slope weights and window ids of the IMU steps of ``nw`` windows of ``m`` GNSS epochs (into
+    ``wgt``, ``win``, ``win_end``); returns per window the GNSS acceleration and R_f, and the
+    centroid lag of the last window."""
+    sv2 = np.broadcast_to(np.asarray(gnss.sigma_vel, float) ** 2, (3,))
+    e0 = np.arange(nw) * m                         # first and last epoch of each window
+    k0, k1 = idx[e0], idx[e0 + m - 1]
+    wid = np.repeat(np.arange(nw), k1 - k0)        # the IMU steps k0..k1-1 of each window
+    start = np.cumsum(k1 - k0) - (k1 - k0)
+    ks = k0[wid] + np.arange(wid.size) - start[wid]
+    te = np.asarray(gnss.t, float)[:nw * m].reshape(nw, m)
+    ww, d, dd = _window_weights(te, np.asarray(gnss.t, float), t, ks, wid)
+    wgt[ks] = ww
+    win[ks] = wid
+    win_end[e0 + m - 1] = np.arange(nw)
+    a_g = np.empty((nw, 3))
+    for w in range(nw):
+        a_g[w] = (d[w] / dd[w]) @ gnss.v_enu[w * m:(w + 1) * m]
+    white = np.add.reduceat(ww**2 / (t[ks + 1] - t[ks]), start)      # Σ w²/Δt of each window
+    R_sf = sv2[None, :] / dd[:, None] + np.asarray(model.accel_psd)[None, :] * white[:, None]
+    last = ks[start[-1]:]
+    lag = te[-1, -1] - np.sum(ww[start[-1]:] * 0.5 * (t[last] + t[last + 1]))
+    return a_g, R_sf, lag
 
 
 def _discrete_gravity_steps(model, gblk, gs, discrete, sf_interval, m, n_epochs: int):
