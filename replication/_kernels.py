@@ -97,7 +97,7 @@ def _cross(a, b, out):
 
 
 @njit(**_NJ)
-def _qmul(p, q, out):
+def qmul(p, q, out):
     a1, b1, c1, d1 = p[0], p[1], p[2], p[3]
     a2, b2, c2, d2 = q[0], q[1], q[2], q[3]
     out[0] = a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2
@@ -125,7 +125,7 @@ def _rv2q(x, y, z, out):
 
 
 @njit(inline="always", **_NJ)
-def _q2c(q, c):
+def q2c(q, c):
     a, b, cc, d = q[0], q[1], q[2], q[3]
     c[0, 0] = a * a + b * b - cc * cc - d * d
     c[0, 1] = 2 * (b * cc - a * d)
@@ -190,7 +190,7 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
     gam = (GAMMA_E * (1.0 + K_SOMIGLIANA * s2) * iw) * (
         1.0 - 2.0 / A * (1.0 + FLAT + M_RATIO - 2.0 * FLAT * s2) * hm + 3.0 * hm * hm / (A * A))
     # velocity: sculling + rotation compensation in b, then (I - ζ×/2) C_{k-1}
-    _q2c(q, c)
+    q2c(q, c)
     _cross(dth, dvv, tmp3a)
     sx = dvv[0] + 0.5 * tmp3a[0]
     sy = dvv[1] + 0.5 * tmp3a[1]
@@ -546,7 +546,7 @@ def _series_into(F, Qc, T, order, Phi, Qd, w1, w2, ptr, col, val):
 
 
 @njit(**_NJ)
-def _chol_scaled(P, d, Lc):
+def chol_scaled(P, d, Lc):
     """The standard deviations ``d`` of P and the Cholesky factor ``Lc`` of P scaled to a
     correlation matrix (P may span many decades): the factorization of :func:`_chol_solve_scaled`."""
     n = P.shape[0]
@@ -560,8 +560,8 @@ def _chol_scaled(P, d, Lc):
 
 
 @njit(**_NJ)
-def _solve_scaled(Lc, d, e):
-    """eᵀ P⁻¹ e from the factorization ``_chol_scaled`` of P."""
+def solve_scaled(Lc, d, e):
+    """eᵀ P⁻¹ e from the factorization ``chol_scaled`` of P."""
     n = Lc.shape[0]
     y = np.empty(n)
     for i in range(n):
@@ -581,14 +581,14 @@ def _chol_solve_scaled(P, e):
     n = P.shape[0]
     d = np.empty(n)
     Lc = np.empty((n, n))
-    _chol_scaled(P, d, Lc)
-    return _solve_scaled(Lc, d, e)
+    chol_scaled(P, d, Lc)
+    return solve_scaled(Lc, d, e)
 
 
 # ----------------------------------------------------------------------------- closed loop
 
 @njit(inline="always", **_NJ)
-def _apply_corrections(u, T, p_hat, blk_target, blk_kind, blk_start, blk_size, target, out, B):
+def apply_corrections(u, T, p_hat, blk_target, blk_kind, blk_start, blk_size, target, out, B):
     """out = u - Σ_blocks B(u) p̂ (bias-like blocks scaled by T for increments)."""
     out[0], out[1], out[2] = u[0], u[1], u[2]
     nav = 9
@@ -615,7 +615,7 @@ def _apply_corrections(u, T, p_hat, blk_target, blk_kind, blk_start, blk_size, t
 # feedback, resets.
 
 @njit(inline="always", **_NJ)
-def _accumulate_interval(c, fb, st, fsum, Csum, navsum):
+def accumulate_interval(c, fb, st, fsum, Csum, navsum):
     """Interval sums of the inputs of F at the start of an IMU step: f^n = C f^b, C_b^n and the
     navigation state (lat, h, vE, vN, vU)."""
     for i in range(3):
@@ -627,8 +627,8 @@ def _accumulate_interval(c, fb, st, fsum, Csum, navsum):
 
 
 @njit(inline="always", **_NJ)
-def _reset_interval(Cpl, fsum, Csum, navsum):
-    """Zero the interval sums of ``_accumulate_interval`` and the block couplings."""
+def reset_interval(Cpl, fsum, Csum, navsum):
+    """Zero the interval sums of ``accumulate_interval`` and the block couplings."""
     for i in range(6):
         for jj in range(Cpl.shape[1]):
             Cpl[i, jj] = 0.0
@@ -641,7 +641,7 @@ def _reset_interval(Cpl, fsum, Csum, navsum):
 
 
 @njit(inline="always", **_NJ)
-def _interval_discretize(F, qc_const, Cm, q_accel, q_gyro, T, order, Qc, Phi, Qd, w1, w2):
+def interval_discretize(F, qc_const, Cm, q_accel, q_gyro, T, order, Qc, Phi, Qd, w1, w2):
     """(Φ, Q_d) of one GNSS interval of length ``T``: Qc = ``qc_const`` plus the navigation white
     noise G diag(q) Gᵀ with G = [0; C; -C] (``Cm`` the interval-mean C_b^n, accelerometer and gyro
     PSDs ``q_accel``, ``q_gyro``), then the Van Loan series of ``discretize_series``."""
@@ -745,7 +745,7 @@ def accumulate_coupling(c, fb, wb, blk_target, blk_kind, blk_start, blk_size, we
 
 
 @njit(inline="always", **_NJ)
-def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp, nq):
+def feedback_nav(xk, st, st_prev, q, p_hat, qtmp, nq):
     """Feedback of the estimate ``xk``: δp, δv subtracted from ``st`` and ``st_prev``, the attitude
     corrected by q ← q(φ) ⊗ q (normalized), and p̂ += x̂[9:]."""
     n_aug = xk.shape[0] - 9
@@ -753,7 +753,7 @@ def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp, nq):
         st[i] -= xk[i]
         st_prev[i] -= xk[i]
     _rv2q(xk[6], xk[7], xk[8], qtmp)
-    _qmul(qtmp, q, nq)
+    qmul(qtmp, q, nq)
     nn = math.sqrt(nq[0] * nq[0] + nq[1] * nq[1] + nq[2] * nq[2] + nq[3] * nq[3])
     q[0], q[1], q[2], q[3] = nq[0] / nn, nq[1] / nn, nq[2] / nn, nq[3] / nn
     for i in range(n_aug):
@@ -761,7 +761,7 @@ def _feedback_nav(xk, st, st_prev, q, p_hat, qtmp, nq):
 
 
 @njit(inline="always", **_NJ)
-def _feedback_blocks(p_hat, blk_target, blk_start, blk_size, fconst, lever0, lever, g_extra):
+def feedback_blocks(p_hat, blk_target, blk_start, blk_size, fconst, lever0, lever, g_extra):
     """Apply the accumulated estimates p̂ of the lever-arm block (lever = lever0 + δl) and of the
     gravity block (ĝ^n = output rows of ``fconst``, velocity rows with sign -, into ``g_extra``)."""
     for b in range(blk_target.shape[0]):

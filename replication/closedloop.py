@@ -55,7 +55,7 @@ _MMAX = 9   # at most 9 measurement rows: position, velocity, specific force
 
 #: Configuration of the filter (numba-compatible bundle).  ``fconst``/``qc`` are the model's
 #: constant F and process-noise parts, ``tg/kd/bs/bz`` its block encoding
-#: (``ErrorModel._encoding``), ``dyn_rows`` the augmented states with
+#: (``ErrorModel.kernel_encoding``), ``dyn_rows`` the augmented states with
 #: dynamics, ``ar_T``/``ar_Q`` the discrete AR transition applied at ``ar_tick`` epochs,
 #: ``sf_H`` the gravity columns of the specific-force rows.
 Spec = namedtuple("Spec", ["fconst", "qc", "q_accel", "q_gyro", "tg", "kd", "bs", "bz", "order", "dyn_rows",
@@ -200,7 +200,7 @@ def _attitude_error(q, tq, e):
     """φ (e[6:9]) from Ĉ Cᵀ = exp(−φ×): the quaternion of q̂ ⊗ q_true*."""
     tc = np.array([tq[0], -tq[1], -tq[2], -tq[3]])
     r = np.empty(4)
-    K._qmul(q, tc, r)
+    K.qmul(q, tc, r)
     sg = 1.0 if r[0] >= 0 else -1.0
     e[6] = -2.0 * sg * r[1]
     e[7] = -2.0 * sg * r[2]
@@ -224,7 +224,7 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cp
     for i in range(3):
         for jj in range(3):
             Csum[i, jj] *= inv
-    K._interval_discretize(F, qc, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2)
+    K.interval_discretize(F, qc, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2)
     _row_nonzeros(Phi, nzc, nzv, cnt)
     _propagate_sparse(Phi, P, Qd, w1, w2, w3, nzc, nzv, cnt)
     if use_pbar:
@@ -287,10 +287,10 @@ def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_
         T = inp.dt[k]
         for i in range(3):
             u[i] = inp.dth[r, k, i]
-        K._apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 1, dth_c, B)
+        K.apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 1, dth_c, B)
         for i in range(3):
             u[i] = inp.dvv[r, k, i]
-        K._apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 0, dv_c, B)
+        K.apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 0, dv_c, B)
         if first and k == 0:
             for i in range(3):
                 dth_cp[i] = dth_c[i]
@@ -299,11 +299,11 @@ def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_
         in_win = inp.sf_win[k] >= 0
         if lead_acc:
             # inputs of F at the start of the step, summed over the GNSS interval
-            K._q2c(q, c)
+            K.q2c(q, c)
             for i in range(3):
                 fb[i] = dv_c[i] / T
                 wb[i] = dth_c[i] / T
-            K._accumulate_interval(c, fb, st, fsum, Csum, navsum)
+            K.accumulate_interval(c, fb, st, fsum, Csum, navsum)
             K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, 1.0, Cpl, B)
             if in_win:
                 for i in range(3):
@@ -438,7 +438,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                     out.rec_Pp[j] = lead.P
             # ---------------- measurement rows and gains (lead)
             if is_lead:
-                K._q2c(bs_.q[0], c)
+                K.q2c(bs_.q[0], c)
                 for i in range(_MMAX):
                     for jj in range(n):
                         H[i, jj] = 0.0
@@ -460,7 +460,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                 for a in range(m):
                     gains.H[j, a, :] = H[a]
                 if gains.nees_L.shape[0] > 0:
-                    K._chol_scaled(lead.P, gains.nees_sd[j], gains.nees_L[j])
+                    K.chol_scaled(lead.P, gains.nees_sd[j], gains.nees_L[j])
                 if sf >= 0:
                     lead.facc[:] = 0.0
                     lead.Cw[:, :] = 0.0
@@ -474,7 +474,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                 q_r = bs_.q[r]
                 ph_r = bs_.p_hat[r]
                 lev_r = bs_.lever[r]
-                K._q2c(q_r, c)
+                K.q2c(q_r, c)
                 wx, wy, wz = _body_rate(bs_.dth_cp[r], T, c, st_r, w_ie, w_en)
                 mr = _innovations(st_r, c, lev_r, wx, wy, wz, inp.gpos[r, j], inp.gvel[r, j],
                                   spec.use_pos, spec.use_vel, z)
@@ -497,8 +497,8 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                     out.innov[r, j, a] = z[a]
                 if record_x:
                     out.rec_x[r, j, :] = xk
-                K._feedback_nav(xk, st_r, bs_.st_prev[r], q_r, ph_r, qtmp, e)
-                K._feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, bs_.g_extra[r])
+                K.feedback_nav(xk, st_r, bs_.st_prev[r], q_r, ph_r, qtmp, e)
+                K.feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, bs_.g_extra[r])
                 for i in range(6):
                     out.st[r, j, i] = st_r[i]
                 for i in range(4):
@@ -511,7 +511,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                     _attitude_error(q_r, inp.truth_q[j], e)
                     for i in range(n_aug):
                         e[9 + i] = inp.truth_p[r, j, i] - ph_r[i]
-                    out.nees[r, j] = K._solve_scaled(gains.nees_L[j], gains.nees_sd[j], e)
+                    out.nees[r, j] = K.solve_scaled(gains.nees_L[j], gains.nees_sd[j], e)
             if is_lead:
                 for i in range(n):
                     out.pdiag[j, i] = lead.P[i, i]
@@ -522,7 +522,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                     out.P[f] = lead.P
                     if spec.use_pbar and out.Pbar.shape[0] > 0:
                         out.Pbar[f] = lead.Pbar
-            K._reset_interval(Cpl, fsum, Csum, navsum)
+            K.reset_interval(Cpl, fsum, Csum, navsum)
             sums[0] = 0.0
             sums[1] = 0.0
             j += 1
@@ -865,7 +865,7 @@ def build_spec(model: ErrorModel, *, R_pos, R_vel, lever_arm_b=(0.0, 0.0, 0.0), 
             raise ValueError(f"{name} must be a 3×3 diagonal matrix with positive variances (independent axes)")
     if int(series_order) < 1:
         raise ValueError("series_order must be at least 1")
-    fconst, qc, tg, kd, bs, bz = model._encoding()
+    fconst, qc, tg, kd, bs, bz = model.kernel_encoding()
     n = model.n
     dyn = np.array([i - 9 for i in range(9, n) if np.any(fconst[i, 9:] != 0)], dtype=np.int64)
     if ar is None:

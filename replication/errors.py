@@ -200,7 +200,17 @@ class ErrorModel:
         return replace(self, blocks=self.blocks + tuple(blocks))
 
     # -- constant parts and kernel encoding
-    def _encoding(self):
+    def kernel_encoding(self):
+        """The model as the compiled filters take it.
+
+        Returns
+        -------
+        fconst, qc : numpy.ndarray
+            The constant part of F (the blocks' dynamics and the gravity output rows) and the
+            process-noise PSD of the blocks (n × n each).
+        tg, kd, st, sz : numpy.ndarray
+            Per block: target and kind codes, first state and size (int64).
+        """
         n = self.n
         fconst = np.zeros((n, n))
         qc = np.zeros((n, n))
@@ -227,7 +237,7 @@ class ErrorModel:
     def F(self, point: NavPoint) -> np.ndarray:
         """Continuous error-state matrix at ``point`` (chen2019 eqs. (3-14)-(3-16))."""
         earth.check_latitude(point.lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
-        fconst, _, tg, kd, st, sz = self._encoding()
+        fconst, _, tg, kd, st, sz = self.kernel_encoding()
         F = np.zeros((self.n, self.n))
         v = np.asarray(point.v_enu, float)
         K.build_F(float(point.lat), float(point.h), v[0], v[1], v[2], np.ascontiguousarray(point.C_bn, float),
@@ -236,7 +246,7 @@ class ErrorModel:
 
     def G_Qc(self, C_bn) -> np.ndarray:
         """Continuous process-noise intensity G Q Gᵀ (n×n) for attitude C_b^n."""
-        _, qc, *_ = self._encoding()
+        _, qc, *_ = self.kernel_encoding()
         q = qc.copy()
         C = np.asarray(C_bn, float)
         q[3:6, 3:6] += C @ np.diag(self.accel_psd) @ C.T
@@ -269,7 +279,7 @@ class ErrorModel:
             return d
 
         J = np.zeros((n, n))
-        fconst, *_ = self._encoding()
+        fconst, *_ = self.kernel_encoding()
         B = np.empty((3, 6))
         slices = self.slices
         for j in range(n):
@@ -313,7 +323,7 @@ class ErrorModel:
         x = np.asarray(x0, float).copy()
         if x.shape != (self.n,):
             raise ValueError(f"x0 must have {self.n} components ({self.labels})")
-        fconst, _, tg, kd, st, sz = self._encoding()
+        fconst, _, tg, kd, st, sz = self.kernel_encoding()
         n = self.n
         idx = np.arange(0, traj.n + 1, step)
         out = np.empty((len(idx), n))

@@ -89,7 +89,7 @@ def test_interval_couplings_are_the_error_model_columns(kind):
         m = m.extend(*blocks)
     C = rotvec_to_dcm(np.array([0.1, -0.2, 0.9]))
     f_b, w_b = np.array([0.3, -0.4, 9.9]), np.array([0.02, -0.01, 0.1])
-    fconst, _, tg, kd, bs, bz = m._encoding()
+    fconst, _, tg, kd, bs, bz = m.kernel_encoding()
     Cpl = np.zeros((6, m.n))
     K.accumulate_coupling(C, f_b, w_b, tg, kd, bs, bz, 1.0, Cpl, np.empty((3, 6)))
     F = m.F(er.NavPoint(0.8, 2.0, 1000.0, np.array([50.0, 20.0, 0.0]), C, f_b, w_b))
