@@ -1,10 +1,14 @@
 """Benchmark the closed-loop filter, the current implementation beside an earlier one, in one run.
 
-    python scripts/benchmark_closed_loop.py [--before GIT_REF] [--repeats N] [--skip-rts]
+    python scripts/benchmark_closed_loop.py [--before GIT_REF] [--repeats N] [--processes P] [--skip-rts]
 
-Every workload runs through the public API, in a fresh process per implementation (the earlier
-one is the tree of ``GIT_REF``, exported with ``git archive``), after a warm-up call (numba
-compilation excluded); the best of ``--repeats`` wall times is kept with its CPU time.
+Every workload runs through the public API, in fresh processes (the earlier implementation is the
+tree of ``GIT_REF``, exported with ``git archive``), after a warm-up call (numba compilation
+excluded).  Each process keeps the best of ``--repeats`` wall times with its CPU time; ``--processes``
+processes per implementation, the implementations alternating, and the best of them is kept (a
+compiled loop's speed moves by several per cent from one process to the next with its memory
+layout; the best of several is the stable figure).  Without a target of its own, a workload is
+"met" when the current implementation is not slower than the earlier one.
 
 Workloads:
 
@@ -153,7 +157,8 @@ def _run(tree: Path, name: str, repeats: int) -> dict:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--before", default=None, help="git ref of the earlier implementation")
-    ap.add_argument("--repeats", type=int, default=2)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--processes", type=int, default=3, help="processes per implementation and workload")
     ap.add_argument("--skip-rts", action="store_true", help="leave out the 20-run RTS batch (the longest)")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "closed_loop.json"))
@@ -175,11 +180,21 @@ def main(argv=None):
         trees = {"before": (Path(tmp.name) / "before", args.before), **trees}
     res = {k: {} for k in trees}
     for name in names:
-        for k, (tree, _) in trees.items():
-            res[k][name] = _run(tree, name, 1 if name == "chen2019_45_20_runs_rts" else args.repeats)
-            print(f"{name:28s} {k:8s} {res[k][name]}", flush=True)
+        rts = name == "chen2019_45_20_runs_rts"
+        for _ in range(1 if rts else args.processes):
+            for k, (tree, _) in trees.items():
+                r = _run(tree, name, 1 if rts else args.repeats)
+                print(f"{name:28s} {k:8s} {r}", flush=True)
+                old = res[k].get(name)
+                if old is None or ("wall_s" in r and ("wall_s" not in old or r["wall_s"] < old["wall_s"])):
+                    res[k][name] = r
     met = {}
     cur = res["current"]
+    if "before" in res:
+        for name in names:
+            if name not in ("monte_carlo_20_hour", "chen2019_45_20_runs_rts") and "wall_s" in cur.get(name, {}) \
+                    and "wall_s" in res["before"].get(name, {}):
+                met[f"{name}_not_slower"] = cur[name]["wall_s"] <= res["before"][name]["wall_s"]
     if "wall_s" in cur.get("monte_carlo_20_hour", {}):
         met["monte_carlo_20_hour"] = cur["monte_carlo_20_hour"]["wall_s"] <= TARGETS["monte_carlo_20_hour_wall_s_max"]
     if "before" in res and "wall_s" in cur.get("chen2019_45_20_runs_rts", {}) and \
@@ -191,8 +206,9 @@ def main(argv=None):
                            "python": platform.python_version(),
                            **{p: metadata.version(p) for p in ("numpy", "numba", "scipy")}},
            "implementations": {k: v[1] for k, v in trees.items()}, "targets": TARGETS, "met": met,
-           "notes": "best wall time of --repeats calls after a warm-up (compilation excluded), CPU time of that "
-                    "call beside it; each implementation in its own process, one after the other",
+           "notes": f"best wall time over {args.processes} processes per implementation (alternating) of the best of "
+                    f"{args.repeats} calls after a warm-up (compilation excluded), CPU time of that call beside it; "
+                    "the 20-run batch with the smoother: one process, one call",
            "timings": res}
     Path(args.out).write_text(json.dumps(doc, indent=2, sort_keys=True) + "\n")
     if tmp is not None:
