@@ -449,20 +449,37 @@ def build_F_core(lat, h, ve, vn, vu, fn0, fn1, fn2, fconst, F):
 
 # ----------------------------------------------------------------------------- dense helpers
 
-@njit(inline="always", **_NJ)
-def _csr(a, ptr, col, val):
-    """The non-zeros of ``a`` row by row, columns ascending (compressed sparse rows)."""
+@njit(**_NJ)
+def row_nonzeros(a, nzc, nzv, cnt):
+    """The non-zeros of ``a`` by row: column indices ``nzc[i, :cnt[i]]`` (ascending) and values
+    ``nzv[i, :cnt[i]]``."""
     n, m = a.shape
-    c = 0
     for i in range(n):
-        ptr[i] = c
+        c = 0
         for k in range(m):
             v = a[i, k]
             if v != 0.0:
-                col[c] = k
-                val[c] = v
+                nzc[i, c] = k
+                nzv[i, c] = v
                 c += 1
-    ptr[n] = c
+        cnt[i] = c
+
+
+@njit(**_NJ)
+def sparse_times(nzc, nzv, cnt, b, out):
+    """out = A b for A given by its non-zeros by row (:func:`row_nonzeros`): row i of out is
+    Σ_t nzv[i, t] b[nzc[i, t], :] over ascending columns, the order of the dense product.  The
+    terms left out are exact zeros, which leave a sum that starts at +0.0 unchanged: the result
+    is the dense product's bit for bit (the inner loops run over contiguous rows of b)."""
+    n, p = out.shape
+    for i in range(n):
+        for j in range(p):
+            out[i, j] = 0.0
+        for t in range(cnt[i]):
+            k = nzc[i, t]
+            v = nzv[i, t]
+            for j in range(p):
+                out[i, j] += v * b[k, j]
 
 
 @njit(**_NJ)
@@ -475,34 +492,16 @@ def discretize_series(F, Qc, T, order, Phi, Qd, w1, w2):
     zeros, so the arithmetic is that of the dense products, bit for bit.
     """
     n = F.shape[0]
-    ptr = np.empty(n + 1, np.int64)
-    col = np.empty(n * n, np.int64)
-    val = np.empty(n * n)
-    _series_into(F, Qc, T, order, Phi, Qd, w1, w2, ptr, col, val)
+    discretize_series_into(F, Qc, T, order, Phi, Qd, w1, w2, np.empty((n, n), np.int64), np.empty((n, n)),
+                           np.empty(n, np.int64))
 
 
 @njit(**_NJ)
-def _csr_matmul(ptr, col, val, b, out):
-    """out = A @ b for A in compressed rows: out[i] = Σ_t val[t] b[col[t], :] over ascending
-    columns, the order of the dense product (the terms left out are exact zeros, which leave a
-    sum that starts at +0.0 unchanged: the dense product's result bit for bit)."""
-    n, p = out.shape
-    for i in range(n):
-        for j in range(p):
-            out[i, j] = 0.0
-        for t in range(ptr[i], ptr[i + 1]):
-            k = col[t]
-            aik = val[t]
-            for j in range(p):
-                out[i, j] += aik * b[k, j]
-
-
-@njit(**_NJ)
-def _series_into(F, Qc, T, order, Phi, Qd, w1, w2, ptr, col, val):
-    """``discretize_series`` with its scratch passed in (the closed-loop filter calls it every
-    GNSS epoch): ``ptr``, ``col``, ``val`` receive the compressed rows of F."""
+def discretize_series_into(F, Qc, T, order, Phi, Qd, w1, w2, nzc, nzv, cnt):
+    """:func:`discretize_series` with its scratch passed in (the closed-loop filter calls it every
+    GNSS epoch): ``nzc``, ``nzv``, ``cnt`` receive the non-zeros of F (:func:`row_nonzeros`)."""
     n = F.shape[0]
-    _csr(F, ptr, col, val)
+    row_nonzeros(F, nzc, nzv, cnt)
     # Φ: running term w1 = (F T)^k / k!; the first term F·I / 1 is F T
     t1 = T if order >= 1 else 0.0
     for i in range(n):
@@ -511,21 +510,13 @@ def _series_into(F, Qc, T, order, Phi, Qd, w1, w2, ptr, col, val):
             w1[i, j] = v
             Phi[i, j] = (1.0 if i == j else 0.0) + v
     for k in range(2, order + 1):
-        # row i of the next term, (F w1)[i] T / k, built in w2; then w1 <-> w2
+        sparse_times(nzc, nzv, cnt, w1, w2)
         fac = T / k
         for i in range(n):
             for j in range(n):
-                w2[i, j] = 0.0
-            for t in range(ptr[i], ptr[i + 1]):
-                kk = col[t]
-                a = val[t]
-                for j in range(n):
-                    w2[i, j] += a * w1[kk, j]
-            for j in range(n):
                 v = w2[i, j] * fac
-                w2[i, j] = v
+                w1[i, j] = v
                 Phi[i, j] += v
-        w1, w2 = w2, w1
     # Q_d: running term w1 = M_k
     for i in range(n):
         for j in range(n):
@@ -533,7 +524,7 @@ def _series_into(F, Qc, T, order, Phi, Qd, w1, w2, ptr, col, val):
             Qd[i, j] = Qc[i, j] * T
     coef = T
     for k in range(1, order + 1):
-        _csr_matmul(ptr, col, val, w1, w2)
+        sparse_times(nzc, nzv, cnt, w1, w2)
         coef = coef * T / (k + 1)
         for i in range(n):
             for j in range(i, n):
@@ -641,10 +632,11 @@ def reset_interval(Cpl, fsum, Csum, navsum):
 
 
 @njit(inline="always", **_NJ)
-def interval_discretize(F, qc_const, Cm, q_accel, q_gyro, T, order, Qc, Phi, Qd, w1, w2):
+def interval_discretize(F, qc_const, Cm, q_accel, q_gyro, T, order, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt):
     """(Φ, Q_d) of one GNSS interval of length ``T``: Qc = ``qc_const`` plus the navigation white
     noise G diag(q) Gᵀ with G = [0; C; -C] (``Cm`` the interval-mean C_b^n, accelerometer and gyro
-    PSDs ``q_accel``, ``q_gyro``), then the Van Loan series of ``discretize_series``."""
+    PSDs ``q_accel``, ``q_gyro``), then the Van Loan series of :func:`discretize_series_into`
+    (scratch ``nzc``, ``nzv``, ``cnt``)."""
     n = Qc.shape[0]
     for i in range(n):
         for jj in range(n):
@@ -658,7 +650,7 @@ def interval_discretize(F, qc_const, Cm, q_accel, q_gyro, T, order, Qc, Phi, Qd,
                 sg += Cm[i, m] * q_gyro[m] * Cm[jj, m]
             Qc[3 + i, 3 + jj] += sa
             Qc[6 + i, 6 + jj] += sg
-    discretize_series(F, Qc, T, order, Phi, Qd, w1, w2)
+    discretize_series_into(F, Qc, T, order, Phi, Qd, w1, w2, nzc, nzv, cnt)
 
 
 @njit(**_NJ)

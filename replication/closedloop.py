@@ -90,46 +90,17 @@ ChunkOut = namedtuple("ChunkOut", ["st", "q", "phat", "nis", "innov", "nees", "n
 # ----------------------------------------------------------------------------- compiled pieces
 
 @njit(inline="always", **_NJ)
-def _row_nonzeros(Phi, nzc, nzv, cnt):
-    """The non-zeros of Φ by row: column indices ``nzc[i, :cnt[i]]`` (ascending), values ``nzv``."""
-    n = Phi.shape[0]
-    for i in range(n):
-        c = 0
-        for k in range(n):
-            v = Phi[i, k]
-            if v != 0.0:
-                nzc[i, c] = k
-                nzv[i, c] = v
-                c += 1
-        cnt[i] = c
-
-
-@njit(inline="always", **_NJ)
 def _propagate_sparse(Phi, P, Qd, W, Wt, U, nzc, nzv, cnt):
     """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (``nzc``, ``nzv``, ``cnt`` of
-    :func:`_row_nonzeros`; Φ of an INS error model is sparse).  W = Φ P and U = Φ Wᵀ are built row
-    by row (contiguous inner loops); each element sums the same products in the same order as
-    Σ_k W[i, k] Φ[j, k] over Φ's non-zeros, ascending k."""
+    ``replication._kernels.row_nonzeros``; Φ of an INS error model is sparse): W = Φ P, then
+    U = Φ Wᵀ, whose element (j, i) sums the products W[i, k] Φ[j, k] over Φ's non-zeros in
+    ascending k, and P[i, j] = U[j, i] + Q_d (symmetrized)."""
     n = P.shape[0]
-    for i in range(n):
-        for j in range(n):
-            W[i, j] = 0.0
-        for t in range(cnt[i]):
-            k = nzc[i, t]
-            v = nzv[i, t]
-            for j in range(n):
-                W[i, j] += v * P[k, j]
+    K.sparse_times(nzc, nzv, cnt, P, W)
     for i in range(n):
         for j in range(n):
             Wt[j, i] = W[i, j]
-    for j in range(n):
-        for i in range(n):
-            U[j, i] = 0.0
-        for t in range(cnt[j]):
-            k = nzc[j, t]
-            v = nzv[j, t]
-            for i in range(n):
-                U[j, i] += v * Wt[k, i]
+    K.sparse_times(nzc, nzv, cnt, Wt, U)
     for i in range(n):
         for j in range(i, n):
             v = U[j, i] + 0.5 * (Qd[i, j] + Qd[j, i])
@@ -224,8 +195,8 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cp
     for i in range(3):
         for jj in range(3):
             Csum[i, jj] *= inv
-    K.interval_discretize(F, qc, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2)
-    _row_nonzeros(Phi, nzc, nzv, cnt)
+    K.interval_discretize(F, qc, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt)
+    K.row_nonzeros(Phi, nzc, nzv, cnt)
     _propagate_sparse(Phi, P, Qd, w1, w2, w3, nzc, nzv, cnt)
     if use_pbar:
         _propagate_sparse(Phi, Pbar, Qd, w1, w2, w3, nzc, nzv, cnt)
@@ -620,7 +591,7 @@ def _nonzeros(Phi, nzc, nzv, cnt, rzc, rzv, rcnt):
     """The non-zeros of Φ by column (row indices ``nzc[i, :cnt[i]]``, values ``nzv``) and by row
     (column indices ``rzc[k, :rcnt[k]]``, values ``rzv``)."""
     n = Phi.shape[0]
-    _row_nonzeros(Phi, rzc, rzv, rcnt)
+    K.row_nonzeros(Phi, rzc, rzv, rcnt)
     for i in range(n):
         cnt[i] = 0
     for k in range(n):
@@ -639,14 +610,7 @@ def _congruence_transposed(Phi, L, W, row, nzc, nzv, cnt, rzc, rzv, rcnt):
     row (row i: Σ_k Φ_ki L[k, :]), then row i of W Φ as Σ_k W[i, k] Φ[k, :] (a dense row of Φ
     whole, a sparse one by its non-zeros); the upper triangle is kept and mirrored."""
     n = L.shape[0]
-    for i in range(n):
-        for j in range(n):
-            W[i, j] = 0.0
-        for t in range(cnt[i]):
-            k = nzc[i, t]
-            v = nzv[i, t]
-            for j in range(n):
-                W[i, j] += v * L[k, j]
+    K.sparse_times(nzc, nzv, cnt, L, W)
     dense = n // 4
     for i in range(n):
         for j in range(n):
