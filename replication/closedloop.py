@@ -378,7 +378,8 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
             # ---------------- time update (lead)
             if is_lead:
                 _lead_time_update(spec.fconst, spec.qc, spec.q_accel, spec.q_gyro, spec.order, navsum, fsum, Csum, Cpl,
-                                  nsum, tsum, F, Qc, Phi, Qd, w1, w2, w3, nzc, nzv, cnt, lead.P, lead.Pbar, spec.use_pbar)
+                                  nsum, tsum, F, Qc, Phi, Qd, w1, w2, w3, nzc, nzv, cnt, lead.P, lead.Pbar,
+                                  spec.use_pbar)
                 for t in range(n_dyn):
                     for jj in range(n_aug):
                         gains.Phid[j, t, jj] = Phi[9 + spec.dyn_rows[t], 9 + jj]

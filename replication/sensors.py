@@ -37,7 +37,8 @@ from scipy.signal import lfilter
 from .strapdown import validate_increments, validate_time
 
 __all__ = ["TriadErrors", "ImuErrors", "misalignment_matrix", "apply_imu_errors", "draw_imu_errors",
-           "markov_sigma_from_driving_psd", "gauss_markov_coefficients", "gauss_markov_recursion", "GnssMeasurements", "gnss_measurements", "barometric_height",
+           "markov_sigma_from_driving_psd", "gauss_markov_coefficients", "gauss_markov_recursion",
+           "GnssMeasurements", "gnss_measurements", "barometric_height",
            "lever_arm_offset"]
 
 
