@@ -318,11 +318,24 @@ class ErrorModel:
         return J
 
     def propagate_linear(self, traj, x0, *, step: int = 10, order: int = 6):
-        """Propagate δx along a trajectory with the linear model: δx_{j+1} = Φ_j δx_j,
-        Φ_j = exp(F(t_mid) T) over ``step`` samples.  Returns (sample indices, δx (m, n))."""
+        """Propagate δx along a trajectory with the linear model δẋ = F(t) δx (chen2019 eqs. (3-14)-(3-16)):
+        δx_{j+1} = Φ_j δx_j, Φ_j = exp(F̄_j T_j) over intervals of ``step`` samples, T_j their
+        duration and F̄_j the mean of F over the interval by Simpson's rule,
+        F̄ = [F(t_0) + 4 F(t_½) + F(t_1)] / 6.  For an even ``step`` t_½ is a sample; for an odd
+        one F(t_½) is the mean of the two samples around the midpoint (linear interpolation, exact
+        for F linear in time), which for ``step=1`` reduces Simpson's rule to the trapezoid
+        [F(t_0) + F(t_1)] / 2.  Φ_j by the truncated series of ``order`` terms.
+
+        Parameters: ``traj`` a trajectory (``trajectory.generate``); ``x0`` the initial error
+        state (``self.n`` components, in ``self.labels`` order); ``step`` a positive integer number
+        of samples per interval (an incomplete last interval is dropped).
+        Returns (sample indices, δx (m, n))."""
         x = np.asarray(x0, float).copy()
         if x.shape != (self.n,):
             raise ValueError(f"x0 must have {self.n} components ({self.labels})")
+        if isinstance(step, bool) or int(step) != step or step < 1:
+            raise ValueError(f"step must be a positive integer number of samples per interval, got {step!r}")
+        step = int(step)
         fconst, _, tg, kd, st, sz = self.kernel_encoding()
         n = self.n
         idx = np.arange(0, traj.n + 1, step)
@@ -332,14 +345,21 @@ class ErrorModel:
         Phi, Qd, w1, w2 = (np.empty((n, n)) for _ in range(4))
         Z = np.zeros((n, n))
         C_all = euler_to_dcm(traj.hpr[:, 0], traj.hpr[:, 1], traj.hpr[:, 2])
+
+        def build(k):
+            K.build_F(traj.lat[k], traj.h[k], traj.v_enu[k, 0], traj.v_enu[k, 1], traj.v_enu[k, 2],
+                      np.ascontiguousarray(C_all[k]), traj.f_b[k], traj.w_ib_b[k], fconst, tg, kd, st, sz, F)
+            return F.copy()
+
         for j in range(1, len(idx)):
             k0, k1 = idx[j - 1], idx[j]
-            # average F over the interval (trapezoid of the sample values)
+            km = (k0 + k1) // 2
+            # Simpson mean of F over the interval; an odd step interpolates F at the midpoint
+            F_mid = build(km) if step % 2 == 0 else 0.5 * (build(km) + build(km + 1))
             Fa = np.zeros((n, n))
-            for k in (k0, (k0 + k1) // 2, k1):
-                K.build_F(traj.lat[k], traj.h[k], traj.v_enu[k, 0], traj.v_enu[k, 1], traj.v_enu[k, 2],
-                          np.ascontiguousarray(C_all[k]), traj.f_b[k], traj.w_ib_b[k], fconst, tg, kd, st, sz, F)
-                Fa += F * (4.0 if k == (k0 + k1) // 2 else 1.0)
+            Fa += build(k0)
+            Fa += F_mid * 4.0
+            Fa += build(k1)
             Fa /= 6.0
             K.discretize_series(Fa, Z, traj.t[k1] - traj.t[k0], order, Phi, Qd, w1, w2)
             x = Phi @ x
