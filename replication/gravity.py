@@ -22,6 +22,7 @@ disturbance of geodesy (a stronger downward pull gives a negative up component).
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,6 +54,7 @@ __all__ = [
     "augment_transition", "specific_force_measurement", "gauss_markov", "analog_direct_difference",
     "survey_flight", "local_east_north", "disturbed_increments", "direct_difference_from_filter",
     "compensated_increments", "attitude_position_errors", "photo_epochs", "compensation_run", "compensation_first_pass",
+    "compensation_runs",
     "consistent_kinematics", "ar_continuous", "ar_gravity_block", "slope_weights", "augmented_filter",
 ]
 
@@ -732,6 +734,26 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
     out["ar"] = ar
     out["dd"] = dict(t=gnss.t, measured=dd, true=dg[gnss.index])
     return out
+
+
+def compensation_runs(traj, fields, seeds, *, workers: int = 2, **kw) -> list:
+    """:func:`compensation_run` for each (field, seed) pair, ``workers`` runs at a time on threads.
+
+    The Monte Carlo of the Table 4-50 analog (chen2019 §4.3): every run is independent
+    (its own truth, sensor errors and filters; the compiled filter releases the GIL), so the
+    result is the list of the sequential calls whatever ``workers``.  ``kw`` goes to
+    :func:`compensation_run` (not ``first_pass``: each run makes its own and drops it, which keeps
+    the memory to ``workers`` runs).
+    """
+    fields, seeds = list(fields), [int(s) for s in seeds]
+    if len(fields) != len(seeds):
+        raise ValueError(f"fields and seeds must pair up (got {len(fields)} fields and {len(seeds)} seeds)")
+    if int(workers) != workers or workers < 1:
+        raise ValueError("workers must be a positive integer (threads running runs at once)")
+    if "first_pass" in kw:
+        raise ValueError("compensation_runs makes each run's first pass itself; drop first_pass")
+    with ThreadPoolExecutor(max_workers=int(workers)) as ex:
+        return list(ex.map(lambda fs: compensation_run(traj, fs[0], seed=fs[1], **kw), zip(fields, seeds)))
 
 
 def consistent_kinematics(n: int, rng: np.random.Generator, *, lat=math.radians(40.0), h=500.0, speed=30.0,

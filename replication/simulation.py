@@ -70,7 +70,8 @@ __all__ = ["SimulationSetup", "table_4_41_setup", "MISALIGNMENT_UNITS", "MARKOV_
            "simulated_flight", "segment_summary", "filter_model", "BatchResult", "run_batch",
            "truth_parameters", "observable_nees", "fraction_in_band", "attitude_errors",
            "segment_mask", "survey_line_mask", "rms_with_ci", "improvement_percent",
-           "improvement_with_ci", "paired_improvement", "single_flight_interval", "printed_improvements",
+           "improvement_with_ci", "paired_improvement", "single_flight_interval", "runs_for_half_width", "rms_and_sd",
+           "printed_improvements",
            "total_bias_estimates", "FIGURE_4_14_QUANTITIES", "figure_4_14_estimates", "figure_4_14_ledger",
            "figure_4_14_retained_sigma", "display_scales"]
 
@@ -778,6 +779,36 @@ def paired_improvement(per_other, per_new, prob: float = 0.95):
         return d, mean, mean * np.nan, mean * np.nan
     half = stats.t.ppf(0.5 + prob / 2, d.shape[0] - 1) * d.std(0, ddof=1) / math.sqrt(d.shape[0])
     return d, mean, mean - half, mean + half
+
+
+def runs_for_half_width(sd, target, prob: float = 0.95, n_min: int = 2) -> int:
+    """Smallest number of runs n whose two-sided ``prob`` Student-t half-width of a mean,
+    t_{(1+prob)/2, n-1} sd / sqrt(n), is below ``target`` for a per-run standard deviation ``sd``
+    (the pilot runs' spread; array-like: the largest ratio sd/target decides).  Returns n >= ``n_min``."""
+    s = np.atleast_1d(np.asarray(sd, float))
+    g = np.broadcast_to(np.atleast_1d(np.asarray(target, float)), s.shape)
+    if np.any(~np.isfinite(s)) or np.any(s < 0):
+        raise ValueError("sd must be finite and non-negative (the per-run standard deviations)")
+    if np.any(~np.isfinite(g)) or np.any(g <= 0):
+        raise ValueError("target must be finite and positive (the half-width to get under)")
+    if not 0 < prob < 1:
+        raise ValueError("prob must lie in (0, 1)")
+    if int(n_min) != n_min or n_min < 2:
+        raise ValueError("n_min must be an integer of at least 2 (an interval needs two runs)")
+    r = float(np.max(s / g))
+    n = int(n_min)
+    while stats.t.ppf(0.5 + prob / 2, n - 1) * r / math.sqrt(n) >= 1.0:
+        n += 1
+    return n
+
+
+def rms_and_sd(err, axis: int = -1):
+    """Raw RMS sqrt(mean(e^2)) and offset-removed RMS (the standard deviation about the run's mean
+    error, sqrt(mean((e - mean e)^2))) of errors ``err`` along ``axis``; RMS^2 = mean^2 + SD^2."""
+    e = np.asarray(err, float)
+    if e.size == 0 or not np.all(np.isfinite(e)):
+        raise ValueError("err must be a non-empty array of finite errors")
+    return np.sqrt(np.mean(e ** 2, axis=axis)), np.std(e, axis=axis)
 
 
 def single_flight_interval(per_other, per_new, prob: float = 0.95):

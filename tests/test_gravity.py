@@ -428,3 +428,31 @@ def test_augmented_filter_equals_the_core_filter_for_every_block_kind(noisy_line
     np.testing.assert_allclose(sol.lat, ref.lat, rtol=0, atol=1e-13)
     np.testing.assert_allclose(sol.v_enu, ref.v_enu, rtol=0, atol=1e-9)
     np.testing.assert_allclose(sol.q_bn, ref.q_bn, rtol=0, atol=1e-11)
+
+
+def test_compensation_runs_equal_the_sequential_runs_whatever_the_threads():
+    """compensation_runs maps compensation_run over (field, seed); threads change nothing (exact:
+    every run is independent and deterministic)."""
+    from replication.units import DEG, DEG_PER_H
+
+    origin = (math.radians(30.0), math.radians(110.0), 500.0)
+    tr = gr.survey_flight(n_lines=2, duration=2400.0, turn_duration=60.0, speed=30.0, lat0=origin[0], lon0=origin[1],
+                          h0=origin[2], dt=0.01)
+    kw = dict(origin=origin, offset=(20e3, 20e3), photos=gr.photo_epochs(tr, 20),
+              imu=dict(accel_bias_sd=50 * MICRO_G, gyro_bias_sd=0.01 * DEG_PER_H, accel_psd=(10 * MICRO_G) ** 2,
+                       gyro_psd=(0.003 * DEG / 60) ** 2),
+              gnss_kw=dict(rate_hz=10, sigma_pos=0.1, sigma_vel=0.03),
+              model_kw=dict(position_sd=0.1, velocity_sd=0.03, attitude_sd=(1e-4, 1e-4, 5e-4)), cutoff_period=100.0)
+    seeds = [11, 12]
+    fields = [gr.synthetic_field(100e3, 60e3, 250.0, sigma=30 * MGAL, correlation_length=10e3, altitude=500.0, seed=s)
+              for s in seeds]
+    one = gr.compensation_runs(tr, fields, seeds, workers=1, **kw)
+    two = gr.compensation_runs(tr, fields, seeds, workers=2, **kw)
+    ref = gr.compensation_run(tr, fields[1], seed=seeds[1], **kw)
+    for m in ("normal", "direct", "state"):
+        for c in ("pitch", "height"):
+            assert np.array_equal(one[1][m][c], ref[m][c]) and np.array_equal(two[1][m][c], ref[m][c])
+            assert np.array_equal(one[0][m][c], two[0][m][c])
+    assert not np.array_equal(one[0]["state"]["pitch"], one[1]["state"]["pitch"])  # two different runs
+    with pytest.raises(ValueError, match="pair up"):
+        gr.compensation_runs(tr, fields, seeds[:1], **kw)

@@ -285,3 +285,26 @@ def test_run_batch_validates_inputs(short_flight, t441):
         sim.run_batch(short_flight, s, m, n_runs=0)
     with pytest.raises(ValueError, match="IMU rate"):
         sim.run_batch(short_flight, sim.table_4_41_setup(t441, imu_rate_hz=200.0, gnss_rate_hz=20.0), m)
+
+
+def test_runs_for_half_width_meets_target_and_is_smallest():
+    from scipy import stats as st
+    from replication.simulation import runs_for_half_width
+    sd, target = 1.6e-3, 2.8e-3 / 3
+    n = runs_for_half_width(sd, target)
+    hw = lambda k: st.t.ppf(0.975, k - 1) * sd / np.sqrt(k)
+    assert hw(n) < target <= hw(n - 1)          # smallest n under the target
+    assert runs_for_half_width([sd, sd / 10], [target, target]) == n   # the largest ratio decides
+    with pytest.raises(ValueError, match="target"):
+        runs_for_half_width(sd, 0.0)
+
+
+def test_rms_and_sd_split_offset():
+    from replication.simulation import rms_and_sd
+    e = np.array([[1.0, 3.0], [2.0, 2.0]])
+    rms, sd = rms_and_sd(e)
+    assert np.allclose(rms, [np.sqrt(5.0), 2.0], rtol=1e-15, atol=0)   # exact up to rounding
+    assert np.allclose(sd, [1.0, 0.0], rtol=0, atol=1e-15)
+    assert np.allclose(rms ** 2, e.mean(-1) ** 2 + sd ** 2, rtol=1e-14, atol=0)
+    with pytest.raises(ValueError, match="err"):
+        rms_and_sd([])
