@@ -9,10 +9,21 @@ from . import reproduction as rp
 
 
 def _cmd_status(args) -> int:
-    status, errata = rp.build_index(write=args.write)
+    status, register = rp.build_index(write=args.write)
     if args.source:
         status = status[status["source"] == args.source]
-        errata = errata[errata["source"] == args.source]
+        register = register[register["source"] == args.source]
+    fail = rp.failing_artifacts(status)
+    if len(fail):
+        n = int(fail["not_reproduced"].sum())
+        print(f"== not reproduced: {len(fail)} paper artifacts hold {n} not-reproduced rows")
+        for _, r in fail.iterrows():
+            print(f"{r['id']}  {r['label']}\n    {r['reason']}\n    tables: {r['tables']}")
+        print()
+    elif args.failing:
+        print("no paper artifact holds a not-reproduced row")
+    if args.failing:
+        return 0
     width = max(len(i) for i in status["id"]) if len(status) else 10
     for kind, title in (("paper", "artifacts of the four documents"), ("supplementary", "supplementary checks")):
         part = status[status["kind"] == kind]
@@ -25,7 +36,9 @@ def _cmd_status(args) -> int:
         print()
     for line in rp.status_tally(status).values():
         print(line)
-    print(f"errata proven{' in ' + args.source if args.source else ''}: {len(errata)}")
+    kinds = register["kind"].value_counts()
+    print(f"register{' of ' + args.source if args.source else ''}: {int(kinds.get('erratum', 0))} errata, "
+          f"{int(kinds.get('inconsistent', 0))} inconsistencies (tables/register.csv)")
     return 0
 
 
@@ -46,8 +59,9 @@ def _cmd_cite(args) -> int:
 
 
 def _cmd_index(args) -> int:
-    status, errata = rp.build_index(write=True)
-    print(f"wrote tables/status.csv ({len(status)} artifacts) and tables/errata.csv ({len(errata)} errata)")
+    status, register = rp.build_index(write=True)
+    print(f"wrote tables/status.csv ({len(status)} artifacts) and tables/register.csv ({len(register)} errata and "
+          "inconsistencies)")
     return 0
 
 
@@ -56,7 +70,9 @@ def main(argv: list[str] | None = None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("status", help="the reproduction dashboard: one line per seed artifact")
     p.add_argument("--source", choices=rp.SOURCE_KEYS + ("toolkit",), help="only one source document")
-    p.add_argument("--write", action="store_true", help="also rewrite tables/status.csv and errata.csv")
+    p.add_argument("--write", action="store_true", help="also rewrite tables/status.csv and register.csv")
+    p.add_argument("--failing", action="store_true",
+                   help="only the paper artifacts holding not-reproduced rows, each with its reason")
     p.set_defaults(func=_cmd_status)
     p = sub.add_parser("show", help="print one exported table")
     p.add_argument("id", help="table id, e.g. chen2019-eq-3-1")
@@ -65,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("cite", help="a BibTeX entry for one exported table")
     p.add_argument("id")
     p.set_defaults(func=_cmd_cite)
-    p = sub.add_parser("index", help="rebuild tables/status.csv and tables/errata.csv")
+    p = sub.add_parser("index", help="check the verdict rule, rebuild tables/status.csv and tables/register.csv")
     p.set_defaults(func=_cmd_index)
     args = parser.parse_args(argv)
     try:

@@ -8,8 +8,11 @@ This module is the one way a chapter records a result.
 * A chapter compares its computed values with the paper's through :func:`compare`, which writes
   ``tables/<id>.csv`` (long format), ``.md``, ``.tex`` and a ``.json`` sidecar.
 * :func:`build_index` aggregates every exported table into ``tables/status.csv`` (one row per
-  reproducible artifact listed in ``data/artifacts.csv``) and ``tables/errata.csv`` (every row
-  whose status is ``erratum``).
+  reproducible artifact listed in ``data/artifacts.csv``) and ``tables/register.csv`` (every row
+  whose status is ``erratum`` or ``inconsistent``, with its ``kind``), after checking the verdict
+  rule (:func:`verdict_violations`): no ``not-reproduced`` or ``erratum`` row that a reading of its
+  table's readings ledger reproduces, unless the table names the printed evidence that rules that
+  reading out.
 
 Status vocabulary (:data:`STATUSES`):
 
@@ -501,7 +504,8 @@ def display_cell(row: Mapping[str, Any], column: str) -> str:
 
 SIDECAR_IDENTITY = (
     "id", "title", "description", "source", "notebook", "notebook_digest", "paper_source", "paper_digest",
-    "table_digest", "seeds", "status_counts", "generated_by",
+    "table_digest", "seeds", "status_counts", "generated_by", "main_reading", "main_reading_evidence",
+    "readings", "ruled_out", "summary",
 )
 """Sidecar fields that identify a table and its inputs; when all are unchanged on a rerun the
 stored sidecar (commit, versions) is kept."""
@@ -669,6 +673,11 @@ def compare(
     seeds: Mapping[str, int] | None = None,
     paper_source: str | None = None,
     description: str = "",
+    main_reading: str = "",
+    reading_evidence: str = "",
+    readings: Sequence[str] | None = None,
+    ruled_out: Mapping[str, str] | None = None,
+    summary: str = "",
 ) -> pd.DataFrame:
     """Compare reproduced with paper values and export ``tables/<table_id>.*``.
 
@@ -678,11 +687,34 @@ def compare(
     the one named like ``table_id`` when it exists).  Writes ``.csv`` (long format), ``.md``,
     ``.tex`` and a ``.json`` sidecar; returns the comparison table.
 
+    The verdict layer (CONTRIBUTING.md, "Readings and the main reading"): where the text leaves
+    a choice open or two printed parts disagree, ``main_reading`` names the reading the table
+    follows and ``reading_evidence`` says, in one sentence, which printed numbers support it;
+    ``readings`` names the readings ledgers (default: ``<key>-check-<rest>-readings`` when it is
+    exported, see :func:`readings_ledgers`); ``ruled_out`` maps a reading of a ledger (or the
+    prefix shared by several) to the printed evidence that excludes it — the only way a
+    ``not-reproduced`` or ``erratum`` row may stand beside a reading that reproduces it
+    (:func:`verdict_violations`).  ``summary`` is the table's verdict in one line, quoted by the
+    roll-ups (:func:`failing_artifacts`).  All five are stored in the sidecar when given.
+
     Writing is idempotent: when the table and its inputs are unchanged the files are not
     touched, so re-running a chapter leaves ``git status`` clean.  The sidecar's ``git_commit`` is
     the commit on top of which the values were last (re)computed.
     """
     validate_id(table_id)
+    if bool(main_reading) != bool(reading_evidence):
+        raise RegistryError(f"{table_id}: give main_reading and reading_evidence together (the reading and the "
+                            "printed numbers that support it)")
+    for name, text in (("main_reading", main_reading), ("reading_evidence", reading_evidence), ("summary", summary)):
+        if not isinstance(text, str):
+            raise RegistryError(f"{table_id}: {name} must be a string, not {type(text).__name__}")
+    ledgers = [] if readings is None else [validate_id(t) for t in ([readings] if isinstance(readings, str) else readings)]
+    ruled = {}
+    for k, v in dict(ruled_out or {}).items():
+        if not (isinstance(k, str) and k.strip() and isinstance(v, str) and v.strip()):
+            raise RegistryError(f"{table_id}: ruled_out maps a reading to the printed evidence excluding it "
+                                f"(two non-empty strings), not {k!r}: {v!r}")
+        ruled[k] = v
     if isinstance(rows, pd.DataFrame):
         rows = rows.to_dict("records")
     df = comparison_frame(rows)
@@ -717,6 +749,10 @@ def compare(
         "status_counts": counts,
         "generated_by": "replication.reproduction.compare",
     }
+    for key, value in (("main_reading", main_reading), ("main_reading_evidence", reading_evidence),
+                       ("readings", ledgers), ("ruled_out", ruled), ("summary", summary)):
+        if value:
+            sidecar[key] = value
     json_path = out_dir / f"{table_id}.json"
     old = None
     if json_path.exists():
@@ -725,7 +761,7 @@ def compare(
         except ValueError:
             old = None
     same = (old is not None and (out_dir / f"{table_id}.csv").exists()
-            and all(old.get(k) == sidecar[k] for k in SIDECAR_IDENTITY))
+            and all(old.get(k) == sidecar.get(k) for k in SIDECAR_IDENTITY))
     if same:
         # the same table from the same inputs: its provenance (the commit, library and package
         # versions that first produced it) stands, so a rerun on another machine changes nothing
@@ -871,19 +907,28 @@ def summarize_status(statuses: Iterable[str]) -> str:
 
 def status_label(row: Mapping[str, Any]) -> str:
     """``status`` of a ``tables/status.csv`` row with its findings about the print, e.g.
-    ``reproduced, 52 errata`` — so that an artifact's status never hides its errata."""
+    ``reproduced, 52 errata`` — so that an artifact's status never hides its errata; ``mixed``
+    always carries its split, failures first: ``mixed (3 not-reproduced, 20 reproduced)``."""
     n_e, n_i = int(row.get("erratum", 0) or 0), int(row.get("inconsistent", 0) or 0)
     extra = ([f"{n_e} {'erratum' if n_e == 1 else 'errata'}"] if n_e else []) + \
             ([f"{n_i} {'inconsistency' if n_i == 1 else 'inconsistencies'}"] if n_i else [])
-    return ", ".join([str(row["status"])] + extra)
+    head = str(row["status"])
+    if head == "mixed":          # a mixed artifact always carries its split (failures first)
+        order = ("not-reproduced", "unverifiable", "analog", "reproduced", "qualitative", "pending")
+        head += " (" + ", ".join(f"{int(row.get(s.replace('-', '_'), 0) or 0)} {s}" for s in order
+                                 if int(row.get(s.replace("-", "_"), 0) or 0)) + ")"
+    return ", ".join([head] + extra)
 
 
 def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Aggregate the exported tables into ``tables/status.csv`` and ``tables/errata.csv``.
+    """Aggregate the exported tables into ``tables/status.csv`` and ``tables/register.csv``.
 
     Status: one row per artifact of ``data/artifacts.csv`` (``pending`` until a chapter exports
     it), followed by supplementary tables that a chapter exported beyond the seed artifacts.
-    Errata: every row with status ``erratum`` in any exported table.
+    Register (:func:`build_register`): every row with status ``erratum`` or ``inconsistent`` in any
+    exported table, with its ``kind``.  Refuses (:class:`RegistryError`) when an exported table
+    breaks the verdict rule (:func:`verdict_violations`), after writing the files, so that the pages
+    show the state that the message describes.  Returns ``(status, register)``.
     """
     arts = load_artifacts()
     exported = {tid: json.loads((tables_dir() / f"{tid}.json").read_text(encoding="utf-8")) for tid in list_tables()}
@@ -899,33 +944,45 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
         rows.append(_status_row(tid, meta.get("source", tid.split("-")[0]), "supplementary", meta.get("title", ""),
                                 [tid], exported))
     status = pd.DataFrame(rows)
-    errata_rows = []
-    for tid in sorted(exported):
-        df = read_table(tid)
-        for _, r in df[df["status"] == "erratum"].iterrows():
-            errata_rows.append({
-                "source": tid.split("-")[0],
-                "location": f"{tid}: {r['quantity']}",
-                "printed": display_cell(r, "paper"),
-                "corrected": r["corrected"] or display_cell(r, "reproduced"),
-                "evidence": r["evidence"] or exported[tid].get("notebook", ""),
-                "note": r["note"],
-            })
-    errata = pd.DataFrame(errata_rows, columns=["source", "location", "printed", "corrected", "evidence", "note"])
+    register = build_register(exported)
     if write:
         d = tables_dir()
         d.mkdir(exist_ok=True)
         _write_if_changed(d / "status.csv", status.to_csv(index=False, lineterminator="\n"))
-        _write_if_changed(d / "errata.csv", errata.to_csv(index=False, lineterminator="\n"))
+        _write_if_changed(d / "register.csv", register.to_csv(index=False, lineterminator="\n"))
         _write_if_changed(d / "status.md", _status_markdown(status))
-        _write_if_changed(d / "errata.md", _errata_markdown(errata))
+        _write_if_changed(d / "register.md", _register_markdown(register))
         for src in SOURCE_KEYS:
             _write_if_changed(d / f"status-{src}.md", _paper_summary_markdown(status, src))
         notebooks = sorted({n for ns in status["notebook"].astype(str) for n in ns.split() if n.startswith("book/")})
         for nb in notebooks:
             _write_if_changed(d / findings_file(nb), _findings_markdown(status, nb))
         write_datapackage()
-    return status, errata
+    check_verdicts()
+    return status, register
+
+
+FIELD_DESCRIPTIONS = {
+    "quantity": "what is compared; in a readings ledger '<reading> | <quantity of the main table>'",
+    "unit": "unit of paper, reproduced, abs_error and tolerance (an absolute tolerance)",
+    "paper": "the printed value as a number (empty when the print is a formula, a range or text: see paper_text)",
+    "paper_text": "the printed form where it is not a single number",
+    "reproduced": "the value computed by the package, stored with the digits every machine computes",
+    "reproduced_text": "the computed result where it is not a single number",
+    "abs_error": "|reproduced - paper|, shown only for rows compared against a tolerance",
+    "rel_error": "abs_error / |paper|",
+    "tolerance": "the tolerance stated before the comparison (absolute in the row's unit, or relative)",
+    "tolerance_kind": "abs or rel",
+    "status": "reproduced, erratum, inconsistent, qualitative, analog, unverifiable, not-reproduced or pending "
+              "(CONTRIBUTING.md, Statuses)",
+    "note": "why the row has its status",
+    "evidence": "the notebook and test that prove an erratum (or support a finding)",
+    "corrected": "the corrected expression or value of an erratum",
+    "kind": "erratum (a printed value proven wrong) or inconsistent (two printed parts that disagree)",
+    "table": "the exported table holding the row",
+    "printed": "what the source prints, as printed",
+}
+"""Descriptions of the columns of the exported CSVs (``tables/datapackage.json``)."""
 
 
 DATAPACKAGE = "datapackage.json"
@@ -954,8 +1011,11 @@ def datapackage() -> dict:
         res = {"name": path.stem, "path": path.name, "profile": "tabular-data-resource", "format": "csv",
                "mediatype": "text/csv", "encoding": "utf-8",
                "title": meta.get("title", {"status": "Reproduction status of every artifact",
-                                           "errata": "Errata register"}.get(path.stem, path.stem)),
-               "schema": {"fields": [{"name": c, "type": _field_type(c, df[c])} for c in df.columns],
+                                           "register": "Register of errata and inconsistencies"}.get(path.stem,
+                                                                                                       path.stem)),
+               "schema": {"fields": [dict({"name": c, "type": _field_type(c, df[c])},
+                                          **({"description": FIELD_DESCRIPTIONS[c]} if c in FIELD_DESCRIPTIONS else {}))
+                                     for c in df.columns],
                           "missingValues": [""]}}
         if meta:
             res["sources"] = [{"title": meta.get("notebook", ""), "path": meta.get("notebook", "")}]
@@ -1002,6 +1062,203 @@ def artifact_tables(artifact: Mapping[str, Any]) -> list[str]:
     for tid in extra:
         validate_id(tid)
     return extra or [artifact["id"]]
+
+
+# --------------------------------------------------------------------------- the verdict rule
+
+READING_SEPARATOR = " | "
+"""A readings ledger names each row ``<reading> | <quantity of the main table>``."""
+
+DIAGNOSTIC = "diagnostic"
+"""A ledger row whose reading starts with this word is a counterfactual of the package's own (an
+error source removed, a setting the print excludes), shown for understanding: not a reading of
+the print, so it neither supports nor threatens a verdict."""
+
+REPRODUCING = ("reproduced", "qualitative", "analog")
+"""Statuses with which a ledger row *reaches* the print under its reading (CONTRIBUTING.md,
+"Statuses": within tolerance, found to hold, or not contradicting it)."""
+
+
+def _sidecar(table_id: str) -> dict:
+    path = tables_dir() / f"{table_id}.json"
+    return json.loads(path.read_text(encoding="utf-8")) if path.exists() else {}
+
+
+def readings_ledgers(table_id: str, meta: Mapping[str, Any] | None = None) -> list[str]:
+    """The readings ledgers of an exported table: those its sidecar names (``readings``), else
+    ``<key>-check-<rest>-readings`` for ``<key>-<rest>`` when that table is exported."""
+    meta = _sidecar(table_id) if meta is None else meta
+    if meta.get("readings"):
+        return list(meta["readings"])
+    key, rest = table_id.split("-", 1)
+    cand = f"{key}-check-{rest}-readings"
+    return [cand] if (tables_dir() / f"{cand}.csv").exists() else []
+
+
+def _split_reading(quantity: str) -> tuple[str, str] | None:
+    if READING_SEPARATOR not in quantity:
+        return None
+    reading, rest = quantity.split(READING_SEPARATOR, 1)
+    return reading, rest
+
+
+def _reaches(ledger_row: Mapping[str, Any], main_row: Mapping[str, Any]) -> bool:
+    """Whether a ledger row reaches the printed value of the main row: by its own status, or — for
+    a numeric row with a tolerance — by lying within the main row's tolerance of the print."""
+    if ledger_row["status"] in REPRODUCING:
+        return True
+    p, r, tol = (_as_float_or_nan(main_row["paper"]), _as_float_or_nan(ledger_row["reproduced"]),
+                 _as_float_or_nan(main_row["tolerance"]))
+    if any(math.isnan(x) for x in (p, r, tol)):
+        return False
+    err = abs(r - p) if main_row["tolerance_kind"] != "rel" else (abs(r - p) / abs(p) if p else float("inf"))
+    return err <= tol
+
+
+def verdict_violations(table_ids: Iterable[str] | None = None) -> list[str]:
+    """Where exported tables break the verdict rule (CONTRIBUTING.md, "Readings and the main
+    reading"); an empty list when none does.
+
+    1. A ``not-reproduced`` row is refused while a reading of its table's readings ledger reaches
+       the print (a ledger row ``<reading> | <quantity>`` with a status in :data:`REPRODUCING`, or
+       within the row's tolerance), unless the table's ``ruled_out`` names that reading (or a prefix
+       of it) with the printed evidence that excludes it.
+    2. The same for an ``erratum`` row: a printed value that a faithful reading reproduces is
+       another convention or a second printed part, recorded as ``inconsistent``, not a misprint.
+    3. Each ``not-reproduced`` row of a table with a ledger appears in it under at least one
+       reading (otherwise the ledger says nothing about that verdict).
+    4. A table with a readings ledger records its main reading and the printed evidence for it.
+    5. A ``ruled_out`` entry names a reading of the ledger.
+    """
+    out = []
+    ids = list_tables() if table_ids is None else list(table_ids)
+    for tid in ids:
+        if "-check-" in tid and tid.endswith("-readings"):
+            continue
+        meta = _sidecar(tid)
+        ledgers = readings_ledgers(tid, meta)
+        if not ledgers:
+            continue
+        if not meta.get("main_reading") or not meta.get("main_reading_evidence"):
+            out.append(f"{tid}: has the readings ledger {', '.join(ledgers)} but records no main_reading with "
+                       "its printed evidence (compare(..., main_reading=, reading_evidence=))")
+        df = read_table(tid)
+        ruled = dict(meta.get("ruled_out") or {})
+        flagged = df[df["status"].isin(["not-reproduced", "erratum"])]
+        by_q = {r["quantity"]: r for _, r in flagged.iterrows()}
+        all_readings: set[str] = set()
+        covered: set[str] = set()
+        for lid in ledgers:
+            if not (tables_dir() / f"{lid}.csv").exists():
+                out.append(f"{tid}: its readings ledger {lid} is not exported")
+                continue
+            ledger = read_table(lid)
+            rows: dict[str, dict[str, Any]] = {}
+            for _, lr in ledger.iterrows():
+                split = _split_reading(lr["quantity"])
+                if split is None:
+                    continue
+                reading, q = split
+                if reading.lower().startswith(DIAGNOSTIC):
+                    continue
+                all_readings.add(reading)
+                rows.setdefault(reading, {})[q] = lr
+            for reading, per_q in rows.items():
+                covered.update(q for q in per_q if q in by_q)
+                excluded = any(reading == k or reading.startswith(k) for k in ruled)
+                if excluded:
+                    continue
+                for q, mr in by_q.items():
+                    lr = per_q.get(q)
+                    if lr is not None and _reaches(lr, mr):
+                        what = ("a misprint that a faithful reading reproduces is an inconsistency or another "
+                                "convention" if mr["status"] == "erratum" else "not-reproduced needs every faithful "
+                                "reading to miss the print")
+                        out.append(f"{tid}: row {q!r} is {mr['status']} but reading {reading!r} of {lid} reaches the "
+                                   f"print ({lr['status']}): {what}; give the printed evidence ruling the reading out "
+                                   "(ruled_out=) or change the status")
+        for q, mr in by_q.items():
+            if mr["status"] == "not-reproduced" and q not in covered:
+                out.append(f"{tid}: row {q!r} is not-reproduced but no reading of {', '.join(ledgers)} shows it "
+                           f"(a ledger row '<reading>{READING_SEPARATOR}{q}')")
+        for k in ruled:
+            if not any(r == k or r.startswith(k) for r in all_readings):
+                out.append(f"{tid}: ruled_out names {k!r}, which is no reading of {', '.join(ledgers)}")
+    return out
+
+
+def check_verdicts(table_ids: Iterable[str] | None = None) -> None:
+    """Raise :class:`RegistryError` listing every break of the verdict rule (see
+    :func:`verdict_violations`)."""
+    bad = verdict_violations(table_ids)
+    if bad:
+        raise RegistryError("the verdict rule is broken (CONTRIBUTING.md, \"Readings and the main reading\"):\n  - "
+                            + "\n  - ".join(bad))
+
+
+REGISTER_COLUMNS = ("kind", "source", "table", "quantity", "printed", "reproduced", "corrected", "note",
+                    "evidence")
+"""Columns of ``tables/register.csv``: every ``erratum`` and ``inconsistent`` row of every table."""
+
+
+def build_register(exported: Mapping[str, dict] | None = None) -> pd.DataFrame:
+    """The register of findings about the print: every row with status ``erratum`` (a printed
+    value proven wrong) or ``inconsistent`` (two printed parts that disagree), with its ``kind``,
+    the printed text as printed (``paper_text`` where the print is a formula or a range), the
+    reproduced value, the correction (errata), the reason and the evidence."""
+    exported = {t: _sidecar(t) for t in list_tables()} if exported is None else exported
+    rows = []
+    for tid in sorted(exported):
+        df = read_table(tid)
+        for _, r in df[df["status"].isin(["erratum", "inconsistent"])].iterrows():
+            rows.append({
+                "kind": r["status"], "source": tid.split("-")[0], "table": tid, "quantity": r["quantity"],
+                "printed": r["paper_text"] or r["paper"],
+                "reproduced": r["reproduced_text"] or r["reproduced"],
+                "corrected": r["corrected"] if r["status"] == "erratum" else "",
+                "note": r["note"],
+                "evidence": r["evidence"] or exported[tid].get("notebook", ""),
+            })
+    reg = pd.DataFrame(rows, columns=list(REGISTER_COLUMNS))
+    order = {k: i for i, k in enumerate(SOURCE_KEYS + ("toolkit",))}
+    return reg.sort_values(["source", "kind", "table"], key=lambda c: c.map(order) if c.name == "source" else c,
+                           kind="stable").reset_index(drop=True)
+
+
+def _first_clause(text: str, n: int = 160) -> str:
+    """The first sentence or clause of a note, whole (never cut inside a word or a number)."""
+    t = " ".join(str(text).split())
+    for sep in (". ", "; ", ": "):
+        head = t.split(sep, 1)[0]
+        if len(head) <= n:
+            return head.rstrip(".")
+    return t[:n].rsplit(" ", 1)[0]
+
+
+def failing_artifacts(status: pd.DataFrame) -> pd.DataFrame:
+    """The paper artifacts holding ``not-reproduced`` rows, most such rows first, each with its
+    one-line reason: the ``summary`` of its table's sidecar, else the first clause of the first
+    not-reproduced row's note.  Columns ``id``, ``source``, ``artifact``, ``label``,
+    ``not_reproduced``, ``tables``, ``notebook``, ``reason``."""
+    sub = status[(status["kind"] == "paper") & (status["not_reproduced"].astype(int) > 0)]
+    rows = []
+    for _, r in sub.iterrows():
+        reason = ""
+        for tid in str(r["tables"]).split():
+            meta = _sidecar(tid)
+            df = read_table(tid)
+            if not (df["status"] == "not-reproduced").any():
+                continue
+            notes = [n for n in df.loc[df["status"] == "not-reproduced", "note"] if str(n).strip()]
+            reason = meta.get("summary") or (_first_clause(notes[0]) if notes else
+                                             "differs from the print beyond the tolerance stated before comparing")
+            break
+        rows.append({"id": r["id"], "source": r["source"], "artifact": r["artifact"], "label": status_label(r),
+                     "not_reproduced": int(r["not_reproduced"]), "tables": r["tables"], "notebook": r["notebook"],
+                     "reason": reason})
+    out = pd.DataFrame(rows, columns=["id", "source", "artifact", "label", "not_reproduced", "tables", "notebook",
+                                      "reason"])
+    return out.sort_values("not_reproduced", ascending=False, kind="stable").reset_index(drop=True)
 
 
 def _status_row(tid: str, source: str, artifact: str, description: str, present: list[str],
@@ -1100,13 +1357,26 @@ def _row_split(r) -> str:
     return ", ".join(f"{int(r[s.replace('-', '_')])} {s}" for s in STATUSES if int(r[s.replace('-', '_')])) or "-"
 
 
+def _failing_markdown(status: pd.DataFrame, up: str) -> list[str]:
+    """Lines naming first the paper artifacts that hold not-reproduced rows, each with its reason."""
+    fail = failing_artifacts(status)
+    if fail.empty:
+        return []
+    n = int(fail["not_reproduced"].sum())
+    lines = [f"**Not reproduced** — {len(fail)} paper {'artifact holds' if len(fail) == 1 else 'artifacts hold'} "
+             f"{n} not-reproduced {'row' if n == 1 else 'rows'}:", ""]
+    for _, r in fail.iterrows():
+        lines.append(f"- {_chapter_link(r)} ({r['artifact']}): **{r['label']}** — {r['reason']}")
+    return lines + [""]
+
+
 def _paper_summary_markdown(status: pd.DataFrame, source: str) -> str:
     """The reproduction record of one document for its part's index page: status bar, tally and
     one row per paper artifact (linked to its chapter, to the table where it is shown, to its CSV),
     then the supplementary checks of the same chapters, counted apart."""
     root = project_root()
     part = status[status["source"] == source]
-    lines = []
+    lines = _failing_markdown(part, "../../")
     for kind, title in (("paper", "Artifacts of the paper"), ("supplementary", "Supplementary checks of the chapters")):
         sub = part[part["kind"] == kind]
         if sub.empty:
@@ -1116,8 +1386,8 @@ def _paper_summary_markdown(status: pd.DataFrame, source: str) -> str:
                   *_md_table(["id", "artifact", "status", "rows", "tables"],
                              ([_chapter_link(r), r["artifact"], f"**{status_label(r)}**", _row_split(r),
                                _table_links(r, root, "../../")] for _, r in sub.iterrows())), ""]
-    lines.append("Statuses are defined on the {doc}`status page </status>`; the errata of every document "
-                 "are collected in the {doc}`errata register </errata>`.")
+    lines.append("Statuses are defined on the {doc}`status page </status>`; the errata and inconsistencies of "
+                 "every document are collected in the {doc}`register </register>`.")
     return "\n".join(lines) + "\n"
 
 
@@ -1169,7 +1439,7 @@ def _findings_markdown(status: pd.DataFrame, notebook: str) -> str:
         if n_e or n_i:
             lines.append(f"- {n_e} {'erratum' if n_e == 1 else 'errata'} and {n_i} "
                          f"{'inconsistency' if n_i == 1 else 'inconsistencies'} recorded "
-                         "(the {doc}`errata register </errata>` lists the errata)")
+                         "(listed in the {doc}`register </register>`)")
         lines.append("")
     if len(lines) == 3:
         lines.append("This chapter exports no comparison table.")
@@ -1189,7 +1459,7 @@ def _status_markdown(status: pd.DataFrame) -> str:
     present = set(paper["status"])
     cols = [s for s in ARTIFACT_STATUSES if s not in ("erratum", "inconsistent") and s in present]  # the others are 0
     by = {src: paper[paper["source"] == src] for src in SOURCE_KEYS}
-    lines = ["**At a glance** — the artifacts of each document by status, and the errata and "
+    lines = _failing_markdown(status, "../") + ["**At a glance** — the artifacts of each document by status, and the errata and "
              "inconsistencies their rows record:", "",
              *_md_table(["", *SOURCE_KEYS],
                         [["artifacts", *(len(by[k]) for k in SOURCE_KEYS)],
@@ -1216,18 +1486,27 @@ def _formula(text: str) -> str:
     return f"${t}$" if "\\" in t and "$" not in t else t
 
 
-def _errata_markdown(errata: pd.DataFrame) -> str:
-    if errata.empty:
-        return "No erratum has been proven yet.\n"
+def _register_markdown(register: pd.DataFrame) -> str:
+    """The register page: per document, the errata and then the inconsistencies, each with where it
+    is, what is printed, what the package computes (or the correction) and why."""
+    if register.empty:
+        return "No erratum or inconsistency has been recorded yet.\n"
     lines = []
-    for source in [k for k in SOURCE_KEYS if k in set(errata["source"])] + \
-            sorted(set(errata["source"]) - set(SOURCE_KEYS)):
-        part = errata[errata["source"] == source]
-        rows = ([r["location"], r["printed"], _formula(r["corrected"]),
-                 re.sub(r"book/([\w/.-]+?)\.ipynb", r"{doc}`/\1`", str(r["evidence"]))]  # link the chapter
-                for _, r in part.iterrows())
-        lines += [f"## {source} ({len(part)} {'erratum' if len(part) == 1 else 'errata'})", "",
-                  *_md_table(["location", "printed", "corrected", "evidence"], rows), ""]
+    for source in [k for k in SOURCE_KEYS if k in set(register["source"])] + \
+            sorted(set(register["source"]) - set(SOURCE_KEYS)):
+        part = register[register["source"] == source]
+        n_e, n_i = int((part["kind"] == "erratum").sum()), int((part["kind"] == "inconsistent").sum())
+        lines += [f"## {source}", "", f"{n_e} {'erratum' if n_e == 1 else 'errata'}, "
+                  f"{n_i} {'inconsistency' if n_i == 1 else 'inconsistencies'}.", ""]
+        for kind, title, third in (("erratum", "Errata", "corrected"), ("inconsistent", "Inconsistencies", "reproduced")):
+            sub = part[part["kind"] == kind]
+            if sub.empty:
+                continue
+            rows = ([f"`{r['table']}`: {r['quantity']}", r["printed"],
+                     _formula(r["corrected"] or r["reproduced"]) if kind == "erratum" else r["reproduced"],
+                     re.sub(r"book/([\w/.-]+?)\.ipynb", r"{doc}`/\1`", str(r["note"]))]
+                    for _, r in sub.iterrows())
+            lines += [f"### {title} of {source}", "", *_md_table(["where", "printed", third, "why"], rows), ""]
     return "\n".join(lines)
 
 

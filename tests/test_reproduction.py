@@ -171,19 +171,94 @@ def test_compare_exports_all_formats_and_is_idempotent(sandbox):
     assert back.loc[0, "status"] == "reproduced"
 
 
-def test_index_lists_every_artifact_and_collects_errata(sandbox):
+def test_index_lists_every_artifact_and_collects_the_register(sandbox):
     rows = [dict(quantity="beta", unit="°", paper=0.0025, reproduced=0.0035, status="erratum",
-                 note="prose says 0.0035", evidence="tests/test_x.py::test_beta")]
+                 note="prose says 0.0035", evidence="tests/test_x.py::test_beta"),
+            dict(quantity="alpha", unit="m", paper=1.5, paper_text="1.5 (caption: 2.5)", reproduced=1.5,
+                 status="inconsistent", note="the caption prints 2.5, the table 1.5")]
     rp.compare("chen2019-table-9-9", rows, title="T", notebook="book/x.ipynb")
     rp.compare("chen2019-check-extra", [dict(quantity="q", unit="", paper=1, reproduced=1, tolerance=0)],
                title="Extra", notebook="book/x.ipynb")
-    status, errata = rp.build_index()
+    status, register = rp.build_index()
     assert list(status["id"]) == ["chen2019-table-9-9", "chen2019-table-9-8", "chen2019-check-extra"]
     assert list(status["status"]) == ["erratum", "pending", "reproduced"]
     assert status.iloc[2]["artifact"] == "supplementary"
-    assert len(errata) == 1 and errata.iloc[0]["evidence"] == "tests/test_x.py::test_beta"
-    on_disk = pd.read_csv(sandbox / "tables" / "errata.csv", dtype=str)
-    assert list(on_disk.columns[:5]) == ["source", "location", "printed", "corrected", "evidence"]
+    assert list(register["kind"]) == ["erratum", "inconsistent"]           # both kinds, one register
+    assert register.iloc[0]["evidence"] == "tests/test_x.py::test_beta"
+    assert register.iloc[1]["printed"] == "1.5 (caption: 2.5)"             # the print as printed
+    on_disk = pd.read_csv(sandbox / "tables" / "register.csv", dtype=str, keep_default_na=False)
+    assert tuple(on_disk.columns) == rp.REGISTER_COLUMNS
+    assert not (sandbox / "tables" / "errata.csv").exists()
+    desc = {f["name"]: f.get("description") for r in rp.datapackage()["resources"] if r["name"] == "register"
+            for f in r["schema"]["fields"]}
+    assert desc["kind"] and desc["printed"]
+
+
+def _main_and_ledger(ledger_status="qualitative", ledger_value=2.0, **kw):
+    """A main table with one not-reproduced row and a readings ledger with one other reading."""
+    rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1)],
+               title="T", notebook="book/x.ipynb", **kw)
+    rp.compare("chen2019-check-table-9-9-readings",
+               [dict(quantity="main | alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1),
+                dict(quantity="other convention | alpha", unit="m", paper=1.5, reproduced=ledger_value,
+                     **({"tolerance": 0.1} if ledger_status is None else {"status": ledger_status, "note": "n"}))],
+               title="ledger", notebook="book/x.ipynb")
+
+
+def test_verdict_rule_refuses_a_not_reproduced_row_that_a_reading_reproduces(sandbox):
+    """A planted bad status: the row is not-reproduced while 'other convention' reproduces it."""
+    _main_and_ledger(main_reading="main", reading_evidence="the printed numbers of column 2")
+    bad = rp.verdict_violations()
+    assert len(bad) == 1 and "other convention" in bad[0] and "'alpha'" in bad[0]
+    with pytest.raises(rp.RegistryError, match="verdict rule"):
+        rp.build_index()
+    assert cli(["index"]) == 2
+
+
+def test_verdict_rule_reads_the_tolerance_of_the_main_row(sandbox):
+    """A ledger row whose own status says nothing still reaches the print within the row's tolerance."""
+    _main_and_ledger(ledger_status=None, ledger_value=1.55, main_reading="main", reading_evidence="e")
+    assert any("other convention" in v for v in rp.verdict_violations())
+    _main_and_ledger(ledger_status=None, ledger_value=1.7, main_reading="main", reading_evidence="e")
+    assert rp.verdict_violations() == []                                   # 0.2 > 0.1: it misses too
+
+
+def test_verdict_rule_accepts_a_reading_ruled_out_by_printed_evidence(sandbox):
+    _main_and_ledger(main_reading="main", reading_evidence="column 2 identifies the main convention",
+                     ruled_out={"other": "the printed column 2 (3.0, 1e-18) contradicts the other convention"})
+    assert rp.verdict_violations() == []
+    status, _ = rp.build_index()
+    fail = rp.failing_artifacts(status)
+    assert list(fail["id"]) == ["chen2019-table-9-9"] and fail.iloc[0]["reason"]
+
+
+def test_verdict_rule_needs_a_main_reading_and_a_named_reading(sandbox):
+    _main_and_ledger(ledger_status="not-reproduced")
+    assert any("no main_reading" in v for v in rp.verdict_violations())
+    _main_and_ledger(ledger_status="not-reproduced", main_reading="main", reading_evidence="e",
+                     ruled_out={"a reading nobody tried": "x"})
+    assert any("is no reading" in v for v in rp.verdict_violations())
+    with pytest.raises(rp.RegistryError, match="together"):
+        rp.compare("chen2019-table-9-9", [dict(quantity="a", unit="", paper=1, reproduced=1, tolerance=0)],
+                   title="T", notebook="book/x.ipynb", main_reading="main")
+
+
+def test_verdict_rule_refuses_an_erratum_that_a_reading_reproduces(sandbox):
+    """A 'misprint' that another printed part (a reading) reproduces is an inconsistency."""
+    rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1,
+                                           status="erratum", note="n", evidence="tests/t.py::t")],
+               title="T", notebook="book/x.ipynb", main_reading="main", reading_evidence="e")
+    rp.compare("chen2019-check-table-9-9-readings",
+               [dict(quantity="the table's convention | alpha", unit="m", paper=1.5, reproduced=1.5, tolerance=0.1)],
+               title="ledger", notebook="book/x.ipynb")
+    bad = rp.verdict_violations()
+    assert len(bad) == 1 and "is erratum" in bad[0] and "inconsistency" in bad[0]
+
+
+def test_the_stored_tables_obey_the_verdict_rule():
+    """Every exported table of the project: no not-reproduced or erratum row that a reading of its
+    ledger reproduces without printed evidence ruling that reading out."""
+    assert rp.verdict_violations() == []
 
 
 def test_roll_up_rules():
@@ -203,6 +278,8 @@ def test_roll_up_rules():
         s(["fine"])
     row = {"status": "reproduced", "erratum": 52, "inconsistent": 1}
     assert rp.status_label(row) == "reproduced, 52 errata, 1 inconsistency"
+    mixed = {"status": "mixed", "reproduced": 20, "not_reproduced": 3, "analog": 1, "erratum": 2}
+    assert rp.status_label(mixed) == "mixed (3 not-reproduced, 1 analog, 20 reproduced), 2 errata"   # split, failures first
 
 
 def test_cli_show_cite_and_unknown_id(sandbox, capsys):
