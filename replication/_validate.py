@@ -4,8 +4,11 @@ Each function returns the checked argument in the form the caller computes with 
 float array) and raises ``ValueError`` naming the argument, what it must be and what was given;
 where a module words its message differently, ``message`` replaces the text (a ``str.format``
 template with the fields ``name`` and ``value``, for :func:`choice` also ``allowed``).
-The domain-specific checks stay with their modules (latitudes and heights in
-:mod:`replication.earth`, increments in :mod:`replication.strapdown`).
+Text where a number is expected raises ``TypeError`` naming the argument (``float("100")``
+would silently convert it). The domain-specific checks stay with their modules (latitudes,
+heights and speeds in :mod:`replication.earth`, navigation states and increments in
+:mod:`replication.strapdown`). Every check works on whole arrays with numpy, once per call,
+so that it stays outside the compiled loops and costs nothing per step.
 """
 
 from __future__ import annotations
@@ -14,11 +17,184 @@ from typing import Any, Collection
 
 import numpy as np
 
-__all__ = ["positive", "nonnegative", "finite", "vector3", "matrix3", "components", "choice"]
+__all__ = ["positive", "nonnegative", "finite", "vector3", "matrix3", "components", "choice", "numeric",
+           "finite_array", "nonnegative_array", "rotation", "covariance", "ORTHONORMAL_TOL", "COVARIANCE_TOL"]
+
+ORTHONORMAL_TOL = 1e-6
+"""Largest element of |C Cᵀ - I| (and |det C - 1|) accepted for a rotation matrix. Float64 round-off of a
+product of orthonormal matrices grows by about 1e-16 per product, so even a DCM carried through
+millions of products without re-orthonormalization stays below 1e-9; an error of 1e-6 is a
+wrong matrix (a scaled one, a transposed product of non-rotations), not round-off."""
+
+COVARIANCE_TOL = 1e-9
+"""Relative tolerance of :func:`covariance`: asymmetry |M - Mᵀ| ≤ tol·max|M| and smallest eigenvalue
+≥ -tol·max|eigenvalue|. The round-off of a symmetric eigen-decomposition is about n·ε·max|λ|
+(≈ 1e-14 for n ≤ 45), and a propagated covariance carries a few such round-offs; a negative
+eigenvalue beyond 1e-9 of the largest is a wrong input (a negative variance, a sign lost)."""
+
+
+def numeric(value, name: str) -> np.ndarray:
+    """``value`` as a float array; ``TypeError`` naming the argument for text, ``None`` and objects.
+
+    Parameters
+    ----------
+    value : float or array_like
+        The argument.
+    name : str
+        Its name for the error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``value`` as a float array (not checked for NaN: see :func:`finite_array`).
+    """
+    if isinstance(value, (str, bytes)):
+        raise TypeError(f"{name} must be a number or an array of numbers, got text {value!r:.40}")
+    try:
+        a = np.asarray(value)
+    except ValueError as exc:                                   # ragged nested sequences
+        raise ValueError(f"{name} must be a number or a rectangular array of numbers: {exc}") from None
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must be a number or an array of numbers, got {type(value).__name__} "
+                        f"{value!r:.40}")
+    return a.astype(float)
+
+
+def finite_array(value, name: str, shape: tuple | None = None) -> np.ndarray:
+    """A float array without NaN or infinity, optionally of a given ``shape``.
+
+    Parameters
+    ----------
+    value : float or array_like
+        The argument.
+    name : str
+        Its name for the error message.
+    shape : tuple, optional
+        The required shape.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``value`` as a float array; ``TypeError`` for text, ``ValueError`` for another shape or a
+        NaN/infinite element (the message gives the first one's index).
+    """
+    a = numeric(value, name)
+    if shape is not None and a.shape != tuple(shape):
+        raise ValueError(f"{name} must have shape {tuple(shape)}, got shape {a.shape}")
+    bad = ~np.isfinite(a)
+    if np.any(bad):
+        where = "" if a.ndim == 0 else f" at index {tuple(int(i) for i in np.argwhere(bad)[0])}"
+        raise ValueError(f"{name} must be finite, got {a[bad].flat[0]!r}{where}")
+    return a
+
+
+def nonnegative_array(value, name: str, shape: tuple | None = None) -> np.ndarray:
+    """A finite float array with no negative element (standard deviations, variances, densities, rates).
+
+    Arguments and return as :func:`finite_array`; ``ValueError`` naming the argument and its most
+    negative element otherwise.
+    """
+    a = finite_array(value, name, shape)
+    if np.any(a < 0):
+        raise ValueError(f"{name} must be non-negative (a standard deviation, variance, density or rate), "
+                         f"got {float(np.min(a)):.6g}")
+    return a
+
+
+def rotation(value, name: str, tol: float = ORTHONORMAL_TOL) -> np.ndarray:
+    """An array of rotation matrices (trailing shape (3, 3), orthonormal, det +1).
+
+    Parameters
+    ----------
+    value : array_like
+        The argument, shape (..., 3, 3).
+    name : str
+        Its name for the error message.
+    tol : float, optional
+        Largest accepted element of |C Cᵀ - I| and |det C - 1| (default :data:`ORTHONORMAL_TOL`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``value`` as a float array.
+
+    Raises
+    ------
+    TypeError
+        For text.
+    ValueError
+        For another shape, a non-finite element, or a matrix that is not a rotation.
+    """
+    m = matrix3(finite_array(value, name), name)
+    err = np.max(np.abs(m @ np.swapaxes(m, -1, -2) - np.eye(3)), initial=0.0)
+    det = np.linalg.det(m) if m.size else np.ones(0)
+    if err > tol or np.any(np.abs(det - 1.0) > tol):
+        raise ValueError(f"{name} is not a rotation matrix: max|C Cᵀ - I| = {err:.3g}, det = "
+                         f"{float(np.ravel(det)[np.argmax(np.abs(np.ravel(det) - 1))]):.6g} (tolerance {tol:g}); "
+                         "build it with rotations.euler_to_dcm or repair it with rotations.orthonormalize")
+    return m
+
+
+def covariance(value, name: str, n: int | None = None, tol: float = COVARIANCE_TOL) -> np.ndarray:
+    """A covariance (or noise-intensity) matrix: square, finite, symmetric, positive semidefinite.
+
+    Positive semidefinite means smallest eigenvalue ≥ -tol·max|eigenvalue|. A Cholesky factor
+    of M + tol·max|diag M|·I proves it cheaply; only when that fails are the eigenvalues computed.
+
+    Parameters
+    ----------
+    value : array_like
+        The argument, shape (n, n).
+    name : str
+        Its name for the error message.
+    n : int, optional
+        The required size.
+    tol : float, optional
+        Relative tolerance (default :data:`COVARIANCE_TOL`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``value`` as a float array (unchanged: not symmetrised).
+
+    Raises
+    ------
+    TypeError
+        For text.
+    ValueError
+        For another shape, a non-finite element, asymmetry or a negative eigenvalue.
+    """
+    m = finite_array(value, name)
+    if m.ndim != 2 or m.shape[0] != m.shape[1] or (n is not None and m.shape[0] != n):
+        size = "a square matrix" if n is None else f"{n}×{n}"
+        raise ValueError(f"{name} must be {size}, got shape {m.shape}")
+    scale = np.max(np.abs(m), initial=0.0)
+    if np.max(np.abs(m - m.T), initial=0.0) > tol * scale:
+        raise ValueError(f"{name} must be symmetric (a covariance), max|M - Mᵀ| = "
+                         f"{np.max(np.abs(m - m.T)):.3g} exceeds {tol:g}·max|M|")
+    d = np.max(np.abs(np.diag(m)), initial=0.0)
+    if d == 0.0:
+        ok = scale == 0.0                          # zero diagonal: only the zero matrix is semidefinite
+    else:
+        try:
+            np.linalg.cholesky(m + tol * d * np.eye(m.shape[0]))
+            ok = True
+        except np.linalg.LinAlgError:
+            ok = False
+    if not ok:
+        lam = np.linalg.eigvalsh(0.5 * (m + m.T))
+        if lam[0] < -tol * np.max(np.abs(lam)):
+            raise ValueError(f"{name} must be positive semidefinite (a covariance or noise intensity): its "
+                             f"smallest eigenvalue is {lam[0]:.6g} (largest |eigenvalue| {np.max(np.abs(lam)):.6g}); "
+                             "check the signs of the variances")
+    return m
 
 
 def _number(value, name: str, what: str, ok, message: str | None) -> float:
-    """``float(value)`` if it is finite and ``ok(value)``; else ``ValueError`` saying ``what`` it must be."""
+    """``float(value)`` if it is finite and ``ok(value)``; else ``ValueError`` saying ``what`` it must be
+    (``TypeError`` for text)."""
+    if isinstance(value, (str, bytes)):
+        raise TypeError(f"{name} must be {what}, got text {value!r:.40}")
     value = float(value)
     if not (np.isfinite(value) and ok(value)):
         text = f"{{name}} must be {what}, got {{value!r}}" if message is None else message
@@ -77,7 +253,7 @@ def vector3(value, name: str) -> np.ndarray:
     ValueError
         If the last axis is not of length 3 or an element is not finite.
     """
-    a = np.asarray(value, dtype=float)
+    a = numeric(value, name)
     if a.shape[-1:] != (3,):
         raise ValueError(f"{name} must have a last axis of length 3 (x, y, z), got shape {a.shape}")
     if not np.all(np.isfinite(a)):
@@ -135,7 +311,7 @@ def components(value, name: str, n: int = 3) -> np.ndarray:
     ValueError
         If ``value`` has another shape or an element is not finite.
     """
-    a = np.asarray(value, float)
+    a = numeric(value, name)
     if a.ndim == 0:
         a = np.full(n, float(a))
     if a.shape != (n,):

@@ -37,7 +37,7 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 
 from . import earth
-from ._validate import vector3
+from ._validate import finite, finite_array, nonnegative, positive, vector3
 from .timeseries import gauss_markov
 from .units import ARCSEC, DEG, DEG_PER_H, G0
 
@@ -1032,10 +1032,13 @@ def simulate_static_sensor(duration: float, sample_rate: float, *, constant: flo
     stationary Gauss-Markov process of standard deviation ``gm_sigma`` and correlation time
     ``gm_tau`` (s), discretized exactly: x_{k+1} = e^{-Δt/τ} x_k + σ √(1 - e^{-2Δt/τ}) w_k.
     """
-    if not (duration > 0 and sample_rate > 0 and gm_tau > 0):
-        raise ValueError("duration, sample_rate and gm_tau must be positive")
-    if white_density < 0 or gm_sigma < 0:
-        raise ValueError("noise levels must be non-negative")
+    duration = positive(duration, "duration", "{name} must be a positive finite number of seconds, got {value!r}")
+    sample_rate = positive(sample_rate, "sample_rate", "{name} must be a positive finite rate (Hz), got {value!r}")
+    gm_tau = positive(gm_tau, "gm_tau", "{name} must be a positive finite correlation time (s), got {value!r}")
+    white_density = nonnegative(white_density, "white_density",
+                                "{name} must be a finite non-negative noise density (units/√Hz), got {value!r}")
+    gm_sigma = nonnegative(gm_sigma, "gm_sigma", "{name} must be a finite non-negative standard deviation, got {value!r}")
+    constant = finite(constant, "constant")
     if rng is None:
         raise ValueError("give a seeded generator rng=np.random.default_rng(seed)")
     n = int(round(duration * sample_rate))
@@ -1055,9 +1058,12 @@ def allan_deviation(y, sample_rate: float, taus=None) -> tuple[np.ndarray, np.nd
     """
     import allantools
 
-    y = np.asarray(y, dtype=float)
-    if y.ndim != 1 or y.size < 3 or not np.all(np.isfinite(y)):
-        raise ValueError("y must be a finite 1-D series of at least 3 samples")
+    y = finite_array(y, "y")
+    if y.ndim != 1 or y.size < 3:
+        raise ValueError(f"y must be a finite 1-D series of at least 3 samples, got shape {y.shape}")
+    sample_rate = positive(sample_rate, "sample_rate", "{name} must be a positive finite rate (Hz), got {value!r}")
+    if taus is not None and not isinstance(taus, str) and np.any(finite_array(taus, "taus") <= 0):
+        raise ValueError(f"taus must be positive averaging times (s), got {np.min(taus)!r}")
     t, ad, _, _ = allantools.oadev(y, rate=sample_rate, data_type="freq", taus="octave" if taus is None else taus)
     return np.asarray(t), np.asarray(ad)
 
@@ -1068,7 +1074,9 @@ def bias_stability(y, sample_rate: float, window: float) -> float:
     The usual laboratory definition (e.g. GJB 2426A: 10 s smoothing over the test); the report
     does not state its window, so chapters treat it as a sensitivity.
     """
-    y = np.asarray(y, dtype=float)
+    y = finite_array(y, "y")
+    sample_rate = positive(sample_rate, "sample_rate", "{name} must be a positive finite rate (Hz), got {value!r}")
+    window = positive(window, "window", "{name} must be a positive finite averaging time (s), got {value!r}")
     m = int(round(window * sample_rate))
     if m < 1 or y.size // m < 2:
         raise ValueError("window too long for the series: need at least two windows")

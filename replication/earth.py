@@ -14,6 +14,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from ._validate import vector3
+
 # --- defining and derived WGS-84 constants (NIMA TR8350.2 tables 3.1, 3.3) ---------------
 A = 6378137.0
 """Semi-major axis a (m)."""
@@ -57,7 +59,7 @@ deepest ocean trench to the edge of space, a plausibility bound (the platforms o
 documents fly below 10 km)."""
 
 
-def check_height(h, *, name: str = "height"):
+def check_height(h, *, name: str = "h"):
     """Validate an ellipsoidal height in metres; return it as an array.  Raises ``ValueError`` for
     text, NaN or infinity, and for heights outside :data:`HEIGHT_RANGE` (a value in km or feet, or
     a latitude passed in its place, is the usual cause)."""
@@ -66,12 +68,40 @@ def check_height(h, *, name: str = "height"):
         raise ValueError(f"{name} must be finite (got NaN or infinity)")
     lo, hi = HEIGHT_RANGE
     if np.any(h < lo) or np.any(h > hi):
-        raise ValueError(f"{name} {float(h.flat[np.argmax(np.abs(h))]):.6g} m is outside [{lo:g}, {hi:g}] m: heights "
-                         "are ellipsoidal heights in metres")
+        worst = float(h.flat[np.argmax(np.maximum(lo - h, h - hi))])
+        raise ValueError(f"{name} = {worst:.6g} m is outside the Earth model's range [{lo:g}, {hi:g}] m: heights "
+                         "are ellipsoidal heights in metres (a value in km or feet, or a latitude in its place, "
+                         "is the usual cause)")
     return h
 
 
-def check_latitude(lat, *, polar_limit_deg: float | None = None, name: str = "latitude"):
+SPEED_LIMIT = 1.2e4
+"""Largest speed (m/s) accepted for a navigation velocity: above the escape velocity (11.2 km/s),
+so no vehicle navigated inside :data:`HEIGHT_RANGE` exceeds it; a larger value is a unit error
+(mm/s, km/h) or a position passed in place of a velocity."""
+
+
+def check_velocity(v, *, name: str = "v_enu"):
+    """Validate ENU velocities (m/s, last axis of length 3); return them as an array.  Raises
+    ``TypeError`` for text, ``ValueError`` for another shape, NaN or infinity and for a speed
+    above :data:`SPEED_LIMIT`."""
+    v = vector3(v, name)
+    speed = np.sqrt(np.sum(v * v, axis=-1))
+    if np.any(speed > SPEED_LIMIT):
+        raise ValueError(f"{name} has a speed of {float(np.max(speed)):.6g} m/s, above {SPEED_LIMIT:g} m/s "
+                         "(escape velocity): velocities are in m/s, East-North-Up")
+    return v
+
+
+def check_longitude(lon, *, name: str = "lon"):
+    """Validate a longitude in radians (any finite value: it is periodic); return it as an array."""
+    lon = _numbers(lon, name)
+    if not np.all(np.isfinite(lon)):
+        raise ValueError(f"{name} must be finite (radians)")
+    return lon
+
+
+def check_latitude(lat, *, polar_limit_deg: float | None = None, name: str = "lat"):
     """Validate a latitude in radians; return it as an array.
 
     Raises ``ValueError`` when any value lies beyond ±90° (a degrees value passed as radians
@@ -84,7 +114,7 @@ def check_latitude(lat, *, polar_limit_deg: float | None = None, name: str = "la
     if np.any(np.abs(lat) > np.pi / 2 + 1e-12):
         worst = float(np.max(np.abs(lat)))
         raise ValueError(
-            f"{name} {np.degrees(worst):.6g}° is beyond ±90°: latitudes are in radians "
+            f"{name} = {np.degrees(worst):.6g}° is beyond ±90°: latitudes are in radians "
             f"(convert degrees with np.radians)"
         )
     if polar_limit_deg is not None and np.any(np.abs(lat) >= np.radians(polar_limit_deg)):
@@ -121,9 +151,7 @@ def transport_rate_enu(lat, h, v_enu, *, polar_limit_deg: float = POLAR_LIMIT_DE
     """
     lat = check_latitude(lat, polar_limit_deg=polar_limit_deg)
     h = check_height(h)
-    v = np.asarray(v_enu, dtype=float)
-    if v.shape[-1] != 3:
-        raise ValueError(f"v_enu must have a last axis of length 3, got shape {v.shape}")
+    v = check_velocity(v_enu)
     rm, rn = radii(lat)
     ve, vn = v[..., 0], v[..., 1]
     return np.stack([-vn / (rm + h), ve / (rn + h), ve * np.tan(lat) / (rn + h)], axis=-1)
@@ -225,8 +253,8 @@ def normal_gravity_closed_form(lat, h=0.0):
     return np.hypot(gu, gb)
 
 
-def _check_height(h, name: str = "height"):
-    h = check_height(h)
+def _check_height(h, name: str = "h"):
+    h = check_height(h, name=name)
     if not np.all(np.isfinite(h)):
         raise ValueError(f"{name} must be finite (metres above the ellipsoid)")
     if np.any(h <= -B + 1000.0):
@@ -478,7 +506,7 @@ def gravity_enu(lat, h=0.0):
 def geodetic_to_ecef(lat, lon, h):
     """Geodetic (L, λ, h) to ECEF coordinates (m)."""
     lat = check_latitude(lat)
-    lon = np.asarray(lon, dtype=float)
+    lon = check_longitude(lon)
     h = check_height(h)
     _, rn = radii(lat)
     x = (rn + h) * np.cos(lat) * np.cos(lon)
@@ -489,9 +517,7 @@ def geodetic_to_ecef(lat, lon, h):
 
 def ecef_to_geodetic(r):
     """ECEF (m) to geodetic (L, λ, h), iterating Bowring's formula to machine precision."""
-    r = np.asarray(r, dtype=float)
-    if r.shape[-1] != 3:
-        raise ValueError(f"ECEF positions need a last axis of length 3, got {r.shape}")
+    r = vector3(r, "r (ECEF position)")
     x, y, z = r[..., 0], r[..., 1], r[..., 2]
     lon = np.arctan2(y, x)
     p = np.hypot(x, y)

@@ -42,9 +42,9 @@ import numpy as np
 
 from . import earth
 from . import _kernels as K
-from ._validate import choice
+from ._validate import choice, covariance, finite_array, nonnegative_array, numeric, positive, rotation, vector3
 from .rotations import euler_to_dcm, rotvec_to_dcm
-from .strapdown import navigation_rates
+from .strapdown import NavState, navigation_rates
 
 __all__ = ["StateBlock", "ErrorModel", "NavPoint", "nav_block_labels", "accel_bias", "gyro_bias",
            "accel_markov", "gyro_markov", "accel_scale", "gyro_scale", "accel_misalignment",
@@ -105,10 +105,13 @@ class StateBlock:
             raise ValueError(f"block {self.name!r}: a lever-arm block has 3 states")
         for attr, shape in (("dynamics", (k, k)), ("noise_psd", (k, k)), ("sd", (k,))):
             val = getattr(self, attr)
-            arr = np.zeros(shape) if val is None else np.asarray(val, float)
+            arr = np.zeros(shape) if val is None else numeric(val, f"block {self.name!r}: {attr}")
             if arr.shape != shape:
                 raise ValueError(f"block {self.name!r}: {attr} must have shape {shape}, got {arr.shape}")
             object.__setattr__(self, attr, arr)
+        finite_array(self.dynamics, f"block {self.name!r}: dynamics")
+        covariance(self.noise_psd, f"block {self.name!r}: noise_psd")
+        nonnegative_array(self.sd, f"block {self.name!r}: sd")
         if self.target == "gravity":
             out = np.eye(3, k) if self.output is None else np.asarray(self.output, float)
             if out.shape != (3, k):
@@ -131,6 +134,14 @@ class NavPoint:
     C_bn: np.ndarray
     f_b: np.ndarray
     w_ib_b: np.ndarray
+
+    def validate(self, *, name: str = "point"):
+        """Check the fields as :meth:`replication.strapdown.NavState.validate` does, and finite f_b,
+        w_ib_b; raises naming the field (the compiled F checks nothing)."""
+        NavState.validate(self, name=name)
+        vector3(self.f_b, f"{name}.f_b")
+        vector3(self.w_ib_b, f"{name}.w_ib_b")
+        return self
 
     @classmethod
     def from_trajectory(cls, traj, k: int):
@@ -161,11 +172,12 @@ class ErrorModel:
             raise ValueError(f"duplicated block names {sorted(dup)}: each block needs a unique name")
         if sum(b.target == "lever_arm" for b in self.blocks) > 1:
             raise ValueError("at most one lever-arm block")
-        self.accel_psd = np.broadcast_to(np.asarray(self.accel_psd, float), (3,)).copy()
-        self.gyro_psd = np.broadcast_to(np.asarray(self.gyro_psd, float), (3,)).copy()
-        self.nav_sd = np.asarray(self.nav_sd, float)
+        self.accel_psd = np.broadcast_to(nonnegative_array(self.accel_psd, "accel_psd"), (3,)).copy()
+        self.gyro_psd = np.broadcast_to(nonnegative_array(self.gyro_psd, "gyro_psd"), (3,)).copy()
+        self.nav_sd = numeric(self.nav_sd, "nav_sd")
         if self.nav_sd.shape != (9,):
             raise ValueError("nav_sd needs 9 standard deviations (δL, δλ, δh, δv ENU, φ ENU)")
+        nonnegative_array(self.nav_sd, "nav_sd")
 
     # -- layout
     @property
@@ -237,6 +249,7 @@ class ErrorModel:
     def F(self, point: NavPoint) -> np.ndarray:
         """Continuous error-state matrix at ``point`` (chen2019 eqs. (3-14)-(3-16))."""
         earth.check_latitude(point.lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
+        point.validate()
         fconst, _, tg, kd, st, sz = self.kernel_encoding()
         F = np.zeros((self.n, self.n))
         v = np.asarray(point.v_enu, float)
@@ -248,7 +261,7 @@ class ErrorModel:
         """Continuous process-noise intensity G Q Gᵀ (n×n) for attitude C_b^n."""
         _, qc, *_ = self.kernel_encoding()
         q = qc.copy()
-        C = np.asarray(C_bn, float)
+        C = rotation(C_bn, "C_bn")
         q[3:6, 3:6] += C @ np.diag(self.accel_psd) @ C.T
         q[6:9, 6:9] += C @ np.diag(self.gyro_psd) @ C.T
         return q
@@ -262,6 +275,7 @@ class ErrorModel:
         blocks through g^n.  Rows of the augmented blocks are their (constant) dynamics.
         """
 
+        point.validate()
         n = self.n
         eps = np.array([1e-5, 1e-5, 100.0, 1.0, 1.0, 1.0, 1e-4, 1e-4, 1e-4]
                        + [b.fd_step for b in self.blocks for _ in b.labels]) if steps is None else np.asarray(steps)
@@ -370,28 +384,29 @@ class ErrorModel:
 # ----------------------------------------------------------------------------- block factories
 
 def _diag3(x, name):
-    a = np.broadcast_to(np.asarray(x, float), (3,))
-    if np.any(a < 0):
-        raise ValueError(f"{name} cannot be negative")
-    return np.diag(a)
+    return np.diag(np.broadcast_to(nonnegative_array(x, name), (3,)))
+
+
+def _sd(x, name, n=3):
+    """``n`` standard deviations (one number standing for all): finite and non-negative."""
+    return np.broadcast_to(nonnegative_array(x, name), (n,))
 
 
 def accel_bias(sd=0.0, *, name="accel_bias", random_walk_psd=0.0):
     """Accelerometer random constant ∇_b (chen2019 eq. (2-5)), m/s²; optional random walk."""
-    return StateBlock(name, ("x", "y", "z"), "accel", "identity", noise_psd=_diag3(random_walk_psd, "psd"),
-                      sd=np.broadcast_to(np.asarray(sd, float), (3,)), fd_step=1e-2)
+    return StateBlock(name, ("x", "y", "z"), "accel", "identity", noise_psd=_diag3(random_walk_psd, "random_walk_psd"),
+                      sd=_sd(sd, "sd"), fd_step=1e-2)
 
 
 def gyro_bias(sd=0.0, *, name="gyro_bias", random_walk_psd=0.0):
     """Gyro random constant drift ε_b (chen2019 eq. (2-5)), rad/s; optional random walk."""
-    return StateBlock(name, ("x", "y", "z"), "gyro", "identity", noise_psd=_diag3(random_walk_psd, "psd"),
-                      sd=np.broadcast_to(np.asarray(sd, float), (3,)), fd_step=1e-3)
+    return StateBlock(name, ("x", "y", "z"), "gyro", "identity", noise_psd=_diag3(random_walk_psd, "random_walk_psd"),
+                      sd=_sd(sd, "sd"), fd_step=1e-3)
 
 
 def _markov(target, sigma, tau, name):
-    if not tau > 0:
-        raise ValueError("correlation time tau must be positive (seconds)")
-    s = np.broadcast_to(np.asarray(sigma, float), (3,))
+    tau = positive(tau, "tau", "correlation time {name} must be positive (seconds), got {value!r}")
+    s = _sd(sigma, "sigma")
     return StateBlock(name, ("x", "y", "z"), target, "identity", dynamics=-np.eye(3) / tau,
                       noise_psd=np.diag(2 * s**2 / tau), sd=s, fd_step=1e-2 if target == "accel" else 1e-5)
 
@@ -408,14 +423,12 @@ def gyro_markov(sigma, tau, *, name="gyro_markov"):
 
 def accel_scale(sd=0.0, *, name="accel_scale"):
     """Accelerometer scale-factor errors δK_a (eq. (2-6)), dimensionless."""
-    return StateBlock(name, ("x", "y", "z"), "accel", "scale", sd=np.broadcast_to(np.asarray(sd, float), (3,)),
-                      fd_step=1e-3)
+    return StateBlock(name, ("x", "y", "z"), "accel", "scale", sd=_sd(sd, "sd"), fd_step=1e-3)
 
 
 def gyro_scale(sd=0.0, *, name="gyro_scale"):
     """Gyro scale-factor errors δK_g (eq. (2-6)), dimensionless."""
-    return StateBlock(name, ("x", "y", "z"), "gyro", "scale", sd=np.broadcast_to(np.asarray(sd, float), (3,)),
-                      fd_step=1e-3)
+    return StateBlock(name, ("x", "y", "z"), "gyro", "scale", sd=_sd(sd, "sd"), fd_step=1e-3)
 
 
 def _coupling_kind(coupling):
@@ -426,15 +439,13 @@ def _coupling_kind(coupling):
 def accel_misalignment(sd=0.0, *, name="accel_misalignment", coupling="eq-2-8"):
     """Accelerometer non-orthogonality δA (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad,
     coupled as ``coupling`` says (:data:`MISALIGNMENT_COUPLINGS`)."""
-    return StateBlock(name, _MIS_LABELS, "accel", _coupling_kind(coupling),
-                      sd=np.broadcast_to(np.asarray(sd, float), (6,)), fd_step=1e-3)
+    return StateBlock(name, _MIS_LABELS, "accel", _coupling_kind(coupling), sd=_sd(sd, "sd", 6), fd_step=1e-3)
 
 
 def gyro_misalignment(sd=0.0, *, name="gyro_misalignment", coupling="eq-2-8"):
     """Gyro non-orthogonality δG (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad, coupled as
     ``coupling`` says (:data:`MISALIGNMENT_COUPLINGS`)."""
-    return StateBlock(name, _MIS_LABELS, "gyro", _coupling_kind(coupling),
-                      sd=np.broadcast_to(np.asarray(sd, float), (6,)), fd_step=1e-3)
+    return StateBlock(name, _MIS_LABELS, "gyro", _coupling_kind(coupling), sd=_sd(sd, "sd", 6), fd_step=1e-3)
 
 
 def gravity_shaping(sigma, beta, *, name="gravity", dynamics=None, noise_psd=None, output=None, labels=None):
@@ -442,8 +453,8 @@ def gravity_shaping(sigma, beta, *, name="gravity", dynamics=None, noise_psd=Non
     or a general shaping filter (``dynamics``, ``noise_psd``, ``output``: e.g. the AR models of
     chen2019 ch. 3 in state-space form)."""
     if dynamics is None:
-        s = np.broadcast_to(np.asarray(sigma, float), (3,))
-        b = np.broadcast_to(np.asarray(beta, float), (3,))
+        s = _sd(sigma, "sigma")
+        b = np.broadcast_to(finite_array(beta, "beta"), (3,))
         if np.any(b <= 0):
             raise ValueError("beta (inverse correlation time) must be positive")
         return StateBlock(name, ("E", "N", "U"), "gravity", dynamics=-np.diag(b), noise_psd=np.diag(2 * b * s**2),
@@ -451,13 +462,12 @@ def gravity_shaping(sigma, beta, *, name="gravity", dynamics=None, noise_psd=Non
     A = np.asarray(dynamics, float)
     k = A.shape[0]
     return StateBlock(name, tuple(labels or [f"s{i}" for i in range(k)]), "gravity", dynamics=A,
-                      noise_psd=noise_psd, output=output, sd=np.broadcast_to(np.asarray(sigma, float), (k,)),
-                      fd_step=1e-2)
+                      noise_psd=noise_psd, output=output, sd=_sd(sigma, "sigma", k), fd_step=1e-2)
 
 
 def lever_arm(sd=0.0, *, name="lever_arm"):
     """Lever-arm (spatial synchronisation) error l of the GNSS antenna, chen2019 eq. (2-13), m."""
-    return StateBlock(name, ("x", "y", "z"), "lever_arm", sd=np.broadcast_to(np.asarray(sd, float), (3,)))
+    return StateBlock(name, ("x", "y", "z"), "lever_arm", sd=_sd(sd, "sd"))
 
 
 def model_15(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e-4, 1e-4, 1e-3),
@@ -465,10 +475,11 @@ def model_15(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
     """The classic 15-state model (chen2019 eqs. (3-14)-(3-16)): 9 navigation errors, accelerometer
     bias ∇_b, gyro drift ε_b.  ``position_sd`` in metres (E, N, U), converted to (δL, δλ, δh)
     at (``lat``, ``h``); ``attitude_sd`` in rad (E, N, U)."""
-    ps = np.broadcast_to(np.asarray(position_sd, float), (3,))
+    ps = _sd(position_sd, "position_sd")
+    earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG, name="lat")
+    earth.check_height(h, name="h")
     rm, rn = earth.radii(lat)
     nav_sd = np.concatenate([[ps[1] / (rm + h), ps[0] / ((rn + h) * np.cos(lat)), ps[2]],
-                             np.broadcast_to(np.asarray(velocity_sd, float), (3,)),
-                             np.broadcast_to(np.asarray(attitude_sd, float), (3,))])
-    return ErrorModel(blocks=(accel_bias(accel_bias_sd), gyro_bias(gyro_bias_sd)), accel_psd=accel_psd,
-                      gyro_psd=gyro_psd, nav_sd=nav_sd)
+                             _sd(velocity_sd, "velocity_sd"), _sd(attitude_sd, "attitude_sd")])
+    return ErrorModel(blocks=(accel_bias(_sd(accel_bias_sd, "accel_bias_sd")), gyro_bias(_sd(gyro_bias_sd, "gyro_bias_sd"))),
+                      accel_psd=_sd(accel_psd, "accel_psd"), gyro_psd=_sd(gyro_psd, "gyro_psd"), nav_sd=nav_sd)

@@ -30,6 +30,7 @@ from .rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from .sensors import GnssMeasurements, ImuErrors, TriadErrors
 from .strapdown import NavSolution, NavState, VERTICAL_MODES, validate_increments, validate_time, vertical_damping_gains
 from .sensors import gnss_measurements
+from ._validate import covariance, finite_array, numeric, positive
 
 __all__ = ["van_loan", "discretize_series", "predict", "update", "rts_smoother", "nees", "nis", "chi2_band",
            "ClosedLoopResult", "closed_loop", "perturb_state", "MonteCarloResult", "monte_carlo",
@@ -39,7 +40,7 @@ __all__ = ["van_loan", "discretize_series", "predict", "update", "rts_smoother",
 # ----------------------------------------------------------------------------- linear pieces
 
 def _square(M, name):
-    M = np.asarray(M, float)
+    M = finite_array(M, name)
     if M.ndim != 2 or M.shape[0] != M.shape[1]:
         raise ValueError(f"{name} must be a square matrix, got shape {M.shape}")
     return M
@@ -52,11 +53,10 @@ def van_loan(F, GQGt, dt):
     Q_d = Φ (upper-right).  Computed with scipy.linalg.expm.
     """
     F = _square(F, "F")
-    Q = _square(GQGt, "GQGt")
+    Q = covariance(GQGt, "GQGt")
     if Q.shape != F.shape:
         raise ValueError(f"F {F.shape} and GQGt {Q.shape} must have the same shape")
-    if not dt > 0:
-        raise ValueError("dt must be positive")
+    dt = positive(dt, "dt", "{name} must be a positive finite time step (s), got {value!r}")
     n = F.shape[0]
     M = np.zeros((2 * n, 2 * n))
     M[:n, :n] = -F
@@ -72,7 +72,12 @@ def discretize_series(F, GQGt, dt, order: int = 4):
     """(Φ, Q_d) by the truncated Taylor series of Van Loan's exponential (the compiled filter's
     discretization; accurate when ‖F dt‖ is small — compare with :func:`van_loan`)."""
     F = np.ascontiguousarray(_square(F, "F"))
-    Q = np.ascontiguousarray(_square(GQGt, "GQGt"))
+    Q = np.ascontiguousarray(covariance(GQGt, "GQGt"))
+    if Q.shape != F.shape:
+        raise ValueError(f"F {F.shape} and GQGt {Q.shape} must have the same shape")
+    dt = positive(dt, "dt", "{name} must be a positive finite time step (s), got {value!r}")
+    if isinstance(order, (str, bytes)) or int(order) != order or order < 1:
+        raise ValueError(f"order must be a positive integer (terms of the series), got {order!r}")
     n = F.shape[0]
     Phi, Qd, w1, w2 = (np.empty((n, n)) for _ in range(4))
     K.discretize_series(F, Q, float(dt), int(order), Phi, Qd, w1, w2)
@@ -81,7 +86,12 @@ def discretize_series(F, GQGt, dt, order: int = 4):
 
 def predict(x, P, Phi, Qd):
     """Time update x⁻ = Φ x, P⁻ = Φ P Φᵀ + Q_d (symmetrised)."""
-    x = Phi @ np.asarray(x, float)
+    x = finite_array(x, "x")
+    n = len(np.atleast_1d(x))
+    P = covariance(P, "P", n)
+    Phi = finite_array(Phi, "Phi", (n, n))
+    Qd = covariance(Qd, "Qd", n)
+    x = Phi @ x
     P = Phi @ P @ Phi.T + Qd
     return x, 0.5 * (P + P.T)
 
@@ -91,11 +101,11 @@ def update(x, P, z, H, R):
 
     K = P⁻Hᵀ S⁻¹, S = H P⁻ Hᵀ + R, x⁺ = x⁻ + K ν, P⁺ = (I-KH) P⁻ (I-KH)ᵀ + K R Kᵀ.
     """
-    x = np.asarray(x, float)
-    P = np.asarray(P, float)
-    z = np.atleast_1d(np.asarray(z, float))
-    H = np.atleast_2d(np.asarray(H, float))
-    R = np.atleast_2d(np.asarray(R, float))
+    x = finite_array(x, "x")
+    P = numeric(P, "P")
+    z = np.atleast_1d(finite_array(z, "z"))
+    H = np.atleast_2d(finite_array(H, "H"))
+    R = np.atleast_2d(numeric(R, "R"))
     n = len(x)
     if P.shape != (n, n):
         raise ValueError(f"P must be {n}×{n}, got {P.shape}")
@@ -103,6 +113,8 @@ def update(x, P, z, H, R):
         raise ValueError(f"H must be {len(z)}×{n} (measurements × states), got {H.shape}")
     if R.shape != (len(z), len(z)):
         raise ValueError(f"R must be {len(z)}×{len(z)}, got {R.shape}")
+    covariance(P, "P")
+    covariance(R, "R")
     nu = z - H @ x
     S = H @ P @ H.T + R
     S = 0.5 * (S + S.T)
@@ -136,8 +148,12 @@ def rts_smoother(x_f, P_f, x_p, P_p, Phi):
 
 def nees(e, P):
     """Normalised estimation error squared eᵀ P⁻¹ e (batched over leading axes)."""
-    e = np.asarray(e, float)
-    P = np.asarray(P, float)
+    e = finite_array(e, "e")
+    P = finite_array(P, "P")
+    if P.shape[-2:] != e.shape[-1:] * 2:
+        raise ValueError(f"P must have trailing shape {e.shape[-1:] * 2} for e of shape {e.shape}, got {P.shape}")
+    if np.any(np.diagonal(P, axis1=-2, axis2=-1) <= 0):
+        raise ValueError("P must have a positive diagonal (variances) to normalise the error")
     d = np.sqrt(np.diagonal(P, axis1=-2, axis2=-1))
     Rn = P / (d[..., :, None] * d[..., None, :])
     y = np.linalg.solve(Rn, (e / d)[..., None])[..., 0]
@@ -146,7 +162,8 @@ def nees(e, P):
 
 def nis(nu, S):
     """Normalised innovation squared νᵀ S⁻¹ ν."""
-    nu = np.asarray(nu, float)
+    nu = finite_array(nu, "nu")
+    S = finite_array(S, "S")
     return np.sum(nu * np.linalg.solve(S, nu[..., None])[..., 0], -1)
 
 

@@ -129,14 +129,15 @@ def _nonneg(x, name, n=3):
 def _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h):
     ps = _nonneg(position_sd, "position_sd")
     earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG, name="lat")
+    earth.check_height(h, name="h")
     rm, rn = earth.radii(lat)
     return np.concatenate([[ps[1] / (rm + h), ps[0] / ((rn + h) * math.cos(lat)), ps[2]],
                            _nonneg(velocity_sd, "velocity_sd"), _nonneg(attitude_sd, "attitude_sd")])
 
 
 def _markov_block(kind, sigma, tau, name):
-    s = _nonneg(sigma, f"{name} sigma")
-    tau = positive(tau, f"{name} correlation time tau", _SECONDS)
+    s = _nonneg(sigma, f"{name}_sigma")
+    tau = positive(tau, f"{name}_tau (correlation time)", _SECONDS)
     return (E.accel_markov if kind == "accel" else E.gyro_markov)(s, tau, name=name)
 
 

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import matrix3
+from ._validate import finite_array, matrix3, rotation, vector3
 
 __all__ = [
     "skew", "vee", "euler_to_dcm", "dcm_to_euler", "rotvec_to_dcm", "dcm_to_rotvec",
@@ -40,14 +40,11 @@ __all__ = [
 
 
 def _vec3(v, name):
-    v = np.asarray(v, dtype=float)
-    if v.shape[-1:] != (3,):
-        raise ValueError(f"{name} must have a last axis of length 3, got shape {v.shape}")
-    return v
+    return vector3(v, name)
 
 
 def _quat(q, name="q"):
-    q = np.asarray(q, dtype=float)
+    q = finite_array(q, name)
     if q.shape[-1:] != (4,):
         raise ValueError(f"{name} must have a last axis of length 4 (scalar first), got shape {q.shape}")
     return q
@@ -67,14 +64,15 @@ def skew(v):
 
 def vee(m):
     """Inverse of :func:`skew` applied to the skew-symmetric part of ``m``."""
-    m = matrix3(m, "m")
+    m = matrix3(finite_array(m, "m"), "m")
     return 0.5 * np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0],
                            m[..., 1, 0] - m[..., 0, 1]], -1)
 
 
 def euler_to_dcm(heading, pitch, roll):
     """C_b^n = R_z(-ψ) R_x(θ) R_y(γ) from heading ψ, pitch θ, roll γ (radians), ENU / R-F-U."""
-    h, p, r = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (heading, pitch, roll)))
+    h, p, r = np.broadcast_arrays(*(finite_array(a, n) for a, n in ((heading, "heading"), (pitch, "pitch"),
+                                                                   (roll, "roll"))))
     if np.any(np.abs(p) > np.pi / 2 + 1e-12):
         raise ValueError("pitch must lie within ±90° (radians expected; convert degrees with np.radians)")
     sh, ch = np.sin(h), np.cos(h)
@@ -98,7 +96,7 @@ def dcm_to_euler(c):
 
     Near pitch = ±90° heading and roll are not separable (gimbal lock); the sum is kept.
     """
-    c = matrix3(c, "C_bn")
+    c = rotation(c, "c (C_b^n)")
     pitch = np.arcsin(np.clip(c[..., 2, 1], -1.0, 1.0))
     heading = np.mod(np.arctan2(c[..., 0, 1], c[..., 1, 1]), 2 * np.pi)
     roll = np.arctan2(-c[..., 2, 0], c[..., 2, 2])
@@ -143,7 +141,7 @@ def quat_to_dcm(q):
 
 def dcm_to_quat(c):
     """Scalar-first unit quaternion (q0 ≥ 0) of a DCM (Shepperd's method)."""
-    c = matrix3(c, "C")
+    c = rotation(c, "c")
     tr = c[..., 0, 0] + c[..., 1, 1] + c[..., 2, 2]
     cand = np.stack([tr, c[..., 0, 0], c[..., 1, 1], c[..., 2, 2]], -1)
     i = np.argmax(cand, -1)
@@ -234,7 +232,7 @@ def quat_to_euler(q):
 
 def attitude_error(c_est, c_true):
     """Misalignment φ^n with Ĉ_b^n = exp(-φ×) C_b^n (≈ (I - φ×) C_b^n), chen2019 eq. (3-16) ψ^n."""
-    c_est, c_true = matrix3(c_est, "C_est"), matrix3(c_true, "C_true")
+    c_est, c_true = rotation(c_est, "c_est"), rotation(c_true, "c_true")
     e = c_est @ np.swapaxes(c_true, -1, -2)
     return -dcm_to_rotvec(e)
 
@@ -244,8 +242,10 @@ def body_rate_from_euler_rates(heading, pitch, roll, heading_rate, pitch_rate, r
 
     ω_nb^b = R_y(γ)^T [θ̇ e_x + R_x(θ)^T (-ψ̇ e_z)] + γ̇ e_y.
     """
-    p, r = np.broadcast_arrays(np.asarray(pitch, float), np.asarray(roll, float))
-    hd, pd, rd = np.broadcast_arrays(*(np.asarray(a, float) for a in (heading_rate, pitch_rate, roll_rate)))
+    finite_array(heading, "heading")
+    p, r = np.broadcast_arrays(finite_array(pitch, "pitch"), finite_array(roll, "roll"))
+    hd, pd, rd = np.broadcast_arrays(*(finite_array(a, n) for a, n in (
+        (heading_rate, "heading_rate"), (pitch_rate, "pitch_rate"), (roll_rate, "roll_rate"))))
     sp, cp, sr, cr = np.sin(p), np.cos(p), np.sin(r), np.cos(r)
     # u = θ̇ e_x + R_x(θ)^T(-ψ̇ e_z) = [θ̇, -ψ̇ sinθ, -ψ̇ cosθ]
     ux, uy, uz = pd, -hd * sp, -hd * cp
@@ -258,6 +258,6 @@ def body_rate_from_euler_rates(heading, pitch, roll, heading_rate, pitch_rate, r
 
 def orthonormalize(c):
     """Nearest rotation matrix (polar decomposition via SVD)."""
-    c = matrix3(c, "C")
+    c = matrix3(finite_array(c, "c"), "c")
     u, _, vt = np.linalg.svd(c)
     return u @ vt

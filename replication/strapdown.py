@@ -25,7 +25,7 @@ import numpy as np
 
 from . import earth
 from . import _kernels as K
-from ._validate import choice, matrix3
+from ._validate import choice, matrix3, numeric, positive, rotation, vector3
 from .rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, quat_to_dcm, skew, vee
 from .rotations import attitude_error
 
@@ -46,11 +46,28 @@ class NavState:
     C_bn: np.ndarray
 
     def __post_init__(self):
-        earth.check_latitude(self.lat, polar_limit_deg=earth.POLAR_LIMIT_DEG, name="NavState.lat")
-        self.v_enu = np.asarray(self.v_enu, float).reshape(3)
-        self.C_bn = matrix3(self.C_bn, "C_bn").reshape(3, 3)
-        if not np.allclose(self.C_bn @ self.C_bn.T, np.eye(3), atol=1e-9):
-            raise ValueError("C_bn is not a rotation matrix (C Cᵀ ≠ I); build it with rotations.euler_to_dcm")
+        v = numeric(self.v_enu, "NavState.v_enu")
+        if v.size != 3:
+            raise ValueError(f"NavState.v_enu must have 3 components (East, North, Up), got shape {v.shape}")
+        self.v_enu = v.reshape(3)
+        self.C_bn = matrix3(numeric(self.C_bn, "NavState.C_bn"), "NavState.C_bn").reshape(3, 3)
+        self.validate()
+
+    def validate(self, *, name: str = "NavState", polar_limit_deg: float = earth.POLAR_LIMIT_DEG):
+        """Check every field (also after a field was changed): latitude within ±90° and outside the polar
+        singularity, finite longitude, height within :data:`replication.earth.HEIGHT_RANGE`, finite
+        velocity below :data:`replication.earth.SPEED_LIMIT`, C_bn a rotation matrix
+        (:data:`replication._validate.ORTHONORMAL_TOL`).  Raises ``TypeError``/``ValueError`` naming the
+        field; the compiled mechanization checks nothing."""
+        earth.check_latitude(self.lat, polar_limit_deg=polar_limit_deg, name=f"{name}.lat")
+        earth.check_longitude(self.lon, name=f"{name}.lon")
+        earth.check_height(self.h, name=f"{name}.h")
+        earth.check_velocity(self.v_enu, name=f"{name}.v_enu")
+        rotation(self.C_bn, f"{name}.C_bn")
+        for field_ in ("lat", "lon", "h"):
+            if np.ndim(getattr(self, field_)) != 0:
+                raise ValueError(f"{name}.{field_} must be a single number, got shape {np.shape(getattr(self, field_))}")
+        return self
 
     @classmethod
     def from_euler(cls, lat, lon, h, v_enu, heading, pitch, roll):
@@ -103,7 +120,7 @@ class NavSolution:
 
 def validate_time(t, n_increments: int | None = None, name: str = "t"):
     """Check a time vector: 1-D, finite, strictly increasing, matching the increments."""
-    t = np.asarray(t, float)
+    t = numeric(t, name)
     if t.ndim != 1 or len(t) < 2:
         raise ValueError(f"{name} must be a 1-D array of at least two sample times")
     if not np.all(np.isfinite(t)):
@@ -120,8 +137,8 @@ def validate_time(t, n_increments: int | None = None, name: str = "t"):
 
 
 def validate_increments(dtheta, dv):
-    dtheta = np.ascontiguousarray(dtheta, dtype=float)
-    dv = np.ascontiguousarray(dv, dtype=float)
+    dtheta = np.ascontiguousarray(numeric(dtheta, "dtheta"))
+    dv = np.ascontiguousarray(numeric(dv, "dv"))
     if dtheta.ndim != 2 or dtheta.shape[1] != 3:
         raise ValueError(f"dtheta must have shape (N, 3), got {dtheta.shape}")
     if dv.shape != dtheta.shape:
@@ -138,8 +155,7 @@ def vertical_damping_gains(tau: float = 100.0, lat: float = 0.0, h: float = 0.0)
     With δḣ = δv_U - k1 δh, δv̇_U = (2γ/R) δh - k2 δh - k3 ∫δh, the characteristic polynomial is
     s³ + k1 s² + (k2 - 2γ/R) s + k3 = (s + 1/τ)³.
     """
-    if not tau > 0:
-        raise ValueError("the damping time constant tau must be positive (seconds)")
+    tau = positive(tau, "tau", "the damping time constant {name} must be positive (seconds), got {value!r}")
     g = float(earth.normal_gravity(lat, h))
     rm, rn = earth.radii(lat)
     ws2 = 2 * g / float(np.sqrt(rm * rn) + h)
@@ -147,7 +163,7 @@ def vertical_damping_gains(tau: float = 100.0, lat: float = 0.0, h: float = 0.0)
 
 
 def _ref(arr, n, name):
-    a = np.ascontiguousarray(np.broadcast_to(np.asarray(arr, float), (n,)), dtype=float)
+    a = np.ascontiguousarray(np.broadcast_to(numeric(arr, name), (n,)), dtype=float)
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name} contains NaN or infinite values")
     return a
@@ -170,13 +186,14 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
     if not isinstance(initial, NavState):
         raise TypeError("initial must be a NavState (e.g. Trajectory.initial_state())")
     choice(vertical, sorted(VERTICAL_MODES), "vertical")
-    earth.check_latitude(initial.lat, polar_limit_deg=polar_limit_deg, name="initial latitude")
+    initial.validate(name="initial", polar_limit_deg=polar_limit_deg)
     if vertical in ("hold", "damped"):
         if h_ref is None:
             raise ValueError(f"vertical={vertical!r} needs h_ref (reference heights at the N+1 samples)")
         if np.ndim(h_ref) and len(h_ref) != n + 1:
             raise ValueError(f"h_ref has {len(h_ref)} values; it needs one per sample ({n + 1})")
         href = _ref(h_ref, n + 1, "h_ref")
+        earth.check_height(href, name="h_ref")
     else:
         href = np.zeros(n + 1)
     if vu_ref is not None and np.ndim(vu_ref) and len(vu_ref) != n + 1:
@@ -205,15 +222,18 @@ def navigation_rates(lat, lon, h, v_enu, C_bn, w_ib_b, f_b, g_extra=None):
     n-frame gravity disturbance to the normal gravity.
     """
     lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
-    v = np.asarray(v_enu, float)
-    C = matrix3(C_bn, "C_bn")
+    earth.check_longitude(lon, name="lon")
+    h = earth.check_height(h, name="h")
+    v = earth.check_velocity(v_enu)
+    C = rotation(C_bn, "C_bn")
+    w_ib_b, f_b = vector3(w_ib_b, "w_ib_b"), vector3(f_b, "f_b")
     rm, rn = earth.radii(lat)
     w_ie = earth.earth_rate_enu(lat)
     w_en = earth.transport_rate_enu(lat, h, v)
     g = earth.gravity_enu(lat, h)
     if g_extra is not None:
-        g = g + np.asarray(g_extra, float)
-    f_n = C @ np.asarray(f_b, float)
+        g = g + vector3(g_extra, "g_extra")
+    f_n = C @ f_b
     vdot = f_n - np.cross(2 * w_ie + w_en, v) + g
-    Cdot = C @ skew(np.asarray(w_ib_b, float)) - skew(w_ie + w_en) @ C
+    Cdot = C @ skew(w_ib_b) - skew(w_ie + w_en) @ C
     return (v[..., 1] / (rm + h), v[..., 0] / ((rn + h) * np.cos(lat)), v[..., 2], vdot, Cdot)
