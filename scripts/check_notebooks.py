@@ -4,7 +4,8 @@
 
 Strict nbval compares outputs; this check catches what nbval cannot: a notebook whose cells
 were run out of order, an error output stored in a cell, a cell never executed, or timing
-metadata that would make ``make book`` leave ``git status`` dirty.
+metadata or the interpreter's version (``language_info.version``) that would make ``make book``
+leave ``git status`` dirty.
 """
 
 from __future__ import annotations
@@ -34,6 +35,10 @@ def problems(path: Path) -> list[str]:
     except (OSError, ValueError) as exc:
         return [f"unreadable: {exc}"]
     out = []
+    version = nb.get("metadata", {}).get("language_info", {}).get("version")
+    if version is not None:
+        out.append(f"metadata.language_info.version = {version!r} stored: the interpreter's version makes a run on "
+                   "another Python rewrite the notebook (run it with scripts/run_notebooks.py, which strips it)")
     code = [c for c in nb.get("cells", []) if c.get("cell_type") == "code"]
     counts = [c.get("execution_count") for c in code]
     if counts != list(range(1, len(code) + 1)):

@@ -5,8 +5,8 @@
 Each notebook is executed top to bottom in a fresh kernel from the repository root's
 environment; outputs are stored in place. Notebooks are independent (each writes its own
 tables), so they run in parallel across the cores (``--jobs``, default: every core); their
-outputs do not depend on it. Volatile metadata (execution timings, widget state) is stripped so
-that re-running a reproducing notebook leaves ``git status`` clean. A stored figure is kept when
+outputs do not depend on it. Volatile metadata (execution timings, widget state, the Python
+version in ``language_info``) is stripped so that re-running a reproducing notebook leaves ``git status`` clean. A stored figure is kept when
 the new rendering differs from it by less than ``--image-rms`` (root-mean-square difference on
 the 0-255 scale, as matplotlib's own image comparison): anti-aliasing and font hinting move a
 few pixels between machines while the figure does not change. A failing cell is reported and
@@ -39,9 +39,16 @@ def book_notebooks() -> list[Path]:
     )
 
 
+VOLATILE_LANGUAGE_INFO = ("version",)
+"""Keys of ``metadata.language_info`` that record the executing interpreter (its Python version):
+stripped, so that running the book on any admitted Python leaves the stored notebooks unchanged."""
+
+
 def clean(nb: nbformat.NotebookNode) -> None:
-    """Remove execution timings and other volatile metadata in place."""
+    """Remove execution timings, the interpreter's version and other volatile metadata in place."""
     nb.metadata = nbformat.NotebookNode({k: nb.metadata[k] for k in KEEP_NB_METADATA if k in nb.metadata})
+    for key in VOLATILE_LANGUAGE_INFO:
+        nb.metadata.get("language_info", {}).pop(key, None)
     for cell in nb.cells:
         cell.metadata.pop("execution", None)
         cell.metadata.pop("ExecuteTime", None)

@@ -42,15 +42,28 @@ def test_checker_rejects_out_of_order_and_errors(tmp_path):
     assert any("warning" in m for m in check_notebooks.problems(p))
 
 
+def test_checker_refuses_a_stored_interpreter_version(tmp_path):
+    p = _nb(tmp_path, ["1"])
+    nb = nbformat.read(p, as_version=4)
+    nb.metadata["language_info"] = {"name": "python", "version": "3.13.1"}
+    nbformat.write(nb, p)
+    assert any("language_info.version" in m for m in check_notebooks.problems(p))
+    del nb.metadata["language_info"]["version"]
+    nbformat.write(nb, p)
+    assert check_notebooks.problems(p) == []
+
+
 def test_runner_strips_volatile_metadata(tmp_path):
     nb = nbformat.v4.new_notebook()
     nb.metadata["widgets"] = {"state": 1}
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.metadata["language_info"] = {"name": "python", "version": "3.12.4"}
     cell = nbformat.v4.new_code_cell("1")
     cell.metadata["execution"] = {"iopub.execute_input": "2026-01-01"}
     nb.cells = [cell]
     run_notebooks.clean(nb)
     assert "widgets" not in nb.metadata and "kernelspec" in nb.metadata
+    assert nb.metadata["language_info"] == {"name": "python"}          # the interpreter's version is gone
     assert "execution" not in nb.cells[0].metadata
     assert json.loads(nbformat.writes(nb))["cells"][0]["metadata"] == {}
 
