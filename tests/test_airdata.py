@@ -434,3 +434,55 @@ def test_readings_ledger_rows_reach_the_print_only_within_the_stated_tolerance()
     assert st[:3] == ["reproduced"] * 3 and st[3:] == ["not-reproduced"] * 3
     with pytest.raises(ValueError, match="no finite"):
         ad.readings_ledger_rows({"x": {"misalignment": 1.0}}, t1)
+
+
+def test_mean_interval_is_the_student_t_interval_of_the_mean():
+    x = np.array([1.0, 2.0, 3.0, 4.0])
+    m, lo, hi = ad.mean_interval(x)
+    # t_{0.975, 3} = 3.182446305284263 (tables); s = sqrt(5/3); half = t s / 2
+    half = 3.182446305284263 * np.sqrt(5 / 3) / 2
+    assert m == 2.5 and lo == pytest.approx(2.5 - half, rel=1e-12) and hi == pytest.approx(2.5 + half, rel=1e-12)
+    assert np.isnan(ad.mean_interval([1.0])[1])
+    with pytest.raises(ValueError, match="finite"):
+        ad.mean_interval([1.0, np.nan])
+    with pytest.raises(ValueError, match="level"):
+        ad.mean_interval(x, level=95)
+
+
+def test_accel_bias_axes_removes_the_up_bias_only(short_flight):
+    base = ad.AirdataSetup()
+    no_up = ad.AirdataSetup(accel_bias_axes=(1, 1, 0))
+    dth0, dv0 = ad._corrupt(short_flight, base, np.random.default_rng(4))
+    dth1, dv1 = ad._corrupt(short_flight, no_up, np.random.default_rng(4))
+    T = np.diff(short_flight.t)
+    # same draws: the x, y increments identical to the bit (factor 1.0 is exact), z lower by b T
+    np.testing.assert_array_equal(dv0[:, :2], dv1[:, :2])
+    np.testing.assert_array_equal(dth0, dth1)
+    np.testing.assert_allclose(dv0[:, 2] - dv1[:, 2], base.accel_bias * T, rtol=1e-6)   # cancellation vs dv ~ 2 m/s
+    with pytest.raises(ValueError, match="accel_bias_axes"):
+        ad.AirdataSetup(accel_bias_axes=(1, 0))
+
+
+def test_diagnostic_rows_state_runs_and_interval_without_a_printed_value(short_flight):
+    t1 = rp.load_paper("duan2023-table-1")
+    setup = ad.AirdataSetup(correction_interval=30.0, threshold=1.0)
+    diags = ad.diagnostic_runs(short_flight, setup, n_runs=3, seed=1)
+    assert list(diags) == list(ad.BIAS_DIAGNOSTICS)
+    rows = ad.diagnostic_ledger_rows(diags, t1)
+    assert len(rows) == 6 and all(r["paper"] == "" and "3-run mean" in r["note"] and "95 % CI" in r["note"]
+                                  for r in rows)
+    df = rp.comparison_frame(rows)
+    assert df["abs_error"].eq("").all() and df["paper"].eq("").all()
+    # the status follows the stated rule: qualitative iff the interval's lower end lies beyond
+    # (1 + LEDGER_TOLERANCE) x the printed proposed-method value
+    expect = []
+    for lab, mc in diags.items():
+        s = mc.summary("max")
+        for q in ad.TABLE1_UNITS:
+            lo = ad.mean_interval(s[q])[1]
+            expect.append("qualitative" if lo > 1.5 * t1.value(f"proposed SINS/ADS / {q}") else "not-reproduced")
+    assert list(df["status"]) == expect
+    # 3 minutes of flight stay below the printed position error: that statement fails
+    assert df.loc[df["quantity"].str.endswith("position error"), "status"].eq("not-reproduced").all()
+    with pytest.raises(ValueError, match="n_runs"):
+        ad.diagnostic_runs(short_flight, setup, n_runs=1)
