@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import earth
-from ._validate import components
+from ._validate import components, finite_array, nonnegative, nonnegative_array, numeric, positive, rotation
 from .rotations import euler_to_dcm
 from .units import DEG_PER_H, MICRO_G, PPM, ARCSEC, deg_per_h2
 from scipy.signal import lfilter
@@ -50,9 +50,8 @@ def misalignment_matrix(theta):
 
 def markov_sigma_from_driving_psd(q_drive, tau):
     """Stationary σ of ẋ = -x/τ + w with driving intensity q: σ² = q τ / 2."""
-    if tau <= 0:
-        raise ValueError("the correlation time tau must be positive (seconds)")
-    return np.sqrt(np.asarray(q_drive, float) * tau / 2)
+    tau = positive(tau, "tau", "the correlation time {name} must be positive (seconds), got {value!r}")
+    return np.sqrt(nonnegative_array(q_drive, "q_drive") * tau / 2)
 
 
 @dataclass
@@ -133,7 +132,9 @@ def gauss_markov_coefficients(dt, tau) -> tuple[float, float]:
     q : float
         sqrt(1 - a²): the driving standard deviation per unit of σ.
     """
-    if not dt > 0:
+    dt = float(numeric(dt, "dt")) if np.ndim(dt) == 0 else dt
+    tau = float(numeric(tau, "tau")) if np.ndim(tau) == 0 else tau
+    if not dt > 0 or not math.isfinite(dt):
         raise ValueError(f"dt must be a positive sample interval, got {dt!r}")
     if not tau > 0:
         raise ValueError(f"tau must be a positive correlation time (inf for a random constant), got {tau!r}")
@@ -255,6 +256,8 @@ def lever_arm_offset(lat, h, C_bn, lever_arm_b, w_eb_b=None):
     writes C_b^n ω_nb^n P^b; ω_eb^b = ω_ib^b - C_n^b ω_ie^n is the exact rate).
     """
     lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
+    h = earth.check_height(h)
+    C_bn = rotation(C_bn, "C_bn")
     l = components(lever_arm_b, "lever_arm_b")
     d = np.einsum("...ij,j->...i", C_bn, l)
     rm, rn = earth.radii(lat)
@@ -273,6 +276,9 @@ def gnss_measurements(traj, *, rate_hz: float = 10.0, sigma_pos=(0.03, 0.03, 0.1
     (E, N, U metres) and ``sigma_vel`` (m/s), independent white; ``lever_arm_b`` the antenna
     position in the body frame (chen2019 eq. (2-13)).
     """
+    rate_hz = positive(rate_hz, "rate_hz", "GNSS rate {name} must be a positive finite rate (Hz), got {value!r}")
+    sp = nonnegative_array(components(sigma_pos, "sigma_pos"), "sigma_pos")
+    sv = nonnegative_array(components(sigma_vel, "sigma_vel"), "sigma_vel")
     dt = float(np.median(np.diff(traj.t)))
     step = 1.0 / (rate_hz * dt)
     if rate_hz <= 0 or abs(step - round(step)) > 1e-6:
@@ -280,8 +286,6 @@ def gnss_measurements(traj, *, rate_hz: float = 10.0, sigma_pos=(0.03, 0.03, 0.1
     step = int(round(step))
     idx = np.arange(step, len(traj.t), step)
     rng = np.random.default_rng(rng)
-    sp = components(sigma_pos, "sigma_pos")
-    sv = components(sigma_vel, "sigma_vel")
     l = components(lever_arm_b, "lever_arm_b")
     C = euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2])
     w_ie = earth.earth_rate_enu(traj.lat[idx])
@@ -300,8 +304,11 @@ def gnss_measurements(traj, *, rate_hz: float = 10.0, sigma_pos=(0.03, 0.03, 0.1
 def barometric_height(traj, *, sigma: float = 1.0, bias: float = 0.0, markov_sigma: float = 0.0,
                       markov_tau: float = 600.0, rng=None):
     """Barometric / air-data height at every sample: h + bias + Gauss-Markov + white noise (m)."""
-    if sigma < 0 or markov_sigma < 0:
-        raise ValueError("sigma and markov_sigma cannot be negative")
+    sigma = nonnegative(sigma, "sigma", "{name} cannot be negative or non-finite (m), got {value!r}")
+    markov_sigma = nonnegative(markov_sigma, "markov_sigma", "{name} cannot be negative or non-finite (m), got {value!r}")
+    finite_array(bias, "bias")
+    if not numeric(markov_tau, "markov_tau") > 0:
+        raise ValueError(f"markov_tau must be a positive correlation time (s; inf: no Gauss-Markov term), got {markov_tau!r}")
     rng = np.random.default_rng(rng)
     n = len(traj.t)
     m = _markov_path(n, float(np.median(np.diff(traj.t))), np.array([markov_sigma] * 3), markov_tau, rng)[:, 0]

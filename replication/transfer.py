@@ -42,6 +42,7 @@ from scipy.optimize import brentq
 
 from . import earth
 from ._validate import choice
+from ._validate import nonnegative as _nonnegative, numeric as _numeric, positive as _positive
 from .units import DEG, DEG_PER_H, DEG_PER_SQRT_H, HOUR, MICRO_G, UG_PER_SQRT_HZ
 import mpmath
 import re
@@ -67,19 +68,24 @@ _NOT_ONE_OF = "{name} must be one of {allowed}, not {value!r}"  # the refusal of
 # --------------------------------------------------------------------------- validation
 
 def _check_motion(lat, v_east, v_north):
-    lat = float(np.asarray(lat, dtype=float))
+    lat = _numeric(lat, "lat")
+    if lat.size != 1:
+        raise ValueError(f"lat must be a single latitude (radians), got shape {lat.shape}")
+    lat = float(lat.reshape(()))
     if not math.isfinite(lat):
-        raise ValueError("latitude must be a finite number (radians)")
+        raise ValueError("lat (latitude) must be a finite number (radians)")
     if abs(lat) >= math.pi / 2:
         raise ValueError(
-            f"latitude {math.degrees(lat):.6g}° is at or beyond ±90°: the an2021 model contains "
+            f"lat = {math.degrees(lat):.6g}° (latitude) is at or beyond ±90°: the an2021 model contains "
             f"tan L and sec L, which diverge at the pole (latitudes are in radians; convert degrees "
             f"with np.radians)"
         )
-    v_east, v_north = float(v_east), float(v_north)
-    if not (math.isfinite(v_east) and math.isfinite(v_north)):
-        raise ValueError("velocities must be finite numbers (m/s)")
-    return lat, v_east, v_north
+    for name, v in (("v_east", v_east), ("v_north", v_north)):
+        v = float(_numeric(v, name))
+        if not math.isfinite(v) or abs(v) > earth.SPEED_LIMIT:
+            raise ValueError(f"velocities must be finite numbers (m/s) below {earth.SPEED_LIMIT:g} m/s: "
+                             f"{name} = {v!r}")
+    return lat, float(v_east), float(v_north)
 
 
 def earth_parameters(lat, radius=None, gravity=None):
@@ -659,13 +665,9 @@ class NoiseSettings:
 
     def __post_init__(self):
         for name in ("gyro_arw", "accel_vrw", "gyro_bias_rw", "accel_bias_rw"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and v >= 0):
-                raise ValueError(f"{name} must be finite and non-negative, got {v}")
+            _nonnegative(getattr(self, name), name, "{name} must be finite and non-negative, got {value}")
         for name in ("position_sigma", "position_rate"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be finite and positive, got {v}")
+            _positive(getattr(self, name), name, "{name} must be finite and positive, got {value}")
 
     def scaled(self, **factors):
         """A copy with some fields multiplied by factors, e.g. ``scaled(accel_vrw=10)``."""

@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from replication import calibration, earth, errors, kalman, rotations, strapdown, transfer
-from replication import observability, sensors, timeseries, models
+from replication import models, sensors, trajectory
 from replication.units import DEG
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
@@ -151,6 +151,8 @@ def _bad(kind):
     common = st.one_of(nonfinite, text)
     if kind == "vec2":
         return st.one_of(common, nonfinite.map(lambda x: [x, 0.0]))
+    if kind == "speed":            # one velocity component (m/s)
+        return st.one_of(common, st.floats(1.3e4, 1e12), st.floats(-1e12, -1.3e4))
     if kind == "angle":
         return common
     if kind == "lat":
@@ -166,6 +168,8 @@ def _bad(kind):
         return st.one_of(common, st.floats(1.01, 1e3).map(lambda s: s * I3),
                          st.floats(1e-5, 1.0).map(lambda e: I3 + e * np.triu(np.ones((3, 3)), 1)),
                          st.just(-I3), st.just(np.ones((3, 3))), st.just(np.eye(2)))
+    if kind == "tau":              # a correlation time: positive, inf allowed (a random constant)
+        return st.one_of(st.sampled_from([np.nan, -np.inf]), text, st.floats(-1e6, 0.0))
     if kind in ("sd", "rate"):     # a non-negative / positive number
         lo = st.floats(-1e6, -1e-9) if kind == "sd" else st.floats(-1e6, 0.0)
         return st.one_of(common, lo)
@@ -183,6 +187,7 @@ def _bad(kind):
 
 
 _Y = np.random.default_rng(0).standard_normal(200)
+_TRAJ = trajectory.generate([trajectory.Straight(1.0)], LAT, LON, H, speed=10.0)
 _RNG = np.random.default_rng
 _CALLS = {
     # name: (function, valid keyword arguments, {argument: kind})
@@ -240,6 +245,26 @@ _CALLS = {
                                     {"y": "series", "sample_rate": "rate"}),
     "calibration.bias_stability": (calibration.bias_stability, dict(y=_Y, sample_rate=10.0, window=1.0),
                                    {"y": "series", "sample_rate": "rate", "window": "rate"}),
+    "sensors.markov_sigma_from_driving_psd": (sensors.markov_sigma_from_driving_psd, dict(q_drive=1e-6, tau=100.0),
+                                              {"q_drive": "sd", "tau": "rate"}),
+    "sensors.gauss_markov_coefficients": (sensors.gauss_markov_coefficients, dict(dt=0.01, tau=100.0),
+                                          {"dt": "rate", "tau": "tau"}),
+    "sensors.lever_arm_offset": (sensors.lever_arm_offset, dict(lat=LAT, h=H, C_bn=I3, lever_arm_b=[1.0, 0, 0]),
+                                 {"lat": "lat", "h": "h", "C_bn": "rot", "lever_arm_b": "vec3"}),
+    "sensors.gnss_measurements": (lambda **kw: sensors.gnss_measurements(_TRAJ, rng=0, **kw),
+                                  dict(rate_hz=10.0, sigma_pos=0.1, sigma_vel=0.03),
+                                  {"rate_hz": "rate", "sigma_pos": "sd", "sigma_vel": "sd", "lever_arm_b": "vec3"}),
+    "sensors.barometric_height": (lambda **kw: sensors.barometric_height(_TRAJ, rng=0, **kw),
+                                  dict(sigma=1.0, bias=0.0, markov_sigma=1.0, markov_tau=600.0),
+                                  {"sigma": "sd", "bias": "angle", "markov_sigma": "sd", "markov_tau": "tau"}),
+    "transfer.system_matrix": (transfer.system_matrix, dict(lat=LAT, v_east=100.0, v_north=0.0),
+                               {"lat": "lat", "v_east": "speed", "v_north": "speed"}),
+    "transfer.schuler_frequency": (transfer.schuler_frequency, dict(lat=LAT), {"lat": "lat"}),
+    "transfer.NoiseSettings": (transfer.NoiseSettings,
+                               dict(gyro_arw=1e-5, accel_vrw=1e-4, gyro_bias_rw=1e-8, accel_bias_rw=1e-7,
+                                    position_sigma=1.0),
+                               {"gyro_arw": "sd", "accel_vrw": "sd", "gyro_bias_rw": "sd", "accel_bias_rw": "sd",
+                                "position_sigma": "rate", "position_rate": "rate"}),
 }
 _CASES = [(name, arg) for name, (_, _, kinds) in _CALLS.items() for arg in kinds]
 
