@@ -27,7 +27,7 @@ millions of products without re-orthonormalization stays below 1e-9; an error of
 wrong matrix (a scaled one, a transposed product of non-rotations), not round-off."""
 
 COVARIANCE_TOL = 1e-9
-"""Relative tolerance of :func:`covariance`: asymmetry |M - Mᵀ| ≤ tol·max|M| and smallest eigenvalue
+"""Relative tolerance of :func:`covariance`: asymmetry |M - Mᵀ| ≤ tol·max|diag M| and smallest eigenvalue
 ≥ -tol·max|eigenvalue|. The round-off of a symmetric eigen-decomposition is about n·ε·max|λ|
 (≈ 1e-14 for n ≤ 45), and a propagated covariance carries a few such round-offs; a negative
 eigenvalue beyond 1e-9 of the largest is a wrong input (a negative variance, a sign lost)."""
@@ -57,7 +57,7 @@ def numeric(value, name: str) -> np.ndarray:
     if a.dtype.kind not in "biuf":
         raise TypeError(f"{name} must be a number or an array of numbers, got {type(value).__name__} "
                         f"{value!r:.40}")
-    return a.astype(float)
+    return a.astype(float, copy=False)
 
 
 def finite_array(value, name: str, shape: tuple | None = None) -> np.ndarray:
@@ -138,8 +138,10 @@ def rotation(value, name: str, tol: float = ORTHONORMAL_TOL) -> np.ndarray:
 def covariance(value, name: str, n: int | None = None, tol: float = COVARIANCE_TOL) -> np.ndarray:
     """A covariance (or noise-intensity) matrix: square, finite, symmetric, positive semidefinite.
 
-    Positive semidefinite means smallest eigenvalue ≥ -tol·max|eigenvalue|. A Cholesky factor
-    of M + tol·max|diag M|·I proves it cheaply; only when that fails are the eigenvalues computed.
+    Symmetric means max|M - Mᵀ| ≤ tol·max|diag M| (for a semidefinite M, max|M| = max|diag M|);
+    positive semidefinite means smallest eigenvalue ≥ -tol·max|eigenvalue|. A Cholesky factor
+    of M + tol·max|diag M|·I proves it cheaply (about 20 µs for 15×15); only when that fails are the
+    eigenvalues computed.
 
     Parameters
     ----------
@@ -168,16 +170,21 @@ def covariance(value, name: str, n: int | None = None, tol: float = COVARIANCE_T
     if m.ndim != 2 or m.shape[0] != m.shape[1] or (n is not None and m.shape[0] != n):
         size = "a square matrix" if n is None else f"{n}×{n}"
         raise ValueError(f"{name} must be {size}, got shape {m.shape}")
-    scale = np.max(np.abs(m), initial=0.0)
-    if np.max(np.abs(m - m.T), initial=0.0) > tol * scale:
-        raise ValueError(f"{name} must be symmetric (a covariance), max|M - Mᵀ| = "
-                         f"{np.max(np.abs(m - m.T)):.3g} exceeds {tol:g}·max|M|")
-    d = np.max(np.abs(np.diag(m)), initial=0.0)
+    if m.size == 0:
+        return m
+    diag = m.diagonal()
+    d = float(np.abs(diag).max())              # = max|M| for a semidefinite M (|m_ij| ≤ √(m_ii m_jj))
+    asym = float(np.abs(m - m.T).max())
+    if asym > tol * d and asym > 0.0:
+        raise ValueError(f"{name} must be symmetric (a covariance), max|M - Mᵀ| = {asym:.3g} exceeds "
+                         f"{tol:g}·max|diag M|")
     if d == 0.0:
-        ok = scale == 0.0                          # zero diagonal: only the zero matrix is semidefinite
+        ok = not np.any(m)                     # zero diagonal: only the zero matrix is semidefinite
     else:
+        shifted = m.copy()
+        shifted.flat[::m.shape[0] + 1] += tol * d
         try:
-            np.linalg.cholesky(m + tol * d * np.eye(m.shape[0]))
+            np.linalg.cholesky(shifted)
             ok = True
         except np.linalg.LinAlgError:
             ok = False
