@@ -30,7 +30,7 @@ help:
 	@echo "make nbval  - strict nbval of every notebook on this machine's native code path"
 	@echo "make notebook NB=book/part/file.ipynb - execute one notebook in place"
 	@echo "make lock   - recompile requirements.lock from requirements.in (needs network to PyPI)"
-	@echo "make bench  - run the benchmark scripts, writing benchmarks/*.json (optional pyins comparison from requirements-bench.lock;"
+	@echo "make bench  - run the benchmark scripts, writing benchmarks/*.json (the pyins comparison uses python-ins, pinned in requirements.lock;"
 	@echo "              BENCH_BEFORE=<commit> times the closed-loop filter of an earlier tree beside the current one)"
 
 # ---------------------------------------------------------------- environment

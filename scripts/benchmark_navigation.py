@@ -13,7 +13,8 @@ Measured:
    ``filters.run_feedback_filter`` (position + NED velocity measurements, bias models);
 3. the 20-run Monte Carlo of that hour with sensor-error injection (``kalman.monte_carlo``).
 
-pyins is optional (``requirements-bench.lock``); without it only our numbers are written.
+pyins (``python-ins``) is pinned in requirements.lock, where it is also a test reference
+(tests/test_peers_pyins.py), so ``make env`` installs it; without it only our numbers are written.
 Compilation is excluded from every timing (a warm-up call first).  Results go to
 ``benchmarks/navigation.json``; the book's appendix reads that file.
 """
@@ -199,6 +200,8 @@ def main(argv=None):
     except metadata.PackageNotFoundError:
         have_pyins = False
         res["pyins_version"] = None
+        print("python-ins is not installed: `make env` installs it (pinned in requirements.lock); "
+              "writing the toolkit's numbers only", file=sys.stderr)
     if have_pyins:
         res["pyins"] = {"strapdown": pyins_strapdown(traj, args.repeats),
                         "filter_15_state": pyins_filter(traj, args.pyins_filter_duration)}
