@@ -67,7 +67,8 @@ import pandas as pd
 __all__ = ["observability_matrix", "stripped_observability_matrix", "total_observability_matrix", "som_condition",
            "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
            "covariance_observability", "segment_bounds", "AMBIGUOUS", "spearman", "CHEN2019_MANEUVERS", "Maneuver",
-           "chen2019_maneuvers", "degrees_table", "covariance_table", "rank_metrics", "best_scenario_counts", "unbanked", "sweep"]
+           "chen2019_maneuvers", "degrees_table", "covariance_table", "rank_metrics", "best_scenario_counts", "unbanked", "coordinated", "sweep",
+           "verdict_under", "compare_verdicts"]
 
 
 # ----------------------------------------------------------------------------- validation
@@ -513,6 +514,25 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
     return out
 
 
+def _reflown(traj, roll):
+    """``traj`` flown along the same track with the roll angle ``roll`` (rad, per sample): f^n and
+    the heading and pitch kept, f^b, ω_ib^b and the increments recomputed (see :func:`unbanked`)."""
+    t = np.asarray(traj.t, float)
+    hpr = np.array(traj.hpr, float)
+    f_n = np.einsum("kij,kj->ki", traj.C_bn, traj.f_b)
+    psi = np.unwrap(hpr[:, 0])
+    psi_rate, pitch_rate, roll_rate = np.gradient(psi, t), np.gradient(hpr[:, 1], t), np.gradient(roll, t)
+    hpr[:, 2] = roll
+    C = euler_to_dcm(hpr[:, 0], hpr[:, 1], hpr[:, 2])
+    w_nb = body_rate_from_euler_rates(hpr[:, 0], hpr[:, 1], hpr[:, 2], psi_rate, pitch_rate, roll_rate)
+    w_in = earth.earth_rate_enu(traj.lat) + earth.transport_rate_enu(traj.lat, traj.h, traj.v_enu)
+    w_ib = w_nb + np.einsum("kji,kj->ki", C, w_in)
+    f_b = np.einsum("kji,kj->ki", C, f_n)
+    dt = np.diff(t)[:, None]
+    return Trajectory(t, traj.lat, traj.lon, traj.h, traj.v_enu, hpr, w_ib, f_b, 0.5 * (w_ib[1:] + w_ib[:-1]) * dt,
+                      0.5 * (f_b[1:] + f_b[:-1]) * dt, list(traj.segments))
+
+
 def unbanked(traj):
     """The same track flown *without bank* (flat, skidding turns): roll set to zero, the
     specific force f^n = C_b^n f^b kept, so the centripetal acceleration V ψ̇ appears on the
@@ -522,20 +542,25 @@ def unbanked(traj):
     not say how its Fig. 2-3 maneuvers were flown); the increments ``dtheta``/``dv`` are the
     trapezoid of the new rates (not meant for strapdown accuracy tests)."""
 
-    t = np.asarray(traj.t, float)
-    hpr = np.array(traj.hpr, float)
-    f_n = np.einsum("kij,kj->ki", traj.C_bn, traj.f_b)
-    psi = np.unwrap(hpr[:, 0])
-    psi_rate, pitch_rate = np.gradient(psi, t), np.gradient(hpr[:, 1], t)
-    hpr[:, 2] = 0.0
-    C = euler_to_dcm(hpr[:, 0], hpr[:, 1], hpr[:, 2])
-    w_nb = body_rate_from_euler_rates(hpr[:, 0], hpr[:, 1], hpr[:, 2], psi_rate, pitch_rate, np.zeros_like(t))
-    w_in = earth.earth_rate_enu(traj.lat) + earth.transport_rate_enu(traj.lat, traj.h, traj.v_enu)
-    w_ib = w_nb + np.einsum("kji,kj->ki", C, w_in)
-    f_b = np.einsum("kji,kj->ki", C, f_n)
-    dt = np.diff(t)[:, None]
-    return Trajectory(t, traj.lat, traj.lon, traj.h, traj.v_enu, hpr, w_ib, f_b, 0.5 * (w_ib[1:] + w_ib[:-1]) * dt,
-                      0.5 * (f_b[1:] + f_b[:-1]) * dt, list(traj.segments))
+    return _reflown(traj, np.zeros(len(traj.t)))
+
+
+def coordinated(traj):
+    """The same track flown with the bank that leaves *no* lateral specific force (f_x = 0 on the
+    body x, right, axis): the roll of ``traj`` corrected by the angle of (f_x, f_z), so that the
+    Coriolis and transport residual a kinematically banked turn leaves on f_x (~0.01 m/s² at
+    100 m/s) is absorbed in the bank, as a perfectly coordinated turn would; f^n kept, the roll rate
+    by central differences (see :func:`unbanked`).  A kinematic variant for the sensitivity study of
+    chen2019 Table 2-3, whose Fig. 2-3 maneuvers are not specified."""
+
+    f_b = np.asarray(traj.f_b, float)
+    roll = np.array(traj.hpr, float)[:, 2]
+    for sign in (1.0, -1.0):
+        out = _reflown(traj, roll + sign * np.arctan2(f_b[:, 0], f_b[:, 2]))
+        if np.max(np.abs(out.f_b[:, 0])) < 1e-6 * np.max(np.abs(out.f_b[:, 2])):
+            return out
+    raise RuntimeError("coordinated: no roll correction zeroes f_x (a trajectory with pitch beyond the small-angle "
+                       "range?)")
 
 
 def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, before_segments: int = 1,
@@ -607,9 +632,11 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
     :func:`degrees_table` plus optional ``model``, ``maneuvers`` and ``states`` overrides.
     Returns one row per variant: Spearman ρ per scenario, total verdict agreement (of
     states × scenarios), the scenario winning most states and the number of states above the
-    rank tolerance per scenario ("observable <scenario>", the bar count of chen2019 Fig. 2-4)."""
+    rank tolerance per scenario ("observable <scenario>", the bar count of chen2019 Fig. 2-4).
+    ``out.attrs["tables"]`` keeps each variant's degrees table (states of ``reference``), with its
+    ``rank_tol`` and ``ambiguity`` attributes, for :func:`compare_verdicts`."""
 
-    rows = []
+    rows, tables = [], {}
     for name, spec in variants.items():
         spec = dict(spec)
         mdl, mvs, sts = spec.pop("model", model), spec.pop("maneuvers", maneuvers), spec.pop("states", states)
@@ -623,4 +650,154 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
         row["best maneuver"] = best_scenario_counts(table).idxmax()
         row.update({f"observable {c}": int((table[c] > tol[c]).sum()) for c in reference.columns})
         rows.append(row)
-    return pd.DataFrame(rows).set_index("variant")
+        tables[name] = table
+    out = pd.DataFrame(rows).set_index("variant")
+    out.attrs["tables"] = tables
+    return out
+
+
+ROUND_OFF_MARGIN = 10.0
+"""A degree within this factor above the numerical-rank tolerance is round-off: unobservable."""
+
+
+def verdict_under(printed_value: float, degree: float, rank_tol: float, ambiguity: float, *,
+                  printed_threshold: float = 1e-5) -> tuple[bool, bool, bool]:
+    """The verdicts on one value of an observability table: ``(printed, reproduced, decided)``.
+
+    *printed* is ``printed_value > printed_threshold`` (observable), *reproduced* is
+    ``degree > rank_tol``; *decided* is False when the two differ but the state lies almost equally
+    in two singular subspaces (``ambiguity > AMBIGUOUS``): the assignment rule, not the model,
+    decides such a value, which therefore neither agrees nor disagrees with the print.  *reproduced*
+    uses a margin: a degree within :data:`ROUND_OFF_MARGIN` of the rank tolerance is round-off —
+    singular values of numerically zero directions reach just above ``rank_tol`` (a state whose
+    columns of F and H are identically zero has been seen at 1.01 ``rank_tol``) — and counts as
+    unobservable, so that no verdict hangs on the last bits of an SVD.
+    """
+    for name, v in (("printed_value", printed_value), ("degree", degree), ("rank_tol", rank_tol),
+                    ("ambiguity", ambiguity), ("printed_threshold", printed_threshold)):
+        if isinstance(v, (str, bytes)) or not np.isfinite(float(v)) or float(v) < 0:
+            raise ValueError(f"{name} must be a finite number >= 0, got {v!r}")
+    vp, vo = float(printed_value) > printed_threshold, float(degree) > ROUND_OFF_MARGIN * rank_tol
+    return vp, vo, bool(vp == vo or float(ambiguity) <= AMBIGUOUS)
+
+
+def _stored_degree(table, state, scenario) -> float:
+    """A degree to 6 significant digits, or 0 when it is round-off (see :func:`verdict_under`)."""
+    d = float(table.loc[state, scenario])
+    return 0.0 if d <= ROUND_OFF_MARGIN * table.attrs["rank_tol"][scenario] else float(f"{d:.6g}")
+
+
+def _word(observable: bool) -> str:
+    return "observable" if observable else "unobservable"
+
+
+def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain: dict, symbols=None,
+                     ruled_out=(), level_combinations=LEVEL_COMBINATIONS, before="before maneuver",
+                     printed_threshold: float = 1e-5):
+    """The status of every verdict of an observability table under its main reading, and the
+    readings ledger that supports it (chen2019 Table 2-3; CONTRIBUTING.md, "Readings and the main
+    reading").
+
+    Parameters
+    ----------
+    printed : DataFrame
+        The printed degrees (rows: states, columns: scenarios).
+    readings : dict
+        Reading name → degrees table of the same shape with ``attrs["rank_tol"]`` and
+        ``attrs["ambiguity"]`` (:func:`degrees_table`, or ``sweep(...).attrs["tables"]``).
+    main : str
+        The main reading, a key of ``readings``.
+    exact : dict
+        ``(state, scenario)`` → bool: the second computation's verdict (exact null-space
+        criterion) under the main reading.
+    explain : dict
+        State → the physical reason a verdict differs (one line).
+    symbols : dict, optional
+        State → printed symbol used in the quantities (default: the state name).
+    ruled_out : iterable of str
+        Prefixes of readings that printed evidence excludes: shown in the ledger, never used to
+        reach the print.
+    level_combinations : set
+        States observable in level flight only in a combination (scenario ``before``).
+    printed_threshold : float
+        A printed degree above it is *observable*.
+
+    Returns
+    -------
+    main_rows, ledger_rows : list of dict
+        Rows for :func:`replication.reproduction.compare`.  A value whose verdict differs under the
+        main reading is ``not-reproduced`` only when it is decided (not ambiguous, not a level
+        combination), the second computation agrees with the main reading, and no reading that is
+        not ruled out gives the printed verdict; otherwise ``qualitative`` with the reason.  A value
+        without a verdict carries no reproduced degree.  The ledger holds, for every reading, the
+        Spearman rank correlation per scenario (a statistic of agreement with the printed ranks, not
+        a printed value) and its verdict on every value whose verdict under the main reading differs
+        from the print (the values whose status the ledger decides).
+    """
+    if main not in readings:
+        raise ValueError(f"main reading {main!r} is not one of the readings {list(readings)}")
+    sym = symbols or {s: s for s in printed.index}
+    ruled = tuple(ruled_out)
+    excluded = {r for r in readings if any(r.startswith(k) for k in ruled)}
+    if main in excluded:
+        raise ValueError(f"the main reading {main!r} is itself ruled out")
+
+    def decide(r, s, c):
+        t = readings[r]
+        return verdict_under(printed.loc[s, c], t.loc[s, c], t.attrs["rank_tol"][c], t.attrs["ambiguity"][c][s],
+                             printed_threshold=printed_threshold)
+
+    main_rows, differ = [], []
+    for s in printed.index:
+        for c in printed.columns:
+            vp, vo, decided = decide(main, s, c)
+            t, q = readings[main], f"{sym[s]} | {c}"
+            says = f"printed {_word(vp)}, reproduced {_word(vo)}"
+            value = _stored_degree(t, s, c)
+            ex = exact[(s, c)]
+            if vp != vo:
+                differ.append((s, c))
+            if vp == vo:
+                status, note = "qualitative", f"verdict agrees ({_word(vp)}); magnitudes depend on unstated choices" + (
+                    "" if ex == vp else f"; alone it is {_word(ex)} by the exact null-space criterion (second computation)")
+            elif not decided:
+                status, value = "qualitative", None
+                note = (f"no verdict ({says}): the state lies almost equally in two singular subspaces (projection ratio "
+                        f"{t.attrs['ambiguity'][c][s]:.2f}), so the assignment rule, not the model, decides")
+            elif c == before and s in level_combinations and not ex:
+                status, value = "qualitative", None
+                note = (f"no verdict ({says}): {explain[s]}; alone each member is unobservable (exact null-space "
+                        "criterion, second computation) and the member an SVD names depends on the scaling")
+            elif ex == vp:
+                status, note = "qualitative", (f"{says} with this chapter's rank tolerance; the exact null-space criterion "
+                                               f"(second computation) agrees with the print: {explain[s]}")
+            else:
+                reach = [r for r in readings if r not in excluded and r != main
+                         and (lambda v: v[0] == v[1] or not v[2])(decide(r, s, c))]
+                if reach:
+                    status, note = "qualitative", (f"{says} under the main reading, but the reading '{reach[0]}' of the "
+                                                   f"ledger does not contradict the print: {explain[s]}")
+                else:
+                    status, note = "not-reproduced", (f"{says} under every reading of the ledger not ruled out by the "
+                                                      f"print (the exact null-space criterion agrees): {explain[s]}")
+            main_rows.append(dict(quantity=q, unit="1", paper=printed.loc[s, c], reproduced=value, status=status,
+                                  note=note))
+
+    ledger = []
+    for r, t in readings.items():
+        tag = " (ruled out by the print)" if r in excluded else ""
+        for c in printed.columns:
+            rho = spearman(printed[c].to_numpy(float), t[c].to_numpy(float))
+            ledger.append(dict(quantity=f"{r} | Spearman ρ with the printed ranks, {c}", unit="1", paper=None,
+                               paper_text="ranks of the printed column", reproduced=round(float(rho), 2),
+                               status="qualitative" if rho >= 0.7 else "not-reproduced",
+                               note=f"a statistic of agreement, not a printed value: accepted when ρ ≥ 0.7{tag}"))
+        for s, c in differ:
+            vp, vo, decided = decide(r, s, c)
+            ok = vp == vo or not decided
+            ledger.append(dict(quantity=f"{r} | {sym[s]} | {c}", unit="1", paper=printed.loc[s, c],
+                               reproduced=_stored_degree(t, s, c) if decided else None,
+                               status="qualitative" if ok else "not-reproduced",
+                               note=("verdict agrees" if vp == vo else "no verdict (ambiguous assignment)" if ok
+                                     else f"SVD verdict: printed {_word(vp)}, reproduced {_word(vo)}") + tag))
+    return main_rows, ledger

@@ -253,3 +253,61 @@ def test_rank_uses_the_documented_tolerance():
         assert list(d.observable()) == [True, False]
     d = O.observability_degrees(Q, normalize="scale", state_scale=[2.0, 3.0])
     assert d.rank == 1
+
+
+def test_coordinated_turns_leave_no_lateral_specific_force():
+    """observability.coordinated: the bank absorbs the ~0.01 m/s² Coriolis/transport residual of a
+    kinematically banked turn (f_x below 1e-9 m/s², round-off of the rotation), f^n unchanged to
+    round-off, and the roll changes by less than 0.1° (0.0119/9.8 rad ≈ 0.07°)."""
+    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
+    t = mv["U-turn"].traj
+    c = O.coordinated(t)
+    assert np.abs(t.f_b[:, 0]).max() > 1e-3                       # the residual is there before
+    assert np.abs(c.f_b[:, 0]).max() < 1e-9
+    f_n, f_n_c = (np.einsum("kij,kj->ki", x.C_bn, x.f_b) for x in (t, c))
+    assert np.abs(f_n - f_n_c).max() < 1e-12
+    assert np.degrees(np.abs(c.hpr[:, 2] - t.hpr[:, 2]).max()) < 0.1
+
+
+def test_verdict_under_decides_with_a_round_off_margin():
+    assert O.verdict_under(2.0, 5.0, 1e-9, 0.1) == (True, True, True)
+    # a degree within a decade of the rank tolerance is round-off: unobservable
+    assert O.verdict_under(1e-18, 5e-9, 1e-9, 0.1) == (False, False, True)
+    assert O.verdict_under(3.0, 5e-9, 1e-9, 0.1) == (True, False, True)
+    # verdicts differ but the assignment is ambiguous: no verdict
+    assert O.verdict_under(3.0, 0.0, 1e-9, 0.99)[2] is False
+    with pytest.raises(ValueError, match="degree"):
+        O.verdict_under(1.0, float("nan"), 1e-9, 0.1)
+
+
+def _degrees(values, tol=1e-9, amb=0.1):
+    import pandas as pd
+    values = {k: v + [0.0] for k, v in values.items()}                 # a third state, unobservable everywhere
+    t = pd.DataFrame(values, index=["a", "b", "c"], columns=["before maneuver", "turn"])
+    t.attrs["rank_tol"] = {c: tol for c in t.columns}
+    t.attrs["ambiguity"] = {c: {s: amb for s in t.index} for c in t.columns}
+    return t
+
+
+def test_compare_verdicts_follows_the_ledger_and_the_printed_evidence():
+    """A verdict that differs under the main reading is not-reproduced only when no reading that the
+    print does not rule out gives the printed verdict; a ruled-out reading never rescues it."""
+    printed = _degrees({"before maneuver": [1.0, 1e-20], "turn": [2.0, 3.0]})
+    main = _degrees({"before maneuver": [1.0, 0.0], "turn": [0.0, 0.0]})
+    other = _degrees({"before maneuver": [1.0, 0.0], "turn": [0.0, 4.0]})          # reaches 'b | turn'
+    excluded = _degrees({"before maneuver": [1.0, 0.0], "turn": [5.0, 4.0]})       # would reach 'a | turn'
+    exact = {(s, c): False for s in "abc" for c in printed.columns}
+    exact[("a", "before maneuver")] = True
+    rows, ledger = O.compare_verdicts(printed, {"main": main, "other": other, "old convention": excluded}, "main",
+                                      exact=exact, explain={"a": "why a", "b": "why b"}, ruled_out=["old"])
+    st = {r["quantity"]: r["status"] for r in rows if not r["quantity"].startswith("c")}
+    assert st == {"a | before maneuver": "qualitative", "a | turn": "not-reproduced",
+                  "b | before maneuver": "qualitative", "b | turn": "qualitative"}
+    assert "reading 'other'" in next(r["note"] for r in rows if r["quantity"] == "b | turn")
+    # the ledger: rank statistics without a printed value, and each reading's verdict on the differing values
+    q = {r["quantity"]: r for r in ledger}
+    assert q["main | Spearman ρ with the printed ranks, turn"]["paper"] is None
+    assert q["old convention | a | turn"]["status"] == "qualitative" and "ruled out" in q["old convention | a | turn"]["note"]
+    assert q["other | a | turn"]["status"] == "not-reproduced"
+    with pytest.raises(ValueError, match="ruled out"):
+        O.compare_verdicts(printed, {"old": main}, "old", exact=exact, explain={}, ruled_out=["old"])
