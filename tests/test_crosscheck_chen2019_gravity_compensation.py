@@ -1,7 +1,7 @@
 """Second computation of the height rows of chen2019 Table 4-50 (the chapter's simulated analog).
 
 The stored rows ``height normal / direct / state`` of ``tables/chen2019-table-4-50.csv`` are the
-mean photo-epoch RMS of four simulated flights, with a 95 % half-width in the note.  The
+mean photo-epoch RMS of the simulated flights (their number in the note), with a 95 % half-width in the note.  The
 cross-check (replication.crosschecks.chen2019_gravity_compensation) predicts the same RMS by a
 linear covariance analysis of the vertical channel alone (chen2019 eqs. 3-14, 3-15, 3-17, 3-18),
 with the true error covariance of the closed-loop filter for the methods that leave the
@@ -28,6 +28,7 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
+from scipy import stats
 
 from replication.crosschecks import chen2019_gravity_compensation as xc
 
@@ -44,7 +45,7 @@ def _stored():
     out = {}
     for m in xc.METHODS:
         row = table.loc[table["quantity"] == f"height {m}"].iloc[0]
-        hw = float(re.search(r"\+-\s*([0-9.]+)", str(row["note"])).group(1))
+        hw = float(re.search(r"\+-\s*([0-9.eE+-]+?) \(95", str(row["note"])).group(1))
         out[m] = (float(row["reproduced"]), hw)
     return out
 
@@ -89,28 +90,27 @@ def test_ordering_normal_direct_state(predicted):
     assert stored[0] > stored[1] > stored[2]
 
 
-@pytest.mark.parametrize("method", ["direct", "state"])
+@pytest.mark.parametrize("method", ["normal", "direct", "state"])
 def test_height_rms_agrees(predicted, method):
     lo, hi = _band(predicted, method)
     assert lo <= STORED[method][0] <= hi, (method, lo, STORED[method][0], hi)
 
 
-def test_normal_row_differs_as_recorded(predicted):
-    """The normal-gravity row is the one open difference between the two computations of the
-    analog (stated in the chapter, not blamed on the paper): the linear model predicts 0.064-0.066 m
-    along the re-flown strips against the analog's 0.0525 +- 0.0036 m, above the agreement band,
-    and a run-to-run scatter of one flight's RMS several times what the analog's 4 runs show
-    (the field's few independent patches over 53 km at D = 10 km).  Asserted as recorded, so that
-    a change on either side (the field synthesis, the filter, this model) brings it back for review:
-    the stored row lies below the band, the prediction's lower edge 10-40 % above it, and the
-    predicted scatter more than 3 times the analog's per-run scatter."""
-    lo, hi = _band(predicted, "normal")
+def test_normal_row_lies_low_in_the_band_as_recorded(predicted):
+    """The normal-gravity row agrees (test above) but sits near the band's lower edge: the linear
+    model predicts 0.064-0.066 m along the re-flown strips against the analog's mean of n runs,
+    and a run-to-run scatter of one flight's RMS larger than the analog's (the field's few
+    independent patches over 53 km at D = 10 km).  Asserted as recorded, so that a change on
+    either side (the field synthesis, the filter, this model) brings it back for review: the
+    prediction's lower edge 5-40 % above the stored row, its scatter more than 1.5 times the
+    analog's per-run scatter."""
     stored, hw = STORED["normal"]
-    assert stored < lo, ("normal", lo, stored, hi)
     low_pred = min(predicted[("normal", s)]["rms"] for s in xc.SHAPES)
-    assert 0.10 < low_pred / stored - 1.0 < 0.40, (low_pred, stored)
-    per_run_sd = hw * 4 ** 0.5 / 3.182  # the 95 % half-width of 4 runs, t(0.975, 3) = 3.182
-    assert min(predicted[("normal", s)]["run_sd"] for s in xc.SHAPES) > 3.0 * per_run_sd
+    assert 0.05 < low_pred / stored - 1.0 < 0.40, (low_pred, stored)
+    n = int(re.search(r"mean RMS of (\d+) runs", str(pd.read_csv(TABLE).loc[lambda d: d["quantity"] == "height normal",
+                                                                               "note"].iloc[0])).group(1))
+    per_run_sd = hw * n ** 0.5 / stats.t.ppf(0.975, n - 1)  # the stored 95 % half-width of n runs
+    assert min(predicted[("normal", s)]["run_sd"] for s in xc.SHAPES) > 1.5 * per_run_sd
 
 
 def test_filter_own_covariance_is_not_the_error():
@@ -163,7 +163,7 @@ def _stored_level():
     out = {}
     for c in ("pitch", "roll"):
         row = table.loc[table["quantity"] == f"{c} normal"].iloc[0]
-        out[c] = (float(row["reproduced"]), float(re.search(r"\+-\s*([0-9.]+)", str(row["note"])).group(1)))
+        out[c] = (float(row["reproduced"]), float(re.search(r"\+-\s*([0-9.eE+-]+?) \(95", str(row["note"])).group(1)))
     return out
 
 
