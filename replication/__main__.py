@@ -1,10 +1,11 @@
-"""Command-line interface: ``python -m replication status|show|cite|index``."""
+"""Command-line interface: ``python -m replication status|show|cite|index``, ``--version``."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
+from . import __version__, repository_url
 from . import reproduction as rp
 
 
@@ -43,13 +44,16 @@ def _cmd_status(args) -> int:
 
 
 def _cmd_show(args) -> int:
-    table_id = rp.resolve_table_id(args.id)
-    df = rp.read_table(table_id)
-    if args.format == "csv":
-        sys.stdout.write(df.to_csv(index=False, lineterminator="\n"))
-    else:
-        path = rp.tables_dir() / f"{table_id}.{args.format}"
-        sys.stdout.write(path.read_text(encoding="utf-8"))
+    tables = rp.resolve_table_ids(args.id)
+    for i, table_id in enumerate(tables):
+        if len(tables) > 1:                      # an artifact covered by several tables: each in turn
+            heading = f"{table_id} ({i + 1} of {len(tables)} tables covering {args.id})"
+            sys.stdout.write(("\n" if i else "") + {"md": f"## {heading}\n\n", "tex": f"% {heading}\n",
+                                                     "csv": f"# {heading}\n"}[args.format])
+        if args.format == "csv":
+            sys.stdout.write(rp.read_table(table_id).to_csv(index=False, lineterminator="\n"))
+        else:
+            sys.stdout.write((rp.tables_dir() / f"{table_id}.{args.format}").read_text(encoding="utf-8"))
     return 0
 
 
@@ -67,6 +71,8 @@ def _cmd_index(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m replication", description=__doc__)
+    parser.add_argument("--version", action="version",
+                        version=f"replication {__version__} ({repository_url()})")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("status", help="the reproduction dashboard: one line per seed artifact")
     p.add_argument("--source", choices=rp.SOURCE_KEYS + ("toolkit",), help="only one source document")
@@ -74,12 +80,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--failing", action="store_true",
                    help="only the paper artifacts holding not-reproduced rows, each with its reason")
     p.set_defaults(func=_cmd_status)
-    p = sub.add_parser("show", help="print one exported table")
-    p.add_argument("id", help="table id, e.g. chen2019-eq-3-1")
+    p = sub.add_parser("show", help="print an exported table (every table covering an artifact id)")
+    p.add_argument("id", help="an id printed by `status`: a table id, e.g. chen2019-eq-3-1, or an artifact id")
     p.add_argument("--format", choices=("csv", "md", "tex"), default="md")
     p.set_defaults(func=_cmd_show)
-    p = sub.add_parser("cite", help="a BibTeX entry for one exported table")
-    p.add_argument("id")
+    p = sub.add_parser("cite", help="BibTeX for an exported table (one entry per table covering an artifact id)")
+    p.add_argument("id", help="an id printed by `status`")
     p.set_defaults(func=_cmd_cite)
     p = sub.add_parser("index", help="check the verdict rule, rebuild tables/status.csv and tables/register.csv")
     p.set_defaults(func=_cmd_index)

@@ -42,7 +42,7 @@ from typing import Any, Iterable, Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from . import __version__
+from . import __version__, repository_url
 
 STATUSES = (
     "reproduced", "erratum", "inconsistent", "qualitative", "analog", "unverifiable", "not-reproduced", "pending",
@@ -806,9 +806,9 @@ def read_table(table_id: str) -> pd.DataFrame:
     validate_id(table_id)
     path = tables_dir() / f"{table_id}.csv"
     if not path.exists():
-        known = list_tables()
-        near = [k for k in known if k.split("-")[0] == table_id.split("-")[0]][:10]
-        raise RegistryError(f"no exported table {table_id!r}; exported tables of that source: {near}")
+        near = [k for k in list_tables() if k.split("-")[0] == table_id.split("-")[0]]
+        raise RegistryError(f"no exported table {table_id!r}; the {len(near)} exported tables of that source: "
+                            f"{', '.join(near) or 'none'}")
     return pd.read_csv(path, dtype=str, keep_default_na=False)
 
 
@@ -1040,8 +1040,12 @@ def load_table(table_id: str) -> pd.DataFrame:
     Numeric columns (``paper``, ``reproduced``, ``abs_error``, ``rel_error``, ``tolerance``) are
     floats (NaN where the cell holds text or nothing: the printed form is in ``paper_text``,
     ``reproduced_text``); ``df.attrs`` holds the sidecar (title, notebook, commit, seeds, package
-    versions).  ``table_id`` as printed by ``python -m replication status``.
+    versions).  ``table_id`` as printed by ``python -m replication status``: a table id, or an
+    artifact id covered by one table.  An artifact covered by several tables raises
+    :class:`RegistryError` listing all of them (one call always returns one table);
+    :func:`load_tables` returns them all.
     """
+    table_id = resolve_table_id(table_id)
     df = read_table(table_id)
     for c in NUMERIC_COLUMNS:
         if c in df.columns:
@@ -1050,6 +1054,13 @@ def load_table(table_id: str) -> pd.DataFrame:
     if side.exists():
         df.attrs.update(json.loads(side.read_text(encoding="utf-8")))
     return df
+
+
+def load_tables(ident: str) -> dict[str, pd.DataFrame]:
+    """Every exported table behind an id printed by ``python -m replication status``, as
+    ``{table_id: DataFrame}`` typed as by :func:`load_table` (one entry for a table id or an
+    artifact covered by one table, one per table for an artifact covered by several)."""
+    return {tid: load_table(tid) for tid in resolve_table_ids(ident)}
 
 
 def artifact_tables(artifact: Mapping[str, Any]) -> list[str]:
@@ -1514,37 +1525,58 @@ PACKAGE_YEAR = 2026
 """Year of the package release cited by :func:`bibtex_for` (as in CITATION.cff)."""
 
 
-def resolve_table_id(ident: str) -> str:
-    """The exported table behind ``ident``: a table id, or an artifact id of
-    ``tables/status.csv`` covered by exactly one table.  Raises :class:`RegistryError` saying
-    which tables to use otherwise (an artifact covered by several, or not exported yet)."""
+def resolve_table_ids(ident: str) -> list[str]:
+    """The exported tables behind ``ident``: ``[ident]`` for a table id, the tables of
+    ``tables/status.csv`` that cover an artifact id otherwise (one or several).  Raises
+    :class:`RegistryError` for an artifact no table covers yet, and for an unknown id (naming
+    every exported table of that source)."""
     validate_id(ident)
     if (tables_dir() / f"{ident}.csv").exists():
-        return ident
+        return [ident]
     status_path = tables_dir() / "status.csv"
     if status_path.exists():
         st = pd.read_csv(status_path, dtype=str, keep_default_na=False)
         hit = st[st["id"] == ident]
         if len(hit):
             tables = hit.iloc[0]["tables"].split()
-            if len(tables) == 1:
-                return tables[0]
             if not tables:
                 raise RegistryError(f"{ident!r} is {hit.iloc[0]['status']}: no table has been exported for it yet")
-            raise RegistryError(f"{ident!r} is covered by several tables: {', '.join(tables)}; name one of them")
+            return tables
     read_table(ident)                   # not a table either: raises, naming the tables of that source
-    return ident
+    return [ident]
 
 
-def bibtex_for(table_id: str) -> str:
-    """A BibTeX entry citing the exported table ``table_id`` (or the artifact it covers).
+def resolve_table_id(ident: str) -> str:
+    """The one exported table behind ``ident`` (:func:`resolve_table_ids`); an artifact covered
+    by several tables raises :class:`RegistryError` listing every one of them."""
+    tables = resolve_table_ids(ident)
+    if len(tables) > 1:
+        raise RegistryError(f"{ident!r} is covered by {len(tables)} tables: {', '.join(tables)}; name one of "
+                            f"them, or use replication.load_tables({ident!r}) for all")
+    return tables[0]
 
-    Year and version of the package, the commit recorded in the table's sidecar (the one on top
-    of which its values were computed, not the checkout's), its status with the row split; a
-    table reproducing a paper relates to that paper's entry, which follows; a supplementary check
-    of the package's own cites the package only.
+
+def bibtex_for(ident: str) -> str:
+    """BibTeX citing the exported table ``ident``, or every table covering the artifact ``ident``.
+
+    One ``@misc`` entry per table: year and version of the package, its repository (``url``),
+    the commit recorded in the table's sidecar (the one on top of which its values were
+    computed, not the checkout's), its status with the row split; a table reproducing a paper
+    relates to that paper's entry, which follows once; a supplementary check of the package's
+    own cites the package only.
     """
-    table_id = resolve_table_id(table_id)
+    entries, sources = [], []
+    for table_id in resolve_table_ids(ident):
+        entry, source = _table_bibtex(table_id)
+        entries.append(entry)
+        if source in SOURCE_KEYS and source not in sources:
+            sources.append(source)
+    originals = [b for b in (source_bibtex(s) for s in sources) if b]
+    return "\n".join(entries) + "".join("\n" + b for b in originals)
+
+
+def _table_bibtex(table_id: str) -> tuple[str, str]:
+    """The ``@misc`` entry of one exported table, and the source key it reproduces."""
     df = read_table(table_id)
     meta = json.loads((tables_dir() / f"{table_id}.json").read_text(encoding="utf-8"))
     source = meta.get("source", table_id.split("-")[0])
@@ -1562,12 +1594,12 @@ def bibtex_for(table_id: str) -> str:
              f"  version      = {{{version}}},",
              f"  howpublished = {{Table \\texttt{{tables/{table_id}.csv}} of the reproduction package "
              f"\\texttt{{replication}} v{version}, commit {commit[:12]}}},",
+             f"  url          = {{{repository_url()}}},",
              f"  note         = {{Status {overall} ({split}).{' Reproduces ' + source + '; cite the original as well.' if is_paper else ' A supplementary check of the package.'}}},"]
     if is_paper:
         lines.append(f"  related      = {{{source}}},")
     lines.append("}")
-    original = source_bibtex(source) if is_paper else ""
-    return "\n".join(lines) + "\n" + ("\n" + original if original else "")
+    return "\n".join(lines) + "\n", source
 
 
 def source_bibtex(key: str) -> str:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import shutil
 import subprocess
 import sys
@@ -12,6 +13,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+import replication
 from replication import reproduction as rp
 from replication.__main__ import main as cli
 
@@ -354,19 +356,86 @@ def test_an_artifact_can_be_covered_by_check_tables(sandbox):
 
 
 def test_every_id_printed_by_status_resolves_in_show_and_cite():
-    """An artifact id resolves to the one table that covers it; otherwise the error names the
-    tables to use (several) or says it is pending."""
+    """Every id of the stored status (artifact or table) resolves to the tables that cover it; an
+    artifact covered by several gives all of them, one BibTeX entry each; load_table refuses it
+    naming every table, load_tables returns them all."""
     status = pd.read_csv(rp.tables_dir() / "status.csv", dtype=str, keep_default_na=False)
+    several = 0
     for _, r in status.iterrows():
         tables = r["tables"].split()
         for t in tables:
-            assert rp.resolve_table_id(t) == t
+            assert rp.resolve_table_ids(t) == [t] and rp.resolve_table_id(t) == t
             assert rp.bibtex_for(t).startswith(f"@misc{{repro-{t},")
+        if not tables:
+            continue
+        assert rp.resolve_table_ids(r["id"]) == tables
         if len(tables) == 1:
             assert rp.resolve_table_id(r["id"]) == tables[0]
-        elif len(tables) > 1:
-            with pytest.raises(rp.RegistryError, match="several tables"):
-                rp.resolve_table_id(r["id"])
+        else:
+            several += 1
+            bib = rp.bibtex_for(r["id"])
+            assert [m for m in re.findall(r"@misc\{repro-([^,]+),", bib)] == tables
+            with pytest.raises(rp.RegistryError, match=f"covered by {len(tables)} tables: {', '.join(tables)};"):
+                rp.load_table(r["id"])
+            assert list(rp.load_tables(r["id"])) == tables
+    assert several >= 1                           # the case is exercised on the real tables
+
+
+def test_every_id_the_status_command_prints_works_in_show_and_cite(sandbox, capsys):
+    """Run ``status`` on a sandbox holding an artifact covered by one table, one covered by two
+    check tables, a supplementary check and a pending artifact; every id it prints is shown and
+    cited (each covering table in turn, with a heading), the pending one refused with its reason."""
+    (sandbox / "data" / "artifacts.csv").write_text(
+        "id,source,artifact,description,tables\n"
+        "chen2019-table-9-9,chen2019,Table 9-9,one table,\n"
+        "chen2019-eq-4-8,chen2019,Eq. (4-8),two tables,chen2019-check-a chen2019-check-b\n"
+        "chen2019-table-9-8,chen2019,Table 9-8,never exported,\n", encoding="utf-8")
+    one = [dict(quantity="q", unit="", paper=1, reproduced=1, tolerance=0)]
+    for tid in ("chen2019-table-9-9", "chen2019-check-a", "chen2019-check-b", "toolkit-check-own"):
+        rp.compare(tid, one, title=f"Title of {tid}", notebook="book/x.ipynb")
+    assert cli(["index"]) == 0
+    capsys.readouterr()
+    assert cli(["status"]) == 0
+    printed = sorted(set(re.findall(r"\b(?:chen2019|toolkit)-(?:table|eq|check)-[0-9a-z.-]*[0-9a-z]",
+                                    capsys.readouterr().out)))
+    assert printed == ["chen2019-check-a", "chen2019-check-b", "chen2019-eq-4-8", "chen2019-table-9-8",
+                       "chen2019-table-9-9", "toolkit-check-own"]
+    for ident in printed:
+        if ident == "chen2019-table-9-8":         # pending: nothing to show or cite yet, and it says so
+            for cmd in ("show", "cite"):
+                assert cli([cmd, ident]) == 2
+                assert "no table has been exported for it yet" in capsys.readouterr().err
+            continue
+        tables = rp.resolve_table_ids(ident)
+        for fmt in ("md", "csv", "tex"):
+            assert cli(["show", ident, "--format", fmt]) == 0, (ident, fmt)
+            out = capsys.readouterr().out
+            assert out.count("Title of ") == len(tables) if fmt != "csv" else "q,,1.0,,1.0," in out
+            headings = re.findall(r"^(?:## |# |% )(chen2019-check-[ab]) \((\d) of 2 tables covering chen2019-eq-4-8\)$",
+                                  out, flags=re.M)
+            assert headings == ([("chen2019-check-a", "1"), ("chen2019-check-b", "2")] if len(tables) > 1 else [])
+        assert cli(["cite", ident]) == 0
+        bib = capsys.readouterr().out
+        assert re.findall(r"@misc\{repro-([^,]+),", bib) == tables
+        assert bib.count(f"url          = {{{replication.repository_url()}}}") == len(tables)
+        assert bib.count("@techreport{chen2019,") == (0 if ident.startswith("toolkit") else 1)
+
+
+def test_load_table_refuses_an_artifact_of_several_tables_naming_all(sandbox):
+    (sandbox / "data" / "artifacts.csv").write_text(
+        "id,source,artifact,description,tables\n"
+        "chen2019-eq-4-8,chen2019,Eq. (4-8),two tables,chen2019-check-a chen2019-check-b\n"
+        "chen2019-eq-4-9,chen2019,Eq. (4-9),one table,chen2019-check-c\n", encoding="utf-8")
+    for tid in ("chen2019-check-a", "chen2019-check-b", "chen2019-check-c"):
+        rp.compare(tid, [dict(quantity="q", unit="", paper=1, reproduced=1, tolerance=0)], title=tid,
+                   notebook="book/x.ipynb")
+    rp.build_index(write=True)
+    assert replication.load_table("chen2019-eq-4-9").attrs["id"] == "chen2019-check-c"
+    with pytest.raises(rp.RegistryError, match=r"covered by 2 tables: chen2019-check-a, chen2019-check-b; .*"
+                                               r"load_tables\('chen2019-eq-4-8'\)"):
+        replication.load_table("chen2019-eq-4-8")
+    both = replication.load_tables("chen2019-eq-4-8")
+    assert list(both) == ["chen2019-check-a", "chen2019-check-b"] and both["chen2019-check-b"]["paper"].dtype.kind == "f"
 
 
 def test_cite_gives_year_version_and_the_sidecar_commit():
