@@ -19,14 +19,15 @@ unexport PYTHONDONTWRITEBYTECODE
 
 NOTEBOOKS := $(shell find book -name '*.ipynb' -not -path '*/_build/*' -not -path '*/.ipynb_checkpoints/*' | sort)
 
-.PHONY: help env lock book notebooks notebook tables html test unit units unit-portable portability suite nbval \
+.PHONY: help env sysdeps lock book notebooks notebook tables html test unit units unit-portable portability suite nbval \
         check-notebooks check-tables html-strict browser bench clean
 
 help:
 	@echo "make book   - create the environment if missing, re-execute every notebook, regenerate tables/, build book/_build/html"
 	@echo "make test   - unit tests (native and on a perturbed numerical code path), strict nbval of every notebook"
 	@echo "              re-executed under two perturbed numerical configurations, tables unchanged, strict book build,"
-	@echo "              browser check"
+	@echo "              browser check (first installs Debian's chromium, fonts-wqy-zenhei and texlive-latex-base"
+	@echo "              where the user may: make sysdeps)"
 	@echo "make nbval  - strict nbval of every notebook on this machine's native code path"
 	@echo "make notebook NB=book/part/file.ipynb - execute one notebook in place"
 	@echo "make lock   - recompile requirements.lock from requirements.in (needs network to PyPI)"
@@ -69,7 +70,12 @@ html: env
 	$(VENV)/bin/jupyter-book build book --path-output book --quiet
 
 # ---------------------------------------------------------------- tests
-test: env check-notebooks suite tables check-tables
+test: sysdeps env check-notebooks suite tables check-tables
+
+# the Debian packages the checks need (chromium, a CJK font, pdflatex): installed as root or with sudo
+# without a password, otherwise a stop naming them (scripts/sysdeps.sh; .ci/run calls it too)
+sysdeps:
+	bash scripts/sysdeps.sh
 
 unit: env
 	$(PY) -m pytest -q tests -m "not browser"
