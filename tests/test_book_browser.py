@@ -59,7 +59,7 @@ class _QuietHandler(http.server.SimpleHTTPRequestHandler):
 @pytest.fixture(scope="module")
 def browser():
     if not Path(CHROMIUM).exists():
-        pytest.fail(f"Chromium not found at {CHROMIUM}: install Debian's 'chromium' (done by .ci/run)")
+        pytest.fail(f"Chromium not found at {CHROMIUM}: install Debian's 'chromium' (make sysdeps does)")
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as pw:

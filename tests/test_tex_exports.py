@@ -25,7 +25,7 @@ def _pdflatex():
     exe = shutil.which("pdflatex")
     if exe is None:
         if os.environ.get("REPLICATION_REQUIRE_LATEX") == "1":
-            pytest.fail("pdflatex not found: install Debian's texlive-latex-base (done by .ci/run)")
+            pytest.fail("pdflatex not found: install Debian's texlive-latex-base (make sysdeps does)")
         pytest.skip("pdflatex not installed (Debian: texlive-latex-base)")
     return exe
 
