@@ -251,12 +251,25 @@ def test_figures_are_present_and_decoded(seen):
     assert (ROOT / "book" / "_build" / "screenshot.png").stat().st_size > 10_000
 
 
+def test_figures_are_described_by_their_captions(seen):
+    """Every figure image's alt text is words (its caption's first sentence, book/_ext/figure_alt.py),
+    not its hashed file name."""
+    bad = []
+    for rel in (rel for rel, r in seen.items() if r["has_figure"]):
+        for tag in re.findall(r"<img [^>]*_images/[^>]*>", (HTML / rel).read_text(encoding="utf-8")):
+            alt = re.search(r'alt="([^"]*)"', tag)
+            if not alt or len(alt.group(1).split()) < 3 or "_images/" in alt.group(1):
+                bad.append(f"{rel}: {tag[:120]}")
+    assert not bad, "figures without a description:\n" + "\n".join(bad[:10])
+
+
 CJK_RUN = re.compile(r"[\u4e00-\u9fff]{2,}")
 
 
 def test_chinese_terms_of_the_sources_are_searchable(server, browser):
     """The book quotes the sources' Chinese terms (逆序检验, 截尾, 子午圈 …): the search index
-    holds each quoted run as a term, and the search page finds a chapter for one of them."""
+    holds each quoted run as a term, and the search page finds a chapter for one of them and for
+    two characters inside it."""
     import json
 
     text = (HTML / "searchindex.js").read_text(encoding="utf-8")
@@ -269,8 +282,10 @@ def test_chinese_terms_of_the_sources_are_searchable(server, browser):
     missing = sorted(q for q in quoted if not any(q in t for t in terms))
     assert not missing, f"Chinese terms missing from the search index: {missing[:10]}"
     page = browser.new_page(viewport={"width": 1280, "height": 900})
-    page.goto(f"{server}/search.html?q=逆序检验", wait_until="load", timeout=60_000)
-    page.wait_for_selector("ul.search li a", timeout=30_000)
-    hits = page.eval_on_selector_all("ul.search li a", "els => els.map(e => e.getAttribute('href'))")
+    # the whole term, and two characters inside it (book/_ext/cjk_search.py indexes the bigrams)
+    for query in ("逆序检验", "逆序", "检验"):
+        page.goto(f"{server}/search.html?q={query}", wait_until="load", timeout=60_000)
+        page.wait_for_selector("ul.search li a", timeout=30_000)
+        hits = page.eval_on_selector_all("ul.search li a", "els => els.map(e => e.getAttribute('href'))")
+        assert any("05_gravity_time_series" in h for h in hits), (query, hits)
     page.close()
-    assert any("05_gravity_time_series" in h for h in hits), hits

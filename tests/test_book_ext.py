@@ -1,0 +1,41 @@
+"""The book's small Sphinx extensions (book/_ext): figure alt text and Chinese search terms."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "book" / "_ext"))
+
+from cjk_search import SearchEnglishCJK, cjk_terms  # noqa: E402
+from figure_alt import MAX_CHARS, first_sentence  # noqa: E402
+
+
+def test_first_sentence_skips_the_periods_of_abbreviations():
+    cap = ("Reproduction of Fig. 2: zeros (o) and poles (x) of eqs. (4) and (5) for north-south motion\n"
+           "(upper half-plane). The conjugates mirror them.")
+    assert first_sentence(cap) == ("Reproduction of Fig. 2: zeros (o) and poles (x) of eqs. (4) and (5) "
+                                   "for north-south motion (upper half-plane).")
+    assert first_sentence("Bode plot of H_y(s). The dotted line marks it.") == "Bode plot of H_y(s)."
+    assert first_sentence("Analog of Fig. 6: 3-D position error.") == "Analog of Fig. 6: 3-D position error."
+    assert first_sentence("逆序检验的结果。第二句") == "逆序检验的结果。"
+
+
+def test_first_sentence_cuts_a_long_caption_at_a_word():
+    out = first_sentence("word " * 200)
+    assert len(out) <= MAX_CHARS + 2 and out.endswith(" …")
+
+
+def test_first_sentence_refuses_a_non_string():
+    with pytest.raises(TypeError, match="text must be a str"):
+        first_sentence(None)
+
+
+def test_chinese_runs_are_indexed_whole_and_as_bigrams():
+    assert cjk_terms("逆序检验") == ["逆序", "序检", "检验"]
+    assert cjk_terms("ADF") == []
+    words = SearchEnglishCJK({}).split("the 逆序检验 (reverse arrangement test) and 截尾")
+    assert {"逆序检验", "逆序", "检验", "截尾", "reverse", "test"} <= set(words)
+    assert words.count("截尾") == 1           # a two-character run is its own only window
