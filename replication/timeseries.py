@@ -33,9 +33,9 @@ from scipy import linalg, signal, stats
 from .sensors import gauss_markov_coefficients, gauss_markov_recursion
 
 __all__ = [
-    "NonStationaryError", "ar_coefficients", "InversionTest", "inversion_count", "inversion_moments", "inversion_distribution", "inversion_test",
+    "NonStationaryError", "StationarityWarning", "ar_coefficients", "InversionTest", "inversion_count", "inversion_moments", "inversion_distribution", "inversion_test",
     "stationarity_report", "difference", "make_stationary", "acf_printed", "pacf_printed",
-    "correlogram", "cutoff_lag", "Identification", "identify_model", "ar_design",
+    "correlogram", "cutoff_lag", "Identification", "cutoff_aic", "identify_model", "simulate_arma", "identification_rate", "ar_design",
     "ar_least_squares", "require_stationary_series", "fit_ar", "order_cap", "aic_by_order", "select_order",
     "aic_increment_bound", "ar_poles", "is_stationary", "ar_autocorrelation", "ar_variance",
     "check_ar_model", "simulate_ar", "gauss_markov", "aic_batch", "order_recovery",
@@ -44,6 +44,10 @@ __all__ = [
 
 class NonStationaryError(ValueError):
     """A series (or a fitted AR model) is not stationary where chen2019 step 2 requires it."""
+
+
+class StationarityWarning(UserWarning):
+    """The stationarity tests disagree (ADF cannot reject a unit root, KPSS accepts stationarity)."""
 
 
 def _series(y, name: str = "y", min_length: int = 3) -> np.ndarray:
@@ -317,37 +321,161 @@ class Identification:
     note: str
 
 
-def identify_model(y, *, nlags: int | None = None, max_order: int = 10, alpha: float = 0.05) -> Identification:
+def cutoff_aic(y, ar_order: int, ma_order: int) -> dict:
+    """AIC of white noise, AR(``ar_order``) and MA(``ma_order``) on one sample, by conditional least squares.
+
+    The two candidates that the cut-offs of the PACF (AR) and of the ACF (MA) propose, scored
+    on equal footing: both are fitted to the demeaned series by minimizing the sum of squared
+    innovations over the same observations t = s+1..n, s = max(p, q) (the conditional sum of
+    squares of Box & Jenkins): AR(p) by the least squares of eq. (3-11)-(3-12), MA(q) by
+    nonlinear least squares of w_t = y_t - theta_1 w_{t-1} - ... - theta_q w_{t-q} (pre-sample
+    w = 0; ``scipy.optimize.least_squares`` from theta = 0 within |theta_k| <= C(q, k), the bound
+    of an invertible polynomial).  Then
+    AIC_k = N ln(RSS_k/N) + 2 (k + 1) (eq. (3-13) with the noise variance counted).
+    Returns ``{"white noise": aic, "AR": aic, "MA": aic, "nobs": N}``.
+    """
+    from scipy.optimize import least_squares
+
+    y = _series(y, min_length=20)
+    p, q = int(ar_order), int(ma_order)
+    if p != ar_order or q != ma_order or p < 0 or q < 0:
+        raise ValueError(f"ar_order and ma_order must be non-negative integers, got {ar_order}, {ma_order}")
+    n = y.size
+    s = max(p, q)
+    if n - s < 10 + p + q:
+        raise ValueError(f"a series of {n} samples is too short to compare AR({p}) and MA({q})")
+    y = y - y.mean()
+    t = y[s:]
+    N = t.size
+
+    def aic(rss, k):
+        return N * math.log(rss / N) + 2 * (k + 1)
+
+    out = {"white noise": aic(float(t @ t), 0), "nobs": N}
+    if p:
+        X = np.column_stack([y[s - i : n - i] for i in range(1, p + 1)])
+        r = t - X @ np.linalg.lstsq(X, t, rcond=None)[0]
+        out["AR"] = aic(float(r @ r), p)
+    else:
+        out["AR"] = out["white noise"]
+    if q:
+        def innovations(th):
+            with np.errstate(over="ignore", invalid="ignore"):  # a non-invertible trial point
+                return np.nan_to_num(signal.lfilter([1.0], np.r_[1.0, th], y)[s:], nan=1e150, posinf=1e150, neginf=-1e150)
+
+        # an invertible MA(q) polynomial has |theta_k| <= C(q, k)
+        bound = np.array([math.comb(q, k) for k in range(1, q + 1)], dtype=float)
+        fit = least_squares(innovations, np.zeros(q), bounds=(-bound, bound))
+        out["MA"] = aic(float(fit.fun @ fit.fun), q)
+    else:
+        out["MA"] = out["white noise"]
+    return out
+
+
+def identify_model(y, *, nlags: int | None = None, max_order: int = 10, alpha: float = 0.05,
+                   rule: str = "aic", margin: float = 4.0) -> Identification:
     """Apply chen2019 Table 3-1 to the correlogram of ``y``.
 
-    Each function's cut-off lag comes from :func:`cutoff_lag` (``max_lag = max_order``).  A
-    function *tails off* when it has no cut-off up to ``max_order``, or when both functions cut
-    off and its cut-off comes strictly later than the other's (a geometric decay that reaches
-    the noise level within ``max_order`` lags is a tail, judged against the abrupt end of the
-    other function).  Then: ACF tails off and PACF cuts off after p -> AR(p); ACF cuts off after
-    q and PACF tails off -> MA(q); both tail off -> ARMA (orders by AIC); both cut off at the
-    same lag -> white noise at lag 0, otherwise AR of that order (noted).  ``nlags`` defaults
-    to min(4 max_order, n/4).
+    Each function's cut-off lag comes from :func:`cutoff_lag` (``max_lag = max_order``): q_a
+    for the ACF (Bartlett band), q_p for the PACF (band z/sqrt(n)).  Table 3-1 then reads: ACF
+    tails off and PACF cuts off after p -> AR(p); ACF cuts off after q and PACF tails off ->
+    MA(q); both tail off -> ARMA (orders by AIC); no significant lag at all -> white noise.
+
+    When *both* functions cut off, one of them is a tail that reached the noise level within
+    ``max_order`` lags, and the rule must say which.  The lag reading takes the earlier cut-off
+    (AR on a tie).  It is not on equal footing: after a large lag-1 autocorrelation Bartlett's
+    band widens, so a damped-sine ACF (an oscillatory AR(2), the sunspot numbers) "cuts off
+    after lag 1" before its PACF does after lag 2.  ``rule="aic"`` (the default) therefore
+    scores the candidates the cut-offs propose — AR(q_p), MA(q_a) and white noise — on one
+    sample by AIC (:func:`cutoff_aic`, conditional least squares) and lets the best one overrule
+    the lag reading when its AIC is lower by more than ``margin`` (4: "considerably less
+    support" for the other model, Burnham & Anderson 2002, §2.6); within the margin the lag
+    reading stands.  The chosen model's function cuts off, the other tails off.
+    ``rule="earliest"`` is the lag reading alone: right on long series, it identifies an
+    oscillatory AR(2) of 100 samples as MA(1) most of the time.  ``nlags`` defaults to
+    min(4 max_order, n/4).
     """
     y = _series(y, min_length=4 * max_order + 10)
+    if rule not in ("aic", "earliest"):
+        raise ValueError(f"rule must be 'aic' or 'earliest', got {rule!r}")
+    if not margin >= 0:
+        raise ValueError(f"margin must be a non-negative AIC difference, got {margin}")
     nlags = nlags or int(min(4 * max_order, y.size // 4))
     cg = correlogram(y, nlags, alpha=alpha)
     qa = cutoff_lag(cg["acf"], cg["acf_band"], max_lag=max_order, alpha=alpha)
     qp = cutoff_lag(cg["pacf"], cg["pacf_band"], max_lag=max_order, alpha=alpha)
     acf_cuts = qa is not None and (qp is None or qa <= qp)
     pacf_cuts = qp is not None and (qa is None or qp <= qa)
+    extra = ""
+    if rule == "aic" and qa is not None and qp is not None and max(qa, qp) > 0:
+        a = cutoff_aic(y, qp, qa)
+        lag_choice = "AR" if qp <= qa else ("MA" if qa > 0 else "white noise")
+        best = min(("white noise", "AR", "MA"), key=lambda k: a[k])
+        choice = best if a[lag_choice] - a[best] > margin else lag_choice
+        extra = (f"; both cut off, AIC: AR({qp}) {a['AR']:.1f}, MA({qa}) {a['MA']:.1f}, white noise "
+                 f"{a['white noise']:.1f}" + (f" (overrules the earlier cut-off)" if choice != lag_choice else ""))
+        if choice == "white noise":
+            qa = qp = 0
+        acf_cuts, pacf_cuts = choice in ("MA", "white noise"), choice in ("AR", "white noise")
     ab = "cuts off" if acf_cuts else "tails off"
     pb = "cuts off" if pacf_cuts else "tails off"
     desc = f"ACF {ab}" + (f" after lag {qa}" if acf_cuts else "") + f", PACF {pb}" + (f" after lag {qp}" if pacf_cuts else "")
     if acf_cuts and pacf_cuts:
         if qa == 0:
-            return Identification("white noise", 0, qa, qp, ab, pb, "no significant correlation")
-        return Identification("AR", qp, qa, qp, ab, pb, desc + f"; ambiguous, AR({qp}) taken")
+            return Identification("white noise", 0, qa, qp, ab, pb, "no significant correlation" + extra)
+        return Identification("AR", qp, qa, qp, ab, pb, desc + f"; ambiguous, AR({qp}) taken" + extra)
     if pacf_cuts:
-        return Identification("AR", qp, qa, qp, ab, pb, desc)
+        return Identification("AR", qp, qa, qp, ab, pb, desc + extra)
     if acf_cuts:
-        return Identification("MA", qa, qa, qp, ab, pb, desc)
+        return Identification("MA", qa, qa, qp, ab, pb, desc + extra)
     return Identification("ARMA", None, qa, qp, ab, pb, desc)
+
+
+def simulate_arma(phi, theta, n: int, n_series: int, rng: np.random.Generator, *, burn: int = 200) -> np.ndarray:
+    """``n_series`` ARMA series y_t = sum phi_i y_{t-i} + w_t + sum theta_j w_{t-j} of length ``n`` (rows).
+
+    Unit-variance Gaussian w; ``phi`` or ``theta`` may be empty (MA or AR); ``burn`` samples
+    discarded.  Filtered with ``scipy.signal.lfilter([1, theta], [1, -phi])``.
+    """
+    ph = np.atleast_1d(np.asarray(phi, dtype=float))
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    if ph.size:
+        _require_stationary(ph, "the AR part of the model to simulate")
+    if not np.all(np.isfinite(th)):
+        raise ValueError("theta must hold finite MA coefficients [theta_1, ..., theta_q]")
+    if not isinstance(rng, np.random.Generator):
+        raise TypeError("pass a seeded numpy Generator, e.g. np.random.default_rng(2019)")
+    if n < 2 or n_series < 1 or burn < 0:
+        raise ValueError("n >= 2, n_series >= 1 and burn >= 0 are required")
+    e = rng.standard_normal((n_series, n + burn))
+    return signal.lfilter(np.r_[1.0, th], np.r_[1.0, -ph], e, axis=1)[:, burn:]
+
+
+def identification_rate(phi, theta, n: int, *, n_series: int, seed: int, rules=("aic", "earliest"),
+                        max_order: int = 10) -> pd.DataFrame:
+    """How often :func:`identify_model` names the class and order of a known ARMA process.
+
+    ``n_series`` series of length ``n`` from :func:`simulate_arma` (seeded; the same series for
+    every rule).  Correct: AR(p) for a pure AR(p), MA(q) for a pure MA(q), the class ARMA for a
+    mixed model.  Returns one row per rule: ``rate``, its 95 % Wilson interval ``low``/``high``,
+    ``hits``, ``n_series``.
+    """
+    from statsmodels.stats.proportion import proportion_confint
+
+    ph, th = np.atleast_1d(np.asarray(phi, float)), np.atleast_1d(np.asarray(theta, float))
+    if ph.size == 0 and th.size == 0:
+        raise ValueError("give at least one AR (phi) or MA (theta) coefficient")
+    expect = ("ARMA", None) if ph.size and th.size else ("AR", ph.size) if ph.size else ("MA", th.size)
+    Y = simulate_arma(ph, th, n, n_series, np.random.default_rng(seed))
+    rows = {}
+    for rule in rules:
+        hits = 0
+        for y in Y:
+            idf = identify_model(y, max_order=max_order, rule=rule)
+            hits += (idf.model, idf.order) == expect
+        lo, hi = proportion_confint(hits, n_series, alpha=0.05, method="wilson")
+        rows[rule] = dict(rate=hits / n_series, low=lo, high=hi, hits=hits, n_series=n_series)
+    return pd.DataFrame(rows).T.astype({"hits": int, "n_series": int})
 
 
 # --------------------------------------------------------------------------- estimation
@@ -381,11 +509,21 @@ def ar_least_squares(y, p: int) -> tuple[np.ndarray, float]:
 
 
 def require_stationary_series(y, segments: int = 20, *, alpha: float = 0.05, max_lag: int = 12) -> None:
-    """The premise of chen2019 step 2 (Fig. 3-4): the series passes the two-sided inversion test
-    with ``segments`` and the ADF test (at most ``max_lag`` augmentation lags, chosen by AIC)
-    rejects a unit root.  Raises :class:`NonStationaryError` saying which test failed and what
-    to do; shared by :func:`fit_ar` and :func:`select_order`."""
-    from statsmodels.tsa.stattools import adfuller
+    """The premise of chen2019 step 2 (Fig. 3-4), shared by :func:`fit_ar` and :func:`select_order`.
+
+    1. The two-sided inversion test with ``segments`` (:func:`inversion_test`) must accept
+       stationarity; otherwise :class:`NonStationaryError`.
+    2. A unit root is judged by ADF (null: unit root; at most ``max_lag`` augmentation lags,
+       chosen by AIC) *paired with* KPSS (null: level stationarity; statsmodels' automatic
+       bandwidth).  The series is refused (:class:`NonStationaryError`) only when both point to a
+       unit root: ADF cannot reject it (p >= ``alpha``) and KPSS rejects stationarity
+       (p < ``alpha``).  When ADF alone cannot reject — it has little power on short
+       pseudo-periodic series such as the yearly sunspot numbers 1770-1869 (ADF p = 0.22,
+       KPSS p >= 0.1) — a :class:`StationarityWarning` is issued and the series accepted.
+
+    The error message says which test failed and what to do.
+    """
+    from statsmodels.tsa.stattools import adfuller, kpss
 
     t = inversion_test(y, segments, alpha=alpha)
     if not t.stationary:
@@ -396,25 +534,35 @@ def require_stationary_series(y, segments: int = 20, *, alpha: float = 0.05, max
             f"(timeseries.difference / make_stationary) or remove the trend"
         )
     adf_p = adfuller(y, maxlag=max_lag, regression="c", autolag="AIC", result_object=False)[1]
-    if adf_p >= alpha:
+    if adf_p < alpha:
+        return
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # InterpolationWarning: p-value at the end of KPSS' table
+        kpss_p = kpss(y, regression="c", nlags="auto", result_object=False)[1]
+    if kpss_p < alpha:
         raise NonStationaryError(
-            f"the series is not stationary: the ADF test cannot reject a unit root (p = {adf_p:.3f} >= "
-            f"{alpha}). Difference it first (timeseries.difference / make_stationary)"
+            f"the series is not stationary: the ADF test cannot reject a unit root (p = {adf_p:.3f} >= {alpha}) "
+            f"and the KPSS test rejects stationarity (p {'<=' if kpss_p <= 0.01 else '='} {kpss_p:.3f}). "
+            f"Difference it first (timeseries.difference / make_stationary)"
         )
+    warnings.warn(
+        f"the ADF test cannot reject a unit root (p = {adf_p:.3f} >= {alpha}), but the KPSS test does not reject "
+        f"stationarity (p {'>=' if kpss_p >= 0.1 else '='} {kpss_p:.3f}); ADF has little power on short or "
+        f"pseudo-periodic series, so the series is accepted", StationarityWarning, stacklevel=3)
 
 
 def fit_ar(y, p: int, *, segments: int = 20, alpha: float = 0.05, check: bool = True, demean: bool = True):
     """Fit AR(p) by conditional least squares with statsmodels ``AutoReg`` (chen2019 eq. 3-11/3-12).
 
     Returns the statsmodels ``AutoRegResults`` (``.params`` = phi, ``.sigma2``, ``.aic`` ...).
-    With ``check`` (the default) the premise of chen2019 step 2 is enforced: the series must pass
-    the two-sided inversion test with ``segments`` and the ADF test (at most max(12, 2p)
-    augmentation lags, chosen by AIC) must reject a unit root, and
+    With ``check`` (the default) the premise of chen2019 step 2 is enforced
+    (:func:`require_stationary_series`: the two-sided inversion test with ``segments``, and no
+    unit root by ADF (at most max(12, 2p) augmentation lags) paired with KPSS — refused only when
+    both point to a unit root, a :class:`StationarityWarning` when only ADF does), and
     the fitted poles must lie inside the unit circle; otherwise :class:`NonStationaryError` says
     which check failed and what to do.
     """
     from statsmodels.tsa.ar_model import AutoReg
-    from statsmodels.tsa.stattools import adfuller
 
     y = _series(y, min_length=max(2 * segments, 2 * p + 2))
     if int(p) != p or p < 1:
@@ -484,7 +632,9 @@ def select_order(y, max_order: int | None = None, *, demean: bool = True, check:
     """AR order minimizing AIC over 1..min(max_order, sqrt(n)), by statsmodels ``ar_select_order``.
 
     With ``check`` (the default) the series must be stationary as for :func:`fit_ar`
-    (:func:`require_stationary_series`): an order selected on a random walk means nothing.
+    (:func:`require_stationary_series`: refused when the inversion test fails or when ADF and
+    KPSS both point to a unit root, a :class:`StationarityWarning` when only ADF does): an order
+    selected on a random walk means nothing.
     """
     from statsmodels.tsa.ar_model import ar_select_order
 

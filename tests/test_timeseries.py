@@ -328,3 +328,70 @@ def test_order_selection_and_stationarity_refuse_what_they_cannot_judge():
     assert ts.select_order(walk, 10, check=False) >= 1  # the unchecked AIC still runs when asked
     with pytest.raises(ValueError, match="constant"):
         ts.inversion_test(np.full(200, 3.0), 10)
+
+
+# --------------------------------------------------------------------------- short oscillatory series
+
+@pytest.fixture(scope="module")
+def sunspots():
+    """Wolfer's yearly sunspot numbers 1770-1869 (Box & Jenkins' series E, 100 values): the
+    textbook AR(2), pseudo-periodic with an ~11-year cycle."""
+    import statsmodels.api as sm
+    d = sm.datasets.sunspots.load_pandas().data.set_index("YEAR")["SUNACTIVITY"]
+    return d.loc[1770:1869].to_numpy(dtype=float)
+
+
+def test_sunspots_identified_as_ar2_in_agreement_with_information_criteria(sunspots):
+    """The lag reading alone calls the damped-sine ACF cut off after lag 1 (Bartlett's band has
+    widened after rho_1 = 0.81) and names MA(1); the AIC comparison of the two candidates
+    names AR(2), as statsmodels' exact-likelihood ARMA order selection and BIC AR order
+    selection do."""
+    import warnings
+    from statsmodels.tsa.stattools import arma_order_select_ic
+
+    assert len(sunspots) == 100
+    old = ts.identify_model(sunspots, rule="earliest")
+    assert (old.model, old.order) == ("MA", 1)
+    new = ts.identify_model(sunspots)
+    assert (new.model, new.order) == ("AR", 2)
+    assert (new.acf_behaviour, new.pacf_behaviour) == ("tails off", "cuts off")
+    y = sunspots - sunspots.mean()
+    assert max(ar_select_order(y, 10, ic="bic", trend="n").ar_lags) == 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # convergence warnings of the larger ARMA fits
+        sel = arma_order_select_ic(y, max_ar=4, max_ma=2, ic=["aic", "bic"], trend="n")
+    assert sel.bic_min_order[0] == 2 and sel.aic_min_order[0] == 2
+    # exact likelihood and the conditional sums of squares rank AR(2) far above MA(1): the
+    # AIC gap (~70 exact) is many times the 4 units of the rule's margin
+    a = ts.cutoff_aic(sunspots, 2, 1)
+    assert sel.aic.loc[2, 0] < sel.aic.loc[0, 1] - 4 and a["AR"] < a["MA"] - 4
+
+
+def test_identification_rate_at_100_samples():
+    """500 seeded series of 100 samples each (the rate's 95 % Wilson half-width is <= 4.4 %).
+    Requirement: the oscillatory AR(2) phi = (1.0, -0.5) is identified in >= 80 % of series
+    (the interval's lower end above 0.8), where the lag reading alone fails most of the time;
+    on an ordinary AR(1) and MA(1) the rule loses nothing: its rate is not below the lower end
+    of the lag reading's interval."""
+    osc = ts.identification_rate([1.0, -0.5], [], 100, n_series=500, seed=2019)
+    assert osc.loc["aic", "low"] >= 0.8 and osc.loc["earliest", "high"] < 0.5
+    for phi, theta in (([0.7], []), ([], [0.7])):
+        r = ts.identification_rate(phi, theta, 100, n_series=500, seed=2019)
+        assert r.loc["aic", "rate"] >= r.loc["earliest", "low"]
+    with pytest.raises(ValueError, match="rule"):
+        ts.identify_model(np.random.default_rng(0).standard_normal(200), rule="latest")
+
+
+def test_stationarity_gate_pairs_adf_with_kpss(sunspots):
+    """ADF cannot reject a unit root on the sunspot numbers (p ~ 0.2: little power on a short
+    pseudo-periodic series) but KPSS does not reject stationarity: accepted with a warning.
+    A random walk that passes the inversion test (seed 4) fails both: refused."""
+    with pytest.warns(ts.StationarityWarning, match="KPSS"):
+        fit = ts.fit_ar(sunspots, 2)
+    assert ts.is_stationary(fit.params)
+    with pytest.warns(ts.StationarityWarning):
+        assert ts.select_order(sunspots, 10) >= 2
+    walk = np.cumsum(np.random.default_rng(4).standard_normal(2000))
+    assert ts.inversion_test(walk, 10).stationary       # so the unit-root pair decides
+    with pytest.raises(ts.NonStationaryError, match="KPSS test rejects stationarity"):
+        ts.require_stationary_series(walk, 10)
