@@ -336,6 +336,50 @@ def test_citation_cff_lists_the_four_documents():
         assert doi_or_title in text
 
 
+def test_one_repository_address_everywhere():
+    """pyproject.toml's ``[project.urls] Repository`` is the address the package reports, and the
+    one the README (near the top), CITATION.cff, the book's configuration, the book's ``[source]``
+    links, ``cite`` and ``--version`` carry; no other repository address appears.  LICENSE is the
+    licence pyproject.toml names."""
+    import tomllib
+
+    import yaml
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    url = project["urls"]["Repository"]
+    assert url.startswith("https://") and not url.endswith("/") and replication.repository_url() == url
+    texts = {name: (ROOT / name).read_text(encoding="utf-8") for name in ("README.md", "CITATION.cff", "book/_config.yml")}
+    for name, text in texts.items():
+        others = {u for u in re.findall(r"https?://(?:www\.)?github\.com/[^\s\"')>]*", text)
+                  if u.rstrip("/.") != url and not u.startswith(url + "/")}
+        assert url in text and not others, (name, others)
+    assert url in "\n".join(texts["README.md"].splitlines()[:6])
+    cff = yaml.safe_load(texts["CITATION.cff"])
+    assert cff["repository-code"] == url and cff["url"] == url and cff["date-released"]
+    assert cff["license"] == project["license"]["text"] == "MIT" and cff["version"] == replication.__version__
+    assert (ROOT / "LICENSE").read_text(encoding="utf-8").startswith("MIT License\n")
+    book = yaml.safe_load(texts["book/_config.yml"])
+    assert book["repository"]["url"] == url and book["html"]["use_repository_button"] is True
+    assert "sphinx.ext.linkcode" in book["sphinx"]["extra_extensions"] and "source_links" in book["sphinx"]["local_extensions"]
+    sys.path.insert(0, str(ROOT / "book" / "_ext"))
+    try:
+        import source_links
+    finally:
+        sys.path.remove(str(ROOT / "book" / "_ext"))
+    link = source_links.source_url({"module": "replication.reproduction", "fullname": "resolve_table_ids"},
+                                   base=url, ref="abc", root=ROOT)
+    first, last = (int(n) for n in re.fullmatch(re.escape(url) + r"/blob/abc/replication/reproduction\.py#L(\d+)-L(\d+)",
+                                                link).groups())
+    lines = (ROOT / "replication" / "reproduction.py").read_text(encoding="utf-8").splitlines()
+    assert lines[first - 1].startswith("def resolve_table_ids(") and lines[last - 1].strip() == "return [ident]"
+    assert source_links.source_url({"module": "replication.reproduction", "fullname": "PACKAGE_YEAR"},
+                                   base=url, ref="abc", root=ROOT) is None          # data has no source lines
+    assert f"url          = {{{url}}}," in rp.bibtex_for("fang2020-table-1")
+    version = subprocess.run([sys.executable, "-m", "replication", "--version"], capture_output=True, text=True,
+                             check=True).stdout
+    assert version.strip() == f"replication {replication.__version__} ({url})"
+
+
 def test_an_artifact_can_be_covered_by_check_tables(sandbox):
     (sandbox / "data" / "artifacts.csv").write_text(
         "id,source,artifact,description,tables\n"
