@@ -186,3 +186,26 @@ def test_compiled_kernels_are_bit_identical_across_numba_targets(tmp_path):
         digests[cpu] = r.stdout.strip()
     assert len(digests["host"]) == 64
     assert len(set(digests.values())) == 1, digests
+
+
+def test_system_packages_have_one_list_and_an_unprivileged_user_is_told_which(tmp_path):
+    """scripts/sysdeps.sh is the one list of Debian packages (make test and .ci/run call it); a
+    user who may not install (not root, no sudo) is stopped with the packages named, exit 1."""
+    import shutil
+    import subprocess
+
+    root = Path(__file__).resolve().parent.parent
+    makefile = (root / "Makefile").read_text(encoding="utf-8")
+    assert any(line.startswith("test:") and "sysdeps" in line.split() for line in makefile.splitlines())
+    ci = (root / ".ci" / "run").read_text(encoding="utf-8")
+    assert "bash scripts/sysdeps.sh" in ci and "apt-get" not in ci
+    # a machine without chromium and pdflatex, seen by an ordinary user without sudo
+    (tmp_path / "bin").mkdir()
+    for tool in ("grep", "env"):
+        (tmp_path / "bin" / tool).symlink_to(shutil.which(tool))
+    (tmp_path / "bin" / "id").write_text("#!/bin/sh\necho 1000\n", encoding="utf-8")
+    (tmp_path / "bin" / "id").chmod(0o755)
+    out = subprocess.run([shutil.which("bash"), str(root / "scripts" / "sysdeps.sh")], capture_output=True, text=True,
+                         env={"PATH": str(tmp_path / "bin")}, timeout=60)
+    assert out.returncode == 1 and "chromium" in out.stderr and "texlive-latex-base" in out.stderr, out
+    assert "apt-get install" in out.stderr
