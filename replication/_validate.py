@@ -18,7 +18,8 @@ from typing import Any, Collection
 import numpy as np
 
 __all__ = ["positive", "nonnegative", "finite", "vector3", "matrix3", "components", "choice", "numeric",
-           "finite_array", "nonnegative_array", "rotation", "covariance", "ORTHONORMAL_TOL", "COVARIANCE_TOL"]
+           "finite_array", "nonnegative_array", "rotation", "covariance", "integer", "probability",
+           "ORTHONORMAL_TOL", "COVARIANCE_TOL"]
 
 ORTHONORMAL_TOL = 1e-6
 """Largest element of |C Cᵀ - I| (and |det C - 1|) accepted for a rotation matrix. Float64 round-off of a
@@ -238,6 +239,43 @@ def nonnegative(value, name: str, message: str | None = None) -> float:
 def finite(value, name: str, message: str | None = None) -> float:
     """A finite number (arguments and return as :func:`positive`; ``ValueError`` if NaN or infinite)."""
     return _number(value, name, "a finite number", lambda v: True, message)
+
+
+def integer(value, name: str, minimum: int = 1, message: str | None = None) -> int:
+    """A whole number >= ``minimum`` (a count, an order, a number of lags or runs).
+
+    Parameters
+    ----------
+    value : int-like
+        The argument; a float is accepted when it is whole (``3.0``), ``bool`` and text are not.
+    name : str
+        Its name for the error message.
+    minimum : int, optional
+        The smallest accepted value (default 1).
+    message : str, optional
+        The error message as a template with the fields ``name`` and ``value``; by default
+        "{name} must be an integer >= {minimum}, got {value!r}".
+
+    Returns
+    -------
+    int
+        ``int(value)``; ``TypeError`` for text, ``bool`` and non-numbers, ``ValueError`` for NaN,
+        infinity, a fraction or a value below ``minimum``.
+    """
+    if isinstance(value, (str, bytes, bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be an integer >= {minimum}, got {type(value).__name__} {value!r:.40}")
+    if not (np.isfinite(value) and float(value).is_integer() and value >= minimum):
+        text = f"{{name}} must be an integer >= {minimum}, got {{value!r}}" if message is None else message
+        raise ValueError(text.format(name=name, value=value))
+    return int(value)
+
+
+def probability(value, name: str, message: str | None = None) -> float:
+    """A number strictly between 0 and 1 (a significance level, a confidence, a probability of a band).
+
+    Arguments and return as :func:`positive`; ``ValueError`` unless 0 < value < 1.
+    """
+    return _number(value, name, "a number strictly between 0 and 1", lambda v: 0.0 < v < 1.0, message)
 
 
 def vector3(value, name: str) -> np.ndarray:

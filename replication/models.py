@@ -69,7 +69,7 @@ import numpy as np
 from . import earth
 from . import errors as E
 from .rotations import rotvec_to_dcm, skew
-from ._validate import components, positive
+from ._validate import components, numeric, positive
 from replication import models, errors
 from .rotations import euler_to_dcm
 from ._kernels import KIND_MISALIGN, coupling_matrix
@@ -336,7 +336,7 @@ def noise_input(model, C_bn):
 # ----------------------------------------------------------------------------- measurement (2-13)
 
 def _lever(lever_arm_b):
-    l = np.asarray(lever_arm_b, float)
+    l = numeric(lever_arm_b, "lever_arm_b")
     if l.shape != (3,) or not np.all(np.isfinite(l)):
         raise ValueError(f"lever_arm_b must be 3 finite body-frame components in metres, got {lever_arm_b!r}")
     return l

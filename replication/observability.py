@@ -63,6 +63,7 @@ from . import earth
 from .rotations import body_rate_from_euler_rates, euler_to_dcm
 from .trajectory import Trajectory
 import pandas as pd
+from ._validate import choice, covariance, finite, finite_array, integer, nonnegative, numeric, positive, vector3
 
 __all__ = ["observability_matrix", "stripped_observability_matrix", "total_observability_matrix", "som_condition",
            "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
@@ -73,31 +74,33 @@ __all__ = ["observability_matrix", "stripped_observability_matrix", "total_obser
 
 # ----------------------------------------------------------------------------- validation
 
-def _FH(F, H):
-    F = np.asarray(F, float)
-    H = np.atleast_2d(np.asarray(H, float))
+def _FH(F, H, where: str = ""):
+    F = numeric(F, f"F{where}")
+    H = np.atleast_2d(numeric(H, f"H{where}"))
     if F.ndim != 2 or F.shape[0] != F.shape[1]:
-        raise ValueError(f"F must be a square n×n matrix, got shape {F.shape}")
+        raise ValueError(f"F{where} must be a square n×n matrix, got shape {F.shape}")
     if H.ndim != 2 or H.shape[1] != F.shape[0]:
-        raise ValueError(f"H must be m×n with n = {F.shape[0]} columns (one per state), got shape {H.shape}")
-    if not (np.all(np.isfinite(F)) and np.all(np.isfinite(H))):
-        raise ValueError("F and H must be finite")
-    return F, H
+        raise ValueError(f"H{where} must be m×n with n = {F.shape[0]} columns (one per state of F{where}, shape "
+                         f"{F.shape}), got shape {H.shape}")
+    return finite_array(F, f"F{where}"), finite_array(H, f"H{where}")
 
 
 def _powers(n_powers, n):
     if n_powers is None:
         return n
-    if int(n_powers) != n_powers or n_powers < 1:
-        raise ValueError(f"n_powers must be a positive integer (the default is the state dimension {n}), got {n_powers}")
-    return int(n_powers)
+    return integer(n_powers, "n_powers", 1, "{name} must be a positive integer (the default is the state dimension "
+                   f"{n}), got {{value!r}}")
 
 
 def _systems(systems):
+    if isinstance(systems, (str, bytes)) or not hasattr(systems, "__iter__"):
+        raise TypeError(f"systems must be a sequence of (F, H) segments, got {type(systems).__name__}")
     systems = list(systems)
     if not systems:
-        raise ValueError("give at least one (F, H) segment")
-    out = [_FH(F, H) for F, H in systems]
+        raise ValueError("systems: give at least one (F, H) segment")
+    if any(not isinstance(p, (tuple, list)) or len(p) != 2 for p in systems):
+        raise ValueError("systems must hold one (F, H) pair per segment")
+    out = [_FH(F, H, f" (systems[{j}])") for j, (F, H) in enumerate(systems)]
     n = out[0][0].shape[0]
     if any(F.shape[0] != n for F, _ in out):
         raise ValueError("all segments must have the same state dimension")
@@ -126,7 +129,7 @@ def total_observability_matrix(systems, durations, n_powers=None) -> np.ndarray:
     """The TOM [Q_1; Q_2 Φ_1; Q_3 Φ_2 Φ_1; ...] with Φ_j = exp(F_j Δ_j) (``durations`` Δ_j, s)."""
 
     sy = _systems(systems)
-    d = np.asarray(durations, float)
+    d = finite_array(durations, "durations")
     if d.shape != (len(sy),) or np.any(d <= 0):
         raise ValueError(f"durations must hold one positive duration per segment ({len(sy)})")
     out, Phi = [], np.eye(sy[0][0].shape[0])
@@ -144,6 +147,7 @@ def som_condition(F, H, n_powers=None, rtol: float = 1e-9) -> bool:
     σ_max · max(m, n) · ε (as :func:`observability_degrees`); the condition holds when
     max abs(F_j N) ≤ ``rtol`` · max abs(F_j) (rounding leaves ~1e-13 here)."""
     F, H = _FH(F, H)
+    rtol = nonnegative(rtol, "rtol")
     Q = observability_matrix(F, H, n_powers)
     _, s, Vt = np.linalg.svd(Q, full_matrices=Q.shape[0] < Q.shape[1])
     tol = (s[0] if s.size else 0.0) * max(Q.shape) * np.finfo(float).eps
@@ -193,7 +197,7 @@ class ObservabilityDegrees:
 
     def observable(self, threshold=None) -> np.ndarray:
         """Boolean per state: degree above ``threshold`` (default: the numerical-rank tolerance)."""
-        t = self.rank_tol if threshold is None else float(threshold)
+        t = self.rank_tol if threshold is None else nonnegative(threshold, "threshold")
         return self.degree > t
 
     def as_dict(self) -> dict:
@@ -241,21 +245,19 @@ def observability_degrees(Q, *, assignment: str = "state", normalize: str | None
     largest component is shared (within ``TIE_TOL``) gets the larger singular value.  Both make
     the assignment independent of round-off.
     """
-    Q = np.atleast_2d(np.asarray(Q, float))
+    Q = np.atleast_2d(numeric(Q, "Q"))
     if Q.ndim != 2 or not np.all(np.isfinite(Q)):
         raise ValueError("Q must be a finite 2-D matrix (rows: outputs and their derivatives, columns: states)")
     m, n = Q.shape
-    if assignment not in ("state", "singular"):
-        raise ValueError(f"assignment must be 'state' or 'singular', got {assignment!r}")
-    if normalize not in (None, "max", "scale"):
-        raise ValueError(f"normalize must be None, 'max' or 'scale', got {normalize!r}")
+    choice(assignment, ("state", "singular"), "assignment")
+    choice(normalize, (None, "max", "scale"), "normalize")
     labels = list(labels) if labels is not None else [f"x{k}" for k in range(n)]
     if len(labels) != n:
         raise ValueError(f"labels must name the {n} states (columns of Q)")
     if normalize == "scale":
         if state_scale is None:
             raise ValueError("normalize='scale' needs state_scale (one positive scale per state, e.g. prior sd)")
-        d = np.asarray(state_scale, float)
+        d = numeric(state_scale, "state_scale")
         if d.shape != (n,) or np.any(~(d > 0)) or not np.all(np.isfinite(d)):
             raise ValueError(f"state_scale must hold {n} positive finite numbers")
         Q = Q * d
@@ -300,8 +302,8 @@ def observability_degrees(Q, *, assignment: str = "state", normalize: str | None
 
 def segment_bounds(t0: float, t1: float, n_segments: int) -> list:
     """Equal segments [(a, b), ...] covering [t0, t1]."""
-    if int(n_segments) != n_segments or n_segments < 1:
-        raise ValueError(f"n_segments must be a positive integer, got {n_segments}")
+    n_segments = integer(n_segments, "n_segments")
+    t0, t1 = finite(t0, "t0"), finite(t1, "t1")
     if not t1 > t0:
         raise ValueError(f"the time span needs t1 > t0, got {t0}, {t1}")
     e = np.linspace(t0, t1, int(n_segments) + 1)
@@ -316,6 +318,28 @@ def _state_index(model, states):
     if bad:
         raise ValueError(f"unknown states {bad[:5]}; the model's labels are {model.labels[:12]}...")
     return np.array([pos[s] for s in states], dtype=int)
+
+
+def _trajectory(traj, name: str = "traj"):
+    if not isinstance(traj, Trajectory):
+        raise TypeError(f"{name} must be a replication.trajectory.Trajectory (trajectory.generate), got "
+                        f"{type(traj).__name__}")
+    return traj
+
+
+def _spans(spans, traj):
+    """``spans`` as a (k, 2) float array of segments [t_a, t_b] with t_a < t_b inside ``traj``."""
+    spans = list(spans) if not isinstance(spans, (str, bytes)) else spans
+    a = numeric(spans, "spans") if len(spans) else np.zeros((0, 2))
+    if a.ndim != 2 or a.shape[1] != 2 or len(a) == 0:
+        raise ValueError(f"spans must be a non-empty sequence of (t_start, t_end) pairs (s), got shape {a.shape}")
+    finite_array(a, "spans")
+    if np.any(a[:, 1] <= a[:, 0]):
+        raise ValueError(f"spans must have t_end > t_start in every segment, got {a[a[:, 1] <= a[:, 0]][0].tolist()}")
+    if a.min() < traj.t[0] - 1e-9 or a.max() > traj.t[-1] + 1e-9:
+        raise ValueError(f"spans must lie inside the trajectory [{traj.t[0]}, {traj.t[-1]}] s, got "
+                         f"[{a.min()}, {a.max()}]")
+    return [tuple(p) for p in spans]
 
 
 def _sample(traj, t):
@@ -338,10 +362,10 @@ def piecewise_systems(model, traj, spans, *, evaluate: str = "mid", lever_arm_b=
 
     if not isinstance(model, E.ErrorModel):
         raise TypeError("model must be a replication.errors.ErrorModel (e.g. models.model_45())")
-    if evaluate not in ("mid", "mean"):
-        raise ValueError(f"evaluate must be 'mid' or 'mean', got {evaluate!r}")
-    if position_units not in ("m", "rad"):
-        raise ValueError(f"position_units must be 'm' or 'rad', got {position_units!r}")
+    _trajectory(traj)
+    choice(evaluate, ("mid", "mean"), "evaluate")
+    choice(position_units, ("m", "rad"), "position_units")
+    spans = _spans(spans, traj)
     idx = _state_index(model, states)
     out = []
     for a, b in spans:
@@ -396,19 +420,26 @@ def covariance_observability(model, traj, t0: float, t1: float, *, update_interv
 
     if not isinstance(model, E.ErrorModel):
         raise TypeError("model must be a replication.errors.ErrorModel (e.g. models.model_45())")
-    if not update_interval > 0:
-        raise ValueError("update_interval must be a positive number of seconds")
+    _trajectory(traj)
+    update_interval = positive(update_interval, "update_interval",
+                               "{name} must be a positive finite number of seconds, got {value!r}")
+    series_order = integer(series_order, "series_order")
+    t0, t1 = finite(t0, "t0"), finite(t1, "t1")
     idx = _state_index(model, states)
     n = len(idx)
-    P = (model.P0() if P0 is None else np.asarray(P0, float))
+    P = (model.P0() if P0 is None else numeric(P0, "P0"))
     if P.shape == (model.n, model.n) and n != model.n:
         P = P[np.ix_(idx, idx)]
     if P.shape != (n, n):
         raise ValueError(f"P0 must be {n}×{n} (states kept) or {model.n}×{model.n}")
-    R = np.asarray(R, float) if R is not None else None
-    if R is None or R.shape != (6, 6):
+    if P0 is not None:
+        covariance(P, "P0")
+    if R is None or numeric(R, "R").shape != (6, 6):
         raise ValueError("R must be the 6×6 measurement noise covariance (position m², velocity (m/s)²)")
-    _sample(traj, t0), _sample(traj, t1)
+    R = covariance(R, "R")
+    for name, t in (("t0", t0), ("t1", t1)):
+        if not (traj.t[0] - 1e-9 <= t <= traj.t[-1] + 1e-9):
+            raise ValueError(f"{name} = {t} s lies outside the trajectory [{traj.t[0]}, {traj.t[-1]}] s")
     if not t1 > t0:
         raise ValueError("t1 must be later than t0")
     n_ep = int(math.floor((t1 - t0) / update_interval + 1e-9))
@@ -443,11 +474,11 @@ def spearman(a, b) -> float:
     """Spearman rank correlation of two equal-length sequences (average ranks for ties;
     scipy.stats.spearmanr)."""
 
-    a, b = np.asarray(a, float), np.asarray(b, float)
+    a, b = numeric(a, "a"), numeric(b, "b")
     if a.shape != b.shape or a.ndim != 1 or len(a) < 3:
-        raise ValueError("spearman needs two 1-D sequences of equal length ≥ 3")
-    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
-        raise ValueError("spearman needs finite values")
+        raise ValueError(f"spearman needs two 1-D sequences a and b of equal length ≥ 3, got shapes {a.shape} and "
+                         f"{b.shape}")
+    finite_array(a, "a"), finite_array(b, "b")
     return float(stats.spearmanr(a, b).statistic)
 
 
@@ -497,8 +528,12 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
     """
 
     for nm, v in (("straight", straight), ("u_turn", u_turn), ("figure_eight", figure_eight), ("s_turn", s_turn)):
-        if not (v > 0 and math.isfinite(v)):
-            raise ValueError(f"{nm} must be a positive duration in seconds, got {v}")
+        positive(v, nm, "{name} must be a positive duration in seconds, got {value!r}")
+    finite(s_swing, "s_swing")
+    integer(s_cycles, "s_cycles")
+    positive(dt, "dt", "{name} must be a positive sample interval in seconds, got {value!r}")
+    if total is not None:
+        positive(total, "total", "{name} must be a positive duration in seconds, got {value!r}")
     _, init = tr.chen2019_flight()
     man = {"before maneuver": [], "U-turn": [tr.UTurn(u_turn)], "figure-8": [tr.FigureEight(figure_eight)],
            "S-turn": [tr.STurn(s_turn, swing=s_swing, cycles=int(s_cycles))]}
@@ -542,7 +577,7 @@ def unbanked(traj):
     not say how its Fig. 2-3 maneuvers were flown); the increments ``dtheta``/``dv`` are the
     trapezoid of the new rates (not meant for strapdown accuracy tests)."""
 
-    return _reflown(traj, np.zeros(len(traj.t)))
+    return _reflown(_trajectory(traj), np.zeros(len(traj.t)))
 
 
 def coordinated(traj):
@@ -553,7 +588,7 @@ def coordinated(traj):
     by central differences (see :func:`unbanked`).  A kinematic variant for the sensitivity study of
     chen2019 Table 2-3, whose Fig. 2-3 maneuvers are not specified."""
 
-    f_b = np.asarray(traj.f_b, float)
+    f_b = np.asarray(_trajectory(traj).f_b, float)
     roll = np.array(traj.hpr, float)[:, 2]
     for sign in (1.0, -1.0):
         out = _reflown(traj, roll + sign * np.arctan2(f_b[:, 0], f_b[:, 2]))
@@ -561,6 +596,27 @@ def coordinated(traj):
             return out
     raise RuntimeError("coordinated: no roll correction zeroes f_x (a trajectory with pitch beyond the small-angle "
                        "range?)")
+
+
+def _maneuvers(maneuvers, name: str = "maneuvers"):
+    """``maneuvers`` must be a non-empty {name: Maneuver} mapping (:func:`chen2019_maneuvers`)."""
+    if not isinstance(maneuvers, dict) or not maneuvers:
+        raise TypeError(f"{name} must be a non-empty dict {{scenario: Maneuver}} (observability.chen2019_maneuvers), "
+                        f"got {type(maneuvers).__name__}")
+    bad = [k for k, v in maneuvers.items() if not isinstance(v, Maneuver)]
+    if bad:
+        raise TypeError(f"{name}[{bad[0]!r}] must be an observability.Maneuver, got "
+                        f"{type(maneuvers[bad[0]]).__name__}")
+    return maneuvers
+
+
+def _table(table, name: str) -> pd.DataFrame:
+    """``table`` must be a DataFrame of finite numbers (rows: states, columns: scenarios)."""
+    if not isinstance(table, pd.DataFrame):
+        raise TypeError(f"{name} must be a pandas DataFrame (rows: states, columns: scenarios), got "
+                        f"{type(table).__name__}")
+    finite_array(numeric(table.to_numpy(), name), name)
+    return table
 
 
 def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, before_segments: int = 1,
@@ -573,6 +629,8 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
     scenario's tolerance, ``df.attrs["ambiguity"]`` (scenario → state → ratio) each
     state's ``ambiguity`` (:class:`ObservabilityDegrees`)."""
 
+    _maneuvers(maneuvers)
+    integer(n_segments, "n_segments"), integer(before_segments, "before_segments")
     cols, tols, amb = {}, {}, {}
     for name, mv in maneuvers.items():
         d = pwcs_observability(model, mv.traj, mv.spans(n_segments, before_segments), states=states, **kw)
@@ -589,6 +647,7 @@ def covariance_table(model, maneuvers: dict, R, *, states, update_interval: floa
     """√(P0/P) (:func:`covariance_observability`) over each scenario's whole trajectory, as a
     DataFrame (rows: states, columns: scenarios)."""
 
+    _maneuvers(maneuvers)
     cols = {}
     for name, mv in maneuvers.items():
         cols[name] = covariance_observability(model, mv.traj, 0.0, float(mv.traj.t[-1]), update_interval=update_interval,
@@ -602,11 +661,21 @@ def rank_metrics(reference, reproduced, *, reference_threshold: float, reproduce
     column's threshold) agrees, and the counts of unobservable states.  ``reproduced_threshold``
     is a number or a {column: threshold} mapping.  Returns a DataFrame indexed by column."""
 
+    _table(reference, "reference"), _table(reproduced, "reproduced")
     if list(reference.columns) != list(reproduced.columns) or list(reference.index) != list(reproduced.index):
-        raise ValueError("the two tables must have the same states (rows) and scenarios (columns) in the same order")
+        raise ValueError("the two tables (reference, reproduced) must have the same states (rows) and scenarios "
+                         "(columns) in the same order")
+    reference_threshold = nonnegative(reference_threshold, "reference_threshold")
+    if isinstance(reproduced_threshold, dict):
+        missing = [c for c in reference.columns if c not in reproduced_threshold]
+        if missing:
+            raise ValueError(f"reproduced_threshold has no threshold for the scenarios {missing}")
+        thresholds = {c: nonnegative(reproduced_threshold[c], f"reproduced_threshold[{c!r}]") for c in reference.columns}
+    else:
+        thresholds = dict.fromkeys(reference.columns, nonnegative(reproduced_threshold, "reproduced_threshold"))
     rows = []
     for c in reference.columns:
-        thr = reproduced_threshold[c] if isinstance(reproduced_threshold, dict) else float(reproduced_threshold)
+        thr = thresholds[c]
         a, b = reference[c].to_numpy(float), reproduced[c].to_numpy(float)
         va, vb = a > reference_threshold, b > thr
         rows.append(dict(scenario=c, spearman=spearman(a, b), verdicts_agree=int(np.sum(va == vb)),
@@ -636,6 +705,15 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
     ``out.attrs["tables"]`` keeps each variant's degrees table (states of ``reference``), with its
     ``rank_tol`` and ``ambiguity`` attributes, for :func:`compare_verdicts`."""
 
+    _maneuvers(maneuvers)
+    _table(reference, "reference")
+    nonnegative(reference_threshold, "reference_threshold")
+    if not isinstance(variants, dict) or not variants:
+        raise TypeError(f"variants must be a non-empty dict {{name: keyword arguments of degrees_table}}, got "
+                        f"{type(variants).__name__}")
+    bad = [k for k, v in variants.items() if not isinstance(v, dict)]
+    if bad:
+        raise TypeError(f"variants[{bad[0]!r}] must be a dict of keyword arguments of degrees_table")
     rows, tables = [], {}
     for name, spec in variants.items():
         spec = dict(spec)
@@ -675,8 +753,7 @@ def verdict_under(printed_value: float, degree: float, rank_tol: float, ambiguit
     """
     for name, v in (("printed_value", printed_value), ("degree", degree), ("rank_tol", rank_tol),
                     ("ambiguity", ambiguity), ("printed_threshold", printed_threshold)):
-        if isinstance(v, (str, bytes)) or not np.isfinite(float(v)) or float(v) < 0:
-            raise ValueError(f"{name} must be a finite number >= 0, got {v!r}")
+        nonnegative(v, name)
     vp, vo = float(printed_value) > printed_threshold, float(degree) > ROUND_OFF_MARGIN * rank_tol
     return vp, vo, bool(vp == vo or float(ambiguity) <= AMBIGUOUS)
 
@@ -734,8 +811,25 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
         a printed value) and its verdict on every value whose verdict under the main reading differs
         from the print (the values whose status the ledger decides).
     """
+    _table(printed, "printed")
+    nonnegative(printed_threshold, "printed_threshold")
+    if not isinstance(readings, dict) or not readings:
+        raise TypeError(f"readings must be a non-empty dict {{reading: degrees table}}, got {type(readings).__name__}")
     if main not in readings:
         raise ValueError(f"main reading {main!r} is not one of the readings {list(readings)}")
+    for r, t in readings.items():
+        _table(t, f"readings[{r!r}]")
+        if not (set(printed.index) <= set(t.index) and set(printed.columns) <= set(t.columns)):
+            raise ValueError(f"readings[{r!r}] must hold every state and scenario of printed")
+        if not all(c in t.attrs.get("rank_tol", {}) and c in t.attrs.get("ambiguity", {}) for c in printed.columns):
+            raise ValueError(f"readings[{r!r}] needs attrs['rank_tol'] and attrs['ambiguity'] for every scenario "
+                             "(observability.degrees_table)")
+    if not isinstance(exact, dict):
+        raise TypeError(f"exact must be a dict {{(state, scenario): observable}}, got {type(exact).__name__}")
+    missing = [(s, c) for s in printed.index for c in printed.columns if (s, c) not in exact]
+    if missing:
+        raise ValueError(f"exact has no verdict of the second computation for {missing[:3]} (one per state and "
+                         "scenario of printed)")
     sym = symbols or {s: s for s in printed.index}
     ruled = tuple(ruled_out)
     excluded = {r for r in readings if any(r.startswith(k) for k in ruled)}
