@@ -46,6 +46,7 @@ from numba import njit
 
 from . import _kernels as K
 from .errors import ErrorModel
+from ._validate import choice, covariance, finite_array, integer, numeric
 
 __all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state",
            "Records", "run", "filter_chunk", "rts_chunk", "mbf_chunk", "no_windows"]
@@ -823,13 +824,16 @@ def build_spec(model: ErrorModel, *, R_pos, R_vel, lever_arm_b=(0.0, 0.0, 0.0), 
         raise TypeError("model must be a replication.errors.ErrorModel")
     if not (use_position or use_velocity):
         raise ValueError("use at least one of GNSS position and velocity")
-    R_pos = np.asarray(R_pos, float)
-    R_vel = np.asarray(R_vel, float)
+    R_pos = numeric(R_pos, "R_pos")
+    R_vel = numeric(R_vel, "R_vel")
     for name, M in (("R_pos", R_pos), ("R_vel", R_vel)):
-        if M.shape != (3, 3) or np.any(M != np.diag(np.diag(M))) or np.any(np.diag(M) <= 0):
+        if M.shape != (3, 3) or np.any(M != np.diag(np.diag(M))) or not np.all(np.diag(M) > 0):
             raise ValueError(f"{name} must be a 3×3 diagonal matrix with positive variances (independent axes)")
-    if int(series_order) < 1:
-        raise ValueError("series_order must be at least 1")
+        finite_array(M, name)
+    series_order = integer(series_order, "series_order")
+    lever = finite_array(lever_arm_b, "lever_arm_b", (3,))
+    finite_array(gains, "gains", (3,))
+    choice(vmode, (0, 1, 2), "vmode", "{name} must be one of {allowed} (free, held, damped), got {value!r}")
     fconst, qc, tg, kd, bs, bz = model.kernel_encoding()
     n = model.n
     dyn = np.array([i - 9 for i in range(9, n) if np.any(fconst[i, 9:] != 0)], dtype=np.int64)
@@ -844,19 +848,21 @@ def build_spec(model: ErrorModel, *, R_pos, R_vel, lever_arm_b=(0.0, 0.0, 0.0), 
         raise ValueError(f"sf_H must be 3×{n - 9}")
     return Spec(fconst, qc, np.asarray(model.accel_psd, float), np.asarray(model.gyro_psd, float), tg, kd, bs, bz,
                 int(series_order), dyn, bool(use_position), bool(use_velocity), R_pos, R_vel,
-                np.asarray(lever_arm_b, float).copy(), int(vmode), np.asarray(gains, float), arT, arQ, sfH,
+                lever.copy(), int(vmode), np.asarray(gains, float), arT, arQ, sfH,
                 bool(prior_covariance), bool(nees))
 
 
 def initial_batch_state(st, q, lever0) -> BatchState:
     """Per-run state at the start: navigation states ``st`` (R × 6: L, λ, h, vE, vN, vU),
     quaternions ``q`` (R × 4), the lever arm in use ``lever0``."""
-    st = np.ascontiguousarray(st, dtype=float)
-    q = np.ascontiguousarray(q, dtype=float)
+    st = np.ascontiguousarray(numeric(st, "st"))
+    q = np.ascontiguousarray(numeric(q, "q"))
     if st.ndim != 2 or st.shape[1] != 6 or q.shape != (st.shape[0], 4):
         raise ValueError("st must be R×6 and q R×4")
+    finite_array(st, "st"), finite_array(q, "q")
+    lever0 = finite_array(lever0, "lever0", (3,))
     R = st.shape[0]
-    return BatchState(st, st.copy(), q, None, np.tile(np.asarray(lever0, float), (R, 1)), np.zeros((R, 3)),
+    return BatchState(st, st.copy(), q, None, np.tile(lever0, (R, 1)), np.zeros((R, 3)),
                       np.zeros((R, 3)), np.zeros((R, 3)), np.column_stack([st[:, 0], np.sin(st[:, 0]),
                                                                             np.cos(st[:, 0])]),
                       np.zeros(R), np.zeros((R, 3)), np.array([1], np.int64))
@@ -907,17 +913,22 @@ def _empty_gains(E_, n, n_dyn, n_aug, with_nees):
 
 def _run_arguments(spec: Spec, P0, ep_samples, n_steps: int, record_every, chunk_epochs, workers, smoother_form):
     """The checked epoch samples and initial covariance of :func:`run` (``ValueError`` otherwise)."""
+    if not isinstance(spec, Spec):
+        raise TypeError(f"spec must be a closedloop.Spec (closedloop.build_spec), got {type(spec).__name__}")
+    n_steps = integer(n_steps, "n_steps")
+    e = numeric(ep_samples, "ep_samples")
+    if e.ndim != 1 or len(e) < 1 or not np.all(np.isfinite(e)) or np.any(e != np.round(e)):
+        raise ValueError(f"ep_samples must be a non-empty 1-D array of whole sample indices, got {e!r:.60}")
     ep = np.asarray(ep_samples, np.int64)
     n = spec.fconst.shape[0]
-    if ep.ndim != 1 or len(ep) < 1 or np.any(np.diff(ep) <= 0) or ep[0] < 1 or ep[-1] > n_steps:
+    if np.any(np.diff(ep) <= 0) or ep[0] < 1 or ep[-1] > n_steps:
         raise ValueError(f"ep_samples must be strictly increasing sample indices in 1..{n_steps}")
-    if int(record_every) < 1 or int(chunk_epochs) < 2 or int(workers) < 1:
-        raise ValueError("record_every ≥ 1, chunk_epochs ≥ 2 and workers ≥ 1 are required")
-    if smoother_form not in ("mbf", "rts"):
-        raise ValueError('smoother_form must be "mbf" or "rts"')
-    P0 = np.array(P0, dtype=float)
+    integer(record_every, "record_every"), integer(chunk_epochs, "chunk_epochs", 2), integer(workers, "workers")
+    choice(smoother_form, ("mbf", "rts"), "smoother_form")
+    P0 = np.array(numeric(P0, "P0"), dtype=float)
     if P0.shape != (n, n):
         raise ValueError(f"P0 must be {n}×{n}")
+    covariance(P0, "P0")
     return ep, P0
 
 
@@ -1153,6 +1164,11 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     Records
     """
     ep, P0 = _run_arguments(spec, P0, ep_samples, n_steps, record_every, chunk_epochs, workers, smoother_form)
+    if not isinstance(state, BatchState):
+        raise TypeError(f"state must be a closedloop.BatchState (closedloop.initial_batch_state), got "
+                        f"{type(state).__name__}")
+    if not callable(inputs) or (lead_inputs is not None and not callable(lead_inputs)):
+        raise TypeError("inputs (and lead_inputs) must be callables (chunk, k0, k1, epochs) -> ChunkInputs")
     n = spec.fconst.shape[0]
     state = _with_phat(state, n - 9)
     R = state.st.shape[0]

@@ -30,7 +30,8 @@ from .rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from .sensors import GnssMeasurements, ImuErrors, TriadErrors
 from .strapdown import NavSolution, NavState, VERTICAL_MODES, validate_increments, validate_time, vertical_damping_gains
 from .sensors import gnss_measurements
-from ._validate import covariance, finite_array, numeric, positive
+from ._validate import choice, components, covariance, finite_array, integer, numeric, positive
+from .trajectory import Trajectory
 
 __all__ = ["van_loan", "discretize_series", "predict", "update", "rts_smoother", "nees", "nis", "chi2_band",
            "ClosedLoopResult", "closed_loop", "perturb_state", "MonteCarloResult", "monte_carlo",
@@ -76,8 +77,7 @@ def discretize_series(F, GQGt, dt, order: int = 4):
     if Q.shape != F.shape:
         raise ValueError(f"F {F.shape} and GQGt {Q.shape} must have the same shape")
     dt = positive(dt, "dt", "{name} must be a positive finite time step (s), got {value!r}")
-    if isinstance(order, (str, bytes)) or int(order) != order or order < 1:
-        raise ValueError(f"order must be a positive integer (terms of the series), got {order!r}")
+    order = integer(order, "order", 1, "{name} must be a positive integer (terms of the series), got {value!r}")
     n = F.shape[0]
     Phi, Qd, w1, w2 = (np.empty((n, n)) for _ in range(4))
     K.discretize_series(F, Q, float(dt), int(order), Phi, Qd, w1, w2)
@@ -246,6 +246,25 @@ def _prepare(t, dtheta, dv, gnss, model, n):
     earth.check_latitude(gnss.lat, polar_limit_deg=earth.POLAR_LIMIT_DEG, name="GNSS latitude")
 
 
+def _reference(value, name: str, n: int) -> np.ndarray:
+    """A vertical reference (``h_ref``/``vu_ref``): zeros when ``None``, else finite and one value or ``n`` values."""
+    if value is None:
+        return np.zeros(n)
+    a = finite_array(value, name)
+    if a.ndim > 1 or a.size not in (1, n):
+        raise ValueError(f"{name} must be one number or {n} values (one per IMU sample), got shape {a.shape}")
+    return np.ascontiguousarray(np.broadcast_to(value, (n,)), float)
+
+
+def _gnss_noise(value, name: str) -> np.ndarray:
+    """The filter's GNSS noise covariance diag(sd²) (3×3) from positive finite standard deviations ``value``."""
+    sd = components(value, name)
+    if not np.all(sd > 0):
+        raise ValueError(f"{name} must be positive standard deviations (the filter divides by the GNSS variance), "
+                         f"got {sd.tolist()}")
+    return np.diag(np.broadcast_to(np.asarray(value, float), (3,)) ** 2)
+
+
 def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model: ErrorModel, *,
                 use_position: bool = True, use_velocity: bool = True, P0=None, vertical: str = "free",
                 h_ref=None, vu_ref=None, damping_tau: float = 100.0, truth=None, true_params=None,
@@ -266,33 +285,40 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     n = len(dtheta)
     t = validate_time(t, n)
     _prepare(t, dtheta, dv, gnss, model, n)
+    if not isinstance(initial, NavState):
+        raise TypeError(f"initial must be a strapdown.NavState, got {type(initial).__name__}")
     if not (use_position or use_velocity):
-        raise ValueError("use at least one of GNSS position and velocity")
-    if vertical not in VERTICAL_MODES:
-        raise ValueError(f"vertical must be one of {sorted(VERTICAL_MODES)}")
-    href = np.zeros(n + 1) if h_ref is None else np.ascontiguousarray(np.broadcast_to(h_ref, (n + 1,)), float)
-    vuref = np.zeros(n + 1) if vu_ref is None else np.ascontiguousarray(np.broadcast_to(vu_ref, (n + 1,)), float)
+        raise ValueError("use at least one of GNSS position and velocity (use_position, use_velocity)")
+    choice(vertical, sorted(VERTICAL_MODES), "vertical")
+    href, vuref = _reference(h_ref, "h_ref", n + 1), _reference(vu_ref, "vu_ref", n + 1)
     if vertical != "free" and h_ref is None:
         raise ValueError(f"vertical={vertical!r} needs h_ref")
+    positive(damping_tau, "damping_tau", "{name} must be a positive finite time constant (s), got {value!r}")
     gains = vertical_damping_gains(damping_tau, initial.lat, initial.h) if vertical == "damped" else np.zeros(3)
-    P0 = model.P0() if P0 is None else np.asarray(P0, float)
-    if P0.shape != (model.n, model.n):
-        raise ValueError(f"P0 must be {model.n}×{model.n}")
+    P0 = model.P0() if P0 is None else covariance(P0, "P0", model.n)
+    R_pos = _gnss_noise(gnss.sigma_pos, "gnss.sigma_pos")
+    R_vel = _gnss_noise(gnss.sigma_vel, "gnss.sigma_vel")
     m_ep = len(gnss.index)
     n_aug = model.n - 9
     compute_nees = truth is not None
     idx = np.asarray(gnss.index, np.int64)
     if compute_nees:
+        if not isinstance(truth, Trajectory):
+            raise TypeError(f"truth must be a trajectory.Trajectory on the IMU samples, got {type(truth).__name__}")
         if len(truth.t) != n + 1:
             raise ValueError("truth must have the same samples as the IMU record")
         tst = np.column_stack([truth.lat[idx], truth.lon[idx], truth.h[idx], truth.v_enu[idx]])
         tq = dcm_to_quat(euler_to_dcm(truth.hpr[idx, 0], truth.hpr[idx, 1], truth.hpr[idx, 2]))
+        if true_params is not None:
+            a = finite_array(true_params, "true_params")
+            if a.ndim > 1 or a.size not in (1, n_aug):
+                raise ValueError(f"true_params must hold the {n_aug} augmented states (true_parameter_vector), got "
+                                 f"shape {a.shape}")
         tp = np.zeros((m_ep, n_aug)) if true_params is None else np.broadcast_to(
             np.asarray(true_params, float), (m_ep, n_aug))
     else:
         tst, tq, tp = np.zeros((m_ep, 6)), np.zeros((m_ep, 4)), np.zeros((m_ep, n_aug))
-    spec = CL.build_spec(model, R_pos=np.diag(np.asarray(gnss.sigma_pos, float) ** 2),
-                         R_vel=np.diag(np.broadcast_to(np.asarray(gnss.sigma_vel, float), (3,)) ** 2),
+    spec = CL.build_spec(model, R_pos=R_pos, R_vel=R_vel,
                          lever_arm_b=gnss.lever_arm_b, use_position=use_position, use_velocity=use_velocity,
                          vmode=VERTICAL_MODES[vertical], gains=gains, series_order=series_order, nees=compute_nees)
     state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], gnss.lever_arm_b)
@@ -451,24 +477,28 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     -------
     MonteCarloResult
     """
-    if int(n_runs) < 1:
-        raise ValueError("n_runs must be at least 1")
-    if vertical not in VERTICAL_MODES:
-        raise ValueError(f"vertical must be one of {sorted(VERTICAL_MODES)}")
+    if not isinstance(traj, Trajectory):
+        raise TypeError(f"traj must be a trajectory.Trajectory (trajectory.generate), got {type(traj).__name__}")
+    if not isinstance(model, ErrorModel):
+        raise TypeError("model must be an replication.errors.ErrorModel (e.g. errors.model_15(...))")
+    n_runs = integer(n_runs, "n_runs")
+    if seed is not None:
+        integer(seed, "seed", 0, "{name} must be a non-negative integer (the SeedSequence entropy), got {value!r}")
+    workers = integer(workers, "workers")
+    choice(vertical, sorted(VERTICAL_MODES), "vertical")
+    positive(gnss_rate_hz, "gnss_rate_hz", "{name} must be a positive finite rate (Hz), got {value!r}")
+    R_pos, R_vel = _gnss_noise(sigma_pos, "sigma_pos"), _gnss_noise(sigma_vel, "sigma_vel")
     for need in ("accel_bias", "gyro_bias"):
         model.block(need)
-    n_runs = int(n_runs)
     n = traj.n
+    href, vuref = _reference(h_ref, "h_ref", n + 1), _reference(vu_ref, "vu_ref", n + 1)
+    if vertical != "free" and h_ref is None:
+        raise ValueError(f"vertical={vertical!r} needs h_ref")
     p_true, dth, dvv, gn, st0, q0 = _draw_runs(traj, model, n_runs, seed, gnss_rate_hz, sigma_pos, sigma_vel, workers)
     g0 = gn[0]
     idx = np.asarray(g0.index, np.int64)
-    href = np.zeros(n + 1) if h_ref is None else np.ascontiguousarray(np.broadcast_to(h_ref, (n + 1,)), float)
-    vuref = np.zeros(n + 1) if vu_ref is None else np.ascontiguousarray(np.broadcast_to(vu_ref, (n + 1,)), float)
-    if vertical != "free" and h_ref is None:
-        raise ValueError(f"vertical={vertical!r} needs h_ref")
     gains = vertical_damping_gains(100.0, traj.lat[0], traj.h[0]) if vertical == "damped" else np.zeros(3)
-    spec = CL.build_spec(model, R_pos=np.diag(np.broadcast_to(np.asarray(sigma_pos, float), (3,)) ** 2),
-                         R_vel=np.diag(np.broadcast_to(np.asarray(sigma_vel, float), (3,)) ** 2),
+    spec = CL.build_spec(model, R_pos=R_pos, R_vel=R_vel,
                          lever_arm_b=g0.lever_arm_b, vmode=VERTICAL_MODES[vertical], gains=gains, nees=True)
     rec = CL.run(spec, CL.initial_batch_state(st0, q0, g0.lever_arm_b), model.P0(), idx, n,
                  _batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref), store_P=False, workers=workers)

@@ -12,12 +12,13 @@ inside a compiled loop.
 import re
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from replication import calibration, earth, errors, kalman, rotations, strapdown, transfer
-from replication import models, sensors, trajectory
+from replication import closedloop, models, observability, sensors, trajectory
 from replication.units import DEG
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
@@ -110,6 +111,163 @@ PROBES = [
      lambda: strapdown.navigation_rates(LAT, LON, 1e8, [0, 0, 0], I3, np.zeros(3), [0, 0, 9.8])),
 ]
 
+# ------------------------------------------------------------------ observability, closed loop, Monte Carlo
+
+_T1 = trajectory.generate([trajectory.Straight(1.0)], LAT, LON, H, speed=10.0)     # 1 s straight, 100 Hz
+_M15 = errors.model_15()
+_R6 = np.diag([1.0, 1.0, 1.0, 0.01, 0.01, 0.01])
+_MV = {"straight": observability.Maneuver("straight", _T1, 1.0, 1.0)}
+_G1 = sensors.gnss_measurements(_T1, rate_hz=10.0, rng=0)
+_F2, _H12 = np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[1.0, 0.0]])
+
+
+def _deg_table(values=(1.0, 1e-3, 0.0), scenarios=("before maneuver", "turn"), states=("a", "b", "c")):
+    """A degrees table of three states (as observability.degrees_table returns it)."""
+    t = pd.DataFrame({c: list(values) for c in scenarios}, index=list(states))
+    t.attrs["rank_tol"] = dict.fromkeys(scenarios, 1e-9)
+    t.attrs["ambiguity"] = {c: dict.fromkeys(t.index, 0.1) for c in scenarios}
+    return t
+
+
+_DV = ("dvE", "dvN", "dvU")
+_EXACT = {(s, c): True for s in "abc" for c in ("before maneuver", "turn")}
+
+
+def _closed_loop(**kw):
+    args = dict(t=_T1.t, dtheta=_T1.dtheta, dv=_T1.dv, initial=_T1.initial_state(), gnss=_G1, model=_M15)
+    args.update(kw)
+    return kalman.closed_loop(**args)
+
+
+def _cl_run(**kw):
+    """closedloop.run of one recorded run along _T1 (the inputs of kalman.closed_loop)."""
+    n = _T1.n
+    idx = np.asarray(_G1.index, np.int64)
+    spec = closedloop.build_spec(_M15, R_pos=0.01 * I3, R_vel=1e-4 * I3)
+    state = closedloop.initial_batch_state(_T1.initial_state().vector()[None, :],
+                                           rotations.dcm_to_quat(_T1.initial_state().C_bn)[None, :], np.zeros(3))
+    m = len(idx)
+    inputs = kalman._single_run_inputs(_T1.t, _T1.dtheta, _T1.dv, np.zeros(n + 1), np.zeros(n + 1), idx, _G1,
+                                       np.zeros((m, 6)), np.zeros((m, 4)), np.zeros((m, _M15.n - 9)))
+    args = dict(spec=spec, state=state, P0=_M15.P0(), ep_samples=idx, n_steps=n, inputs=inputs, workers=1)
+    args.update(kw)
+    return closedloop.run(**args)
+
+
+PROBES += [
+    ("observability_matrix(F with NaN)", "F", lambda: observability.observability_matrix(np.diag([np.nan, 0.0]), _H12)),
+    ("observability_matrix(H = 'a')", "H", lambda: observability.observability_matrix(_F2, "a")),
+    ("observability_matrix(n_powers = 2.5)", "n_powers", lambda: observability.observability_matrix(_F2, _H12, 2.5)),
+    ("observability_matrix(n_powers = nan)", "n_powers",
+     lambda: observability.observability_matrix(_F2, _H12, np.nan)),
+    ("stripped_observability_matrix(pair of three)", "systems",
+     lambda: observability.stripped_observability_matrix([(_F2, _H12, 1.0)])),
+    ("total_observability_matrix(durations = [nan])", "durations",
+     lambda: observability.total_observability_matrix([(_F2, _H12)], [np.nan])),
+    ("total_observability_matrix(durations = 'a')", "durations",
+     lambda: observability.total_observability_matrix([(_F2, _H12)], "a")),
+    ("som_condition(rtol = -1e-9)", "rtol", lambda: observability.som_condition(_F2, _H12, rtol=-1e-9)),
+    ("som_condition(rtol = nan)", "rtol", lambda: observability.som_condition(_F2, _H12, rtol=np.nan)),
+    ("observability_degrees(normalize = 'min')", "normalize",
+     lambda: observability.observability_degrees(np.eye(2), normalize="min")),
+    ("observability_degrees(Q = 'a')", "Q", lambda: observability.observability_degrees("a")),
+    ("ObservabilityDegrees.observable(threshold = -1)", "threshold",
+     lambda: observability.observability_degrees(np.eye(2)).observable(-1.0)),
+    ("segment_bounds(t1 = inf)", "t1", lambda: observability.segment_bounds(0.0, np.inf, 4)),
+    ("segment_bounds(n_segments = 'a')", "n_segments", lambda: observability.segment_bounds(0.0, 1.0, "a")),
+    ("pwcs_observability(spans = [(0, nan)])", "spans",
+     lambda: observability.pwcs_observability(_M15, _T1, [(0.0, np.nan)])),
+    ("pwcs_observability(spans beyond the trajectory)", "spans",
+     lambda: observability.pwcs_observability(_M15, _T1, [(0.0, 100.0)])),
+    ("pwcs_observability(spans reversed)", "spans",
+     lambda: observability.pwcs_observability(_M15, _T1, [(0.8, 0.2)])),
+    ("pwcs_observability(evaluate = 'end')", "evaluate",
+     lambda: observability.pwcs_observability(_M15, _T1, [(0.0, 1.0)], evaluate="end")),
+    ("pwcs_observability(traj = None)", "traj", lambda: observability.pwcs_observability(_M15, None, [(0.0, 1.0)])),
+    ("pwcs_observability(lever_arm_b = 'a')", "lever_arm_b",
+     lambda: observability.pwcs_observability(_M15, _T1, [(0.0, 1.0)], lever_arm_b="a")),
+    ("covariance_observability(R = -I)", "R",
+     lambda: observability.covariance_observability(_M15, _T1, 0.0, 1.0, update_interval=0.5, R=-np.eye(6))),
+    ("covariance_observability(R not symmetric)", "R",
+     lambda: observability.covariance_observability(_M15, _T1, 0.0, 1.0, update_interval=0.5,
+                                                    R=np.eye(6) + np.triu(np.ones((6, 6)), 1))),
+    ("covariance_observability(P0 = -I)", "P0",
+     lambda: observability.covariance_observability(_M15, _T1, 0.0, 1.0, update_interval=0.5, R=_R6,
+                                                    P0=-np.eye(15))),
+    ("covariance_observability(update_interval = inf)", "update_interval",
+     lambda: observability.covariance_observability(_M15, _T1, 0.0, 1.0, update_interval=np.inf, R=_R6)),
+    ("covariance_observability(t1 = nan)", "t1",
+     lambda: observability.covariance_observability(_M15, _T1, 0.0, np.nan, update_interval=0.5, R=_R6)),
+    ("covariance_observability(series_order = 0)", "series_order",
+     lambda: observability.covariance_observability(_M15, _T1, 0.0, 1.0, update_interval=0.5, R=_R6, series_order=0)),
+    ("spearman(a = 'abc')", "a", lambda: observability.spearman("abc", [1, 2, 3])),
+    ("spearman(b with NaN)", "b", lambda: observability.spearman([1, 2, 3], [1, np.nan, 3])),
+    ("chen2019_maneuvers(u_turn = '400')", "u_turn", lambda: observability.chen2019_maneuvers(u_turn="400")),
+    ("chen2019_maneuvers(total = nan)", "total", lambda: observability.chen2019_maneuvers(total=np.nan)),
+    ("chen2019_maneuvers(s_cycles = 0)", "s_cycles", lambda: observability.chen2019_maneuvers(s_cycles=0)),
+    ("chen2019_maneuvers(dt = -1)", "dt", lambda: observability.chen2019_maneuvers(dt=-1.0)),
+    ("unbanked(traj = array)", "traj", lambda: observability.unbanked(np.zeros((10, 3)))),
+    ("coordinated(traj = None)", "traj", lambda: observability.coordinated(None)),
+    ("degrees_table(maneuvers = list)", "maneuvers",
+     lambda: observability.degrees_table(_M15, [_T1], states=_M15.labels)),
+    ("degrees_table(n_segments = 0)", "n_segments",
+     lambda: observability.degrees_table(_M15, _MV, states=_M15.labels, n_segments=0)),
+    ("covariance_table(R with NaN)", "R",
+     lambda: observability.covariance_table(_M15, _MV, np.diag([np.nan, 1, 1, 1, 1, 1]), states=_M15.labels)),
+    ("rank_metrics(reference_threshold = -1)", "reference_threshold",
+     lambda: observability.rank_metrics(_deg_table(), _deg_table(), reference_threshold=-1.0, reproduced_threshold=0.0)),
+    ("rank_metrics(reproduced_threshold = nan)", "reproduced_threshold",
+     lambda: observability.rank_metrics(_deg_table(), _deg_table(), reference_threshold=0.0,
+                                        reproduced_threshold=np.nan)),
+    ("rank_metrics(reference with NaN)", "reference",
+     lambda: observability.rank_metrics(_deg_table((1.0, np.nan, 0.0)), _deg_table(), reference_threshold=0.0,
+                                        reproduced_threshold=0.0)),
+    ("rank_metrics(reproduced = array)", "reproduced",
+     lambda: observability.rank_metrics(_deg_table(), np.eye(3), reference_threshold=0.0, reproduced_threshold=0.0)),
+    ("sweep(reference_threshold = nan)", "reference_threshold",
+     lambda: observability.sweep(_M15, _MV, _deg_table(scenarios=("straight",), states=_DV), {"v": {}}, states=_DV,
+                                 reference_threshold=np.nan)),
+    ("sweep(variants = list)", "variants",
+     lambda: observability.sweep(_M15, _MV, _deg_table(scenarios=("straight",), states=_DV), [{}], states=_DV)),
+    ("verdict_under(rank_tol = -1e-9)", "rank_tol", lambda: observability.verdict_under(1.0, 1.0, -1e-9, 0.1)),
+    ("verdict_under(degree = '1')", "degree", lambda: observability.verdict_under(1.0, "1", 1e-9, 0.1)),
+    ("compare_verdicts(printed_threshold = -1)", "printed_threshold",
+     lambda: observability.compare_verdicts(_deg_table(), {"m": _deg_table()}, "m", exact=_EXACT, explain={},
+                                            printed_threshold=-1.0)),
+    ("compare_verdicts(exact incomplete)", "exact",
+     lambda: observability.compare_verdicts(_deg_table(), {"m": _deg_table()}, "m", exact={}, explain={})),
+    ("compare_verdicts(printed with NaN)", "printed",
+     lambda: observability.compare_verdicts(_deg_table((np.nan, 0.0, 0.0)), {"m": _deg_table()}, "m", exact=_EXACT,
+                                            explain={})),
+    ("closed_loop(P0 = -I)", "P0", lambda: _closed_loop(P0=-np.eye(15))),
+    ("closed_loop(P0 with NaN)", "P0", lambda: _closed_loop(P0=np.diag([np.nan] + [1.0] * 14))),
+    ("closed_loop(vertical = 'up')", "vertical", lambda: _closed_loop(vertical="up")),
+    ("closed_loop(h_ref = [nan])", "h_ref", lambda: _closed_loop(vertical="hold", h_ref=[np.nan])),
+    ("closed_loop(damping_tau = -100)", "damping_tau", lambda: _closed_loop(damping_tau=-100.0)),
+    ("closed_loop(series_order = 2.5)", "series_order", lambda: _closed_loop(series_order=2.5)),
+    ("closed_loop(initial = tuple)", "initial", lambda: _closed_loop(initial=(LAT, LON, H))),
+    ("closed_loop(gnss sigma_pos = 0)", "sigma_pos",
+     lambda: _closed_loop(gnss=sensors.gnss_measurements(_T1, rate_hz=10.0, sigma_pos=0.0, rng=0))),
+    ("monte_carlo(n_runs = 0)", "n_runs", lambda: kalman.monte_carlo(_T1, _M15, n_runs=0)),
+    ("monte_carlo(n_runs = 2.5)", "n_runs", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2.5)),
+    ("monte_carlo(n_runs = '20')", "n_runs", lambda: kalman.monte_carlo(_T1, _M15, n_runs="20")),
+    ("monte_carlo(seed = -1)", "seed", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, seed=-1)),
+    ("monte_carlo(sigma_pos = -0.03)", "sigma_pos", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, sigma_pos=-0.03)),
+    ("monte_carlo(sigma_vel = nan)", "sigma_vel", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, sigma_vel=np.nan)),
+    ("monte_carlo(gnss_rate_hz = inf)", "gnss_rate_hz",
+     lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, gnss_rate_hz=np.inf)),
+    ("monte_carlo(workers = 0)", "workers", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, workers=0)),
+    ("monte_carlo(model = '15-state')", "model", lambda: kalman.monte_carlo(_T1, "15-state", n_runs=2)),
+    ("closedloop.build_spec(R_pos with NaN)", "R_pos",
+     lambda: closedloop.build_spec(_M15, R_pos=np.diag([np.nan, 1.0, 1.0]), R_vel=I3)),
+    ("closedloop.build_spec(lever_arm_b = [nan, 0, 0])", "lever_arm_b",
+     lambda: closedloop.build_spec(_M15, R_pos=I3, R_vel=I3, lever_arm_b=[np.nan, 0.0, 0.0])),
+    ("closedloop.run(P0 = -I)", "P0", lambda: _cl_run(P0=-np.eye(15))),
+    ("closedloop.run(record_every = 0)", "record_every", lambda: _cl_run(record_every=0)),
+    ("closedloop.run(smoother_form = 'ukf')", "smoother_form", lambda: _cl_run(smoother_form="ukf")),
+    ("closedloop.run(ep_samples = [2.5])", "ep_samples", lambda: _cl_run(ep_samples=[2.5])),
+]
+
 
 def _names(message: str, arg: str) -> bool:
     """The message names ``arg`` as a word (``h`` in "NavState.h = ...", not the h of "height")."""
@@ -183,6 +341,45 @@ def _bad(kind):
                          st.just(np.r_[np.zeros(50), np.inf, np.zeros(49)]))
     if kind == "mat2":
         return st.one_of(text, st.just(np.diag([np.nan, 0.0])), st.just(np.diag([np.inf, 0.0])), st.just(np.eye(3)))
+    if kind == "count":            # a positive whole number (order, number of segments, runs, workers)
+        return st.one_of(common, st.sampled_from([0, -1, 2.5, True]))
+    if kind == "seed":             # SeedSequence entropy: a non-negative whole number
+        return st.one_of(common, st.sampled_from([-1, 2.5, -(2 ** 40)]))
+    if kind == "gnss_sd":          # a GNSS standard deviation of the filter: positive
+        return st.one_of(common, st.floats(-1e6, 0.0), nonfinite.map(lambda x: [0.03, x, 0.1]), st.just([0.1, 0.1]))
+    if kind.startswith("cov") and kind[3:].isdigit():      # an n×n covariance
+        n = int(kind[3:])
+        return st.one_of(common, st.floats(1e-6, 1e3).map(lambda s: -s * np.eye(n)),
+                         st.floats(1e-3, 1e3).map(lambda s: np.eye(n) + s * np.triu(np.ones((n, n)), 1)),
+                         st.just(np.diag([np.nan] + [1.0] * (n - 1))), st.just(np.eye(n + 1)))
+    if kind == "mat":              # a finite matrix of any shape
+        return st.one_of(text, st.just(np.diag([np.nan, 1.0])), st.just(np.diag([np.inf, 1.0])),
+                         st.just(np.zeros((2, 2, 2))))
+    if kind == "mat3":             # a 3×3 diagonal noise covariance
+        return st.one_of(common, st.just(np.diag([np.nan, 1.0, 1.0])), st.just(-I3), st.just(np.eye(2)))
+    if kind == "option":           # one of a fixed set of strings
+        return st.sampled_from(["bogus", "MAX", "", 3.5])
+    if kind == "object":           # an object of a given class (model, trajectory, table, dict of scenarios...)
+        return st.sampled_from(["abc", 3.0, [1.0, 2.0], np.zeros((2, 2))])
+    if kind == "table":            # a DataFrame of degrees
+        return st.one_of(text, st.just(np.eye(3)), st.just(pd.DataFrame({"x": [1.0, np.nan, 0.0]})),
+                         st.just(pd.DataFrame({"x": ["a", "b", "c"]})))
+    if kind == "labels":           # state names of the model
+        return st.sampled_from([["no such state"], ["dvE", "bogus"]])
+    if kind == "names2":           # one name per column of a two-column matrix
+        return st.sampled_from([["x"], ["a", "b", "c"], []])
+    if kind == "systems":          # (F, H) segments
+        return st.one_of(text, st.just([]), st.just([(np.eye(2), np.ones((1, 2)), 1.0)]),
+                         st.just([(np.diag([np.nan, 0.0]), np.ones((1, 2)))]), st.just([(np.eye(2), "a")]))
+    if kind == "durations":        # one positive duration per segment
+        return st.one_of(common, nonfinite.map(lambda x: [x]), st.floats(-1e6, 0.0).map(lambda x: [x]),
+                         st.just([1.0, 1.0]))
+    if kind == "spans":            # (t_start, t_end) segments inside the trajectory
+        return st.one_of(text, st.just([]), nonfinite.map(lambda x: [(0.0, x)]), st.just([(0.8, 0.2)]),
+                         st.just([(0.0, 100.0)]), st.just([(0.0, 0.5, 1.0)]))
+    if kind == "epochs":           # strictly increasing IMU sample indices
+        return st.one_of(text, st.just([]), st.just([np.nan]), st.just([2.5]), st.just([5, 3]), st.just([0]),
+                         st.just([10 ** 6]))
     raise KeyError(kind)
 
 
@@ -265,11 +462,90 @@ _CALLS = {
                                     position_sigma=1.0),
                                {"gyro_arw": "sd", "accel_vrw": "sd", "gyro_bias_rw": "sd", "accel_bias_rw": "sd",
                                 "position_sigma": "rate", "position_rate": "rate"}),
+    "observability.observability_matrix": (observability.observability_matrix, dict(F=_F2, H=_H12),
+                                           {"F": "mat2", "H": "mat2", "n_powers": "count"}),
+    "observability.stripped_observability_matrix": (observability.stripped_observability_matrix,
+                                                    dict(systems=[(_F2, _H12)]),
+                                                    {"systems": "systems", "n_powers": "count"}),
+    "observability.total_observability_matrix": (observability.total_observability_matrix,
+                                                 dict(systems=[(_F2, _H12)], durations=[1.0]),
+                                                 {"systems": "systems", "durations": "durations", "n_powers": "count"}),
+    "observability.som_condition": (observability.som_condition, dict(F=_F2, H=_H12),
+                                    {"F": "mat2", "H": "mat2", "n_powers": "count", "rtol": "sd"}),
+    "observability.observability_degrees": (observability.observability_degrees, dict(Q=np.eye(2)),
+                                            {"Q": "mat", "assignment": "option", "normalize": "option",
+                                             "labels": "names2"}),
+    "observability.segment_bounds": (observability.segment_bounds, dict(t0=0.0, t1=1.0, n_segments=2),
+                                     {"t0": "angle", "t1": "angle", "n_segments": "count"}),
+    "observability.piecewise_systems": (observability.piecewise_systems, dict(model=_M15, traj=_T1, spans=[(0.0, 1.0)]),
+                                        {"model": "object", "traj": "object", "spans": "spans", "evaluate": "option",
+                                         "position_units": "option", "lever_arm_b": "vec3", "states": "labels"}),
+    "observability.pwcs_observability": (observability.pwcs_observability, dict(model=_M15, traj=_T1, spans=[(0.0, 1.0)]),
+                                         {"model": "object", "traj": "object", "spans": "spans", "n_powers": "count",
+                                          "evaluate": "option", "assignment": "option", "normalize": "option",
+                                          "lever_arm_b": "vec3", "position_units": "option"}),
+    "observability.covariance_observability": (observability.covariance_observability,
+                                               dict(model=_M15, traj=_T1, t0=0.0, t1=1.0, update_interval=0.5, R=_R6),
+                                               {"model": "object", "traj": "object", "t0": "angle", "t1": "angle",
+                                                "update_interval": "rate", "R": "cov6", "P0": "cov15",
+                                                "lever_arm_b": "vec3", "series_order": "count"}),
+    "observability.spearman": (observability.spearman, dict(a=[1.0, 2.0, 3.0], b=[1.0, 3.0, 2.0]),
+                               {"a": "vec2", "b": "vec2"}),
+    "observability.chen2019_maneuvers": (observability.chen2019_maneuvers,
+                                         dict(straight=2.0, u_turn=4.0, figure_eight=8.0, s_turn=8.0, dt=1.0),
+                                         {"straight": "rate", "u_turn": "rate", "figure_eight": "rate", "s_turn": "rate",
+                                          "s_swing": "angle", "s_cycles": "count", "total": "rate", "dt": "rate"}),
+    "observability.unbanked": (observability.unbanked, dict(traj=_T1), {"traj": "object"}),
+    "observability.coordinated": (observability.coordinated, dict(traj=_T1), {"traj": "object"}),
+    "observability.degrees_table": (observability.degrees_table, dict(model=_M15, maneuvers=_MV, states=_M15.labels),
+                                    {"model": "object", "maneuvers": "object", "n_segments": "count",
+                                     "before_segments": "count", "states": "labels"}),
+    "observability.covariance_table": (observability.covariance_table,
+                                       dict(model=_M15, maneuvers=_MV, R=_R6, states=_M15.labels, update_interval=0.5),
+                                       {"model": "object", "maneuvers": "object", "R": "cov6", "P0": "cov15",
+                                        "update_interval": "rate", "states": "labels"}),
+    "observability.rank_metrics": (observability.rank_metrics,
+                                   dict(reference=_deg_table(), reproduced=_deg_table(), reference_threshold=1e-5,
+                                        reproduced_threshold=1e-5),
+                                   {"reference": "table", "reproduced": "table", "reference_threshold": "sd",
+                                    "reproduced_threshold": "sd"}),
+    "observability.sweep": (observability.sweep,
+                            dict(model=_M15, maneuvers=_MV, reference=_deg_table(scenarios=("straight",), states=_DV),
+                                 variants={"default": {}}, states=_DV),
+                            {"model": "object", "maneuvers": "object", "reference": "table", "variants": "object",
+                             "reference_threshold": "sd"}),
+    "observability.verdict_under": (observability.verdict_under,
+                                    dict(printed_value=1.0, degree=1.0, rank_tol=1e-9, ambiguity=0.1),
+                                    {"printed_value": "sd", "degree": "sd", "rank_tol": "sd", "ambiguity": "sd",
+                                     "printed_threshold": "sd"}),
+    "observability.compare_verdicts": (observability.compare_verdicts,
+                                       dict(printed=_deg_table(), readings={"m": _deg_table()}, main="m", exact=_EXACT,
+                                            explain={}),
+                                       {"printed": "table", "readings": "object", "exact": "object",
+                                        "printed_threshold": "sd"}),
+    "kalman.closed_loop": (_closed_loop, dict(),
+                           {"initial": "object", "gnss": "object", "model": "object", "P0": "cov15",
+                            "vertical": "option", "h_ref": "series", "vu_ref": "series", "damping_tau": "rate",
+                            "series_order": "count", "truth": "object"}),
+    "kalman.monte_carlo": (kalman.monte_carlo, dict(traj=_T1, model=_M15, n_runs=2, workers=1),
+                           {"traj": "object", "model": "object", "n_runs": "count", "seed": "seed",
+                            "gnss_rate_hz": "rate", "sigma_pos": "gnss_sd", "sigma_vel": "gnss_sd",
+                            "vertical": "option", "workers": "count", "h_ref": "series", "vu_ref": "series"}),
+    "closedloop.build_spec": (closedloop.build_spec, dict(model=_M15, R_pos=I3, R_vel=I3),
+                              {"model": "object", "R_pos": "mat3", "R_vel": "mat3", "lever_arm_b": "vec3",
+                               "vmode": "option", "gains": "vec3", "series_order": "count"}),
+    "closedloop.initial_batch_state": (closedloop.initial_batch_state,
+                                       dict(st=np.zeros((1, 6)), q=np.array([[1.0, 0, 0, 0]]), lever0=np.zeros(3)),
+                                       {"st": "mat", "q": "mat", "lever0": "vec3"}),
+    "closedloop.run": (_cl_run, dict(),
+                       {"spec": "object", "state": "object", "P0": "cov15", "ep_samples": "epochs", "n_steps": "count",
+                        "inputs": "object", "record_every": "count", "chunk_epochs": "count", "workers": "count",
+                        "smoother_form": "option"}),
 }
 _CASES = [(name, arg) for name, (_, _, kinds) in _CALLS.items() for arg in kinds]
 
 
-@settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
+@settings(max_examples=800, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 @given(data=st.data())
 def test_public_functions_refuse_bad_input(data):
     name, arg = data.draw(st.sampled_from(_CASES), label="function, argument")
