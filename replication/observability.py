@@ -244,6 +244,15 @@ def observability_degrees(Q, *, assignment: str = "state", normalize: str | None
     state's component on it is the norm of its projection onto their subspace; a state whose
     largest component is shared (within ``TIE_TOL``) gets the larger singular value.  Both make
     the assignment independent of round-off.
+
+    The rank and the unobservable subspace do not depend on the scaling, but the *naming* of
+    states does: an SVD assigns each state to the singular vector it loads most, and column
+    scaling (``normalize="scale"`` with prior standard deviations vs raw units, where a
+    position in radians and a bias in m/s² differ by orders of magnitude) rotates the singular
+    vectors.  Per-state verdicts such as which states span a stationary INS's unobservable
+    directions (whether a level accelerometer bias or the tilt it cancels, the east gyro drift
+    or the azimuth error is named) can therefore differ between the two scalings; report the
+    scaling with the verdict.
     """
     Q = np.atleast_2d(numeric(Q, "Q"))
     if Q.ndim != 2 or not np.all(np.isfinite(Q)):

@@ -179,6 +179,14 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
     ``vertical`` is "free", "hold" (needs ``h_ref`` and optionally ``vu_ref``, N+1 values each:
     the papers' height channel held to the true height) or "damped" (third-order loop on
     ``h_ref``, e.g. a barometric height, with poles at -1/``damping_tau``).
+
+    Comparing the free vertical channel with another package: gravity here is the WGS-84
+    normal gravity of :func:`replication.earth.normal_gravity` (NIMA TR8350.2, Somigliana with
+    the second-order height series), not a linear free-air term γ_0 - 3.086e-6 h.  The two
+    differ by ~1e-7 m/s² at 150 m (more with another peer's constants or formula), and the
+    free channel, unstable with rate sqrt(2g/R) ≈ 1.75e-3 s⁻¹, amplifies any such difference
+    by about cosh(sqrt(2g/R) t) ≈ 280 in an hour: height differences against a peer's free
+    channel of that origin are a choice of gravity model, not an error of either.
     """
     dtheta, dv = validate_increments(dtheta, dv)
     n = len(dtheta)
