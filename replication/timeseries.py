@@ -31,6 +31,7 @@ import pandas as pd
 from scipy import linalg, signal, stats
 
 from .sensors import gauss_markov_coefficients, gauss_markov_recursion
+from ._validate import choice as _choice, finite_array, integer, nonnegative, numeric, positive, probability
 
 __all__ = [
     "NonStationaryError", "StationarityWarning", "ar_coefficients", "InversionTest", "inversion_count", "inversion_moments", "inversion_distribution", "inversion_test",
@@ -51,7 +52,7 @@ class StationarityWarning(UserWarning):
 
 
 def _series(y, name: str = "y", min_length: int = 3) -> np.ndarray:
-    y = np.asarray(y, dtype=float)
+    y = numeric(y, name)
     if y.ndim != 1:
         raise ValueError(f"{name} must be a one-dimensional series, got shape {y.shape}")
     if y.size < min_length:
@@ -63,7 +64,7 @@ def _series(y, name: str = "y", min_length: int = 3) -> np.ndarray:
 
 def ar_coefficients(phi) -> np.ndarray:
     """AR coefficients [φ_1, ..., φ_p] as a validated 1-D float array (a scalar is AR(1))."""
-    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    phi = np.atleast_1d(numeric(phi, "phi"))
     if phi.ndim != 1 or phi.size == 0 or not np.all(np.isfinite(phi)):
         raise ValueError("phi must be a non-empty 1-D array of finite AR coefficients [phi_1, ..., phi_p]")
     return phi
@@ -77,9 +78,10 @@ def inversion_count(values) -> int:
     Note the printed definition counts *larger* later values: an increasing sequence has the
     maximum count m(m-1)/2, a decreasing one has zero.
     """
-    v = np.asarray(values, dtype=float)
+    v = numeric(values, "values")
     if v.ndim != 1 or v.size < 2:
         raise ValueError("inversion_count needs a 1-D sequence of at least two values")
+    finite_array(v, "values")
     return int(np.sum(np.triu(v[None, :] > v[:, None], k=1)))
 
 
@@ -89,8 +91,7 @@ def inversion_moments(m: int) -> tuple[float, float]:
     D(A) equals the variance m(m-1)(2m+5)/72 of the number of inversions of a random
     permutation (Kendall's statistic), since m(m-1)(2m+5) = m(2m^2+3m-5).
     """
-    if int(m) != m or m < 2:
-        raise ValueError(f"the number of segments m must be an integer >= 2, got {m}")
+    integer(m, "m", 2, "the number of segments {name} must be an integer >= 2, got {value!r}")
     return m * (m - 1) / 4.0, m * (2 * m**2 + 3 * m - 5) / 72.0
 
 
@@ -100,8 +101,7 @@ def inversion_distribution(m: int) -> np.ndarray:
     P(A = a) for a = 0..m(m-1)/2 under a uniformly random order, from the generating function
     prod_{k=1}^{m} (1 + x + ... + x^{k-1}) / m!.  An independent check of (E(A), D(A)).
     """
-    if int(m) != m or m < 2:
-        raise ValueError(f"m must be an integer >= 2, got {m}")
+    integer(m, "m", 2)
     c = np.array([1.0])
     for k in range(1, int(m) + 1):
         c = np.convolve(c, np.ones(k))
@@ -142,13 +142,11 @@ def inversion_test(y, segments: int, *, alpha: float = 0.05) -> InversionTest:
     (with the continuity correction toward E(A)), which is the test of Bendat & Piersol.
     """
     y = _series(y)
-    m = int(segments)
-    if m != segments or m < 2:
-        raise ValueError(f"segments must be an integer >= 2, got {segments}")
+    m = integer(segments, "segments", 2)
     if y.size < 2 * m:
-        raise ValueError(f"a series of {y.size} samples cannot be cut into {m} segments of >= 2 samples; use fewer segments")
-    if not 0 < alpha < 1:
-        raise ValueError("alpha must lie in (0, 1)")
+        raise ValueError(f"a series of {y.size} samples (y) cannot be cut into {m} segments of >= 2 samples; use "
+                         "fewer segments")
+    probability(alpha, "alpha", "{name} must lie in (0, 1), got {value!r}")
     if np.ptp(y) == 0:
         raise ValueError("the series is constant: it has no stochastic part whose stationarity could be tested")
     L = y.size // m
@@ -171,6 +169,8 @@ def stationarity_report(y, segments: int, *, alpha: float = 0.05, regression: st
     from statsmodels.tsa.stattools import adfuller, kpss
 
     y = _series(y, min_length=20)
+    _choice(regression, ("c", "ct"), "regression", "{name} must be one of {allowed} (constant, constant and trend: "
+           "the trends both ADF and KPSS accept), got {value!r}")
     inv = inversion_test(y, segments, alpha=alpha)
     adf = adfuller(y, regression=regression, autolag="AIC", result_object=False)
     with warnings.catch_warnings():
@@ -190,10 +190,9 @@ def stationarity_report(y, segments: int, *, alpha: float = 0.05, regression: st
 def difference(y, d: int = 1) -> np.ndarray:
     """The d-th difference (1 - B)^d y_t (chen2019 Fig. 3-4, 差分平稳处理)."""
     y = _series(y)
-    if int(d) != d or d < 0:
-        raise ValueError(f"the differencing order d must be a non-negative integer, got {d}")
+    integer(d, "d", 0, "the differencing order {name} must be a non-negative integer, got {value!r}")
     if y.size <= d + 2:
-        raise ValueError(f"a series of {y.size} samples is too short to difference {d} times")
+        raise ValueError(f"y: a series of {y.size} samples is too short to difference {d} times")
     return np.diff(y, n=int(d)) if d else y.copy()
 
 
@@ -204,6 +203,9 @@ def make_stationary(y, segments: int, *, max_d: int = 2, alpha: float = 0.05) ->
     do not suffice.
     """
     y = _series(y)
+    integer(max_d, "max_d", 0)
+    integer(segments, "segments", 2)
+    probability(alpha, "alpha", "{name} must lie in (0, 1), got {value!r}")
     for d in range(max_d + 1):
         yd = difference(y, d)
         t = inversion_test(yd, segments, alpha=alpha)
@@ -224,6 +226,7 @@ def acf_printed(y, nlags: int) -> np.ndarray:
     ``acf(y, adjusted=False, demean=False)``.
     """
     y = _series(y)
+    integer(nlags, "nlags")
     if not 1 <= nlags < y.size:
         raise ValueError(f"nlags must lie in [1, {y.size - 1}], got {nlags}")
     n = y.size
@@ -257,6 +260,8 @@ def correlogram(y, nlags: int, *, alpha: float = 0.05) -> pd.DataFrame:
     from statsmodels.tsa.stattools import acf, pacf
 
     y = _series(y, min_length=10)
+    integer(nlags, "nlags")
+    probability(alpha, "alpha", "{name} must lie in (0, 1), got {value!r}")
     if not 1 <= nlags < y.size // 2:
         raise ValueError(f"nlags must lie in [1, {y.size // 2 - 1}] for a series of {y.size} samples")
     r, rci = acf(y, nlags=nlags, alpha=alpha, adjusted=False, fft=True, result_object=False)
@@ -283,14 +288,17 @@ def cutoff_lag(values, band, *, max_lag: int, alpha: float = 0.05) -> int | None
 
     The smallest such q is returned; if there is none up to ``max_lag`` the function tails off.
     """
-    c = np.asarray(values, dtype=float)
-    b = np.broadcast_to(np.asarray(band, dtype=float), c.shape)
+    c = finite_array(values, "values")
     if c.ndim != 1 or c.size < 2:
         raise ValueError("values must be a 1-D array of lags 1..K (K >= 2)")
+    b = finite_array(band, "band")
+    if b.ndim > 1 or b.size not in (1, c.size) or not np.all(b > 0):
+        raise ValueError(f"band must hold one positive half-width or one per lag ({c.size}), got {b!r:.60}")
+    b = np.broadcast_to(np.asarray(band, dtype=float), c.shape)
+    integer(max_lag, "max_lag", 0)
     if max_lag < 0 or max_lag >= c.size:
         raise ValueError(f"max_lag must lie in [0, {c.size - 1}] for {c.size} lags")
-    if not 0 < alpha < 1:
-        raise ValueError("alpha must lie in (0, 1)")
+    probability(alpha, "alpha", "{name} must lie in (0, 1), got {value!r}")
     K = c.size
     z = stats.norm.ppf(1 - alpha / 2)
     ratio = np.abs(c) / b
@@ -337,13 +345,11 @@ def cutoff_aic(y, ar_order: int, ma_order: int) -> dict:
     from scipy.optimize import least_squares
 
     y = _series(y, min_length=20)
-    p, q = int(ar_order), int(ma_order)
-    if p != ar_order or q != ma_order or p < 0 or q < 0:
-        raise ValueError(f"ar_order and ma_order must be non-negative integers, got {ar_order}, {ma_order}")
+    p, q = integer(ar_order, "ar_order", 0), integer(ma_order, "ma_order", 0)
     n = y.size
     s = max(p, q)
     if n - s < 10 + p + q:
-        raise ValueError(f"a series of {n} samples is too short to compare AR({p}) and MA({q})")
+        raise ValueError(f"y: a series of {n} samples is too short to compare AR({p}) and MA({q})")
     y = y - y.mean()
     t = y[s:]
     N = t.size
@@ -395,11 +401,13 @@ def identify_model(y, *, nlags: int | None = None, max_order: int = 10, alpha: f
     oscillatory AR(2) of 100 samples as MA(1) most of the time.  ``nlags`` defaults to
     min(4 max_order, n/4).
     """
+    integer(max_order, "max_order")
+    if nlags is not None:
+        integer(nlags, "nlags")
+    probability(alpha, "alpha", "{name} must lie in (0, 1), got {value!r}")
     y = _series(y, min_length=4 * max_order + 10)
-    if rule not in ("aic", "earliest"):
-        raise ValueError(f"rule must be 'aic' or 'earliest', got {rule!r}")
-    if not margin >= 0:
-        raise ValueError(f"margin must be a non-negative AIC difference, got {margin}")
+    _choice(rule, ("aic", "earliest"), "rule")
+    nonnegative(margin, "margin", "{name} must be a non-negative AIC difference, got {value!r}")
     nlags = nlags or int(min(4 * max_order, y.size // 4))
     cg = correlogram(y, nlags, alpha=alpha)
     qa = cutoff_lag(cg["acf"], cg["acf_band"], max_lag=max_order, alpha=alpha)
@@ -437,8 +445,9 @@ def simulate_arma(phi, theta, n: int, n_series: int, rng: np.random.Generator, *
     Unit-variance Gaussian w; ``phi`` or ``theta`` may be empty (MA or AR); ``burn`` samples
     discarded.  Filtered with ``scipy.signal.lfilter([1, theta], [1, -phi])``.
     """
-    ph = np.atleast_1d(np.asarray(phi, dtype=float))
-    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    ph = np.atleast_1d(numeric(phi, "phi"))
+    th = np.atleast_1d(numeric(theta, "theta"))
+    integer(n, "n", 2), integer(n_series, "n_series"), integer(burn, "burn", 0)
     if ph.size:
         _require_stationary(ph, "the AR part of the model to simulate")
     if not np.all(np.isfinite(th)):
@@ -462,7 +471,13 @@ def identification_rate(phi, theta, n: int, *, n_series: int, seed: int, rules=(
     """
     from statsmodels.stats.proportion import proportion_confint
 
-    ph, th = np.atleast_1d(np.asarray(phi, float)), np.atleast_1d(np.asarray(theta, float))
+    ph, th = np.atleast_1d(numeric(phi, "phi")), np.atleast_1d(numeric(theta, "theta"))
+    integer(n_series, "n_series"), integer(max_order, "max_order")
+    integer(seed, "seed", 0, "{name} must be a non-negative integer (the generator seed), got {value!r}")
+    if isinstance(rules, str) or not rules:
+        raise ValueError(f"rules must be a non-empty sequence of rules of identify_model, got {rules!r}")
+    for rule in rules:
+        _choice(rule, ("aic", "earliest"), "rules", "{name} may hold only {allowed}, got {value!r}")
     if ph.size == 0 and th.size == 0:
         raise ValueError("give at least one AR (phi) or MA (theta) coefficient")
     expect = ("ARMA", None) if ph.size and th.size else ("AR", ph.size) if ph.size else ("MA", th.size)
@@ -486,10 +501,9 @@ def ar_design(y, p: int) -> tuple[np.ndarray, np.ndarray]:
     Row t of C is [y_{t-1}, ..., y_{t-p}] for t = p+1..n (1-based), D = [y_{p+1}, ..., y_n].
     """
     y = _series(y)
-    if int(p) != p or p < 1:
-        raise ValueError(f"the AR order p must be a positive integer, got {p}")
+    integer(p, "p", 1, "the AR order {name} must be a positive integer, got {value!r}")
     if y.size <= 2 * p:
-        raise ValueError(f"a series of {y.size} samples is too short for AR({p}) (need > {2 * p})")
+        raise ValueError(f"y: a series of {y.size} samples is too short for AR({p}) (need > {2 * p})")
     n = y.size
     C = np.column_stack([y[p - i - 1 : n - i - 1] for i in range(p)])
     return C, y[p:]
@@ -525,6 +539,7 @@ def require_stationary_series(y, segments: int = 20, *, alpha: float = 0.05, max
     """
     from statsmodels.tsa.stattools import adfuller, kpss
 
+    integer(max_lag, "max_lag", 0)
     t = inversion_test(y, segments, alpha=alpha)
     if not t.stationary:
         raise NonStationaryError(
@@ -564,9 +579,10 @@ def fit_ar(y, p: int, *, segments: int = 20, alpha: float = 0.05, check: bool = 
     """
     from statsmodels.tsa.ar_model import AutoReg
 
+    integer(p, "p", 1, "the AR order {name} must be a positive integer, got {value!r}")
+    integer(segments, "segments", 2)
+    probability(alpha, "alpha", "{name} must lie in (0, 1), got {value!r}")
     y = _series(y, min_length=max(2 * segments, 2 * p + 2))
-    if int(p) != p or p < 1:
-        raise ValueError(f"the AR order p must be a positive integer, got {p}")
     if demean:
         y = y - y.mean()
     if check:
@@ -584,9 +600,7 @@ def fit_ar(y, p: int, *, segments: int = 20, alpha: float = 0.05, check: bool = 
 
 def order_cap(n: int) -> int:
     """The order cap floor(sqrt(n)) of chen2019 §3 step 2 (模型阶数的上限为 sqrt(n))."""
-    if int(n) != n or n < 1:
-        raise ValueError(f"n must be a positive integer, got {n}")
-    return int(math.isqrt(int(n)))
+    return int(math.isqrt(integer(n, "n")))
 
 
 def aic_by_order(y, max_order: int | None = None, *, demean: bool = True) -> pd.DataFrame:
@@ -613,8 +627,7 @@ def aic_by_order(y, max_order: int | None = None, *, demean: bool = True) -> pd.
     cap = order_cap(y.size)
     if max_order is None:
         max_order = cap
-    if int(max_order) != max_order or max_order < 1:
-        raise ValueError(f"max_order must be a positive integer, got {max_order}")
+    integer(max_order, "max_order")
     if max_order > cap:
         raise ValueError(f"max_order {max_order} exceeds the cap floor(sqrt(n)) = {cap} of chen2019 §3 step 2")
     rows = []
@@ -639,6 +652,9 @@ def select_order(y, max_order: int | None = None, *, demean: bool = True, check:
     from statsmodels.tsa.ar_model import ar_select_order
 
     y = _series(y, min_length=8)
+    if max_order is not None:
+        integer(max_order, "max_order")
+    integer(segments, "segments", 2)
     if check:
         require_stationary_series(y, segments, max_lag=12)
     if demean:
@@ -661,6 +677,8 @@ def select_order_checked(y, max_order: int | None = None, *, demean: bool = True
     from statsmodels.tsa.ar_model import ar_select_order
 
     y = _series(y, min_length=8)
+    if max_order is not None:
+        integer(max_order, "max_order")
     if demean:
         y = y - y.mean()
     cap = order_cap(y.size)
@@ -684,7 +702,8 @@ def aic_increment_bound(aic_values, *, penalty_per_order: float = 2.0) -> dict:
     smallest scale it requires (s >= increment/penalty) and, for a per-observation
     normalization, the largest series length N <= penalty/increment compatible with it.
     """
-    a = np.asarray(aic_values, dtype=float)
+    a = numeric(aic_values, "aic_values")
+    penalty_per_order = positive(penalty_per_order, "penalty_per_order")
     if a.ndim != 1 or a.size < 2 or not np.all(np.isfinite(a)):
         raise ValueError("aic_values must be a 1-D array of AIC values for consecutive orders")
     inc = np.diff(a)
@@ -722,14 +741,14 @@ def ar_autocorrelation(phi, nlags: int) -> np.ndarray:
     from statsmodels.tsa.arima_process import ArmaProcess
 
     phi = _require_stationary(phi)
+    integer(nlags, "nlags", 0)
     return ArmaProcess(np.r_[1.0, -phi], [1.0]).acf(nlags + 1)
 
 
 def ar_variance(phi, sigma2: float) -> float:
     """Stationary variance gamma_0 = sigma2 / (1 - sum phi_i rho_i) of an AR model."""
     phi = _require_stationary(phi)
-    if not sigma2 > 0:
-        raise ValueError("the noise variance sigma2 must be positive")
+    positive(sigma2, "sigma2", "the noise variance {name} must be positive and finite, got {value!r}")
     rho = ar_autocorrelation(phi, phi.size)
     return float(sigma2 / (1.0 - phi @ rho[1 : phi.size + 1]))
 
@@ -746,8 +765,11 @@ def check_ar_model(phi, sigma2: float, *, dt: float | None = None, speed: float 
     the correlation time (s), with ``speed`` the correlation distance (m).
     """
     phi = ar_coefficients(phi)
-    if not sigma2 > 0:
-        raise ValueError("the noise variance sigma2 must be positive")
+    positive(sigma2, "sigma2", "the noise variance {name} must be positive and finite, got {value!r}")
+    if dt is not None:
+        positive(dt, "dt", "{name} must be positive (s), got {value!r}")
+    if speed is not None:
+        positive(speed, "speed", "{name} must be positive (m/s), got {value!r}")
     poles = ar_poles(phi)
     mod = np.abs(poles)
     dom = poles[np.argmax(mod)]
@@ -780,10 +802,12 @@ def simulate_ar(phi, sigma2: float, n: int, n_series: int, rng: np.random.Genera
     A burn-in of ``burn`` samples (default: 10 correlation lengths, at least 100) is discarded.
     """
     phi = _require_stationary(phi, "the model to simulate")
+    nonnegative(sigma2, "sigma2", "the noise variance {name} must be non-negative and finite, got {value!r}")
     if not isinstance(rng, np.random.Generator):
-        raise TypeError("pass a seeded numpy Generator, e.g. np.random.default_rng(2019)")
-    if n < 2 or n_series < 1:
-        raise ValueError("n >= 2 and n_series >= 1 are required")
+        raise TypeError("rng: pass a seeded numpy Generator, e.g. np.random.default_rng(2019)")
+    integer(n, "n", 2), integer(n_series, "n_series")
+    if burn is not None:
+        integer(burn, "burn", 0)
     if burn is None:
         burn = int(max(100, 10 * -1.0 / math.log(np.max(np.abs(ar_poles(phi))) + 1e-300)))
     e = rng.standard_normal((n_series, n + burn)) * math.sqrt(sigma2)
@@ -817,8 +841,10 @@ def gauss_markov(n: int, dt: float, std: float, tau: float, rng: np.random.Gener
     numpy.ndarray
         Shape (n, size).
     """
-    if not (n >= 1 and dt > 0 and std >= 0 and tau > 0):
-        raise ValueError("need n >= 1, dt > 0, std >= 0 and tau > 0")
+    integer(n, "n"), integer(size, "size")
+    positive(dt, "dt", "need {name} > 0 and finite (sample interval), got {value!r}")
+    nonnegative(std, "std", "need {name} >= 0 and finite (standard deviation), got {value!r}")
+    positive(tau, "tau", "need {name} > 0 and finite (correlation time), got {value!r}")
     a, q = gauss_markov_coefficients(dt, tau)
     w = rng.standard_normal((n, size)) * std * q
     w[0] = rng.standard_normal(size) * std
@@ -833,11 +859,12 @@ def aic_batch(Y, max_order: int, *, chunk: int = 16) -> np.ndarray:
     AIC_p = N (ln 2 pi sigma²_p + 1) + 2 (p + 1).  Solved from the normal equations of all
     orders at once, ``chunk`` series at a time.  Returns shape (n_series, max_order + 1).
     """
-    Y = np.asarray(Y, dtype=float)
+    Y = finite_array(Y, "Y")
     if Y.ndim != 2:
         raise ValueError("Y must have shape (n_series, n)")
     K, n = Y.shape
-    P = int(max_order)
+    P = integer(max_order, "max_order")
+    integer(chunk, "chunk")
     if P < 1 or n <= 3 * P:
         raise ValueError(f"max_order must be >= 1 and the series longer than 3*max_order (n={n})")
     Y = Y - Y.mean(axis=1, keepdims=True)
@@ -868,6 +895,9 @@ def order_recovery(phi, sigma2: float, n: int, *, n_series: int, max_order: int,
     frequency at ``len(phi)`` is the recovery rate.
     """
     phi = ar_coefficients(phi)
+    integer(max_order, "max_order"), integer(n_series, "n_series")
+    integer(seed, "seed", 0, "{name} must be a non-negative integer (the generator seed), got {value!r}")
+    positive(sigma2, "sigma2", "the noise variance {name} must be positive and finite, got {value!r}")
     if max_order > order_cap(n):
         raise ValueError(f"max_order {max_order} exceeds the cap floor(sqrt({n})) = {order_cap(n)}")
     rng = np.random.default_rng(seed)

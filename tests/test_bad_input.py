@@ -18,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from replication import calibration, earth, errors, kalman, rotations, strapdown, transfer
-from replication import closedloop, models, observability, sensors, trajectory
+from replication import closedloop, models, observability, sensors, timeseries, trajectory
 from replication.units import DEG
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
@@ -154,6 +154,8 @@ def _cl_run(**kw):
     return closedloop.run(**args)
 
 
+_Y0 = np.random.default_rng(1).standard_normal(200)         # white noise: a stationary series
+
 PROBES += [
     ("observability_matrix(F with NaN)", "F", lambda: observability.observability_matrix(np.diag([np.nan, 0.0]), _H12)),
     ("observability_matrix(H = 'a')", "H", lambda: observability.observability_matrix(_F2, "a")),
@@ -266,6 +268,44 @@ PROBES += [
     ("closedloop.run(record_every = 0)", "record_every", lambda: _cl_run(record_every=0)),
     ("closedloop.run(smoother_form = 'ukf')", "smoother_form", lambda: _cl_run(smoother_form="ukf")),
     ("closedloop.run(ep_samples = [2.5])", "ep_samples", lambda: _cl_run(ep_samples=[2.5])),
+    ("inversion_test(segments = 2.5)", "segments", lambda: timeseries.inversion_test(_Y0, 2.5)),
+    ("inversion_test(alpha = 1.5)", "alpha", lambda: timeseries.inversion_test(_Y0, 10, alpha=1.5)),
+    ("inversion_test(y with NaN)", "y", lambda: timeseries.inversion_test(np.r_[_Y0[:50], np.nan, _Y0[51:]], 10)),
+    ("inversion_test(y = 'abc')", "y", lambda: timeseries.inversion_test("abc", 10)),
+    ("stationarity_report(regression = 'n')", "regression",
+     lambda: timeseries.stationarity_report(_Y0, 10, regression="n")),
+    ("difference(d = -1)", "d", lambda: timeseries.difference(_Y0, -1)),
+    ("acf_printed(nlags = '5')", "nlags", lambda: timeseries.acf_printed(_Y0, "5")),
+    ("correlogram(alpha = 0)", "alpha", lambda: timeseries.correlogram(_Y0, 5, alpha=0.0)),
+    ("cutoff_lag(band = -0.2)", "band", lambda: timeseries.cutoff_lag([0.5, 0.1, 0.0], -0.2, max_lag=1)),
+    ("cutoff_lag(max_lag = 1.5)", "max_lag", lambda: timeseries.cutoff_lag([0.5, 0.1, 0.0], 0.2, max_lag=1.5)),
+    ("cutoff_aic(ma_order = nan)", "ma_order", lambda: timeseries.cutoff_aic(_Y0, 1, np.nan)),
+    ("identify_model(max_order = 0)", "max_order", lambda: timeseries.identify_model(_Y0, max_order=0)),
+    ("identify_model(nlags = 2.5)", "nlags", lambda: timeseries.identify_model(_Y0, nlags=2.5)),
+    ("identify_model(alpha = nan)", "alpha", lambda: timeseries.identify_model(_Y0, alpha=np.nan)),
+    ("identify_model(rule = 'bic')", "rule", lambda: timeseries.identify_model(_Y0, rule="bic")),
+    ("identify_model(margin = -4)", "margin", lambda: timeseries.identify_model(_Y0, margin=-4.0)),
+    ("identify_model(y too short for max_order)", "y", lambda: timeseries.identify_model(_Y0[:40], max_order=10)),
+    ("simulate_arma(n_series = 0)", "n_series",
+     lambda: timeseries.simulate_arma([0.5], [], 50, 0, np.random.default_rng(0))),
+    ("identification_rate(rules = ['bic'])", "rules",
+     lambda: timeseries.identification_rate([0.5], [], 60, n_series=2, seed=0, rules=["bic"])),
+    ("ar_design(p = 0)", "p", lambda: timeseries.ar_design(_Y0, 0)),
+    ("ar_design(y too short for p)", "y", lambda: timeseries.ar_design(_Y0[:6], 3)),
+    ("fit_ar(p = '2')", "p", lambda: timeseries.fit_ar(_Y0, "2")),
+    ("fit_ar(alpha = 5)", "alpha", lambda: timeseries.fit_ar(_Y0, 2, alpha=5.0)),
+    ("require_stationary_series(max_lag = -1)", "max_lag",
+     lambda: timeseries.require_stationary_series(_Y0, 10, max_lag=-1)),
+    ("aic_by_order(max_order = 2.5)", "max_order", lambda: timeseries.aic_by_order(_Y0, 2.5)),
+    ("select_order(max_order = 0)", "max_order", lambda: timeseries.select_order(_Y0, 0)),
+    ("order_cap(n = nan)", "n", lambda: timeseries.order_cap(np.nan)),
+    ("ar_variance(sigma2 = '1')", "sigma2", lambda: timeseries.ar_variance([0.5], "1")),
+    ("check_ar_model(dt = -1)", "dt", lambda: timeseries.check_ar_model([0.5], 1.0, dt=-1.0)),
+    ("simulate_ar(sigma2 = -1)", "sigma2", lambda: timeseries.simulate_ar([0.5], -1.0, 50, 2, np.random.default_rng(0))),
+    ("gauss_markov(std = nan)", "std", lambda: timeseries.gauss_markov(10, 0.1, np.nan, 5.0, np.random.default_rng(0))),
+    ("aic_batch(Y with NaN)", "Y", lambda: timeseries.aic_batch(np.r_[np.nan, np.zeros(99)].reshape(2, 50), 3)),
+    ("order_recovery(seed = -1)", "seed",
+     lambda: timeseries.order_recovery([0.5], 1.0, 100, n_series=2, max_order=3, seed=-1)),
 ]
 
 
@@ -341,6 +381,12 @@ def _bad(kind):
                          st.just(np.r_[np.zeros(50), np.inf, np.zeros(49)]))
     if kind == "mat2":
         return st.one_of(text, st.just(np.diag([np.nan, 0.0])), st.just(np.diag([np.inf, 0.0])), st.just(np.eye(3)))
+    if kind == "count0":           # a non-negative whole number (a differencing order, a lag)
+        return st.one_of(common, st.sampled_from([-1, 2.5, True]))
+    if kind == "prob":             # a significance level in (0, 1)
+        return st.one_of(common, st.floats(1.0, 1e3), st.floats(-1e3, 0.0))
+    if kind == "rules":            # rules of timeseries.identify_model
+        return st.sampled_from([["bogus"], ["aic", "AIC"], [], "aic"])
     if kind == "count":            # a positive whole number (order, number of segments, runs, workers)
         return st.one_of(common, st.sampled_from([0, -1, 2.5, True]))
     if kind == "seed":             # SeedSequence entropy: a non-negative whole number
@@ -541,6 +587,69 @@ _CALLS = {
                        {"spec": "object", "state": "object", "P0": "cov15", "ep_samples": "epochs", "n_steps": "count",
                         "inputs": "object", "record_every": "count", "chunk_epochs": "count", "workers": "count",
                         "smoother_form": "option"}),
+    "timeseries.inversion_count": (timeseries.inversion_count, dict(values=[1.0, 3.0, 2.0]), {"values": "series"}),
+    "timeseries.inversion_moments": (timeseries.inversion_moments, dict(m=5), {"m": "count"}),
+    "timeseries.inversion_distribution": (timeseries.inversion_distribution, dict(m=5), {"m": "count"}),
+    "timeseries.ar_coefficients": (timeseries.ar_coefficients, dict(phi=[0.5]), {"phi": "vec2"}),
+    "timeseries.inversion_test": (timeseries.inversion_test, dict(y=_Y, segments=10),
+                                  {"y": "series", "segments": "count", "alpha": "prob"}),
+    "timeseries.stationarity_report": (timeseries.stationarity_report, dict(y=_Y, segments=10),
+                                       {"y": "series", "segments": "count", "alpha": "prob", "regression": "option"}),
+    "timeseries.difference": (timeseries.difference, dict(y=_Y, d=1), {"y": "series", "d": "count0"}),
+    "timeseries.make_stationary": (timeseries.make_stationary, dict(y=_Y, segments=10),
+                                   {"y": "series", "segments": "count", "max_d": "count0", "alpha": "prob"}),
+    "timeseries.acf_printed": (timeseries.acf_printed, dict(y=_Y, nlags=5), {"y": "series", "nlags": "count"}),
+    "timeseries.pacf_printed": (timeseries.pacf_printed, dict(y=_Y, nlags=5), {"y": "series", "nlags": "count"}),
+    "timeseries.correlogram": (timeseries.correlogram, dict(y=_Y, nlags=5),
+                               {"y": "series", "nlags": "count", "alpha": "prob"}),
+    "timeseries.cutoff_lag": (timeseries.cutoff_lag, dict(values=[0.5, 0.1, 0.0, 0.05], band=0.2, max_lag=2),
+                              {"values": "series", "band": "sd", "max_lag": "count0", "alpha": "prob"}),
+    "timeseries.cutoff_aic": (timeseries.cutoff_aic, dict(y=_Y, ar_order=1, ma_order=1),
+                              {"y": "series", "ar_order": "count0", "ma_order": "count0"}),
+    "timeseries.identify_model": (timeseries.identify_model, dict(y=_Y),
+                                  {"y": "series", "nlags": "count", "max_order": "count", "alpha": "prob",
+                                   "rule": "option", "margin": "sd"}),
+    "timeseries.simulate_arma": (lambda **kw: timeseries.simulate_arma(rng=_RNG(0), **kw),
+                                 dict(phi=[0.5], theta=[], n=50, n_series=2),
+                                 {"phi": "vec2", "theta": "vec2", "n": "count", "n_series": "count", "burn": "count0"}),
+    "timeseries.identification_rate": (timeseries.identification_rate,
+                                       dict(phi=[0.5], theta=[], n=60, n_series=2, seed=0, max_order=3),
+                                       {"phi": "vec2", "theta": "vec2", "n": "count", "n_series": "count",
+                                        "seed": "seed", "max_order": "count", "rules": "rules"}),
+    "timeseries.ar_design": (timeseries.ar_design, dict(y=_Y, p=2), {"y": "series", "p": "count"}),
+    "timeseries.ar_least_squares": (timeseries.ar_least_squares, dict(y=_Y, p=2), {"y": "series", "p": "count"}),
+    "timeseries.require_stationary_series": (timeseries.require_stationary_series, dict(y=_Y, segments=10),
+                                             {"y": "series", "segments": "count", "alpha": "prob",
+                                              "max_lag": "count0"}),
+    "timeseries.fit_ar": (timeseries.fit_ar, dict(y=_Y, p=2, segments=10),
+                          {"y": "series", "p": "count", "segments": "count", "alpha": "prob"}),
+    "timeseries.order_cap": (timeseries.order_cap, dict(n=100), {"n": "count"}),
+    "timeseries.aic_by_order": (timeseries.aic_by_order, dict(y=_Y, max_order=3), {"y": "series", "max_order": "count"}),
+    "timeseries.select_order": (timeseries.select_order, dict(y=_Y, max_order=3, segments=10),
+                                {"y": "series", "max_order": "count", "segments": "count"}),
+    "timeseries.select_order_checked": (timeseries.select_order_checked, dict(y=_Y, max_order=3),
+                                        {"y": "series", "max_order": "count"}),
+    "timeseries.aic_increment_bound": (timeseries.aic_increment_bound, dict(aic_values=[3.0, 2.0, 2.5]),
+                                       {"aic_values": "series", "penalty_per_order": "rate"}),
+    "timeseries.ar_poles": (timeseries.ar_poles, dict(phi=[0.5]), {"phi": "vec2"}),
+    "timeseries.is_stationary": (timeseries.is_stationary, dict(phi=[0.5]), {"phi": "vec2"}),
+    "timeseries.ar_autocorrelation": (timeseries.ar_autocorrelation, dict(phi=[0.5], nlags=3),
+                                      {"phi": "vec2", "nlags": "count0"}),
+    "timeseries.ar_variance": (timeseries.ar_variance, dict(phi=[0.5], sigma2=1.0), {"phi": "vec2", "sigma2": "rate"}),
+    "timeseries.check_ar_model": (timeseries.check_ar_model, dict(phi=[0.5], sigma2=1.0, dt=1.0, speed=100.0),
+                                  {"phi": "vec2", "sigma2": "rate", "dt": "rate", "speed": "rate"}),
+    "timeseries.simulate_ar": (lambda **kw: timeseries.simulate_ar(rng=_RNG(0), **kw),
+                               dict(phi=[0.5], sigma2=1.0, n=50, n_series=2),
+                               {"phi": "vec2", "sigma2": "sd", "n": "count", "n_series": "count", "burn": "count0"}),
+    "timeseries.gauss_markov": (lambda **kw: timeseries.gauss_markov(rng=_RNG(0), **kw),
+                                dict(n=10, dt=0.1, std=1.0, tau=5.0),
+                                {"n": "count", "dt": "rate", "std": "sd", "tau": "rate", "size": "count"}),
+    "timeseries.aic_batch": (timeseries.aic_batch, dict(Y=_Y.reshape(2, 100), max_order=3),
+                             {"Y": "mat", "max_order": "count", "chunk": "count"}),
+    "timeseries.order_recovery": (timeseries.order_recovery,
+                                  dict(phi=[0.5], sigma2=1.0, n=100, n_series=2, max_order=3, seed=0),
+                                  {"phi": "vec2", "sigma2": "rate", "n": "count", "n_series": "count",
+                                   "max_order": "count", "seed": "seed"}),
 }
 _CASES = [(name, arg) for name, (_, _, kinds) in _CALLS.items() for arg in kinds]
 
