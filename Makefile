@@ -20,14 +20,15 @@ unexport PYTHONDONTWRITEBYTECODE
 NOTEBOOKS := $(shell find book -name '*.ipynb' -not -path '*/_build/*' -not -path '*/.ipynb_checkpoints/*' | sort)
 
 .PHONY: help env sysdeps lock book notebooks notebook tables html test unit units unit-portable portability suite nbval \
-        check-notebooks check-tables html-strict browser bench clean
+        check-notebooks check-tables html-strict browser pdf pdf-test bench clean
 
 help:
 	@echo "make book   - create the environment if missing, re-execute every notebook, regenerate tables/, build book/_build/html"
 	@echo "make test   - unit tests (native and on a perturbed numerical code path), strict nbval of every notebook"
 	@echo "              re-executed under two perturbed numerical configurations, tables unchanged, strict book build,"
-	@echo "              browser check (first installs Debian's chromium, fonts-wqy-zenhei and texlive-latex-base"
+	@echo "              browser check, the PDF printed and checked (first installs Debian's chromium, fonts-wqy-zenhei and texlive-latex-base"
 	@echo "              where the user may: make sysdeps)"
+	@echo "make pdf    - the whole book as one PDF, book/_build/pdf/book.pdf (single-page HTML of the stored outputs, printed by Chromium)"
 	@echo "make nbval  - strict nbval of every notebook on this machine's native code path"
 	@echo "make notebook NB=book/part/file.ipynb - execute one notebook in place"
 	@echo "make lock   - recompile requirements.lock from requirements.in (needs network to PyPI)"
@@ -116,6 +117,15 @@ html-strict: env
 
 browser: env
 	$(PY) -m pytest -q tests/test_book_browser.py -m browser
+
+# the whole book as one PDF (book/_build/pdf/book.pdf): the single-page HTML build of the stored
+# outputs (execution off), printed on A4 by headless Chromium, offline, maths typeset by the local MathJax
+pdf: env
+	$(VENV)/bin/jupyter-book build book --path-output book --builder singlehtml --quiet
+	$(PY) scripts/book_pdf.py
+
+pdf-test: env
+	$(PY) -m pytest -q tests/test_book_pdf.py -m browser
 
 bench: env
 	$(PY) scripts/benchmark_navigation.py

@@ -241,10 +241,13 @@ def _interleave(jobs: list) -> list:
     return out
 
 
-BOOK_JOB = ("strict book build and browser check", ["make", "--no-print-directory", "html-strict", "browser"])
+BOOK_JOB = ("strict book build, browser check and PDF", ["make", "--no-print-directory", "html-strict", "browser",
+                                                         "pdf", "pdf-test"])
 """The side job of :func:`suite`: it reads only stored files, and the browser check spends most of
 its time waiting for pages to go network-idle (one tab visits every page: about 30 s of CPU,
-Chromium's renderer included, in 45 s), so it runs beside the workers instead of occupying one."""
+Chromium's renderer included, in 45 s), so it runs beside the workers instead of occupying one.
+The PDF follows: the single-page build reuses the strict build's parsed sources and Chromium
+prints it (about 50 s together), then tests/test_book_pdf.py reads a sample of its pages."""
 
 
 def _report(label: str, r: subprocess.CompletedProcess, dt: float, failed: list[str]) -> None:
@@ -315,7 +318,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("notebooks", nargs="*", type=Path)
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     p.add_argument("--config", action="append", choices=list(CONFIGS), help="default: every configuration")
-    p.add_argument("--book", action="store_true", help="also build the book strictly and run the browser check")
+    p.add_argument("--book", action="store_true", help="also build the book strictly, run the browser check, print the PDF and check it")
     sub.add_parser("show")
     args = ap.parse_args(argv)
     if args.cmd == "units":
