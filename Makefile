@@ -19,7 +19,7 @@ unexport PYTHONDONTWRITEBYTECODE
 
 NOTEBOOKS := $(shell find book -name '*.ipynb' -not -path '*/_build/*' -not -path '*/.ipynb_checkpoints/*' | sort)
 
-.PHONY: help env sysdeps lock book notebooks notebook tables html test unit units unit-portable portability suite nbval \
+.PHONY: help env sysdeps lint lock book notebooks notebook tables html test unit units unit-portable portability suite nbval \
         check-notebooks check-tables html-strict browser pdf pdf-test bench clean
 
 help:
@@ -71,7 +71,7 @@ html: env
 	$(VENV)/bin/jupyter-book build book --path-output book --quiet
 
 # ---------------------------------------------------------------- tests
-test: sysdeps env check-notebooks suite tables check-tables
+test: sysdeps env lint check-notebooks suite tables check-tables
 
 # the Debian packages the checks need (chromium, a CJK font, pdflatex): installed as root or with sudo
 # without a password, otherwise a stop naming them (scripts/sysdeps.sh; .ci/run calls it too)
@@ -103,6 +103,9 @@ nbval: env
 	@test -n "$(NOTEBOOKS)" || { echo "no notebooks under book/"; exit 1; }
 	$(PY) -m pytest -q -p no:cacheprovider --nbval --nbval-current-env $(NOTEBOOKS) \
 	    --nbval-sanitize-with book/sanitize.cfg --nbval-cell-timeout=900 -o testpaths= -o addopts=
+
+lint: env
+	$(PY) -m ruff check replication tests scripts book/_ext
 
 check-notebooks: env
 	$(PY) scripts/check_notebooks.py $(NOTEBOOKS)

@@ -35,6 +35,6 @@ def repository_url() -> str:
                        "installed 'replication' distribution declares none; reinstall with `make env`")
 
 
-from .reproduction import load_table, load_tables  # noqa: E402  (the typed loaders of the exported tables)
+from replication.registry.reproduction import load_table, load_tables  # noqa: E402  (the typed loaders of the exported tables)
 
 __all__ = ["__version__", "load_table", "load_tables", "repository_url"]

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from . import __version__, repository_url
-from . import reproduction as rp
+from replication import __version__, repository_url
+from replication.registry import reproduction as rp
 
 
 def _cmd_status(args) -> int:

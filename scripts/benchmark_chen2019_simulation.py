@@ -31,7 +31,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from replication import reproduction as rp, simulation as sim  # noqa: E402
+from replication.papers.chen2019 import simulation as sim  # noqa: E402
+from replication.registry import reproduction as rp
 
 TARGET_ONE_RUN_S = 30.0
 SEED = 7

@@ -49,8 +49,9 @@ TARGETS = {"monte_carlo_20_hour_wall_s_max": 3.0, "chen2019_45_20_runs_rts_ratio
 # ----------------------------------------------------------------------------- workloads (child process)
 
 def _hour():
-    from replication import errors as er, trajectory as tr
-    from replication.units import DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
+    from replication.nav import errors as er
+    from replication.nav import trajectory as tr
+    from replication.nav.units import DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
 
     segs, init = tr.chen2019_flight()
     traj = tr.generate(segs[:4] + [tr.Straight(900.0)], **init)
@@ -63,8 +64,9 @@ def _hour():
 def _corrupted(traj, model, seed=20240):
     import numpy as np
 
-    from replication import kalman as kf, sensors as se
-    from replication.units import DEG_PER_H, MICRO_G
+    from replication.nav import kalman as kf
+    from replication.nav import sensors as se
+    from replication.nav.units import DEG_PER_H, MICRO_G
 
     rng = np.random.default_rng(seed)
     errs = se.ImuErrors(gyro=se.TriadErrors(bias=np.array([0.05, -0.04, 0.06]) * DEG_PER_H, white_psd=model.gyro_psd),
@@ -76,14 +78,18 @@ def _corrupted(traj, model, seed=20240):
 
 def _workload(name):
     """(warm-up callable, timed callable) of a workload."""
-    from replication import errors as er, gravity as gr, kalman as kf, reproduction as rp, simulation as sim
-    from replication.units import MGAL
+    from replication.nav import errors as er
+    from replication.nav import kalman as kf
+    from replication.nav.units import MGAL
+    from replication.papers.chen2019 import gravity as gr
+    from replication.papers.chen2019 import simulation as sim
+    from replication.registry import reproduction as rp
 
     if name in ("filter_15_hour", "monte_carlo_20_hour", "augmented_hour"):
         traj, model = _hour()
         short = traj.t[:6001]
         if name == "monte_carlo_20_hour":
-            from replication import trajectory as tr
+            from replication.nav import trajectory as tr
 
             warm = tr.generate([tr.Straight(20.0)], traj.lat[0], traj.lon[0], traj.h[0], speed=100.0)
             return (lambda: kf.monte_carlo(warm, model, n_runs=3, seed=1, workers=2),

@@ -4,7 +4,7 @@
 
 Workload: both 20-run Monte Carlos of fang2020 §3 — 10 h at 100 Hz (3.6 M steps per
 run), fixes at 2 h and 3.5 h, plus the reset-only continuation of one run per case — exactly as
-``book/fang2020/01_polar_grid_calibration.ipynb`` runs them (``replication.polar.run_fang2020``).
+``book/fang2020/01_polar_grid_calibration.ipynb`` runs them (``replication.papers.fang2020.polar.run_fang2020``).
 Compilation is excluded (a short warm-up run first).  Budget: ≤ 180 s added to ``make test``.
 Results go to ``benchmarks/polar.json``; the chapter reports that file.
 """
@@ -24,8 +24,8 @@ sys.path.insert(0, str(ROOT))
 
 import numba  # noqa: E402
 
-from replication import polar  # noqa: E402
-from replication import units  # noqa: E402
+from replication.nav import units  # noqa: E402
+from replication.papers.fang2020 import polar  # noqa: E402
 
 BUDGET_SECONDS = 180.0
 

@@ -1,12 +1,12 @@
-"""Tests of replication.airdata: duan2023 correction geometry, derivation checks, simulation."""
+"""Tests of replication.papers.duan2023.airdata: duan2023 correction geometry, derivation checks, simulation."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from replication import airdata as ad
-from replication import reproduction as rp
-from replication.rotations import dcm_to_rotvec, rotvec_to_dcm
+from replication.nav.rotations import dcm_to_rotvec, rotvec_to_dcm
+from replication.papers.duan2023 import airdata as ad
+from replication.registry import reproduction as rp
 
 # A 30-s interval at ~180 m/s climbing at ~3°: S ≈ 5.4 km, h ≈ 280 m.
 SX, SY, H = 2696.0, 4670.0, 283.0
@@ -233,15 +233,15 @@ def test_eq21_rejects_start_at_origin(eq22):
 
 @pytest.fixture(scope="module")
 def short_flight():
-    from replication import trajectory as tr
-    from replication.units import DEG
+    from replication.nav import trajectory as tr
+    from replication.nav.units import DEG
 
     segs = [tr.Straight(60.0), tr.Climb(60.0, height_change=300.0), tr.Straight(60.0)]
     return tr.generate(segs, 45 * DEG, 110 * DEG, 1000.0, dt=0.1, heading=0.3, speed=180.0)
 
 
 def test_eq1_structure_from_core(short_flight):
-    from replication.errors import NavPoint
+    from replication.nav.errors import NavPoint
 
     c = ad.eq1_checks(NavPoint.from_trajectory(short_flight, 900))
     # a structurally zero block: entries of the neighbouring blocks are O(1e-3..1), so anything
@@ -279,7 +279,7 @@ def test_setup_from_paper_and_validation():
 
 
 def test_error_correction_step_meets_ads_height(short_flight):
-    from replication.strapdown import NavState
+    from replication.nav.strapdown import NavState
 
     tr_ = short_flight
     k0, k1 = 0, 300                       # straight flight: V parallel to the displacement (eq. (8))
@@ -375,10 +375,10 @@ def test_schuler_response_matches_core():
     """The tilt-to-horizontal-error amplitudes used in the chapter against a strapdown run: a
     0.1-mrad tilt, height held, one Schuler period; Earth-rate coupling and the Coriolis term
     allow ~10 % (stated before the comparison)."""
-    from replication import trajectory as tr
-    from replication.rotations import rotvec_to_dcm
-    from replication.strapdown import NavState, mechanize
-    from replication.units import DEG
+    from replication.nav import trajectory as tr
+    from replication.nav.rotations import rotvec_to_dcm
+    from replication.nav.strapdown import NavState, mechanize
+    from replication.nav.units import DEG
 
     traj = tr.generate([tr.Straight(5100.0)], 45 * DEG, 110 * DEG, 3000.0, dt=0.2, heading=0.5, speed=200.0)
     s0 = traj.initial_state()

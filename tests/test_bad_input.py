@@ -17,9 +17,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from replication import calibration, earth, errors, kalman, rotations, strapdown, transfer
-from replication import closedloop, models, observability, sensors, timeseries, trajectory
-from replication.units import DEG
+from replication.nav import closedloop, earth, errors, kalman, rotations, sensors, strapdown, timeseries, trajectory
+from replication.nav.units import DEG
+from replication.papers.an2021 import transfer
+from replication.papers.chen2019 import calibration, models, observability
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
 I3 = np.eye(3)

@@ -1,4 +1,4 @@
-"""Tests of replication.calibration (chen2019 ch. 2 §2 and ch. 4 §1).
+"""Tests of replication.papers.chen2019.calibration (chen2019 ch. 2 §2 and ch. 4 §1).
 
 Tolerances, stated before each comparison:
 
@@ -15,10 +15,10 @@ import math
 import numpy as np
 import pytest
 
-from replication import calibration as cal
-from replication import earth
-from replication import reproduction as rp
-from replication.units import DEG, DEG_PER_H, DEG_PER_S
+from replication.nav import earth
+from replication.nav.units import DEG, DEG_PER_H, DEG_PER_S
+from replication.papers.chen2019 import calibration as cal
+from replication.registry import reproduction as rp
 
 LAT = 40.0 * DEG
 RATE = 10 * DEG_PER_S

@@ -1,14 +1,19 @@
-"""The one closed-loop filter (replication.closedloop): its update against the textbook Joseph
+"""The one closed-loop filter (replication.nav.closedloop): its update against the textbook Joseph
 form, its GNSS rows against numerical Jacobians of the antenna measurement, its couplings against
 the error model, batches independent of the thread count, and every entry point on one kernel."""
 
 import numpy as np
 import pytest
 
-from replication import _kernels as K, closedloop as cl, earth, errors as er, kalman as kf, simulation as sim
-from replication import trajectory as tr
-from replication.rotations import rotvec_to_dcm
-from replication.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MICRO_G
+from replication.nav import _kernels as K
+from replication.nav import closedloop as cl
+from replication.nav import earth
+from replication.nav import errors as er
+from replication.nav import kalman as kf
+from replication.nav import trajectory as tr
+from replication.nav.rotations import rotvec_to_dcm
+from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MICRO_G
+from replication.papers.chen2019 import simulation as sim
 
 
 def test_sequential_gains_equal_the_joseph_update():
@@ -52,7 +57,7 @@ def _measurement(x, st_hat, C_hat, lever_used, w_eb):
 
 @pytest.mark.parametrize("lever", [(0.0, 0.0, 0.0), (0.4, -1.2, 2.5)])
 def test_gnss_rows_are_the_jacobian_of_the_antenna_measurement(lever):
-    """chen2019 eq. (2-13): H of :func:`replication._kernels.gnss_rows` (position and velocity at the
+    """chen2019 eq. (2-13): H of :func:`replication.nav._kernels.gnss_rows` (position and velocity at the
     antenna, lever-arm state columns) equals the central-difference Jacobian of the nonlinear
     measurement, column-relative difference < 1e-6 (steps 1e-7 of each state's scale: the
     truncation error is O(step²), the rounding O(1e-16/step))."""
@@ -77,8 +82,8 @@ def test_gnss_rows_are_the_jacobian_of_the_antenna_measurement(lever):
 
 @pytest.mark.parametrize("kind", ["bias", "scale", "misalignment"])
 def test_interval_couplings_are_the_error_model_columns(kind):
-    """The couplings the filter accumulates (C_b^n B(u), :func:`replication._kernels.accumulate_coupling`)
-    are F's sensor-block columns of :class:`replication.errors.ErrorModel` (chen2019 eq. (2-10)),
+    """The couplings the filter accumulates (C_b^n B(u), :func:`replication.nav._kernels.accumulate_coupling`)
+    are F's sensor-block columns of :class:`replication.nav.errors.ErrorModel` (chen2019 eq. (2-10)),
     accelerometer into δv with sign +, gyro into φ with sign −: exact to rounding."""
     m = er.model_15(lat=0.8, h=1000.0, accel_bias_sd=1e-4, gyro_bias_sd=1e-7)
     if kind == "bias":

@@ -22,8 +22,8 @@ the field's Gauss-Markov law (its stored ``state-gm`` and ``true-model`` columns
 """
 from __future__ import annotations
 
-from pathlib import Path
 import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd

@@ -17,9 +17,8 @@ Tolerances, fixed from the physics before comparing:
 """
 
 import itertools
-from pathlib import Path
-
 import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd

@@ -1,4 +1,4 @@
-"""The WGS-84 Earth model and normal gravity (replication.earth), and the errata of chen2019 eq. (3-1).
+"""The WGS-84 Earth model and normal gravity (replication.nav.earth), and the errata of chen2019 eq. (3-1).
 
 Tolerances, stated before any comparison:
 
@@ -18,8 +18,8 @@ import math
 import numpy as np
 import pytest
 
-from replication import earth
-from replication import reproduction as rp
+from replication.nav import earth
+from replication.registry import reproduction as rp
 
 TOL_GRAVITY = 0.1 * earth.MGAL  # m/s^2
 H_MAX = 10_000.0
@@ -362,10 +362,11 @@ def test_inputs_that_are_not_numbers_or_heights_are_refused():
 def test_compiled_somigliana_forms_equal_the_earth_model():
     """The compiled form of Somigliana's formula (``_kernels.somigliana_s``, written on scalars
     for numba, behind the strapdown's gravity with its height terms and the polar grid INS's on
-    the ellipsoid) equals :func:`replication.earth.somigliana` exactly (the same operations) and
-    :func:`replication.earth.normal_gravity_ellipsoid` / :func:`~replication.earth.normal_gravity`
+    the ellipsoid) equals :func:`replication.nav.earth.somigliana` exactly (the same operations) and
+    :func:`replication.nav.earth.normal_gravity_ellipsoid` / :func:`~replication.nav.earth.normal_gravity`
     to rounding (1e-15 relative) from the equator to the pole."""
-    from replication import _kernels as K, _polar_kernels as PK
+    from replication.nav import _kernels as K
+    from replication.papers.fang2020 import _polar_kernels as PK
 
     lat = np.radians(np.linspace(0.0, 90.0, 19))
     s2 = np.sin(lat) ** 2

@@ -1,12 +1,12 @@
-"""The consequence column of chen2019 Table 2-1 (replication.error_effects)."""
+"""The consequence column of chen2019 Table 2-1 (replication.papers.chen2019.error_effects)."""
 
 import numpy as np
 import pytest
 
-from replication import error_effects as ee
-from replication import trajectory as tr
-from replication.sensors import ImuErrors, TriadErrors
-from replication.units import DEG
+from replication.nav import trajectory as tr
+from replication.nav.sensors import ImuErrors, TriadErrors
+from replication.nav.units import DEG
+from replication.papers.chen2019 import error_effects as ee
 
 
 @pytest.fixture(scope="module")

@@ -3,9 +3,11 @@
 import numpy as np
 import pytest
 
-from replication import errors as er, strapdown as sd, trajectory as tr
-from replication.rotations import attitude_error, rotvec_to_dcm
-from replication.units import DEG, DEG_PER_H, MICRO_G
+from replication.nav import errors as er
+from replication.nav import strapdown as sd
+from replication.nav import trajectory as tr
+from replication.nav.rotations import attitude_error, rotvec_to_dcm
+from replication.nav.units import DEG, DEG_PER_H, MICRO_G
 
 
 @pytest.fixture(scope="module")

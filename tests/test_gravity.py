@@ -1,4 +1,4 @@
-"""Tests of replication.gravity (chen2019 ch. 3: field, direct difference, AR augmentation)."""
+"""Tests of replication.papers.chen2019.gravity (chen2019 ch. 3: field, direct difference, AR augmentation)."""
 
 import math
 
@@ -7,10 +7,9 @@ import pytest
 from scipy import signal
 from scipy.spatial.transform import Rotation
 
-from replication import earth
-from replication import gravity as gr
-from replication import timeseries as ts
-from replication.units import MGAL, MICRO_G
+from replication.nav import timeseries as ts
+from replication.nav.units import MGAL, MICRO_G
+from replication.papers.chen2019 import gravity as gr
 
 PHI_E = np.array([0.9168, -0.0758, 0.0991])  # sign-reversed chen2019 (4-13) east model (stationary)
 
@@ -260,7 +259,7 @@ def test_disturbed_and_compensated_increments_are_inverse(short_flight):
 
 
 def test_errors_of_the_truth_are_zero(short_flight):
-    from replication.strapdown import NavSolution
+    from replication.nav.strapdown import NavSolution
 
     tr = short_flight
     sol = NavSolution(tr.t, tr.lat, tr.lon, tr.h, tr.v_enu, tr.q_bn)
@@ -272,9 +271,9 @@ def test_errors_of_the_truth_are_zero(short_flight):
 def test_direct_difference_from_filter_obeys_eq_3_8():
     """Error-free IMU and GNSS, constant disturbance: the direct difference returns dg + C nabla-hat
     (the part of the disturbance the 15-state filter has taken for accelerometer bias), eq. (3-8)."""
-    from replication import errors as er
-    from replication import kalman as kf
-    from replication import sensors as se
+    from replication.nav import errors as er
+    from replication.nav import kalman as kf
+    from replication.nav import sensors as se
 
     tr = gr.survey_flight(n_lines=1, duration=600.0, speed=30.0, lat0=math.radians(30.0), lon0=math.radians(110.0),
                           h0=500.0, dt=0.01)
@@ -351,9 +350,9 @@ def test_slope_weights_reproduce_the_least_squares_slope():
 
 @pytest.fixture(scope="module")
 def noisy_line():
-    from replication import errors as er
-    from replication import kalman as kf
-    from replication import sensors as se
+    from replication.nav import errors as er
+    from replication.nav import kalman as kf
+    from replication.nav import sensors as se
 
     tr = gr.survey_flight(n_lines=1, duration=600.0, speed=30.0, lat0=math.radians(30.0), lon0=math.radians(110.0),
                           h0=500.0, dt=0.01)
@@ -370,8 +369,8 @@ def noisy_line():
 
 
 def test_augmented_filter_without_specific_force_is_the_core_filter(noisy_line):
-    from replication import errors as er
-    from replication import kalman as kf
+    from replication.nav import errors as er
+    from replication.nav import kalman as kf
 
     tr, dth, dv, gnss, m, init = noisy_line
     mg = m.extend(er.gravity_shaping([13e-5, 13e-5, 26e-5], 1 / 300.0))
@@ -386,7 +385,7 @@ def test_augmented_filter_without_specific_force_is_the_core_filter(noisy_line):
 def test_augmented_filter_with_the_9_dimensional_measurement(noisy_line):
     from scipy.linalg import solve_discrete_lyapunov
 
-    from replication import errors as er
+    from replication.nav import errors as er
 
     tr, dth, dv, gnss, m, init = noisy_line
     aug = gr.gravity_augmentation([(PHI_E, 1e-9)] * 3, 20.0)
@@ -416,8 +415,8 @@ def test_augmented_filter_equals_the_core_filter_for_every_block_kind(noisy_line
     """Scale-factor and misalignment blocks couple through C_b^n B(u) (chen2019 eq. (2-10)), not
     through C_b^n alone: both filters take it from _kernels.accumulate_coupling, so they agree to
     rounding for every kind (same strapdown, discretization, update, feedback)."""
-    from replication import errors as er
-    from replication import kalman as kf
+    from replication.nav import errors as er
+    from replication.nav import kalman as kf
 
     tr, dth, dv, gnss, m, init = noisy_line
     block = {"accel scale": er.accel_scale(1e-4), "gyro scale": er.gyro_scale(1e-4),
@@ -433,7 +432,7 @@ def test_augmented_filter_equals_the_core_filter_for_every_block_kind(noisy_line
 def test_compensation_runs_equal_the_sequential_runs_whatever_the_threads():
     """compensation_runs maps compensation_run over (field, seed); threads change nothing (exact:
     every run is independent and deterministic)."""
-    from replication.units import DEG, DEG_PER_H
+    from replication.nav.units import DEG, DEG_PER_H
 
     origin = (math.radians(30.0), math.radians(110.0), 500.0)
     tr = gr.survey_flight(n_lines=2, duration=2400.0, turn_duration=60.0, speed=30.0, lat0=origin[0], lon0=origin[1],

@@ -2,10 +2,12 @@
 
 import numpy as np
 import pytest
-import scipy.linalg
 
-from replication import errors as er, kalman as kf, sensors as se, trajectory as tr
-from replication.units import DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
+from replication.nav import errors as er
+from replication.nav import kalman as kf
+from replication.nav import sensors as se
+from replication.nav import trajectory as tr
+from replication.nav.units import DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
 
 
 def test_van_loan_double_integrator_closed_form():

@@ -4,10 +4,10 @@ lever arm (eq. (2-13)), permutations, input validation."""
 import numpy as np
 import pytest
 
-from replication import errors as E
-from replication import models as M
-from replication import trajectory as tr
-from replication.units import DEG
+from replication.nav import errors as E
+from replication.nav import trajectory as tr
+from replication.nav.units import DEG
+from replication.papers.chen2019 import models as M
 
 
 @pytest.fixture(scope="module")
@@ -208,7 +208,7 @@ def test_frozen_earth_jacobian_differs_from_F_only_by_the_omitted_earth_terms(ma
     frozen-Earth Jacobian only in the δL column (dR/dL, ∂γ/∂L) and in (δv_U, δh), which is
     -∂γ/∂h ≈ +3.08e-6 s⁻².  Elsewhere agreement to 1e-9 of the column scale (Richardson-extrapolated
     central differences: ≲ 6e-10)."""
-    from replication import earth
+    from replication.nav import earth
     m = M.model_45()
     for p in _points(maneuvering):
         F, J = m.F(p)[:9, :9], M.frozen_earth_jacobian(p)

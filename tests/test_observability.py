@@ -3,10 +3,9 @@
 import numpy as np
 import pytest
 
-from replication import models as M
-from replication import observability as O
-from replication import trajectory as tr
-from replication.units import DEG
+from replication.nav import trajectory as tr
+from replication.papers.chen2019 import models as M
+from replication.papers.chen2019 import observability as O
 
 G, R = 9.8, 6.4e6
 
@@ -188,8 +187,8 @@ def test_series_discretization_matches_expm(flight):
     """The covariance recursion's order-8 series (Φ, Q_d) equals Van Loan's expm to 1e-9 of
     the largest element over a 2 s interval in a turn (F's products decay through the 1/R
     couplings: the truncated terms are below (ω_s T)^8 / 8!)."""
-    from replication import errors as E
-    from replication.kalman import discretize_series, van_loan
+    from replication.nav import errors as E
+    from replication.nav.kalman import discretize_series, van_loan
     m = M.model_45(accel_markov_sigma=1e-4, gyro_markov_sigma=1e-8, gravity_sigma=1e-4, accel_psd=1e-8, gyro_psd=1e-14)
     p = E.NavPoint.from_trajectory(flight, 200)
     F, Qc = m.F(p), m.G_Qc(p.C_bn)

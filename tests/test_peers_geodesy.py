@@ -1,4 +1,4 @@
-"""The WGS-84 geometry and normal gravity of replication.earth held against pymap3d (geodetic ↔
+"""The WGS-84 geometry and normal gravity of replication.nav.earth held against pymap3d (geodetic ↔
 ECEF, radii of curvature) and boule (Fatiando a Terra's normal gravity, on and above the
 ellipsoid; the exact field also against a 40-digit gradient of the normal potential).
 
@@ -14,7 +14,7 @@ import pymap3d
 import pytest
 from pymap3d import rcurve
 
-from replication import earth
+from replication.nav import earth
 
 # --------------------------------------------------------------------------------------- pymap3d
 
@@ -85,7 +85,7 @@ def test_normal_gravity_on_the_ellipsoid_matches_boule():
     γ = (a γ_e cos²L + b γ_p sin²L)/√(a² cos²L + b² sin²L) is linear in (γ_e, γ_p) with
     non-negative weights whose sum is ≤ 1 (Cauchy-Schwarz), so the difference is bounded by
     max(|Δγ_e|, |Δγ_p|) plus round-off, taken as 1e-6 mGal (1e-13 relative, some hundred ulp).
-    With boule's own γ_e and γ_p, :func:`replication.earth.somigliana` agrees to round-off alone
+    With boule's own γ_e and γ_p, :func:`replication.nav.earth.somigliana` agrees to round-off alone
     (1e-6 mGal).  The exact closed form of the package (:func:`normal_gravity_closed_form`) and
     the series form at h = 0 are held to the same bound.  Measured: 6.3e-6 mGal (at the poles,
     the Δγ_p) with the printed constants, 8e-10 mGal with boule's.
@@ -107,7 +107,7 @@ def test_normal_gravity_on_the_ellipsoid_matches_boule():
 # source: boule.WGS84.normal_gravity above the ellipsoid; tolerance: the TR8350.2 series truncation (docstring)
 @pytest.mark.parametrize("h", [100.0, 1000.0, 3000.0, 10_000.0])
 def test_normal_gravity_series_in_height_matches_boule_within_its_truncation(h):
-    """:func:`replication.earth.normal_gravity` above the ellipsoid against boule.
+    """:func:`replication.nav.earth.normal_gravity` above the ellipsoid against boule.
 
     The package evaluates TR8350.2 eq. 4-3, γ_h = γ_0[1 - 2h/a(1 + f + m - 2f sin²L) + 3h²/a²]:
     the Taylor series in x = h/a of the exact field, kept to first order in the flattening in the
@@ -163,7 +163,7 @@ def _exact_normal_gravity_at(lat_deg, h):
 # tolerance: boule's own h² departure from the exact field (docstring)
 @pytest.mark.parametrize("h", [1000.0, 10_000.0])
 def test_normal_gravity_closed_form_at_height_matches_boule(h):
-    """:func:`replication.earth.normal_gravity_closed_form` (the exact field, no series) above the
+    """:func:`replication.nav.earth.normal_gravity_closed_form` (the exact field, no series) above the
     ellipsoid against boule, latitude -90..90°.
 
     Tolerance.  Closed forms of one field should agree to round-off, but boule's value departs

@@ -4,7 +4,7 @@
 The scenarios and thresholds are those of pyins' own tests (``pyins/tests/test_strapdown.py``:
 ``test_integrate_stationary``, ``test_integrate_sine_velocity``; ``pyins/tests/test_error_model.py``:
 ``test_propagate_errors``), re-run here with pyins' simulated IMU (``pyins.sim``) fed into
-:func:`replication.strapdown.mechanize` and :meth:`replication.errors.ErrorModel.propagate_linear`.
+:func:`replication.nav.strapdown.mechanize` and :meth:`replication.nav.errors.ErrorModel.propagate_linear`.
 
 Frames: pyins navigates in NED with a Front-Right-Down body frame, the package in ENU with a
 Right-Front-Up one; the map between them is the same permutation P = [[0,1,0],[1,0,0],[0,0,-1]] for
@@ -27,13 +27,16 @@ import pandas as pd
 import pytest
 from pyins import earth as pearth
 from pyins import error_model as perror
-from pyins import sim, transform as ptransform
+from pyins import sim
+from pyins import transform as ptransform
 from pyins.strapdown import Integrator, compute_increments_from_imu
 from pyins.util import ACCEL_COLS, GYRO_COLS, NED_COLS, RPH_COLS, TRAJECTORY_ERROR_COLS, VEL_COLS
 
-from replication import earth, rotations as rot, strapdown as sd
-from replication.errors import model_15
-from replication.trajectory import Trajectory
+from replication.nav import earth
+from replication.nav import rotations as rot
+from replication.nav import strapdown as sd
+from replication.nav.errors import model_15
+from replication.nav.trajectory import Trajectory
 
 P = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 """NED <-> ENU and FRD <-> RFU (its own inverse)."""

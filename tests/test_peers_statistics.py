@@ -1,5 +1,5 @@
-"""The AR tools of replication.timeseries held against statsmodels, and the Allan deviation of
-replication.calibration against the published NBS14 reference values (Riley, NIST SP 1065
+"""The AR tools of replication.nav.timeseries held against statsmodels, and the Allan deviation of
+replication.papers.chen2019.calibration against the published NBS14 reference values (Riley, NIST SP 1065
 "Handbook of Frequency Stability Analysis", 2008, §12.3-12.4).
 
 Already held against statsmodels in tests/test_timeseries.py (not repeated here): the printed
@@ -18,9 +18,9 @@ import pytest
 from statsmodels.tsa.ar_model import ar_select_order
 from statsmodels.tsa.arima_process import ArmaProcess, arma_acovf
 
-from replication import calibration as cal
-from replication import reproduction as rp
-from replication import timeseries as ts
+from replication.nav import timeseries as ts
+from replication.papers.chen2019 import calibration as cal
+from replication.registry import reproduction as rp
 
 
 def _printed_east_model():

@@ -1,4 +1,4 @@
-"""The error model of replication.errors held against textbook results for the stationary INS.
+"""The error model of replication.nav.errors held against textbook results for the stationary INS.
 
 * Observability (Bar-Itzhack & Berman 1988, "Control theoretic approach to inertial navigation
   systems", J. Guid. Control Dyn. 11(3); the single-channel form is in tests/test_observability.py):
@@ -22,8 +22,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from replication import earth, errors as er, observability as O
-from replication.errors import NavPoint
+from replication.nav import earth
+from replication.nav import errors as er
+from replication.nav.errors import NavPoint
+from replication.papers.chen2019 import observability as O
 
 W = earth.OMEGA_IE
 

@@ -7,8 +7,10 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from replication import plots, simulation as sim, trajectory as tr  # noqa: E402
-from replication.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MICRO_G  # noqa: E402
+from replication.nav import trajectory as tr  # noqa: E402
+from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MICRO_G  # noqa: E402
+from replication.papers import plots
+from replication.papers.chen2019 import simulation as sim
 
 
 def test_state_estimates_has_one_panel_per_state():

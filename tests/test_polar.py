@@ -11,8 +11,9 @@ import scipy.integrate
 import scipy.linalg
 from scipy.spatial.transform import Rotation
 
-from replication import earth, polar, units
-from replication import _polar_kernels as K
+from replication.nav import earth, units
+from replication.papers.fang2020 import _polar_kernels as K
+from replication.papers.fang2020 import polar
 
 R_SPHERE = 6371000.0
 RNG = np.random.default_rng(20200458)
@@ -272,7 +273,7 @@ def test_kernel_gravity_and_truth_kinematics():
 def test_truth_rocking_matches_trajectory_ship_rocking():
     """Our in-kernel eq. (28) (needed per step inside numba) against the navigation core's
     ShipRocking segment at 85°N, where the ENU angles of both are defined."""
-    from replication import trajectory as tr
+    from replication.nav import trajectory as tr
 
     sc = polar.fang2020_scenario(1)
     ph = np.array([0.4, 2.2, 5.1])
@@ -386,7 +387,7 @@ def test_shared_truth_gives_the_same_bits_as_each_run_computing_its_own():
     """Runs sharing one rocking-phase set get their truth from one truth_table (a speed-up of the
     chapter's main reading): the records and the final states must equal, bit for bit, those of
     the same runs each computing its own truth (the same calls in the same order)."""
-    from replication import _polar_kernels as K
+    from replication.papers.fang2020 import _polar_kernels as K
 
     sc = polar.fang2020_scenario(1, **polar.FANG2020_READING)
     k1, every = 3000, 500

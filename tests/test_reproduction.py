@@ -14,8 +14,8 @@ import pandas as pd
 import pytest
 
 import replication
-from replication import reproduction as rp
 from replication.__main__ import main as cli
+from replication.registry import reproduction as rp
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -366,13 +366,13 @@ def test_one_repository_address_everywhere():
         import source_links
     finally:
         sys.path.remove(str(ROOT / "book" / "_ext"))
-    link = source_links.source_url({"module": "replication.reproduction", "fullname": "resolve_table_ids"},
+    link = source_links.source_url({"module": "replication.registry.reproduction", "fullname": "resolve_table_ids"},
                                    base=url, ref="abc", root=ROOT)
-    first, last = (int(n) for n in re.fullmatch(re.escape(url) + r"/blob/abc/replication/reproduction\.py#L(\d+)-L(\d+)",
+    first, last = (int(n) for n in re.fullmatch(re.escape(url) + r"/blob/abc/replication/registry/reproduction\.py#L(\d+)-L(\d+)",
                                                 link).groups())
-    lines = (ROOT / "replication" / "reproduction.py").read_text(encoding="utf-8").splitlines()
+    lines = (ROOT / "replication" / "registry" / "reproduction.py").read_text(encoding="utf-8").splitlines()
     assert lines[first - 1].startswith("def resolve_table_ids(") and lines[last - 1].strip() == "return [ident]"
-    assert source_links.source_url({"module": "replication.reproduction", "fullname": "PACKAGE_YEAR"},
+    assert source_links.source_url({"module": "replication.registry.reproduction", "fullname": "PACKAGE_YEAR"},
                                    base=url, ref="abc", root=ROOT) is None          # data has no source lines
     assert f"url          = {{{url}}}," in rp.bibtex_for("fang2020-table-1")
     version = subprocess.run([sys.executable, "-m", "replication", "--version"], capture_output=True, text=True,

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from replication import rotations as ro
-from replication.units import DEG
+from replication.nav import rotations as ro
+from replication.nav.units import DEG
 
 RNG = np.random.default_rng(7)
 

@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from replication import sensors as se, trajectory as tr
-from replication.rotations import euler_to_dcm
-from replication.units import ARCSEC, DEG, DEG_PER_H, MICRO_G, PPM
+from replication.nav import sensors as se
+from replication.nav import trajectory as tr
+from replication.nav.rotations import euler_to_dcm
+from replication.nav.units import ARCSEC, DEG, DEG_PER_H, MICRO_G, PPM
 
 
 @pytest.fixture(scope="module")
@@ -117,7 +118,7 @@ def test_gnss_lever_arm_eq_2_13(flight):
     g0 = se.gnss_measurements(flight, rate_hz=10, sigma_pos=0.0, sigma_vel=0.0, rng=1)
     g1 = se.gnss_measurements(flight, rate_hz=10, sigma_pos=0.0, sigma_vel=0.0, lever_arm_b=l, rng=1)
     assert np.array_equal(g0.index, np.arange(10, flight.n + 1, 10))
-    from replication import earth
+    from replication.nav import earth
     rm, rn = earth.radii(g0.lat)
     C = euler_to_dcm(flight.hpr[g0.index, 0], flight.hpr[g0.index, 1], flight.hpr[g0.index, 2])
     d = np.einsum("kij,j->ki", C, l)

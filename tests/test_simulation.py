@@ -6,10 +6,13 @@ import math
 import numpy as np
 import pytest
 
-from replication import closedloop as cl, errors as er, kalman as kf, reproduction as rp, sensors as se, simulation as sim
-from replication import trajectory as tr
-from replication.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MICRO_G
-
+from replication.nav import closedloop as cl
+from replication.nav import kalman as kf
+from replication.nav import sensors as se
+from replication.nav import trajectory as tr
+from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MICRO_G
+from replication.papers.chen2019 import simulation as sim
+from replication.registry import reproduction as rp
 
 # ----------------------------------------------------------------------------- setup
 
@@ -112,10 +115,10 @@ def test_batched_runs_replay_exactly_and_share_gains_to_first_order(short_flight
 
 @pytest.mark.parametrize("model,lever", [(m, lv) for m in ("15", "36", "45") for lv in (False, True)])
 def test_batched_filter_agrees_with_the_core_closed_loop(short_flight, model, lever):
-    """One run of the batch (simulation.run_batch) vs replication.kalman.closed_loop on the same
+    """One run of the batch (simulation.run_batch) vs replication.nav.kalman.closed_loop on the same
     increments and fixes (one chunk so that the truths coincide), with and without an antenna
     lever arm (an estimated one in the 36- and 45-state models): both entry points run the one
-    filter of replication.closedloop, so they agree to rounding: sensor states to 1e-9 σ, the
+    filter of replication.nav.closedloop, so they agree to rounding: sensor states to 1e-9 σ, the
     navigation errors to 1e-6 σ (a latitude of 0.8 rad carries 1e-16 rad of rounding, 1e-8 of the
     centimetre-level σ; the batch forms them in numpy, the test here)."""
     kw = dict(lever_arm_b=(0.2, 0.5, 1.0), lever_arm_sd=0.05 if model != "15" else 0.0) if lever else \
@@ -132,8 +135,8 @@ def test_batched_filter_agrees_with_the_core_closed_loop(short_flight, model, le
     dth, dvv, gpos, gvel, _ = truth.chunk(0, 0, short_flight.n, ep, ar)
     gn = se.GnssMeasurements(short_flight.t[ep], ep, gpos[0, :, 0], gpos[0, :, 1], gpos[0, :, 2], gvel[0],
                              np.asarray(s.sigma_pos), np.full(3, s.sigma_vel), np.asarray(s.lever_arm_b, float))
-    from replication.rotations import quat_to_dcm
-    from replication.strapdown import NavState
+    from replication.nav.rotations import quat_to_dcm
+    from replication.nav.strapdown import NavState
     init = NavState(st[0, 0], st[0, 1], st[0, 2], st[0, 3:6], quat_to_dcm(q[0]))
     core = kf.closed_loop(short_flight.t, dth[0], dvv[0], init, gn, m, store_nav=False)
     sig = res.sigma()
@@ -289,7 +292,8 @@ def test_run_batch_validates_inputs(short_flight, t441):
 
 def test_runs_for_half_width_meets_target_and_is_smallest():
     from scipy import stats as st
-    from replication.simulation import runs_for_half_width
+
+    from replication.papers.chen2019.simulation import runs_for_half_width
     sd, target = 1.6e-3, 2.8e-3 / 3
     n = runs_for_half_width(sd, target)
     hw = lambda k: st.t.ppf(0.975, k - 1) * sd / np.sqrt(k)
@@ -300,7 +304,7 @@ def test_runs_for_half_width_meets_target_and_is_smallest():
 
 
 def test_rms_and_sd_split_offset():
-    from replication.simulation import rms_and_sd
+    from replication.papers.chen2019.simulation import rms_and_sd
     e = np.array([[1.0, 3.0], [2.0, 2.0]])
     rms, sd = rms_and_sd(e)
     assert np.allclose(rms, [np.sqrt(5.0), 2.0], rtol=1e-15, atol=0)   # exact up to rounding

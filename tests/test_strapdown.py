@@ -3,10 +3,11 @@
 import numpy as np
 import pytest
 
-from replication import earth, strapdown as sd, trajectory as tr
-from replication import _kernels as K
-from replication.rotations import euler_to_dcm
-from replication.units import DEG
+from replication.nav import _kernels as K
+from replication.nav import earth
+from replication.nav import strapdown as sd
+from replication.nav import trajectory as tr
+from replication.nav.units import DEG
 
 
 def test_compiled_earth_formulas_equal_the_earth_module():

@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 
-from replication import reproduction as rp
+from replication.registry import reproduction as rp
 
 PREAMBLE = "\\documentclass{article}\n\\begin{document}\n"
 

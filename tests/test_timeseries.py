@@ -1,4 +1,4 @@
-"""Tests of replication.timeseries (chen2019 ch. 3 §3 step 2)."""
+"""Tests of replication.nav.timeseries (chen2019 ch. 3 §3 step 2)."""
 
 import itertools
 import math
@@ -8,8 +8,8 @@ import pytest
 from statsmodels.tsa.ar_model import AutoReg, ar_select_order
 from statsmodels.tsa.stattools import acf, pacf
 
-from replication import reproduction as rp
-from replication import timeseries as ts
+from replication.nav import timeseries as ts
+from replication.registry import reproduction as rp
 
 # statistical tolerances below are stated from the sampling distributions before comparing
 
@@ -274,9 +274,9 @@ def test_simulated_variance_matches_theory():
 
 def test_gauss_markov_is_the_recursion_of_its_draws():
     """gauss_markov draws the n × size driving values, then the size initial values, and runs the
-    shared first-order recursion (replication.sensors.gauss_markov_recursion) from x_0 = w_0: the
+    shared first-order recursion (replication.nav.sensors.gauss_markov_recursion) from x_0 = w_0: the
     same numbers exactly."""
-    from replication import sensors as se
+    from replication.nav import sensors as se
 
     n, dt, std, tau, size = 300, 0.2, 1.5, 4.0, 3
     x = ts.gauss_markov(n, dt, std, tau, np.random.default_rng(5), size=size)
@@ -347,6 +347,7 @@ def test_sunspots_identified_as_ar2_in_agreement_with_information_criteria(sunsp
     names AR(2), as statsmodels' exact-likelihood ARMA order selection and BIC AR order
     selection do."""
     import warnings
+
     from statsmodels.tsa.stattools import arma_order_select_ic
 
     assert len(sunspots) == 100

@@ -72,13 +72,13 @@ def test_book_glue_makes_numpy_scalars_plain():
     import numpy as np
     import pytest
 
-    from replication.book import plain
+    from replication.registry.book import plain
 
     assert repr(plain(np.float64(0.1))) == "0.1"
     assert type(plain(np.int64(3))) is int and type(plain(np.bool_(True))) is bool
     assert type(plain(np.array(2.5))) is float
     assert plain("text") == "text"
-    from replication.book import glue
+    from replication.registry.book import glue
 
     with pytest.raises(ValueError, match="not finite"):
         glue("x", float("nan"), display=False)
@@ -88,7 +88,7 @@ def test_book_precision_helpers_round_to_what_is_determined():
     import numpy as np
     import pytest
 
-    from replication.book import below, order_bound, sig
+    from replication.registry.book import below, order_bound, sig
 
     assert sig(10.74049, 3) == pytest.approx(10.7, abs=1e-12)
     assert sig(np.array([1.23456e-7, -987.65]), 2).tolist() == pytest.approx([1.2e-7, -990.0])
@@ -137,7 +137,7 @@ def test_book_glue_closes_a_figure_once_glued():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from replication.book import glue
+    from replication.registry.book import glue
 
     fig, _ = plt.subplots()
     glue("fig-test", fig, display=False)
@@ -146,7 +146,8 @@ def test_book_glue_closes_a_figure_once_glued():
 
 _TARGET_PROBE = r"""
 import hashlib, numpy as np
-from replication import _kernels as K, _polar_kernels as PK
+from replication.nav import _kernels as K
+from replication.papers.fang2020 import _polar_kernels as PK
 rng = np.random.default_rng(5)
 n = 2000
 dt = np.full(n, 0.01)

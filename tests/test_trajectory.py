@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 
-from replication import earth, trajectory as tr
-from replication.rotations import euler_to_dcm
-from replication.units import DEG
+from replication.nav import earth
+from replication.nav import trajectory as tr
+from replication.nav.rotations import euler_to_dcm
+from replication.nav.units import DEG
 
 
 @pytest.fixture(scope="module")

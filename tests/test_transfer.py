@@ -1,4 +1,4 @@
-"""Tests of replication.transfer (an2021: gravity disturbance → horizontal attitude error)."""
+"""Tests of replication.papers.an2021.transfer (an2021: gravity disturbance → horizontal attitude error)."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from replication import earth
-from replication import reproduction as rp
-from replication import transfer as tr
-from replication.units import ARCSEC, MGAL
+from replication.nav import earth
+from replication.nav.units import ARCSEC, MGAL
+from replication.papers.an2021 import transfer as tr
+from replication.registry import reproduction as rp
 
 RNG_SEED = 2021
 

@@ -6,8 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from replication import reproduction as rp, simulation as sim, turntable as tt
-from replication.units import DEG, DEG_PER_H, G0
+from replication.nav.units import DEG, DEG_PER_H, G0
+from replication.papers.chen2019 import simulation as sim
+from replication.papers.chen2019 import turntable as tt
+from replication.registry import reproduction as rp
 
 
 @pytest.fixture(scope="module")

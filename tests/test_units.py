@@ -1,4 +1,4 @@
-"""Unit conversions of replication.units against independent definitions (exact up to round-off)."""
+"""Unit conversions of replication.nav.units against independent definitions (exact up to round-off)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from replication import units as u
+from replication.nav import units as u
 
 
 def test_angles():

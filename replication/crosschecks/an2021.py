@@ -46,8 +46,8 @@ from numpy.polynomial import Polynomial
 from scipy.optimize import brentq
 from scipy.signal import ss2tf
 
-from replication._validate import choice
-from replication.earth import somigliana
+from replication.nav._validate import choice
+from replication.nav.earth import somigliana
 
 __all__ = [
     "OMEGA_IE",
@@ -80,7 +80,7 @@ def normal_gravity(lat_deg):
     float
         Normal gravity, m/s² (the ``g`` of eqs. (1) and (4)-(7), which the paper does not print).
     """
-    # the printed TR8350.2 constants γ_e, k, e² (the derived ones of replication.earth differ by < 1e-10 m/s²)
+    # the printed TR8350.2 constants γ_e, k, e² (the derived ones of replication.nav.earth differ by < 1e-10 m/s²)
     return somigliana(np.sin(np.radians(lat_deg)) ** 2, gamma_e=9.7803253359, k=0.00193185265241, e2=6.69437999014e-3)
 
 

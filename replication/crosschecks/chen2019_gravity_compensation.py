@@ -62,9 +62,10 @@ from scipy.linalg import expm, solve_continuous_lyapunov
 from scipy.optimize import least_squares
 from scipy.special import j0
 
-from replication._validate import choice
-from replication.earth import A as EARTH_A, GAMMA_E
-from replication.units import MGAL, MICRO_G, UG_PER_SQRT_HZ
+from replication.nav._validate import choice
+from replication.nav.earth import GAMMA_E
+from replication.nav.earth import A as EARTH_A
+from replication.nav.units import MGAL, MICRO_G, UG_PER_SQRT_HZ
 
 METHODS = ("normal", "direct", "state")
 """The three gravity-compensation methods of chen2019 Table 4-50, in the table's column order."""

@@ -67,9 +67,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.linalg import expm
 
-from replication._validate import choice
-from replication.earth import OMEGA_IE, normal_gravity, radii
-from replication.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MGAL, MICRO_G
+from replication.nav._validate import choice
+from replication.nav.earth import OMEGA_IE, normal_gravity, radii
+from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MGAL, MICRO_G
 
 # ---------------------------------------------------------------------------------------------
 # Settings: chen2019 Table 4-41 / 4-42 and the simulation chapter's stated choices.
@@ -245,7 +245,7 @@ def system_matrix(p: FlightPoint, s: Settings = Settings()) -> np.ndarray:
     sl, cl, tl = np.sin(lat), np.cos(lat), np.tan(lat)
     sec = 1.0 / cl
     F = np.zeros((N_SUPER, N_SUPER))
-    P, V, A = _SL["pos"], _SL["vel"], _SL["att"]
+    V, A = _SL["vel"], _SL["att"]
     # position (δL, δλ, δh)
     F[0, 4] = 1.0 / rm
     F[0, 2] = -vn / rm**2

@@ -54,8 +54,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import expm
 
-from replication._validate import choice, finite, nonnegative, positive
-from replication.earth import somigliana
+from replication.nav._validate import choice, finite, nonnegative, positive
+from replication.nav.earth import somigliana
 
 __all__ = [
     "PAPER",

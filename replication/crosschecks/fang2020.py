@@ -78,8 +78,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from replication import earth, units
-from replication._validate import positive
+from replication.nav import earth, units
+from replication.nav._validate import positive
 
 __all__ = [
     "PAPER",

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import finite_array, matrix3, rotation, vector3
+from replication.nav._validate import finite_array, matrix3, rotation, vector3
 
 __all__ = [
     "skew", "vee", "euler_to_dcm", "dcm_to_euler", "rotvec_to_dcm", "dcm_to_rotvec",

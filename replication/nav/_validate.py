@@ -6,8 +6,8 @@ where a module words its message differently, ``message`` replaces the text (a `
 template with the fields ``name`` and ``value``, for :func:`choice` also ``allowed``).
 Text where a number is expected raises ``TypeError`` naming the argument (``float("100")``
 would silently convert it). The domain-specific checks stay with their modules (latitudes,
-heights and speeds in :mod:`replication.earth`, navigation states and increments in
-:mod:`replication.strapdown`). Every check works on whole arrays with numpy, once per call,
+heights and speeds in :mod:`replication.nav.earth`, navigation states and increments in
+:mod:`replication.nav.strapdown`). Every check works on whole arrays with numpy, once per call,
 so that it stays outside the compiled loops and costs nothing per step.
 """
 

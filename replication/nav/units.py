@@ -7,7 +7,7 @@ Multiply to convert *to* SI, divide to convert *from* SI::
     print(drift / DEG_PER_H)          # back to °/h
 
 Gravity unit ``G0`` is the conventional 9.80665 m/s^2 (the papers' "g" for sensor
-specifications); local gravity comes from :mod:`replication.earth`.
+specifications); local gravity comes from :mod:`replication.nav.earth`.
 """
 
 from __future__ import annotations

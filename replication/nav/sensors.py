@@ -19,7 +19,7 @@ IMU model per triad (gyro or accelerometer), chen2019 eq. (2-10):
 On increments over T: Δũ = (I + δK + δM) Δu + x_b T + x̄_m T + n,  n ~ N(0, q T); the Markov
 process is propagated exactly at the sample rate and held over each interval.
 
-Units as printed in the papers (°/h, μg, ppm, ″, (°/h)²) convert with :mod:`replication.units`.
+Units as printed in the papers (°/h, μg, ppm, ″, (°/h)²) convert with :mod:`replication.nav.units`.
 """
 
 from __future__ import annotations
@@ -28,13 +28,13 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from . import earth
-from ._validate import components, finite_array, nonnegative, nonnegative_array, numeric, positive, rotation
-from .rotations import euler_to_dcm
-from .units import DEG_PER_H, MICRO_G, PPM, ARCSEC, deg_per_h2
 from scipy.signal import lfilter
-from .strapdown import validate_increments, validate_time
+
+from replication.nav import earth
+from replication.nav._validate import components, finite_array, nonnegative, nonnegative_array, numeric, positive, rotation
+from replication.nav.rotations import euler_to_dcm
+from replication.nav.strapdown import validate_increments, validate_time
+from replication.nav.units import ARCSEC, DEG_PER_H, MICRO_G, PPM, deg_per_h2
 
 __all__ = ["TriadErrors", "ImuErrors", "misalignment_matrix", "apply_imu_errors", "draw_imu_errors",
            "markov_sigma_from_driving_psd", "gauss_markov_coefficients", "gauss_markov_recursion",

@@ -14,7 +14,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ._validate import vector3
+from replication.nav._validate import vector3
 
 # --- defining and derived WGS-84 constants (NIMA TR8350.2 tables 3.1, 3.3) ---------------
 A = 6378137.0
@@ -121,7 +121,7 @@ def check_latitude(lat, *, polar_limit_deg: float | None = None, name: str = "la
         raise ValueError(
             f"{name} reaches {np.degrees(float(np.max(np.abs(lat)))):.6g}°, within the n-frame polar "
             f"singularity (limit ±{polar_limit_deg}°): tan L diverges there; use a grid-frame "
-            f"mechanization (replication.polar) near the pole"
+            f"mechanization (replication.papers.fang2020.polar) near the pole"
         )
     return lat
 
@@ -422,7 +422,7 @@ EQ_3_1_QUANTITIES = {
 def eq_3_1_coefficients(paper) -> dict:
     """The printed coefficients of chen2019 eq. (3-1) in SI from its paper-value table.
 
-    ``paper`` is the :class:`~replication.reproduction.PaperTable` of ``chen2019-eq-3-1``
+    ``paper`` is the :class:`~replication.registry.reproduction.PaperTable` of ``chen2019-eq-3-1``
     (printed mantissa × ``si_factor``).
     """
     data = paper.data.set_index("quantity")

@@ -3,7 +3,7 @@ batched closed-loop Kalman filter with a Rauch-Tung-Striebel smoother pass for t
 45-state models.
 
 What this module adds to the navigation core: the truth of the chapter's Monte Carlo and the
-chapter's diagnostics; the filter itself is :mod:`replication.closedloop`, the one closed-loop
+chapter's diagnostics; the filter itself is :mod:`replication.nav.closedloop`, the one closed-loop
 filter of the package.
 
 * :func:`table_4_41_setup` — the sensor errors of chen2019 Table 4-41 in SI units, with the two
@@ -11,12 +11,12 @@ filter of the package.
   (``misalignment_unit``) and the meaning of the Markov "驱动白噪声方差强度" (``markov_reading``);
   the parameters the report does not print (initial navigation errors, gravity disturbance,
   lever arm) are this package's stated choices;
-* :func:`simulated_flight` — the Table 4-42 flight from :func:`replication.trajectory.chen2019_flight`;
-* :func:`filter_model` — the 15-state (:func:`replication.errors.model_15`), 36-state
-  (:func:`replication.models.model_36`) and 45-state (:func:`replication.models.model_45`) models
+* :func:`simulated_flight` — the Table 4-42 flight from :func:`replication.nav.trajectory.chen2019_flight`;
+* :func:`filter_model` — the 15-state (:func:`replication.nav.errors.model_15`), 36-state
+  (:func:`replication.papers.chen2019.models.model_36`) and 45-state (:func:`replication.papers.chen2019.models.model_45`) models
   built from one setup;
 * :func:`run_batch` — a Monte Carlo of the closed-loop (feedback) filter *batched across runs*
-  (:func:`replication.closedloop.run`): every run has its own truth (sensor errors, Markov paths,
+  (:func:`replication.nav.closedloop.run`): every run has its own truth (sensor errors, Markov paths,
   gravity disturbance, lever arm, GNSS noise, initial errors), its own strapdown, innovations and
   feedback; the covariance recursion (Φ, Q_d, P, gains) is computed once per epoch along the
   first run's solution and shared — to first order the gain of an error-state filter depends on
@@ -27,9 +27,9 @@ filter of the package.
 * diagnostics: NEES of the full state and of the observable subspace (:func:`observable_nees`),
   χ² bands, attitude RMS with Monte-Carlo confidence intervals, the improvement percentages.
 
-Closed-loop smoothing (the derivation behind :func:`replication.closedloop.rts_chunk`): let e_k⁺ be the error of the
+Closed-loop smoothing (the derivation behind :func:`replication.nav.closedloop.rts_chunk`): let e_k⁺ be the error of the
 solution after feedback at epoch k (navigation: computed − true; sensor states: true −
-compensated, the convention of :mod:`replication.errors`) and x_k the correction applied at
+compensated, the convention of :mod:`replication.nav.errors`) and x_k the correction applied at
 epoch k (so e_k⁻ = e_k⁺ + x_k).  The filtered estimate of e_k⁺ is 0 with covariance P_k⁺, the
 prediction of e_{k+1}⁻ is 0 with covariance P_{k+1}⁻ = Φ_k P_k⁺ Φ_kᵀ + Q_k.  The RTS recursion
 (Rauch, Tung & Striebel 1965) then reads
@@ -37,10 +37,10 @@ prediction of e_{k+1}⁻ is 0 with covariance P_{k+1}⁻ = Φ_k P_k⁺ Φ_kᵀ +
     C_k = P_k⁺ Φ_kᵀ (P_{k+1}⁻)⁻¹,   ê_k^s = C_k (ê_{k+1}^s + x_{k+1}),
     P_k^s = P_k⁺ + C_k (P_{k+1}^s − P_{k+1}⁻) C_kᵀ,
 
-and the smoothed solution's error is e_k⁺ − ê_k^s.  This is :func:`replication.kalman.rts_smoother`
+and the smoothed solution's error is e_k⁺ − ê_k^s.  This is :func:`replication.nav.kalman.rts_smoother`
 with x_f = 0 and x_p[k+1] = −x_{k+1}; the test suite checks the two against each other.  The
 default backward pass is the same smoother in the modified Bryson-Frazier form
-(:func:`replication.closedloop.mbf_chunk`): ê_k^s = −P_k⁺ λ_k and P_k^s = P_k⁺ − P_k⁺ Λ_k P_k⁺ with
+(:func:`replication.nav.closedloop.mbf_chunk`): ê_k^s = −P_k⁺ λ_k and P_k^s = P_k⁺ − P_k⁺ Λ_k P_k⁺ with
 the adjoint λ_k and its covariance Λ_k carried back through the updates' rows, gains and
 innovations and through Φ — no inverse of P_{k+1}⁻, and the O(n³) products only at the recorded
 epochs; the test suite checks it against the RTS form.
@@ -49,22 +49,22 @@ epochs; the test suite checks it against the RTS form.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
+import pandas as pd
 from scipy import stats
 
-from . import earth
-from . import errors as E
-from . import models as M
-from . import closedloop as CL
-from ._validate import choice
-from .rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
-from .sensors import gauss_markov_coefficients, gauss_markov_recursion, lever_arm_offset, misalignment_matrix
-from .units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MGAL, MICRO_G
-from .trajectory import chen2019_flight, generate
-import pandas as pd
+from replication.nav import closedloop as CL
+from replication.nav import earth
+from replication.nav import errors as E
+from replication.nav._validate import choice
+from replication.nav.rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
+from replication.nav.sensors import gauss_markov_coefficients, gauss_markov_recursion, lever_arm_offset, misalignment_matrix
+from replication.nav.trajectory import chen2019_flight, generate
+from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MGAL, MICRO_G
+from replication.papers.chen2019 import models as M
 
 __all__ = ["SimulationSetup", "table_4_41_setup", "MISALIGNMENT_UNITS", "MARKOV_READINGS",
            "simulated_flight", "segment_summary", "filter_model", "BatchResult", "run_batch",
@@ -176,7 +176,7 @@ def table_4_41_setup(paper, *, misalignment_unit: str = "arcsec", markov_reading
     * Markov "驱动白噪声方差强度 (σ)²": ``markov_reading="stationary"`` (default) takes σ as the
       stationary standard deviation of the process; ``"driving-psd"`` takes σ² as the driving
       intensity q (per Hz), stationary σ_m = σ √(τ/2)
-      (:func:`replication.sensors.markov_sigma_from_driving_psd`);
+      (:func:`replication.nav.sensors.markov_sigma_from_driving_psd`);
     * scale factor 0.00001 (both triads);
     * misalignment "1.5" in ``misalignment_unit`` (``"arcsec"`` default; ``"arcmin"``,
       ``"mrad"`` as alternatives, :data:`MISALIGNMENT_UNITS`);
@@ -233,9 +233,9 @@ def simulated_flight(paper=None, *, imu_rate_hz: float = 100.0, s_swing: float =
 
     Initial state from ``paper`` (``rp.load_paper("chen2019-table-4-41")``: 47°N, 115°E, 6000 m,
     heading 45°, 100 m/s) or, without it, the same numbers built into
-    :func:`replication.trajectory.chen2019_flight`.  The S-maneuver amplitude (``s_swing``) and its
+    :func:`replication.nav.trajectory.chen2019_flight`.  The S-maneuver amplitude (``s_swing``) and its
     number of cycles are not printed (this package's choice).  Cached: repeated calls return the
-    same :class:`replication.trajectory.Trajectory` object — do not modify it.
+    same :class:`replication.nav.trajectory.Trajectory` object — do not modify it.
     """
     if not imu_rate_hz > 0:
         raise ValueError("imu_rate_hz must be positive")
@@ -276,12 +276,12 @@ def filter_model(kind: str, setup: SimulationSetup, lat: float, h: float) -> E.E
 
     * 15 — chen2019 eqs. (3-14)-(3-16): random-constant bias/drift with σ the RSS of the truth's
       constant and Markov parts (the only bias it has);
-    * 36 — chen2019 ref. [35] as the report describes it (:func:`replication.models.model_36`):
+    * 36 — chen2019 ref. [35] as the report describes it (:func:`replication.papers.chen2019.models.model_36`):
       constant + random walk + Markov bias/drift, scale factors, lever arm; the random walk is
       not in the truth and its intensity is not printed: q_rw = (f σ_b)² / T_flight with
       f = ``setup.random_walk_fraction`` (the walk reaches f times the random-constant σ over
       the flight);
-    * 45 — chen2019 eqs. (2-14), (2-15), Table 2-2 (:func:`replication.models.model_45`), every
+    * 45 — chen2019 eqs. (2-14), (2-15), Table 2-2 (:func:`replication.papers.chen2019.models.model_45`), every
       source of the truth.
     """
     if kind not in ("15", "36", "45"):
@@ -535,7 +535,7 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
     fixed-interval smoother pass (replaying the lead's forward pass chunk by chunk, ``chunk_epochs``
     epochs each);
     ``smoother_covariance=False`` skips the smoothed covariance (P^s) and keeps only the smoothed
-    states; ``smoother_form`` picks the backward recursion (:func:`replication.closedloop.run`: the
+    states; ``smoother_form`` picks the backward recursion (:func:`replication.nav.closedloop.run`: the
     modified Bryson-Frazier form or the Rauch-Tung-Striebel covariance form, the same results to
     rounding); ``prior_covariance`` propagates the covariance without
     measurements as well (for :func:`observable_nees`).  Runs are numbered ``first_run`` ..
@@ -547,7 +547,7 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
     Deterministic for a given ``seed``.
     """
     if not isinstance(model, E.ErrorModel):
-        raise TypeError("model must be a replication.errors.ErrorModel (see filter_model)")
+        raise TypeError("model must be a replication.nav.errors.ErrorModel (see filter_model)")
     if not isinstance(setup, SimulationSetup):
         raise TypeError("setup must be a SimulationSetup (see table_4_41_setup)")
     if int(n_runs) < 1 or int(chunk_epochs) < 2 or int(record_every) < 1:
@@ -669,7 +669,7 @@ def observable_nees(e, P, P_bar, threshold: float = 0.1):
 
 def fraction_in_band(nees, dof, prob: float = 0.95, mask=None):
     """Fraction of epochs whose run-averaged NEES lies in its two-sided ``prob`` χ² band
-    (χ²(R d) quantiles / R, :func:`replication.kalman.chi2_band`), with the band per epoch when
+    (χ²(R d) quantiles / R, :func:`replication.nav.kalman.chi2_band`), with the band per epoch when
     ``dof`` varies.  Returns (fraction, mean NEES per epoch, lower, upper)."""
     nees = np.asarray(nees, float)
     R_ = nees.shape[0]
@@ -934,7 +934,7 @@ def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1
     ``value, unit, lower, upper``).  A run matches a range when the window-mean |estimate| of every
     axis lies inside it; a reading reaches the print when at least half of its runs match (fixed
     before looking: one flight is one realisation, so the print is matched by a typical run, not
-    by a lucky one).  Returns (rows for :func:`replication.reproduction.compare`, {(label,
+    by a lucky one).  Returns (rows for :func:`replication.registry.reproduction.compare`, {(label,
     quantity): True when reached}).
     """
     if not isinstance(readings, dict) or not readings:

@@ -12,9 +12,9 @@ Discrete algorithm (one update per IMU interval T, increments Δθ_k, Δv_k):
 * vertical channel — ``"free"``, ``"hold"`` (height and vertical speed reset to a reference at
   every step, as the papers do) or ``"damped"`` (third-order loop on a reference height).
 
-Earth quantities are those of :mod:`replication.earth` (WGS-84 radii, Somigliana normal gravity
+Earth quantities are those of :mod:`replication.nav.earth` (WGS-84 radii, Somigliana normal gravity
 with height, Earth and transport rates), evaluated inside a compiled loop
-(``replication._kernels``).  Frames and angles: :mod:`replication.rotations`.
+(``replication.nav._kernels``).  Frames and angles: :mod:`replication.nav.rotations`.
 """
 
 from __future__ import annotations
@@ -23,11 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import earth
-from . import _kernels as K
-from ._validate import choice, matrix3, numeric, positive, rotation, vector3
-from .rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, quat_to_dcm, skew, vee
-from .rotations import attitude_error
+from replication.nav import _kernels as K
+from replication.nav import earth
+from replication.nav._validate import choice, matrix3, numeric, positive, rotation, vector3
+from replication.nav.rotations import attitude_error, dcm_to_euler, dcm_to_quat, euler_to_dcm, quat_to_dcm, skew
 
 __all__ = ["NavState", "NavSolution", "mechanize", "navigation_rates", "vertical_damping_gains",
            "validate_time", "validate_increments", "VERTICAL_MODES"]
@@ -55,9 +54,9 @@ class NavState:
 
     def validate(self, *, name: str = "NavState", polar_limit_deg: float = earth.POLAR_LIMIT_DEG):
         """Check every field (also after a field was changed): latitude within ±90° and outside the polar
-        singularity, finite longitude, height within :data:`replication.earth.HEIGHT_RANGE`, finite
-        velocity below :data:`replication.earth.SPEED_LIMIT`, C_bn a rotation matrix
-        (:data:`replication._validate.ORTHONORMAL_TOL`).  Raises ``TypeError``/``ValueError`` naming the
+        singularity, finite longitude, height within :data:`replication.nav.earth.HEIGHT_RANGE`, finite
+        velocity below :data:`replication.nav.earth.SPEED_LIMIT`, C_bn a rotation matrix
+        (:data:`replication.nav._validate.ORTHONORMAL_TOL`).  Raises ``TypeError``/``ValueError`` naming the
         field; the compiled mechanization checks nothing."""
         earth.check_latitude(self.lat, polar_limit_deg=polar_limit_deg, name=f"{name}.lat")
         earth.check_longitude(self.lon, name=f"{name}.lon")
@@ -101,7 +100,7 @@ class NavSolution:
         return np.stack([self.lat, self.lon, self.h], -1)
 
     def errors_against(self, truth):
-        """Errors against a :class:`~replication.trajectory.Trajectory` with the same samples.
+        """Errors against a :class:`~replication.nav.trajectory.Trajectory` with the same samples.
 
         Returns a dict: ``east``, ``north``, ``up`` (m), ``v`` (m/s, ENU), ``phi`` (rad, n-frame
         misalignment with Ĉ = exp(-φ×) C)."""
@@ -181,7 +180,7 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
     ``h_ref``, e.g. a barometric height, with poles at -1/``damping_tau``).
 
     Comparing the free vertical channel with another package: gravity here is the WGS-84
-    normal gravity of :func:`replication.earth.normal_gravity` (NIMA TR8350.2, Somigliana with
+    normal gravity of :func:`replication.nav.earth.normal_gravity` (NIMA TR8350.2, Somigliana with
     the second-order height series), not a linear free-air term γ_0 - 3.086e-6 h.  The two
     differ by ~1e-7 m/s² at 150 m (more with another peer's constants or formula), and the
     free channel, unstable with rate sqrt(2g/R) ≈ 1.75e-3 s⁻¹, amplifies any such difference

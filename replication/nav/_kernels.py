@@ -1,6 +1,6 @@
 """Compiled (numba) inner loops of the navigation core.  Private: use the public modules.
 
-The scalar Earth formulas below are the *same* expressions as :mod:`replication.earth`
+The scalar Earth formulas below are the *same* expressions as :mod:`replication.nav.earth`
 (radii of curvature, Somigliana normal gravity with the second-order height term, Earth and
 transport rates), written on scalars with the constants imported from ``earth`` so that they can
 run inside compiled loops; ``tests/test_strapdown.py`` checks them against ``earth`` to rounding.
@@ -16,11 +16,12 @@ import math
 import numpy as np
 from numba import njit
 
-from .earth import A, E2, F as FLAT, GAMMA_E, K_SOMIGLIANA, M_RATIO, OMEGA_IE
+from replication.nav.earth import E2, GAMMA_E, K_SOMIGLIANA, M_RATIO, OMEGA_IE, A
+from replication.nav.earth import F as FLAT
 
 _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
-# block targets / couplings (see replication.errors)
+# block targets / couplings (see replication.nav.errors)
 TARGET_ACCEL, TARGET_GYRO, TARGET_GRAVITY, TARGET_LEVER, TARGET_NONE = 0, 1, 2, 3, 4
 KIND_IDENTITY, KIND_SCALE, KIND_MISALIGN, KIND_MISALIGN_T22 = 0, 1, 2, 3
 _TWELFTH = 1.0 / 12.0
@@ -602,7 +603,7 @@ def apply_corrections(u, T, p_hat, blk_target, blk_kind, blk_start, blk_size, ta
 
 
 # ----------------------------------------------------------------------------- closed-loop steps
-# Steps of the closed-loop filter of replication.closedloop: interval sums, discretization,
+# Steps of the closed-loop filter of replication.nav.closedloop: interval sums, discretization,
 # feedback, resets.
 
 @njit(inline="always", **_NJ)

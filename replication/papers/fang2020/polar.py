@@ -29,13 +29,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-
-from . import earth
-from . import rotations
-from . import units
-from . import _polar_kernels as _k
-from ._validate import choice, positive, vector3
 import pandas as pd
+
+from replication.nav import earth, rotations, units
+from replication.nav._validate import choice, positive, vector3
+from replication.papers.fang2020 import _polar_kernels as _k
 
 OMEGA = earth.OMEGA_IE
 
@@ -164,7 +162,7 @@ def grid_heading(c_b_g):
 
 def attitude_from_euler(heading, pitch, roll):
     """C_b^G = R_z(-heading) R_x(pitch) R_y(roll) (body axes right, forward, up), the convention of
-    :func:`replication.rotations.euler_to_dcm` applied to grid angles."""
+    :func:`replication.nav.rotations.euler_to_dcm` applied to grid angles."""
     return rotations.euler_to_dcm(heading, pitch, roll)
 
 
@@ -362,7 +360,7 @@ def two_point_drift(p2, r2, c_b_g, tau, *, p1=None, r1=None, mean_c_b_e=None,
     rad2 = gaussian_radius(lat2) if radius is None else np.broadcast_to(positive(radius, "radius"), lat2.shape)
     psi2 = _psi_at(p2, lat2, lon2, rad2)
     a = OMEGA * tau
-    t_mat, u_mat = transition_t(a), input_u(a)
+    t_mat = transition_t(a)
     rhs = psi2
     if p1 is not None:
         p1 = vector3(p1, "p1")

@@ -2,16 +2,16 @@
 chapter, batched over Monte-Carlo runs.
 
 One IMU step of every run: the accumulated sensor-error estimates are removed from the
-increments (chen2019 eq. (2-10)) and the strapdown of ``replication._kernels.sd_step``
+increments (chen2019 eq. (2-10)) and the strapdown of ``replication.nav._kernels.sd_step``
 (chen2019 eq. (3-2)) advances the run.  One GNSS epoch: the error-state F of
-``replication._kernels.build_F_core`` plus the sensor-block couplings C_b^n B(u) — both
+``replication.nav._kernels.build_F_core`` plus the sensor-block couplings C_b^n B(u) — both
 averaged over the interval's IMU steps (F is affine in them, so this is the interval mean of F)
 — gives (Φ, Q_d) by the Van Loan series; P⁻ = Φ P Φᵀ + Q_d; the measurement rows are written
-once, in ``replication._kernels.gnss_rows`` (antenna position and velocity with the lever arm,
+once, in ``replication.nav._kernels.gnss_rows`` (antenna position and velocity with the lever arm,
 chen2019 eq. (2-13)) and ``_specific_force_rows`` (chen2019 eq. (3-18)); the update is the
 Joseph form one (independent) measurement at a time; then the navigation errors are fed back and
 the sensor-error estimates accumulated.  Optional: a vertical channel held or damped
-(:mod:`replication.strapdown`), discrete AR transitions of a gravity block at chosen epochs, the
+(:mod:`replication.nav.strapdown`), discrete AR transitions of a gravity block at chosen epochs, the
 recording of what the fixed-interval smoother needs (Φ, rows, gains and innovations for the
 modified Bryson-Frazier form :func:`mbf_chunk`; P⁺, P⁻, Φ, x̂ for the Rauch-Tung-Striebel form
 :func:`rts_chunk`), NEES against a truth.
@@ -26,10 +26,10 @@ follow on other threads, chunk by chunk, while the lead goes on: the result does
 the number of threads.
 
 :func:`run` is the driver (chunks, threads, records, smoother); :func:`build_spec` bundles the
-configuration of an :class:`replication.errors.ErrorModel`.  The public entry points are
-:func:`replication.kalman.closed_loop` (one run), :func:`replication.kalman.monte_carlo`,
-:func:`replication.simulation.run_batch` (chen2019 §4.2) and
-:func:`replication.gravity.augmented_filter` (chen2019 eq. (3-18)).
+configuration of an :class:`replication.nav.errors.ErrorModel`.  The public entry points are
+:func:`replication.nav.kalman.closed_loop` (one run), :func:`replication.nav.kalman.monte_carlo`,
+:func:`replication.papers.chen2019.simulation.run_batch` (chen2019 §4.2) and
+:func:`replication.papers.chen2019.gravity.augmented_filter` (chen2019 eq. (3-18)).
 """
 
 from __future__ import annotations
@@ -44,9 +44,9 @@ from typing import Callable
 import numpy as np
 from numba import njit
 
-from . import _kernels as K
-from .errors import ErrorModel
-from ._validate import choice, covariance, finite_array, integer, numeric
+from replication.nav import _kernels as K
+from replication.nav._validate import choice, covariance, finite_array, integer, numeric
+from replication.nav.errors import ErrorModel
 
 __all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state",
            "Records", "run", "filter_chunk", "rts_chunk", "mbf_chunk", "no_windows"]
@@ -93,7 +93,7 @@ ChunkOut = namedtuple("ChunkOut", ["st", "q", "phat", "nis", "innov", "nees", "n
 @njit(inline="always", **_NJ)
 def _propagate_sparse(Phi, P, Qd, W, Wt, U, nzc, nzv, cnt):
     """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (``nzc``, ``nzv``, ``cnt`` of
-    ``replication._kernels.row_nonzeros``; Φ of an INS error model is sparse): W = Φ P, then
+    ``replication.nav._kernels.row_nonzeros``; Φ of an INS error model is sparse): W = Φ P, then
     U = Φ Wᵀ, whose element (j, i) sums the products W[i, k] Φ[j, k] over Φ's non-zeros in
     ascending k, and P[i, j] = U[j, i] + Q_d (symmetrized)."""
     n = P.shape[0]
@@ -144,7 +144,7 @@ def _body_rate(dth, T, c, st, w_ie, w_en):
 
 @njit(inline="always", **_NJ)
 def _innovations(st, c, lever, wx, wy, wz, gpos, gvel, use_pos, use_vel, z):
-    """GNSS innovations INS − GNSS at the antenna (rows as in ``replication._kernels.gnss_rows``);
+    """GNSS innovations INS − GNSS at the antenna (rows as in ``replication.nav._kernels.gnss_rows``);
     returns the number of rows written."""
     rm, rn = K.radii_s(st[0])
     h = st[2]
@@ -206,7 +206,7 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cp
 @njit(**_NJ)
 def _lead_gains(P, H, m, Rd, gK, gs, bvec, hz):
     """Sequential Joseph update of P for rows 0..m-1 of H (variances ``Rd``): gains ``gK[a]`` and
-    innovation variances ``gs[a]`` (see the Joseph form of :func:`replication.kalman.update`).
+    innovation variances ``gs[a]`` (see the Joseph form of :func:`replication.nav.kalman.update`).
 
     The updates write P's upper triangle (contiguous rows) and mirror it once at the end; the
     rows after the first read P from the upper triangle, which is what the lower one would hold.
@@ -796,7 +796,7 @@ def build_spec(model: ErrorModel, *, R_pos, R_vel, lever_arm_b=(0.0, 0.0, 0.0), 
     Parameters
     ----------
     model : ErrorModel
-        The error-state model (15 states or any extension, :mod:`replication.errors`).
+        The error-state model (15 states or any extension, :mod:`replication.nav.errors`).
     R_pos, R_vel : (3, 3) array_like
         Diagonal GNSS position (ENU metres) and velocity noise covariances.
     lever_arm_b : (3,) array_like
@@ -804,7 +804,7 @@ def build_spec(model: ErrorModel, *, R_pos, R_vel, lever_arm_b=(0.0, 0.0, 0.0), 
     use_position, use_velocity : bool
         Which GNSS rows to use (at least one).
     vmode, gains : int, (3,) array_like
-        Vertical channel: 0 free, 1 held, 2 damped with ``gains`` (:mod:`replication.strapdown`).
+        Vertical channel: 0 free, 1 held, 2 damped with ``gains`` (:mod:`replication.nav.strapdown`).
     series_order : int
         Order of the Van Loan series for (Φ, Q_d).
     ar : tuple (T, Q) of (n, n) arrays, optional
@@ -821,7 +821,7 @@ def build_spec(model: ErrorModel, *, R_pos, R_vel, lever_arm_b=(0.0, 0.0, 0.0), 
     Spec
     """
     if not isinstance(model, ErrorModel):
-        raise TypeError("model must be a replication.errors.ErrorModel")
+        raise TypeError("model must be a replication.nav.errors.ErrorModel")
     if not (use_position or use_velocity):
         raise ValueError("use at least one of GNSS position and velocity")
     R_pos = numeric(R_pos, "R_pos")

@@ -1,6 +1,6 @@
 """The chen2019 family of SINS/GNSS error-state models (45-state and 36-state), with G, H and w.
 
-Built on :mod:`replication.errors` (the physics of F lives there, verified against a numerical
+Built on :mod:`replication.nav.errors` (the physics of F lives there, verified against a numerical
 Jacobian of the mechanization); this module fixes the *state order* of chen2019, the noise
 input G w of eq. (2-14) and the 6-dimensional position/velocity measurement with the lever-arm
 correction of eq. (2-13).
@@ -28,9 +28,9 @@ The 45 of the text (and the three position rows of Table 2-2's F1) need δλ: th
 was lost from the list, and is restored here between δL and δh.
 
 The six misalignment angles follow the text's order (xy, yx, xz, zx, yz, zy), which is also
-the parameter order of :func:`replication.sensors.misalignment_matrix` (eq. (2-8)).
+the parameter order of :func:`replication.nav.sensors.misalignment_matrix` (eq. (2-8)).
 
-Sign conventions (those of :mod:`replication.errors`): navigation errors are computed minus
+Sign conventions (those of :mod:`replication.nav.errors`): navigation errors are computed minus
 true, Ĉ_b^n = (I - φ×) C_b^n; a sensor-error state is the true error minus the compensated one.
 With these, the gyro-error columns of the attitude rows carry -C_b^n where chen2019 eq. (2-15)
 and Table 2-2 print +C_b^n (the report counts ε with the opposite sign; flipping the sign of
@@ -56,8 +56,8 @@ Typical use::
     models.state_symbols(m)                                             # chen2019 symbols
     p = models.state_permutation(m, other)                              # x_other = x_m[p]
 
-Because the returned object is a plain :class:`replication.errors.ErrorModel`, it runs in
-:func:`replication.kalman.closed_loop` unchanged (blocks are found by name, not position).
+Because the returned object is a plain :class:`replication.nav.errors.ErrorModel`, it runs in
+:func:`replication.nav.kalman.closed_loop` unchanged (blocks are found by name, not position).
 """
 
 from __future__ import annotations
@@ -65,15 +65,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from . import earth
-from . import errors as E
-from .rotations import rotvec_to_dcm, skew
-from ._validate import components, numeric, positive
-from replication import models, errors
-from .rotations import euler_to_dcm
-from ._kernels import KIND_MISALIGN, coupling_matrix
 import pandas as pd
+
+from replication.nav import earth
+from replication.nav import errors as E
+from replication.nav._kernels import KIND_MISALIGN, coupling_matrix
+from replication.nav._validate import components, numeric, positive
+from replication.nav.rotations import euler_to_dcm, rotvec_to_dcm, skew
 
 __all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "EXTEND_ORDER_45", "NAV_SYMBOLS", "model_45", "model_36",
            "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
@@ -154,12 +152,12 @@ def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
 
     ``misalignment_coupling``: ``"eq-2-8"`` (the layout of δC in eq. (2-8), default) or
     ``"table-2-2"`` (the F32/F33, F52/F53 columns as Table 2-2 prints them) — the report's two
-    printed parts disagree on it (:data:`replication.errors.MISALIGNMENT_COUPLINGS`).
+    printed parts disagree on it (:data:`replication.nav.errors.MISALIGNMENT_COUPLINGS`).
 
-    Dynamics: eq. (2-15) with every first-order term (:meth:`replication.errors.ErrorModel.F`); random
+    Dynamics: eq. (2-15) with every first-order term (:meth:`replication.nav.errors.ErrorModel.F`); random
     constants (eq. (2-5), (2-6), (2-9)): ẋ = 0; first-order Gauss-Markov biases (eq. (2-5)):
     ẋ = -x/τ + w with stationary σ (``*_markov_sigma``; driving intensity 2σ²/τ — convert the
-    report's "驱动白噪声方差强度" with :func:`replication.sensors.markov_sigma_from_driving_psd`);
+    report's "驱动白噪声方差强度" with :func:`replication.nav.sensors.markov_sigma_from_driving_psd`);
     gravity disturbance (eqs. (2-11), (2-12)): δġ = -β δg + n per ENU axis with stationary σ
     (``gravity_sigma``, ``gravity_beta`` = 1/correlation time); lever arm: constant, enters the
     measurement only (eq. (2-13), :func:`measurement_matrix`).
@@ -167,8 +165,8 @@ def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
     All arguments are SI (m, m/s, rad, m/s², rad/s, 1/s); ``position_sd`` in metres (E, N, U),
     converted to (δL, δλ, δh) at (``lat``, ``h``); ``accel_psd``/``gyro_psd`` are the white-noise
     intensities (velocity/angle random walk squared).  The defaults of the standard deviations
-    are zero (no prior); set them (e.g. from chen2019 Table 4-41 with :mod:`replication.units`)
-    before running a filter.  Returns an :class:`replication.errors.ErrorModel` (45 states).
+    are zero (no prior); set them (e.g. from chen2019 Table 4-41 with :mod:`replication.nav.units`)
+    before running a filter.  Returns an :class:`replication.nav.errors.ErrorModel` (45 states).
     """
     nav_sd = _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h)
     beta = positive(gravity_beta, "gravity_beta", _SECONDS)
@@ -232,7 +230,7 @@ def model_36(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
 
 def _check_model(model):
     if not isinstance(model, E.ErrorModel):
-        raise TypeError(f"expected an replication.errors.ErrorModel (e.g. models.model_45()), got {type(model).__name__}")
+        raise TypeError(f"expected an replication.nav.errors.ErrorModel (e.g. models.model_45()), got {type(model).__name__}")
     return model
 
 
@@ -354,7 +352,7 @@ def lever_arm_correction(point, lever_arm_b):
     Returns ``(dp_enu, dv_enu)`` in metres and m/s (ENU).  The report prints the velocity term
     as C_b^n ω_nb^n P_SINS^b; the rigid-body rate of the lever arm seen from the Earth is
     ω_eb^b = ω_ib^b - C_n^b ω_ie^n (ω_nb^b differs from it by ω_en^b, ~1e-5 rad/s here).
-    Note: :func:`replication.sensors.gnss_measurements` takes the antenna seen from the SINS
+    Note: :func:`replication.nav.sensors.gnss_measurements` takes the antenna seen from the SINS
     centre, i.e. ``lever_arm_b = -l``.
     """
     l = _lever(lever_arm_b)
@@ -454,7 +452,7 @@ def frozen_earth_jacobian(point, *, steps=(3e-3, 3e-3, 1000.0, 1.0, 1.0, 1.0, 3e
     """9×9 navigation block of F at the approximation level of chen2019 eq. (2-15) and Table 2-2:
     central finite differences of the mechanization ``_frozen_rates`` in which R_M, R_N and
     the normal gravity γ are held at their values at ``point`` (so dR/dL, ∂γ/∂L, ∂γ/∂h — which
-    the report's F omits — are absent).  Perturbations as :meth:`replication.errors.ErrorModel.numerical_jacobian`:
+    the report's F omits — are absent).  Perturbations as :meth:`replication.nav.errors.ErrorModel.numerical_jacobian`:
     δL, δλ, δh, δv additive, Ĉ = exp(-φ×) C.  The difference to the full
     ``ErrorModel.F`` is confined to the δL column and the (δv_U, δh) element
     (tests/test_models.py).
@@ -524,7 +522,7 @@ def table_2_2_reference_point():
 
 def table_2_2_printed(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.0) -> dict:
     """The sub-blocks of chen2019 Table 2-2 *as printed*, evaluated at ``point`` (a
-    :class:`replication.errors.NavPoint`), in the report's conventions (gyro errors with +C_b^n).
+    :class:`replication.nav.errors.NavPoint`), in the report's conventions (gyro errors with +C_b^n).
 
     Reading of the damaged print (data/paper/chen2019/chen2019-table-2-2.csv): the single
     "(R_n+h)^2" under the third column of F21 is the denominator of all three third-column
@@ -661,7 +659,7 @@ def table_2_2_differences(model, point, *, rtol=1e-6, floor=1e-8) -> list:
     return out
 
 
-def jacobian_agreement(model, traj, indices) -> "pandas.DataFrame":
+def jacobian_agreement(model, traj, indices) -> "pd.DataFrame":
     """Largest relative difference, over the samples ``indices`` of ``traj``, between
     ``model.F`` and ``model.numerical_jacobian`` for every non-zero (row block × column block)
     of the navigation rows (relative to the block's largest element).  Columns ``row_block``,

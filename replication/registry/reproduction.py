@@ -42,7 +42,7 @@ from typing import Any, Iterable, Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from . import __version__, repository_url
+from replication import __version__, repository_url
 
 STATUSES = (
     "reproduced", "erratum", "inconsistent", "qualitative", "analog", "unverifiable", "not-reproduced", "pending",
@@ -747,7 +747,7 @@ def compare(
         "packages": _package_versions(),
         "seeds": dict(seeds or {}),
         "status_counts": counts,
-        "generated_by": "replication.reproduction.compare",
+        "generated_by": "replication.registry.reproduction.compare",
     }
     for key, value in (("main_reading", main_reading), ("main_reading_evidence", reading_evidence),
                        ("readings", ledgers), ("ruled_out", ruled), ("summary", summary)):

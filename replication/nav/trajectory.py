@@ -16,7 +16,7 @@ independently of the strapdown algorithm's discrete scheme (nothing here inverts
 mechanization).  Segment boundaries lie on the sampling grid, so each quadrature interval sees
 a smooth integrand.
 
-Conventions: see :mod:`replication.rotations` (heading clockwise from north, pitch nose-up,
+Conventions: see :mod:`replication.nav.rotations` (heading clockwise from north, pitch nose-up,
 roll right-wing-down; C_b^n = R_z(-ψ) R_x(θ) R_y(γ)).  Coordinated turns bank by
 tan γ = V ψ̇ / g_0 with g_0 = 9.80665 m/s².
 """
@@ -29,10 +29,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import earth
-from .rotations import body_rate_from_euler_rates, euler_to_dcm, dcm_to_quat
-from .units import DEG, G0
-from .strapdown import NavState
+from replication.nav import earth
+from replication.nav.rotations import body_rate_from_euler_rates, dcm_to_quat, euler_to_dcm
+from replication.nav.strapdown import NavState
+from replication.nav.units import DEG, G0
 
 __all__ = [
     "Segment", "Straight", "Turn", "UTurn", "STurn", "FigureEight", "Climb", "Accelerate",
@@ -333,7 +333,7 @@ class Trajectory:
         return np.stack([self.lat, self.lon, self.h], -1)
 
     def initial_state(self, index: int = 0):
-        """The true navigation state at sample ``index`` (a :class:`replication.strapdown.NavState`)."""
+        """The true navigation state at sample ``index`` (a :class:`replication.nav.strapdown.NavState`)."""
 
         return NavState(lat=float(self.lat[index]), lon=float(self.lon[index]), h=float(self.h[index]),
                         v_enu=self.v_enu[index].copy(), C_bn=euler_to_dcm(*self.hpr[index]))

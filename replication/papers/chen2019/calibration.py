@@ -19,7 +19,7 @@ Contents, in the report's order:
 * static-data simulation (random constant + first-order Gauss-Markov + white noise, (2-4)-(2-5))
   and Allan deviation through ``allantools``.
 
-Units: SI inside (rad, rad/s, m/s^2); the papers' units through :mod:`replication.units`.  The
+Units: SI inside (rad, rad/s, m/s^2); the papers' units through :mod:`replication.nav.units`.  The
 sensor *output* of the rate-table experiment is a pulse rate (pulses/s), as for the flexure gyros
 and quartz accelerometers of the report: a sensor is described by its bias ``b`` (input units),
 a matrix ``C`` whose rows are the direction cosines of the sensing axes (2-1), and a scale factor
@@ -31,15 +31,15 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
-from typing import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Mapping, Sequence
 
 import numpy as np
 
-from . import earth
-from ._validate import finite, finite_array, nonnegative, positive, vector3
-from .timeseries import gauss_markov
-from .units import ARCSEC, DEG, DEG_PER_H, G0
+from replication.nav import earth
+from replication.nav._validate import finite, finite_array, nonnegative, positive, vector3
+from replication.nav.timeseries import gauss_markov
+from replication.nav.units import ARCSEC, DEG_PER_H, G0
 
 AXES = ("x", "y", "z")
 POSITIONS = ("X+", "X-", "Y+", "Y-", "Z+", "Z-")
@@ -108,7 +108,7 @@ def misalignment_matrix(theta: Mapping[str, float]) -> np.ndarray:
     t = {k: float(theta[k]) for k in need}
     if any(abs(v) > 0.1 for v in t.values()):
         raise ValueError("misalignment angles are small-angle quantities in radians (|θ| ≤ 0.1 rad); "
-                         "convert arc-seconds with replication.units.ARCSEC")
+                         "convert arc-seconds with replication.nav.units.ARCSEC")
     return np.array([[0.0, -t["yz"], t["zy"]],
                      [t["xz"], 0.0, -t["zx"]],
                      [-t["xy"], t["yx"], 0.0]])
@@ -1097,7 +1097,7 @@ def paper_triads(load, temperature: int, *, missing_signs: Mapping[str, float] |
                  accel_scale_unit: float = 1e-5) -> dict[str, SensorTriad]:
     """Gyro and accelerometer triads from the printed tables of one temperature.
 
-    ``load`` is :func:`replication.reproduction.load_paper`; units: gyro bias °/h, gyro scale
+    ``load`` is :func:`replication.registry.reproduction.load_paper`; units: gyro bias °/h, gyro scale
     ″/pulse, accelerometer bias g, accelerometer scale factor in g·s/pulse: the printed header
     says 1.0e-5 g·s/pulse; ``accel_scale_unit`` is the unit the printed *numbers* are read in
     (1e-5 for Table 4-6; Tables 4-14/4-22/4-30 print numbers already in g·s/pulse, read them with

@@ -3,10 +3,10 @@
 Each function takes the result of a chapter's computation and returns a matplotlib figure;
 nothing here computes a number that a table or a test uses.
 
-* :func:`state_estimates` — chen2019 Fig. 4-14 analog (:func:`replication.simulation.run_batch`);
-* :func:`airdata_error_histories` — duan2023 Figs. 3-5 analog (``replication.airdata.simulate``);
+* :func:`state_estimates` — chen2019 Fig. 4-14 analog (:func:`replication.papers.chen2019.simulation.run_batch`);
+* :func:`airdata_error_histories` — duan2023 Figs. 3-5 analog (``replication.papers.duan2023.airdata.simulate``);
 * :func:`polar_error_histories`, :func:`polar_drift_estimates` — fang2020 Figs. 4-10
-  (:func:`replication.polar.simulate`).
+  (:func:`replication.papers.fang2020.polar.simulate`).
 """
 
 from __future__ import annotations
@@ -16,7 +16,10 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import airdata as ad, polar, simulation as sim, units
+from replication.nav import units
+from replication.papers.chen2019 import simulation as sim
+from replication.papers.duan2023 import airdata as ad
+from replication.papers.fang2020 import polar
 
 __all__ = ["state_estimates", "airdata_error_histories", "polar_error_histories", "polar_drift_estimates"]
 
@@ -63,7 +66,7 @@ def state_estimates(result: sim.BatchResult, run: int = 0, *, ncols: int = 5, ev
 
 
 def airdata_error_histories(mc: ad.MonteCarlo, quantity: str, *, scale=1.0, unit="", axes_labels=("E", "N", "U")):
-    """duan2023 Figs. 3-5 analog (``replication.airdata.simulate``): per axis, the run-mean of each system with a ±1σ band (one panel per axis)."""
+    """duan2023 Figs. 3-5 analog (``replication.papers.duan2023.airdata.simulate``): per axis, the run-mean of each system with a ±1σ band (one panel per axis)."""
     if quantity not in ("phi", "v", "enu"):
         raise ValueError("quantity must be 'phi', 'v' or 'enu'")
     fig, axs = plt.subplots(3, 1, figsize=(7, 6.5), sharex=True)
@@ -89,7 +92,7 @@ _PANELS = {
 
 
 def polar_error_histories(result, kind, *, run=0, title=None):
-    """fang2020 Figs. 4-6 / 8-10 equivalents (:func:`replication.polar.simulate`): error histories of one run, calibrated (solid) and reset
+    """fang2020 Figs. 4-6 / 8-10 equivalents (:func:`replication.papers.fang2020.polar.simulate`): error histories of one run, calibrated (solid) and reset
     only (dashed), with the fix times marked.  ``kind``: "attitude", "velocity" or "position"."""
     if kind not in _PANELS:
         raise ValueError(f"kind must be one of {sorted(_PANELS)}")

@@ -5,7 +5,7 @@ State vector: the 9 navigation errors, always first,
     [δL, δλ, δh | δv_E, δv_N, δv_U | φ_E, φ_N, φ_U]     (rad, rad, m | m/s | rad)
 
 followed by *augmented blocks*, each a named slice with its own linear dynamics and a coupling
-into the navigation equations.  Definitions (consistent with :mod:`replication.rotations`):
+into the navigation equations.  Definitions (consistent with :mod:`replication.nav.rotations`):
 
 * navigation errors are computed minus true: δL = L̂ - L, δv = v̂ - v, Ĉ_b^n = (I - φ×) C_b^n;
 * an augmented state is the true value of an error source minus the value currently compensated
@@ -40,11 +40,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import earth
-from . import _kernels as K
-from ._validate import choice, covariance, finite_array, nonnegative_array, numeric, positive, rotation, vector3
-from .rotations import euler_to_dcm, rotvec_to_dcm
-from .strapdown import NavState, navigation_rates
+from replication.nav import _kernels as K
+from replication.nav import earth
+from replication.nav._validate import choice, covariance, finite_array, nonnegative_array, numeric, positive, rotation, vector3
+from replication.nav.rotations import euler_to_dcm, rotvec_to_dcm
+from replication.nav.strapdown import NavState, navigation_rates
 
 __all__ = ["StateBlock", "ErrorModel", "NavPoint", "nav_block_labels", "accel_bias", "gyro_bias",
            "accel_markov", "gyro_markov", "accel_scale", "gyro_scale", "accel_misalignment",
@@ -136,7 +136,7 @@ class NavPoint:
     w_ib_b: np.ndarray
 
     def validate(self, *, name: str = "point"):
-        """Check the fields as :meth:`replication.strapdown.NavState.validate` does, and finite f_b,
+        """Check the fields as :meth:`replication.nav.strapdown.NavState.validate` does, and finite f_b,
         w_ib_b; raises naming the field (the compiled F checks nothing)."""
         NavState.validate(self, name=name)
         vector3(self.f_b, f"{name}.f_b")
@@ -268,7 +268,7 @@ class ErrorModel:
 
     def numerical_jacobian(self, point: NavPoint, *, steps=None) -> np.ndarray:
         """Central finite-difference Jacobian of the continuous mechanization
-        (:func:`replication.strapdown.navigation_rates`) with respect to the error state.
+        (:func:`replication.nav.strapdown.navigation_rates`) with respect to the error state.
 
         Column j perturbs the state by ±ε_j: position/velocity additively, attitude by
         Ĉ = exp(-ε e_j×) C, sensor blocks through their coupling B(u) on f^b or ω_ib^b, gravity

@@ -4,7 +4,7 @@ column of chen2019 Table 2-1 (§2.1), shown by injecting one error at a time.
 Each error class of the table — bias, scale factor, misalignment, random noise — is injected
 alone (gyro and accelerometer triads separately) into ideal IMU increments of a flight with turns
 (:func:`consequence_flight`), the increments are integrated by the package's strapdown
-mechanization (chen2019 eq. (3-2), :func:`replication.strapdown.mechanize`, height held to the
+mechanization (chen2019 eq. (3-2), :func:`replication.nav.strapdown.mechanize`, height held to the
 truth as the papers do), and the error histories are reduced to a few features
 (:func:`error_features`):
 
@@ -25,12 +25,12 @@ numbers.
 from __future__ import annotations
 
 import numpy as np
-
-from . import trajectory as tr
-from .sensors import ImuErrors, TriadErrors, apply_imu_errors
-from .strapdown import mechanize
-from .units import DEG
 import pandas as pd
+
+from replication.nav import trajectory as tr
+from replication.nav.sensors import ImuErrors, TriadErrors, apply_imu_errors
+from replication.nav.strapdown import mechanize
+from replication.nav.units import DEG
 
 __all__ = ["consequence_flight", "single_errors", "error_features", "error_effects", "classify", "CONSEQUENCE_RULES"]
 
@@ -48,7 +48,7 @@ def consequence_flight(*, dt: float = 0.05, lat0: float = 47 * DEG, lon0: float 
 
 def single_errors(*, gyro_bias_deg_h=0.01, accel_bias_ug=100.0, scale_ppm=100.0, misalignment_arcsec=10.0,
                   gyro_white_deg_rt_h=0.002, accel_white_ug_rt_hz=20.0) -> dict:
-    """One :class:`~replication.sensors.ImuErrors` per error class and triad, each holding a
+    """One :class:`~replication.nav.sensors.ImuErrors` per error class and triad, each holding a
     single error on all three axes (defaults: navigation-grade values of chen2019 ch. 2)."""
     d = {}
     for triad in ("gyro", "accel"):
@@ -75,7 +75,7 @@ def error_features(traj, errors: ImuErrors, *, seed=0) -> dict:
     """Inject ``errors`` into ``traj``'s ideal increments, navigate (height held) and reduce the
     error histories to the features of the module docstring.  Returns a dict of floats."""
     if not isinstance(errors, ImuErrors):
-        raise TypeError("errors must be a replication.sensors.ImuErrors")
+        raise TypeError("errors must be a replication.nav.sensors.ImuErrors")
     dth, dv, _ = apply_imu_errors(traj.t, traj.dtheta, traj.dv, errors, rng=seed)
     sol = mechanize(traj.t, dth, dv, traj.initial_state(), vertical="hold", h_ref=traj.h)
     e = sol.errors_against(traj)

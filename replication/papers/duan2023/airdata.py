@@ -32,41 +32,30 @@ The module has four parts.
 
 4. **The simulation of the three systems** (pure SINS, a SINS/ADS Kalman filter of the kind of
    duan2023 refs. [15-17], the error-correction method) built on the navigation core
-   (:mod:`replication.trajectory`, :mod:`replication.sensors`, :mod:`replication.strapdown`,
-   :mod:`replication.errors`, :mod:`replication.kalman`).
+   (:mod:`replication.nav.trajectory`, :mod:`replication.nav.sensors`, :mod:`replication.nav.strapdown`,
+   :mod:`replication.nav.errors`, :mod:`replication.nav.kalman`).
 
 Units: SI and radians; displacements in metres, velocities in m/s.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
-
-from . import earth
-from ._validate import choice
 import pandas as pd
-from .errors import NavPoint, model_15
-from . import trajectory as tr
-from .units import DEG
-from .units import DEG_PER_H, MICRO_G
-from .strapdown import NavState
-from .strapdown import mechanize
-from .rotations import orthonormalize, quat_to_dcm
-from .rotations import rotvec_to_dcm
-from .rotations import attitude_error, euler_to_dcm, rotvec_to_dcm
-from .strapdown import NavState, mechanize
-from .rotations import attitude_error, euler_to_dcm
-from .errors import StateBlock, model_15
-from .errors import NavPoint
-from .kalman import update, van_loan
-from .rotations import quat_to_dcm, rotvec_to_dcm
 from scipy import stats
 from scipy.integrate import solve_ivp
-from dataclasses import replace
-from .errors import model_15
+
+from replication.nav import earth
+from replication.nav import trajectory as tr
+from replication.nav._validate import choice
+from replication.nav.errors import NavPoint, StateBlock, model_15
+from replication.nav.kalman import van_loan
+from replication.nav.rotations import attitude_error, euler_to_dcm, orthonormalize, quat_to_dcm, rotvec_to_dcm
+from replication.nav.strapdown import NavState, mechanize
+from replication.nav.units import DEG, DEG_PER_H, MICRO_G
 
 __all__ = [
     "pitch_correction", "rotation_axis", "rodrigues", "rotation_vector_from_dcm",
@@ -716,7 +705,7 @@ def sins_error_matrix(point):
 
     duan2023 cites the standard ENU model of Yan & Weng (2019) (their ref. [21]) without
     printing it.  It is built here from the navigation core's 15-state model
-    (:func:`replication.errors.model_15`, states [δp, δv, φ]) by permuting into the paper's
+    (:func:`replication.nav.errors.model_15`, states [δp, δv, φ]) by permuting into the paper's
     order φ = [φ_E, φ_N, φ_U], δv = [δv_E, δv_N, δv_U], δp = [δL, δλ, δh]:
 
         M_φφ = -(ω_in^n ×),  M_φv = ∂ω_in^n/∂v,  M_φp = ∂ω_in^n/∂p,
@@ -727,11 +716,11 @@ def sins_error_matrix(point):
     with the forcing -C_b^n δω_ib^b (attitude) and +C_b^n δf^b (velocity).  Returns a dict with
     ``F`` (9×9), ``G_gyro`` and ``G_accel`` (9×3 forcing of a body-frame gyro / accelerometer
     error) and the nine blocks ``M_phiphi`` ... ``M_pp``.  ``point`` is an
-    :class:`replication.errors.NavPoint`.
+    :class:`replication.nav.errors.NavPoint`.
     """
 
     if not isinstance(point, NavPoint):
-        raise TypeError("point must be a replication.errors.NavPoint (e.g. NavPoint.from_trajectory(traj, k))")
+        raise TypeError("point must be a replication.nav.errors.NavPoint (e.g. NavPoint.from_trajectory(traj, k))")
     F15 = model_15().F(point)
     perm = np.r_[6:9, 3:6, 0:3]
     F = F15[np.ix_(perm, perm)]
@@ -788,7 +777,7 @@ def duan2023_flight(*, dt: float = 0.02, start_speed: float = 10.0, height0: flo
     (120 s), 1300 s straight, a 300-s descent of ``climb`` m and a 120-s deceleration back to
     ``start_speed`` ("起飞加速阶段与降落减速阶段").  The cruise speed
     V_c = (729 km - 120 s · start_speed) / 3660 s makes the along-track range exactly 729 km
-    (≈ 198.9 m/s with the defaults).  Returns a :class:`replication.trajectory.Trajectory`.
+    (≈ 198.9 m/s with the defaults).  Returns a :class:`replication.nav.trajectory.Trajectory`.
     """
 
     if not (0 < start_speed < 100):
@@ -939,7 +928,7 @@ def error_correction_step(origin, state, h_ads, setup):
     """One correction of the proposed method (duan2023 eqs. (4)-(22)) applied to a SINS state.
 
     ``origin`` is the SINS position (lat, lon, h) at the start of the interval (point o of
-    Fig. 1), ``state`` the SINS :class:`~replication.strapdown.NavState` at its end, ``h_ads``
+    Fig. 1), ``state`` the SINS :class:`~replication.nav.strapdown.NavState` at its end, ``h_ads``
     the ADS height then.  Returns (corrected state, info dict with S, Ṡ/S, δh^c, gated, X^C).
     Gate (duan2023 §3): when Ṡ/S > ``setup.threshold`` the interval is either not corrected
     (``gate="skip"``: the step-like height error of Fig. 5) or only its height is reset
@@ -1003,7 +992,7 @@ def correction_experiment_flight(kind: str = "cruise", *, dt: float = 0.02):
 
     ``"cruise"``: 200 m/s; ``"accelerate"``: 100 → 160 m/s; ``"decelerate"``: 160 → 100 m/s
     (raised-cosine speed change over the 60 s: mean along-track acceleration ±1 m/s² over the
-    first 30 s).  Returns a :class:`replication.trajectory.Trajectory`.
+    first 30 s).  Returns a :class:`replication.nav.trajectory.Trajectory`.
     """
 
     choice(kind, EXPERIMENT_KINDS, "kind")
@@ -1151,7 +1140,7 @@ def schuler_response(tilt, lat=np.radians(45.0), height: float = 0.0):
 def literature_filter_model(setup):
     """Error model of the SINS/ADS Kalman filter standing in for duan2023 refs. [15-17].
 
-    15 states (core :func:`replication.errors.model_15`: δp, δv, φ, ∇_b, ε_b) plus two
+    15 states (core :func:`replication.nav.errors.model_15`: δp, δv, φ, ∇_b, ε_b) plus two
     first-order Markov states for the air data (height error and airspeed error, σ =
     ``sigma_height`` / ``sigma_airspeed``, τ = ``markov_tau``) — "建立一阶马尔可夫过程".
     """
@@ -1174,7 +1163,7 @@ def literature_gains(traj, setup):
     Measurements every ``setup.filter_interval`` s: z = [ĥ - h_ADS, |v̂| - V_TAS] =
     H x + n, H = [[e_h, -1 (height Markov)], [v/|v| on δv, -1 (airspeed Markov)]], white noise
     R = diag(σ_h², σ_V²) on top of the Markov states (a filter of the kind of refs. [15-17]).
-    The covariance is propagated along the truth (F from :class:`replication.errors.ErrorModel`,
+    The covariance is propagated along the truth (F from :class:`replication.nav.errors.ErrorModel`,
     Φ and Q_d by Van Loan) and does not depend on the measured values, so the gains are computed
     once.  Returns (epoch indices, gains (m × n × 2), H (m × 2 × n), Φ_ads (2×2), model).
     """
@@ -1395,7 +1384,7 @@ PROPOSED_REASON = (
 
 
 def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> list[dict]:
-    """Rows of duan2023 Table 1 for :func:`replication.reproduction.compare`, with the statuses of
+    """Rows of duan2023 Table 1 for :func:`replication.registry.reproduction.compare`, with the statuses of
     the written criteria (CONTRIBUTING.md, "Statuses") and the 95 % interval of every Monte-Carlo
     mean in the note.  ``until``: end of the cruise (s; the proposed method's maximum before the
     final deceleration is reported beside the maximum over the flight); ``ideal``: the pure SINS
@@ -1517,7 +1506,7 @@ LEDGER_QUANTITIES = {"misalignment": "max misalignment (deg)", "velocity error":
 
 
 def readings_ledger_rows(readings, table1, system="proposed SINS/ADS", *, runs=None):
-    """Rows of duan2023 Table 1's readings ledger for :func:`replication.reproduction.compare`.
+    """Rows of duan2023 Table 1's readings ledger for :func:`replication.registry.reproduction.compare`.
 
     Parameters
     ----------

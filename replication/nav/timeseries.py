@@ -30,8 +30,9 @@ import numpy as np
 import pandas as pd
 from scipy import linalg, signal, stats
 
-from .sensors import gauss_markov_coefficients, gauss_markov_recursion
-from ._validate import choice as _choice, finite_array, integer, nonnegative, numeric, positive, probability
+from replication.nav._validate import choice as _choice
+from replication.nav._validate import finite_array, integer, nonnegative, numeric, positive, probability
+from replication.nav.sensors import gauss_markov_coefficients, gauss_markov_recursion
 
 __all__ = [
     "NonStationaryError", "StationarityWarning", "ar_coefficients", "InversionTest", "inversion_count", "inversion_moments", "inversion_distribution", "inversion_test",
@@ -421,7 +422,7 @@ def identify_model(y, *, nlags: int | None = None, max_order: int = 10, alpha: f
         best = min(("white noise", "AR", "MA"), key=lambda k: a[k])
         choice = best if a[lag_choice] - a[best] > margin else lag_choice
         extra = (f"; both cut off, AIC: AR({qp}) {a['AR']:.1f}, MA({qa}) {a['MA']:.1f}, white noise "
-                 f"{a['white noise']:.1f}" + (f" (overrules the earlier cut-off)" if choice != lag_choice else ""))
+                 f"{a['white noise']:.1f}" + (" (overrules the earlier cut-off)" if choice != lag_choice else ""))
         if choice == "white noise":
             qa = qp = 0
         acf_cuts, pacf_cuts = choice in ("MA", "white noise"), choice in ("AR", "white noise")
@@ -818,8 +819,8 @@ def gauss_markov(n: int, dt: float, std: float, tau: float, rng: np.random.Gener
     """Stationary first-order Gauss-Markov sequences, sampled exactly.
 
     x_{k+1} = a x_k + w_k with a = e^{-dt/tau} and w_k ~ N(0, std²(1 - a²)); x_0 ~ N(0, std²), so
-    every sample has the standard deviation ``std`` (:func:`replication.sensors.gauss_markov_coefficients`,
-    :func:`replication.sensors.gauss_markov_recursion`).
+    every sample has the standard deviation ``std`` (:func:`replication.nav.sensors.gauss_markov_coefficients`,
+    :func:`replication.nav.sensors.gauss_markov_recursion`).
 
     Parameters
     ----------

@@ -1,11 +1,11 @@
-"""Numba kernels behind :mod:`replication.polar` (private; the public API validates inputs).
+"""Numba kernels behind :mod:`replication.papers.fang2020.polar` (private; the public API validates inputs).
 
 Everything here is scalar arithmetic on preallocated arrays so that a batch of Monte Carlo runs
 (the leading array axis) can be integrated at 100 Hz for hours.  Runs are independent: ``prange``
 distributes them over the available cores and every run owns its random-number state, so the
 results do not depend on the number of threads.
 
-Conventions (see :mod:`replication.polar` for the derivations):
+Conventions (see :mod:`replication.papers.fang2020.polar` for the derivations):
 
 * ECEF ``e``, inertial ``i`` (ECEF at t = 0, C_e^i = R_z(Ω t)), grid ``G`` (E, N, U of the grid
   frame, fang2020 §2.1), body ``b`` (right, forward, up), platform ``p`` (the computed attitude).
@@ -23,8 +23,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from . import earth
-from ._kernels import somigliana_s
+from replication.nav import earth
+from replication.nav._kernels import somigliana_s
 
 A = earth.A
 B = earth.B
@@ -488,8 +488,6 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
                 f1 = f1 - 0.5 * (zz * f0 - zx * f2)
                 f0 = h0
                 rotate_left_right(c, zx, zy, zz, dth[0], dth[1], dth[2], tmp)
-                ox = 2.0 * wie0 + wv[0]
-                oy = 2.0 * wie1 + wv[1]
                 oz = 2.0 * wie2 + wv[2]
                 # (ω × v) with v = (vE, vN, 0)
                 cor0 = -oz * v[1]

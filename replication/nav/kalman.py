@@ -5,9 +5,9 @@ Generic linear pieces (any state size):
 :func:`van_loan`, :func:`discretize_series`, :func:`predict`, :func:`update`,
 :func:`rts_smoother`, :func:`nees`, :func:`nis`, :func:`chi2_band`.
 
-INS/GNSS: :func:`closed_loop` runs strapdown (:mod:`replication.strapdown`) and the error-state
-filter of an :class:`replication.errors.ErrorModel` (15 states or any extension) — the one
-closed-loop filter of :mod:`replication.closedloop` — with feedback of navigation errors and
+INS/GNSS: :func:`closed_loop` runs strapdown (:mod:`replication.nav.strapdown`) and the error-state
+filter of an :class:`replication.nav.errors.ErrorModel` (15 states or any extension) — the one
+closed-loop filter of :mod:`replication.nav.closedloop` — with feedback of navigation errors and
 accumulated sensor-error estimates; :func:`monte_carlo` runs it as one batch over independent
 sensor/GNSS/initial-error realisations (run 0 leads the covariance and the gains, the other runs
 follow on threads; the result does not depend on the number of threads).
@@ -22,16 +22,22 @@ import numpy as np
 import scipy.linalg
 from scipy import stats
 
-from . import earth
-from . import _kernels as K
-from . import closedloop as CL
-from .errors import ErrorModel
-from .rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
-from .sensors import GnssMeasurements, ImuErrors, TriadErrors
-from .strapdown import NavSolution, NavState, VERTICAL_MODES, validate_increments, validate_time, vertical_damping_gains
-from .sensors import gnss_measurements
-from ._validate import choice, components, covariance, finite_array, integer, numeric, positive
-from .trajectory import Trajectory
+from replication.nav import _kernels as K
+from replication.nav import closedloop as CL
+from replication.nav import earth
+from replication.nav._validate import choice, components, covariance, finite_array, integer, numeric, positive
+from replication.nav.errors import ErrorModel
+from replication.nav.rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
+from replication.nav.sensors import GnssMeasurements, ImuErrors, gnss_measurements
+from replication.nav.strapdown import (
+    VERTICAL_MODES,
+    NavSolution,
+    NavState,
+    validate_increments,
+    validate_time,
+    vertical_damping_gains,
+)
+from replication.nav.trajectory import Trajectory
 
 __all__ = ["van_loan", "discretize_series", "predict", "update", "rts_smoother", "nees", "nis", "chi2_band",
            "ClosedLoopResult", "closed_loop", "perturb_state", "MonteCarloResult", "monte_carlo",
@@ -231,7 +237,7 @@ def true_parameter_vector(model: ErrorModel, errors: ImuErrors | None = None, **
 
 def _prepare(t, dtheta, dv, gnss, model, n):
     if not isinstance(model, ErrorModel):
-        raise TypeError("model must be an replication.errors.ErrorModel (e.g. errors.model_15(...))")
+        raise TypeError("model must be an replication.nav.errors.ErrorModel (e.g. errors.model_15(...))")
     if not isinstance(gnss, GnssMeasurements):
         raise TypeError("gnss must be a sensors.GnssMeasurements (see sensors.gnss_measurements)")
     idx = np.asarray(gnss.index, dtype=np.int64)
@@ -334,7 +340,7 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
 
 
 def _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp):
-    """The :class:`replication.closedloop.ChunkInputs` of one recorded run, chunk by chunk."""
+    """The :class:`replication.nav.closedloop.ChunkInputs` of one recorded run, chunk by chunk."""
     gpos = np.ascontiguousarray(gnss.position, dtype=float)[None]
     gvel = np.ascontiguousarray(gnss.v_enu, dtype=float)[None]
     dt = np.diff(t)
@@ -422,7 +428,7 @@ def _draw_runs(traj, model: ErrorModel, n_runs: int, seed, gnss_rate_hz, sigma_p
 
 
 def _batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref):
-    """The :class:`replication.closedloop.ChunkInputs` of a batch of runs, chunk by chunk, with the NEES truth."""
+    """The :class:`replication.nav.closedloop.ChunkInputs` of a batch of runs, chunk by chunk, with the NEES truth."""
     n_runs, n_aug = p_true.shape
     m_ep = len(idx)
     gpos = np.stack([g.position for g in gn])
@@ -454,20 +460,20 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     drawn from the blocks' ``sd`` (accel_bias, gyro_bias required), white noise from the model's
     ``accel_psd``/``gyro_psd``, GNSS noise, initial navigation errors from ``nav_sd``.
 
-    One batch of :mod:`replication.closedloop` (run 0 leads, the others follow on ``workers``
+    One batch of :mod:`replication.nav.closedloop` (run 0 leads, the others follow on ``workers``
     threads; the result does not depend on ``workers``).  Per-run generators come from
     ``SeedSequence(seed).spawn(n_runs)``.
 
     Parameters
     ----------
     traj : Trajectory
-        The true motion (:func:`replication.trajectory.generate`).
+        The true motion (:func:`replication.nav.trajectory.generate`).
     model : ErrorModel
         The filter's model; its prior draws the truth of the random constants.
     n_runs, seed : int
         Number of runs and the seed of their generators.
     gnss_rate_hz, sigma_pos, sigma_vel :
-        GNSS fixes (:func:`replication.sensors.gnss_measurements`).
+        GNSS fixes (:func:`replication.nav.sensors.gnss_measurements`).
     vertical, h_ref, vu_ref :
         Vertical channel, as in :func:`closed_loop`.
     workers : int
@@ -480,7 +486,7 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     if not isinstance(traj, Trajectory):
         raise TypeError(f"traj must be a trajectory.Trajectory (trajectory.generate), got {type(traj).__name__}")
     if not isinstance(model, ErrorModel):
-        raise TypeError("model must be an replication.errors.ErrorModel (e.g. errors.model_15(...))")
+        raise TypeError("model must be an replication.nav.errors.ErrorModel (e.g. errors.model_15(...))")
     n_runs = integer(n_runs, "n_runs")
     if seed is not None:
         integer(seed, "seed", 0, "{name} must be a non-negative integer (the SeedSequence entropy), got {value!r}")

@@ -31,23 +31,25 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 from dataclasses import dataclass, replace
 
 import control as ct
+import mpmath
 import numpy as np
 import pandas as pd
 import scipy.linalg as sla
 import sympy as sp
 from scipy.optimize import brentq
-
-from . import earth
-from ._validate import choice
-from ._validate import nonnegative as _nonnegative, numeric as _numeric, positive as _positive
-from .units import DEG, DEG_PER_H, DEG_PER_SQRT_H, HOUR, MICRO_G, UG_PER_SQRT_HZ
-import mpmath
-import re
 from scipy.signal import dlsim
-from .kalman import predict, update, van_loan
+
+from replication.nav import earth
+from replication.nav._validate import choice
+from replication.nav._validate import nonnegative as _nonnegative
+from replication.nav._validate import numeric as _numeric
+from replication.nav._validate import positive as _positive
+from replication.nav.kalman import predict, update, van_loan
+from replication.nav.units import DEG_PER_H, DEG_PER_SQRT_H, HOUR, MICRO_G, UG_PER_SQRT_HZ
 
 STATES = ("phi_E", "phi_N", "phi_U", "dV_E", "dV_N", "dL", "dlambda")
 """State names of the 7-state model, an2021 eq. (1)."""
@@ -93,7 +95,7 @@ def earth_parameters(lat, radius=None, gravity=None):
 
     an2021 eq. (1) uses one radius R and one g without giving values.  Defaults: the Gaussian
     mean radius of curvature sqrt(R_M R_N) and WGS-84 normal gravity at latitude ``lat``
-    (:mod:`replication.earth`).  Pass ``radius`` / ``gravity`` to override.
+    (:mod:`replication.nav.earth`).  Pass ``radius`` / ``gravity`` to override.
     """
     lat, _, _ = _check_motion(lat, 0.0, 0.0)
     if radius is None:
@@ -982,8 +984,8 @@ def time_domain_response(lat, v_east, v_north, noise: NoiseSettings, omegas, *, 
     sinusoidal gravity disturbance: a second computation of |G(jω)| and its phase that shares only
     Ā, B, C, H̄ of eqs. (8)-(9) with :func:`integrated_gravity_to_attitude`.
 
-    The filter runs at the position-fix rate: Φ, Q_d by Van Loan (:func:`replication.kalman.van_loan`),
-    the covariance recursion (:func:`replication.kalman.predict`/``update``) from a prior of
+    The filter runs at the position-fix rate: Φ, Q_d by Van Loan (:func:`replication.nav.kalman.van_loan`),
+    the covariance recursion (:func:`replication.nav.kalman.predict`/``update``) from a prior of
     ``P0_scale`` × the state scale for ``settle`` seconds, which gives the discrete steady-state
     gain K_d without any Riccati solver; the corrected error e_{k+1} = (I - K_d C)(Φ e_k + Γ u_k)
     is then driven by u = sin ωt in the input of ``pair`` (Γ = ∫Φ(s)ds B) and the amplitude and

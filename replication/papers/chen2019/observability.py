@@ -52,18 +52,18 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
-from . import errors as E
-from .kalman import discretize_series, update
-import scipy.linalg
-from .models import measurement_matrix
-from scipy import stats
-from . import trajectory as tr
-from . import earth
-from .rotations import body_rate_from_euler_rates, euler_to_dcm
-from .trajectory import Trajectory
 import pandas as pd
-from ._validate import choice, covariance, finite, finite_array, integer, nonnegative, numeric, positive, vector3
+import scipy.linalg
+from scipy import stats
+
+from replication.nav import earth
+from replication.nav import errors as E
+from replication.nav import trajectory as tr
+from replication.nav._validate import choice, covariance, finite, finite_array, integer, nonnegative, numeric, positive
+from replication.nav.kalman import discretize_series, update
+from replication.nav.rotations import body_rate_from_euler_rates, euler_to_dcm
+from replication.nav.trajectory import Trajectory
+from replication.papers.chen2019.models import measurement_matrix
 
 __all__ = ["observability_matrix", "stripped_observability_matrix", "total_observability_matrix", "som_condition",
            "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
@@ -331,7 +331,7 @@ def _state_index(model, states):
 
 def _trajectory(traj, name: str = "traj"):
     if not isinstance(traj, Trajectory):
-        raise TypeError(f"{name} must be a replication.trajectory.Trajectory (trajectory.generate), got "
+        raise TypeError(f"{name} must be a replication.nav.trajectory.Trajectory (trajectory.generate), got "
                         f"{type(traj).__name__}")
     return traj
 
@@ -361,7 +361,7 @@ def piecewise_systems(model, traj, spans, *, evaluate: str = "mid", lever_arm_b=
                       position_units: str = "m"):
     """The constant (F_j, H_j) of each segment ``spans`` = [(t_a, t_b), ...] of ``traj``.
 
-    F_j = ``model.F`` (chen2019 eq. (2-15)) and H_j = :func:`replication.models.measurement_matrix`
+    F_j = ``model.F`` (chen2019 eq. (2-15)) and H_j = :func:`replication.papers.chen2019.models.measurement_matrix`
     (6-dim position/velocity measurement, Table 2-2, with the lever arm of eq. (2-13)) at the
     sample nearest the segment midpoint (``evaluate="mid"``) or averaged over the samples of the
     segment (``"mean"``).  ``position_units``: ``"m"`` (rows scaled by R_M+h, (R_N+h) cos L as the
@@ -370,7 +370,7 @@ def piecewise_systems(model, traj, spans, *, evaluate: str = "mid", lever_arm_b=
     """
 
     if not isinstance(model, E.ErrorModel):
-        raise TypeError("model must be a replication.errors.ErrorModel (e.g. models.model_45())")
+        raise TypeError("model must be a replication.nav.errors.ErrorModel (e.g. models.model_45())")
     _trajectory(traj)
     choice(evaluate, ("mid", "mean"), "evaluate")
     choice(position_units, ("m", "rad"), "position_units")
@@ -416,11 +416,11 @@ def covariance_observability(model, traj, t0: float, t1: float, *, update_interv
 
     Kalman covariance recursion of ``model`` along the *true* trajectory (the error-state
     linearization point): every ``update_interval`` seconds Φ, Q_d by Van Loan
-    series (:func:`replication.kalman.discretize_series`, order ``series_order``; the products of
+    series (:func:`replication.nav.kalman.discretize_series`, order ``series_order``; the products of
     F decay through the 1/R couplings, so order 8 is exact to rounding for intervals of a few
     seconds — tests/test_observability.py compares with scipy's expm) with F and G Q Gᵀ at the
     interval midpoint, then a
-    Joseph-form update with the 6-dim measurement of :func:`replication.models.measurement_matrix`
+    Joseph-form update with the 6-dim measurement of :func:`replication.papers.chen2019.models.measurement_matrix`
     (position in metres) and noise covariance ``R`` (6×6, m² and (m/s)²).  ``P0`` defaults to
     ``model.P0()``; states with zero prior variance are reported as NaN.  ``states`` restricts
     the model as in :func:`piecewise_systems`.  Returns the ratios (and, with
@@ -428,7 +428,7 @@ def covariance_observability(model, traj, t0: float, t1: float, *, update_interv
     """
 
     if not isinstance(model, E.ErrorModel):
-        raise TypeError("model must be a replication.errors.ErrorModel (e.g. models.model_45())")
+        raise TypeError("model must be a replication.nav.errors.ErrorModel (e.g. models.model_45())")
     _trajectory(traj)
     update_interval = positive(update_interval, "update_interval",
                                "{name} must be a positive finite number of seconds, got {value!r}")
@@ -528,7 +528,7 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
     * ``figure-8`` — straight leg, a full right then a full left turn in ``figure_eight`` s (not
       in Table 4-42; the default 1600 s keeps the U-turn's mean turn rate, 0.45°/s);
     * ``S-turn`` — straight leg, S-maneuver of ``s_turn`` s (Table 4-42: 1200 s) swinging
-      ``s_swing`` rad ``s_cycles`` times (not printed; :func:`replication.trajectory.chen2019_flight`'s choice).
+      ``s_swing`` rad ``s_cycles`` times (not printed; :func:`replication.nav.trajectory.chen2019_flight`'s choice).
 
     Every scenario starts with ``straight`` s (Table 4-42's first leg: 100 s).  With ``total``
     every trajectory is continued straight (the straight scenario extended) to ``total`` s, so
@@ -811,7 +811,7 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
     Returns
     -------
     main_rows, ledger_rows : list of dict
-        Rows for :func:`replication.reproduction.compare`.  A value whose verdict differs under the
+        Rows for :func:`replication.registry.reproduction.compare`.  A value whose verdict differs under the
         main reading is ``not-reproduced`` only when it is decided (not ambiguous, not a level
         combination), the second computation agrees with the main reading, and no reading that is
         not ruled out gives the printed verdict; otherwise ``qualitative`` with the reason.  A value

@@ -2,10 +2,10 @@
 turntable attitude experiments of Tables 4-37, 4-38 and 4-39.
 
 The report mounts the SINS/GNSS system on a three-axis turntable, runs the rotation sequences
-printed in the text (:func:`replication.trajectory.turntable_chen2019`) and prints the standard
+printed in the text (:func:`replication.nav.trajectory.turntable_chen2019`) and prints the standard
 deviation of the post-processed (smoothed) attitude, position and velocity errors
 (后处理平滑 STD).  The raw data are unpublished; this module builds the analog on the batched
-closed-loop filter and RTS smoother of :mod:`replication.simulation`:
+closed-loop filter and RTS smoother of :mod:`replication.papers.chen2019.simulation`:
 
 * :func:`tested_imu_setup` — the sensor errors of the unit tested in §4.1 (Tables 4-33 and
   4-34: bias repeatability and in-run bias stability), completed with the Table 4-41 values for
@@ -33,10 +33,10 @@ from functools import lru_cache
 
 import numpy as np
 
-from . import earth
-from . import simulation as S
-from .trajectory import generate, turntable_chen2019
-from .units import DEG, DEG_PER_H, G0
+from replication.nav import earth
+from replication.nav.trajectory import generate, turntable_chen2019
+from replication.nav.units import DEG, DEG_PER_H, G0
+from replication.papers.chen2019 import simulation as S
 
 __all__ = ["QUANTITIES", "UNITS", "SITE", "tested_imu_setup", "scenario", "run_scenario", "error_std",
            "summary", "ordering_rows"]
@@ -83,14 +83,14 @@ def tested_imu_setup(t433, t434, t441, *, imu_rate_hz: float = 100.0, reference_
       first-order Gauss-Markov process with that stationary σ; its correlation time is not
       printed in §4.1 and is taken from Table 4-41 (300 s gyro, 2.5 h accelerometer);
     * white noise, scale-factor and misalignment residuals after calibration are not printed in
-      §4.1: Table 4-41's values (:func:`replication.simulation.table_4_41_setup`);
+      §4.1: Table 4-41's values (:func:`replication.papers.chen2019.simulation.table_4_41_setup`);
     * no gravity disturbance (a fixed site: a constant disturbance is part of the accelerometer
       bias), no lever arm (the IMU at the rotation centre);
     * aiding: position and zero velocity at ``reference_rate_hz`` with white errors
       ``sigma_pos`` (m, each ENU axis) and ``sigma_vel`` (m/s).
 
     ``duration`` (s) is the scenario length (used only by the 36-state model's random walk);
-    ``choices`` override other :class:`replication.simulation.SimulationSetup` fields.
+    ``choices`` override other :class:`replication.papers.chen2019.simulation.SimulationSetup` fields.
     """
     for name, v in (("imu_rate_hz", imu_rate_hz), ("reference_rate_hz", reference_rate_hz),
                     ("sigma_pos", sigma_pos), ("sigma_vel", sigma_vel), ("duration", duration)):
@@ -130,9 +130,9 @@ def scenario(experiment: int, *, imu_rate_hz: float = 100.0, dwell: float = 300.
 
 
 def run_scenario(traj, setup: S.SimulationSetup, *, n_runs: int = 12, seed: int = 0, model: str = "15"):
-    """Forward closed-loop filter plus RTS smoother (:func:`replication.simulation.run_batch`) over
+    """Forward closed-loop filter plus RTS smoother (:func:`replication.papers.chen2019.simulation.run_batch`) over
     ``n_runs`` Monte Carlo runs on ``traj``, recording every aiding epoch.  ``model`` is the
-    filter model kind of :func:`replication.simulation.filter_model` (default the 15-state model
+    filter model kind of :func:`replication.papers.chen2019.simulation.filter_model` (default the 15-state model
     of chen2019 eqs. (3-14)-(3-16); the report does not say which model the turntable test used)."""
     if not isinstance(setup, S.SimulationSetup):
         raise TypeError("setup must be a SimulationSetup (see tested_imu_setup)")

@@ -1,0 +1,2 @@
+"""an2021's transfer functions from gravity disturbance to horizontal attitude.
+"""

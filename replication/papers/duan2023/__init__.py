@@ -1,0 +1,2 @@
+"""duan2023's SINS/ADS error-correction method.
+"""

@@ -1,0 +1,2 @@
+"""fang2020's polar grid INS and its two-point calibration.
+"""

@@ -1,0 +1,104 @@
+"""The package's four parts and the one-way import rules between them (CONTRIBUTING.md, "Library").
+
+``replication.nav`` (the navigation toolkit) imports nothing else of the package; the paper methods
+``replication.papers.<key>`` import the toolkit and their own paper, never another paper;
+``replication.crosschecks`` import only the Earth model, the units and the shared checks of the
+toolkit (an error of a chapter's code path cannot repeat itself there); ``replication.registry``
+knows no physics: it imports neither the toolkit nor the methods.  The rules are read from the
+source with ``ast``, so a deferred import inside a function counts too.
+"""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PKG = Path(__file__).resolve().parents[1] / "replication"
+CROSSCHECK_ALLOWED = {"replication.nav.earth", "replication.nav.units", "replication.nav._validate"}
+
+
+def _modules():
+    for path in sorted(PKG.rglob("*.py")):
+        rel = path.relative_to(PKG.parent).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        yield ".".join(parts), path
+
+
+def _imports(name: str, path: Path) -> set[str]:
+    """Every module of the package that ``path`` imports (absolute or relative, at any depth)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names if a.name.startswith("replication")}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - node.level + 1]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            if not mod.startswith("replication"):
+                continue
+            out.add(mod)
+            out |= {f"{mod}.{a.name}" for a in node.names}     # 'from replication.nav import earth'
+    known = {n for n, _ in _modules()}
+    return {m for m in out if m in known}
+
+
+def _part(module: str) -> str:
+    parts = module.split(".")
+    if len(parts) < 2:
+        return "top"
+    if parts[1] == "papers" and len(parts) > 2 and parts[2] not in ("plots",):
+        return f"papers.{parts[2]}"
+    return ".".join(parts[:2])
+
+
+MODULES = dict(_modules())
+
+
+def test_the_four_parts_are_folders():
+    parts = {_part(m) for m in MODULES}
+    assert {"replication.nav", "replication.registry", "replication.crosschecks",
+            "papers.chen2019", "papers.fang2020", "papers.duan2023", "papers.an2021"} <= parts
+    # nothing but the package's entry points lives at the top
+    top = {m for m in MODULES if m.count(".") == 1 and _part(m) not in
+           {"replication.nav", "replication.registry", "replication.crosschecks", "replication.papers"}}
+    assert top == {"replication.__main__"}
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_imports_run_one_way(module):
+    imported = _imports(module, MODULES[module])
+    part = _part(module)
+    bad = set()
+    for m in imported:
+        target = _part(m)
+        if part == "replication.nav":
+            ok = target == "replication.nav"
+        elif part.startswith("papers."):
+            ok = target in ("replication.nav", part, "replication.papers") or m == "replication"
+        elif part == "replication.papers":          # plots and the package docstring: any method, no registry
+            ok = target.startswith("papers.") or target in ("replication.nav", "replication.papers")
+        elif part == "replication.crosschecks":
+            ok = m in CROSSCHECK_ALLOWED or m in ("replication.nav", "replication.crosschecks") or \
+                target == "replication.crosschecks"
+        elif part == "replication.registry":
+            ok = target == "replication.registry" or m == "replication"
+        else:                                       # the package itself and the CLI
+            ok = target in ("replication.registry", "top")
+        if not ok:
+            bad.add(m)
+    assert not bad, f"{module} ({part}) imports {sorted(bad)} against the one-way rules"
+
+
+def test_the_rule_test_can_fail(tmp_path):
+    """A planted import of a method into the registry is caught."""
+    p = tmp_path / "planted.py"
+    p.write_text("from replication.papers.chen2019 import models\n", encoding="utf-8")
+    assert "replication.papers.chen2019.models" in _imports("replication.registry.planted", p)
