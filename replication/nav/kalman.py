@@ -15,8 +15,10 @@ follow on threads; the result does not depend on the number of threads).
 
 from __future__ import annotations
 
+import dataclasses
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 import scipy.linalg
@@ -25,6 +27,7 @@ from scipy import stats
 from replication.nav import _kernels as K
 from replication.nav import closedloop as CL
 from replication.nav import earth
+from replication.nav import parallel as PAR
 from replication.nav._validate import choice, components, covariance, finite_array, integer, numeric, positive
 from replication.nav.errors import ErrorModel
 from replication.nav.rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
@@ -391,13 +394,14 @@ class MonteCarloResult:
         return float(np.mean((m >= lo) & (m <= hi)))
 
 
-def _draw_runs(traj, model: ErrorModel, n_runs: int, seed, gnss_rate_hz, sigma_pos, sigma_vel, workers):
+def _draw_runs(traj, model: ErrorModel, seeds, gnss_rate_hz, sigma_pos, sigma_vel, workers):
     """Every run's truth of :func:`monte_carlo`: augmented-state values, increments, GNSS and initial state.
 
-    Per run, from its own generator of ``SeedSequence(seed).spawn(n_runs)``, in this order: the
-    random constants (block by block), the gyro then the accelerometer white noise, the GNSS
-    fixes, the initial navigation errors.
+    Per run, from its own generator of ``seeds`` (the children of ``SeedSequence(seed).spawn(n_runs)``,
+    or a chunk's share of them), in this order: the random constants (block by block), the gyro
+    then the accelerometer white noise, the GNSS fixes, the initial navigation errors.
     """
+    n_runs = len(seeds)
     n = traj.n
     T = np.diff(traj.t)[:, None]
     n_aug = model.n - 9
@@ -421,7 +425,6 @@ def _draw_runs(traj, model: ErrorModel, n_runs: int, seed, gnss_rate_hz, sigma_p
         st0[r] = init.vector()
         q0[r] = dcm_to_quat(init.C_bn)
 
-    seeds = np.random.SeedSequence(seed).spawn(n_runs)
     with ThreadPoolExecutor(max_workers=max(int(workers), 1)) as ex:
         list(ex.map(draw, range(n_runs), seeds))
     return p_true, dth, dvv, gn, st0, q0
@@ -455,7 +458,7 @@ def _batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref):
 
 def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gnss_rate_hz: float = 10.0,
                 sigma_pos=(0.03, 0.03, 0.1), sigma_vel=0.03, vertical: str = "free", workers: int = 2,
-                h_ref=None, vu_ref=None) -> MonteCarloResult:
+                h_ref=None, vu_ref=None, executor=None, chunk_runs=None, progress=None) -> MonteCarloResult:
     """Monte Carlo of the closed-loop filter along ``traj``: per run, random-constant sensor errors
     drawn from the blocks' ``sd`` (accel_bias, gyro_bias required), white noise from the model's
     ``accel_psd``/``gyro_psd``, GNSS noise, initial navigation errors from ``nav_sd``.
@@ -463,6 +466,14 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     One batch of :mod:`replication.nav.closedloop` (run 0 leads, the others follow on ``workers``
     threads; the result does not depend on ``workers``).  Per-run generators come from
     ``SeedSequence(seed).spawn(n_runs)``.
+
+    With ``executor`` (any :class:`concurrent.futures.Executor`: a ``ProcessPoolExecutor``,
+    ``dask.distributed.Client(...).get_executor()``, …) or ``chunk_runs``, the runs are split into
+    chunks of ``chunk_runs`` (:func:`replication.nav.parallel.run_chunks`), each chunk one picklable
+    task.  Run 0 leads every run (its covariance and gains serve them all), so every chunk that
+    lacks it recomputes run 0 from the same stream as its lead and drops it; each run's stream is
+    ``SeedSequence(seed, spawn_key=(r,))``, the ``r``-th child of the in-process ``spawn``.  The
+    reassembled result equals the in-process one bit for bit, whatever the executor and chunking.
 
     Parameters
     ----------
@@ -477,7 +488,15 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     vertical, h_ref, vu_ref :
         Vertical channel, as in :func:`closed_loop`.
     workers : int
-        Threads for the runs that follow run 0.
+        Threads for the runs that follow run 0 (within each chunk when chunked).
+    executor : concurrent.futures.Executor or None
+        Where the chunks run; ``None`` with ``chunk_runs=None``: the one in-process batch.
+    chunk_runs : int or None
+        Runs per chunk (with ``executor=None``: chunks one after the other in this process, memory
+        bounded by one chunk); ``None`` with an executor: two chunks per worker, or four.
+    progress : bool or None
+        Progress bar of the finished runs of a chunked batch (``None``: on unless the environment
+        variable ``REPLICATION_PROGRESS`` is 0).
 
     Returns
     -------
@@ -493,14 +512,46 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     workers = integer(workers, "workers")
     choice(vertical, sorted(VERTICAL_MODES), "vertical")
     positive(gnss_rate_hz, "gnss_rate_hz", "{name} must be a positive finite rate (Hz), got {value!r}")
-    R_pos, R_vel = _gnss_noise(sigma_pos, "sigma_pos"), _gnss_noise(sigma_vel, "sigma_vel")
+    _gnss_noise(sigma_pos, "sigma_pos"), _gnss_noise(sigma_vel, "sigma_vel")
     for need in ("accel_bias", "gyro_bias"):
         model.block(need)
     n = traj.n
-    href, vuref = _reference(h_ref, "h_ref", n + 1), _reference(vu_ref, "vu_ref", n + 1)
+    _reference(h_ref, "h_ref", n + 1), _reference(vu_ref, "vu_ref", n + 1)
     if vertical != "free" and h_ref is None:
         raise ValueError(f"vertical={vertical!r} needs h_ref")
-    p_true, dth, dvv, gn, st0, q0 = _draw_runs(traj, model, n_runs, seed, gnss_rate_hz, sigma_pos, sigma_vel, workers)
+    opts = dict(gnss_rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, vertical=vertical,
+                h_ref=h_ref, vu_ref=vu_ref)
+    if executor is None and chunk_runs is None:
+        return _monte_carlo_batch(traj, model, np.random.SeedSequence(seed).spawn(n_runs), workers=workers, **opts)
+    entropy = PAR.seed_entropy(seed)
+    task = partial(_monte_carlo_chunk, traj, model, entropy, workers if executor is None else 1, opts)
+    parts = PAR.run_chunks(task, n_runs, executor=executor, chunk_runs=chunk_runs, progress=progress,
+                           desc="Monte Carlo runs")
+    return PAR.concat_runs(parts, _MC_RUN_FIELDS)
+
+
+#: The fields of :class:`MonteCarloResult` with the runs on their first axis.
+_MC_RUN_FIELDS = ("nees", "nis", "final_estimates", "true_params", "final_sigma")
+
+
+def _monte_carlo_chunk(traj, model, entropy, workers, opts, r0, r1) -> MonteCarloResult:
+    """Runs ``r0 … r1−1`` of :func:`monte_carlo` (a picklable task): led by run 0, recomputed and dropped when
+    ``r0 > 0``."""
+    runs = list(range(r0, r1)) if r0 == 0 else [0] + list(range(r0, r1))
+    res = _monte_carlo_batch(traj, model, PAR.run_seeds(entropy, runs), workers=workers, **opts)
+    if r0 == 0:
+        return res
+    return dataclasses.replace(res, **{f: getattr(res, f)[1:] for f in _MC_RUN_FIELDS})
+
+
+def _monte_carlo_batch(traj, model, seeds, *, gnss_rate_hz, sigma_pos, sigma_vel, vertical, workers,
+                       h_ref, vu_ref) -> MonteCarloResult:
+    """One batch of :func:`monte_carlo` over the runs of ``seeds`` (arguments validated), the first leading."""
+    n_runs = len(seeds)
+    R_pos, R_vel = _gnss_noise(sigma_pos, "sigma_pos"), _gnss_noise(sigma_vel, "sigma_vel")
+    n = traj.n
+    href, vuref = _reference(h_ref, "h_ref", n + 1), _reference(vu_ref, "vu_ref", n + 1)
+    p_true, dth, dvv, gn, st0, q0 = _draw_runs(traj, model, seeds, gnss_rate_hz, sigma_pos, sigma_vel, workers)
     g0 = gn[0]
     idx = np.asarray(g0.index, np.int64)
     gains = vertical_damping_gains(100.0, traj.lat[0], traj.h[0]) if vertical == "damped" else np.zeros(3)
