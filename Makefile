@@ -11,6 +11,8 @@ export OMP_NUM_THREADS := 1
 export MKL_NUM_THREADS := 1
 export MPLBACKEND := module://matplotlib_inline.backend_inline
 export REPLICATION_ROOT := $(CURDIR)
+# no progress bars (replication.nav.parallel) in stored notebook outputs, nbval runs, tests and benchmarks
+export REPLICATION_PROGRESS := 0
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 # bytecode is compiled on first import and kept in .venv (and replication/__pycache__, beside numba's
 # cache): a PYTHONDONTWRITEBYTECODE inherited from the shell would make every notebook kernel and
@@ -135,6 +137,7 @@ bench: env
 	$(PY) scripts/benchmark_polar.py
 	$(PY) scripts/benchmark_chen2019_simulation.py
 	$(PY) scripts/benchmark_closed_loop.py $(if $(BENCH_BEFORE),--before $(BENCH_BEFORE))
+	$(PY) scripts/benchmark_parallel.py
 
 clean:
 	rm -rf book/_build .pytest_cache

@@ -175,6 +175,8 @@ def main(argv: list[str] | None = None) -> int:
     paths = [p.resolve() for p in args.notebooks] or book_notebooks()
     os.environ["MPLBACKEND"] = "module://matplotlib_inline.backend_inline"
     os.environ["PYTHONHASHSEED"] = "0"
+    # no progress bars in stored outputs (replication.nav.parallel): the kernels inherit this
+    os.environ["REPLICATION_PROGRESS"] = "0"
     for p in paths:
         if not p.exists():
             print(f"no such notebook: {p}", file=sys.stderr)
