@@ -1,6 +1,7 @@
 """Monte Carlo batches on executors (replication.nav.parallel): a Dask LocalCluster of two worker
 processes, a ProcessPoolExecutor and in-process chunks each give the one-batch result bit for bit,
-also when a worker process dies in the middle of the batch."""
+also when a worker process dies in the middle of the batch (kalman.monte_carlo and chen2019's
+simulation.run_batch with its smoother), and the per-setting sweeps of fang2020 and duan2023."""
 
 import os
 import signal
@@ -9,6 +10,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+import pandas as pd
 import pytest
 from dask.distributed import Client, LocalCluster
 
@@ -16,7 +18,10 @@ from replication.nav import errors as er
 from replication.nav import kalman as kf
 from replication.nav import parallel as par
 from replication.nav import trajectory as tr
-from replication.nav.units import DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
+from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
+from replication.papers.chen2019 import simulation as sim
+from replication.papers.duan2023 import airdata as ad
+from replication.papers.fang2020 import polar
 
 FIELDS = ("t_epoch", "nees", "nis", "final_estimates", "true_params", "final_sigma", "P_diag_run0")
 N_RUNS, SEED = 7, 20260
@@ -115,3 +120,59 @@ def test_bad_executor_and_chunking(case):
         kf.monte_carlo(traj, model, n_runs=2, executor="dask")
     with pytest.raises(ValueError, match="chunk_runs"):
         kf.monte_carlo(traj, model, n_runs=2, chunk_runs=0)
+
+
+@pytest.fixture(scope="module")
+def chen_case():
+    traj = tr.generate([tr.Straight(10.0), tr.Turn(20.0, np.pi / 2), tr.Straight(10.0)],
+                       47 * DEG, 115 * DEG, 6000.0, heading=45 * DEG, speed=100.0, dt=0.01)
+    setup = sim.SimulationSetup(
+        imu_rate_hz=100.0, gnss_rate_hz=10.0, gyro_bias_sd=0.05 * DEG_PER_H, gyro_markov_sigma=0.02 * DEG_PER_H,
+        gyro_markov_tau=300.0, gyro_white_psd=(0.02 * DEG_PER_H) ** 2, accel_bias_sd=100 * MICRO_G,
+        accel_markov_sigma=0.0, accel_markov_tau=3600.0, accel_white_psd=(30 * MICRO_G) ** 2,
+        scale_sd=2e-5, misalignment_sd=0.0, sigma_pos=(0.05, 0.05, 0.1), sigma_vel=0.02,
+        position_sd=(0.05, 0.05, 0.1), velocity_sd=0.02, attitude_sd=(30 * ARCSEC, 30 * ARCSEC, 10 * ARCMIN),
+        gravity_sigma=0.0, lever_arm_b=(0.2, 0.5, 1.0), lever_arm_sd=0.05, flight_duration=40.0)
+    model = sim.filter_model("36", setup, traj.lat[0], traj.h[0])
+    kw = dict(n_runs=5, seed=9, first_run=2, record_every=10, chunk_epochs=150, smoother=True)
+    return traj, setup, model, kw, sim.run_batch(traj, setup, model, **kw)
+
+
+def assert_same_batch(a, b):
+    for f in ("t", "nav_err", "p_hat", "p_true", "P", "nis", "P_diag_all", "ds", "P_s"):
+        x, y = getattr(a, f), getattr(b, f)
+        assert x.shape == y.shape, f
+        assert np.array_equal(x, y), f"{f} differs from the in-process batch"
+    assert a.const.keys() == b.const.keys()
+    for k in a.const:
+        assert np.array_equal(a.const[k], b.const[k]), k
+
+
+def test_chen2019_batch_on_dask_and_process_pool(chen_case, cluster):
+    traj, setup, model, kw, ref = chen_case
+    _, client = cluster
+    assert_same_batch(sim.run_batch(traj, setup, model, executor=client.get_executor(), chunk_runs=2, **kw), ref)
+    with ProcessPoolExecutor(2) as ex:
+        assert_same_batch(sim.run_batch(traj, setup, model, executor=ex, chunk_runs=3, **kw), ref)
+    assert_same_batch(sim.run_batch(traj, setup, model, chunk_runs=1, **kw), ref)
+
+
+def test_fang2020_sensitivity_on_dask_equals_in_process(cluster):
+    _, client = cluster
+    base = dict(polar.FANG2020_READING, fix_times=(600.0, 1200.0))
+    variants = {"nominal": base, "no accel bias": dict(base, accel_bias=(0.0, 0.0, 0.0)),
+                "Euler-heading observation": dict(base, heading_observation="euler")}
+    ref = polar.sensitivity(1, variants, n_runs=2)
+    got = polar.sensitivity(1, variants, n_runs=2, executor=client.get_executor(), chunk_runs=1)
+    pd.testing.assert_frame_equal(got, ref, check_exact=True)
+
+
+def test_duan2023_sweep_on_process_pool_equals_in_process():
+    traj = tr.generate([tr.Straight(60.0), tr.Climb(60.0, height_change=300.0)], 45 * DEG, 110 * DEG, 1000.0,
+                       dt=0.1, heading=0.3, speed=180.0)
+    setup = ad.AirdataSetup(correction_interval=30.0, threshold=1.0)
+    changes = [dict(threshold=1.2 / 30.0), dict(gate="height-only"), dict(sigma_height=0.0)]
+    ref = ad.sweep(traj, setup, changes, n_runs=1, seed=3)
+    with ProcessPoolExecutor(2) as ex:
+        got = ad.sweep(traj, setup, changes, n_runs=1, seed=3, executor=ex, chunk_runs=2)
+    pd.testing.assert_frame_equal(got, ref, check_exact=True)

@@ -28,7 +28,7 @@ import numpy as np
 
 from replication.nav._validate import integer
 
-__all__ = ["chunk_bounds", "concat_runs", "progress_enabled", "run_chunks", "run_seeds", "seed_entropy"]
+__all__ = ["chunk_bounds", "concat_runs", "default_chunk_runs", "progress_enabled", "run_chunks", "run_seeds", "seed_entropy"]
 
 _OFF = {"0", "false", "no", "off"}
 

@@ -49,8 +49,8 @@ epochs; the test suite checks it against the RTS form.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from functools import lru_cache
+from dataclasses import dataclass, field, replace
+from functools import lru_cache, partial
 
 import numpy as np
 import pandas as pd
@@ -59,6 +59,7 @@ from scipy import stats
 from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import errors as E
+from replication.nav import parallel as PAR
 from replication.nav._validate import choice
 from replication.nav.rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from replication.nav.sensors import gauss_markov_coefficients, gauss_markov_recursion, lever_arm_offset, misalignment_matrix
@@ -322,9 +323,12 @@ class _Truth:
     on the chunk length)."""
 
     def __init__(self, setup: SimulationSetup, traj, n_runs: int, seed: int, nav_sd, first_run: int = 0,
-                 fixed_constants: bool = False):
+                 fixed_constants: bool = False, run_ids=None):
         s = setup
-        self.setup, self.traj, self.R, self.seed, self.r0 = s, traj, n_runs, int(seed), int(first_run)
+        self.setup, self.traj, self.R, self.seed = s, traj, n_runs, int(seed)
+        # the run numbers of the batch's rows: first_run … first_run + n_runs − 1, or a chunk's own list
+        self.ids = (np.arange(int(first_run), int(first_run) + n_runs) if run_ids is None
+                    else np.asarray(run_ids, np.int64))
         R = n_runs
         self.const = {k: np.empty((R, n)) for k, n in (("gyro_bias", 3), ("accel_bias", 3), ("gyro_scale", 3),
                                                        ("accel_scale", 3), ("gyro_misalignment", 6),
@@ -332,7 +336,7 @@ class _Truth:
                                                        ("nav0", 9))}
         self.x0 = {k: np.empty((R, 3)) for k in ("gyro_markov", "accel_markov", "gravity")}
         for r in range(R):
-            g = np.random.default_rng([self.seed, self.r0 + r, 0])
+            g = np.random.default_rng([self.seed, int(self.ids[r]), 0])
             self.const["gyro_bias"][r] = s.gyro_bias_sd * g.standard_normal(3)
             self.const["accel_bias"][r] = s.accel_bias_sd * g.standard_normal(3)
             self.const["gyro_scale"][r] = s.scale_sd * g.standard_normal(3)
@@ -394,7 +398,7 @@ class _Truth:
         taus = {"gyro_markov": s.gyro_markov_tau, "accel_markov": s.accel_markov_tau, "gravity": s.gravity_tau}
         sigmas = {"gyro_markov": s.gyro_markov_sigma, "accel_markov": s.accel_markov_sigma, "gravity": s.gravity_sigma}
         for r in range(R):
-            g = np.random.default_rng([self.seed, self.r0 + r, c + 1])
+            g = np.random.default_rng([self.seed, int(self.ids[r]), c + 1])
             paths = {}
             for name in ("gyro_markov", "accel_markov", "gravity"):
                 a, q = gauss_markov_coefficients(Tm, taus[name])
@@ -526,7 +530,7 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
               chunk_epochs: int = 1000, record_every: int = 20, smoother: bool = False,
               smoother_covariance: bool = True, prior_covariance: bool = False, first_run: int = 0,
               fixed_constants: bool = False, series_order: int = 4, workers: int = 2,
-              smoother_form: str = "mbf") -> BatchResult:
+              smoother_form: str = "mbf", executor=None, chunk_runs=None, progress=None) -> BatchResult:
     """Monte Carlo of the closed-loop INS/GNSS filter of ``model`` on ``traj`` with the truth of
     ``setup`` (chen2019 eq. (2-10) sensor errors, eq. (2-12) gravity disturbance, eq. (2-13)
     lever arm, Table 4-41 noise), batched across ``n_runs`` runs (see the module docstring).
@@ -545,6 +549,14 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
     its printed value (+σ on every axis) instead of drawing it — the reading of Table 4-41 under
     which the ranges stated for Fig. 4-14 make sense; the NEES Monte Carlo draws them.
     Deterministic for a given ``seed``.
+
+    ``executor`` (any :class:`concurrent.futures.Executor`, e.g. a ``ProcessPoolExecutor`` or
+    ``dask.distributed.Client(...).get_executor()``) or ``chunk_runs``: the runs are split into chunks
+    of ``chunk_runs`` (:func:`replication.nav.parallel.run_chunks`), each one picklable task on one
+    thread.  Every run follows the covariance and gains of the lead (run ``first_run``), so a chunk
+    without it recomputes the lead from its own (``seed``, run) streams and drops it; the
+    reassembled result equals the one batch bit for bit.  ``progress``: progress bar of the
+    finished runs of a chunked batch (``None``: on unless ``REPLICATION_PROGRESS=0``).
     """
     if not isinstance(model, E.ErrorModel):
         raise TypeError("model must be a replication.nav.errors.ErrorModel (see filter_model)")
@@ -562,8 +574,44 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
         raise ValueError("the trajectory is shorter than two GNSS epochs")
     if int(first_run) < 0:
         raise ValueError("first_run must be non-negative")
-    truth = _Truth(setup, traj, n_runs, seed, model.nav_sd, first_run=int(first_run),
-                   fixed_constants=bool(fixed_constants))
+    opts = dict(seed=seed, chunk_epochs=chunk_epochs, record_every=record_every, smoother=smoother,
+                smoother_covariance=smoother_covariance, prior_covariance=prior_covariance,
+                fixed_constants=fixed_constants, series_order=series_order, smoother_form=smoother_form)
+    if executor is None and chunk_runs is None:
+        return _run_rows(traj, setup, model, np.arange(int(first_run), int(first_run) + n_runs), workers=workers,
+                         **opts)
+    task = partial(_run_batch_chunk, traj, setup, model, int(first_run), workers if executor is None else 1, opts)
+    parts = PAR.run_chunks(task, n_runs, executor=executor, chunk_runs=chunk_runs, progress=progress,
+                           desc="chen2019 runs")
+    out = PAR.concat_runs(parts, [f for f in _BATCH_RUN_FIELDS if getattr(parts[0], f) is not None])
+    out.const = {k: np.concatenate([p.const[k] for p in parts]) for k in parts[0].const}
+    return out
+
+
+#: The fields of :class:`BatchResult` with the runs on their first axis (``const`` is a dict of them).
+_BATCH_RUN_FIELDS = ("nav_err", "p_hat", "p_true", "nis", "ds")
+
+
+def _run_batch_chunk(traj, setup, model, first_run, workers, opts, r0, r1) -> BatchResult:
+    """Runs ``first_run + r0 … first_run + r1 − 1`` of :func:`run_batch` (a picklable task), led by run
+    ``first_run``: recomputed and dropped when ``r0 > 0``."""
+    ids = np.arange(first_run + r0, first_run + r1)
+    if r0 == 0:
+        return _run_rows(traj, setup, model, ids, workers=workers, **opts)
+    res = _run_rows(traj, setup, model, np.concatenate([[first_run], ids]), workers=workers, **opts)
+    drop = {f: getattr(res, f)[1:] for f in _BATCH_RUN_FIELDS if getattr(res, f) is not None}
+    return replace(res, const={k: v[1:] for k, v in res.const.items()}, **drop)
+
+
+def _run_rows(traj, setup, model, run_ids, *, seed, chunk_epochs, record_every, smoother, smoother_covariance,
+              prior_covariance, fixed_constants, series_order, workers, smoother_form) -> BatchResult:
+    """One batch of :func:`run_batch` over the runs numbered ``run_ids`` (arguments validated), the first leading."""
+    n_runs = len(run_ids)
+    step = setup.gnss_step
+    N = traj.n
+    ep_samples = np.arange(step, N + 1, step)
+    n_ep = len(ep_samples)
+    truth = _Truth(setup, traj, n_runs, seed, model.nav_sd, run_ids=run_ids, fixed_constants=bool(fixed_constants))
     n = model.n
     n_aug = n - 9
     lever0 = np.asarray(setup.lever_arm_b, float)

@@ -41,7 +41,7 @@ Units: SI and radians; displacements in metres, velocities in m/s.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import lru_cache
+from functools import lru_cache, partial
 
 import numpy as np
 import pandas as pd
@@ -49,6 +49,7 @@ from scipy import stats
 from scipy.integrate import solve_ivp
 
 from replication.nav import earth
+from replication.nav import parallel as PAR
 from replication.nav import trajectory as tr
 from replication.nav._validate import choice
 from replication.nav.errors import NavPoint, StateBlock, model_15
@@ -1470,15 +1471,31 @@ def claim_checks(mc: MonteCarlo):
     return out
 
 
-def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7):
+def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7, executor=None, chunk_runs=None,
+          progress=None):
     """Sensitivity of the proposed method: one Monte Carlo per dict of ``changes`` to ``setup``.
 
     Returns a DataFrame with the changed values and the run-mean of the flight maxima and the
     final values (misalignment °, velocity m/s, position km) and the gated corrections per run.
-    """
 
+    Each setting is its own Monte Carlo with the same ``seed``, so with ``executor`` (any
+    :class:`concurrent.futures.Executor`) or ``chunk_runs`` the settings are computed in chunks of
+    ``chunk_runs`` settings, one picklable task each (:func:`replication.nav.parallel.run_chunks`),
+    the rows in the order of ``changes``, equal to the in-process ones bit for bit; ``progress``:
+    progress bar of the finished settings (``None``: on unless ``REPLICATION_PROGRESS=0``).
+    """
+    changes = list(changes)
+    if executor is None and chunk_runs is None:
+        return pd.DataFrame(_sweep_rows(traj, setup, changes, n_runs, seed, 0, len(changes)))
+    parts = PAR.run_chunks(partial(_sweep_rows, traj, setup, changes, n_runs, seed), len(changes),
+                           executor=executor, chunk_runs=chunk_runs, progress=progress, desc="duan2023 settings")
+    return pd.DataFrame([row for part in parts for row in part])
+
+
+def _sweep_rows(traj, setup, changes, n_runs, seed, i0, i1) -> list:
+    """The rows of :func:`sweep` for the settings ``changes[i0:i1]`` (a picklable task)."""
     rows = []
-    for ch in changes:
+    for ch in changes[i0:i1]:
         s2 = AirdataSetup(**{**setup.__dict__, **ch})
         mc = simulate(traj, s2, n_runs=n_runs, seed=seed, systems=("proposed SINS/ADS",))
         mx = mc.summary("max").query("system == 'proposed SINS/ADS'")
@@ -1488,7 +1505,7 @@ def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7)
                      "max position error (km)": mx["position error"].mean(),
                      "final position error (km)": fi["position error"].mean(),
                      "gated per run": float(np.mean([sum(i["gated"] for i in r) for r in mc.infos]))})
-    return pd.DataFrame(rows)
+    return rows
 
 
 

@@ -27,11 +27,13 @@ the true rate (strapdown convention); fang2020's ψ equation (18)-(24) is writte
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import partial
 
 import numpy as np
 import pandas as pd
 
 from replication.nav import earth, rotations, units
+from replication.nav import parallel as PAR
 from replication.nav._validate import choice, positive, vector3
 from replication.papers.fang2020 import _polar_kernels as _k
 
@@ -902,13 +904,29 @@ def p_equation_check(lats, lons, radius):
     return pd.DataFrame(rows)
 
 
-def sensitivity(case, variants, *, n_runs=4, seed=None):
+def sensitivity(case, variants, *, n_runs=4, seed=None, executor=None, chunk_runs=None, progress=None):
     """Drift-estimate summaries (°/h) of short runs (to the second fix) for scenario ``variants``
     (name → dict of scenario overrides, plus optionally ``heading_observation``); one row per
-    variant and estimator."""
+    variant and estimator.
 
+    Each variant is its own Monte Carlo with its own seed, so with ``executor`` (any
+    :class:`concurrent.futures.Executor`) or ``chunk_runs`` the variants are computed in chunks of
+    ``chunk_runs`` variants, one picklable task each (:func:`replication.nav.parallel.run_chunks`),
+    and the rows come back in the variants' order, equal to the in-process ones bit for bit;
+    ``progress``: progress bar of the finished variants (``None``: on unless ``REPLICATION_PROGRESS=0``).
+    """
+    items = list(variants.items())
+    if executor is None and chunk_runs is None:
+        return pd.DataFrame(_sensitivity_rows(case, items, n_runs, seed, 0, len(items)))
+    parts = PAR.run_chunks(partial(_sensitivity_rows, case, items, n_runs, seed), len(items), executor=executor,
+                           chunk_runs=chunk_runs, progress=progress, desc="fang2020 variants")
+    return pd.DataFrame([row for part in parts for row in part])
+
+
+def _sensitivity_rows(case, items, n_runs, seed, i0, i1) -> list:
+    """The rows of :func:`sensitivity` for the variants ``items[i0:i1]`` (a picklable task)."""
     rows = []
-    for name, changes in variants.items():
+    for name, changes in items[i0:i1]:
         changes = dict(changes)
         heading_observation = changes.pop("heading_observation", "misalignment")
         sc = fang2020_scenario(case, **changes)
@@ -920,7 +938,7 @@ def sensitivity(case, variants, *, n_runs=4, seed=None):
             s = drift_summary(res, est)
             rows.append({"variant": name, "estimator": est, "runs": n_runs,
                          **{f"{a} mean": s[a][0] for a in "XYZ"}, **{f"{a} std": s[a][1] for a in "XYZ"}})
-    return pd.DataFrame(rows)
+    return rows
 
 
 READINGS = {
@@ -936,12 +954,13 @@ shared by the 20 runs; zero phases, for which every rocking angle vanishes at bo
 draw that leaves the ship level at the fixes)."""
 
 
-def readings_ledger(case, *, n_runs=8, shared_draws=3, seed=None):
+def readings_ledger(case, *, n_runs=8, shared_draws=3, seed=None, executor=None, chunk_runs=None, progress=None):
     """Drift-estimate summaries of every reading of :data:`READINGS`, of ``shared_draws`` random
     rocking-phase sets shared by all runs (damped position) and of the three other sign patterns
     of the horizontal accelerometer biases (not printed) under :data:`FANG2020_READING`, for both
     estimators: short runs to the second fix (:func:`sensitivity`).  Columns as
-    :func:`sensitivity`, with ``reading`` for ``variant``."""
+    :func:`sensitivity`, with ``reading`` for ``variant``; ``executor``, ``chunk_runs``, ``progress``
+    as there (the readings in chunks, the same rows bit for bit)."""
     if not isinstance(shared_draws, (int, np.integer)) or shared_draws < 0:
         raise ValueError("shared_draws must be a non-negative integer")
     variants = dict(READINGS)
@@ -953,4 +972,5 @@ def readings_ledger(case, *, n_runs=8, shared_draws=3, seed=None):
     g = 1e-4 * units.G0
     for signs, bias in (("+,-,+", (g, -g, g)), ("-,+,+", (-g, g, g)), ("-,-,+", (-g, -g, g))):
         variants[f"as the first, accelerometer biases ({signs})"] = dict(**FANG2020_READING, accel_bias=bias)
-    return sensitivity(case, variants, n_runs=n_runs, seed=seed).rename(columns={"variant": "reading"})
+    return sensitivity(case, variants, n_runs=n_runs, seed=seed, executor=executor, chunk_runs=chunk_runs,
+                       progress=progress).rename(columns={"variant": "reading"})
