@@ -176,3 +176,19 @@ def test_duan2023_sweep_on_process_pool_equals_in_process():
     with ProcessPoolExecutor(2) as ex:
         got = ad.sweep(traj, setup, changes, n_runs=1, seed=3, executor=ex, chunk_runs=2)
     pd.testing.assert_frame_equal(got, ref, check_exact=True)
+
+
+def _squares(r0, r1):
+    return np.arange(r0, r1) ** 2
+
+
+def test_progress_bar_on_request_and_off_by_environment(capsys, monkeypatch):
+    """A bar on stderr with progress=True; none with REPLICATION_PROGRESS=0 (set for the tests) or progress=False."""
+    parts = par.run_chunks(_squares, 5, chunk_runs=2, progress=True, desc="squares")
+    assert np.array_equal(np.concatenate(parts), np.arange(5) ** 2)
+    assert "squares" in capsys.readouterr().err
+    assert not par.progress_enabled() and not par.progress_enabled(False)
+    par.run_chunks(_squares, 5, chunk_runs=2)
+    assert capsys.readouterr().err == ""
+    monkeypatch.setenv("REPLICATION_PROGRESS", "1")
+    assert par.progress_enabled()
