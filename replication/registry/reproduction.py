@@ -989,12 +989,17 @@ DATAPACKAGE = "datapackage.json"
 """The Frictionless data-package descriptor of ``tables/`` (written by :func:`build_index`)."""
 
 
-def _field_type(name: str, values: pd.Series) -> str:
-    if name in NUMERIC_COLUMNS:
+def _field_type(name: str, values: pd.Series, comparison: bool = True) -> str:
+    """The Frictionless type of a column: a comparison table's numeric columns are ``number``; any
+    other column (and every column of the status and register files) is ``integer`` when every cell
+    is one, ``number`` when every cell parses as a number, else ``string``."""
+    if comparison and name in NUMERIC_COLUMNS:
         return "number"
     v = values[values != ""]
     if len(v) and v.str.fullmatch(r"-?\d+").all():
         return "integer"
+    if not comparison and len(v) and pd.to_numeric(v, errors="coerce").notna().all():
+        return "number"
     return "string"
 
 
@@ -1013,7 +1018,7 @@ def datapackage() -> dict:
                "title": meta.get("title", {"status": "Reproduction status of every artifact",
                                            "register": "Register of errata and inconsistencies"}.get(path.stem,
                                                                                                        path.stem)),
-               "schema": {"fields": [dict({"name": c, "type": _field_type(c, df[c])},
+               "schema": {"fields": [dict({"name": c, "type": _field_type(c, df[c], comparison=bool(meta))},
                                           **({"description": FIELD_DESCRIPTIONS[c]} if c in FIELD_DESCRIPTIONS else {}))
                                      for c in df.columns],
                           "missingValues": [""]}}
