@@ -1626,9 +1626,6 @@ _ERRATA = {
                                  "test_erratum_eq6_half_and_eq12_cos", "S_y/(S^2+h^2)"),
     "eq. (6) phi_N^c per dh^c": ("factor 1/2 too many (as for phi_E^c)", "test_erratum_eq6_half_and_eq12_cos",
                                  "-S_x/(S^2+h^2)"),
-    "eq. (12) dV_U^c per phi^c": ("turning V by phi^c changes its up component by phi^c V cos(theta_2); eq. (13) contains "
-                                  "the cos(theta_2) = S/sqrt(S^2+h^2) that eq. (12) omits (relative O(h^2/S^2))",
-                                  "test_erratum_eq6_half_and_eq12_cos", "phi^c V S/sqrt(S^2+h^2)"),
     "text below (19) dL-dot^c per dV_N^c": ("metric factors exchanged: the latitude rate is dV_N/R_Mh",
                                             "test_reading_b_is_the_economical_one", "1/R_Mh"),
     "text below (19) dlambda-dot^c per dV_E^c": ("metric factors exchanged: the longitude rate is dV_E/(R_Nh cos L)",
@@ -1649,18 +1646,23 @@ _INCONSISTENT = {
     "eq. (16) dS_y^c per dS^c": "sin(beta) for the north component: beta from east, as for dS_x^c; eq. (21) reads it from north",
     "eq. (19) dS_x^c per dh^c": "cos(beta) for the east component (beta from east, as eq. (16)); eq. (21) reads it from north",
     "eq. (19) dS_y^c per dh^c": "sin(beta) for the north component (beta from east, as eq. (16)); eq. (21) reads it from north",
+    "eq. (12) dV_U^c per phi^c": "eq. (12) writes phi^c V where turning V by phi^c changes its up component by phi^c V "
+                                 "cos(theta_2), and eq. (13) keeps that cos(theta_2) = S/sqrt(S^2+h^2): at the paper's first "
+                                 "order in h/S (the level of eq. (4)) both hold; the two printed parts differ at relative "
+                                 "O(h^2/S^2)",
 }
 
 
-#: Remarks on printed elements that are reproduced but carry a stated approximation (the note of the
-#: reproduced row), as functions of the reference state (:func:`reference_state`).
+#: Printed elements that match the re-derivation but disagree with another printed part at the
+#: paper's approximation level (status ``inconsistent``), as functions of the reference state
+#: (:func:`reference_state`).
 _REMARKS = {
     "eq. (4) phi^c per dh^c": lambda st: (
-        "reproduced as printed: the first-order expansion of tan(theta_1 - theta_2) with S^c = S; assumption 1 "
-        "(SINS/ADS and SINS displacements of equal length) gives dh^c/S instead: the two differ by "
+        "reproduced as printed (the first-order expansion of tan(theta_1 - theta_2) with S^c = S), but assumption 1 and "
+        "eq. (18) (SINS/ADS and SINS displacements of equal length) give dh^c/S instead: two printed parts differ by "
         "cos^2(theta_2) = S^2/(S^2+h^2), a relative O(h^2/S^2) "
         f"({st['h'] ** 2 / (st['Sx'] ** 2 + st['Sy'] ** 2):.1e} at this state, below 1e-2 for flight-path angles "
-        "under 6 deg): a tension between eq. (4) and assumption 1 within the paper's first order, not an error"),
+        "under 6 deg), within the paper's first order: neither is a misprint"),
 }
 
 
@@ -1681,7 +1683,7 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
         elif not r["match"] and r["quantity"] in _INCONSISTENT:
             row.update(status="inconsistent", note=_INCONSISTENT[r["quantity"]])
         elif r["match"] and r["quantity"] in _REMARKS:
-            row.update(note=_REMARKS[r["quantity"]](reference_state(state)))
+            row.update(status="inconsistent", note=_REMARKS[r["quantity"]](reference_state(state)))
         rows.append(row)
     m = manifold_residuals(paper, reading, states=(state,), conventions=("C1",))
     notes = {"14": "right only if dh^c is held constant over the interval and the flight is level; with "
