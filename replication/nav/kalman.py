@@ -467,7 +467,7 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     threads; the result does not depend on ``workers``).  Per-run generators come from
     ``SeedSequence(seed).spawn(n_runs)``.
 
-    With ``executor`` (any :class:`concurrent.futures.Executor`: a ``ProcessPoolExecutor``,
+    With ``executor`` (any ``concurrent.futures.Executor``: a ``ProcessPoolExecutor``,
     ``dask.distributed.Client(...).get_executor()``, …) or ``chunk_runs``, the runs are split into
     chunks of ``chunk_runs`` (:func:`replication.nav.parallel.run_chunks`), each chunk one picklable
     task.  Run 0 leads every run (its covariance and gains serve them all), so every chunk that

@@ -1,12 +1,12 @@
-"""Batches of independent runs split into chunks on any :class:`concurrent.futures.Executor`.
+"""Batches of independent runs split into chunks on any ``concurrent.futures.Executor``.
 
 One place for the chunking, submission and reassembly that the batch entry points share
 (:func:`replication.nav.kalman.monte_carlo` first).  An entry point describes one chunk as a
 picklable callable ``task(r0, r1)`` (a module-level function bound with
-:func:`functools.partial`) that computes the runs ``r0 … r1−1`` and returns their results with the
+``functools.partial``) that computes the runs ``r0 … r1−1`` and returns their results with the
 runs on the first axis; :func:`run_chunks` submits the chunks, waits for them in any order, and
 returns their results in run order, which :func:`concat_runs` joins.  Whatever the executor — a
-:class:`~concurrent.futures.ProcessPoolExecutor`, ``dask.distributed.Client(...).get_executor()``
+``concurrent.futures.ProcessPoolExecutor``, ``dask.distributed.Client(...).get_executor()``
 or none — and whatever the chunking, the joined result equals the one-batch result bit for bit as
 long as each run draws its numbers from its own stream, ``SeedSequence(entropy, spawn_key=(r,))``
 (:func:`run_seeds`, the same children as ``SeedSequence(entropy).spawn(n)``), and each chunk

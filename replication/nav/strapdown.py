@@ -56,7 +56,7 @@ class NavState:
         """Check every field (also after a field was changed): latitude within ±90° and outside the polar
         singularity, finite longitude, height within :data:`replication.nav.earth.HEIGHT_RANGE`, finite
         velocity below :data:`replication.nav.earth.SPEED_LIMIT`, C_bn a rotation matrix
-        (:data:`replication.nav._validate.ORTHONORMAL_TOL`).  Raises ``TypeError``/``ValueError`` naming the
+        (``_validate.ORTHONORMAL_TOL``).  Raises ``TypeError``/``ValueError`` naming the
         field; the compiled mechanization checks nothing."""
         earth.check_latitude(self.lat, polar_limit_deg=polar_limit_deg, name=f"{name}.lat")
         earth.check_longitude(self.lon, name=f"{name}.lon")

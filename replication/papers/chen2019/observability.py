@@ -755,7 +755,7 @@ def verdict_under(printed_value: float, degree: float, rank_tol: float, ambiguit
     ``degree > rank_tol``; *decided* is False when the two differ but the state lies almost equally
     in two singular subspaces (``ambiguity > AMBIGUOUS``): the assignment rule, not the model,
     decides such a value, which therefore neither agrees nor disagrees with the print.  *reproduced*
-    uses a margin: a degree within :data:`ROUND_OFF_MARGIN` of the rank tolerance is round-off —
+    uses a margin: a degree within ``ROUND_OFF_MARGIN`` of the rank tolerance is round-off —
     singular values of numerically zero directions reach just above ``rank_tol`` (a state whose
     columns of F and H are identically zero has been seen at 1.01 ``rank_tol``) — and counts as
     unobservable, so that no verdict hangs on the last bits of an SVD.

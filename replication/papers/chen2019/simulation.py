@@ -550,7 +550,7 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
     which the ranges stated for Fig. 4-14 make sense; the NEES Monte Carlo draws them.
     Deterministic for a given ``seed``.
 
-    ``executor`` (any :class:`concurrent.futures.Executor`, e.g. a ``ProcessPoolExecutor`` or
+    ``executor`` (any ``concurrent.futures.Executor``, e.g. a ``ProcessPoolExecutor`` or
     ``dask.distributed.Client(...).get_executor()``) or ``chunk_runs``: the runs are split into chunks
     of ``chunk_runs`` (:func:`replication.nav.parallel.run_chunks`), each one picklable task on one
     thread.  Every run follows the covariance and gains of the lead (run ``first_run``), so a chunk

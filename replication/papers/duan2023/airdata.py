@@ -1479,7 +1479,7 @@ def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7,
     final values (misalignment °, velocity m/s, position km) and the gated corrections per run.
 
     Each setting is its own Monte Carlo with the same ``seed``, so with ``executor`` (any
-    :class:`concurrent.futures.Executor`) or ``chunk_runs`` the settings are computed in chunks of
+    ``concurrent.futures.Executor``) or ``chunk_runs`` the settings are computed in chunks of
     ``chunk_runs`` settings, one picklable task each (:func:`replication.nav.parallel.run_chunks`),
     the rows in the order of ``changes``, equal to the in-process ones bit for bit; ``progress``:
     progress bar of the finished settings (``None``: on unless ``REPLICATION_PROGRESS=0``).
@@ -1561,7 +1561,7 @@ def readings_ledger_rows(readings, table1, system="proposed SINS/ADS", *, runs=N
 BIAS_DIAGNOSTICS = {"no up accelerometer bias": {"accel_bias_axes": (1.0, 1.0, 0.0)},
                     "no accelerometer bias (three axes)": {"accel_bias": 0.0}}
 """Diagnostics of the proposed method (not readings of duan2023 §3, which prints a 100-μg bias on
-every axis): the changes to :class:`AirdataSetup` that remove the up (body z) constant bias only,
+every axis): the changes to ``AirdataSetup`` that remove the up (body z) constant bias only,
 and the constant bias of all three axes."""
 
 
@@ -1569,9 +1569,9 @@ def diagnostic_runs(traj, setup: AirdataSetup, diagnostics=None, *, n_runs: int 
                     seed: int = 2023) -> dict:
     """Monte Carlo of the proposed SINS/ADS under each diagnostic change of ``setup``.
 
-    ``diagnostics``: label → dict of :class:`AirdataSetup` fields (default :data:`BIAS_DIAGNOSTICS`).
-    The runs draw from ``SeedSequence(seed)`` as :func:`simulate` does, so with the main run's seed
-    they share its noise (common random numbers).  Returns label → :class:`MonteCarlo`.
+    ``diagnostics``: label → dict of ``AirdataSetup`` fields (default :data:`BIAS_DIAGNOSTICS`).
+    The runs draw from ``SeedSequence(seed)`` as ``simulate`` does, so with the main run's seed
+    they share its noise (common random numbers).  Returns label → ``MonteCarlo``.
     """
     diagnostics = BIAS_DIAGNOSTICS if diagnostics is None else diagnostics
     if not isinstance(diagnostics, dict) or not diagnostics:

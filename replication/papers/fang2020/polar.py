@@ -910,7 +910,7 @@ def sensitivity(case, variants, *, n_runs=4, seed=None, executor=None, chunk_run
     variant and estimator.
 
     Each variant is its own Monte Carlo with its own seed, so with ``executor`` (any
-    :class:`concurrent.futures.Executor`) or ``chunk_runs`` the variants are computed in chunks of
+    ``concurrent.futures.Executor``) or ``chunk_runs`` the variants are computed in chunks of
     ``chunk_runs`` variants, one picklable task each (:func:`replication.nav.parallel.run_chunks`),
     and the rows come back in the variants' order, equal to the in-process ones bit for bit;
     ``progress``: progress bar of the finished variants (``None``: on unless ``REPLICATION_PROGRESS=0``).
