@@ -48,7 +48,9 @@ TARGETS = {"monte_carlo_20_hour_wall_s_max": 3.0, "chen2019_45_20_runs_rts_ratio
 
 # ----------------------------------------------------------------------------- workloads (child process)
 
-def _hour():
+def hour_workload():
+    """The 15-state hour of the benchmarks: the first four chen2019 segments plus 900 s straight, and
+    its model (also timed by ``scripts/benchmark_parallel.py``)."""
     from replication.nav import errors as er
     from replication.nav import trajectory as tr
     from replication.nav.units import DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
@@ -86,7 +88,7 @@ def _workload(name):
     from replication.registry import reproduction as rp
 
     if name in ("filter_15_hour", "monte_carlo_20_hour", "augmented_hour"):
-        traj, model = _hour()
+        traj, model = hour_workload()
         short = traj.t[:6001]
         if name == "monte_carlo_20_hour":
             from replication.nav import trajectory as tr

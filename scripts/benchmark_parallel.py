@@ -30,23 +30,11 @@ from importlib import metadata
 from pathlib import Path
 
 import numpy as np
+from benchmark_closed_loop import hour_workload  # the same 15-state hour as the closed-loop benchmark
 
 ROOT = Path(__file__).resolve().parent.parent
 FIELDS = ("t_epoch", "nees", "nis", "final_estimates", "true_params", "final_sigma", "P_diag_run0")
 SEED = 20240
-
-
-def _hour():
-    from replication.nav import errors as er
-    from replication.nav import trajectory as tr
-    from replication.nav.units import DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
-
-    segs, init = tr.chen2019_flight()
-    traj = tr.generate(segs[:4] + [tr.Straight(900.0)], **init)
-    model = er.model_15(position_sd=1.0, velocity_sd=0.05, attitude_sd=(1e-4, 1e-4, 1e-3), lat=47 * DEG, h=6000.0,
-                        accel_bias_sd=100 * MICRO_G, gyro_bias_sd=0.05 * DEG_PER_H,
-                        accel_psd=(20 * MICRO_G) ** 2, gyro_psd=(0.005 * DEG_PER_SQRT_H) ** 2)
-    return traj, model
 
 
 def _warm():
@@ -54,7 +42,7 @@ def _warm():
     from replication.nav import kalman as kf
     from replication.nav import trajectory as tr
 
-    traj, model = _hour()
+    traj, model = hour_workload()
     warm = tr.generate([tr.Straight(20.0)], traj.lat[0], traj.lon[0], traj.h[0], speed=100.0)
     kf.monte_carlo(warm, model, n_runs=3, seed=1, workers=1)
     return os.getpid()
@@ -87,7 +75,7 @@ def main(argv=None) -> int:
 
     from replication.nav import kalman as kf
 
-    traj, model = _hour()
+    traj, model = hour_workload()
     load_before = os.getloadavg()
     _warm()
     timings, same = {}, {}
