@@ -423,7 +423,7 @@ def combination_sd_ratio(segment: str, weights: Mapping[str, float], noise_scale
     weights : mapping of str to float
         Coefficients on states in physical units, e.g. ``{"∇_z": 1.0, "δK_az": 9.8}`` for
         ∇_z + g δK_az (m/s²).  Names from :data:`STATES`.
-    noise_scale, coupling
+    noise_scale, coupling : float, str
         As in :func:`posterior_sd_ratio`.
 
     Returns
@@ -494,7 +494,7 @@ def verdict_table(noise_scale: float = 0.0, coupling: str = "eq-2-8",
 
     Parameters
     ----------
-    noise_scale, coupling
+    noise_scale, coupling : float, str
         As in :func:`posterior_sd_ratio`.
     threshold : float, default :data:`THRESHOLD`
         As in :func:`observable_states`.

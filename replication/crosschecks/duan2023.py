@@ -404,7 +404,7 @@ def pure_sins_sources(**kwargs):
 
     Parameters
     ----------
-    ``**kwargs``
+    **kwargs : dict
         Flight arguments passed to ``pure_sins_linear_propagation`` (``duration_s``,
         ``speed_mps``, ``heading_deg``, ``lat0_deg``, ``height_m``, ``step_s``).
 
