@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from replication import __version__, repository_url
+from replication._meta import __version__, repository_url
 from replication.registry import reproduction as rp
 
 

@@ -4,7 +4,8 @@
 ``replication.papers.<key>`` import the toolkit and their own paper, never another paper;
 ``replication.crosschecks`` import only the Earth model, the units and the shared checks of the
 toolkit (an error of a chapter's code path cannot repeat itself there); ``replication.registry``
-knows no physics: it imports neither the toolkit nor the methods.  The rules are read from the
+knows no physics: it imports neither the toolkit nor the methods, only the package's metadata leaf
+``replication._meta`` (version, repository address), which imports nothing of the package.  The rules are read from the
 source with ``ast``, so a deferred import inside a function counts too.
 """
 from __future__ import annotations
@@ -69,7 +70,7 @@ def test_the_four_parts_are_folders():
     # nothing but the package's entry points lives at the top
     top = {m for m in MODULES if m.count(".") == 1 and _part(m) not in
            {"replication.nav", "replication.registry", "replication.crosschecks", "replication.papers"}}
-    assert top == {"replication.__main__"}
+    assert top == {"replication.__main__", "replication._meta"}
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))
@@ -88,10 +89,12 @@ def test_imports_run_one_way(module):
         elif part == "replication.crosschecks":
             ok = m in CROSSCHECK_ALLOWED or m in ("replication.nav", "replication.crosschecks") or \
                 target == "replication.crosschecks"
-        elif part == "replication.registry":
-            ok = target == "replication.registry" or m == "replication"
+        elif part == "replication.registry":         # the registry and the package's metadata leaf
+            ok = target == "replication.registry" or m == "replication._meta"
+        elif part == "replication._meta":           # version and repository address: a leaf
+            ok = False
         else:                                       # the package itself and the CLI
-            ok = target in ("replication.registry", "top")
+            ok = target in ("replication.registry", "top", "replication._meta")
         if not ok:
             bad.add(m)
     assert not bad, f"{module} ({part}) imports {sorted(bad)} against the one-way rules"
