@@ -105,3 +105,38 @@ def test_the_rule_test_can_fail(tmp_path):
     p = tmp_path / "planted.py"
     p.write_text("from replication.papers.chen2019 import models\n", encoding="utf-8")
     assert "replication.papers.chen2019.models" in _imports("replication.registry.planted", p)
+
+
+# ---------------------------------------------------------------- verdicts apart from the methods
+STATUS_WORDS = {"reproduced", "erratum", "inconsistent", "qualitative", "analog", "unverifiable", "not-reproduced"}
+
+# method modules that still decide statuses; the list only shrinks
+STATUS_PENDING = {
+    "replication.papers.chen2019.calibration",
+    "replication.papers.chen2019.observability",
+    "replication.papers.chen2019.simulation",
+    "replication.papers.chen2019.turntable",
+    "replication.papers.duan2023.airdata",
+}
+
+
+def _status_literals(path: Path) -> set[str]:
+    """The status words that appear as whole string constants in a module."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and n.value in STATUS_WORDS}
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if _part(m).startswith("papers.")))
+def test_statuses_are_decided_in_findings_only(module):
+    """A paper's methods compute; its ``findings`` module turns the results into the rows the
+    chapter hands to the registry (status, note, evidence, corrected text).  No other module of a
+    paper writes a status, and none imports its findings."""
+    if module.endswith(".findings"):
+        users = [m for m, p in MODULES.items() if module in _imports(m, p)]
+        assert not users, f"{module} is imported by {users}: the findings are read by notebooks and tests only"
+        return
+    words = _status_literals(MODULES[module])
+    if module in STATUS_PENDING:
+        assert words, f"{module} no longer writes statuses: remove it from STATUS_PENDING"
+        return
+    assert not words, f"{module} writes statuses {sorted(words)}: they belong in its paper's findings module"
