@@ -44,7 +44,6 @@ PENDING: set[str] = {
     "replication.papers.chen2019.models",
     "replication.papers.chen2019.observability",
     "replication.papers.chen2019.simulation",
-    "replication.papers.chen2019.turntable",
     "replication.papers.duan2023.airdata",
     "replication.papers.fang2020.polar",
     "replication.papers.plots",
