@@ -39,7 +39,6 @@ PENDING: set[str] = {
     "replication.nav.units",
     "replication.papers.an2021.transfer",
     "replication.papers.chen2019.calibration",
-    "replication.papers.chen2019.error_effects",
     "replication.papers.chen2019.gravity",
     "replication.papers.chen2019.models",
     "replication.papers.chen2019.observability",
