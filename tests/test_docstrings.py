@@ -40,7 +40,6 @@ PENDING: set[str] = {
     "replication.papers.an2021.transfer",
     "replication.papers.chen2019.calibration",
     "replication.papers.chen2019.gravity",
-    "replication.papers.chen2019.models",
     "replication.papers.chen2019.observability",
     "replication.papers.chen2019.simulation",
     "replication.papers.duan2023.airdata",
