@@ -41,7 +41,6 @@ PENDING: set[str] = {
     "replication.papers.chen2019.calibration",
     "replication.papers.chen2019.gravity",
     "replication.papers.chen2019.observability",
-    "replication.papers.chen2019.simulation",
     "replication.papers.duan2023.airdata",
     "replication.papers.fang2020.polar",
     "replication.papers.plots",
