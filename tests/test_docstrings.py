@@ -40,7 +40,6 @@ PENDING: set[str] = {
     "replication.papers.an2021.transfer",
     "replication.papers.chen2019.calibration",
     "replication.papers.chen2019.gravity",
-    "replication.papers.chen2019.observability",
     "replication.papers.duan2023.airdata",
     "replication.papers.fang2020.polar",
     "replication.papers.plots",
