@@ -38,7 +38,6 @@ PENDING: set[str] = {
     "replication.nav.trajectory",
     "replication.nav.units",
     "replication.papers.an2021.transfer",
-    "replication.papers.chen2019.calibration",
     "replication.papers.duan2023.airdata",
     "replication.papers.fang2020.polar",
     "replication.papers.plots",
