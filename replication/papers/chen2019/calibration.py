@@ -74,10 +74,25 @@ def _as_mat3(m, name: str) -> np.ndarray:
 def direction_cosine_matrix(alpha) -> np.ndarray:
     """Direction cosines of the sensing axes, chen2019 eq. (2-1).
 
-    ``alpha[i, j]`` is the angle (rad) between sensing axis i (x, y, z) and IMU axis j (X, Y, Z);
-    the sensed rates are ``omega_sensed = cos(alpha) @ omega_IMU``.  Each row of the result is a
+    The sensed rates are ``omega_sensed = cos(alpha) @ omega_IMU``.  Each row of the result is a
     unit vector only if the three angles of that axis are geometrically consistent; the function
     checks this to 1e-9 and says which row is not.
+
+    Parameters
+    ----------
+    alpha : array_like, shape (3, 3)
+        ``alpha[i, j]`` is the angle between sensing axis i (x, y, z) and IMU axis j (X, Y, Z)
+        [rad].
+
+    Returns
+    -------
+    C : ndarray, shape (3, 3)
+        cos(alpha), rows the unit direction vectors of the sensing axes (dimensionless).
+
+    Raises
+    ------
+    ValueError
+        When ``alpha`` is not a finite 3×3 matrix or a row is not a unit vector.
     """
     a = _as_mat3(alpha, "alpha")
     c = np.cos(a)
@@ -92,14 +107,29 @@ def direction_cosine_matrix(alpha) -> np.ndarray:
 def misalignment_matrix(theta: Mapping[str, float]) -> np.ndarray:
     """Small-angle non-orthogonal misalignment matrix δC_m^s, chen2019 eq. (2-8).
 
-    ``theta`` maps the six angles (rad) ``'yz', 'zy', 'xz', 'zx', 'xy', 'yx'`` to values::
+    ::
 
         δC = [[ 0,     -θyz,  θzy],
               [ θxz,    0,   -θzx],
               [-θxy,   θyx,   0  ]]
 
-    (θxz, θxy: axis X_m out of plane/in plane; θyx, θyz for Y_m; θzy, θzx for Z_m, Fig. 2-2).
-    The same layout holds for the gyro matrix δG and the accelerometer matrix δA of (2-9).
+    (θxz, θxy: axis X_m out of plane/in plane; θyx, θyz for Y_m; θzy, θzx for Z_m, Fig. 2-2).  The
+    same layout holds for the gyro matrix δG and the accelerometer matrix δA of (2-9).
+
+    Parameters
+    ----------
+    theta : Mapping[str, float]
+        The six angles ``'yz', 'zy', 'xz', 'zx', 'xy', 'yx'`` [rad], each at most 0.1 rad.
+
+    Returns
+    -------
+    dC : ndarray, shape (3, 3)
+        The misalignment matrix [rad], zero diagonal.
+
+    Raises
+    ------
+    ValueError
+        When an angle is missing or larger than 0.1 rad in magnitude (not in radians?).
     """
     need = ("yz", "zy", "xz", "zx", "xy", "yx")
     missing = [k for k in need if k not in theta]
@@ -115,7 +145,23 @@ def misalignment_matrix(theta: Mapping[str, float]) -> np.ndarray:
 
 
 def nonorthogonal_transform(theta: Mapping[str, float]) -> np.ndarray:
-    """C_m^s = I + δC_m^s from the non-orthogonal measurement axes to the IMU axes, chen2019 eq. (2-7)."""
+    """C_m^s = I + δC_m^s from the non-orthogonal measurement axes to the IMU axes, chen2019 eq. (2-7).
+
+    Parameters
+    ----------
+    theta : Mapping[str, float]
+        The six angles ``'yz', 'zy', 'xz', 'zx', 'xy', 'yx'`` [rad], each at most 0.1 rad.
+
+    Returns
+    -------
+    C : ndarray, shape (3, 3)
+        The transformation (dimensionless, first order in the angles).
+
+    Raises
+    ------
+    ValueError
+        As :func:`misalignment_matrix`.
+    """
     return np.eye(3) + misalignment_matrix(theta)
 
 
@@ -127,10 +173,31 @@ def full_model_output(u, scale, bias, cross1, cross2, coupling1, coupling2, seco
 
         out_i = K_i u_i + B0_i + B1_i u_j + B2_i u_k + B3_i u_i u_j + B4_i u_i u_k + B5_i u_i^2
 
-    ``u`` has shape (..., 3); every coefficient is a length-3 array (one per axis): ``scale`` K,
-    ``bias`` B0, ``cross1``/``cross2`` the misalignment coefficients B1, B2, ``coupling1``/
-    ``coupling2`` the cross-coupling coefficients B3, B4, ``second_order`` B5.  The same
-    function serves gyros (G) and accelerometers (A).
+    The same function serves gyros (G) and accelerometers (A).
+
+    Parameters
+    ----------
+    u : array_like, shape (..., 3)
+        Input (angular rate [rad/s] or specific force [m/s²]) along the IMU axes.
+    scale : array_like, shape (3,)
+        Scale factors K [output unit per input unit].
+    bias : array_like, shape (3,)
+        Biases B0 [output unit].
+    cross1 : array_like, shape (3,)
+        Misalignment coefficients B1 [output unit per input unit].
+    cross2 : array_like, shape (3,)
+        Misalignment coefficients B2 [output unit per input unit].
+    coupling1 : array_like, shape (3,)
+        Cross-coupling coefficients B3 [output unit per input unit²].
+    coupling2 : array_like, shape (3,)
+        Cross-coupling coefficients B4 [output unit per input unit²].
+    second_order : array_like, shape (3,)
+        Second-order coefficients B5 [output unit per input unit²].
+
+    Returns
+    -------
+    out : ndarray, shape (..., 3)
+        Sensor output [output unit].
     """
     u = vector3(u, "u")
     co = [vector3(c, n) for c, n in ((scale, "scale"), (bias, "bias"), (cross1, "cross1"), (cross2, "cross2"),
@@ -149,12 +216,42 @@ def imu_error(omega_ib, f_b, *, gyro_bias, accel_bias, gyro_scale_error=(0, 0, 0
               gyro_misalignment=None, accel_misalignment=None) -> tuple[np.ndarray, np.ndarray]:
     """Total IMU error model, chen2019 eq. (2-10) (and (2-3)).
 
-    δω = ε + (δK_g + δG) ω_ib^b,   δf = ∇ + (δK_a + δA) f^b
+    ::
 
-    ``gyro_bias`` ε and ``accel_bias`` ∇ are the summed drift/bias (random constant +
-    Gauss-Markov + white, (2-4)), arrays broadcastable to the inputs; the scale-factor errors are
-    the diagonals of δK (2-6); the misalignment matrices are the 3x3 δG, δA of (2-9) (build them
-    with :func:`misalignment_matrix`).  Returns (δω, δf) with the shapes of the inputs.
+        δω = ε + (δK_g + δG) ω_ib^b,   δf = ∇ + (δK_a + δA) f^b
+
+    Parameters
+    ----------
+    omega_ib : array_like, shape (..., 3)
+        Angular rate ω_ib^b [rad/s].
+    f_b : array_like, shape (..., 3)
+        Specific force f^b [m/s²].
+    gyro_bias : array_like
+        Summed gyro drift ε (random constant + Gauss-Markov + white, (2-4)) [rad/s], broadcastable
+        to ``omega_ib``.
+    accel_bias : array_like
+        Summed accelerometer bias ∇ [m/s²], broadcastable to ``f_b``.
+    gyro_scale_error : array_like, shape (3,)
+        Diagonal of δK_g (2-6) [1].
+    accel_scale_error : array_like, shape (3,)
+        Diagonal of δK_a [1].
+    gyro_misalignment : array_like, shape (3, 3), optional
+        δG of (2-9) [rad], zero diagonal (build it with :func:`misalignment_matrix`).
+    accel_misalignment : array_like, shape (3, 3), optional
+        δA of (2-9) [rad], zero diagonal.
+
+    Returns
+    -------
+    d_omega : ndarray, shape (..., 3)
+        Gyro error δω [rad/s].
+    d_f : ndarray, shape (..., 3)
+        Accelerometer error δf [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When a misalignment matrix has a non-zero diagonal (scale-factor errors belong in the
+        ``*_scale_error`` arguments).
     """
     w = vector3(omega_ib, "omega_ib")
     f = vector3(f_b, "f_b")
@@ -178,10 +275,22 @@ def imu_error(omega_ib, f_b, *, gyro_bias, accel_bias, gyro_scale_error=(0, 0, 0
 class SensorTriad:
     """A gyro or accelerometer triad as the report tabulates it (Tables 4-1..4-3, 4-5..4-7).
 
-    ``bias``: b (input units, SI: rad/s or m/s^2); ``scale``: k, input units per output pulse
-    (SI: rad/pulse or m/s/pulse); ``axes``: C, rows = direction cosines of the sensing axes
-    (2-1).  Pulse-rate output: ``N = (b + C u) / k``; in the form of (4-1)/(4-2)
-    ``N = N0 + M u`` with ``N0 = b/k`` and ``M = diag(1/k) C``.
+    Pulse-rate output: ``N = (b + C u) / k``; in the form of (4-1)/(4-2) ``N = N0 + M u`` with
+    ``N0 = b/k`` and ``M = diag(1/k) C``.
+
+    Attributes
+    ----------
+    bias : ndarray, shape (3,)
+        b, in input units (SI: rad/s or m/s²).
+    scale : ndarray, shape (3,)
+        k, input units per output pulse (SI: rad/pulse or m/s/pulse), positive.
+    axes : ndarray, shape (3, 3)
+        C, rows the direction cosines of the sensing axes (2-1); a reversed axis is a negative row.
+
+    Raises
+    ------
+    ValueError
+        When a shape is wrong, a value not finite or a scale factor not positive.
     """
 
     bias: np.ndarray
@@ -210,19 +319,58 @@ class SensorTriad:
         return self.axes / self.scale[:, None]
 
     def output(self, u) -> np.ndarray:
-        """Noise-free pulse rate N = N0 + M u for inputs ``u`` (..., 3), chen2019 eq. (4-1)/(4-2)."""
+        """Noise-free pulse rate N = N0 + M u, chen2019 eq. (4-1)/(4-2).
+
+        Parameters
+        ----------
+        u : array_like, shape (..., 3)
+            Inputs along the IMU axes [rad/s or m/s²].
+
+        Returns
+        -------
+        N : ndarray, shape (..., 3)
+            Pulse rates [pulses/s].
+        """
         return self.null_output + vector3(u, "u") @ self.matrix.T
 
     def compensate(self, n) -> np.ndarray:
-        """Input estimate û = M⁻¹ (N - N0) from pulse rates (..., 3): the compensation of §1.4 step 8."""
+        """Input estimate û = M⁻¹ (N - N0) from pulse rates: the compensation of §1.4 step 8.
+
+        Parameters
+        ----------
+        n : array_like, shape (..., 3)
+            Pulse rates [pulses/s].
+
+        Returns
+        -------
+        u : ndarray, shape (..., 3)
+            Estimated inputs along the IMU axes [rad/s or m/s²].
+        """
         return (vector3(n, "pulse rate") - self.null_output) @ np.linalg.inv(self.matrix).T
 
     @classmethod
     def from_model(cls, null_output, matrix) -> "SensorTriad":
         """Split a calibrated (N0, M) into bias, scale and unit-row axes (the tabulated form).
 
-        k_i = 1/‖M_i‖, C_i = M_i/‖M_i‖, b_i = N0_i k_i.  This is how the printed misalignment
-        tables are normalized: every printed row has unit norm to 1e-15.
+        k_i = 1/‖M_i‖, C_i = M_i/‖M_i‖, b_i = N0_i k_i.  This is how the printed misalignment tables are
+        normalized: every printed row has unit norm to 1e-15.
+
+        Parameters
+        ----------
+        null_output : array_like, shape (3,)
+            N0 [pulses/s].
+        matrix : array_like, shape (3, 3)
+            M [pulses per input unit, e.g. pulses/rad].
+
+        Returns
+        -------
+        triad : SensorTriad
+            The sensor in bias/scale/axes form.
+
+        Raises
+        ------
+        CalibrationError
+            When a row of M is zero.
         """
         m = _as_mat3(matrix, "matrix")
         n0 = vector3(null_output, "null_output")
@@ -235,10 +383,27 @@ class SensorTriad:
 def complete_unit_rows(axes, signs: Mapping[tuple[int, int], float] | None = None) -> np.ndarray:
     """Fill one missing (NaN) element per row of a direction-cosine matrix from ‖row‖ = 1.
 
-    Used for the two elements lost in the extraction (Tables 4-11 and 4-15, row 1 column 3):
-    the magnitude follows from the unit norm that every printed row satisfies to 1e-15; the
-    sign cannot, and must be given in ``signs`` as {(row, col): ±1} (0-based), e.g. from the
-    other temperatures.  Raises when a row misses more than one element or a sign is not given.
+    Used for the two elements lost in the extraction (Tables 4-11 and 4-15, row 1 column 3): the
+    magnitude follows from the unit norm that every printed row satisfies to 1e-15; the sign
+    cannot, and must be given.
+
+    Parameters
+    ----------
+    axes : array_like, shape (3, 3)
+        Direction cosines with at most one NaN per row.
+    signs : Mapping[tuple[int, int], float] or None
+        {(row, col): ±1} (0-based) for every missing element, e.g. from the other temperatures.
+
+    Returns
+    -------
+    C : ndarray, shape (3, 3)
+        The completed matrix (dimensionless).
+
+    Raises
+    ------
+    ValueError
+        When a row misses more than one element, a sign is not given, or a row already has a norm
+        above 1.
     """
     c = np.array(axes, dtype=float)
     if c.shape != (3, 3):
@@ -266,11 +431,22 @@ def complete_unit_rows(axes, signs: Mapping[tuple[int, int], float] | None = Non
 
 @dataclass(frozen=True)
 class Run:
-    """One rate-table run: ``position`` (an axis up/down, see :data:`POSITIONS`) and ``rate``.
+    """One rate-table run: an axis up or down along the table axis, and the table rate.
 
-    ``rate`` (rad/s) is the table rate about the IMU axis that lies along the table axis,
-    positive right-handed about that IMU axis (the ω(i) of (4-3)); the runs of (4-3) are, per
-    axis, (up, +ω), (up, -ω), (down, +ω), (down, -ω).
+    The runs of (4-3) are, per axis, (up, +ω), (up, -ω), (down, +ω), (down, -ω).
+
+    Attributes
+    ----------
+    position : str
+        One of :data:`POSITIONS` (the named IMU axis up (+) or down (-)).
+    rate : float
+        The table rate about the IMU axis that lies along the table axis, positive right-handed
+        about that IMU axis (the ω(i) of (4-3)) [rad/s].
+
+    Raises
+    ------
+    CalibrationError
+        When the position is unknown or the rate not finite.
     """
 
     position: str
@@ -295,8 +471,23 @@ class Run:
 def six_position_runs(rate: float) -> list[Run]:
     """The 12 runs of chen2019 eq. (4-3)/(4-4), in the printed row order.
 
-    Rows 1-4: X axis along the table axis, (up, +ω), (up, -ω), (down, +ω), (down, -ω); rows 5-8
-    the same for Y; rows 9-12 for Z.  ``rate`` > 0 in rad/s (10 °/s in Tables 4-1..4-32).
+    Rows 1-4: X axis along the table axis, (up, +ω), (up, -ω), (down, +ω), (down, -ω); rows 5-8 the
+    same for Y; rows 9-12 for Z.
+
+    Parameters
+    ----------
+    rate : float
+        The calibration rate ω > 0 [rad/s] (10 °/s in Tables 4-1..4-32).
+
+    Returns
+    -------
+    runs : list of Run
+        The 12 runs.
+
+    Raises
+    ------
+    CalibrationError
+        When ``rate`` is not positive.
     """
     if not rate > 0:
         raise CalibrationError("the calibration rate must be positive (rad/s), e.g. 10 * units.DEG_PER_S")
@@ -307,22 +498,54 @@ def six_position_runs(rate: float) -> list[Run]:
 
 
 def vertical_earth_rate(lat) -> float:
-    """Ω_e sin φ (rad/s): the Earth-rate component along a vertical table axis, chen2019 eq. (4-3).
+    """Ω_e sin φ: the Earth-rate component along a vertical table axis, chen2019 eq. (4-3).
 
     The printed text calls φ 'the angle between the system and north at time t'; the term is the
-    vertical Earth rate, so φ is the latitude (the horizontal Earth rate rotates with the table
-    and averages to zero over whole revolutions).
+    vertical Earth rate, so φ is the latitude (the horizontal Earth rate rotates with the table and
+    averages to zero over whole revolutions).
+
+    Parameters
+    ----------
+    lat : float
+        Latitude [rad].
+
+    Returns
+    -------
+    rate : float
+        Vertical Earth rate [rad/s].
     """
     lat = float(earth.check_latitude(lat))
     return earth.OMEGA_IE * math.sin(lat)
 
 
 def run_inputs(runs: Sequence[Run], *, channel: str, lat: float | None = None, gravity: float | None = None) -> np.ndarray:
-    """Mean sensor inputs (n, 3) of each run over whole revolutions, the regressors of (4-3)/(4-4).
+    """Mean sensor inputs of each run over whole revolutions, the regressors of (4-3)/(4-4).
 
     Gyro (``channel='gyro'``): along the table axis ω(i) ± Ω_e sin φ — the ω_{e+}, ω_{e-},
     ω̂_{e+}, ω̂_{e-} of (4-3) — and zero on the horizontal axes.  Accelerometer
     (``channel='accel'``): ±g along the table axis (4-4).
+
+    Parameters
+    ----------
+    runs : sequence of Run
+        The rate-table runs.
+    channel : str
+        ``'gyro'`` or ``'accel'``.
+    lat : float or None
+        Latitude [rad]; required for the gyro, gives normal gravity for the accelerometer when
+        ``gravity`` is not given.
+    gravity : float or None
+        Gravity magnitude [m/s²].
+
+    Returns
+    -------
+    u : ndarray of numpy.longdouble, shape (n, 3)
+        Inputs along the IMU axes [rad/s or m/s²], in extended precision.
+
+    Raises
+    ------
+    CalibrationError
+        When the runs are invalid, the channel unknown, or the latitude/gravity missing.
     """
     runs = _check_runs(runs)
     u = np.zeros((len(runs), 3), dtype=np.longdouble)       # extended precision: see solve_rate_calibration
@@ -357,9 +580,24 @@ def _check_runs(runs) -> list[Run]:
 class CalibrationResult:
     """Least-squares rate-table calibration of one triad (chen2019 eq. (4-3)/(4-4)).
 
-    ``null_output`` N0 (3,), ``matrix`` M (3, 3) — or, with ``asymmetric=True``, the diagonal
-    split into ``k_plus``/``k_minus`` (M's diagonal is then their mean) — the design matrices per
-    output channel, ``residuals`` (n, 3) and ``rank``.
+    Attributes
+    ----------
+    null_output : ndarray, shape (3,)
+        N0 [pulses/s].
+    matrix : ndarray, shape (3, 3)
+        M [pulses per input unit: pulses/rad or pulses/(m/s)]; with ``asymmetric`` its diagonal is
+        the mean of ``k_plus`` and ``k_minus``.
+    designs : list of ndarray
+        The design matrix of each output channel, shape (n, 4) (or (n, 5) asymmetric); columns
+        [1, u_x, u_y, u_z] (asymmetric: [1, u_j⁺, u_j⁻, the other two inputs]).
+    residuals : ndarray, shape (n, 3)
+        Least-squares residuals [pulses/s].
+    asymmetric : bool
+        Whether separate scale factors K⁺/K⁻ were estimated on each channel's own axis.
+    k_plus : ndarray, shape (3,), or None
+        K⁺ per channel (asymmetric only), units of ``matrix``.
+    k_minus : ndarray, shape (3,), or None
+        K⁻ per channel (asymmetric only), units of ``matrix``.
     """
 
     null_output: np.ndarray
@@ -371,16 +609,37 @@ class CalibrationResult:
     k_minus: np.ndarray | None = None
 
     def triad(self) -> SensorTriad:
-        """The calibrated sensor in the tabulated form (bias, scale, unit-row axes)."""
+        """The calibrated sensor in the tabulated form (bias, scale, unit-row axes).
+
+        Returns
+        -------
+        triad : SensorTriad
+            :meth:`SensorTriad.from_model` of (``null_output``, ``matrix``).
+        """
         return SensorTriad.from_model(self.null_output, self.matrix)
 
     def covariance(self, run_variance) -> list[np.ndarray]:
         """Parameter covariance per output channel for independent run means.
 
-        ``run_variance`` (n,) or (n, 3): variance of each run's mean output (pulses/s)^2.
-        Ordinary least squares: Cov = (AᵀA)⁻¹ Aᵀ Σ A (AᵀA)⁻¹ with Σ = diag(run_variance).
-        Parameter order per channel j: [N0_j, M_j,x, M_j,y, M_j,z] (asymmetric: the own-axis
-        column is replaced by K⁺_j, K⁻_j).
+        Ordinary least squares: Cov = (AᵀA)⁻¹ Aᵀ Σ A (AᵀA)⁻¹ with Σ = diag(run_variance).  Parameter
+        order per channel j: [N0_j, M_j,x, M_j,y, M_j,z] (asymmetric: the own-axis column is replaced
+        by K⁺_j, K⁻_j).
+
+        Parameters
+        ----------
+        run_variance : array_like, shape (n,) or (n, 3)
+            Variance of each run's mean output [(pulses/s)²], non-negative.
+
+        Returns
+        -------
+        cov : list of ndarray
+            Three covariance matrices, shape (4, 4) (asymmetric (5, 5)), in the parameters' units
+            squared.
+
+        Raises
+        ------
+        CalibrationError
+            When ``run_variance`` has the wrong shape or a negative entry.
         """
         v = np.asarray(run_variance, dtype=float)
         n = self.designs[0].shape[0]
@@ -415,13 +674,43 @@ def solve_rate_calibration(runs: Sequence[Run], outputs, *, channel: str, lat: f
                            rcond: float = 1e-10) -> CalibrationResult:
     """General least-squares solution of chen2019 eq. (4-3) (gyro) or (4-4) (accelerometer).
 
-    ``outputs`` (n, 3): the mean pulse rate of each run (the left-hand side of (4-3)/(4-4)).
     For every output channel j the unknowns [N0_j, M_jx, M_jy, M_jz] solve Y = A Θ in the least
     squares sense, A = [1, u] with the run inputs of :func:`run_inputs` (Earth-rate terms
-    included).  Any set of positions and rates is accepted as long as the design has full
-    column rank; otherwise :class:`RankDeficientDesignError` names the parameter that no run
-    excites.  ``asymmetric=True`` (gyro only) estimates separate scale factors K⁺/K⁻ for
-    positive/negative input on each channel's own axis, the K_{x+}, K_{x-} of (4-5).
+    included).  Any set of positions and rates is accepted as long as the design has full column
+    rank.
+
+    Parameters
+    ----------
+    runs : sequence of Run
+        The rate-table runs.
+    outputs : array_like, shape (n, 3)
+        The mean pulse rate of each run and channel (the left-hand side of (4-3)/(4-4))
+        [pulses/s].
+    channel : str
+        ``'gyro'`` or ``'accel'``.
+    lat : float or None
+        Latitude [rad] (needed for the gyro's Earth-rate terms).
+    gravity : float or None
+        Gravity magnitude [m/s²] (accelerometer; else normal gravity at ``lat``).
+    asymmetric : bool
+        Gyro only: separate scale factors K⁺/K⁻ for positive/negative input on each channel's own
+        axis, the K_{x+}, K_{x-} of (4-5).
+    rcond : float
+        Smallest singular value of the design, relative to the largest, counted as full rank.
+
+    Returns
+    -------
+    result : CalibrationResult
+        N0 [pulses/s], M [pulses per input unit], designs and residuals.
+
+    Raises
+    ------
+    CalibrationError
+        When ``outputs`` has the wrong shape or non-finite entries, or ``asymmetric`` is asked for
+        the accelerometer.
+    RankDeficientDesignError
+        When the design does not determine every parameter; the message names the parameter that no
+        run excites.
     """
     runs = _check_runs(runs)
     y = np.asarray(outputs, dtype=np.longdouble)
@@ -500,9 +789,8 @@ def _standard_means(outputs, rate: float) -> np.ndarray:
 def closed_form_gyro(outputs, rate: float, lat: float) -> dict[str, np.ndarray]:
     """Six-position closed forms for the gyro channel, chen2019 eq. (4-5)/(4-6), re-derived.
 
-    ``outputs`` (12, 3): mean pulse rates ω̄_{j,r} of the 12 runs of :func:`six_position_runs`
-    (r = 1..12, j = x, y, z).  With s = Ω_e sin φ and ω = ``rate``, for the group g of rows
-    (4g-3 .. 4g) in which axis i lies along the table axis:
+    With ω̄_{j,r} the mean pulse rates (r = 1..12, j = x, y, z), s = Ω_e sin φ and ω = ``rate``,
+    for the group g of rows (4g-3 .. 4g) in which axis i lies along the table axis:
 
     * bias (4-6): N0_j = (1/12) Σ_r ω̄_{j,r}  (exact for symmetric scale factors);
     * scale factor, least squares with the Earth-rate terms:
@@ -512,11 +800,29 @@ def closed_form_gyro(outputs, rate: float, lat: float) -> dict[str, np.ndarray]:
       K⁻_j = (4 N0_j - 2ω̄_2 - 2ω̄_4)/(4ω) (own group) and
       E_ji = (ω̄_1 - ω̄_2 + ω̄_3 - ω̄_4)/(4ω) (Earth rate cancels between up and down);
     * with K⁺ ≠ K⁻ the 1/12 mean is biased by ω (K⁺_j - K⁻_j)/6; the unbiased bias is the mean
-      of the 8 rows in which axis j is horizontal: ``bias_cross``.
+      of the 8 rows in which axis j is horizontal: ``null_output_cross``.
 
-    Returns a dict with ``null_output`` (3,), ``matrix`` (3, 3) (least squares),
-    ``matrix_earth_free`` (3, 3) (the Earth-rate-free (4-5) form), ``k_plus``, ``k_minus``,
-    ``null_output_cross`` (3,).
+    Parameters
+    ----------
+    outputs : array_like, shape (12, 3)
+        Mean pulse rates of the 12 runs of :func:`six_position_runs`, in order, per output
+        channel x, y, z [pulses/s].
+    rate : float
+        The calibration rate ω(i) > 0 [rad/s].
+    lat : float
+        Latitude [rad].
+
+    Returns
+    -------
+    forms : dict of str to ndarray
+        ``null_output`` (3,) [pulses/s], ``matrix`` (3, 3) (least squares) [pulses/rad],
+        ``matrix_earth_free`` (3, 3) (the Earth-rate-free (4-5) form) [pulses/rad], ``k_plus``,
+        ``k_minus`` (3,) [pulses/rad], ``null_output_cross`` (3,) [pulses/s].
+
+    Raises
+    ------
+    CalibrationError
+        When ``outputs`` is not (12, 3) and finite or ``rate`` is not positive.
     """
     y = _standard_means(outputs, rate)
     s = np.longdouble(earth.OMEGA_IE) * np.sin(np.longdouble(earth.check_latitude(lat)))
@@ -545,7 +851,26 @@ def closed_form_accel(outputs, gravity: float) -> dict[str, np.ndarray]:
     """Six-position closed forms for the accelerometer channel, chen2019 eq. (4-7)/(4-8), re-derived.
 
     a_j0 = (1/12) Σ_r ā_{j,r}  (4-7; the printed form lacks the factor 1/12);
-    M_ji = (ā_1 + ā_2 - ā_3 - ā_4)/(4g) over the rows of group i (4-8; the printed form lacks 1/(4g)).
+    M_ji = (ā_1 + ā_2 - ā_3 - ā_4)/(4g) over the rows of group i (4-8; the printed form lacks
+    1/(4g)).
+
+    Parameters
+    ----------
+    outputs : array_like, shape (12, 3)
+        Mean pulse rates of the 12 runs of :func:`six_position_runs`, in order, per output
+        channel x, y, z [pulses/s].
+    gravity : float
+        Gravity magnitude g [m/s²].
+
+    Returns
+    -------
+    forms : dict of str to ndarray
+        ``null_output`` (3,) [pulses/s] and ``matrix`` (3, 3) [pulses per m/s].
+
+    Raises
+    ------
+    CalibrationError
+        When ``outputs`` is not (12, 3) and finite or ``gravity`` is not positive.
     """
     y = _standard_means(outputs, 1.0)
     if not gravity > 0:
@@ -561,8 +886,26 @@ def closed_form_accel(outputs, gravity: float) -> dict[str, np.ndarray]:
 def printed_closed_form_gyro(outputs, rate: float) -> dict[str, np.ndarray]:
     """chen2019 eq. (4-5)/(4-6) evaluated literally as printed, to quantify the damage.
 
-    Printed: K_{x-} = (-2ω̄_{x2} - 2ω̄_{x3} - 4ω_{x0})/(4ω(i)) and K_{y-}, K_{z-} with
-    -4ω_{y0}, -4ω_{z0}; K_{x+}, K_{y+}, K_{z+} and the cross terms as re-derived.
+    Printed: K_{x-} = (-2ω̄_{x2} - 2ω̄_{x3} - 4ω_{x0})/(4ω(i)) and K_{y-}, K_{z-} with -4ω_{y0},
+    -4ω_{z0}; K_{x+}, K_{y+}, K_{z+} and the cross terms as re-derived.
+
+    Parameters
+    ----------
+    outputs : array_like, shape (12, 3)
+        Mean pulse rates of the 12 runs of :func:`six_position_runs`, in order, per output
+        channel x, y, z [pulses/s].
+    rate : float
+        The calibration rate ω(i) > 0 [rad/s].
+
+    Returns
+    -------
+    forms : dict of str to ndarray
+        ``null_output`` (3,) [pulses/s] and the printed ``k_minus`` (3,) [pulses/rad].
+
+    Raises
+    ------
+    CalibrationError
+        When ``outputs`` is not (12, 3) and finite or ``rate`` is not positive.
     """
     y = _standard_means(outputs, rate)
     n0 = y.mean(axis=0)
@@ -578,14 +921,20 @@ def symbolic_closed_forms() -> dict[str, object]:
     """Derive the six-position closed forms of chen2019 (4-5)/(4-6) with sympy.
 
     Symbols: y1..y12 the mean outputs of one channel (x) over the 12 runs of (4-3), w = ω(i),
-    s = Ω_e sin φ.  Returns sympy expressions:
+    s = Ω_e sin φ.
 
-    * ``'N0'``, ``'Mx'``, ``'My'``, ``'Mz'`` — least squares of the symmetric model (normal
-      equations of (4-3) solved exactly);
-    * ``'N0_asym'``, ``'Kplus'``, ``'Kminus'`` — the asymmetric model (own-axis input split
-      into positive and negative parts), least squares over the 12 rows;
-    * ``'Kplus_45'``, ``'Kminus_45'`` — the forward/reverse forms with N0 = mean of 12 (the
-      structure of the printed (4-5)), to compare with the printed text.
+    Returns
+    -------
+    forms : dict of str to object
+        sympy expressions:
+
+        * ``'N0'``, ``'Mx'``, ``'My'``, ``'Mz'`` — least squares of the symmetric model (normal
+          equations of (4-3) solved exactly);
+        * ``'N0_asym'``, ``'Kplus'``, ``'Kminus'`` — the asymmetric model (own-axis input split
+          into positive and negative parts), least squares over the 12 rows;
+        * ``'Kplus_45'``, ``'Kminus_45'`` — the forward/reverse forms with N0 = mean of 12 (the
+          structure of the printed (4-5)), to compare with the printed text;
+        * ``'symbols'`` — the tuple (y, w, s) of the symbols used.
     """
     import sympy as sp
 
@@ -649,7 +998,26 @@ disagree, ``qualitative`` for a property of the method or a symbol the extractio
 
 @dataclass
 class RateTableExperiment:
-    """A synthetic rate-table experiment (see :func:`simulate_rate_table`)."""
+    """A synthetic rate-table experiment (see :func:`simulate_rate_table`).
+
+    Attributes
+    ----------
+    runs : list of Run
+        The runs.
+    outputs : ndarray of numpy.longdouble, shape (n, 3)
+        Mean pulse rates with noise [pulses/s] (extended precision: see
+        :func:`solve_rate_calibration`).
+    noise_free : ndarray of numpy.longdouble, shape (n, 3)
+        Mean pulse rates without noise [pulses/s].
+    run_variance : ndarray, shape (n, 3)
+        Variance of each run mean [(pulses/s)²].
+    durations : ndarray, shape (n,)
+        Run durations [s].
+    lat : float
+        Latitude [rad].
+    gravity : float
+        Normal gravity at ``lat`` [m/s²].
+    """
 
     runs: list[Run]
     outputs: np.ndarray          # (n, 3) mean pulse rates (np.longdouble: see solve_rate_calibration)
@@ -667,18 +1035,50 @@ def simulate_rate_table(gyro: SensorTriad | None, accel: SensorTriad | None, run
     """Synthetic six-position rate-table data from a sensor description (chen2019 §4.1, Fig. 4-2).
 
     For each run the table turns at ``run.rate`` about the IMU axis that points up/down for
-    ``revolutions`` turns (the report: "at least 360° per rate"), sampled at ``sample_rate``.
-    The body rate is the table rate plus the Earth rate at latitude ``lat``
-    (ω_ie^n = [0, Ω cos φ, Ω sin φ] in ENU); the specific force is [0, 0, g] with g the normal
-    gravity at ``lat``.  The horizontal Earth rate rotates with the table: its sampled average
-    vanishes over whole revolutions and leaks into the means otherwise (the point of turning
-    whole revolutions).  ``azimuth0`` is the heading of the horizontal IMU axes at the start.
+    ``revolutions`` turns (the report: "at least 360° per rate"), sampled at ``sample_rate``.  The
+    body rate is the table rate plus the Earth rate at latitude ``lat`` (ω_ie^n = [0, Ω cos φ,
+    Ω sin φ] in ENU); the specific force is [0, 0, g] with g the normal gravity at ``lat``.  The
+    horizontal Earth rate rotates with the table: its sampled average vanishes over whole
+    revolutions and leaks into the means otherwise (the point of turning whole revolutions).
 
-    Noise: white, with density ``*_noise_density`` (rad/s/√Hz = rad/√s for gyros,
-    m/s²/√Hz for accelerometers) on the input-referred output; per sample std = density·√fs.
-    ``noise_on='means'`` draws the exact distribution of each run mean (std density/√T),
-    ``'samples'`` draws every sample and averages (same distribution, slower).
-    Returns {'gyro': RateTableExperiment, 'accel': ...} for the triads given.
+    Noise: white on the input-referred output; per sample std = density·√fs.
+
+    Parameters
+    ----------
+    gyro : SensorTriad or None
+        The gyro triad (``None``: no gyro data).
+    accel : SensorTriad or None
+        The accelerometer triad (``None``: no accelerometer data).
+    runs : sequence of Run
+        The rate-table runs (non-zero rates).
+    lat : float
+        Latitude [rad].
+    revolutions : float
+        Table revolutions per run.
+    sample_rate : float
+        Sampling rate [Hz].
+    gyro_noise_density : float
+        Gyro white-noise density [rad/s/√Hz = rad/√s].
+    accel_noise_density : float
+        Accelerometer white-noise density [m/s²/√Hz].
+    azimuth0 : float
+        Heading of the horizontal IMU axes at the start [rad].
+    rng : numpy.random.Generator or None
+        Seeded generator (required when a noise density is positive).
+    noise_on : str
+        ``'means'`` draws the exact distribution of each run mean (std density/√T), ``'samples'``
+        draws every sample and averages (same distribution, slower).
+
+    Returns
+    -------
+    experiments : dict of str to RateTableExperiment
+        ``'gyro'`` and/or ``'accel'``, for the triads given.
+
+    Raises
+    ------
+    CalibrationError
+        When an argument is out of range, a run has rate 0, noise is asked without ``rng``, or no
+        triad is given.
     """
     runs = _check_runs(runs)
     lat = float(earth.check_latitude(lat))
@@ -734,10 +1134,26 @@ def simulate_rate_table(gyro: SensorTriad | None, accel: SensorTriad | None, run
 
 
 def run_mean_std(triad: SensorTriad, durations, noise_density: float, sample_rate: float) -> np.ndarray:
-    """Standard deviation (n, 3) of each run's mean pulse rate under white noise.
+    """Standard deviation of each run's mean pulse rate under white noise.
 
-    Per-sample input-referred std σ = density·√fs; a run of n = round(T·fs) samples has a mean
-    with std σ/√n per input axis, i.e. σ/(k_j √n) on output channel j (unit-norm rows of C).
+    Per-sample input-referred std σ = density·√fs; a run of n = round(T·fs) samples has a mean with
+    std σ/√n per input axis, i.e. σ/(k_j √n) on output channel j (unit-norm rows of C).
+
+    Parameters
+    ----------
+    triad : SensorTriad
+        The sensor description.
+    durations : array_like, shape (n,)
+        Run durations [s].
+    noise_density : float
+        White-noise density of the input [input unit/√Hz].
+    sample_rate : float
+        Sampling rate [Hz].
+
+    Returns
+    -------
+    std : ndarray, shape (n, 3)
+        Standard deviation of each run mean per output channel [pulses/s].
     """
     d = np.asarray(durations, dtype=float)
     n = np.maximum(np.round(d * sample_rate), 2)
@@ -763,10 +1179,41 @@ def _body_to_enu(run: Run, table_angle: np.ndarray) -> np.ndarray:
 
 def monte_carlo_calibration(gyro: SensorTriad, runs: Sequence[Run], *, lat: float, noise_density: float,
                             revolutions: float, n_trials: int, rng, sample_rate: float = 100.0) -> np.ndarray:
-    """Monte Carlo of the gyro least-squares calibration: (n_trials, 12) parameter estimates.
+    """Monte Carlo of the gyro least-squares calibration.
 
     Each trial draws the run means of :func:`simulate_rate_table` (noise on the means, exact for
-    white noise) and solves (4-3); columns: N0 (3) then M row-major (9).  Vectorized over trials.
+    white noise) and solves (4-3).  Vectorized over trials.
+
+    Parameters
+    ----------
+    gyro : SensorTriad
+        The true gyro triad.
+    runs : sequence of Run
+        The rate-table runs.
+    lat : float
+        Latitude [rad].
+    noise_density : float
+        Gyro white-noise density [rad/s/√Hz].
+    revolutions : float
+        Table revolutions per run.
+    n_trials : int
+        Number of trials (≥ 2).
+    rng : numpy.random.Generator
+        Seeded generator.
+    sample_rate : float
+        Sampling rate [Hz].
+
+    Returns
+    -------
+    estimates : ndarray, shape (n_trials, 12)
+        Per trial N0 (3) [pulses/s] then M row-major (9) [pulses/rad].
+
+    Raises
+    ------
+    CalibrationError
+        When ``n_trials`` < 2.
+    RankDeficientDesignError
+        When the runs do not determine every parameter.
     """
     if n_trials < 2:
         raise CalibrationError("n_trials must be at least 2")
@@ -788,7 +1235,24 @@ def monte_carlo_calibration(gyro: SensorTriad, runs: Sequence[Run], *, lat: floa
 # =============================================================================================
 
 def static_inputs(position: str, *, lat: float, azimuth: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """True (ω_ib^b, f^b) for the IMU at rest in a rate-table position (rad/s, m/s^2)."""
+    """True (ω_ib^b, f^b) for the IMU at rest in a rate-table position.
+
+    Parameters
+    ----------
+    position : str
+        One of :data:`POSITIONS`.
+    lat : float
+        Latitude [rad].
+    azimuth : float
+        Heading of the horizontal IMU axes [rad].
+
+    Returns
+    -------
+    omega_ib : ndarray, shape (3,)
+        Angular rate in the body frame [rad/s].
+    f_b : ndarray, shape (3,)
+        Specific force in the body frame [m/s²].
+    """
     run = Run(position, 0.0)
     c = _body_to_enu(run, np.array(azimuth))
     w = c.T @ earth.earth_rate_enu(lat)
@@ -797,10 +1261,27 @@ def static_inputs(position: str, *, lat: float, azimuth: float = 0.0) -> tuple[n
 
 
 def latitude_from_static(omega_mean, f_mean) -> float:
-    """Latitude (rad) of a static IMU from its mean angular rate and specific force.
+    """Latitude of a static IMU from its mean angular rate and specific force.
 
     At rest the gyro triad senses the Earth rate and the accelerometer triad the local vertical,
     whatever the attitude: sin φ = ω·f / (‖ω‖ ‖f‖).  Any common scale of either vector cancels.
+
+    Parameters
+    ----------
+    omega_mean : array_like, shape (3,)
+        Mean angular rate (any unit, non-zero).
+    f_mean : array_like, shape (3,)
+        Mean specific force (any unit, non-zero).
+
+    Returns
+    -------
+    lat : float
+        Latitude [rad].
+
+    Raises
+    ------
+    ValueError
+        When a mean vector is zero.
     """
     w = vector3(omega_mean, "omega_mean")
     f = vector3(f_mean, "f_mean")
@@ -815,6 +1296,18 @@ def self_check_magnitude(triad: SensorTriad, pulse_rate) -> np.ndarray:
 
     At rest, the gyro value should equal Ω_e (15.0411 °/h) and the accelerometer value the local
     gravity (1 g in the report's normalization), whatever the orientation.
+
+    Parameters
+    ----------
+    triad : SensorTriad
+        The sensor description.
+    pulse_rate : array_like, shape (..., 3)
+        Pulse rates [pulses/s].
+
+    Returns
+    -------
+    magnitude : ndarray, shape (...)
+        Magnitude of the compensated input, in the triad's input units (e.g. rad/s, m/s²).
     """
     return np.linalg.norm(triad.compensate(pulse_rate), axis=-1)
 
@@ -829,15 +1322,37 @@ OUT_OF_RANGE_POLICIES = ("raise", "clamp", "extrapolate")
 def interpolate_temperature(temperature, nodes, values, *, out_of_range: str = "raise") -> np.ndarray:
     """Piecewise-linear temperature model, chen2019 eq. (4-9)-(4-12).
 
-    For T in [T_{i-1}, T_i]:  p(T) = (T - T_i)/(T_{i-1} - T_i) p_{i-1} + (T - T_{i-1})/(T_i - T_{i-1}) p_i
-    (gyro bias (4-9), gyro scale factor (4-10), accelerometer bias (4-11) and scale factor
-    (4-12) alike).  ``nodes`` are the calibration temperatures (°C, any order, distinct);
-    ``values`` has shape (n_nodes,) or (n_nodes, k) (e.g. the three axes).
+    For T in [T_{i-1}, T_i]:  p(T) = (T - T_i)/(T_{i-1} - T_i) p_{i-1} + (T - T_{i-1})/(T_i -
+    T_{i-1}) p_i (gyro bias (4-9), gyro scale factor (4-10), accelerometer bias (4-11) and scale
+    factor (4-12) alike).
 
     Outside [min(nodes), max(nodes)] the calibration says nothing; ``out_of_range`` decides:
     ``'raise'`` (default) raises :class:`TemperatureOutOfRangeError`; ``'clamp'`` holds the end
-    value (zero-order hold, the usual firmware choice); ``'extrapolate'`` continues the end
-    segment linearly.  No other value is produced silently.
+    value (zero-order hold, the usual firmware choice); ``'extrapolate'`` continues the end segment
+    linearly.  No other value is produced silently.
+
+    Parameters
+    ----------
+    temperature : float or array_like
+        Temperatures at which to evaluate [°C].
+    nodes : array_like, shape (n_nodes,)
+        The calibration temperatures [°C], any order, distinct, at least two.
+    values : array_like, shape (n_nodes,) or (n_nodes, k)
+        The calibrated parameter at each node (e.g. the three axes), any unit.
+    out_of_range : str
+        ``'raise'``, ``'clamp'`` or ``'extrapolate'``.
+
+    Returns
+    -------
+    p : ndarray, shape of ``temperature`` (+ (k,))
+        The interpolated parameter, unit of ``values``.
+
+    Raises
+    ------
+    TemperatureOutOfRangeError
+        When a temperature lies outside the calibrated range and ``out_of_range='raise'``.
+    ValueError
+        When the nodes or values are invalid or the policy unknown.
     """
     if out_of_range not in OUT_OF_RANGE_POLICIES:
         raise ValueError(f"out_of_range must be one of {OUT_OF_RANGE_POLICIES}, not {out_of_range!r}")
@@ -880,6 +1395,23 @@ def linearity_r2(temperatures, values) -> float:
 
     Used to test the report's conclusions 3)/4) of §1.5 ('nonlinear' for the gyro, 'approximately
     linear' for the accelerometer) on the tabulated values.
+
+    Parameters
+    ----------
+    temperatures : array_like, shape (n,)
+        Temperatures [°C], n ≥ 3.
+    values : array_like, shape (n,)
+        The parameter at each temperature, any unit.
+
+    Returns
+    -------
+    r2 : float
+        R² of the linear fit [1].
+
+    Raises
+    ------
+    ValueError
+        When fewer than three pairs are given, the lengths differ, or the values are constant.
     """
     t = np.asarray(temperatures, dtype=float)
     v = np.asarray(values, dtype=float)
@@ -901,6 +1433,21 @@ def half_unit(text: str) -> float:
     """Half a unit in the last printed digit of a number written as text ('0.454119' → 5e-7).
 
     Handles exponents ('9.309078e-4' → 5e-11) and spaces left by the extraction ('e -5').
+
+    Parameters
+    ----------
+    text : str
+        The printed number.
+
+    Returns
+    -------
+    half : float
+        Half a unit in the last digit, in the number's unit.
+
+    Raises
+    ------
+    ValueError
+        When ``text`` is not a printed number.
     """
     s = str(text).strip().replace(" ", "")
     m = re.fullmatch(r"[-+]?(\d*)(?:\.(\d*))?(?:[eE]([-+]?\d+))?", s)
@@ -913,7 +1460,19 @@ def half_unit(text: str) -> float:
 
 @dataclass(frozen=True)
 class SummaryCheck:
-    """A recomputed summary statistic with the bound that the printed rounding allows."""
+    """A recomputed summary statistic with the bound that the printed rounding allows.
+
+    Attributes
+    ----------
+    statistic : str
+        The statistic (``'mean'``, ``'std'``, ``'std0'``, ``'sum/<d>'``).
+    recomputed : float
+        Its value recomputed from the printed per-run values (their unit).
+    printed : float
+        The printed summary value.
+    tolerance : float
+        The largest difference the printed rounding allows (same unit).
+    """
 
     statistic: str
     recomputed: float
@@ -928,10 +1487,28 @@ class SummaryCheck:
 def summary_statistic(texts: Sequence[str], printed: str, statistic: str) -> SummaryCheck:
     """Recompute a summary row from per-run values printed as text, with a rounding tolerance.
 
-    ``statistic``: ``'mean'``; ``'std'`` (sample, n-1, the report's 'repeatability'); ``'std0'``
-    (population); ``'sum/<d>'`` (the sum divided by d, to test a wrong divisor).
-    Tolerance = propagated half-units of the inputs (mean: their average; std: ‖h‖₂/√(n-ddof),
-    a worst-case bound by the reverse triangle inequality) + half a unit of the printed summary.
+    Tolerance = propagated half-units of the inputs (mean: their average; std: ‖h‖₂/√(n-ddof), a
+    worst-case bound by the reverse triangle inequality) + half a unit of the printed summary.
+
+    Parameters
+    ----------
+    texts : sequence of str
+        The per-run values as printed (at least two).
+    printed : str
+        The printed summary value.
+    statistic : str
+        ``'mean'``; ``'std'`` (sample, n-1, the report's 'repeatability'); ``'std0'``
+        (population); ``'sum/<d>'`` (the sum divided by d, to test a wrong divisor).
+
+    Returns
+    -------
+    check : SummaryCheck
+        Recomputed and printed values with the tolerance (units of the printed values).
+
+    Raises
+    ------
+    ValueError
+        When fewer than two values are given or the statistic is unknown.
     """
     x = np.array([float(str(t).replace(" ", "")) for t in texts])
     h = np.array([half_unit(t) for t in texts])
@@ -954,8 +1531,25 @@ def summary_statistic(texts: Sequence[str], printed: str, statistic: str) -> Sum
 def digit_mismatch(printed: str, value: float) -> list[tuple[int, str, str]]:
     """Digits where ``printed`` differs from ``value`` written with the same mantissa length.
 
-    Returns [(position, printed digit, recomputed digit)], position counted in the mantissa; one
-    entry with the trailing digits equal is the signature of a single mistyped digit.
+    One entry with the trailing digits equal is the signature of a single mistyped digit.
+
+    Parameters
+    ----------
+    printed : str
+        A number printed in scientific notation, e.g. ``'1.253175e-5'``.
+    value : float
+        The recomputed value.
+
+    Returns
+    -------
+    mismatches : list of tuple (int, str, str)
+        (position in the mantissa, printed digit, recomputed digit); a single ``(-1, printed
+        exponent, recomputed exponent)`` when the exponents differ.
+
+    Raises
+    ------
+    ValueError
+        When ``printed`` is not in scientific notation.
     """
     s = str(printed).strip().replace(" ", "")
     m = re.fullmatch(r"([-+]?)(\d)\.(\d+)[eE]([-+]?\d+)", s)
@@ -973,9 +1567,23 @@ def digit_mismatch(printed: str, value: float) -> list[tuple[int, str, str]]:
 def match_in_order(values: Sequence[float], reference: Sequence[float], tol: float) -> list[int] | None:
     """An order-preserving assignment of ``values`` to entries of ``reference`` within ``tol``.
 
-    Returns the reference indices (increasing) or None when no assignment exists.  Used to
-    locate the 9 printed gyro runs of Table 4-33 among the 11 runs of Table 4-35 through the
-    Earth-rate magnitudes.  Depth-first search; the first (lexicographically smallest) assignment.
+    Used to locate the 9 printed gyro runs of Table 4-33 among the 11 runs of Table 4-35 through
+    the Earth-rate magnitudes.  Depth-first search; the first (lexicographically smallest)
+    assignment.
+
+    Parameters
+    ----------
+    values : sequence of float
+        Values to place, in order.
+    reference : sequence of float
+        Candidate entries, same unit.
+    tol : float
+        Largest accepted difference, same unit.
+
+    Returns
+    -------
+    indices : list of int or None
+        The reference indices (increasing), or None when no assignment exists.
     """
     vals, ref = list(values), list(reference)
 
@@ -995,11 +1603,33 @@ def match_in_order(values: Sequence[float], reference: Sequence[float], tol: flo
 def reconstruct_missing_pair(rows, mean, std, n_total: int, ddof: int = 1) -> list[tuple[np.ndarray, np.ndarray]]:
     """The two unprinted rows implied by printed column means and standard deviations.
 
-    ``rows`` (n_total-2, k) printed rows; ``mean``, ``std`` (k,) the printed summary over all
-    n_total runs.  Per column, the missing pair has sum S = n·mean - Σrows and sum of squares
-    Q = (n-ddof)·std² + n·mean² - Σrows²; its values are S/2 ± √(2Q - S²)/2.  Returns the 2^(k-1)
-    ways to pair the columns' roots into two rows (empty list when 2Q < S² in a column: then no
-    pair of rows can produce the printed summary).
+    Per column, the missing pair has sum S = n·mean - Σrows and sum of squares Q = (n-ddof)·std² +
+    n·mean² - Σrows²; its values are S/2 ± √(2Q - S²)/2.
+
+    Parameters
+    ----------
+    rows : array_like, shape (n_total - 2, k)
+        The printed rows.
+    mean : array_like, shape (k,)
+        The printed column means over all ``n_total`` runs.
+    std : array_like, shape (k,)
+        The printed column standard deviations.
+    n_total : int
+        Number of runs including the two missing ones.
+    ddof : int
+        Delta degrees of freedom of the printed standard deviation.
+
+    Returns
+    -------
+    pairs : list of tuple (ndarray, ndarray)
+        The 2^(k-1) ways to pair the columns' roots into two rows, each of shape (k,) in the unit
+        of ``rows``; empty when 2Q < S² in a column (then no pair of rows can produce the printed
+        summary).
+
+    Raises
+    ------
+    ValueError
+        When the shapes do not fit.
     """
     r = np.asarray(rows, dtype=float)
     mu, sd = np.asarray(mean, dtype=float), np.asarray(std, dtype=float)
@@ -1027,10 +1657,36 @@ def simulate_static_sensor(duration: float, sample_rate: float, *, constant: flo
                            gm_sigma: float = 0.0, gm_tau: float = 1.0, rng=None) -> np.ndarray:
     """A static sensor error series: random constant + first-order Gauss-Markov + white, chen2019 (2-4)-(2-5).
 
-    ε = ε_b + ε_m + w_g with ε̇_b = 0, ε̇_m = -ε_m/τ + w_m (the printed (2-5) lost the dots),
-    white noise of density ``white_density`` (units/√Hz; per-sample std density·√fs) and a
-    stationary Gauss-Markov process of standard deviation ``gm_sigma`` and correlation time
-    ``gm_tau`` (s), discretized exactly: x_{k+1} = e^{-Δt/τ} x_k + σ √(1 - e^{-2Δt/τ}) w_k.
+    ε = ε_b + ε_m + w_g with ε̇_b = 0, ε̇_m = -ε_m/τ + w_m (the printed (2-5) lost the dots), white
+    noise of per-sample std density·√fs and a stationary Gauss-Markov process, discretized
+    exactly: x_{k+1} = e^{-Δt/τ} x_k + σ √(1 - e^{-2Δt/τ}) w_k.
+
+    Parameters
+    ----------
+    duration : float
+        Length of the series [s].
+    sample_rate : float
+        Sampling rate [Hz].
+    constant : float
+        Random constant ε_b (any unit, e.g. rad/s).
+    white_density : float
+        White-noise density [unit/√Hz].
+    gm_sigma : float
+        Stationary standard deviation of the Gauss-Markov process [unit].
+    gm_tau : float
+        Its correlation time [s].
+    rng : numpy.random.Generator
+        Seeded generator (required).
+
+    Returns
+    -------
+    y : ndarray, shape (round(duration · sample_rate),)
+        The error series, unit of ``constant``.
+
+    Raises
+    ------
+    ValueError
+        When an argument is out of range or ``rng`` is missing.
     """
     duration = positive(duration, "duration", "{name} must be a positive finite number of seconds, got {value!r}")
     sample_rate = positive(sample_rate, "sample_rate", "{name} must be a positive finite rate (Hz), got {value!r}")
@@ -1054,7 +1710,27 @@ def simulate_static_sensor(duration: float, sample_rate: float, *, constant: flo
 def allan_deviation(y, sample_rate: float, taus=None) -> tuple[np.ndarray, np.ndarray]:
     """Overlapping Allan deviation of a rate series (``allantools.oadev``, data_type 'freq').
 
-    Returns (tau, adev) with adev in the units of ``y``; ``taus`` defaults to octaves.
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        Finite rate samples, n ≥ 3, any unit.
+    sample_rate : float
+        Sampling rate [Hz].
+    taus : array_like or str or None
+        Averaging times [s] or an ``allantools`` keyword (``None``: octaves).
+
+    Returns
+    -------
+    tau : ndarray, shape (m,)
+        Averaging times used [s].
+    adev : ndarray, shape (m,)
+        Allan deviation, unit of ``y``.
+
+    Raises
+    ------
+    ValueError
+        When ``y`` is not a finite 1-D series of at least 3 samples, or a rate or tau is not
+        positive.
     """
     import allantools
 
@@ -1073,6 +1749,25 @@ def bias_stability(y, sample_rate: float, window: float) -> float:
 
     The usual laboratory definition (e.g. GJB 2426A: 10 s smoothing over the test); the report
     does not state its window, so chapters treat it as a sensitivity.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        Rate samples, any unit.
+    sample_rate : float
+        Sampling rate [Hz].
+    window : float
+        Averaging time [s].
+
+    Returns
+    -------
+    stability : float
+        Sample standard deviation of the window means, unit of ``y``.
+
+    Raises
+    ------
+    ValueError
+        When a rate or window is not positive or the series holds fewer than two windows.
     """
     y = finite_array(y, "y")
     sample_rate = positive(sample_rate, "sample_rate", "{name} must be a positive finite rate (Hz), got {value!r}")
@@ -1097,12 +1792,33 @@ def paper_triads(load, temperature: int, *, missing_signs: Mapping[str, float] |
                  accel_scale_unit: float = 1e-5) -> dict[str, SensorTriad]:
     """Gyro and accelerometer triads from the printed tables of one temperature.
 
-    ``load`` is :func:`replication.registry.reproduction.load_paper`; units: gyro bias °/h, gyro scale
-    ″/pulse, accelerometer bias g, accelerometer scale factor in g·s/pulse: the printed header
-    says 1.0e-5 g·s/pulse; ``accel_scale_unit`` is the unit the printed *numbers* are read in
-    (1e-5 for Table 4-6; Tables 4-14/4-22/4-30 print numbers already in g·s/pulse, read them with
-    ``accel_scale_unit=1``).  ``missing_signs`` {'gyro': ±1, 'accel': ±1} gives the sign of the
-    element (1,3) lost in Tables 4-11/4-15 (filled by :func:`complete_unit_rows`).
+    Units of the tables: gyro bias °/h, gyro scale ″/pulse, accelerometer bias g, accelerometer
+    scale factor in g·s/pulse: the printed header says 1.0e-5 g·s/pulse.
+
+    Parameters
+    ----------
+    load : callable
+        :func:`replication.registry.reproduction.load_paper`.
+    temperature : int
+        A printed calibration temperature [°C] (:data:`TEMPERATURE_TABLES`).
+    missing_signs : Mapping[str, float] or None
+        {'gyro': ±1, 'accel': ±1}: the sign of the element (1,3) lost in Tables 4-11/4-15 (filled
+        by :func:`complete_unit_rows`).
+    accel_scale_unit : float
+        The unit the printed accelerometer scale *numbers* are read in [g·s/pulse] (1e-5 for
+        Table 4-6; Tables 4-14/4-22/4-30 print numbers already in g·s/pulse, read them with
+        ``accel_scale_unit=1``).
+
+    Returns
+    -------
+    triads : dict of str to SensorTriad
+        ``'gyro'`` (bias [rad/s], scale [rad/pulse]) and ``'accel'`` (bias [m/s²], scale
+        [m/s per pulse]), SI.
+
+    Raises
+    ------
+    ValueError
+        When no calibration is printed at ``temperature`` or a missing element's sign is not given.
     """
     if temperature not in TEMPERATURE_TABLES:
         raise ValueError(f"no printed calibration at {temperature} °C; printed: {sorted(TEMPERATURE_TABLES)}")

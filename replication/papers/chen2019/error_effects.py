@@ -36,10 +36,28 @@ __all__ = ["consequence_flight", "single_errors", "error_features", "error_effec
 
 
 def consequence_flight(*, dt: float = 0.05, lat0: float = 47 * DEG, lon0: float = 115 * DEG, h0: float = 6000.0):
-    """A 2-h flight at chen2019's conditions (47°N, 6000 m, 100 m/s) with four coordinated turns
-    (90°, 180°, -90°, 360°) between straight legs: rotations excite scale-factor and misalignment
-    errors, the straight legs show what persists.  At 20 Hz the error-free increments leave an
-    algorithm floor of ~0.1 m over the flight, below every effect studied here."""
+    """A 2-h flight at chen2019's conditions (47°N, 6000 m, 100 m/s) with four coordinated turns.
+
+    The turns (90°, 180°, -90°, 360°) lie between straight legs: rotations excite scale-factor and
+    misalignment errors, the straight legs show what persists.  At 20 Hz the error-free increments
+    leave an algorithm floor of ~0.1 m over the flight, below every effect studied here.
+
+    Parameters
+    ----------
+    dt : float
+        Sampling interval of the IMU increments [s].
+    lat0 : float
+        Initial latitude [rad].
+    lon0 : float
+        Initial longitude [rad].
+    h0 : float
+        Flight height [m].
+
+    Returns
+    -------
+    traj : replication.nav.trajectory.Trajectory
+        The true motion (7200 s) with its ideal increments and segment labels.
+    """
     segs = [tr.Straight(900.0), tr.Turn(60.0, np.pi / 2), tr.Straight(1500.0), tr.Turn(90.0, np.pi),
             tr.Straight(1500.0), tr.Turn(60.0, -np.pi / 2), tr.Straight(1500.0), tr.Turn(150.0, 2 * np.pi),
             tr.Straight(1440.0)]
@@ -48,8 +66,33 @@ def consequence_flight(*, dt: float = 0.05, lat0: float = 47 * DEG, lon0: float 
 
 def single_errors(*, gyro_bias_deg_h=0.01, accel_bias_ug=100.0, scale_ppm=100.0, misalignment_arcsec=10.0,
                   gyro_white_deg_rt_h=0.002, accel_white_ug_rt_hz=20.0) -> dict:
-    """One :class:`~replication.nav.sensors.ImuErrors` per error class and triad, each holding a
-    single error on all three axes (defaults: navigation-grade values of chen2019 ch. 2)."""
+    """One :class:`~replication.nav.sensors.ImuErrors` per error class and triad.
+
+    Each holds a single error on all three axes (defaults: navigation-grade values of chen2019
+    ch. 2), converted to SI units.
+
+    Parameters
+    ----------
+    gyro_bias_deg_h : float
+        Gyro constant drift [°/h].
+    accel_bias_ug : float
+        Accelerometer constant bias [μg], g = 9.80665 m/s².
+    scale_ppm : float
+        Scale-factor error of either triad [ppm].
+    misalignment_arcsec : float
+        Each of the six misalignment angles of either triad [″].
+    gyro_white_deg_rt_h : float
+        Gyro angle random walk [°/√h].
+    accel_white_ug_rt_hz : float
+        Accelerometer white-noise density [μg/√Hz].
+
+    Returns
+    -------
+    errors : dict
+        ``(error class, triad)`` -> :class:`~replication.nav.sensors.ImuErrors`, with error class
+        one of ``"bias"``, ``"scale factor"``, ``"misalignment"``, ``"random noise"`` and triad
+        ``"gyro"`` or ``"accel"``.
+    """
     d = {}
     for triad in ("gyro", "accel"):
         bias = np.full(3, gyro_bias_deg_h * DEG / 3600.0 if triad == "gyro" else accel_bias_ug * 9.80665e-6)
@@ -72,8 +115,35 @@ def _turning(traj):
 
 
 def error_features(traj, errors: ImuErrors, *, seed=0) -> dict:
-    """Inject ``errors`` into ``traj``'s ideal increments, navigate (height held) and reduce the
-    error histories to the features of the module docstring.  Returns a dict of floats."""
+    """Inject ``errors`` into ``traj``'s ideal increments, navigate (height held) and reduce the error histories.
+
+    The features are those of the module docstring.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true motion with its ideal increments (e.g. :func:`consequence_flight`).
+    errors : replication.nav.sensors.ImuErrors
+        The sensor errors to inject (chen2019 eq. (2-10)).
+    seed : int or numpy.random.Generator or None
+        Seed of the random-noise and Markov draws (``rng`` of
+        :func:`replication.nav.sensors.apply_imu_errors`).
+
+    Returns
+    -------
+    features : dict of float
+        ``pos_end``, ``pos_half``, ``pos_max`` (horizontal position error at the end, at half time,
+        largest [m]); ``tilt_max``, ``heading_max`` (largest level and azimuth attitude error
+        [rad]); ``heading_turns`` (share of the turns in the net heading-error changes over the
+        segments [1]); ``turning_fraction`` (share of the increments taken while turning [1]);
+        ``tilt_rms_half``, ``tilt_rms_end`` (RMS level attitude error over the first and the second
+        half of the samples [rad]).
+
+    Raises
+    ------
+    TypeError
+        When ``errors`` is not an ``ImuErrors``.
+    """
     if not isinstance(errors, ImuErrors):
         raise TypeError("errors must be a replication.nav.sensors.ImuErrors")
     dth, dv, _ = apply_imu_errors(traj.t, traj.dtheta, traj.dv, errors, rng=seed)
@@ -101,9 +171,33 @@ def error_features(traj, errors: ImuErrors, *, seed=0) -> dict:
 
 
 def error_effects(traj=None, errors: dict | None = None, *, noise_runs: int = 4, seed: int = 2019):
-    """:func:`error_features` for every entry of ``errors`` (default :func:`single_errors`);
-    random-noise entries are averaged over ``noise_runs`` realisations.  Returns a DataFrame
-    indexed by (error class, triad)."""
+    """:func:`error_features` for every entry of ``errors``.
+
+    Random-noise entries are averaged over ``noise_runs`` realisations.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory or None
+        The true motion; ``None`` for :func:`consequence_flight`.
+    errors : dict or None
+        Key -> :class:`~replication.nav.sensors.ImuErrors`; ``None`` for :func:`single_errors`
+        (keys ``(error class, triad)``).
+    noise_runs : int
+        Number of realisations averaged for an entry with white noise (≥ 1).
+    seed : int
+        Seed of the first realisation (realisation k uses ``seed + k``).
+
+    Returns
+    -------
+    effects : pandas.DataFrame
+        Indexed by (error class, triad) (index names ``error``, ``triad``); one column per feature
+        of :func:`error_features`, in its units (m, rad, 1).
+
+    Raises
+    ------
+    ValueError
+        When ``noise_runs`` is not a positive integer.
+    """
 
     traj = consequence_flight() if traj is None else traj
     errors = single_errors() if errors is None else errors
@@ -132,8 +226,20 @@ CONSEQUENCE_RULES = {
 
 
 def classify(effects) -> dict:
-    """Apply :data:`CONSEQUENCE_RULES` to an :func:`error_effects` table: per error class, whether
-    the printed consequence holds (bool) and the numbers behind it (text)."""
+    """Apply :data:`CONSEQUENCE_RULES` to an :func:`error_effects` table.
+
+    Parameters
+    ----------
+    effects : pandas.DataFrame
+        The table of :func:`error_effects` with the default keys of :func:`single_errors`.
+
+    Returns
+    -------
+    verdicts : dict
+        Per error class of Table 2-1 (``"bias error"``, ``"scale-factor error"``,
+        ``"misalignment error"``, ``"random noise"``): a tuple (bool, str), whether the printed
+        consequence holds and the numbers behind it (km, %, ″, m as written in the text).
+    """
     f = effects
     out = {}
     b = f.loc["bias"]

@@ -66,14 +66,35 @@ __all__ = [
 # --------------------------------------------------------------------------- synthetic field
 
 def vertical_psd(k, sigma: float, correlation_length: float, altitude: float = 0.0):
-    """2-D power spectral density of the vertical disturbance component ((m/s²)² m²).
+    """2-D power spectral density of the vertical disturbance component.
 
-    Covariance model: at ground level (z = 0) the vertical component is an isotropic process
-    with the exponential (planar first-order Markov) covariance C(r) = sigma² exp(-r/D),
+    Covariance model: at ground level (z = 0) the vertical component is an isotropic process with
+    the exponential (planar first-order Markov) covariance C(r) = sigma² exp(-r/D),
     D = ``correlation_length``; its 2-D spectrum is S(k) = 2 pi sigma² D² / (1 + (k D)²)^{3/2}
-    (k in rad/m).  Harmonic upward continuation to ``altitude`` multiplies by exp(-2 k h).
-    For a harmonic field the horizontal components have S_x = (k_x/k)² S and S_y = (k_y/k)² S,
-    so each carries half of the vertical variance.
+    (k in rad/m).  Harmonic upward continuation to ``altitude`` multiplies by exp(-2 k h).  For a
+    harmonic field the horizontal components have S_x = (k_x/k)² S and S_y = (k_y/k)² S, so each
+    carries half of the vertical variance.
+
+    Parameters
+    ----------
+    k : array_like
+        Radial wavenumber [rad/m].
+    sigma : float
+        Standard deviation of the vertical component at ground level [m/s²].
+    correlation_length : float
+        Correlation length D of the exponential covariance [m].
+    altitude : float
+        Height of upward continuation [m], ≥ 0.
+
+    Returns
+    -------
+    S : ndarray, shape of ``k``
+        Power spectral density [(m/s²)² m²].
+
+    Raises
+    ------
+    ValueError
+        When ``sigma`` or ``correlation_length`` is not positive or ``altitude`` is negative.
     """
     k = np.asarray(k, dtype=float)
     if not (sigma > 0 and correlation_length > 0 and altitude >= 0):
@@ -83,10 +104,31 @@ def vertical_psd(k, sigma: float, correlation_length: float, altitude: float = 0
 
 
 def field_std(sigma: float, correlation_length: float, altitude: float) -> tuple[float, float]:
-    """Standard deviations (vertical, each horizontal) of the model at ``altitude`` (m/s²).
+    """Standard deviations (vertical, each horizontal) of the model at ``altitude``.
 
     var_z(h) = (1/2 pi) int_0^inf S(k) k dk = sigma² int_0^inf u (1 + u²)^{-3/2} exp(-2 u h / D) du
     (u = k D; the integral is 1 at ground level), var_x = var_y = var_z / 2.
+
+    Parameters
+    ----------
+    sigma : float
+        Standard deviation of the vertical component at ground level [m/s²].
+    correlation_length : float
+        Correlation length D [m].
+    altitude : float
+        Height [m], ≥ 0.
+
+    Returns
+    -------
+    std_vertical : float
+        Standard deviation of the vertical component at ``altitude`` [m/s²].
+    std_horizontal : float
+        Standard deviation of each horizontal component [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When ``sigma`` or ``correlation_length`` is not positive or ``altitude`` is negative.
     """
     if not (sigma > 0 and correlation_length > 0 and altitude >= 0):
         raise ValueError("sigma and correlation_length must be positive and altitude >= 0 (SI units)")
@@ -100,7 +142,23 @@ def field_std(sigma: float, correlation_length: float, altitude: float) -> tuple
 class PlanarGravityField:
     """A gravity-disturbance field on a regular east/north grid at a fixed altitude.
 
-    ``dg`` has shape (n_north, n_east, 3): the ENU disturbance vector (m/s²) at each node.
+    Attributes
+    ----------
+    east : ndarray, shape (n_east,)
+        East coordinates of the grid nodes [m], increasing.
+    north : ndarray, shape (n_north,)
+        North coordinates of the grid nodes [m], increasing.
+    dg : ndarray, shape (n_north, n_east, 3)
+        The ENU disturbance vector at each node [m/s²].
+    sigma : float
+        Standard deviation of the vertical component at ground level of the generating model
+        [m/s²].
+    correlation_length : float
+        Correlation length of the generating model [m].
+    altitude : float
+        Altitude of the field [m].
+    seed : int or None
+        Seed of the synthesis.
     """
 
     east: np.ndarray
@@ -118,9 +176,24 @@ class PlanarGravityField:
         ]
 
     def sample(self, east, north) -> np.ndarray:
-        """Disturbance vector (m/s², shape (..., 3), ENU) at planar positions (m), bilinear.
+        """Disturbance vector at planar positions, bilinear interpolation.
 
-        Raises ``ValueError`` when a position lies outside the grid (enlarge the field).
+        Parameters
+        ----------
+        east : array_like
+            East coordinates [m] (broadcast against ``north``).
+        north : array_like
+            North coordinates [m].
+
+        Returns
+        -------
+        dg : ndarray, shape (..., 3)
+            ENU disturbance vector [m/s²], leading shape that of the broadcast positions.
+
+        Raises
+        ------
+        ValueError
+            When a position lies outside the grid (enlarge the field).
         """
         e = np.asarray(east, dtype=float)
         n = np.asarray(north, dtype=float)
@@ -141,13 +214,40 @@ def synthetic_field(
 ) -> PlanarGravityField:
     """A random harmonic gravity-disturbance field (spectral synthesis by FFT).
 
-    One disturbing potential T generates all three components: with T-hat(k) exp(-k z) the
-    Fourier coefficients are dg_x = i k_x T-hat, dg_y = i k_y T-hat, dg_z = -k T-hat, so
-    dg_x = -i (k_x/k) dg_z and dg_y = -i (k_y/k) dg_z.  The vertical component has the
-    spectrum :func:`vertical_psd` (exponential covariance, sigma, D at ground level, upward
-    continued to ``altitude``).  Defaults: sigma = 30 mGal (the 20-50 mGal of chen2019
-    Fig. 3-2, Texas-Oklahoma), D = 10 km, altitude 500 m (Table 4-47 relative height).
-    The grid is periodic: make it several D larger than the track.  Grid origin at (0, 0).
+    One disturbing potential T generates all three components: with T-hat(k) exp(-k z) the Fourier
+    coefficients are dg_x = i k_x T-hat, dg_y = i k_y T-hat, dg_z = -k T-hat, so
+    dg_x = -i (k_x/k) dg_z and dg_y = -i (k_y/k) dg_z.  The vertical component has the spectrum
+    :func:`vertical_psd` (exponential covariance, sigma, D at ground level, upward continued to
+    ``altitude``).  The grid is periodic: make it several D larger than the track.  Grid origin at
+    (0, 0).
+
+    Parameters
+    ----------
+    extent_east : float
+        East extent of the grid [m].
+    extent_north : float
+        North extent of the grid [m].
+    spacing : float
+        Grid spacing [m], below an eighth of each extent and ≤ D/5.
+    sigma : float
+        Standard deviation of the vertical component at ground level [m/s²]; default 30 mGal (the
+        20-50 mGal of chen2019 Fig. 3-2, Texas-Oklahoma).
+    correlation_length : float
+        Correlation length D [m]; default 10 km.
+    altitude : float
+        Altitude of the field [m]; default 500 m (Table 4-47 relative height).
+    seed : int
+        Seed of the synthesis (required).
+
+    Returns
+    -------
+    field : PlanarGravityField
+        The field, mean removed (a disturbance field has no mean over a large area).
+
+    Raises
+    ------
+    ValueError
+        When the extents or spacing are out of range.
     """
     if not (extent_east > 0 and extent_north > 0 and 0 < spacing < min(extent_east, extent_north) / 8):
         raise ValueError("extents must be positive and spacing smaller than an eighth of each extent (m)")
@@ -175,11 +275,36 @@ def survey_lines(n_lines: int, line_length: float, spacing: float, speed: float,
                  start=(0.0, 0.0)) -> dict:
     """Planar east-west survey pattern (chen2019 Table 4-47: east-west strips) sampled in time.
 
-    Lines of ``line_length`` (m), ``spacing`` (m) apart northwards, flown alternately eastwards
-    and westwards and joined by semicircular turns of radius spacing/2, at constant ground
-    ``speed`` (m/s).  Space becomes time through t = s/speed (arc length s).  Returns a dict of
-    arrays: ``t`` (s), ``east``, ``north`` (m), ``heading`` (rad, from north, clockwise),
-    ``on_line`` (bool: straight segment, not a turn), ``line`` (index, -1 in turns).
+    Lines of ``line_length``, ``spacing`` apart northwards, flown alternately eastwards and
+    westwards and joined by semicircular turns of radius spacing/2, at constant ground ``speed``.
+    Space becomes time through t = s/speed (arc length s).
+
+    Parameters
+    ----------
+    n_lines : int
+        Number of lines (positive).
+    line_length : float
+        Length of each line [m].
+    spacing : float
+        Distance between lines [m].
+    speed : float
+        Ground speed [m/s].
+    dt : float
+        Sampling interval [s].
+    start : tuple of float
+        East, north offset of the pattern [m].
+
+    Returns
+    -------
+    track : dict of ndarray
+        ``t`` [s], ``east``, ``north`` [m], ``heading`` (from north, clockwise) [rad],
+        ``on_line`` (bool: straight segment, not a turn), ``line`` (index, -1 in turns); one entry
+        per sample.
+
+    Raises
+    ------
+    ValueError
+        When ``n_lines`` is not a positive integer or a length, speed or interval is not positive.
     """
     if int(n_lines) != n_lines or n_lines < 1:
         raise ValueError("n_lines must be a positive integer")
@@ -219,7 +344,25 @@ def survey_lines(n_lines: int, line_length: float, spacing: float, speed: float,
 # --------------------------------------------------------------------------- direct difference
 
 def specific_force_nav(C_bn, f_b) -> np.ndarray:
-    """f^n = C_b^n f^b for arrays of DCMs (..., 3, 3) and specific forces (..., 3)."""
+    """f^n = C_b^n f^b for arrays of DCMs and specific forces.
+
+    Parameters
+    ----------
+    C_bn : array_like, shape (..., 3, 3)
+        Body-to-ENU attitude matrices.
+    f_b : array_like, shape (..., 3)
+        Specific force in the body frame [m/s²].
+
+    Returns
+    -------
+    f_n : ndarray, shape (..., 3)
+        Specific force in the navigation (ENU) frame [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When the shapes do not fit.
+    """
     C = np.asarray(C_bn, dtype=float)
     f = np.asarray(f_b, dtype=float)
     if C.shape[-2:] != (3, 3) or f.shape[-1] != 3:
@@ -233,13 +376,39 @@ def _coriolis_transport(v, lat, h):
 
 
 def direct_difference(v_dot, v, lat, h, *, f_n=None, C_bn=None, f_b=None) -> np.ndarray:
-    """Direct-difference gravity disturbance, chen2019 eq. (3-7) (m/s², ENU).
+    """Direct-difference gravity disturbance, chen2019 eq. (3-7).
 
-    delta g^n = dV^n/dt - C_b^n f^b + (2 omega_ie^n + omega_en^n) x V^n - g_m^n, with the GNSS
-    kinematic acceleration ``v_dot``, the GNSS velocity ``v`` (both (..., 3) ENU), latitude (rad),
-    height (m), and either the navigation-frame specific force ``f_n`` or ``C_bn`` and ``f_b``.
-    g_m^n = [0, 0, -gamma(L, h)] is WGS-84 normal gravity (:func:`replication.nav.earth.gravity_enu`;
-    the (0, 0, gamma) printed in (3-1) is the same vector with an up-positive magnitude).
+    delta g^n = dV^n/dt - C_b^n f^b + (2 omega_ie^n + omega_en^n) x V^n - g_m^n, with
+    g_m^n = [0, 0, -gamma(L, h)] the WGS-84 normal gravity (:func:`replication.nav.earth.gravity_enu`;
+    the (0, 0, gamma) printed in (3-1) is the same vector with an up-positive magnitude).  Give
+    either ``f_n`` or both ``C_bn`` and ``f_b``.
+
+    Parameters
+    ----------
+    v_dot : array_like, shape (..., 3)
+        GNSS kinematic acceleration, ENU [m/s²].
+    v : array_like, shape (..., 3)
+        GNSS velocity, ENU [m/s].
+    lat : float or array_like
+        Latitude [rad] (broadcast against the vectors' leading axes).
+    h : float or array_like
+        Height [m].
+    f_n : array_like, shape (..., 3), optional
+        Specific force in the navigation frame [m/s²].
+    C_bn : array_like, shape (..., 3, 3), optional
+        Body-to-ENU attitude matrices (with ``f_b``).
+    f_b : array_like, shape (..., 3), optional
+        Specific force in the body frame [m/s²] (with ``C_bn``).
+
+    Returns
+    -------
+    dg : ndarray, shape (..., 3)
+        Disturbance vector delta g^n, ENU [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When neither ``f_n`` nor both ``C_bn`` and ``f_b`` are given, or a last axis is not 3.
     """
     if f_n is None:
         if C_bn is None or f_b is None:
@@ -254,15 +423,36 @@ def direct_difference(v_dot, v, lat, h, *, f_n=None, C_bn=None, f_b=None) -> np.
 
 
 def direct_difference_error(psi, f_n, bias_n=0.0, v_dot_error=0.0) -> np.ndarray:
-    """First-order error of the direct difference, chen2019 eq. (3-8), dominant terms (m/s²).
+    """First-order error of the direct difference, chen2019 eq. (3-8), dominant terms.
 
     delta(delta g^n) ~= delta(dV/dt) - psi^n x f^n - C_b^n nabla_b: the GNSS acceleration error,
-    the attitude error acting on the specific force and the accelerometer bias in the
-    navigation frame (``bias_n`` = C_b^n nabla_b).  The attitude error follows chen2019 (3-4),
-    delta f^n = psi^n x f^n + C_b^n nabla_b, i.e. the computed DCM is (I + [psi x]) C_b^n
-    (the opposite sign of psi to Titterton & Weston's convention).  The Coriolis/transport and normal-gravity
-    perturbation terms of (3-8) are below 0.1 mGal for an aircraft with metre-level position
-    and cm/s velocity errors and are omitted.
+    the attitude error acting on the specific force and the accelerometer bias in the navigation
+    frame.  The attitude error follows chen2019 (3-4), delta f^n = psi^n x f^n + C_b^n nabla_b,
+    i.e. the computed DCM is (I + [psi x]) C_b^n (the opposite sign of psi to Titterton &
+    Weston's convention).  The Coriolis/transport and normal-gravity perturbation terms of (3-8)
+    are below 0.1 mGal for an aircraft with metre-level position and cm/s velocity errors and are
+    omitted.
+
+    Parameters
+    ----------
+    psi : array_like, shape (..., 3)
+        Attitude error psi^n, ENU [rad].
+    f_n : array_like, shape (..., 3)
+        Specific force in the navigation frame [m/s²].
+    bias_n : float or array_like, shape (..., 3)
+        Accelerometer bias in the navigation frame, C_b^n nabla_b [m/s²].
+    v_dot_error : float or array_like, shape (..., 3)
+        Error of the GNSS kinematic acceleration [m/s²].
+
+    Returns
+    -------
+    error : ndarray, shape (..., 3)
+        Error of the direct-difference disturbance, ENU [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When ``psi`` or ``f_n`` does not have a last axis of length 3.
     """
     psi = np.asarray(psi, dtype=float)
     f_n = np.asarray(f_n, dtype=float)
@@ -272,10 +462,22 @@ def direct_difference_error(psi, f_n, bias_n=0.0, v_dot_error=0.0) -> np.ndarray
 
 
 def attitude_error_equivalent(level_error_rad, g: float = 9.8) -> float:
-    """Horizontal direct-difference error g x (level attitude error) (m/s²), chen2019 eq. (3-8).
+    """Horizontal direct-difference error g x (level attitude error), chen2019 eq. (3-8).
 
-    In level flight f^n ~ [0, 0, g], so (psi x f)_E = psi_N g and (psi x f)_N = -psi_E g:
-    each radian of level error is g m/s² of apparent horizontal disturbance.
+    In level flight f^n ~ [0, 0, g], so (psi x f)_E = psi_N g and (psi x f)_N = -psi_E g: each
+    radian of level error is g m/s² of apparent horizontal disturbance.
+
+    Parameters
+    ----------
+    level_error_rad : float
+        Level attitude error [rad].
+    g : float
+        Gravity magnitude [m/s²].
+
+    Returns
+    -------
+    error : float
+        Magnitude of the apparent horizontal disturbance [m/s²].
     """
     return float(abs(level_error_rad) * g)
 
@@ -283,10 +485,30 @@ def attitude_error_equivalent(level_error_rad, g: float = 9.8) -> float:
 # --------------------------------------------------------------------------- GNSS acceleration
 
 def gnss_acceleration(x, dt: float, *, source: str = "velocity") -> np.ndarray:
-    """Kinematic acceleration from GNSS velocity (first derivative) or position (second), (..., 3) or 1-D.
+    """Kinematic acceleration from GNSS velocity (first derivative) or position (second).
 
     Central differences along axis 0: velocity a_k = (v_{k+1} - v_{k-1}) / (2 dt); position
     a_k = (p_{k+1} - 2 p_k + p_{k-1}) / dt².  The end samples repeat their neighbours.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,) or (n, ...)
+        Velocity [m/s] or position [m] samples (at least three), e.g. (n, 3) ENU.
+    dt : float
+        Sampling interval [s].
+    source : str
+        ``"velocity"`` (first derivative of GNSS velocity) or ``"position"`` (second derivative
+        of GNSS position).
+
+    Returns
+    -------
+    a : ndarray, shape of ``x``
+        Acceleration [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When ``dt`` is not positive, fewer than three samples are given, or ``source`` is unknown.
     """
     x = np.asarray(x, dtype=float)
     if not dt > 0:
@@ -309,6 +531,26 @@ def differentiation_noise_std(sigma: float, dt: float, *, source: str = "velocit
 
     Velocity noise sigma_v: sigma_a = sigma_v / (sqrt(2) dt); position noise sigma_p:
     sigma_a = sqrt(6) sigma_p / dt².
+
+    Parameters
+    ----------
+    sigma : float
+        Standard deviation of the white velocity [m/s] or position [m] noise.
+    dt : float
+        Sampling interval [s].
+    source : str
+        ``"velocity"`` (first derivative of GNSS velocity) or ``"position"`` (second derivative
+        of GNSS position).
+
+    Returns
+    -------
+    sigma_a : float
+        Standard deviation of the acceleration noise [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When ``sigma`` is negative, ``dt`` not positive, or ``source`` unknown.
     """
     if not (sigma >= 0 and dt > 0):
         raise ValueError("sigma must be >= 0 and dt > 0")
@@ -330,10 +572,31 @@ def _butter(dt, cutoff_period, order):
 def lowpass(x, dt: float, cutoff_period: float, *, order: int = 4) -> np.ndarray:
     """Zero-phase Butterworth low-pass (forward-backward, ``sosfiltfilt``) along axis 0.
 
-    ``cutoff_period`` (s) is the period of the -6 dB point of the forward-backward filter's
-    amplitude response (the half-power point of the single pass); airborne gravimetry uses
-    periods of the order of 100 s.  The ends are padded by even reflection (no step from a noisy end sample) over three cut-off
-    periods so that edge transients stay within the first and last few periods.
+    ``cutoff_period`` is the period of the -6 dB point of the forward-backward filter's amplitude
+    response (the half-power point of the single pass); airborne gravimetry uses periods of the
+    order of 100 s.  The ends are padded by even reflection (no step from a noisy end sample) over
+    three cut-off periods so that edge transients stay within the first and last few periods.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,) or (n, ...)
+        Samples, any unit.
+    dt : float
+        Sampling interval [s].
+    cutoff_period : float
+        Cut-off period [s], longer than two samples.
+    order : int
+        Order of the single-pass Butterworth filter.
+
+    Returns
+    -------
+    y : ndarray, shape of ``x``
+        Filtered samples, unit of ``x``.
+
+    Raises
+    ------
+    ValueError
+        When the cut-off period is not longer than two samples.
     """
     x = np.asarray(x, dtype=float)
     padlen = min(x.shape[0] - 1, int(3 * cutoff_period / dt))  # cover the impulse response, not scipy's default
@@ -344,9 +607,33 @@ def filtered_differentiation_noise_std(sigma: float, dt: float, cutoff_period: f
                                        source: str = "velocity", order: int = 4) -> float:
     """Acceleration noise std after :func:`gnss_acceleration` and :func:`lowpass` of white noise.
 
-    var = sigma² (1/pi) int_0^pi |D(w)|² |H(w)|^4 dw with the central-difference responses
-    |D| = |sin w| / dt (velocity) or |2 cos w - 2| / dt² (position) and the single-pass
+    var = sigma² (1/pi) int_0^pi abs(D(w))² abs(H(w))^4 dw with the central-difference responses
+    abs(D) = abs(sin w) / dt (velocity) or abs(2 cos w - 2) / dt² (position) and the single-pass
     Butterworth response H (applied twice by the forward-backward filter).
+
+    Parameters
+    ----------
+    sigma : float
+        Standard deviation of the white velocity [m/s] or position [m] noise.
+    dt : float
+        Sampling interval [s].
+    cutoff_period : float
+        Cut-off period of :func:`lowpass` [s].
+    source : str
+        ``"velocity"`` (first derivative of GNSS velocity) or ``"position"`` (second derivative
+        of GNSS position).
+    order : int
+        Order of the single-pass Butterworth filter.
+
+    Returns
+    -------
+    sigma_a : float
+        Standard deviation of the filtered acceleration noise [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When ``source`` is unknown or the cut-off period is not longer than two samples.
     """
     sos = _butter(dt, cutoff_period, order)
     w, H = signal.sosfreqz(sos, worN=1 << 16)
@@ -366,8 +653,18 @@ def ar_companion(phi) -> np.ndarray:
     """Companion matrix of y_t = sum phi_i y_{t-i} + w_t for the state x_t = [y_t, ..., y_{t-p+1}].
 
     x_{t+1} = A x_t + e_1 w_{t+1} with A's first row phi and ones on the sub-diagonal; its
-    eigenvalues are the poles (:func:`replication.nav.timeseries.ar_poles`).  The gravity-disturbance
-    state delta d of chen2019 eq. (3-17) for one axis.
+    eigenvalues are the poles (:func:`replication.nav.timeseries.ar_poles`).  The
+    gravity-disturbance state delta d of chen2019 eq. (3-17) for one axis.
+
+    Parameters
+    ----------
+    phi : array_like, shape (p,)
+        AR coefficients phi_1 ... phi_p (dimensionless).
+
+    Returns
+    -------
+    A : ndarray, shape (p, p)
+        Companion matrix (dimensionless).
     """
     phi = ar_coefficients(phi)
     if phi.size == 1:
@@ -379,8 +676,26 @@ def ar_state_space(phi, dt: float):
     """The AR shaping filter as a python-control discrete state-space system (sampling time ``dt``).
 
     x_{k+1} = A x_k + B w_k, y_k = C x_k with A = :func:`ar_companion`, B = e_1, C = e_1^T, D = 0;
-    white input of variance sigma² gives the AR output.  (The one-step delay between w and y of
-    the state-space form does not change the output's statistics.)
+    white input of variance sigma² gives the AR output.  (The one-step delay between w and y of the
+    state-space form does not change the output's statistics.)
+
+    Parameters
+    ----------
+    phi : array_like, shape (p,)
+        AR coefficients (dimensionless).
+    dt : float
+        Sampling interval [s].
+
+    Returns
+    -------
+    sys : control.StateSpace
+        Discrete system with p states, one input and one output (output in the unit of the input
+        noise, e.g. m/s²).
+
+    Raises
+    ------
+    ValueError
+        When ``dt`` is not positive.
     """
     import control
 
@@ -397,9 +712,18 @@ def ar_state_space(phi, dt: float):
 class GravityAugmentation:
     """Block-diagonal AR shaping filters of the three disturbance components (chen2019 eq. 3-17).
 
-    ``A`` (n x n) discrete transition of the augmented states delta d, ``Q`` (n x n) its
-    process-noise covariance, ``S`` (3 x n) the selection delta g^n = S delta d, ``orders``
-    the AR order per axis (E, N, U), ``dt`` the sampling interval (s).
+    Attributes
+    ----------
+    A : ndarray, shape (n, n)
+        Discrete transition of the augmented states delta d over ``dt`` (dimensionless).
+    Q : ndarray, shape (n, n)
+        Its process-noise covariance [(m/s²)²].
+    S : ndarray, shape (3, n)
+        The selection delta g^n = S delta d (ENU).
+    orders : tuple of int
+        The AR order per axis (E, N, U); n is their sum.
+    dt : float
+        The sampling interval [s].
     """
 
     A: np.ndarray
@@ -412,9 +736,28 @@ class GravityAugmentation:
 def gravity_augmentation(models, dt: float, *, require_stationary: bool = True) -> GravityAugmentation:
     """Augmentation blocks F''' (discrete), G_2 Q G_2^T and the coupling selection of chen2019 (3-17).
 
-    ``models``: three (phi, sigma2) pairs for the E, N, U disturbance (sigma2 in (m/s²)² at the
-    filter's sampling interval ``dt``).  A non-stationary model is refused (its variance grows
-    without bound inside the filter) unless ``require_stationary=False``.
+    A non-stationary model is refused (its variance grows without bound inside the filter) unless
+    ``require_stationary=False``.
+
+    Parameters
+    ----------
+    models : sequence of tuple (phi, sigma2)
+        Three AR models for the E, N, U disturbance: coefficients (array_like, shape (p,)) and the
+        driving-noise variance [(m/s²)²] at the filter's sampling interval ``dt``.
+    dt : float
+        Sampling interval of the models [s].
+    require_stationary : bool
+        Refuse a model with a pole on or outside the unit circle.
+
+    Returns
+    -------
+    aug : GravityAugmentation
+        Transition, noise covariance and selection of the augmented states.
+
+    Raises
+    ------
+    ValueError
+        When not three models are given, a variance is not positive, or a model is not stationary.
     """
     models = list(models)
     if len(models) != 3:
@@ -446,8 +789,31 @@ def augment_transition(Phi, Q, aug: GravityAugmentation, velocity_rows=(3, 4, 5)
     """Augment a discrete error-state model with the disturbance states (chen2019 eqs. 3-15, 3-17).
 
     Phi_aug = [[Phi, Gamma], [0, A]], Q_aug = blockdiag(Q, Q_d), with Gamma = dt S on the
-    velocity-error rows (delta V-dot^n = ... + delta g^n, first order in dt).  ``Phi``/``Q``
-    are the navigation error model's n x n transition and noise covariance.
+    velocity-error rows (delta V-dot^n = ... + delta g^n, first order in dt).
+
+    Parameters
+    ----------
+    Phi : array_like, shape (n, n)
+        The navigation error model's transition over ``aug.dt``.
+    Q : array_like, shape (n, n)
+        Its process-noise covariance.
+    aug : GravityAugmentation
+        The disturbance states (m of them).
+    velocity_rows : sequence of int
+        The three velocity-error rows (E, N, U) of the n-state model.
+
+    Returns
+    -------
+    Phi_aug : ndarray, shape (n + m, n + m)
+        Augmented transition (Gamma in s).
+    Q_aug : ndarray, shape (n + m, n + m)
+        Augmented process-noise covariance.
+
+    Raises
+    ------
+    ValueError
+        When ``Phi`` and ``Q`` are not square of one size or ``velocity_rows`` is not three rows of
+        the model.
     """
     Phi = np.asarray(Phi, dtype=float)
     Q = np.asarray(Q, dtype=float)
@@ -469,11 +835,34 @@ def augment_transition(Phi, Q, aug: GravityAugmentation, velocity_rows=(3, 4, 5)
 
 
 def specific_force_measurement(f_n, v_gnss, a_gnss, lat, h) -> np.ndarray:
-    """The specific-force rows of the 9-dimensional measurement, chen2019 eq. (3-18) (m/s², ENU).
+    """The specific-force rows of the 9-dimensional measurement, chen2019 eq. (3-18).
 
     z_f = f^n + g_m^n - (2 omega_ie^n + omega_en^n) x V_GNSS - a_GNSS.  With true quantities
     z_f = -delta g^n, so the gravity-state block of H is -S (:class:`GravityAugmentation`);
     attitude and accelerometer-bias errors enter as psi x f^n and C_b^n nabla (3-4).
+
+    Parameters
+    ----------
+    f_n : array_like, shape (..., 3)
+        Specific force in the navigation frame [m/s²].
+    v_gnss : array_like, shape (..., 3)
+        GNSS velocity, ENU [m/s].
+    a_gnss : array_like, shape (..., 3)
+        GNSS kinematic acceleration, ENU [m/s²].
+    lat : float or array_like
+        Latitude [rad] (broadcast against the vectors' leading axes).
+    h : float or array_like
+        Height [m].
+
+    Returns
+    -------
+    z_f : ndarray, shape (..., 3)
+        Specific-force measurement, ENU [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When a last axis is not 3.
     """
     f_n = np.asarray(f_n, dtype=float)
     v = np.asarray(v_gnss, dtype=float)
@@ -492,14 +881,51 @@ def analog_direct_difference(field_: PlanarGravityField, *, n_lines: int, line_l
     """A simulated direct-difference disturbance series along survey lines (an analog, not flight data).
 
     The true disturbance is sampled along :func:`survey_lines` every ``gnss_dt``; the direct
-    difference (3-7) adds the errors of (3-8) that dominate for a navigation-grade SINS:
-    the acceleration noise of differentiated GNSS velocity (white, ``sigma_v`` per sample) and
-    the level attitude error psi (first-order Gauss-Markov, ``level_error_std`` rad,
-    ``level_error_tau`` s) acting on f^n ~ [0, 0, g]; the sum is low-passed
-    (:func:`lowpass`, ``cutoff_period``), three cut-off periods are dropped at each end
-    (edge transients) and the rest is decimated to ``out_dt``.  Returns a dict with
-    ``t`` (s), ``true`` (low-passed true disturbance, (n, 3) m/s²), ``measured`` ((n, 3) m/s²),
-    ``east``/``north`` (m) and ``on_line``.
+    difference (3-7) adds the errors of (3-8) that dominate for a navigation-grade SINS: the
+    acceleration noise of differentiated GNSS velocity (white, ``sigma_v`` per sample) and the
+    level attitude error psi (first-order Gauss-Markov) acting on f^n ~ [0, 0, g]; the sum is
+    low-passed (:func:`lowpass`, ``cutoff_period``), three cut-off periods are dropped at each end
+    (edge transients) and the rest is decimated to ``out_dt``.
+
+    Parameters
+    ----------
+    field_ : PlanarGravityField
+        The true disturbance field.
+    n_lines : int
+        Number of survey lines.
+    line_length : float
+        Length of each line [m].
+    spacing : float
+        Distance between lines [m].
+    speed : float
+        Ground speed [m/s].
+    seed : int
+        Seed of the noise draws.
+    gnss_dt : float
+        GNSS sampling interval [s].
+    sigma_v : float
+        Standard deviation of the white GNSS velocity noise per sample [m/s].
+    cutoff_period : float
+        Cut-off period of the low-pass [s].
+    level_error_std : float
+        Stationary standard deviation of each level attitude error [rad].
+    level_error_tau : float
+        Correlation time of the level attitude error [s].
+    out_dt : float
+        Output interval [s], an integer multiple of ``gnss_dt``.
+    start : tuple of float
+        East, north offset of the pattern in the field [m].
+
+    Returns
+    -------
+    series : dict of ndarray
+        ``t`` [s], ``true`` (low-passed true disturbance, (n, 3) ENU [m/s²]), ``measured``
+        ((n, 3) [m/s²]), ``east``/``north`` [m] and ``on_line`` (bool).
+
+    Raises
+    ------
+    ValueError
+        When ``out_dt`` is not a multiple of ``gnss_dt`` or the survey is too short for the filter.
     """
     step = int(round(out_dt / gnss_dt))
     if step < 1 or abs(step * gnss_dt - out_dt) > 1e-9:
@@ -530,8 +956,38 @@ def survey_flight(*, n_lines: int = 4, duration: float = 7200.0, turn_duration: 
 
     ``n_lines`` straight east/west lines joined by 180° coordinated U-turns of ``turn_duration``
     (alternately to the left and to the right, so that the lines step northwards), filling
-    ``duration`` at ground speed ``speed``; generated by :func:`replication.nav.trajectory.generate`
-    at the IMU interval ``dt`` (chen2019 Table 4-46: 100 Hz).
+    ``duration`` at ground speed ``speed``; generated by
+    :func:`replication.nav.trajectory.generate` at the IMU interval ``dt`` (chen2019 Table 4-46:
+    100 Hz).
+
+    Parameters
+    ----------
+    n_lines : int
+        Number of lines (positive).
+    duration : float
+        Total flight time [s].
+    turn_duration : float
+        Duration of each U-turn [s].
+    speed : float
+        Ground speed [m/s].
+    lat0 : float
+        Initial latitude [rad].
+    lon0 : float
+        Initial longitude [rad].
+    h0 : float
+        Flight height [m].
+    dt : float
+        IMU sampling interval [s].
+
+    Returns
+    -------
+    traj : replication.nav.trajectory.Trajectory
+        The true motion, first line eastwards.
+
+    Raises
+    ------
+    ValueError
+        When ``n_lines`` is not a positive integer or the turns leave no time for the lines.
     """
 
     if int(n_lines) != n_lines or n_lines < 1:
@@ -548,7 +1004,28 @@ def survey_flight(*, n_lines: int = 4, duration: float = 7200.0, turn_duration: 
 
 
 def local_east_north(lat, lon, lat0: float, lon0: float, h0: float = 0.0):
-    """Planar east/north offsets (m) from (lat0, lon0) for sampling a :class:`PlanarGravityField`."""
+    """Planar east/north offsets from (lat0, lon0) for sampling a :class:`PlanarGravityField`.
+
+    Parameters
+    ----------
+    lat : array_like
+        Latitudes [rad].
+    lon : array_like
+        Longitudes [rad].
+    lat0 : float
+        Origin latitude [rad].
+    lon0 : float
+        Origin longitude [rad].
+    h0 : float
+        Height of the conversion [m].
+
+    Returns
+    -------
+    east : ndarray
+        East offsets [m].
+    north : ndarray
+        North offsets [m].
+    """
     rm, rn = earth.radii(lat0)
     return (np.asarray(lon) - lon0) * (rn + h0) * math.cos(lat0), (np.asarray(lat) - lat0) * (rm + h0)
 
@@ -558,7 +1035,23 @@ def disturbed_increments(traj, dg_n) -> np.ndarray:
 
     The generated increments assume normal gravity; with the disturbance the specific force is
     f^b - C_n^b delta g^n, so dv_k -> dv_k - C_n^b(t_k) delta g^n(mid-interval) Delta t.
-    ``dg_n`` (N+1, 3) is the disturbance at the sample instants (m/s², ENU).
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        True motion with N increments.
+    dg_n : array_like, shape (N + 1, 3)
+        Disturbance at the sample instants, ENU [m/s²].
+
+    Returns
+    -------
+    dv : ndarray, shape (N, 3)
+        Velocity increments in the body frame [m/s].
+
+    Raises
+    ------
+    ValueError
+        When ``dg_n`` does not have one ENU vector per sample.
     """
     dg_n = np.asarray(dg_n, dtype=float)
     if dg_n.shape != (traj.n + 1, 3):
@@ -570,11 +1063,33 @@ def disturbed_increments(traj, dg_n) -> np.ndarray:
 def direct_difference_from_filter(result, dv, t, gnss, *, cutoff_period: float) -> np.ndarray:
     """Direct-difference disturbance (3-7) at the GNSS epochs from a 15-state closed-loop run.
 
-    chen2019 step 1: f^n = C-hat_b^n (f^b - nabla-hat) from the filtered run (``result`` of
-    :func:`replication.nav.kalman.closed_loop` with ``store_nav``), averaged over one GNSS interval
-    centred on each epoch; the kinematic acceleration from the differentiated GNSS velocity
-    (:func:`gnss_acceleration`); Coriolis/transport terms and normal gravity at the GNSS
-    position; the result low-passed (:func:`lowpass`, ``cutoff_period``).  Returns (epochs, 3).
+    chen2019 step 1: f^n = C-hat_b^n (f^b - nabla-hat) from the filtered run, averaged over one GNSS
+    interval centred on each epoch; the kinematic acceleration from the differentiated GNSS
+    velocity (:func:`gnss_acceleration`); Coriolis/transport terms and normal gravity at the GNSS
+    position; the result low-passed (:func:`lowpass`, ``cutoff_period``).
+
+    Parameters
+    ----------
+    result : replication.nav.kalman.ClosedLoopResult
+        The run of :func:`replication.nav.kalman.closed_loop` with ``store_nav``.
+    dv : array_like, shape (N, 3)
+        The velocity increments the run integrated (body frame) [m/s].
+    t : array_like, shape (N + 1,)
+        IMU sample times [s].
+    gnss : replication.nav.sensors.GnssMeasurements
+        The GNSS fixes of the run.
+    cutoff_period : float
+        Cut-off period of the low-pass [s].
+
+    Returns
+    -------
+    dg : ndarray, shape (epochs, 3)
+        Direct-difference disturbance at the GNSS epochs, ENU [m/s²].
+
+    Raises
+    ------
+    ValueError
+        When the run did not store the navigation solution.
     """
     sol = result.solution
     if sol is None:
@@ -597,14 +1112,47 @@ def direct_difference_from_filter(result, dv, t, gnss, *, cutoff_period: float) 
 
 
 def compensated_increments(dv, C_bn, dg_hat_samples, t) -> np.ndarray:
-    """Increments with an estimated disturbance fed back: dv + C_n^b delta g-hat Delta t (method 2 of §4.3)."""
+    """Increments with an estimated disturbance fed back: dv + C_n^b delta g-hat Delta t (method 2 of §4.3).
+
+    Parameters
+    ----------
+    dv : array_like, shape (N, 3)
+        Velocity increments, body frame [m/s].
+    C_bn : array_like, shape (N + 1, 3, 3)
+        Body-to-ENU attitude at the samples (the first N are used).
+    dg_hat_samples : array_like, shape (N + 1, 3)
+        Estimated disturbance at the samples, ENU [m/s²].
+    t : array_like, shape (N + 1,)
+        Sample times [s].
+
+    Returns
+    -------
+    dv : ndarray, shape (N, 3)
+        Compensated velocity increments [m/s].
+    """
     g = np.asarray(dg_hat_samples, dtype=float)
     mid = 0.5 * (g[1:] + g[:-1])
     return dv + np.einsum("kji,kj->ki", np.asarray(C_bn)[:-1], mid) * np.diff(t)[:, None]
 
 
 def attitude_position_errors(sol, traj, index) -> dict:
-    """Errors of a navigation solution at sample ``index``: north/east/up (m), heading/pitch/roll (deg)."""
+    """Errors of a navigation solution at sample ``index``.
+
+    Parameters
+    ----------
+    sol : replication.nav.strapdown.NavSolution
+        The navigation solution.
+    traj : replication.nav.trajectory.Trajectory
+        The truth at the same samples.
+    index : array_like of int
+        Sample indices.
+
+    Returns
+    -------
+    errors : dict of ndarray
+        Computed − true at each index: ``latitude`` (north), ``longitude`` (east), ``height`` [m];
+        ``heading`` (wrapped to ±180°), ``pitch``, ``roll`` [°].
+    """
     idx = np.asarray(index)
     rm, rn = earth.radii(traj.lat[idx])
     d = np.degrees(sol.hpr[idx] - traj.hpr[idx])
@@ -619,6 +1167,25 @@ def photo_epochs(traj, n_photos: int, *, margin: float = 60.0) -> np.ndarray:
 
     Stands in for the photo times of chen2019 Table 4-50 (photos 1~135, not published): the
     straight segments less ``margin`` seconds at each end.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The survey flight (:func:`survey_flight`).
+    n_photos : int
+        Number of exposures.
+    margin : float
+        Time left out at each end of a straight segment [s].
+
+    Returns
+    -------
+    index : ndarray of int, shape (n_photos,)
+        Sample indices of the exposures.
+
+    Raises
+    ------
+    ValueError
+        When the straight lines hold fewer samples than ``n_photos``.
     """
     on = np.zeros(traj.n + 1, bool)
     for label, a, b in traj.segments:
@@ -632,9 +1199,39 @@ def photo_epochs(traj, n_photos: int, *, margin: float = 60.0) -> np.ndarray:
 
 def compensation_first_pass(traj, field_: PlanarGravityField, *, seed: int, origin, offset, imu: dict, gnss_kw: dict,
                             model_kw: dict) -> dict:
-    """The part of :func:`compensation_run` that does not depend on the compensation settings:
-    the truth through ``field_`` (IMU errors, GNSS) drawn from ``seed`` and the 15-state
-    closed-loop filter with normal gravity (chen2019 §4.3, step 0)."""
+    """The part of :func:`compensation_run` that does not depend on the compensation settings.
+
+    The truth through ``field_`` (IMU errors, GNSS) drawn from ``seed`` and the 15-state
+    closed-loop filter with normal gravity (chen2019 §4.3, step 0).
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The survey flight.
+    field_ : PlanarGravityField
+        The true disturbance field.
+    seed : int
+        Seed of the truth's draws.
+    origin : tuple of float
+        (lat0 [rad], lon0 [rad], h0 [m]) of the planar frame.
+    offset : tuple of float
+        East, north shift of the track in the field [m].
+    imu : dict of str to float
+        ``gyro_bias_sd`` [rad/s], ``accel_bias_sd`` [m/s²], ``gyro_psd`` [(rad/s)²/Hz],
+        ``accel_psd`` [(m/s²)²/Hz].
+    gnss_kw : dict
+        Keyword arguments of :func:`replication.nav.sensors.gnss_measurements`.
+    model_kw : dict
+        Keyword arguments of :func:`replication.nav.errors.model_15` (initial σ).
+
+    Returns
+    -------
+    first_pass : dict
+        ``key`` (seed, field id, offset), ``dth`` [rad] and ``dvm`` [m/s] (corrupted increments,
+        (N, 3)), ``gnss`` (GnssMeasurements), ``m15`` (ErrorModel), ``init`` (NavState), ``r1``
+        (ClosedLoopResult of the normal-gravity filter), ``dg`` (true disturbance at the samples,
+        (N + 1, 3) [m/s²]).
+    """
     rng = np.random.default_rng(seed)
     lat0, lon0, h0 = origin
     e, n = local_east_north(traj.lat, traj.lon, lat0, lon0, h0)
@@ -659,37 +1256,82 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
     """One Monte-Carlo run of the three compensation methods of chen2019 §4.3 (Table 4-50 analog).
 
     The truth flies through ``field_`` (sampled at the planar offsets of the track from
-    ``origin`` = (lat0, lon0, h0), shifted by ``offset`` (m)); IMU errors (``imu``: ``accel_bias_sd``,
-    ``gyro_bias_sd``, ``accel_psd``, ``gyro_psd``, SI) and GNSS (``gnss_kw`` for
-    :func:`replication.nav.sensors.gnss_measurements`) are drawn from ``seed``.  Methods:
+    ``origin``, shifted by ``offset``); IMU errors and GNSS are drawn from ``seed``.  Methods:
 
-    * ``normal`` — 15-state closed loop (:func:`replication.nav.kalman.closed_loop`), normal gravity;
+    * ``normal`` — 15-state closed loop (:func:`replication.nav.kalman.closed_loop`), normal
+      gravity;
     * ``direct`` — step 1 (:func:`direct_difference_from_filter`, low-pass ``cutoff_period``) fed
       back into the increments (:func:`compensated_increments`) and the 15-state filter re-run;
     * ``state`` — steps 2-3: AR(3) fitted (:func:`replication.nav.timeseries.fit_ar`) to the
-      direct-difference series sampled every ``ar_interval`` s (default: half the cut-off
-      period, the filter's Nyquist interval).  The inversion test (m = 10) is recorded, not
-      enforced: on a series this strongly correlated the segment means are not independent and
-      the test over-rejects; a fit whose poles leave the unit circle is refused.  The three AR(3)
-      models enter in companion form (:func:`gravity_augmentation`), run as discrete models at
+      direct-difference series sampled every ``ar_interval`` s (default: half the cut-off period,
+      the filter's Nyquist interval).  The inversion test (m = 10) is recorded, not enforced: on a
+      series this strongly correlated the segment means are not independent and the test
+      over-rejects; a fit whose poles leave the unit circle is refused.  The three AR(3) models
+      enter in companion form (:func:`gravity_augmentation`), run as discrete models at
       ``ar_interval`` inside :func:`augmented_filter`, with the 9-dimensional measurement (3-18)
       (position, velocity and, every ``ar_interval``, specific force against GNSS acceleration;
       ``specific_force=False`` drops the last rows);
     * ``state-gm`` (if ``gauss_markov_reference``) — the former stand-in: each AR model as the
       first-order Gauss-Markov block of the same variance and dominant correlation time
       (:func:`replication.nav.errors.gravity_shaping`), position/velocity updates only;
-    * ``true-model`` (if ``true_model`` = (sigma_ENU, beta_ENU)) — the Gauss-Markov block with
-      the field's own statistics in :func:`augmented_filter` (with the specific-force rows when
+    * ``true-model`` (if ``true_model`` = (sigma_ENU, beta_ENU)) — the Gauss-Markov block with the
+      field's own statistics in :func:`augmented_filter` (with the specific-force rows when
       ``specific_force``).
 
-    ``methods`` selects which of ``normal``/``direct`` are returned (``normal`` is always run:
-    step 1 needs it).  ``first_pass`` (from :func:`compensation_first_pass` with the same seed,
-    field and offset) reuses the truth and the normal-gravity filter of an earlier call — they do
-    not depend on the cut-off, the AR interval or the methods.
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The survey flight.
+    field_ : PlanarGravityField
+        The true disturbance field.
+    seed : int
+        Seed of the truth's draws.
+    origin : tuple of float
+        (lat0 [rad], lon0 [rad], h0 [m]) of the planar frame.
+    offset : tuple of float
+        East, north shift of the track in the field [m].
+    photos : array_like of int
+        Sample indices at which the errors are returned (:func:`photo_epochs`).
+    imu : dict of str to float
+        ``gyro_bias_sd`` [rad/s], ``accel_bias_sd`` [m/s²], ``gyro_psd`` [(rad/s)²/Hz],
+        ``accel_psd`` [(m/s²)²/Hz].
+    gnss_kw : dict
+        Keyword arguments of :func:`replication.nav.sensors.gnss_measurements`.
+    model_kw : dict
+        Keyword arguments of :func:`replication.nav.errors.model_15` (initial σ).
+    cutoff_period : float
+        Cut-off period of the direct difference's low-pass [s].
+    ar_interval : float or None
+        Sampling interval of the AR identification and of the specific-force windows [s], a
+        multiple of the GNSS interval (``None``: ``cutoff_period / 2``).
+    true_model : tuple (sigma, beta) or None
+        Per-axis stationary σ [m/s²] and inverse correlation time β [1/s] of the field's own
+        Gauss-Markov model, for the ``true-model`` method.
+    specific_force : bool
+        Use the specific-force rows of (3-18).
+    gauss_markov_reference : bool
+        Also run ``state-gm``.
+    methods : sequence of str
+        Which of ``normal``/``direct`` are returned (``normal`` is always run: step 1 needs it).
+    first_pass : dict or None
+        From :func:`compensation_first_pass` with the same seed, field and offset: reuses the truth
+        and the normal-gravity filter of an earlier call — they do not depend on the cut-off, the AR
+        interval or the methods.
 
-    Returns {method: {component: error array at ``photos``}} plus ``ar`` (per axis: phi, sigma2,
-    the model checks and the inversion test) and
-    ``dd`` (direct difference and true disturbance at the GNSS epochs).
+    Returns
+    -------
+    out : dict
+        {method: {component: error array at ``photos``}} (:func:`attitude_position_errors`: m and
+        °) plus ``ar`` (per axis a tuple: phi, sigma2 [(m/s²)²], the model checks of
+        :func:`replication.nav.timeseries.check_ar_model` and the inversion test) and ``dd`` (dict:
+        ``t`` [s], ``measured`` direct difference and ``true`` disturbance at the GNSS epochs,
+        (epochs, 3) [m/s²]).
+
+    Raises
+    ------
+    ValueError
+        When ``first_pass`` belongs to another seed, field or offset, or an AR(3) fit is not
+        stationary.
     """
 
     fp = compensation_first_pass(traj, field_, seed=seed, origin=origin, offset=offset, imu=imu, gnss_kw=gnss_kw,
@@ -743,11 +1385,34 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
 def compensation_runs(traj, fields, seeds, *, workers: int = 2, **kw) -> list:
     """:func:`compensation_run` for each (field, seed) pair, ``workers`` runs at a time on threads.
 
-    The Monte Carlo of the Table 4-50 analog (chen2019 §4.3): every run is independent
-    (its own truth, sensor errors and filters; the compiled filter releases the GIL), so the
-    result is the list of the sequential calls whatever ``workers``.  ``kw`` goes to
-    :func:`compensation_run` (not ``first_pass``: each run makes its own and drops it, which keeps
-    the memory to ``workers`` runs).
+    The Monte Carlo of the Table 4-50 analog (chen2019 §4.3): every run is independent (its own
+    truth, sensor errors and filters; the compiled filter releases the GIL), so the result is the
+    list of the sequential calls whatever ``workers``.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The survey flight.
+    fields : iterable of PlanarGravityField
+        One field per run.
+    seeds : iterable of int
+        One seed per run, paired with ``fields``.
+    workers : int
+        Runs at a time (threads).
+    **kw : dict, optional
+        Keyword arguments of :func:`compensation_run` (not ``first_pass``: each run makes its own
+        and drops it, which keeps the memory to ``workers`` runs).
+
+    Returns
+    -------
+    runs : list of dict
+        The results of :func:`compensation_run`, in the order of the pairs.
+
+    Raises
+    ------
+    ValueError
+        When fields and seeds do not pair up, ``workers`` is not a positive integer, or
+        ``first_pass`` is given.
     """
     fields, seeds = list(fields), [int(s) for s in seeds]
     if len(fields) != len(seeds):
@@ -765,10 +1430,35 @@ def consistent_kinematics(n: int, rng: np.random.Generator, *, lat=math.radians(
     """Random but exactly consistent kinematics for checking (3-7)/(3-8) and (3-18).
 
     Positions near ``lat``/``h``, velocities around ``speed`` eastwards, accelerations, attitudes
-    and a disturbance (``dg_std`` per axis) drawn from ``rng``; the specific force follows from
-    the specific-force equation (3-2) with g^n = g_m^n + dg^n (3-6):
-    f^n = dV/dt + (2 w_ie + w_en) x V - g_m^n - dg^n, f^b = C_n^b f^n.
-    Returns a dict with ``lat``, ``h``, ``v``, ``v_dot``, ``dg``, ``C_bn``, ``f_n``, ``f_b``.
+    and a disturbance drawn from ``rng``; the specific force follows from the specific-force
+    equation (3-2) with g^n = g_m^n + dg^n (3-6): f^n = dV/dt + (2 w_ie + w_en) x V - g_m^n -
+    dg^n, f^b = C_n^b f^n.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+    rng : numpy.random.Generator
+        Seeded generator.
+    lat : float
+        Mean latitude [rad].
+    h : float
+        Mean height [m].
+    speed : float
+        Mean eastward speed [m/s].
+    dg_std : float
+        Standard deviation of each disturbance component [m/s²].
+
+    Returns
+    -------
+    sample : dict of ndarray
+        ``lat`` (n,) [rad], ``h`` (n,) [m], ``v`` (n, 3) [m/s], ``v_dot`` (n, 3) [m/s²], ``dg``
+        (n, 3) [m/s²], ``C_bn`` (n, 3, 3), ``f_n`` (n, 3) and ``f_b`` (n, 3) [m/s²].
+
+    Raises
+    ------
+    TypeError
+        When ``rng`` is not a numpy Generator.
     """
 
     if not isinstance(rng, np.random.Generator):
@@ -793,16 +1483,41 @@ def ar_continuous(phi, sigma2: float, dt: float):
 
         A_c = logm(A) / dt,      Q_c = -(A_c P + P A_c^T)
 
-    has the transition exp(A_c dt) = A and the stationary covariance P, so its samples every
-    ``dt`` have the discrete process noise P - A P A^T = sigma² e_1 e_1^T: the same
-    second-order statistics as the AR model at the sampling instants (chen2019 eq. (3-17)).
-    Returns ``(A_c, Q_c, P, embeddable)``.  A real logarithm needs no pole on the negative real
-    axis (refused with a message); Q_c must be positive semi-definite for a continuous process
-    with white driving noise to exist — when it is not (``embeddable`` False) its negative
-    eigenvalues are set to zero, which keeps the transition and raises the variance (by a factor
-    1.9 for the sign-reversed east model of eq. (4-13)).  A rank-one e_1 sigma² e_1^T is the
-    sampled noise of a continuous process with PSD Q_c only for an AR(1) model, so an AR(2) or
-    AR(3) model is in general not embeddable.
+    has the transition exp(A_c dt) = A and the stationary covariance P, so its samples every ``dt``
+    have the discrete process noise P - A P A^T = sigma² e_1 e_1^T: the same second-order
+    statistics as the AR model at the sampling instants (chen2019 eq. (3-17)).  A real logarithm
+    needs no pole on the negative real axis (refused with a message); Q_c must be positive
+    semi-definite for a continuous process with white driving noise to exist — when it is not
+    (``embeddable`` False) its negative eigenvalues are set to zero, which keeps the transition and
+    raises the variance (by a factor 1.9 for the sign-reversed east model of eq. (4-13)).  A
+    rank-one e_1 sigma² e_1^T is the sampled noise of a continuous process with PSD Q_c only for an
+    AR(1) model, so an AR(2) or AR(3) model is in general not embeddable.
+
+    Parameters
+    ----------
+    phi : array_like, shape (p,)
+        AR coefficients, stationary.
+    sigma2 : float
+        Driving-noise variance at the interval ``dt`` [(m/s²)²].
+    dt : float
+        Sampling interval of the AR model [s].
+
+    Returns
+    -------
+    A_c : ndarray, shape (p, p)
+        Continuous dynamics [1/s].
+    Q_c : ndarray, shape (p, p)
+        Driving-noise intensity [(m/s²)²/s].
+    P : ndarray, shape (p, p)
+        Stationary covariance [(m/s²)²].
+    embeddable : bool
+        Whether Q_c was positive semi-definite before the repair.
+
+    Raises
+    ------
+    ValueError
+        When ``sigma2`` or ``dt`` is not positive, the model is not stationary, a pole lies on the
+        negative real axis, or the logarithm is not real.
     """
 
     phi = ar_coefficients(phi)
@@ -835,11 +1550,34 @@ def ar_continuous(phi, sigma2: float, dt: float):
 def ar_gravity_block(models, dt: float, *, name: str = "gravity"):
     """Gravity-disturbance block of three AR shaping filters in companion form (chen2019 eq. 3-17).
 
-    ``models``: three (phi, sigma2) pairs (E, N, U) identified at the interval ``dt``; each is
-    converted by :func:`ar_continuous` and the three are stacked block-diagonally into a
-    :func:`replication.nav.errors.gravity_shaping` block whose output selects the first state of
-    each companion block.  Returns ``(block, P0, embeddable)`` with the stationary covariance
-    ``P0`` of the block (the filter's initial covariance of these states).
+    Each model is converted by :func:`ar_continuous` and the three are stacked block-diagonally
+    into a :func:`replication.nav.errors.gravity_shaping` block whose output selects the first
+    state of each companion block.
+
+    Parameters
+    ----------
+    models : sequence of tuple (phi, sigma2)
+        Three AR models (E, N, U) identified at the interval ``dt``: coefficients and
+        driving-noise variance [(m/s²)²].
+    dt : float
+        Sampling interval of the models [s].
+    name : str
+        Name of the block.
+
+    Returns
+    -------
+    block : replication.nav.errors.StateBlock
+        The gravity block (states in m/s²).
+    P0 : ndarray, shape (m, m)
+        Stationary covariance of the block [(m/s²)²] (the filter's initial covariance of these
+        states).
+    embeddable : bool
+        Whether all three models were embeddable (:func:`ar_continuous`).
+
+    Raises
+    ------
+    ValueError
+        When not three models are given (and as :func:`ar_continuous`).
     """
 
 
@@ -859,14 +1597,30 @@ def ar_gravity_block(models, dt: float, *, name: str = "gravity"):
 
 
 def slope_weights(t_gnss, t_imu) -> np.ndarray:
-    """Weights w_k (summing to one) of the IMU steps such that the least-squares slope of GNSS
-    velocity samples at ``t_gnss`` equals sum_k w_k a_k for the step-mean accelerations a_k.
+    """Weights w_k (summing to one) of the IMU steps that reproduce the least-squares slope of GNSS velocity.
 
-    The slope sum_i c_i v_i (c_i = (t_i - t_mean) / sum (t_i - t_mean)²) rewritten with
-    v_{i+1} - v_i = sum_k a_k Delta t_k gives w_k = -(c_0 + ... + c_i) Delta t_k for the steps of
-    GNSS interval i: a parabolic window.  ``t_imu`` are the IMU sample times from ``t_gnss[0]``
-    to ``t_gnss[-1]`` (both included).  This is the GNSS-acceleration low-pass of
-    :func:`augmented_filter`: the INS side is averaged with the same weights.
+    The least-squares slope of GNSS velocity samples at ``t_gnss`` equals sum_k w_k a_k for the
+    step-mean accelerations a_k.  The slope sum_i c_i v_i (c_i = (t_i - t_mean) / sum (t_i -
+    t_mean)²) rewritten with v_{i+1} - v_i = sum_k a_k Delta t_k gives w_k = -(c_0 + ... + c_i)
+    Delta t_k for the steps of GNSS interval i: a parabolic window.  This is the GNSS-acceleration
+    low-pass of :func:`augmented_filter`: the INS side is averaged with the same weights.
+
+    Parameters
+    ----------
+    t_gnss : array_like, shape (m,)
+        GNSS epoch times of the window [s], m ≥ 3.
+    t_imu : array_like, shape (K + 1,)
+        IMU sample times from ``t_gnss[0]`` to ``t_gnss[-1]`` (both included) [s].
+
+    Returns
+    -------
+    w : ndarray, shape (K,)
+        Weight of each IMU step [1].
+
+    Raises
+    ------
+    ValueError
+        When the window has fewer than three GNSS epochs.
     """
     tg = np.asarray(t_gnss, float)
     ti = np.asarray(t_imu, float)
@@ -998,31 +1752,70 @@ def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float 
     """Closed-loop INS/GNSS filter with the 9-dimensional measurement of chen2019 eq. (3-18).
 
     The error-state filter of :func:`replication.nav.kalman.closed_loop` (same strapdown, Van Loan
-    series, Joseph update, feedback; free vertical channel, no lever arm) with ``model``'s
-    gravity block (e.g. :func:`ar_gravity_block`) compensated in the mechanization, and, every
+    series, Joseph update, feedback; free vertical channel, no lever arm) with ``model``'s gravity
+    block (e.g. :func:`ar_gravity_block`) compensated in the mechanization, and, every
     ``sf_interval`` seconds, the specific-force rows of (3-18) stacked under the GNSS position and
     velocity rows::
 
         z_f = mean_w(C_b^n f^b + g_m^n + g-hat^n - (2 omega_ie + omega_en) x V) - a_GNSS
             = f^n x phi + C_b^n nabla - delta g^n(t - lag) + noise
 
-    The GNSS acceleration a_GNSS is the least-squares slope of the GNSS velocity over the
-    window's epochs (the low-pass of this implementation) and the INS side is averaged with the
-    same weights (:func:`slope_weights`), so both sides see the same band.  The windows are
-    disjoint (their noises independent); R_f is the slope's variance from ``gnss.sigma_vel``
-    plus the averaged accelerometer white noise.  The disturbance enters H through the output
-    of the gravity block taken back by the window's centroid lag (exp(-A_c lag)); the attitude
-    and bias columns use the window means.  ``sf_interval=None``: position/velocity only.
+    The GNSS acceleration a_GNSS is the least-squares slope of the GNSS velocity over the window's
+    epochs (the low-pass of this implementation) and the INS side is averaged with the same weights
+    (:func:`slope_weights`), so both sides see the same band.  The windows are disjoint (their
+    noises independent); R_f is the slope's variance from ``gnss.sigma_vel`` plus the averaged
+    accelerometer white noise.  The disturbance enters H through the output of the gravity block
+    taken back by the window's centroid lag (exp(-A_c lag)); the attitude and bias columns use the
+    window means.
 
-    ``discrete`` = (A_d, Q_d): the gravity block is instead the discrete AR model itself, run at
-    the interval ``sf_interval`` (e.g. the ``A`` and ``Q`` of :class:`GravityAugmentation`): the block's
-    continuous dynamics must be zero, its states are held between AR steps and at the start of
-    each window the transition x <- A_d x + w (covariance Q_d) is applied to the estimate and
-    the covariance.  This needs no continuous-time equivalent (which does not exist when an
-    AR pole lies on the negative real axis, see :func:`ar_continuous`); the disturbance is then
-    piecewise constant over each window, so the window lag is zero.  ``use_specific_force=False``
-    keeps the windows (and the AR steps) but drops the specific-force rows.
-    Returns a :class:`replication.nav.strapdown.NavSolution`.
+    With ``discrete`` the gravity block is instead the discrete AR model itself, run at the
+    interval ``sf_interval``: the block's continuous dynamics must be zero, its states are held
+    between AR steps and at the start of each window the transition x <- A_d x + w (covariance
+    Q_d) is applied to the estimate and the covariance.  This needs no continuous-time equivalent
+    (which does not exist when an AR pole lies on the negative real axis, see
+    :func:`ar_continuous`); the disturbance is then piecewise constant over each window, so the
+    window lag is zero.
+
+    Parameters
+    ----------
+    t : array_like, shape (N + 1,)
+        IMU sample times [s].
+    dtheta : array_like, shape (N, 3)
+        Angle increments, body frame [rad].
+    dv : array_like, shape (N, 3)
+        Velocity increments, body frame [m/s].
+    initial : replication.nav.strapdown.NavState
+        Initial navigation state.
+    gnss : replication.nav.sensors.GnssMeasurements
+        GNSS fixes at the IMU (``lever_arm_b`` zero), with ``sigma_pos`` [m] and ``sigma_vel``
+        [m/s].
+    model : replication.nav.errors.ErrorModel
+        Error model with exactly one gravity block (n states).
+    sf_interval : float or None
+        Length of the specific-force windows [s], a multiple (≥ 3) of the GNSS interval;
+        ``None``: position/velocity only.
+    P0 : array_like, shape (n, n), or None
+        Initial covariance (``None``: ``model.P0()``).
+    discrete : tuple (A_d, Q_d) or None
+        Discrete AR transition (dimensionless) and noise covariance [(m/s²)²] of the gravity
+        block, each (m, m), over ``sf_interval`` (e.g. the ``A`` and ``Q`` of
+        :class:`GravityAugmentation`).
+    use_specific_force : bool
+        ``False`` keeps the windows (and the AR steps) but drops the specific-force rows.
+    series_order : int
+        Order of the Van Loan series.
+
+    Returns
+    -------
+    solution : replication.nav.strapdown.NavSolution
+        The corrected navigation solution at every IMU sample.
+
+    Raises
+    ------
+    ValueError
+        When the GNSS has a lever arm, the model has not exactly one gravity block, ``P0`` has the
+        wrong shape, ``sf_interval`` is not a multiple (≥ 3) of the GNSS interval, or ``discrete``
+        does not fit the block.
     """
     dtheta, dv = validate_increments(dtheta, dv)
     n = len(dtheta)

@@ -147,26 +147,80 @@ def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
              gyro_scale_sd=0.0, gyro_misalignment_sd=0.0, gravity_sigma=0.0, gravity_beta=1e-3,
              lever_arm_sd=0.0, accel_psd=0.0, gyro_psd=0.0, lat=0.0, h=0.0,
              misalignment_coupling: str = "eq-2-8") -> E.ErrorModel:
-    """The 45-state SINS/GNSS error model of chen2019 eqs. (2-14), (2-15) and Table 2-2, in the
-    text's state order (see the module docstring; ``model.labels`` / :func:`state_symbols`).
+    """The 45-state SINS/GNSS error model of chen2019 eqs. (2-14), (2-15) and Table 2-2.
 
-    ``misalignment_coupling``: ``"eq-2-8"`` (the layout of δC in eq. (2-8), default) or
-    ``"table-2-2"`` (the F32/F33, F52/F53 columns as Table 2-2 prints them) — the report's two
-    printed parts disagree on it (:data:`replication.nav.errors.MISALIGNMENT_COUPLINGS`).
+    The states are in the text's order (see the module docstring; ``model.labels`` /
+    :func:`state_symbols`).
 
-    Dynamics: eq. (2-15) with every first-order term (:meth:`replication.nav.errors.ErrorModel.F`); random
-    constants (eq. (2-5), (2-6), (2-9)): ẋ = 0; first-order Gauss-Markov biases (eq. (2-5)):
+    Dynamics: eq. (2-15) with every first-order term (:meth:`replication.nav.errors.ErrorModel.F`);
+    random constants (eq. (2-5), (2-6), (2-9)): ẋ = 0; first-order Gauss-Markov biases (eq. (2-5)):
     ẋ = -x/τ + w with stationary σ (``*_markov_sigma``; driving intensity 2σ²/τ — convert the
     report's "驱动白噪声方差强度" with :func:`replication.nav.sensors.markov_sigma_from_driving_psd`);
     gravity disturbance (eqs. (2-11), (2-12)): δġ = -β δg + n per ENU axis with stationary σ
     (``gravity_sigma``, ``gravity_beta`` = 1/correlation time); lever arm: constant, enters the
     measurement only (eq. (2-13), :func:`measurement_matrix`).
 
-    All arguments are SI (m, m/s, rad, m/s², rad/s, 1/s); ``position_sd`` in metres (E, N, U),
-    converted to (δL, δλ, δh) at (``lat``, ``h``); ``accel_psd``/``gyro_psd`` are the white-noise
-    intensities (velocity/angle random walk squared).  The defaults of the standard deviations
-    are zero (no prior); set them (e.g. from chen2019 Table 4-41 with :mod:`replication.nav.units`)
-    before running a filter.  Returns an :class:`replication.nav.errors.ErrorModel` (45 states).
+    All arguments are SI.  The defaults of the standard deviations are zero (no prior); set them
+    (e.g. from chen2019 Table 4-41 with :mod:`replication.nav.units`) before running a filter.  A
+    scalar σ applies to every axis of its block.
+
+    Parameters
+    ----------
+    position_sd : float or array_like, shape (3,)
+        Initial position σ, east, north, up [m]; converted to (δL, δλ, δh) at (``lat``, ``h``).
+    velocity_sd : float or array_like, shape (3,)
+        Initial velocity σ, ENU [m/s].
+    attitude_sd : float or array_like, shape (3,)
+        Initial attitude σ, φ_E, φ_N, φ_U [rad].
+    accel_bias_sd : float or array_like, shape (3,)
+        Accelerometer random-constant bias σ [m/s²].
+    accel_markov_sigma : float or array_like, shape (3,)
+        Stationary σ of the accelerometer Gauss-Markov bias [m/s²].
+    accel_markov_tau : float
+        Correlation time of the accelerometer Gauss-Markov bias [s].
+    accel_scale_sd : float or array_like, shape (3,)
+        Accelerometer scale-factor error σ [1].
+    accel_misalignment_sd : float or array_like, shape (6,)
+        Accelerometer misalignment-angle σ, order xy, yx, xz, zx, yz, zy [rad].
+    gyro_bias_sd : float or array_like, shape (3,)
+        Gyro random-constant drift σ [rad/s].
+    gyro_markov_sigma : float or array_like, shape (3,)
+        Stationary σ of the gyro Gauss-Markov drift [rad/s].
+    gyro_markov_tau : float
+        Correlation time of the gyro Gauss-Markov drift [s].
+    gyro_scale_sd : float or array_like, shape (3,)
+        Gyro scale-factor error σ [1].
+    gyro_misalignment_sd : float or array_like, shape (6,)
+        Gyro misalignment-angle σ, order xy, yx, xz, zx, yz, zy [rad].
+    gravity_sigma : float or array_like, shape (3,)
+        Stationary σ of the gravity disturbance per ENU axis [m/s²].
+    gravity_beta : float
+        Inverse correlation time β of the gravity disturbance [1/s].
+    lever_arm_sd : float or array_like, shape (3,)
+        σ of the lever-arm error, body frame [m].
+    accel_psd : float or array_like, shape (3,)
+        Accelerometer white-noise intensity (velocity random walk squared) [(m/s²)²/Hz].
+    gyro_psd : float or array_like, shape (3,)
+        Gyro white-noise intensity (angle random walk squared) [(rad/s)²/Hz].
+    lat : float
+        Latitude at which ``position_sd`` is converted [rad].
+    h : float
+        Height at which ``position_sd`` is converted [m].
+    misalignment_coupling : str
+        ``"eq-2-8"`` (the layout of δC in eq. (2-8), default) or ``"table-2-2"`` (the F32/F33,
+        F52/F53 columns as Table 2-2 prints them) — the report's two printed parts disagree on it
+        (:data:`replication.nav.errors.MISALIGNMENT_COUPLINGS`).
+
+    Returns
+    -------
+    model : replication.nav.errors.ErrorModel
+        The model with 45 states, blocks in :data:`CHEN2019_45_ORDER`.
+
+    Raises
+    ------
+    ValueError
+        When a σ or intensity is negative or not finite, a correlation time or β is not positive,
+        or ``lat``/``h`` is out of range.
     """
     nav_sd = _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h)
     beta = positive(gravity_beta, "gravity_beta", _SECONDS)
@@ -193,19 +247,68 @@ def model_36(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
              accel_scale_sd=0.0, gyro_bias_sd=0.0, gyro_random_walk_psd=0.0, gyro_markov_sigma=0.0,
              gyro_markov_tau=3600.0, gyro_scale_sd=0.0, lever_arm_sd=0.0, accel_psd=0.0, gyro_psd=0.0,
              lat=0.0, h=0.0) -> E.ErrorModel:
-    """The 36-state model of chen2019's ref. [35] as the report describes it (ch. 1 §3):
-    9 navigation + 24 IMU + 3 lever-arm states.
+    """The 36-state model of chen2019's ref. [35] as the report describes it (ch. 1 §3).
 
-    Interpretation (stated, the report prints no equations for it): the gyro drift and the
-    accelerometer bias are each the sum of a random constant (``*_bias_sd``), a random walk
-    (ẋ = w, intensity ``*_random_walk_psd``; initial value zero) and a first-order Gauss-Markov
-    process (``*_markov_sigma``, ``*_markov_tau``) — 18 states; random-constant scale-factor
-    errors of gyros and accelerometers — 6 states; no misalignment and no gravity states.
-    The random constant and the random walk of one axis enter the dynamics through the same
-    column (both are additive biases), so only their sum is observable from navigation
-    errors; their separation rests on the priors and the noise model.
+    9 navigation + 24 IMU + 3 lever-arm states.  Interpretation (stated, the report prints no
+    equations for it): the gyro drift and the accelerometer bias are each the sum of a random
+    constant (``*_bias_sd``), a random walk (ẋ = w, intensity ``*_random_walk_psd``; initial value
+    zero) and a first-order Gauss-Markov process (``*_markov_sigma``, ``*_markov_tau``) — 18
+    states; random-constant scale-factor errors of gyros and accelerometers — 6 states; no
+    misalignment and no gravity states.  The random constant and the random walk of one axis enter
+    the dynamics through the same column (both are additive biases), so only their sum is
+    observable from navigation errors; their separation rests on the priors and the noise model.
 
-    Units and conventions as :func:`model_45`.  Returns an ``ErrorModel`` with 36 states.
+    Units and conventions as :func:`model_45` (SI; a scalar σ applies to every axis).
+
+    Parameters
+    ----------
+    position_sd : float or array_like, shape (3,)
+        Initial position σ, east, north, up [m]; converted to (δL, δλ, δh) at (``lat``, ``h``).
+    velocity_sd : float or array_like, shape (3,)
+        Initial velocity σ, ENU [m/s].
+    attitude_sd : float or array_like, shape (3,)
+        Initial attitude σ, φ_E, φ_N, φ_U [rad].
+    accel_bias_sd : float or array_like, shape (3,)
+        Accelerometer random-constant bias σ [m/s²].
+    accel_random_walk_psd : float or array_like, shape (3,)
+        Intensity of the accelerometer bias random walk [(m/s²)²/s].
+    accel_markov_sigma : float or array_like, shape (3,)
+        Stationary σ of the accelerometer Gauss-Markov bias [m/s²].
+    accel_markov_tau : float
+        Correlation time of the accelerometer Gauss-Markov bias [s].
+    accel_scale_sd : float or array_like, shape (3,)
+        Accelerometer scale-factor error σ [1].
+    gyro_bias_sd : float or array_like, shape (3,)
+        Gyro random-constant drift σ [rad/s].
+    gyro_random_walk_psd : float or array_like, shape (3,)
+        Intensity of the gyro drift random walk [(rad/s)²/s].
+    gyro_markov_sigma : float or array_like, shape (3,)
+        Stationary σ of the gyro Gauss-Markov drift [rad/s].
+    gyro_markov_tau : float
+        Correlation time of the gyro Gauss-Markov drift [s].
+    gyro_scale_sd : float or array_like, shape (3,)
+        Gyro scale-factor error σ [1].
+    lever_arm_sd : float or array_like, shape (3,)
+        σ of the lever-arm error, body frame [m].
+    accel_psd : float or array_like, shape (3,)
+        Accelerometer white-noise intensity [(m/s²)²/Hz].
+    gyro_psd : float or array_like, shape (3,)
+        Gyro white-noise intensity [(rad/s)²/Hz].
+    lat : float
+        Latitude at which ``position_sd`` is converted [rad].
+    h : float
+        Height at which ``position_sd`` is converted [m].
+
+    Returns
+    -------
+    model : replication.nav.errors.ErrorModel
+        The model with 36 states, blocks in :data:`CHEN2019_36_ORDER`.
+
+    Raises
+    ------
+    ValueError
+        When a σ or intensity is negative or not finite, a correlation time is not positive, or
+        ``lat``/``h`` is out of range.
     """
     nav_sd = _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h)
     blocks = (
@@ -237,7 +340,23 @@ def _check_model(model):
 def state_symbols(model) -> list:
     """chen2019 symbols of the states of ``model`` (e.g. ``'φ_E'``, ``'δA_xy'``), in model order.
 
-    Blocks with a name unknown to chen2019 keep the ``errors`` label (``block.component``)."""
+    Blocks with a name unknown to chen2019 keep the ``errors`` label (``block.component``).
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        Any error model.
+
+    Returns
+    -------
+    symbols : list of str
+        One symbol per state, length ``model.n``.
+
+    Raises
+    ------
+    TypeError
+        When ``model`` is not an ``ErrorModel``.
+    """
     _check_model(model)
     out = list(NAV_SYMBOLS)
     for b in model.blocks:
@@ -247,9 +366,17 @@ def state_symbols(model) -> list:
 
 
 def table_2_3_states() -> list:
-    """The 27 states of chen2019 Table 2-3 in the printed row order, as ``errors`` labels of the
-    45-state model: φ_E, φ_N, φ_U; ∇_x..z (constant accelerometer bias); δK_ax..az;
-    δA_xy, δA_yx, δA_xz, δA_zx, δA_yz, δA_zy; ε_x..z (constant drift); δK_gx..gz; δG_(same order)."""
+    """The 27 states of chen2019 Table 2-3 in the printed row order, as ``errors`` labels of the 45-state model.
+
+    φ_E, φ_N, φ_U; ∇_x..z (constant accelerometer bias); δK_ax..az; δA_xy, δA_yx, δA_xz, δA_zx,
+    δA_yz, δA_zy; ε_x..z (constant drift); δK_gx..gz; δG_(same order).
+
+    Returns
+    -------
+    labels : list of str
+        27 labels of :attr:`replication.nav.errors.ErrorModel.labels`, e.g. ``"phiE"``,
+        ``"accel_bias.x"``, ``"gyro_misalignment.xy"``.
+    """
     out = ["phiE", "phiN", "phiU"]
     out += [f"accel_bias.{a}" for a in "xyz"] + [f"accel_scale.{a}" for a in "xyz"]
     out += [f"accel_misalignment.{p}" for p in _MIS]
@@ -259,10 +386,31 @@ def table_2_3_states() -> list:
 
 
 def state_permutation(source, target) -> np.ndarray:
-    """Index array ``p`` with ``x_target = x_source[p]`` for two models holding the same states
-    (matched by ``labels``), e.g. the chen2019 order of :func:`model_45` and the
+    """Index array ``p`` with ``x_target = x_source[p]`` for two models holding the same states.
+
+    The states are matched by ``labels``, e.g. the chen2019 order of :func:`model_45` and the
     ``model_15(...).extend(...)`` order (:data:`EXTEND_ORDER_45`).  The inverse permutation is
-    ``state_permutation(target, source)``; matrices transform as ``F_t = F_s[np.ix_(p, p)]``."""
+    ``state_permutation(target, source)``; matrices transform as ``F_t = F_s[np.ix_(p, p)]``.
+
+    Parameters
+    ----------
+    source : replication.nav.errors.ErrorModel
+        The model whose state vector is indexed.
+    target : replication.nav.errors.ErrorModel
+        The model whose order is wanted.
+
+    Returns
+    -------
+    p : ndarray of int, shape (n,)
+        Positions in ``source`` of the states of ``target``.
+
+    Raises
+    ------
+    TypeError
+        When either argument is not an ``ErrorModel``.
+    ValueError
+        When the two models hold different states.
+    """
     ls, lt = _check_model(source).labels, _check_model(target).labels
     if sorted(ls) != sorted(lt):
         missing = sorted(set(lt) - set(ls))
@@ -273,8 +421,29 @@ def state_permutation(source, target) -> np.ndarray:
 
 
 def reorder(model, block_order) -> E.ErrorModel:
-    """The same model with its augmented blocks in ``block_order`` (names); the 9 navigation
-    states stay first.  E.g. ``reorder(model_45(), EXTEND_ORDER_45)``."""
+    """The same model with its augmented blocks in ``block_order``; the 9 navigation states stay first.
+
+    E.g. ``reorder(model_45(), EXTEND_ORDER_45)``.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The model to reorder.
+    block_order : sequence of str
+        A permutation of the model's block names.
+
+    Returns
+    -------
+    model : replication.nav.errors.ErrorModel
+        The reordered model (same blocks, noise intensities and navigation σ).
+
+    Raises
+    ------
+    TypeError
+        When ``model`` is not an ``ErrorModel``.
+    ValueError
+        When ``block_order`` is not a permutation of the block names.
+    """
     _check_model(model)
     names = [b.name for b in model.blocks]
     block_order = list(block_order)
@@ -287,16 +456,39 @@ def reorder(model, block_order) -> E.ErrorModel:
 # ----------------------------------------------------------------------------- noise input G w
 
 def noise_input(model, C_bn):
-    """Noise distribution G and white-noise vector w of chen2019 eq. (2-14): ẋ = F x + G w,
-    E[w(t) w(τ)ᵀ] = diag(q) δ(t - τ).
+    """Noise distribution G and white-noise vector w of chen2019 eq. (2-14).
 
-    Returns ``(G, q, labels)``.  Columns of w, in this order (chen2019 Table 2-2's w, extended):
-    accelerometer white noise ω_a (3, enters δV̇ through C_b^n), gyro white noise ω_g (3, enters
-    φ̇ through -C_b^n in this package's sign convention; +C_b^n as printed), then for every
-    augmented block driven by noise (a Markov process ω_am/ω_gm, a random walk, the gravity
+    ẋ = F x + G w, E[w(t) w(τ)ᵀ] = diag(q) δ(t - τ).  Columns of w, in this order (chen2019 Table
+    2-2's w, extended): accelerometer white noise ω_a (3, enters δV̇ through C_b^n), gyro white noise
+    ω_g (3, enters φ̇ through -C_b^n in this package's sign convention; +C_b^n as printed), then for
+    every augmented block driven by noise (a Markov process ω_am/ω_gm, a random walk, the gravity
     shaping filter n of eq. (2-12)) its driving noise entering that block through I (a
     non-diagonal block intensity is factored by Cholesky, q = 1).  Satisfies
     ``G @ diag(q) @ G.T == model.G_Qc(C_bn)``.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model.
+    C_bn : array_like, shape (3, 3)
+        Attitude matrix C_b^n (body to ENU), a rotation matrix.
+
+    Returns
+    -------
+    G : ndarray, shape (n, m)
+        Noise distribution matrix (dimensionless: rotations and identities).
+    q : ndarray, shape (m,)
+        Intensities of the noise components, each in its state's unit squared per second
+        ((m/s²)²/Hz for ω_a, (rad/s)²/Hz for ω_g; 1 for a Cholesky-factored block).
+    labels : list of str
+        Names of the m noise components (``"ω_ax"``, ``"w_gyro_markov.x"``, ...).
+
+    Raises
+    ------
+    TypeError
+        When ``model`` is not an ``ErrorModel``.
+    ValueError
+        When ``C_bn`` is not a 3×3 rotation matrix.
     """
     _check_model(model)
     C = np.asarray(C_bn, float)
@@ -345,15 +537,34 @@ def _w_eb_b(point):
 
 
 def lever_arm_correction(point, lever_arm_b):
-    """chen2019 eq. (2-13): the corrections that carry the GNSS antenna position/velocity to the
-    SINS centre, P_SINS = P_GNSS + C_b^n l, V_SINS = V_GNSS + C_b^n (ω_eb^b × l), with
-    l = P_SINS^b the SINS centre in the body frame *seen from the antenna* (metres).
+    """chen2019 eq. (2-13): the corrections that carry the GNSS antenna position/velocity to the SINS centre.
 
-    Returns ``(dp_enu, dv_enu)`` in metres and m/s (ENU).  The report prints the velocity term
-    as C_b^n ω_nb^n P_SINS^b; the rigid-body rate of the lever arm seen from the Earth is
+    P_SINS = P_GNSS + C_b^n l, V_SINS = V_GNSS + C_b^n (ω_eb^b × l), with l = P_SINS^b the SINS
+    centre in the body frame *seen from the antenna*.  The report prints the velocity term as
+    C_b^n ω_nb^n P_SINS^b; the rigid-body rate of the lever arm seen from the Earth is
     ω_eb^b = ω_ib^b - C_n^b ω_ie^n (ω_nb^b differs from it by ω_en^b, ~1e-5 rad/s here).
     Note: :func:`replication.nav.sensors.gnss_measurements` takes the antenna seen from the SINS
     centre, i.e. ``lever_arm_b = -l``.
+
+    Parameters
+    ----------
+    point : replication.nav.errors.NavPoint
+        Evaluation point: latitude [rad], longitude [rad], height [m], v_enu [m/s], C_bn,
+        f_b [m/s²], w_ib_b [rad/s].
+    lever_arm_b : array_like, shape (3,)
+        l, the SINS centre seen from the antenna, body frame [m].
+
+    Returns
+    -------
+    dp_enu : ndarray, shape (3,)
+        Position correction C_b^n l, ENU [m].
+    dv_enu : ndarray, shape (3,)
+        Velocity correction C_b^n (ω_eb^b × l), ENU [m/s].
+
+    Raises
+    ------
+    ValueError
+        When ``lever_arm_b`` is not three finite components.
     """
     l = _lever(lever_arm_b)
     C = np.asarray(point.C_bn, float)
@@ -366,21 +577,44 @@ def _pos_scale(point):
 
 
 def measurement_matrix(model, point, lever_arm_b=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """H (6 × n) of the position/velocity measurement of chen2019 Table 2-2 with the lever-arm
-    correction of eq. (2-13).
+    """H of the position/velocity measurement of chen2019 Table 2-2 with the lever-arm correction of eq. (2-13).
 
-    z = [ (R_M+h)(L_INS - L_GNSS'), (R_N+h) cos L (λ_INS - λ_GNSS'), h_INS - h_GNSS',
-          V_E,INS - V_E,GNSS', V_N,INS - V_N,GNSS', V_U,INS - V_U,GNSS' ]
+    ::
+
+        z = [ (R_M+h)(L_INS - L_GNSS'), (R_N+h) cos L (λ_INS - λ_GNSS'), h_INS - h_GNSS',
+              V_E,INS - V_E,GNSS', V_N,INS - V_N,GNSS', V_U,INS - V_U,GNSS' ]
 
     (metres north, east, up, then m/s ENU — the row order of the report's Z) where GNSS' is the
     GNSS fix carried to the SINS centre with the *estimated* lever arm l̂ and attitude Ĉ by
-    eq. (2-13).  To first order (derivation in :func:`measurement_function`):
+    eq. (2-13).  To first order (derivation in :func:`measurement_function`)::
 
         z_p = D δp + φ × (C l) + C δl,      z_v = δv + φ × u + C (ω_eb^b ×) δl,   u = C (ω_eb^b × l)
 
     with D δp = [(R_M+h) δL, (R_N+h) cos L δλ, δh] and the ENU vectors reordered to (N, E, U)
     in the position rows.  Gyro-error terms of ω̂_eb (size δω · l ≲ 1e-7 m/s) are neglected.
     The lever-arm columns are filled only when ``model`` has a ``lever_arm`` block.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model (n states).
+    point : replication.nav.errors.NavPoint
+        Evaluation point: latitude [rad], longitude [rad], height [m], v_enu [m/s], C_bn,
+        f_b [m/s²], w_ib_b [rad/s].
+    lever_arm_b : array_like, shape (3,)
+        l, the SINS centre seen from the antenna, body frame [m] (eq. (2-13)).
+
+    Returns
+    -------
+    H : ndarray, shape (6, n)
+        Measurement matrix; rows in m (N, E, U) and m/s (E, N, U) per unit of each state.
+
+    Raises
+    ------
+    TypeError
+        When ``model`` is not an ``ErrorModel``.
+    ValueError
+        When ``lever_arm_b`` is not three finite components.
     """
     _check_model(model)
     l = _lever(lever_arm_b)
@@ -403,11 +637,37 @@ def measurement_matrix(model, point, lever_arm_b=(0.0, 0.0, 0.0)) -> np.ndarray:
 
 
 def measurement_function(model, point, lever_arm_b, x) -> np.ndarray:
-    """The *nonlinear* measurement z(x) of :func:`measurement_matrix` for an error state ``x``
-    (used to verify H by finite differences): the INS state is the truth of ``point`` perturbed
-    by δL, δλ, δh, δv, Ĉ = exp(-φ×) C, the used lever arm is l̂ = l - δl; the GNSS fix is the
-    true antenna (SINS centre minus C l, eq. (2-13)) without noise; the fix is carried to the
-    SINS centre with Ĉ and l̂, differenced with the INS and scaled to metres."""
+    """The *nonlinear* measurement z(x) of :func:`measurement_matrix` for an error state ``x``.
+
+    Used to verify H by finite differences: the INS state is the truth of ``point`` perturbed by
+    δL, δλ, δh, δv, Ĉ = exp(-φ×) C, the used lever arm is l̂ = l - δl; the GNSS fix is the true
+    antenna (SINS centre minus C l, eq. (2-13)) without noise; the fix is carried to the SINS
+    centre with Ĉ and l̂, differenced with the INS and scaled to metres.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model (n states).
+    point : replication.nav.errors.NavPoint
+        Evaluation point: latitude [rad], longitude [rad], height [m], v_enu [m/s], C_bn,
+        f_b [m/s²], w_ib_b [rad/s].
+    lever_arm_b : array_like, shape (3,)
+        l, the true SINS centre seen from the antenna, body frame [m].
+    x : array_like, shape (n,)
+        Error state in the model's layout and units (δL, δλ rad, δh m, δv m/s, φ rad, ...).
+
+    Returns
+    -------
+    z : ndarray, shape (6,)
+        Position differences north, east, up [m] and velocity differences east, north, up [m/s].
+
+    Raises
+    ------
+    TypeError
+        When ``model`` is not an ``ErrorModel``.
+    ValueError
+        When ``x`` does not have n components or ``lever_arm_b`` is not three finite components.
+    """
     _check_model(model)
     x = np.asarray(x, float)
     if x.shape != (model.n,):
@@ -449,19 +709,36 @@ def _frozen_rates(lat, h, v, C, w_b, f_b, rm0, rn0, g0):
 
 
 def frozen_earth_jacobian(point, *, steps=(3e-3, 3e-3, 1000.0, 1.0, 1.0, 1.0, 3e-3, 3e-3, 3e-3)) -> np.ndarray:
-    """9×9 navigation block of F at the approximation level of chen2019 eq. (2-15) and Table 2-2:
-    central finite differences of the mechanization ``_frozen_rates`` in which R_M, R_N and
-    the normal gravity γ are held at their values at ``point`` (so dR/dL, ∂γ/∂L, ∂γ/∂h — which
-    the report's F omits — are absent).  Perturbations as :meth:`replication.nav.errors.ErrorModel.numerical_jacobian`:
-    δL, δλ, δh, δv additive, Ĉ = exp(-φ×) C.  The difference to the full
-    ``ErrorModel.F`` is confined to the δL column and the (δv_U, δh) element
-    (tests/test_models.py).
+    """9×9 navigation block of F at the approximation level of chen2019 eq. (2-15) and Table 2-2.
+
+    Central finite differences of the mechanization ``_frozen_rates`` in which R_M, R_N and the
+    normal gravity γ are held at their values at ``point`` (so dR/dL, ∂γ/∂L, ∂γ/∂h — which the
+    report's F omits — are absent).  Perturbations as
+    :meth:`replication.nav.errors.ErrorModel.numerical_jacobian`: δL, δλ, δh, δv additive,
+    Ĉ = exp(-φ×) C.  The difference to the full ``ErrorModel.F`` is confined to the δL column and
+    the (δv_U, δh) element (tests/test_models.py).
 
     Central differences at h and h/2 combined by Richardson extrapolation (truncation O(h⁴)).
-    Steps: 3e-3 rad (δL, φ), 1000 m (δh), 1 m/s (δv; v̇ is quadratic in v: exact up to
-    rounding).  Against :func:`table_2_2_corrected` the blocks agree to 3e-9 of each block's
-    largest element (mostly round-off of the attitude rows), so digits above 1e-8 of the block
-    scale are the same on every machine."""
+    Against :func:`table_2_2_corrected` the blocks agree to 3e-9 of each block's largest element
+    (mostly round-off of the attitude rows), so digits above 1e-8 of the block scale are the same
+    on every machine.
+
+    Parameters
+    ----------
+    point : replication.nav.errors.NavPoint
+        Evaluation point: latitude [rad], longitude [rad], height [m], v_enu [m/s], C_bn,
+        f_b [m/s²], w_ib_b [rad/s].
+    steps : sequence of float, length 9
+        Finite-difference steps of δL, δλ [rad], δh [m], δv_E, δv_N, δv_U [m/s], φ_E, φ_N, φ_U
+        [rad]; defaults 3e-3 rad (δL, φ), 1000 m (δh), 1 m/s (δv; v̇ is quadratic in v: exact up
+        to rounding).
+
+    Returns
+    -------
+    J : ndarray, shape (9, 9)
+        ∂(L̇, λ̇, ḣ, v̇_ENU, φ̇)/∂(δL, δλ, δh, δv_ENU, φ), each element in its row's unit per
+        its column's unit (e.g. 1/s for ∂φ̇/∂φ, m/s² per rad for ∂v̇/∂φ).
+    """
     lat, h = float(point.lat), float(point.h)
     rm0, rn0 = earth.radii(lat)
     g0 = float(earth.normal_gravity(lat, h))
@@ -513,23 +790,51 @@ TABLE_2_2_BLOCKS = ("F11", "F12", "F21", "F22", "F23", "F31", "F32", "F33", "F41
 
 
 def table_2_2_reference_point():
-    """A generic evaluation point for the Table 2-2 comparison: the chen2019 flight conditions
-    (47°N, 115°E, 6000 m, heading ≈ 45°) with a climb (v_U = 5 m/s), bank, and non-zero
-    components of f^b and ω_ib^b, so that no printed element vanishes by accident."""
+    """A generic evaluation point for the Table 2-2 comparison.
+
+    The chen2019 flight conditions (47°N, 115°E, 6000 m, heading ≈ 45°) with a climb
+    (v_U = 5 m/s), bank, and non-zero components of f^b and ω_ib^b, so that no printed element
+    vanishes by accident.
+
+    Returns
+    -------
+    point : replication.nav.errors.NavPoint
+        Latitude and longitude [rad], height [m], v_enu [m/s], C_bn, f_b [m/s²], w_ib_b [rad/s].
+    """
     return E.NavPoint(math.radians(47.0), math.radians(115.0), 6000.0, np.array([70.7, 68.0, 5.0]),
                       euler_to_dcm(0.7, 0.05, 0.17), np.array([0.3, -0.4, 9.7]), np.array([0.01, -0.02, 0.03]))
 
 
 def table_2_2_printed(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.0) -> dict:
-    """The sub-blocks of chen2019 Table 2-2 *as printed*, evaluated at ``point`` (a
-    :class:`replication.nav.errors.NavPoint`), in the report's conventions (gyro errors with +C_b^n).
+    """The sub-blocks of chen2019 Table 2-2 *as printed*, evaluated at ``point``.
 
-    Reading of the damaged print (data/paper/chen2019/chen2019-table-2-2.csv): the single
-    "(R_n+h)^2" under the third column of F21 is the denominator of all three third-column
-    entries; F42's five garbled rows are the fractions [[0, -1/(R_m+h), 0], [1/(R_n+h), 0, 0],
-    [tan L/(R_n+h), 0, 0]]; the "-f_N" printed at F22(3,3) is kept where printed; F32/F33 fill
-    the six misalignment columns in the text's state order (A_xy, A_yx, A_xz, A_zx, A_yz, A_zy);
-    F6 = diag(-1/α), F7 = diag(-1/β) with α, β the Markov correlation times.
+    In the report's conventions (gyro errors with +C_b^n).  Reading of the damaged print
+    (data/paper/chen2019/chen2019-table-2-2.csv): the single "(R_n+h)^2" under the third column of
+    F21 is the denominator of all three third-column entries; F42's five garbled rows are the
+    fractions [[0, -1/(R_m+h), 0], [1/(R_n+h), 0, 0], [tan L/(R_n+h), 0, 0]]; the "-f_N" printed
+    at F22(3,3) is kept where printed; F32/F33 fill the six misalignment columns in the text's
+    state order (A_xy, A_yx, A_xz, A_zx, A_yz, A_zy); F6 = diag(-1/α), F7 = diag(-1/β) with α, β
+    the Markov correlation times.
+
+    Parameters
+    ----------
+    point : replication.nav.errors.NavPoint
+        Evaluation point: latitude [rad], longitude [rad], height [m], v_enu [m/s], C_bn,
+        f_b [m/s²], w_ib_b [rad/s].
+    accel_markov_tau : float
+        Correlation time α of the accelerometer Markov bias [s].
+    gyro_markov_tau : float
+        Correlation time β of the gyro Markov drift [s].
+
+    Returns
+    -------
+    blocks : dict of str to ndarray, shape (3, 3)
+        Name of :data:`TABLE_2_2_BLOCKS` -> the 3×3 block in SI units (rad, m, m/s, s).
+
+    Raises
+    ------
+    ValueError
+        When a correlation time is not positive.
     """
     q = _nav_quantities(point)
     Rm, Rn, VE, VN, VU, w, s, c, t, sec = (q[k] for k in ("Rm", "Rn", "VE", "VN", "VU", "w", "s", "c", "t", "sec"))
@@ -563,16 +868,38 @@ def table_2_2_printed(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.0)
 
 
 def table_2_2_corrected(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.0) -> dict:
-    """The Table 2-2 sub-blocks re-derived (same conventions and the same approximation level
-    as the report: Earth radii and gravity frozen, gyro errors with +C_b^n), evaluated at
-    ``point``.  Verified against :func:`frozen_earth_jacobian` and ``ErrorModel.F`` in
-    tests/test_models.py; :data:`TABLE_2_2_CORRECTED_TEXT` gives the expressions::
+    """The Table 2-2 sub-blocks re-derived, evaluated at ``point``.
+
+    Same conventions and the same approximation level as the report: Earth radii and gravity
+    frozen, gyro errors with +C_b^n.  Verified against :func:`frozen_earth_jacobian` and
+    ``ErrorModel.F`` in tests/test_models.py; :data:`TABLE_2_2_CORRECTED_TEXT` gives the
+    expressions::
 
         F21(·,3) = [V_E(V_U - V_N tan L)/(R_N+h)², V_E² tan L/(R_N+h)² + V_N V_U/(R_M+h)²,
                     -V_E²/(R_N+h)² - V_N²/(R_M+h)²];  F22(1,1) = (V_N tan L - V_U)/(R_N+h),
         F22(3,·) = [2ω_ie cos L + 2V_E/(R_N+h), 2V_N/(R_M+h), 0];  F23 = (f^n ×);
         F32/F33 = C_b^n ∂(δA f^b)/∂(A_xy, A_yx, A_xz, A_zx, A_yz, A_zy) (eq. (2-8));
         F43(2,1) = -ω_ie sin L - V_E tan L/(R_N+h);  the others as printed.
+
+    Parameters
+    ----------
+    point : replication.nav.errors.NavPoint
+        Evaluation point: latitude [rad], longitude [rad], height [m], v_enu [m/s], C_bn,
+        f_b [m/s²], w_ib_b [rad/s].
+    accel_markov_tau : float
+        Correlation time α of the accelerometer Markov bias [s].
+    gyro_markov_tau : float
+        Correlation time β of the gyro Markov drift [s].
+
+    Returns
+    -------
+    blocks : dict of str to ndarray, shape (3, 3)
+        Name of :data:`TABLE_2_2_BLOCKS` -> the 3×3 block in SI units.
+
+    Raises
+    ------
+    ValueError
+        When a correlation time is not positive.
     """
     B = table_2_2_printed(point, accel_markov_tau=accel_markov_tau, gyro_markov_tau=gyro_markov_tau)
     q = _nav_quantities(point)
@@ -610,12 +937,33 @@ TABLE_2_2_CORRECTED_TEXT = {
 
 
 def table_2_2_verified(model, point) -> dict:
-    """The Table 2-2 sub-blocks taken from the verified matrices, in the report's conventions:
-    navigation blocks from :func:`frozen_earth_jacobian` (finite differences of the
-    mechanization, the report's approximation level), sensor blocks from ``model.F``
-    (checked against ``ErrorModel.numerical_jacobian``) with the gyro-error columns negated
-    (+C_b^n convention of eq. (2-15)), Markov dynamics from the model.  ``model`` must be a
-    :func:`model_45`."""
+    """The Table 2-2 sub-blocks taken from the verified matrices, in the report's conventions.
+
+    Navigation blocks from :func:`frozen_earth_jacobian` (finite differences of the mechanization,
+    the report's approximation level), sensor blocks from ``model.F`` (checked against
+    ``ErrorModel.numerical_jacobian``) with the gyro-error columns negated (+C_b^n convention of
+    eq. (2-15)), Markov dynamics from the model.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        A 45-state model of :func:`model_45`.
+    point : replication.nav.errors.NavPoint
+        Evaluation point: latitude [rad], longitude [rad], height [m], v_enu [m/s], C_bn,
+        f_b [m/s²], w_ib_b [rad/s].
+
+    Returns
+    -------
+    blocks : dict of str to ndarray, shape (3, 3)
+        Name of :data:`TABLE_2_2_BLOCKS` -> the 3×3 block in SI units.
+
+    Raises
+    ------
+    TypeError
+        When ``model`` is not an ``ErrorModel``.
+    ValueError
+        When ``model`` lacks a block of the 45-state model.
+    """
     _check_model(model)
     need = set(CHEN2019_45_ORDER)
     if not need <= {b.name for b in model.blocks}:
@@ -634,13 +982,33 @@ def table_2_2_verified(model, point) -> dict:
 
 
 def table_2_2_differences(model, point, *, rtol=1e-6, floor=1e-8) -> list:
-    """Element-wise comparison of the printed Table 2-2 blocks with the verified ones at
-    ``point``: a list of dicts (block, row, col (1-based), printed, verified, differs) where
-    ``differs`` means abs(printed - verified) > rtol · abs(verified) + floor · max abs(verified block).
-    Defaults: well above the accuracy of the verified blocks (the finite differences of
+    """Element-wise comparison of the printed Table 2-2 blocks with the verified ones at ``point``.
+
+    ``differs`` means abs(printed - verified) > rtol · abs(verified) + floor · max abs(verified
+    block).  Defaults: well above the accuracy of the verified blocks (the finite differences of
     :func:`frozen_earth_jacobian` agree with the re-derived expressions of
-    :func:`table_2_2_corrected` to 3e-9 of the block scale, tests/test_models.py) and far below
-    the smallest erratum (1e-2 relative); the Markov time constants of the printed F6/F7 are taken from ``model``."""
+    :func:`table_2_2_corrected` to 3e-9 of the block scale, tests/test_models.py) and far below the
+    smallest erratum (1e-2 relative); the Markov time constants of the printed F6/F7 are taken from
+    ``model``.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        A 45-state model of :func:`model_45`.
+    point : replication.nav.errors.NavPoint
+        Evaluation point: latitude [rad], longitude [rad], height [m], v_enu [m/s], C_bn,
+        f_b [m/s²], w_ib_b [rad/s].
+    rtol : float
+        Relative tolerance per element [1].
+    floor : float
+        Absolute tolerance as a fraction of the verified block's largest element [1].
+
+    Returns
+    -------
+    rows : list of dict
+        One per element of every block of :data:`TABLE_2_2_BLOCKS`: ``block`` (str), ``row``,
+        ``col`` (int, 1-based), ``printed``, ``verified`` (float, SI units), ``differs`` (bool).
+    """
     F = model.F(point)
     s = model.slices
     ta = -1.0 / F[s["accel_markov"], s["accel_markov"]][0, 0]
@@ -660,10 +1028,32 @@ def table_2_2_differences(model, point, *, rtol=1e-6, floor=1e-8) -> list:
 
 
 def jacobian_agreement(model, traj, indices) -> "pd.DataFrame":
-    """Largest relative difference, over the samples ``indices`` of ``traj``, between
-    ``model.F`` and ``model.numerical_jacobian`` for every non-zero (row block × column block)
-    of the navigation rows (relative to the block's largest element).  Columns ``row_block``,
-    ``column_block``, ``max_rel_diff``."""
+    """Largest relative difference between ``model.F`` and ``model.numerical_jacobian`` per block.
+
+    Over the samples ``indices`` of ``traj``, for every non-zero (row block × column block) of the
+    navigation rows (relative to the block's largest element).
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model.
+    traj : replication.nav.trajectory.Trajectory
+        The trajectory supplying the evaluation points.
+    indices : iterable of int
+        Sample indices of ``traj``.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        Columns ``row_block`` (``position``, ``velocity``, ``attitude``), ``column_block`` (a
+        navigation or augmented block name), ``max_rel_diff`` (largest difference over the
+        samples relative to the block's largest element of F, dimensionless).
+
+    Raises
+    ------
+    TypeError
+        When ``model`` is not an ``ErrorModel``.
+    """
 
     _check_model(model)
     rows = {"position": slice(0, 3), "velocity": slice(3, 6), "attitude": slice(6, 9)}

@@ -110,7 +110,29 @@ def _systems(systems):
 # ----------------------------------------------------------------------------- matrices
 
 def observability_matrix(F, H, n_powers=None) -> np.ndarray:
-    """Q = [H; H F; ...; H F^(k-1)] of a constant segment (k = ``n_powers``, default n)."""
+    """Q = [H; H F; ...; H F^(k-1)] of a constant segment (k = ``n_powers``, default n).
+
+    Parameters
+    ----------
+    F : array_like, shape (n, n)
+        Error dynamics matrix of the segment.
+    H : array_like, shape (m, n)
+        Measurement matrix of the segment.
+    n_powers : int or None
+        Number k of powers of F in each segment's Q (``None``: the state dimension n).
+
+    Returns
+    -------
+    Q : ndarray, shape (k m, n)
+        The observability matrix (rows in the measurement's units per state unit, times 1/s^p for
+        the block of power p).
+
+    Raises
+    ------
+    ValueError
+        When F is not square, H does not have n columns, a matrix is not finite, or ``n_powers``
+        is not a positive integer.
+    """
     F, H = _FH(F, H)
     k = _powers(n_powers, F.shape[0])
     blocks = [H]
@@ -120,13 +142,57 @@ def observability_matrix(F, H, n_powers=None) -> np.ndarray:
 
 
 def stripped_observability_matrix(systems, n_powers=None) -> np.ndarray:
-    """The SOM Q_s(r) = [Q_1; ...; Q_r] of the segments ``systems`` = [(F_1, H_1), ...]
-    (Goshen-Meskin & Bar-Itzhack 1992; the matrix chen2019 ch. 2 §4.2 decomposes)."""
+    """The SOM Q_s(r) = [Q_1; ...; Q_r] of the segments ``systems`` = [(F_1, H_1), ...].
+
+    Goshen-Meskin & Bar-Itzhack 1992; the matrix chen2019 ch. 2 §4.2 decomposes.
+
+    Parameters
+    ----------
+    systems : sequence of tuple (F, H)
+        One pair per segment: F_j, shape (n, n), the error dynamics [1/s and the states' unit
+        ratios], and H_j, shape (m, n), the measurement matrix.
+    n_powers : int or None
+        Number k of powers of F in each segment's Q (``None``: the state dimension n).
+
+    Returns
+    -------
+    Q_s : ndarray, shape (r k m, n)
+        The stacked observability matrices.
+
+    Raises
+    ------
+    TypeError
+        When ``systems`` is not a sequence of segments.
+    ValueError
+        When it is empty, a segment is not an (F, H) pair, or the state dimensions differ.
+    """
     return np.vstack([observability_matrix(F, H, n_powers) for F, H in _systems(systems)])
 
 
 def total_observability_matrix(systems, durations, n_powers=None) -> np.ndarray:
-    """The TOM [Q_1; Q_2 Φ_1; Q_3 Φ_2 Φ_1; ...] with Φ_j = exp(F_j Δ_j) (``durations`` Δ_j, s)."""
+    """The TOM [Q_1; Q_2 Φ_1; Q_3 Φ_2 Φ_1; ...] with Φ_j = exp(F_j Δ_j).
+
+    Parameters
+    ----------
+    systems : sequence of tuple (F, H)
+        One pair per segment: F_j, shape (n, n), the error dynamics [1/s and the states' unit
+        ratios], and H_j, shape (m, n), the measurement matrix.
+    durations : array_like, shape (r,)
+        Segment durations Δ_j [s], positive.
+    n_powers : int or None
+        Number k of powers of F in each segment's Q (``None``: the state dimension n).
+
+    Returns
+    -------
+    Q : ndarray, shape (r k m, n)
+        The total observability matrix.
+
+    Raises
+    ------
+    ValueError
+        When ``durations`` does not hold one positive duration per segment (and as
+        :func:`stripped_observability_matrix`).
+    """
 
     sy = _systems(systems)
     d = finite_array(durations, "durations")
@@ -140,12 +206,29 @@ def total_observability_matrix(systems, durations, n_powers=None) -> np.ndarray:
 
 
 def som_condition(F, H, n_powers=None, rtol: float = 1e-9) -> bool:
-    """True when null(Q_j) ⊂ null(F_j): every unobservable direction of the segment is also
-    a direction F_j does not move, the condition under which rank SOM = rank TOM.
+    """True when null(Q_j) ⊂ null(F_j), the condition under which rank SOM = rank TOM.
 
+    Every unobservable direction of the segment is then also a direction F_j does not move.
     null(Q_j) is spanned by the right singular vectors below the numerical-rank tolerance
     σ_max · max(m, n) · ε (as :func:`observability_degrees`); the condition holds when
-    max abs(F_j N) ≤ ``rtol`` · max abs(F_j) (rounding leaves ~1e-13 here)."""
+    max abs(F_j N) ≤ ``rtol`` · max abs(F_j) (rounding leaves ~1e-13 here).
+
+    Parameters
+    ----------
+    F : array_like, shape (n, n)
+        Error dynamics matrix of the segment.
+    H : array_like, shape (m, n)
+        Measurement matrix of the segment.
+    n_powers : int or None
+        Number k of powers of F in each segment's Q (``None``: the state dimension n).
+    rtol : float
+        Relative tolerance of F_j N = 0 (non-negative).
+
+    Returns
+    -------
+    holds : bool
+        Whether the null space of Q_j lies in that of F_j.
+    """
     F, H = _FH(F, H)
     rtol = nonnegative(rtol, "rtol")
     Q = observability_matrix(F, H, n_powers)
@@ -165,12 +248,30 @@ def som_condition(F, H, n_powers=None, rtol: float = 1e-9) -> bool:
 class ObservabilityDegrees:
     """SVD of a (stripped) observability matrix and the degree assigned to every state.
 
-    ``singular_values`` σ (descending), ``V`` right singular vectors (columns), ``degree`` the
-    value assigned to each state (normalized as requested), ``index`` the singular vector each
-    state was assigned (-1 for none), ``rank_tol`` the numerical-rank tolerance in the same
-    units as ``degree``, ``labels`` the state names, ``ambiguity`` per state the ratio of its
-    second-largest to its largest projection on a singular subspace (near 1: the state lies almost
-    equally in two directions and its assignment hangs on that small difference)."""
+    Attributes
+    ----------
+    singular_values : ndarray, shape (n,)
+        Singular values σ, descending (zeros appended when Q has fewer rows than columns), in the
+        units of Q (or of Q D with ``normalize="scale"``).
+    V : ndarray, shape (n, n)
+        Right singular vectors (columns).
+    degree : ndarray, shape (n,)
+        The value assigned to each state (normalized as requested).
+    index : ndarray of int, shape (n,)
+        The singular vector each state was assigned (-1 for none).
+    rank_tol : float
+        The numerical-rank tolerance, in the same units as ``degree``.
+    labels : list of str
+        The state names.
+    normalize : str or None
+        The normalization: ``None``, ``"max"`` or ``"scale"``.
+    assignment : str
+        The assignment rule: ``"state"`` or ``"singular"``.
+    ambiguity : ndarray, shape (n,), or None
+        Per state the ratio of its second-largest to its largest projection on a singular
+        subspace (near 1: the state lies almost equally in two directions and its assignment hangs
+        on that small difference).
+    """
 
     singular_values: np.ndarray
     V: np.ndarray
@@ -196,11 +297,30 @@ class ObservabilityDegrees:
         return float(self.rank_tol * s[0]) if self.normalize == "max" and s[0] > 0 else float(self.rank_tol)
 
     def observable(self, threshold=None) -> np.ndarray:
-        """Boolean per state: degree above ``threshold`` (default: the numerical-rank tolerance)."""
+        """Boolean per state: degree above ``threshold``.
+
+        Parameters
+        ----------
+        threshold : float or None
+            Non-negative threshold in the units of ``degree`` (``None``: the numerical-rank
+            tolerance ``rank_tol``).
+
+        Returns
+        -------
+        observable : ndarray of bool, shape (n,)
+            True where the state's degree exceeds the threshold.
+        """
         t = self.rank_tol if threshold is None else nonnegative(threshold, "threshold")
         return self.degree > t
 
     def as_dict(self) -> dict:
+        """The degrees by state name.
+
+        Returns
+        -------
+        degrees : dict of str to float
+            Label -> degree (units of ``degree``).
+        """
         return dict(zip(self.labels, self.degree))
 
 
@@ -237,22 +357,45 @@ def observability_degrees(Q, *, assignment: str = "state", normalize: str | None
                           labels=None) -> ObservabilityDegrees:
     """Observability degree of every state from the SVD of ``Q`` (see the module docstring).
 
-    ``assignment``: ``"state"`` or ``"singular"``; ``normalize``: ``None``, ``"max"`` or
-    ``"scale"`` (then ``state_scale``, one positive number per state, multiplies the columns of
-    Q before the SVD).  The numerical-rank tolerance is σ_max · max(m, n) · ε (numpy's rule).
-    Singular values within the rank tolerance of each other count as one repeated value and a
-    state's component on it is the norm of its projection onto their subspace; a state whose
-    largest component is shared (within ``TIE_TOL``) gets the larger singular value.  Both make
-    the assignment independent of round-off.
+    The numerical-rank tolerance is σ_max · max(m, n) · ε (numpy's rule).  Singular values within
+    the rank tolerance of each other count as one repeated value and a state's component on it is
+    the norm of its projection onto their subspace; a state whose largest component is shared
+    (within ``TIE_TOL``) gets the larger singular value.  Both make the assignment independent of
+    round-off.
 
     The rank and the unobservable subspace do not depend on the scaling, but the *naming* of
     states does: an SVD assigns each state to the singular vector it loads most, and column
-    scaling (``normalize="scale"`` with prior standard deviations vs raw units, where a
-    position in radians and a bias in m/s² differ by orders of magnitude) rotates the singular
-    vectors.  Per-state verdicts such as which states span a stationary INS's unobservable
-    directions (whether a level accelerometer bias or the tilt it cancels, the east gyro drift
-    or the azimuth error is named) can therefore differ between the two scalings; report the
-    scaling with the verdict.
+    scaling (``normalize="scale"`` with prior standard deviations vs raw units, where a position in
+    radians and a bias in m/s² differ by orders of magnitude) rotates the singular vectors.
+    Per-state verdicts such as which states span a stationary INS's unobservable directions
+    (whether a level accelerometer bias or the tilt it cancels, the east gyro drift or the azimuth
+    error is named) can therefore differ between the two scalings; report the scaling with the
+    verdict.
+
+    Parameters
+    ----------
+    Q : array_like, shape (m, n)
+        Observability matrix (rows: outputs and their derivatives, columns: states), finite.
+    assignment : str
+        ``"state"`` or ``"singular"`` (module docstring).
+    normalize : str or None
+        ``None`` (raw singular values), ``"max"`` (σ / σ_max) or ``"scale"``.
+    state_scale : array_like, shape (n,), or None
+        With ``normalize="scale"`` only: one positive scale per state, in the state's unit (e.g.
+        its prior standard deviation), multiplying the columns of Q before the SVD.
+    labels : sequence of str or None
+        State names (``None``: ``x0``, ``x1``, ...).
+
+    Returns
+    -------
+    degrees : ObservabilityDegrees
+        Singular values, vectors, the degree of each state and the rank tolerance.
+
+    Raises
+    ------
+    ValueError
+        When Q is not a finite matrix, a choice is unknown, ``labels`` has the wrong length, or
+        ``state_scale`` is missing, misshapen or given without ``normalize="scale"``.
     """
     Q = np.atleast_2d(numeric(Q, "Q"))
     if Q.ndim != 2 or not np.all(np.isfinite(Q)):
@@ -310,7 +453,27 @@ def observability_degrees(Q, *, assignment: str = "state", normalize: str | None
 # ----------------------------------------------------------------------------- along a trajectory
 
 def segment_bounds(t0: float, t1: float, n_segments: int) -> list:
-    """Equal segments [(a, b), ...] covering [t0, t1]."""
+    """Equal segments [(a, b), ...] covering [t0, t1].
+
+    Parameters
+    ----------
+    t0 : float
+        Start of the span [s].
+    t1 : float
+        End of the span [s], later than ``t0``.
+    n_segments : int
+        Number of segments.
+
+    Returns
+    -------
+    bounds : list of tuple (float, float)
+        The segments (a, b) [s].
+
+    Raises
+    ------
+    ValueError
+        When t1 ≤ t0 or ``n_segments`` is not a positive integer.
+    """
     n_segments = integer(n_segments, "n_segments")
     t0, t1 = finite(t0, "t0"), finite(t1, "t1")
     if not t1 > t0:
@@ -361,12 +524,42 @@ def piecewise_systems(model, traj, spans, *, evaluate: str = "mid", lever_arm_b=
                       position_units: str = "m"):
     """The constant (F_j, H_j) of each segment ``spans`` = [(t_a, t_b), ...] of ``traj``.
 
-    F_j = ``model.F`` (chen2019 eq. (2-15)) and H_j = :func:`replication.papers.chen2019.models.measurement_matrix`
-    (6-dim position/velocity measurement, Table 2-2, with the lever arm of eq. (2-13)) at the
-    sample nearest the segment midpoint (``evaluate="mid"``) or averaged over the samples of the
-    segment (``"mean"``).  ``position_units``: ``"m"`` (rows scaled by R_M+h, (R_N+h) cos L as the
-    report's H) or ``"rad"`` (H = I on δL, δλ).  ``states`` (labels) restricts F and H to a
-    subset (the others are dropped, i.e. assumed absent from the model).
+    F_j = ``model.F`` (chen2019 eq. (2-15)) and H_j =
+    :func:`replication.papers.chen2019.models.measurement_matrix` (6-dim position/velocity
+    measurement, Table 2-2, with the lever arm of eq. (2-13)) at the sample nearest the segment
+    midpoint (``evaluate="mid"``) or averaged over the samples of the segment (``"mean"``).
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model (e.g. :func:`replication.papers.chen2019.models.model_45`).
+    traj : replication.nav.trajectory.Trajectory
+        The true trajectory (the linearization point).
+    spans : sequence of tuple (float, float)
+        Segments (t_start, t_end) [s] inside ``traj``, t_end > t_start.
+    evaluate : str
+        ``"mid"`` or ``"mean"``.
+    lever_arm_b : array_like, shape (3,)
+        SINS centre seen from the GNSS antenna, body frame [m] (eq. (2-13)).
+    states : sequence of str or None
+        Labels (``model.labels``) of the states kept; the others are dropped, i.e. assumed absent
+        from the model (``None``: all).
+    position_units : str
+        ``"m"`` (rows scaled by R_M+h, (R_N+h) cos L as the report's H) or ``"rad"`` (H = I on
+        δL, δλ).
+
+    Returns
+    -------
+    systems : list of tuple (ndarray, ndarray)
+        Per segment F_j, shape (n_kept, n_kept), and H_j, shape (6, n_kept); H rows in m (N, E,
+        U; rad with ``position_units="rad"``) and m/s (E, N, U) per state unit.
+
+    Raises
+    ------
+    TypeError
+        When ``model`` or ``traj`` has the wrong type.
+    ValueError
+        When a choice is unknown, a span lies outside the trajectory, or a state label is unknown.
     """
 
     if not isinstance(model, E.ErrorModel):
@@ -397,10 +590,42 @@ def piecewise_systems(model, traj, spans, *, evaluate: str = "mid", lever_arm_b=
 def pwcs_observability(model, traj, spans, *, n_powers=None, evaluate: str = "mid", assignment: str = "state",
                        normalize: str | None = None, state_scale=None, states=None, lever_arm_b=(0.0, 0.0, 0.0),
                        position_units: str = "m") -> ObservabilityDegrees:
-    """PWCS/SVD observability degrees (chen2019 Table 2-3 method) of ``model`` along ``traj``:
-    SOM of the segments ``spans`` (:func:`piecewise_systems`), then
-    :func:`observability_degrees`.  ``state_scale`` for ``normalize="scale"`` is given for the
-    states kept (``states`` order)."""
+    """PWCS/SVD observability degrees (chen2019 Table 2-3 method) of ``model`` along ``traj``.
+
+    SOM of the segments ``spans`` (:func:`piecewise_systems`), then :func:`observability_degrees`.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model (e.g. :func:`replication.papers.chen2019.models.model_45`).
+    traj : replication.nav.trajectory.Trajectory
+        The true trajectory (the linearization point).
+    spans : sequence of tuple (float, float)
+        Segments (t_start, t_end) [s] inside ``traj``, t_end > t_start.
+    n_powers : int or None
+        Number k of powers of F in each segment's Q (``None``: the state dimension n).
+    evaluate : str
+        ``"mid"`` or ``"mean"`` (:func:`piecewise_systems`).
+    assignment : str
+        ``"state"`` or ``"singular"`` (:func:`observability_degrees`).
+    normalize : str or None
+        ``None``, ``"max"`` or ``"scale"``.
+    state_scale : array_like or None
+        For ``normalize="scale"``: one positive scale per state kept (``states`` order), in the
+        states' units.
+    states : sequence of str or None
+        Labels (``model.labels``) of the states kept; the others are dropped, i.e. assumed absent
+        from the model (``None``: all).
+    lever_arm_b : array_like, shape (3,)
+        SINS centre seen from the GNSS antenna, body frame [m] (eq. (2-13)).
+    position_units : str
+        ``"m"`` or ``"rad"`` (:func:`piecewise_systems`).
+
+    Returns
+    -------
+    degrees : ObservabilityDegrees
+        Degrees of the states kept, labelled.
+    """
     systems = piecewise_systems(model, traj, spans, evaluate=evaluate, lever_arm_b=lever_arm_b, states=states,
                                 position_units=position_units)
     Q = stripped_observability_matrix(systems, n_powers)
@@ -415,16 +640,56 @@ def covariance_observability(model, traj, t0: float, t1: float, *, update_interv
     """Covariance-based observability √(P0_kk / P_kk(t1)) of every state over [t0, t1].
 
     Kalman covariance recursion of ``model`` along the *true* trajectory (the error-state
-    linearization point): every ``update_interval`` seconds Φ, Q_d by Van Loan
-    series (:func:`replication.nav.kalman.discretize_series`, order ``series_order``; the products of
-    F decay through the 1/R couplings, so order 8 is exact to rounding for intervals of a few
+    linearization point): every ``update_interval`` seconds Φ, Q_d by Van Loan series
+    (:func:`replication.nav.kalman.discretize_series`, order ``series_order``; the products of F
+    decay through the 1/R couplings, so order 8 is exact to rounding for intervals of a few
     seconds — tests/test_observability.py compares with scipy's expm) with F and G Q Gᵀ at the
-    interval midpoint, then a
-    Joseph-form update with the 6-dim measurement of :func:`replication.papers.chen2019.models.measurement_matrix`
-    (position in metres) and noise covariance ``R`` (6×6, m² and (m/s)²).  ``P0`` defaults to
-    ``model.P0()``; states with zero prior variance are reported as NaN.  ``states`` restricts
-    the model as in :func:`piecewise_systems`.  Returns the ratios (and, with
-    ``return_history``, the epoch times and √diag P history).
+    interval midpoint, then a Joseph-form update with the 6-dim measurement of
+    :func:`replication.papers.chen2019.models.measurement_matrix` (position in metres) and noise
+    covariance ``R``.  States with zero prior variance are reported as NaN.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model (e.g. :func:`replication.papers.chen2019.models.model_45`).
+    traj : replication.nav.trajectory.Trajectory
+        The true trajectory (the linearization point).
+    t0 : float
+        Start of the span [s], inside the trajectory.
+    t1 : float
+        End of the span [s], later than ``t0``.
+    update_interval : float
+        Time between measurement updates [s].
+    R : array_like, shape (6, 6)
+        Measurement noise covariance: position N, E, U [m²], velocity E, N, U [(m/s)²].  Required.
+    P0 : array_like, shape (n, n) or (n_kept, n_kept), or None
+        Prior covariance in the model's units (``None``: ``model.P0()``).
+    states : sequence of str or None
+        Labels (``model.labels``) of the states kept; the others are dropped, i.e. assumed absent
+        from the model (``None``: all).
+    lever_arm_b : array_like, shape (3,)
+        SINS centre seen from the GNSS antenna, body frame [m] (eq. (2-13)).
+    return_history : bool
+        Also return the epoch times and the standard-deviation history.
+    series_order : int
+        Order of the Van Loan series.
+
+    Returns
+    -------
+    ratio : ndarray, shape (n_kept,)
+        √(P0_kk / P_kk(t1)) per state [1] (NaN for a zero prior variance).
+    t : ndarray, shape (epochs + 1,)
+        With ``return_history``: t0 and the update times [s].
+    sigma : ndarray, shape (epochs + 1, n_kept)
+        With ``return_history``: √diag P at those times, in the states' units.
+
+    Raises
+    ------
+    TypeError
+        When ``model`` or ``traj`` has the wrong type.
+    ValueError
+        When ``R`` or ``P0`` is not a covariance of the right size, the span lies outside the
+        trajectory or is shorter than one update interval.
     """
 
     if not isinstance(model, E.ErrorModel):
@@ -480,8 +745,25 @@ def covariance_observability(model, traj, t0: float, t1: float, *, update_interv
 # ----------------------------------------------------------------------------- comparison helper
 
 def spearman(a, b) -> float:
-    """Spearman rank correlation of two equal-length sequences (average ranks for ties;
-    scipy.stats.spearmanr)."""
+    """Spearman rank correlation of two equal-length sequences (average ranks for ties; scipy.stats.spearmanr).
+
+    Parameters
+    ----------
+    a : array_like, shape (k,)
+        First sequence, finite, k ≥ 3.
+    b : array_like, shape (k,)
+        Second sequence, finite.
+
+    Returns
+    -------
+    rho : float
+        The rank correlation, in [-1, 1].
+
+    Raises
+    ------
+    ValueError
+        When the sequences are not 1-D of equal length ≥ 3 or not finite.
+    """
 
     a, b = numeric(a, "a"), numeric(b, "b")
     if a.shape != b.shape or a.ndim != 1 or len(a) < 3:
@@ -499,8 +781,19 @@ CHEN2019_MANEUVERS = ("before maneuver", "U-turn", "figure-8", "S-turn")
 
 @dataclass
 class Maneuver:
-    """A Fig. 2-3 scenario: the trajectory, the end of the straight "before maneuver" leg
-    ``t_start`` and the end of the maneuver ``t_end`` (the trajectory may continue straight)."""
+    """A Fig. 2-3 scenario: the trajectory, the end of the straight leg and the end of the maneuver.
+
+    Attributes
+    ----------
+    name : str
+        Scenario name (:data:`CHEN2019_MANEUVERS`).
+    traj : replication.nav.trajectory.Trajectory
+        The trajectory (it may continue straight after ``t_end``).
+    t_start : float
+        End of the straight "before maneuver" leg [s].
+    t_end : float
+        End of the maneuver [s] (equal to ``t_start`` for the straight scenario).
+    """
 
     name: str
     traj: object
@@ -508,9 +801,23 @@ class Maneuver:
     t_end: float
 
     def spans(self, n_segments: int = 16, before_segments: int = 1) -> list:
-        """PWCS segments: ``before_segments`` equal segments over the straight leg [0, t_start]
-        followed by ``n_segments`` over the maneuver [t_start, t_end] (none for the straight
-        scenario)."""
+        """PWCS segments over the straight leg and the maneuver.
+
+        ``before_segments`` equal segments over the straight leg [0, t_start] followed by
+        ``n_segments`` over the maneuver [t_start, t_end] (none for the straight scenario).
+
+        Parameters
+        ----------
+        n_segments : int
+            Segments over the maneuver.
+        before_segments : int
+            Segments over the straight leg.
+
+        Returns
+        -------
+        spans : list of tuple (float, float)
+            The segments (t_a, t_b) [s].
+        """
         out = segment_bounds(0.0, self.t_start, before_segments)
         if self.t_end > self.t_start:
             out += segment_bounds(self.t_start, self.t_end, n_segments)
@@ -520,20 +827,49 @@ class Maneuver:
 def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure_eight: float = 1600.0,
                        s_turn: float = 1200.0, s_swing: float = math.pi, s_cycles: int = 2, total: float | None = None,
                        dt: float = 1.0) -> dict:
-    """The maneuvers of chen2019 Fig. 2-3 at the flight conditions of Table 4-41/4-42 (47°N,
-    115°E, 6000 m, heading 45°, 100 m/s, constant speed and height, coordinated turns):
+    """The maneuvers of chen2019 Fig. 2-3 at the flight conditions of Table 4-41/4-42.
+
+    47°N, 115°E, 6000 m, heading 45°, 100 m/s, constant speed and height, coordinated turns:
 
     * ``before maneuver`` — straight and level flight;
     * ``U-turn`` — straight leg, clockwise 180° turn in ``u_turn`` s (Table 4-42: 400 s);
     * ``figure-8`` — straight leg, a full right then a full left turn in ``figure_eight`` s (not
       in Table 4-42; the default 1600 s keeps the U-turn's mean turn rate, 0.45°/s);
     * ``S-turn`` — straight leg, S-maneuver of ``s_turn`` s (Table 4-42: 1200 s) swinging
-      ``s_swing`` rad ``s_cycles`` times (not printed; :func:`replication.nav.trajectory.chen2019_flight`'s choice).
+      ``s_swing`` rad ``s_cycles`` times (not printed;
+      :func:`replication.nav.trajectory.chen2019_flight`'s choice).
 
-    Every scenario starts with ``straight`` s (Table 4-42's first leg: 100 s).  With ``total``
-    every trajectory is continued straight (the straight scenario extended) to ``total`` s, so
-    that time-dependent measures (:func:`covariance_observability`) compare equal durations.
-    Returns ``{name: Maneuver}`` in the order of :data:`CHEN2019_MANEUVERS`.
+    Parameters
+    ----------
+    straight : float
+        Length of the straight leg that starts every scenario [s] (Table 4-42's first leg: 100 s).
+    u_turn : float
+        Duration of the U-turn [s].
+    figure_eight : float
+        Duration of the figure-8 [s].
+    s_turn : float
+        Duration of the S-maneuver [s].
+    s_swing : float
+        Heading swing of the S-maneuver [rad].
+    s_cycles : int
+        Number of S-maneuver cycles.
+    total : float or None
+        With a value, every trajectory is continued straight (the straight scenario extended) to
+        ``total`` s, so that time-dependent measures (:func:`covariance_observability`) compare
+        equal durations.
+    dt : float
+        Sampling interval [s].
+
+    Returns
+    -------
+    maneuvers : dict of str to Maneuver
+        ``{name: Maneuver}`` in the order of :data:`CHEN2019_MANEUVERS`.
+
+    Raises
+    ------
+    ValueError
+        When a duration or ``dt`` is not positive, or ``total`` is shorter than the longest
+        scenario.
     """
 
     for nm, v in (("straight", straight), ("u_turn", u_turn), ("figure_eight", figure_eight), ("s_turn", s_turn)):
@@ -578,24 +914,62 @@ def _reflown(traj, roll):
 
 
 def unbanked(traj):
-    """The same track flown *without bank* (flat, skidding turns): roll set to zero, the
-    specific force f^n = C_b^n f^b kept, so the centripetal acceleration V ψ̇ appears on the
-    body x (right) axis; f^b = C'ᵀ f^n and ω_ib^b = ω_nb'^b + C'ᵀ (ω_ie^n + ω_en^n) recomputed
-    with C' = C(ψ, θ, 0) and the heading/pitch rates by central differences of the samples.
-    A kinematic variant for the sensitivity study of the observability degrees (chen2019 does
-    not say how its Fig. 2-3 maneuvers were flown); the increments ``dtheta``/``dv`` are the
-    trapezoid of the new rates (not meant for strapdown accuracy tests)."""
+    """The same track flown *without bank* (flat, skidding turns).
+
+    Roll set to zero, the specific force f^n = C_b^n f^b kept, so the centripetal acceleration
+    V ψ̇ appears on the body x (right) axis; f^b = C'ᵀ f^n and ω_ib^b = ω_nb'^b + C'ᵀ (ω_ie^n +
+    ω_en^n) recomputed with C' = C(ψ, θ, 0) and the heading/pitch rates by central differences of
+    the samples.  A kinematic variant for the sensitivity study of the observability degrees
+    (chen2019 does not say how its Fig. 2-3 maneuvers were flown); the increments
+    ``dtheta``/``dv`` are the trapezoid of the new rates (not meant for strapdown accuracy tests).
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The trajectory to re-fly.
+
+    Returns
+    -------
+    traj : replication.nav.trajectory.Trajectory
+        Same times, position and velocity; roll zero; f_b [m/s²], w_ib_b [rad/s] and the
+        increments recomputed.
+
+    Raises
+    ------
+    TypeError
+        When ``traj`` is not a ``Trajectory``.
+    """
 
     return _reflown(_trajectory(traj), np.zeros(len(traj.t)))
 
 
 def coordinated(traj):
-    """The same track flown with the bank that leaves *no* lateral specific force (f_x = 0 on the
-    body x, right, axis): the roll of ``traj`` corrected by the angle of (f_x, f_z), so that the
-    Coriolis and transport residual a kinematically banked turn leaves on f_x (~0.01 m/s² at
-    100 m/s) is absorbed in the bank, as a perfectly coordinated turn would; f^n kept, the roll rate
-    by central differences (see :func:`unbanked`).  A kinematic variant for the sensitivity study of
-    chen2019 Table 2-3, whose Fig. 2-3 maneuvers are not specified."""
+    """The same track flown with the bank that leaves *no* lateral specific force.
+
+    f_x = 0 on the body x (right) axis: the roll of ``traj`` corrected by the angle of (f_x, f_z),
+    so that the Coriolis and transport residual a kinematically banked turn leaves on f_x
+    (~0.01 m/s² at 100 m/s) is absorbed in the bank, as a perfectly coordinated turn would; f^n
+    kept, the roll rate by central differences (see :func:`unbanked`).  A kinematic variant for
+    the sensitivity study of chen2019 Table 2-3, whose Fig. 2-3 maneuvers are not specified.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The trajectory to re-fly.
+
+    Returns
+    -------
+    traj : replication.nav.trajectory.Trajectory
+        Same times, position and velocity; roll corrected; f_b [m/s²], w_ib_b [rad/s] and the
+        increments recomputed.
+
+    Raises
+    ------
+    TypeError
+        When ``traj`` is not a ``Trajectory``.
+    RuntimeError
+        When no roll correction zeroes f_x.
+    """
 
     f_b = np.asarray(_trajectory(traj).f_b, float)
     roll = np.array(traj.hpr, float)[:, 2]
@@ -630,13 +1004,42 @@ def _table(table, name: str) -> pd.DataFrame:
 
 def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, before_segments: int = 1,
                   clip_null: bool = True, **kw):
-    """PWCS observability degrees of ``states`` for every scenario of ``maneuvers`` (from
-    :func:`chen2019_maneuvers`) as a DataFrame (rows: states, columns: scenarios).  The
-    straight scenario uses its straight leg only; ``kw`` goes to :func:`pwcs_observability`.
-    With ``clip_null`` degrees at or below the numerical-rank tolerance — numerically zero, their
-    digits are rounding noise — are reported as 0.  ``df.attrs["rank_tol"]`` holds each
-    scenario's tolerance, ``df.attrs["ambiguity"]`` (scenario → state → ratio) each
-    state's ``ambiguity`` (:class:`ObservabilityDegrees`)."""
+    """PWCS observability degrees of ``states`` for every scenario of ``maneuvers``.
+
+    The straight scenario uses its straight leg only.  With ``clip_null`` degrees at or below the
+    numerical-rank tolerance — numerically zero, their digits are rounding noise — are reported
+    as 0.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model (e.g. :func:`replication.papers.chen2019.models.model_45`).
+    maneuvers : dict of str to Maneuver
+        Scenarios (:func:`chen2019_maneuvers`).
+    states : sequence of str
+        Labels of the states (rows).
+    n_segments : int
+        PWCS segments over each maneuver (:meth:`Maneuver.spans`).
+    before_segments : int
+        PWCS segments over the straight leg.
+    clip_null : bool
+        Report degrees at or below the rank tolerance as 0.
+    **kw : dict, optional
+        Keyword arguments of :func:`pwcs_observability`.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        Rows: states, columns: scenarios; degrees in the units set by ``normalize`` (dimensionless
+        for ``"max"`` and ``"scale"``).  ``table.attrs["rank_tol"]`` holds each scenario's
+        tolerance, ``table.attrs["ambiguity"]`` (scenario → state → ratio) each state's
+        ``ambiguity`` (:class:`ObservabilityDegrees`).
+
+    Raises
+    ------
+    TypeError
+        When ``maneuvers`` is not a dict of ``Maneuver``.
+    """
 
     _maneuvers(maneuvers)
     integer(n_segments, "n_segments"), integer(before_segments, "before_segments")
@@ -653,8 +1056,33 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
 
 
 def covariance_table(model, maneuvers: dict, R, *, states, update_interval: float = 2.0, P0=None):
-    """√(P0/P) (:func:`covariance_observability`) over each scenario's whole trajectory, as a
-    DataFrame (rows: states, columns: scenarios)."""
+    """√(P0/P) (:func:`covariance_observability`) over each scenario's whole trajectory.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model (e.g. :func:`replication.papers.chen2019.models.model_45`).
+    maneuvers : dict of str to Maneuver
+        Scenarios (:func:`chen2019_maneuvers`).
+    R : array_like, shape (6, 6)
+        Measurement noise covariance: position [m²], velocity [(m/s)²].
+    states : sequence of str
+        Labels of the states (rows).
+    update_interval : float
+        Time between measurement updates [s].
+    P0 : array_like or None
+        Prior covariance (``None``: ``model.P0()``).
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        Rows: states, columns: scenarios; √(P0_kk / P_kk) at the end [1].
+
+    Raises
+    ------
+    TypeError
+        When ``maneuvers`` is not a dict of ``Maneuver``.
+    """
 
     _maneuvers(maneuvers)
     cols = {}
@@ -665,10 +1093,35 @@ def covariance_table(model, maneuvers: dict, R, *, states, update_interval: floa
 
 
 def rank_metrics(reference, reproduced, *, reference_threshold: float, reproduced_threshold):
-    """Agreement of two observability tables (rows: states, columns: scenarios): per column the
-    Spearman rank correlation, the number of states whose verdict (observable: degree above the
-    column's threshold) agrees, and the counts of unobservable states.  ``reproduced_threshold``
-    is a number or a {column: threshold} mapping.  Returns a DataFrame indexed by column."""
+    """Agreement of two observability tables (rows: states, columns: scenarios).
+
+    Per column the Spearman rank correlation, the number of states whose verdict (observable:
+    degree above the column's threshold) agrees, and the counts of unobservable states.
+
+    Parameters
+    ----------
+    reference : pandas.DataFrame
+        Reference degrees (e.g. the printed table), finite.
+    reproduced : pandas.DataFrame
+        Reproduced degrees, same states and scenarios in the same order.
+    reference_threshold : float
+        A reference degree above it is observable (units of ``reference``).
+    reproduced_threshold : float or dict of str to float
+        A reproduced degree above it is observable: one number or one per column.
+
+    Returns
+    -------
+    metrics : pandas.DataFrame
+        Indexed by ``scenario``; columns ``spearman`` (ρ), ``verdicts_agree``,
+        ``unobservable_reference``, ``unobservable_reproduced`` (counts of states).
+
+    Raises
+    ------
+    TypeError
+        When a table is not a DataFrame.
+    ValueError
+        When the tables differ in states or scenarios, or a threshold is negative or missing.
+    """
 
     _table(reference, "reference"), _table(reproduced, "reproduced")
     if list(reference.columns) != list(reproduced.columns) or list(reference.index) != list(reproduced.index):
@@ -693,9 +1146,23 @@ def rank_metrics(reference, reproduced, *, reference_threshold: float, reproduce
 
 
 def best_scenario_counts(table, exclude=("before maneuver",)):
-    """For every state, the scenario with the strictly largest degree (columns in ``exclude``
-    ignored; states whose largest degree is shared, e.g. zero everywhere, count for none);
-    returns the number of states won by each scenario (a Series)."""
+    """The number of states won by each scenario.
+
+    For every state, the scenario with the strictly largest degree wins (columns in ``exclude``
+    ignored; states whose largest degree is shared, e.g. zero everywhere, count for none).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Degrees (rows: states, columns: scenarios).
+    exclude : sequence of str
+        Columns ignored.
+
+    Returns
+    -------
+    counts : pandas.Series
+        Scenario -> number of states won (int).
+    """
     t = table.drop(columns=[c for c in exclude if c in table.columns])
     v = t.to_numpy(float)
     top = v.max(axis=1, keepdims=True)
@@ -705,14 +1172,39 @@ def best_scenario_counts(table, exclude=("before maneuver",)):
 
 
 def sweep(model, maneuvers: dict, reference, variants: dict, *, states, reference_threshold: float = 1e-5):
-    """Sensitivity of the comparison with ``reference`` (rows: states, columns: scenarios) to
-    the unspecified choices.  ``variants`` maps a name to keyword arguments of
-    :func:`degrees_table` plus optional ``model``, ``maneuvers`` and ``states`` overrides.
-    Returns one row per variant: Spearman ρ per scenario, total verdict agreement (of
-    states × scenarios), the scenario winning most states and the number of states above the
-    rank tolerance per scenario ("observable <scenario>", the bar count of chen2019 Fig. 2-4).
-    ``out.attrs["tables"]`` keeps each variant's degrees table (states of ``reference``), with its
-    ``rank_tol`` and ``ambiguity`` attributes, for :func:`compare_verdicts`."""
+    """Sensitivity of the comparison with ``reference`` to the unspecified choices.
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model (e.g. :func:`replication.papers.chen2019.models.model_45`).
+    maneuvers : dict of str to Maneuver
+        Scenarios (:func:`chen2019_maneuvers`).
+    reference : pandas.DataFrame
+        Reference degrees (rows: states, columns: scenarios).
+    variants : dict of str to dict
+        Name -> keyword arguments of :func:`degrees_table` plus optional ``model``, ``maneuvers``
+        and ``states`` overrides.
+    states : sequence of str
+        Labels of the states computed.
+    reference_threshold : float
+        A reference degree above it is observable.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per variant (index ``variant``): ``ρ <scenario>`` (Spearman ρ per scenario),
+        ``verdicts agree`` (of states × scenarios), ``best maneuver`` (the scenario winning most
+        states) and ``observable <scenario>`` (the number of states above the rank tolerance, the
+        bar count of chen2019 Fig. 2-4).  ``table.attrs["tables"]`` keeps each variant's degrees
+        table (states of ``reference``), with its ``rank_tol`` and ``ambiguity`` attributes, for
+        :func:`compare_verdicts`.
+
+    Raises
+    ------
+    TypeError
+        When ``maneuvers``, ``reference`` or ``variants`` has the wrong type.
+    """
 
     _maneuvers(maneuvers)
     _table(reference, "reference")
@@ -754,11 +1246,38 @@ def verdict_under(printed_value: float, degree: float, rank_tol: float, ambiguit
     *printed* is ``printed_value > printed_threshold`` (observable), *reproduced* is
     ``degree > rank_tol``; *decided* is False when the two differ but the state lies almost equally
     in two singular subspaces (``ambiguity > AMBIGUOUS``): the assignment rule, not the model,
-    decides such a value, which therefore neither agrees nor disagrees with the print.  *reproduced*
-    uses a margin: a degree within ``ROUND_OFF_MARGIN`` of the rank tolerance is round-off —
-    singular values of numerically zero directions reach just above ``rank_tol`` (a state whose
-    columns of F and H are identically zero has been seen at 1.01 ``rank_tol``) — and counts as
-    unobservable, so that no verdict hangs on the last bits of an SVD.
+    decides such a value, which therefore neither agrees nor disagrees with the print.
+    *reproduced* uses a margin: a degree within ``ROUND_OFF_MARGIN`` of the rank tolerance is
+    round-off — singular values of numerically zero directions reach just above ``rank_tol`` (a
+    state whose columns of F and H are identically zero has been seen at 1.01 ``rank_tol``) — and
+    counts as unobservable, so that no verdict hangs on the last bits of an SVD.
+
+    Parameters
+    ----------
+    printed_value : float
+        The printed degree (non-negative).
+    degree : float
+        The reproduced degree (non-negative).
+    rank_tol : float
+        The numerical-rank tolerance of the reproduced degrees, same units.
+    ambiguity : float
+        The state's projection ratio (:class:`ObservabilityDegrees`), in [0, 1].
+    printed_threshold : float
+        A printed degree above it is observable.
+
+    Returns
+    -------
+    printed : bool
+        Observable in the print.
+    reproduced : bool
+        Observable in the reproduction (degree > ``ROUND_OFF_MARGIN`` · ``rank_tol``).
+    decided : bool
+        False when the verdicts differ and the assignment is ambiguous.
+
+    Raises
+    ------
+    ValueError
+        When an argument is negative or not finite.
     """
     for name, v in (("printed_value", printed_value), ("degree", degree), ("rank_tol", rank_tol),
                     ("ambiguity", ambiguity), ("printed_threshold", printed_threshold)):
@@ -786,8 +1305,8 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
 
     Parameters
     ----------
-    printed : DataFrame
-        The printed degrees (rows: states, columns: scenarios).
+    printed : pandas.DataFrame
+        The printed degrees (rows: states, columns: scenarios), dimensionless.
     readings : dict
         Reading name → degrees table of the same shape with ``attrs["rank_tol"]`` and
         ``attrs["ambiguity"]`` (:func:`degrees_table`, or ``sweep(...).attrs["tables"]``).
@@ -803,8 +1322,10 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
     ruled_out : iterable of str
         Prefixes of readings that printed evidence excludes: shown in the ledger, never used to
         reach the print.
-    level_combinations : set
+    level_combinations : set of str
         States observable in level flight only in a combination (scenario ``before``).
+    before : str
+        The column of the straight, level scenario.
     printed_threshold : float
         A printed degree above it is *observable*.
 

@@ -91,16 +91,72 @@ the driving noise, whose stationary variance is q τ / 2."""
 class SimulationSetup:
     """Truth and filter parameters of the chen2019 §4.2 simulation, SI units.
 
-    Sensor errors (chen2019 eq. (2-10), Table 4-41), one value per axis:
-    ``*_bias_sd`` random constant (σ of the draw), ``*_markov_sigma``/``*_markov_tau`` first-order
-    Gauss-Markov (stationary σ, correlation time), ``*_white_psd`` white-noise intensity
-    ((rad/s)²·s, (m/s²)²·s), ``scale_sd`` and ``misalignment_sd`` (σ of the draws, both triads).
-    GNSS: ``gnss_rate_hz``, ``sigma_pos`` (E, N, U m), ``sigma_vel`` (m/s).  Not printed by the
-    report (this package's choices): ``position_sd``/``velocity_sd``/``attitude_sd`` (initial
-    navigation errors, E/N/U), ``gravity_sigma``/``gravity_tau`` (eq. (2-12) disturbance per
-    ENU axis), ``lever_arm_b`` (nominal antenna position in the body frame, seen from the IMU)
-    and ``lever_arm_sd`` (σ of its error).  ``random_walk_fraction`` sets the 36-state model's
-    random-walk intensity (see :func:`filter_model`).
+    Sensor errors (chen2019 eq. (2-10), Table 4-41), one value per axis: random constant (σ of the
+    draw), first-order Gauss-Markov (stationary σ, correlation time), white-noise intensity,
+    scale factor and misalignment (σ of the draws, both triads).  Not printed by the report (this
+    package's choices): the initial navigation errors, the gravity disturbance of eq. (2-12) per
+    ENU axis, the lever arm and its error.
+
+    Attributes
+    ----------
+    imu_rate_hz : float
+        IMU sampling rate [Hz].
+    gnss_rate_hz : float
+        GNSS fix rate [Hz]; must divide ``imu_rate_hz``.
+    gyro_bias_sd : float
+        σ of the gyro random-constant drift [rad/s].
+    gyro_markov_sigma : float
+        Stationary σ of the gyro first-order Gauss-Markov drift [rad/s].
+    gyro_markov_tau : float
+        Its correlation time [s].
+    gyro_white_psd : float
+        Gyro white-noise intensity [(rad/s)²·s].
+    accel_bias_sd : float
+        σ of the accelerometer random-constant bias [m/s²].
+    accel_markov_sigma : float
+        Stationary σ of the accelerometer first-order Gauss-Markov bias [m/s²].
+    accel_markov_tau : float
+        Its correlation time [s].
+    accel_white_psd : float
+        Accelerometer white-noise intensity [(m/s²)²·s].
+    scale_sd : float
+        σ of the scale-factor errors of both triads [1].
+    misalignment_sd : float
+        σ of the six misalignment angles of both triads [rad].
+    sigma_pos : tuple of float, length 3
+        σ of the white GNSS position error, east, north, up [m].
+    sigma_vel : float
+        σ of the white GNSS velocity error, each ENU axis [m/s].
+    position_sd : tuple of float, length 3
+        Initial position error σ, east, north, up [m] (this package's choice).
+    velocity_sd : float
+        Initial velocity error σ, each ENU axis [m/s] (this package's choice).
+    attitude_sd : tuple of float, length 3
+        Initial attitude error σ, φ_E, φ_N, φ_U [rad] (this package's choice).
+    gravity_sigma : float
+        Stationary σ of the gravity disturbance per ENU axis, eq. (2-12) [m/s²] (this package's
+        choice).
+    gravity_tau : float
+        Correlation time of the gravity disturbance [s] (this package's choice).
+    lever_arm_b : tuple of float, length 3
+        Nominal antenna position in the body frame, seen from the IMU [m] (this package's choice).
+    lever_arm_sd : float
+        σ of the error of ``lever_arm_b``, each axis [m] (this package's choice).
+    random_walk_fraction : float
+        Sets the 36-state model's random-walk intensity (see :func:`filter_model`) [1].
+    flight_duration : float
+        Flight length T_flight used by that intensity [s].
+    misalignment_unit : str
+        Unit in which Table 4-41's misalignment "1.5" was read (:data:`MISALIGNMENT_UNITS`).
+    markov_reading : str
+        Reading of Table 4-41's Markov intensity (:data:`MARKOV_READINGS`).
+
+    Raises
+    ------
+    ValueError
+        When a rate, correlation time or the flight duration is not positive, a σ or intensity is
+        negative or not finite, the GNSS rate does not divide the IMU rate, or a 3-vector has the
+        wrong length.
     """
 
     imu_rate_hz: float
@@ -167,7 +223,7 @@ def _printed_base(paper, quantity, unit):
 
 def table_4_41_setup(paper, *, misalignment_unit: str = "arcsec", markov_reading: str = "stationary",
                      **choices) -> SimulationSetup:
-    """The sensor-error setup of chen2019 Table 4-41 (``paper`` = ``rp.load_paper("chen2019-table-4-41")``).
+    """The sensor-error setup of chen2019 Table 4-41.
 
     Conversions (stated; the print gives squares without a per-Hz unit):
 
@@ -183,7 +239,28 @@ def table_4_41_setup(paper, *, misalignment_unit: str = "arcsec", markov_reading
       ``"mrad"`` as alternatives, :data:`MISALIGNMENT_UNITS`);
     * GNSS (0.03 m)², (0.1 m)², (0.03 m/s)² are variances of white errors at each fix.
 
-    ``choices`` override the parameters the report does not print (see :class:`SimulationSetup`).
+    Parameters
+    ----------
+    paper : replication.registry.reproduction.PaperTable
+        ``rp.load_paper("chen2019-table-4-41")``.
+    misalignment_unit : str
+        Unit of the printed misalignment angle: ``"arcsec"``, ``"arcmin"`` or ``"mrad"``.
+    markov_reading : str
+        ``"stationary"`` or ``"driving-psd"`` (:data:`MARKOV_READINGS`).
+    **choices : dict, optional
+        Override the parameters the report does not print (fields of :class:`SimulationSetup`,
+        SI units); not the Markov σ, which come from the table.
+
+    Returns
+    -------
+    setup : SimulationSetup
+        The setup in SI units.
+
+    Raises
+    ------
+    ValueError
+        When a choice is not one of the listed ones, a Markov σ is given as a keyword, or a table
+        value is not numeric or not in the expected unit.
     """
     choice(misalignment_unit, sorted(MISALIGNMENT_UNITS), "misalignment_unit")
     choice(markov_reading, MARKOV_READINGS, "markov_reading")
@@ -232,11 +309,31 @@ def _flight_cached(dt, s_swing, s_cycles, lat0, lon0, h0, heading, speed):
 def simulated_flight(paper=None, *, imu_rate_hz: float = 100.0, s_swing: float = np.pi, s_cycles: int = 2):
     """The chen2019 Table 4-42 flight (5100 s) sampled at ``imu_rate_hz``.
 
-    Initial state from ``paper`` (``rp.load_paper("chen2019-table-4-41")``: 47°N, 115°E, 6000 m,
-    heading 45°, 100 m/s) or, without it, the same numbers built into
-    :func:`replication.nav.trajectory.chen2019_flight`.  The S-maneuver amplitude (``s_swing``) and its
-    number of cycles are not printed (this package's choice).  Cached: repeated calls return the
-    same :class:`replication.nav.trajectory.Trajectory` object — do not modify it.
+    Initial state from ``paper`` (47°N, 115°E, 6000 m, heading 45°, 100 m/s) or, without it, the
+    same numbers built into :func:`replication.nav.trajectory.chen2019_flight`.  The S-maneuver
+    amplitude (``s_swing``) and its number of cycles are not printed (this package's choice).
+
+    Parameters
+    ----------
+    paper : replication.registry.reproduction.PaperTable or None
+        ``rp.load_paper("chen2019-table-4-41")`` (initial latitude, longitude [°], height [m],
+        heading [°], speed [m/s]), or ``None`` for the built-in numbers.
+    imu_rate_hz : float
+        IMU sampling rate [Hz].
+    s_swing : float
+        Heading swing of the S-maneuver [rad].
+    s_cycles : int
+        Number of S-maneuver cycles.
+
+    Returns
+    -------
+    traj : replication.nav.trajectory.Trajectory
+        The true motion.  Cached: repeated calls return the same object — do not modify it.
+
+    Raises
+    ------
+    ValueError
+        When ``imu_rate_hz`` is not positive.
     """
     if not imu_rate_hz > 0:
         raise ValueError("imu_rate_hz must be positive")
@@ -250,8 +347,20 @@ def simulated_flight(paper=None, *, imu_rate_hz: float = 100.0, s_swing: float =
 
 
 def segment_summary(traj):
-    """Per segment of ``traj``: label, start, end (s), heading change (°, clockwise positive,
-    unwrapped), largest |roll| (°), speed and height change (m/s, m) — the quantities of Table 4-42."""
+    """Per segment of ``traj``, the quantities of Table 4-42.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        A trajectory with labelled segments.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per segment, columns ``segment`` (label), ``start_s``, ``end_s`` [s],
+        ``heading_change_deg`` (clockwise positive, unwrapped) [°], ``max_abs_roll_deg`` (largest
+        abs(roll)) [°], ``speed_change`` (horizontal speed) [m/s], ``height_change`` [m].
+    """
 
     rows = []
     t = traj.t
@@ -272,18 +381,39 @@ def segment_summary(traj):
 def filter_model(kind: str, setup: SimulationSetup, lat: float, h: float) -> E.ErrorModel:
     """The filter model ``kind`` (``"15"``, ``"36"`` or ``"45"``) for ``setup`` at (``lat``, ``h``).
 
-    Each model receives the truth's parameters for the error sources it has; sources it lacks
-    stay unmodelled (no noise inflation — the comparison is of the models, not of tunings):
+    Each model receives the truth's parameters for the error sources it has; sources it lacks stay
+    unmodelled (no noise inflation — the comparison is of the models, not of tunings):
 
     * 15 — chen2019 eqs. (3-14)-(3-16): random-constant bias/drift with σ the RSS of the truth's
       constant and Markov parts (the only bias it has);
-    * 36 — chen2019 ref. [35] as the report describes it (:func:`replication.papers.chen2019.models.model_36`):
-      constant + random walk + Markov bias/drift, scale factors, lever arm; the random walk is
-      not in the truth and its intensity is not printed: q_rw = (f σ_b)² / T_flight with
-      f = ``setup.random_walk_fraction`` (the walk reaches f times the random-constant σ over
-      the flight);
-    * 45 — chen2019 eqs. (2-14), (2-15), Table 2-2 (:func:`replication.papers.chen2019.models.model_45`), every
-      source of the truth.
+    * 36 — chen2019 ref. [35] as the report describes it
+      (:func:`replication.papers.chen2019.models.model_36`): constant + random walk + Markov
+      bias/drift, scale factors, lever arm; the random walk is not in the truth and its intensity
+      is not printed: q_rw = (f σ_b)² / T_flight with f = ``setup.random_walk_fraction`` (the walk
+      reaches f times the random-constant σ over the flight);
+    * 45 — chen2019 eqs. (2-14), (2-15), Table 2-2
+      (:func:`replication.papers.chen2019.models.model_45`), every source of the truth.
+
+    Parameters
+    ----------
+    kind : str
+        ``"15"``, ``"36"`` or ``"45"``.
+    setup : SimulationSetup
+        Truth and filter parameters.
+    lat : float
+        Latitude at which the initial position σ (m) is converted to δL, δλ [rad].
+    h : float
+        Height of that conversion [m].
+
+    Returns
+    -------
+    model : replication.nav.errors.ErrorModel
+        The filter model with its priors and noise intensities in SI units.
+
+    Raises
+    ------
+    ValueError
+        When ``kind`` is not one of the three.
     """
     if kind not in ("15", "36", "45"):
         raise ValueError(f"kind must be '15', '36' or '45', got {kind!r}")
@@ -426,11 +556,34 @@ class _Truth:
 
 
 def truth_parameters(model: E.ErrorModel, const: dict, procs: dict) -> np.ndarray:
-    """True values of ``model``'s augmented states (runs × epochs × (n − 9)) in its layout, from
-    the batch truth: random constants ``const`` (runs × k) and processes ``procs`` (runs ×
-    epochs × 3).  A 15-state bias holds constant + Markov (the total bias it stands for); a
-    random-walk block of the 36-state model is zero (the truth has no random walk); the lever-arm
-    state is the error of the nominal lever arm (true − used)."""
+    """True values of ``model``'s augmented states in its layout, from the batch truth.
+
+    A 15-state bias holds constant + Markov (the total bias it stands for); a random-walk block of
+    the 36-state model is zero (the truth has no random walk); the lever-arm state is the error of
+    the nominal lever arm (true − used).
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The filter model (n states).
+    const : dict of str to ndarray
+        Random constants of the runs, (runs, k) each: ``gyro_bias`` [rad/s], ``accel_bias``
+        [m/s²], ``gyro_scale``, ``accel_scale`` [1], ``gyro_misalignment``,
+        ``accel_misalignment`` (k = 6) [rad], ``lever_arm_error`` [m].
+    procs : dict of str to ndarray
+        Processes at the epochs, (runs, epochs, 3) each: ``gyro_markov`` [rad/s],
+        ``accel_markov`` [m/s²], ``gravity`` (ENU) [m/s²].
+
+    Returns
+    -------
+    p_true : ndarray, shape (runs, epochs, n - 9)
+        True augmented states in the model's units.
+
+    Raises
+    ------
+    ValueError
+        When the model has a block without a truth.
+    """
     R, E_ = procs["gravity"].shape[:2]
     out = np.zeros((R, E_, model.n - 9))
     has = {b.name for b in model.blocks}
@@ -463,11 +616,46 @@ def truth_parameters(model: E.ErrorModel, const: dict, procs: dict) -> np.ndarra
 class BatchResult:
     """Output of :func:`run_batch` at the recorded epochs (every ``record_every`` GNSS epochs).
 
-    ``nav_err`` runs × epochs × 9 (δL, δλ rad, δh m, δv m/s, φ rad), ``p_hat`` and ``p_true``
-    runs × epochs × (n − 9); ``P`` epochs × n × n (filter, after the update), ``P_bar`` the same
-    model's covariance propagated without measurements (or ``None``); ``nis`` runs × epochs;
-    ``P_diag_all`` the filter variances at every GNSS epoch (epochs × n); with the smoother:
-    ``ds`` runs × epochs × n (smoothed error estimate) and ``P_s`` epochs × n × n.
+    Attributes
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The filter model (n states).
+    setup : SimulationSetup
+        The truth and filter parameters.
+    t : ndarray, shape (epochs,)
+        Times of the recorded epochs [s].
+    epoch_index : ndarray of int, shape (epochs,)
+        Trajectory sample index of each recorded epoch.
+    nav_err : ndarray, shape (runs, epochs, 9)
+        Navigation errors after feedback, computed − true: δL, δλ [rad], δh [m], δv_ENU [m/s],
+        φ_ENU [rad].
+    p_hat : ndarray, shape (runs, epochs, n - 9)
+        Estimated augmented (sensor-error) states, in the model's units.
+    p_true : ndarray, shape (runs, epochs, n - 9)
+        Their true values (:func:`truth_parameters`).
+    P : ndarray, shape (epochs, n, n)
+        Filter covariance after the update.
+    P_bar : ndarray, shape (epochs, n, n), or None
+        The same model's covariance propagated without measurements (``prior_covariance``).
+    nis : ndarray, shape (runs, epochs)
+        Normalised innovation squared of the update [1].
+    t_all : ndarray, shape (gnss_epochs,)
+        Times of every GNSS epoch [s].
+    P_diag_all : ndarray, shape (gnss_epochs, n)
+        Filter variances at every GNSS epoch.
+    ds : ndarray, shape (runs, epochs, n), or None
+        Smoothed error estimate ê^s (with the smoother).
+    P_s : ndarray, shape (epochs, n, n), or None
+        Smoothed covariance (with the smoother and ``smoother_covariance``).
+    seed : int
+        Seed of the batch.
+    const : dict of str to ndarray
+        The runs' random constants, (runs, k) each (keys as in :func:`truth_parameters`, plus
+        ``nav0``, the initial navigation errors in the model's units).
+    lat0 : float
+        Initial latitude of the trajectory [rad].
+    h0 : float
+        Initial height of the trajectory [m].
     """
 
     model: E.ErrorModel
@@ -494,9 +682,25 @@ class BatchResult:
         return self.nav_err.shape[0]
 
     def errors(self, smoothed: bool = False) -> np.ndarray:
-        """Full error vector e (runs × epochs × n) in the filter's convention: navigation errors
-        computed − true, augmented states true − estimated; ``smoothed`` subtracts the RTS
-        estimate ê^s."""
+        """Full error vector e in the filter's convention.
+
+        Navigation errors computed − true, augmented states true − estimated.
+
+        Parameters
+        ----------
+        smoothed : bool
+            Subtract the RTS estimate ê^s (needs ``run_batch(..., smoother=True)``).
+
+        Returns
+        -------
+        e : ndarray, shape (runs, epochs, n)
+            Errors in the model's units (rad, m, m/s, then the sensor states' SI units).
+
+        Raises
+        ------
+        ValueError
+            When ``smoothed`` is asked without a smoother pass.
+        """
         e = np.concatenate([self.nav_err, self.p_true - self.p_hat], axis=-1)
         if smoothed:
             if self.ds is None:
@@ -505,7 +709,23 @@ class BatchResult:
         return e
 
     def estimates(self, smoothed: bool = False) -> np.ndarray:
-        """Estimated augmented states (runs × epochs × (n − 9)), filtered or smoothed."""
+        """Estimated augmented states, filtered or smoothed.
+
+        Parameters
+        ----------
+        smoothed : bool
+            The RTS-smoothed estimates (needs ``run_batch(..., smoother=True)``).
+
+        Returns
+        -------
+        p : ndarray, shape (runs, epochs, n - 9)
+            Estimates in the model's units.
+
+        Raises
+        ------
+        ValueError
+            When ``smoothed`` is asked without a smoother pass.
+        """
         if not smoothed:
             return self.p_hat
         if self.ds is None:
@@ -513,7 +733,23 @@ class BatchResult:
         return self.p_hat + self.ds[..., 9:]
 
     def sigma(self, smoothed: bool = False) -> np.ndarray:
-        """Standard deviations (epochs × n) of the filter (or smoother)."""
+        """Standard deviations of the filter (or smoother).
+
+        Parameters
+        ----------
+        smoothed : bool
+            From the smoothed covariance ``P_s`` instead of ``P``.
+
+        Returns
+        -------
+        sigma : ndarray, shape (epochs, n)
+            Standard deviations in the model's units.
+
+        Raises
+        ------
+        ValueError
+            When the smoothed covariance was not computed.
+        """
         P = self.P_s if smoothed else self.P
         if P is None:
             raise ValueError("no smoothed covariance: run_batch(..., smoother=True)")
@@ -531,32 +767,81 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
               smoother_covariance: bool = True, prior_covariance: bool = False, first_run: int = 0,
               fixed_constants: bool = False, series_order: int = 4, workers: int = 2,
               smoother_form: str = "mbf", executor=None, chunk_runs=None, progress=None) -> BatchResult:
-    """Monte Carlo of the closed-loop INS/GNSS filter of ``model`` on ``traj`` with the truth of
-    ``setup`` (chen2019 eq. (2-10) sensor errors, eq. (2-12) gravity disturbance, eq. (2-13)
-    lever arm, Table 4-41 noise), batched across ``n_runs`` runs (see the module docstring).
+    """Monte Carlo of the closed-loop INS/GNSS filter of ``model`` on ``traj`` with the truth of ``setup``.
 
-    ``record_every`` GNSS epochs are recorded (20 → 1 Hz at 20-Hz GNSS); ``smoother`` adds the
-    fixed-interval smoother pass (replaying the lead's forward pass chunk by chunk, ``chunk_epochs``
-    epochs each);
-    ``smoother_covariance=False`` skips the smoothed covariance (P^s) and keeps only the smoothed
-    states; ``smoother_form`` picks the backward recursion (:func:`replication.nav.closedloop.run`: the
-    modified Bryson-Frazier form or the Rauch-Tung-Striebel covariance form, the same results to
-    rounding); ``prior_covariance`` propagates the covariance without
-    measurements as well (for :func:`observable_nees`).  Runs are numbered ``first_run`` ..
-    ``first_run + n_runs - 1``; run r's truth depends only on (``seed``, r), so run r processed
-    alone (``first_run=r, n_runs=1``) is an exact extended filter of the same truth.
-    ``fixed_constants`` sets every random constant (bias, drift, scale factors, misalignments) to
-    its printed value (+σ on every axis) instead of drawing it — the reading of Table 4-41 under
-    which the ranges stated for Fig. 4-14 make sense; the NEES Monte Carlo draws them.
-    Deterministic for a given ``seed``.
+    The truth: chen2019 eq. (2-10) sensor errors, eq. (2-12) gravity disturbance, eq. (2-13)
+    lever arm, Table 4-41 noise; batched across ``n_runs`` runs (see the module docstring).
+    Runs are numbered ``first_run`` .. ``first_run + n_runs - 1``; run r's truth depends only on
+    (``seed``, r), so run r processed alone (``first_run=r, n_runs=1``) is an exact extended
+    filter of the same truth.  Deterministic for a given ``seed``.
 
-    ``executor`` (any ``concurrent.futures.Executor``, e.g. a ``ProcessPoolExecutor`` or
-    ``dask.distributed.Client(...).get_executor()``) or ``chunk_runs``: the runs are split into chunks
-    of ``chunk_runs`` (:func:`replication.nav.parallel.run_chunks`), each one picklable task on one
-    thread.  Every run follows the covariance and gains of the lead (run ``first_run``), so a chunk
-    without it recomputes the lead from its own (``seed``, run) streams and drops it; the
-    reassembled result equals the one batch bit for bit.  ``progress``: progress bar of the
-    finished runs of a chunked batch (``None``: on unless ``REPLICATION_PROGRESS=0``).
+    With ``executor`` or ``chunk_runs`` the runs are split into chunks of ``chunk_runs``
+    (:func:`replication.nav.parallel.run_chunks`), each one picklable task on one thread.  Every
+    run follows the covariance and gains of the lead (run ``first_run``), so a chunk without it
+    recomputes the lead from its own (``seed``, run) streams and drops it; the reassembled result
+    equals the one batch bit for bit.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        True motion sampled at ``setup.imu_rate_hz``.
+    setup : SimulationSetup
+        Truth and filter parameters.
+    model : replication.nav.errors.ErrorModel
+        The filter model (:func:`filter_model`).
+    n_runs : int
+        Number of Monte Carlo runs (≥ 1).
+    seed : int
+        Seed of the runs' random streams.
+    chunk_epochs : int
+        GNSS epochs per chunk of the forward pass (≥ 2); the smoother replays the lead's forward
+        pass chunk by chunk from checkpoints.
+    record_every : int
+        Record every ``record_every``-th GNSS epoch (20 → 1 Hz at 20-Hz GNSS).
+    smoother : bool
+        Add the fixed-interval smoother pass.
+    smoother_covariance : bool
+        Compute the smoothed covariance P^s; ``False`` keeps only the smoothed states.
+    prior_covariance : bool
+        Propagate the covariance without measurements as well (``P_bar``, for
+        :func:`observable_nees`).
+    first_run : int
+        Number of the first run (≥ 0).
+    fixed_constants : bool
+        Set every random constant (bias, drift, scale factors, misalignments) to its printed value
+        (+σ on every axis) instead of drawing it — the reading of Table 4-41 under which the ranges
+        stated for Fig. 4-14 make sense; the NEES Monte Carlo draws them.
+    series_order : int
+        Order of the series of the Van Loan discretization of Φ and Q_d
+        (:func:`replication.nav.closedloop.build_spec`).
+    workers : int
+        Threads of the compiled passes.
+    smoother_form : str
+        The backward recursion of :func:`replication.nav.closedloop.run`: ``"mbf"`` (modified
+        Bryson-Frazier) or ``"rts"`` (Rauch-Tung-Striebel covariance form), the same results to
+        rounding.
+    executor : concurrent.futures.Executor or None
+        Where the chunks of runs run, e.g. a ``ProcessPoolExecutor`` or
+        ``dask.distributed.Client(...).get_executor()``.
+    chunk_runs : int or None
+        Runs per chunk (``None``: :func:`replication.nav.parallel.default_chunk_runs` when an
+        executor is given, else one batch).
+    progress : bool or None
+        Progress bar of the finished runs of a chunked batch (``None``: on unless
+        ``REPLICATION_PROGRESS=0``).
+
+    Returns
+    -------
+    result : BatchResult
+        Errors, estimates and covariances at the recorded epochs.
+
+    Raises
+    ------
+    TypeError
+        When ``model`` is not an ``ErrorModel`` or ``setup`` not a ``SimulationSetup``.
+    ValueError
+        When a count is out of range, the trajectory is not sampled at the IMU rate or is shorter
+        than two GNSS epochs.
     """
     if not isinstance(model, E.ErrorModel):
         raise TypeError("model must be a replication.nav.errors.ErrorModel (see filter_model)")
@@ -657,9 +942,26 @@ def _run_rows(traj, setup, model, run_ids, *, seed, chunk_epochs, record_every, 
 
 
 def navigation_errors(st, q, truth_st, truth_q) -> np.ndarray:
-    """Navigation errors (runs × epochs × 9: δL, δλ, δh, δv_ENU, φ) of states ``st`` (runs × epochs
-    × 6) and quaternions ``q`` (q_b^n) against the truth; φ from Ĉ Cᵀ = exp(−φ×) via the
-    quaternion q̂ ⊗ q_true*."""
+    """Navigation errors of states ``st`` and quaternions ``q`` against the truth.
+
+    φ from Ĉ Cᵀ = exp(−φ×) via the quaternion q̂ ⊗ q_true*.
+
+    Parameters
+    ----------
+    st : array_like, shape (runs, epochs, 6)
+        Latitude, longitude [rad], height [m], v_ENU [m/s].
+    q : array_like, shape (runs, epochs, 4)
+        Attitude quaternions q_b^n, scalar first.
+    truth_st : array_like, shape (epochs, 6)
+        True states, same layout and units.
+    truth_q : array_like, shape (epochs, 4)
+        True quaternions q_b^n.
+
+    Returns
+    -------
+    e : ndarray, shape (runs, epochs, 9)
+        δL, δλ [rad], δh [m], δv_ENU [m/s], φ_ENU [rad], computed − true.
+    """
     st = np.asarray(st, float)
     q = np.asarray(q, float)
     e = np.empty(st.shape[:2] + (9,))
@@ -685,9 +987,30 @@ def observable_nees(e, P, P_bar, threshold: float = 0.1):
     variance ratio λ_i = v_iᵀ P v_i / v_iᵀ P̄ v_i.  Directions with λ_i ≤ ``threshold`` are the
     subspace the measurements have informed (variance reduced at least 1/threshold times);
     NEES_obs = Σ_{λ_i ≤ thr} (v_iᵀ e)² / λ_i, χ² with d = #{λ_i ≤ thr} degrees of freedom.
+    The problem is solved on the correlation scale of P̄ for conditioning.
 
-    ``e`` runs × epochs × n, ``P``/``P_bar`` epochs × n × n.  Returns (nees runs × epochs, d per
-    epoch).  The problem is solved on the correlation scale of P̄ for conditioning.
+    Parameters
+    ----------
+    e : array_like, shape (runs, epochs, n)
+        Errors (:meth:`BatchResult.errors`), in the model's units.
+    P : array_like, shape (epochs, n, n)
+        Filter covariance.
+    P_bar : array_like, shape (epochs, n, n)
+        Covariance propagated without measurements.
+    threshold : float
+        Largest variance ratio of an observable direction, in (0, 1).
+
+    Returns
+    -------
+    nees : ndarray, shape (runs, epochs)
+        NEES of the observable subspace [1].
+    dof : ndarray of int, shape (epochs,)
+        Its degrees of freedom d per epoch.
+
+    Raises
+    ------
+    ValueError
+        When the shapes do not match or ``threshold`` lies outside (0, 1).
     """
     e = np.asarray(e, float)
     P = np.asarray(P, float)
@@ -716,9 +1039,38 @@ def observable_nees(e, P, P_bar, threshold: float = 0.1):
 
 
 def fraction_in_band(nees, dof, prob: float = 0.95, mask=None):
-    """Fraction of epochs whose run-averaged NEES lies in its two-sided ``prob`` χ² band
-    (χ²(R d) quantiles / R, :func:`replication.nav.kalman.chi2_band`), with the band per epoch when
-    ``dof`` varies.  Returns (fraction, mean NEES per epoch, lower, upper)."""
+    """Fraction of epochs whose run-averaged NEES lies in its two-sided ``prob`` χ² band.
+
+    The band is χ²(R d) quantiles / R (:func:`replication.nav.kalman.chi2_band`), per epoch when
+    ``dof`` varies.
+
+    Parameters
+    ----------
+    nees : array_like, shape (runs, epochs)
+        NEES per run and epoch.
+    dof : int or array_like of int, shape (epochs,)
+        Degrees of freedom d (≥ 1).
+    prob : float
+        Probability of the band.
+    mask : array_like of bool, shape (epochs,), or None
+        Epochs counted in the fraction (``None``: all).
+
+    Returns
+    -------
+    fraction : float
+        Share of the (masked) epochs inside the band.
+    mean : ndarray, shape (epochs,)
+        Run-averaged NEES.
+    lo : ndarray, shape (epochs,)
+        Lower band limit.
+    hi : ndarray, shape (epochs,)
+        Upper band limit.
+
+    Raises
+    ------
+    ValueError
+        When an epoch has fewer than one degree of freedom.
+    """
     nees = np.asarray(nees, float)
     R_ = nees.shape[0]
     dof = np.broadcast_to(np.asarray(dof), nees.shape[1:]).astype(int)
@@ -735,8 +1087,24 @@ def fraction_in_band(nees, dof, prob: float = 0.95, mask=None):
 
 
 def attitude_errors(result: BatchResult, traj, smoothed: bool = False) -> np.ndarray:
-    """Heading, pitch and roll errors (runs × epochs × 3, rad; estimated − true, heading wrapped
-    to ±π) of the filtered or smoothed solution: Ĉ = exp(−φ×) C with φ the attitude error."""
+    """Heading, pitch and roll errors of the filtered or smoothed solution.
+
+    Ĉ = exp(−φ×) C with φ the attitude error; estimated − true, heading wrapped to ±π.
+
+    Parameters
+    ----------
+    result : BatchResult
+        A Monte Carlo result of :func:`run_batch`.
+    traj : replication.nav.trajectory.Trajectory
+        The trajectory the result was computed on.
+    smoothed : bool
+        Errors of the RTS-smoothed solution.
+
+    Returns
+    -------
+    hpr_err : ndarray, shape (runs, epochs, 3)
+        Heading, pitch, roll errors [rad].
+    """
     phi = result.errors(smoothed)[..., 6:9]
     idx = result.epoch_index
     C = euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2])
@@ -747,8 +1115,24 @@ def attitude_errors(result: BatchResult, traj, smoothed: bool = False) -> np.nda
 
 
 def segment_mask(t, traj, labels=("Straight",), after: float = 0.0):
-    """Epochs ``t`` lying in segments of ``traj`` whose label is in ``labels`` and that start at
-    or after ``after`` seconds."""
+    """Epochs ``t`` lying in segments of ``traj`` whose label is in ``labels`` and that start at or after ``after``.
+
+    Parameters
+    ----------
+    t : array_like
+        Epoch times [s].
+    traj : replication.nav.trajectory.Trajectory
+        The trajectory with labelled segments.
+    labels : sequence of str
+        Segment labels to keep.
+    after : float
+        Earliest segment start [s].
+
+    Returns
+    -------
+    mask : ndarray of bool, shape of ``t``
+        True for an epoch t0 < t ≤ t1 of a selected segment.
+    """
     t = np.asarray(t)
     m = np.zeros(t.shape, bool)
     for lab, t0, t1 in traj.segments:
@@ -758,17 +1142,57 @@ def segment_mask(t, traj, labels=("Straight",), after: float = 0.0):
 
 
 def survey_line_mask(t, traj):
-    """The survey lines of the Table 4-42 flight: the straight segments after the S-maneuver
-    (1300-2300, 2700-3700, 4100-5100 s) — the analog of the photo epochs of Table 4-44."""
+    """The survey lines of the Table 4-42 flight: the straight segments after the S-maneuver.
+
+    1300-2300, 2700-3700, 4100-5100 s — the analog of the photo epochs of Table 4-44.
+
+    Parameters
+    ----------
+    t : array_like
+        Epoch times [s].
+    traj : replication.nav.trajectory.Trajectory
+        The flight (:func:`simulated_flight`).
+
+    Returns
+    -------
+    mask : ndarray of bool, shape of ``t``
+        True on a survey line.
+    """
     sturn = [t0 for lab, t0, _ in traj.segments if lab == "STurn"]
     return segment_mask(t, traj, ("Straight",), after=sturn[0] if sturn else 0.0)
 
 
 def rms_with_ci(err, mask, prob: float = 0.95, remove_mean: bool = False):
-    """Per-run RMS over ``mask`` epochs (runs × components), their mean and the two-sided
-    ``prob`` Student-t confidence interval of the mean.  ``remove_mean`` removes each run's
-    mean over the mask first (the error after a boresight calibration, which absorbs a constant
-    attitude offset; the per-run standard deviation).  Returns (per_run, mean, lo, hi)."""
+    """Per-run RMS over ``mask`` epochs, their mean and the two-sided ``prob`` Student-t interval of the mean.
+
+    Parameters
+    ----------
+    err : array_like, shape (runs, epochs, ...)
+        Errors (e.g. :func:`attitude_errors`), any unit.
+    mask : array_like of bool, shape (epochs,)
+        Epochs included (at least one).
+    prob : float
+        Confidence level of the interval.
+    remove_mean : bool
+        Remove each run's mean over the mask first (the error after a boresight calibration, which
+        absorbs a constant attitude offset; the per-run standard deviation).
+
+    Returns
+    -------
+    per_run : ndarray, shape (runs, ...)
+        RMS of each run, unit of ``err``.
+    mean : ndarray, shape (...)
+        Mean over the runs.
+    lo : ndarray, shape (...)
+        Lower limit of the interval (NaN with fewer than two runs).
+    hi : ndarray, shape (...)
+        Upper limit (NaN with fewer than two runs).
+
+    Raises
+    ------
+    ValueError
+        When the mask selects no epoch.
+    """
     err = np.asarray(err, float)
     mask = np.asarray(mask, bool)
     if not mask.any():
@@ -786,8 +1210,27 @@ def rms_with_ci(err, mask, prob: float = 0.95, remove_mean: bool = False):
 
 
 def improvement_percent(other, new):
-    """Improvement of ``new`` over ``other``, 100 (other − new) / other (%) — the reading of the
-    percentages chen2019 prints after Table 4-44."""
+    """Improvement of ``new`` over ``other``, 100 (other − new) / other.
+
+    The reading of the percentages chen2019 prints after Table 4-44.
+
+    Parameters
+    ----------
+    other : array_like
+        Accuracy of the reference (positive), any unit.
+    new : array_like
+        Accuracy of the new method, same unit (broadcast against ``other``).
+
+    Returns
+    -------
+    improvement : ndarray
+        Improvement [%].
+
+    Raises
+    ------
+    ValueError
+        When an accuracy of ``other`` is not positive.
+    """
     other = np.asarray(other, float)
     new = np.asarray(new, float)
     if np.any(other <= 0):
@@ -796,8 +1239,35 @@ def improvement_percent(other, new):
 
 
 def improvement_with_ci(per_other, per_new, prob: float = 0.95, n_boot: int = 2000, seed: int = 0):
-    """Improvement of the run-mean RMS (``per_*`` runs × components, same truths) with a paired
-    bootstrap ``prob`` interval over runs.  Returns (value, lo, hi) per component."""
+    """Improvement of the run-mean RMS with a paired bootstrap ``prob`` interval over runs.
+
+    Parameters
+    ----------
+    per_other : array_like, shape (runs, k)
+        Per-run accuracies (e.g. RMS errors) of the other model, positive, any unit.
+    per_new : array_like, shape (runs, k)
+        Per-run accuracies of the new model on the same truths, same unit.
+    prob : float
+        Confidence level of the interval.
+    n_boot : int
+        Number of bootstrap resamples.
+    seed : int
+        Seed of the resampling.
+
+    Returns
+    -------
+    value : ndarray, shape (k,)
+        Improvement of the run means [%].
+    lo : ndarray, shape (k,)
+        Lower bootstrap limit [%].
+    hi : ndarray, shape (k,)
+        Upper bootstrap limit [%].
+
+    Raises
+    ------
+    ValueError
+        When the two shapes differ.
+    """
     a = np.asarray(per_other, float)
     b = np.asarray(per_new, float)
     if a.shape != b.shape:
@@ -811,10 +1281,36 @@ def improvement_with_ci(per_other, per_new, prob: float = 0.95, n_boot: int = 20
 
 
 def paired_improvement(per_other, per_new, prob: float = 0.95):
-    """Per-run improvement 100 (other − new)/other (%) of paired runs (``per_*`` runs ×
-    components, the same truths and sensor errors), its mean and the two-sided ``prob``
-    Student-t interval of the mean (the runs' differences, not their levels, set its width).
-    Returns (per_run, mean, lo, hi); lo and hi are NaN with fewer than two runs."""
+    """Per-run improvement of paired runs, its mean and the two-sided ``prob`` Student-t interval of the mean.
+
+    The per-run improvement is 100 (other − new)/other of runs with the same truths and sensor
+    errors; the runs' differences, not their levels, set the interval's width.
+
+    Parameters
+    ----------
+    per_other : array_like, shape (runs, k)
+        Per-run accuracies (e.g. RMS errors) of the other model, positive, any unit.
+    per_new : array_like, shape (runs, k)
+        Per-run accuracies of the new model on the same truths, same unit.
+    prob : float
+        Confidence level, in (0, 1).
+
+    Returns
+    -------
+    per_run : ndarray, shape (runs, k)
+        Improvement of each run [%].
+    mean : ndarray, shape (k,)
+        Mean improvement [%].
+    lo : ndarray, shape (k,)
+        Lower limit [%] (NaN with fewer than two runs).
+    hi : ndarray, shape (k,)
+        Upper limit [%] (NaN with fewer than two runs).
+
+    Raises
+    ------
+    ValueError
+        When the shapes differ or are not two-dimensional, or ``prob`` lies outside (0, 1).
+    """
     a = np.asarray(per_other, float)
     b = np.asarray(per_new, float)
     if a.shape != b.shape or a.ndim != 2:
@@ -830,9 +1326,32 @@ def paired_improvement(per_other, per_new, prob: float = 0.95):
 
 
 def runs_for_half_width(sd, target, prob: float = 0.95, n_min: int = 2) -> int:
-    """Smallest number of runs n whose two-sided ``prob`` Student-t half-width of a mean,
-    t_{(1+prob)/2, n-1} sd / sqrt(n), is below ``target`` for a per-run standard deviation ``sd``
-    (the pilot runs' spread; array-like: the largest ratio sd/target decides).  Returns n >= ``n_min``."""
+    """Smallest number of runs n whose two-sided ``prob`` Student-t half-width of a mean is below ``target``.
+
+    The half-width is t_{(1+prob)/2, n-1} sd / sqrt(n) for a per-run standard deviation ``sd``
+    (the pilot runs' spread; array-like: the largest ratio sd/target decides).
+
+    Parameters
+    ----------
+    sd : float or array_like
+        Per-run standard deviations (finite, non-negative), any unit.
+    target : float or array_like
+        Half-width to get under (positive), unit of ``sd``; broadcast against ``sd``.
+    prob : float
+        Confidence level, in (0, 1).
+    n_min : int
+        Smallest number of runs returned (≥ 2).
+
+    Returns
+    -------
+    n : int
+        Number of runs, n ≥ ``n_min``.
+
+    Raises
+    ------
+    ValueError
+        When an argument is out of range.
+    """
     s = np.atleast_1d(np.asarray(sd, float))
     g = np.broadcast_to(np.atleast_1d(np.asarray(target, float)), s.shape)
     if np.any(~np.isfinite(s)) or np.any(s < 0):
@@ -851,8 +1370,30 @@ def runs_for_half_width(sd, target, prob: float = 0.95, n_min: int = 2) -> int:
 
 
 def rms_and_sd(err, axis: int = -1):
-    """Raw RMS sqrt(mean(e^2)) and offset-removed RMS (the standard deviation about the run's mean
-    error, sqrt(mean((e - mean e)^2))) of errors ``err`` along ``axis``; RMS^2 = mean^2 + SD^2."""
+    """Raw RMS and offset-removed RMS of errors ``err`` along ``axis``.
+
+    RMS = sqrt(mean(e^2)); the offset-removed RMS is the standard deviation about the run's mean
+    error, sqrt(mean((e - mean e)^2)); RMS^2 = mean^2 + SD^2.
+
+    Parameters
+    ----------
+    err : array_like
+        Finite errors (non-empty), any unit.
+    axis : int
+        Axis of the average.
+
+    Returns
+    -------
+    rms : ndarray
+        Raw RMS, unit of ``err``.
+    sd : ndarray
+        Population standard deviation, unit of ``err``.
+
+    Raises
+    ------
+    ValueError
+        When ``err`` is empty or not finite.
+    """
     e = np.asarray(err, float)
     if e.size == 0 or not np.all(np.isfinite(e)):
         raise ValueError("err must be a non-empty array of finite errors")
@@ -860,13 +1401,36 @@ def rms_and_sd(err, axis: int = -1):
 
 
 def single_flight_interval(per_other, per_new, prob: float = 0.95):
-    """Where one more flight's improvement 100 (other − new)/other (%) falls: the two-sided
-    ``prob`` Student-t prediction interval  m ± t s √(1 + 1/n)  of the per-run log error ratios
-    ln(new/other) of paired runs (``per_*`` runs × components, positive), mapped back to
-    percent.  On the log scale a ratio of RMS values is closer to normal than the percentage, and
-    the interval stays below 100 %.  A printed single-flight percentage is read against this
-    interval, not against the confidence interval of the mean over the runs.  Returns (lo, hi)
-    per component."""
+    """Where one more flight's improvement 100 (other − new)/other falls.
+
+    The two-sided ``prob`` Student-t prediction interval m ± t s √(1 + 1/n) of the per-run log
+    error ratios ln(new/other) of paired runs, mapped back to percent.  On the log scale a ratio of
+    RMS values is closer to normal than the percentage, and the interval stays below 100 %.  A
+    printed single-flight percentage is read against this interval, not against the confidence
+    interval of the mean over the runs.
+
+    Parameters
+    ----------
+    per_other : array_like, shape (runs, k)
+        Per-run accuracies (e.g. RMS errors) of the other model, positive, any unit.
+    per_new : array_like, shape (runs, k)
+        Per-run accuracies of the new model on the same truths, same unit.
+    prob : float
+        Probability of the prediction interval, in (0, 1).
+
+    Returns
+    -------
+    lo : ndarray, shape (k,)
+        Lower limit of the improvement [%].
+    hi : ndarray, shape (k,)
+        Upper limit [%].
+
+    Raises
+    ------
+    ValueError
+        When the shapes differ or are not two-dimensional, an accuracy is not positive, ``prob``
+        lies outside (0, 1) or fewer than two runs are given.
+    """
     a = np.asarray(per_other, float)
     b = np.asarray(per_new, float)
     if a.shape != b.shape or a.ndim != 2:
@@ -885,9 +1449,21 @@ def single_flight_interval(per_other, per_new, prob: float = 0.95):
 
 
 def printed_improvements(table):
-    """The improvement percentages recomputed from chen2019 Table 4-44 itself
-    (``rp.load_paper("chen2019-table-4-44")``): 45-state vs 15-state and vs 36-state, for
-    heading, pitch, roll.  Returns {quantity of chen2019-claim-table-4-44-improvements: value}."""
+    """The improvement percentages recomputed from chen2019 Table 4-44 itself.
+
+    45-state vs 15-state and vs 36-state, for heading, pitch, roll.
+
+    Parameters
+    ----------
+    table : replication.registry.reproduction.PaperTable
+        ``rp.load_paper("chen2019-table-4-44")``.
+
+    Returns
+    -------
+    improvements : dict of str to float
+        Quantity of ``chen2019-claim-table-4-44-improvements`` (e.g. ``"heading improvement vs
+        15-state"``) -> improvement [%].
+    """
     out = {}
     for ref in ("15", "36"):
         for ang in ("heading", "pitch", "roll"):
@@ -898,8 +1474,24 @@ def printed_improvements(table):
 
 
 def total_bias_estimates(result: BatchResult, smoothed: bool = False):
-    """The filter's estimate of the *total* gyro drift and accelerometer bias (constant + Markov,
-    chen2019's "总体漂移/总体偏置" of Fig. 4-14): runs × epochs × 3 each (rad/s, m/s²)."""
+    """The filter's estimate of the *total* gyro drift and accelerometer bias.
+
+    Constant + Markov, chen2019's "总体漂移/总体偏置" of Fig. 4-14.
+
+    Parameters
+    ----------
+    result : BatchResult
+        A Monte Carlo result of :func:`run_batch`.
+    smoothed : bool
+        RTS-smoothed instead of filtered estimates.
+
+    Returns
+    -------
+    gyro : ndarray, shape (runs, epochs, 3)
+        Total gyro drift estimate [rad/s].
+    accel : ndarray, shape (runs, epochs, 3)
+        Total accelerometer bias estimate [m/s²].
+    """
     m = result.model
     est = result.estimates(smoothed)
 
@@ -977,13 +1569,33 @@ def figure_4_14_estimates(result: BatchResult, *, smoothed: bool = False, window
 def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1000.0):
     """Readings ledger of the ranges stated after chen2019 Fig. 4-14.
 
-    ``readings`` maps a label to ``(result, smoothed, misalignment_unit)``; ``claim`` is the
-    printed ranges (``chen2019-claim-figure-4-14-ranges``, indexed by quantity, columns
-    ``value, unit, lower, upper``).  A run matches a range when the window-mean |estimate| of every
-    axis lies inside it; a reading reaches the print when at least half of its runs match (fixed
-    before looking: one flight is one realisation, so the print is matched by a typical run, not
-    by a lucky one).  Returns (rows for :func:`replication.registry.reproduction.compare`, {(label,
-    quantity): True when reached}).
+    A run matches a range when the window-mean abs(estimate) of every axis lies inside it; a
+    reading reaches the print when at least half of its runs match (fixed before looking: one
+    flight is one realisation, so the print is matched by a typical run, not by a lucky one).
+
+    Parameters
+    ----------
+    readings : dict
+        Label -> ``(result, smoothed, misalignment_unit)``: a 45-state :class:`BatchResult`, bool,
+        display unit of the misalignments [rad].
+    claim : pandas.DataFrame
+        The printed ranges (``chen2019-claim-figure-4-14-ranges``), indexed by quantity, columns
+        ``value, unit, lower, upper``.
+    window : float
+        Seconds at the end of the flight over which abs(estimate) is averaged [s].
+
+    Returns
+    -------
+    rows : list of dict
+        Rows for :func:`replication.registry.reproduction.compare` (``quantity``, ``unit``,
+        ``paper``, ``reproduced`` (the runs' range as text), ``status``, ``note``).
+    reached : dict
+        (label, quantity) -> True when the reading reaches the print.
+
+    Raises
+    ------
+    ValueError
+        When ``readings`` is empty or a reading is not a 3-tuple.
     """
     if not isinstance(readings, dict) or not readings:
         raise ValueError("readings must map a label to (result, smoothed, misalignment_unit)")
@@ -1009,10 +1621,29 @@ def figure_4_14_retained_sigma(result: BatchResult, *, misalignment_unit: float 
 
     Per quantity of :data:`FIGURE_4_14_QUANTITIES`: the smallest and largest over axes of the
     standard deviation at the last epoch (RTS-smoothed if the run has the smoothed covariance,
-    else filtered) and at the first epoch, in the text's units, and their ratio.  For the totals
-    the variance is that of the sum, var(b) + var(m) + 2 cov(b, m).  A ratio near 1 means the
-    flight leaves the quantity unobserved: its estimate stays near the prior mean whatever the
+    else filtered) and at the first recorded epoch, in the text's units, and their ratio.  For the
+    totals the variance is that of the sum, var(b) + var(m) + 2 cov(b, m).  A ratio near 1 means
+    the flight leaves the quantity unobserved: its estimate stays near the prior mean whatever the
     truth.
+
+    Parameters
+    ----------
+    result : BatchResult
+        A Monte Carlo result of :func:`run_batch` with the 45-state model.
+    misalignment_unit : float
+        Display unit of the misalignments [rad], e.g. ``units.ARCSEC``.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        Indexed by quantity; columns ``sigma_start_lo``, ``sigma_start_hi``, ``sigma_end_lo``,
+        ``sigma_end_hi`` (in the text's units: °/h, μg, 1, ``misalignment_unit``) and
+        ``retained_lo``, ``retained_hi`` (ratio end/start, dimensionless).
+
+    Raises
+    ------
+    ValueError
+        When ``result`` is not a ``BatchResult``.
     """
     if not isinstance(result, BatchResult):
         raise ValueError("result must be the BatchResult of simulation.run_batch")
@@ -1043,8 +1674,26 @@ _UNITS = {"accel_bias": (MICRO_G, "μg"), "accel_markov": (MICRO_G, "μg"), "acc
 
 
 def display_scales(model: E.ErrorModel, lat: float, h: float):
-    """Per state of ``model``: (chen2019 symbol, divisor to display units, unit) — positions in
-    metres (north, east, up), velocities m/s, attitude ″, sensor states in the papers' units."""
+    """Per state of ``model``: chen2019 symbol, divisor to display units, unit.
+
+    Positions in metres (north, east, up), velocities m/s, attitude ″, sensor states in the
+    papers' units (μg, °/h, ppm, ″, mGal, m).
+
+    Parameters
+    ----------
+    model : replication.nav.errors.ErrorModel
+        The error model.
+    lat : float
+        Latitude of the metre conversion of δL, δλ [rad].
+    h : float
+        Height of that conversion [m].
+
+    Returns
+    -------
+    scales : list of tuple
+        One ``(symbol, divisor, unit)`` per state: a state value divided by ``divisor`` is in
+        ``unit``.
+    """
     rm, rn = earth.radii(lat)
     nav = [(1.0 / (rm + h), "m"), (1.0 / ((rn + h) * math.cos(lat)), "m"), (1.0, "m"), (1.0, "m/s"), (1.0, "m/s"),
            (1.0, "m/s"), (ARCSEC, "″"), (ARCSEC, "″"), (ARCSEC, "″")]

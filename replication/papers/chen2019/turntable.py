@@ -72,9 +72,6 @@ def tested_imu_setup(t433, t434, t441, *, imu_rate_hz: float = 100.0, reference_
                      **choices) -> S.SimulationSetup:
     """Sensor errors of the unit tested in chen2019 §4.1 and the stationary-table aiding.
 
-    Arguments are the loaded paper files (``rp.load_paper``) of Table 4-33 (gyro static test),
-    Table 4-34 (accelerometer static test) and Table 4-41 (the flight simulation's IMU).
-
     Readings (stated; the largest axis is taken so that one σ serves the three axes):
 
     * random constant (turn-on to turn-on) = the printed repeatability 重复性 of the output
@@ -89,8 +86,42 @@ def tested_imu_setup(t433, t434, t441, *, imu_rate_hz: float = 100.0, reference_
     * aiding: position and zero velocity at ``reference_rate_hz`` with white errors
       ``sigma_pos`` (m, each ENU axis) and ``sigma_vel`` (m/s).
 
-    ``duration`` (s) is the scenario length (used only by the 36-state model's random walk);
-    ``choices`` override other :class:`replication.papers.chen2019.simulation.SimulationSetup` fields.
+    Parameters
+    ----------
+    t433 : replication.registry.reproduction.PaperTable
+        Table 4-33 (gyro static test), ``rp.load_paper("chen2019-table-4-33")``: the per-axis
+        repeatability and mean bias stability of the gyro output, in °/h.
+    t434 : replication.registry.reproduction.PaperTable
+        Table 4-34 (accelerometer static test), ``rp.load_paper("chen2019-table-4-34")``: the
+        same quantities of the accelerometers, in g.
+    t441 : replication.registry.reproduction.PaperTable
+        Table 4-41 (the flight simulation's IMU), ``rp.load_paper("chen2019-table-4-41")``: the
+        values §4.1 does not print.
+    imu_rate_hz : float
+        IMU sampling rate [Hz].
+    reference_rate_hz : float
+        Rate of the position and zero-velocity aiding [Hz]; must divide ``imu_rate_hz``.
+    sigma_pos : float
+        Standard deviation of the white position-aiding error, each ENU axis [m].
+    sigma_vel : float
+        Standard deviation of the white zero-velocity-aiding error, each ENU axis [m/s].
+    duration : float
+        Scenario length [s] (used only by the 36-state model's random walk,
+        ``SimulationSetup.flight_duration``).
+    **choices : dict, optional
+        Other :class:`replication.papers.chen2019.simulation.SimulationSetup` fields to override
+        (SI units).
+
+    Returns
+    -------
+    setup : replication.papers.chen2019.simulation.SimulationSetup
+        The truth and filter parameters in SI units.
+
+    Raises
+    ------
+    ValueError
+        When a rate, σ or the duration is not a positive number, or a paper value is not a
+        non-negative number in the expected unit.
     """
     for name, v in (("imu_rate_hz", imu_rate_hz), ("reference_rate_hz", reference_rate_hz),
                     ("sigma_pos", sigma_pos), ("sigma_vel", sigma_vel), ("duration", duration)):
@@ -119,9 +150,34 @@ def _scenario_cached(experiment, dt, dwell, repeats):
 
 
 def scenario(experiment: int, *, imu_rate_hz: float = 100.0, dwell: float = 300.0, repeats: int = 3):
-    """Experiment ``experiment`` (1, 2 or 3) of chen2019 §4.1.3 at :data:`SITE`, sampled at
-    ``imu_rate_hz``: 5-min dwells (采集 5 分钟) and the printed rotations (outer axis 9°/s, middle
-    axis 1°/s), steps repeated 3 times.  Cached: do not modify the returned trajectory."""
+    """Experiment ``experiment`` (1, 2 or 3) of chen2019 §4.1.3 at :data:`SITE`, sampled at ``imu_rate_hz``.
+
+    5-min dwells (采集 5 分钟) and the printed rotations (outer axis 9°/s, middle axis 1°/s), steps
+    repeated 3 times (:func:`replication.nav.trajectory.turntable_chen2019`).
+
+    Parameters
+    ----------
+    experiment : int
+        The experiment number, 1, 2 or 3.
+    imu_rate_hz : float
+        IMU sampling rate [Hz].
+    dwell : float
+        Length of each stationary dwell [s].
+    repeats : int
+        Number of repetitions of the rotation steps (≥ 1).
+
+    Returns
+    -------
+    traj : replication.nav.trajectory.Trajectory
+        The true motion sampled every 1/``imu_rate_hz`` s.  Cached: do not modify the returned
+        trajectory.
+
+    Raises
+    ------
+    ValueError
+        When ``experiment`` is not 1, 2 or 3, ``imu_rate_hz`` or ``dwell`` is not positive, or
+        ``repeats`` < 1.
+    """
     if experiment not in (1, 2, 3):
         raise ValueError("experiment must be 1, 2 or 3 (chen2019 §4.1.3)")
     if not (imu_rate_hz > 0 and dwell > 0 and int(repeats) >= 1):
@@ -130,10 +186,35 @@ def scenario(experiment: int, *, imu_rate_hz: float = 100.0, dwell: float = 300.
 
 
 def run_scenario(traj, setup: S.SimulationSetup, *, n_runs: int = 12, seed: int = 0, model: str = "15"):
-    """Forward closed-loop filter plus RTS smoother (:func:`replication.papers.chen2019.simulation.run_batch`) over
-    ``n_runs`` Monte Carlo runs on ``traj``, recording every aiding epoch.  ``model`` is the
-    filter model kind of :func:`replication.papers.chen2019.simulation.filter_model` (default the 15-state model
-    of chen2019 eqs. (3-14)-(3-16); the report does not say which model the turntable test used)."""
+    """Forward closed-loop filter plus RTS smoother over ``n_runs`` Monte Carlo runs on ``traj``.
+
+    Runs :func:`replication.papers.chen2019.simulation.run_batch`, recording every aiding epoch.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The turntable motion (:func:`scenario`), sampled at ``setup.imu_rate_hz``.
+    setup : replication.papers.chen2019.simulation.SimulationSetup
+        Truth and filter parameters (:func:`tested_imu_setup`).
+    n_runs : int
+        Number of Monte Carlo runs.
+    seed : int
+        Seed of the runs' random streams (run r's truth depends only on (``seed``, r)).
+    model : str
+        The filter model kind of :func:`replication.papers.chen2019.simulation.filter_model`:
+        ``"15"`` (default, the 15-state model of chen2019 eqs. (3-14)-(3-16); the report does not
+        say which model the turntable test used), ``"36"`` or ``"45"``.
+
+    Returns
+    -------
+    result : replication.papers.chen2019.simulation.BatchResult
+        Filtered and smoothed errors at every aiding epoch (no smoothed covariance).
+
+    Raises
+    ------
+    TypeError
+        When ``setup`` is not a ``SimulationSetup``.
+    """
     if not isinstance(setup, S.SimulationSetup):
         raise TypeError("setup must be a SimulationSetup (see tested_imu_setup)")
     m = S.filter_model(model, setup, float(traj.lat[0]), float(traj.h[0]))
@@ -142,11 +223,31 @@ def run_scenario(traj, setup: S.SimulationSetup, *, n_runs: int = 12, seed: int 
 
 
 def error_std(result, traj, smoothed: bool = True) -> np.ndarray:
-    """Per run, the standard deviation over time (population, all recorded epochs) of the
-    errors printed in chen2019 Tables 4-37 ... 4-39, in :data:`QUANTITIES` order and
+    """Per run, the standard deviation over time of the errors printed in chen2019 Tables 4-37 ... 4-39.
+
+    Population standard deviation over all recorded epochs, in :data:`QUANTITIES` order and
     :data:`UNITS`: pitch, roll, heading (°, from the attitude error), latitude and longitude
     (m: δL (R_M + h), δλ (R_N + h) cos L), height (m), east, north, up velocity (m/s).
-    Returns runs × 9."""
+
+    Parameters
+    ----------
+    result : replication.papers.chen2019.simulation.BatchResult
+        The Monte Carlo result (:func:`run_scenario`).
+    traj : replication.nav.trajectory.Trajectory
+        The trajectory the result was computed on.
+    smoothed : bool
+        Errors of the RTS-smoothed solution (default) instead of the filtered one.
+
+    Returns
+    -------
+    std : ndarray, shape (runs, 9)
+        Per run the standard deviation of the nine errors [°, °, °, m, m, m, m/s, m/s, m/s].
+
+    Raises
+    ------
+    ValueError
+        When ``smoothed`` is true and the result has no smoother pass.
+    """
     if smoothed and result.ds is None:
         raise ValueError("the result has no smoother pass (run_scenario always adds one)")
     e = result.errors(smoothed)
@@ -160,8 +261,24 @@ def error_std(result, traj, smoothed: bool = True) -> np.ndarray:
 
 
 def summary(per_run) -> dict:
-    """Monte-Carlo statistics of ``per_run`` (runs × k): mean, sample standard deviation
-    (the spread of one run), min and max across runs, each a length-k array."""
+    """Monte-Carlo statistics of ``per_run``: mean, spread, extremes across runs.
+
+    Parameters
+    ----------
+    per_run : array_like, shape (runs, k)
+        A per-run statistic of k quantities (e.g. :func:`error_std`), at least two runs; any unit.
+
+    Returns
+    -------
+    stats : dict
+        ``mean``, ``sd`` (sample standard deviation, ddof = 1: the spread of one run), ``min`` and
+        ``max`` across runs, each an ndarray of shape (k,) in the unit of ``per_run``.
+
+    Raises
+    ------
+    ValueError
+        When ``per_run`` is not two-dimensional with at least two runs.
+    """
     a = np.asarray(per_run, float)
     if a.ndim != 2 or a.shape[0] < 2:
         raise ValueError("per_run must be runs × quantities with at least two runs")
@@ -171,14 +288,39 @@ def summary(per_run) -> dict:
 def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indices=(1, 2, 5, 8)):
     """Comparison rows for the orderings between two experiments the printed tables show.
 
-    ``paper_exp``, ``paper_ref``: the nine printed values (:data:`QUANTITIES` order) of the
-    experiment and of the reference experiment; ``runs_exp``, ``runs_ref``: the simulated per-run
-    values (runs × 9, :func:`error_std`, independent runs).  For each index i: the printed ratio
-    paper_exp[i] / paper_ref[i] and the ratio of the Monte-Carlo means.  Status ``qualitative``
-    when the simulated means differ in the printed direction by more than two standard errors of
-    their difference (the ordering is reproduced); ``not-reproduced`` otherwise (opposite
-    direction, no significant difference, or equal printed values).  ``label`` names the
-    reference experiment in the quantity, e.g. ``"experiment 1"``.
+    For each index i: the printed ratio paper_exp[i] / paper_ref[i] and the ratio of the
+    Monte-Carlo means.  Status ``qualitative`` when the simulated means differ in the printed
+    direction by more than two standard errors of their difference (the ordering is reproduced);
+    ``not-reproduced`` otherwise (opposite direction, no significant difference, or equal printed
+    values).
+
+    Parameters
+    ----------
+    paper_exp : array_like, shape (9,)
+        The nine printed values of the experiment, in :data:`QUANTITIES` order and :data:`UNITS`.
+    paper_ref : array_like, shape (9,)
+        The nine printed values of the reference experiment (positive).
+    runs_exp : array_like, shape (runs, 9)
+        The simulated per-run values of the experiment (:func:`error_std`), at least two runs.
+    runs_ref : array_like, shape (runs, 9)
+        The simulated per-run values of the reference experiment (independent runs, positive).
+    label : str
+        Names the reference experiment in the quantity, e.g. ``"experiment 1"``.
+    indices : sequence of int
+        Positions in :data:`QUANTITIES` (0 ... 8) to compare.
+
+    Returns
+    -------
+    rows : list of dict
+        One row per index for :func:`replication.registry.reproduction.compare`: ``quantity``,
+        ``unit`` (``"1"``, the ratios are dimensionless), ``paper`` (printed ratio), ``reproduced``
+        (ratio of the simulated means), ``status``, ``note``.
+
+    Raises
+    ------
+    ValueError
+        When the shapes do not match, fewer than two runs are given, a reference value is not
+        positive or an index lies outside 0 ... 8.
     """
     pe, pr = (np.asarray(x, float) for x in (paper_exp, paper_ref))
     re_, rr = (np.asarray(x, float) for x in (runs_exp, runs_ref))
