@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from replication.nav import closedloop, earth, errors, kalman, rotations, sensors, strapdown, timeseries, trajectory
 from replication.nav.units import DEG
 from replication.papers.an2021 import transfer
-from replication.papers.chen2019 import calibration, models, observability
+from replication.papers.chen2019 import calibration, findings, models, observability
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
 I3 = np.eye(3)
@@ -235,12 +235,12 @@ PROBES += [
     ("verdict_under(rank_tol = -1e-9)", "rank_tol", lambda: observability.verdict_under(1.0, 1.0, -1e-9, 0.1)),
     ("verdict_under(degree = '1')", "degree", lambda: observability.verdict_under(1.0, "1", 1e-9, 0.1)),
     ("compare_verdicts(printed_threshold = -1)", "printed_threshold",
-     lambda: observability.compare_verdicts(_deg_table(), {"m": _deg_table()}, "m", exact=_EXACT, explain={},
+     lambda: findings.compare_verdicts(_deg_table(), {"m": _deg_table()}, "m", exact=_EXACT, explain={},
                                             printed_threshold=-1.0)),
     ("compare_verdicts(exact incomplete)", "exact",
-     lambda: observability.compare_verdicts(_deg_table(), {"m": _deg_table()}, "m", exact={}, explain={})),
+     lambda: findings.compare_verdicts(_deg_table(), {"m": _deg_table()}, "m", exact={}, explain={})),
     ("compare_verdicts(printed with NaN)", "printed",
-     lambda: observability.compare_verdicts(_deg_table((np.nan, 0.0, 0.0)), {"m": _deg_table()}, "m", exact=_EXACT,
+     lambda: findings.compare_verdicts(_deg_table((np.nan, 0.0, 0.0)), {"m": _deg_table()}, "m", exact=_EXACT,
                                             explain={})),
     ("closed_loop(P0 = -I)", "P0", lambda: _closed_loop(P0=-np.eye(15))),
     ("closed_loop(P0 with NaN)", "P0", lambda: _closed_loop(P0=np.diag([np.nan] + [1.0] * 14))),
@@ -565,7 +565,7 @@ _CALLS = {
                                     dict(printed_value=1.0, degree=1.0, rank_tol=1e-9, ambiguity=0.1),
                                     {"printed_value": "sd", "degree": "sd", "rank_tol": "sd", "ambiguity": "sd",
                                      "printed_threshold": "sd"}),
-    "observability.compare_verdicts": (observability.compare_verdicts,
+    "findings.compare_verdicts": (findings.compare_verdicts,
                                        dict(printed=_deg_table(), readings={"m": _deg_table()}, main="m", exact=_EXACT,
                                             explain={}),
                                        {"printed": "table", "readings": "object", "exact": "object",

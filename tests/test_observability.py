@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from replication.nav import trajectory as tr
+from replication.papers.chen2019 import findings
 from replication.papers.chen2019 import models as M
 from replication.papers.chen2019 import observability as O
 
@@ -297,7 +298,7 @@ def test_compare_verdicts_follows_the_ledger_and_the_printed_evidence():
     excluded = _degrees({"before maneuver": [1.0, 0.0], "turn": [5.0, 4.0]})       # would reach 'a | turn'
     exact = {(s, c): False for s in "abc" for c in printed.columns}
     exact[("a", "before maneuver")] = True
-    rows, ledger = O.compare_verdicts(printed, {"main": main, "other": other, "old convention": excluded}, "main",
+    rows, ledger = findings.compare_verdicts(printed, {"main": main, "other": other, "old convention": excluded}, "main",
                                       exact=exact, explain={"a": "why a", "b": "why b"}, ruled_out=["old"])
     st = {r["quantity"]: r["status"] for r in rows if not r["quantity"].startswith("c")}
     assert st == {"a | before maneuver": "qualitative", "a | turn": "not-reproduced",
@@ -309,4 +310,4 @@ def test_compare_verdicts_follows_the_ledger_and_the_printed_evidence():
     assert q["old convention | a | turn"]["status"] == "qualitative" and "ruled out" in q["old convention | a | turn"]["note"]
     assert q["other | a | turn"]["status"] == "not-reproduced"
     with pytest.raises(ValueError, match="ruled out"):
-        O.compare_verdicts(printed, {"old": main}, "old", exact=exact, explain={}, ruled_out=["old"])
+        findings.compare_verdicts(printed, {"old": main}, "old", exact=exact, explain={}, ruled_out=["old"])

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from replication.nav.units import DEG, DEG_PER_H, G0
+from replication.papers.chen2019 import findings
 from replication.papers.chen2019 import simulation as sim
 from replication.papers.chen2019 import turntable as tt
 from replication.registry import reproduction as rp
@@ -86,7 +87,7 @@ def test_summary_and_ordering_rows():
     runs_ref = 1.0 + 0.01 * rng.standard_normal((8, 9))
     runs_exp = runs_ref * np.r_[np.full(8, 1.5), 0.5]                 # up velocity: opposite direction
     runs_exp[:, 5] = 1.0 + 0.01 * rng.standard_normal(8)               # height: no real difference
-    rows = tt.ordering_rows(np.full(9, 2.0), ref, runs_exp, runs_ref, label="experiment 1")
+    rows = findings.ordering_rows(np.full(9, 2.0), ref, runs_exp, runs_ref, label="experiment 1")
     st = {r["quantity"]: r for r in rows}
     assert st["heading error STD ratio to experiment 1"]["status"] == "qualitative"
     assert st["up velocity error STD ratio to experiment 1"]["status"] == "not-reproduced"
@@ -94,6 +95,6 @@ def test_summary_and_ordering_rows():
     assert "no significant" in st["height error STD ratio to experiment 1"]["note"]
     assert len(rows) == 4
     with pytest.raises(ValueError, match="positive"):
-        tt.ordering_rows(ref, np.zeros(9), runs_ref, runs_ref, label="x")
+        findings.ordering_rows(ref, np.zeros(9), runs_ref, runs_ref, label="x")
     with pytest.raises(ValueError, match="two runs"):
-        tt.ordering_rows(ref, ref, runs_ref[:1], runs_ref, label="x")
+        findings.ordering_rows(ref, ref, runs_ref[:1], runs_ref, label="x")

@@ -8,7 +8,7 @@ Contents, in the report's order:
 * the six-position forward/reverse rate calibration on a single-axis rate table — the general
   least-squares solution of the state equations (4-3)/(4-4) for any set of positions and rates,
   and the closed forms (4-5)-(4-8), re-derived (the printed ones are damaged, see
-  :data:`PRINTED_CLOSED_FORM_DAMAGE`);
+  :data:`replication.papers.chen2019.findings.PRINTED_CLOSED_FORM_DAMAGE`);
 * a synthetic rate-table experiment (positions, rates, full revolutions, Earth rate at a stated
   latitude, white sensor noise) and the analytic covariance of the calibrated parameters;
 * the temperature model (4-9)-(4-12): piecewise-linear interpolation with an explicit
@@ -962,36 +962,6 @@ def symbolic_closed_forms() -> dict[str, object]:
     out["Kminus_45"] = sp.simplify((4 * n0 - 2 * y[1] - 2 * y[3]) / (4 * w))
     out["symbols"] = (y, w, s)
     return out
-
-
-PRINTED_CLOSED_FORM_DAMAGE = (
-    ("(4-3)", "row 4 of the design prints ω̂_{i+}; it is ω̂_{i-} = -ω(i) - Ω_e sin φ (axis down, reverse rate)",
-     "erratum"),
-    ("(4-3)", "the design uses ω_{i±} while the definitions below it name ω_{e±}: the same four inputs", "inconsistent"),
-    ("(4-3)", "φ is described as the angle to north at time t; Ω_e sin φ is the vertical Earth rate, φ = latitude",
-     "erratum"),
-    ("(4-5)", "captioned as the accelerometer channel (加速度通道系统状态方程) but it solves the gyro channel: ω inputs, "
-              "gyro K and E", "inconsistent"),
-    ("(4-5)", "K_{x-} prints -2ω̄_{x2} - 2ω̄_{x3} - 4ω_{x0}; it is -2ω̄_{x2} - 2ω̄_{x4} + 4ω_{x0}", "erratum"),
-    ("(4-5)", "K_{y-} and K_{z-} print -4ω_{y0}, -4ω_{z0}; the bias enters with +4ω_{j0}", "erratum"),
-    ("(4-5)", "the last cross term of row z ends in ω̄ without index (possibly lost in the extraction); the only "
-              "consistent reading is -ω̄_{z8}", "qualitative"),
-    ("(4-5)", "a property of the method, not a misprint: the Earth-rate terms cancel in (4-5) only because every "
-              "axis is run up and down at ±ω", "qualitative"),
-    ("(4-6)", "a property of the method, not a misprint: (4-6) is exact under the report's single-K model; with "
-              "K+ ≠ K- the 1/12 mean is biased by ω(K+ - K-)/6 and the unbiased form averages the 8 rows with "
-              "axis j horizontal", "qualitative"),
-    ("(4-6)/(4-7)", "over-bars (averaged outputs) are missing on some ω̄, ā symbols (possibly lost in the "
-                    "extraction); every symbol is read as the run mean", "qualitative"),
-    ("(4-7)", "the factor 1/12 is missing", "erratum"),
-    ("(4-8)", "the left-hand matrix and the right-hand side are printed side by side without '=' and "
-              "without the factor 1/(4g)", "erratum"),
-    ("(4-9)-(4-12)", "'T ∈ [T_{i-1}, T_i], i = 1..n' must start at i = 2", "erratum"),
-)
-"""What the printed six-position and temperature formulas get wrong (equation, finding, status):
-``erratum`` where the derivation proves the print wrong, ``inconsistent`` where two printed parts
-disagree, ``qualitative`` for a property of the method or a symbol the extraction may have lost
-(the only consistent reading stated)."""
 
 
 # ---------------------------------------------------------------------------------- simulation

@@ -77,7 +77,7 @@ __all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "EXTEND_ORDER_45", "NAV_SYM
            "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
            "measurement_function", "lever_arm_correction", "table_2_3_states", "frozen_earth_jacobian",
            "TABLE_2_2_BLOCKS", "table_2_2_printed", "table_2_2_corrected", "table_2_2_verified",
-           "table_2_2_differences", "TABLE_2_2_CORRECTED_TEXT", "table_2_2_reference_point",
+           "table_2_2_differences", "table_2_2_reference_point",
            "jacobian_agreement"]
 
 CHEN2019_45_ORDER = ("accel_bias", "accel_markov", "accel_scale", "accel_misalignment", "gyro_bias",
@@ -872,7 +872,7 @@ def table_2_2_corrected(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.
 
     Same conventions and the same approximation level as the report: Earth radii and gravity
     frozen, gyro errors with +C_b^n.  Verified against :func:`frozen_earth_jacobian` and
-    ``ErrorModel.F`` in tests/test_models.py; :data:`TABLE_2_2_CORRECTED_TEXT` gives the
+    ``ErrorModel.F`` in tests/test_models.py; :data:`replication.papers.chen2019.findings.TABLE_2_2_CORRECTED_TEXT` gives the
     expressions::
 
         F21(·,3) = [V_E(V_U - V_N tan L)/(R_N+h)², V_E² tan L/(R_N+h)² + V_N V_U/(R_M+h)²,
@@ -916,24 +916,6 @@ def table_2_2_corrected(point, *, accel_markov_tau=3600.0, gyro_markov_tau=3600.
     B["F52"], B["F53"] = (C @ Bm)[:, :3], (C @ Bm)[:, 3:]
     B["F43"][1, 0] = -w * s - VE * t / Rn
     return B
-
-
-TABLE_2_2_CORRECTED_TEXT = {
-    "F21": r"third column: [V_E(V_U - V_N \tan L)/(R_N+h)^2,\ V_E^2\tan L/(R_N+h)^2 + V_N V_U/(R_M+h)^2,"
-           r"\ -V_E^2/(R_N+h)^2 - V_N^2/(R_M+h)^2]",
-    "F22": r"F22(1,1) = (V_N \tan L - V_U)/(R_N+h); third row [2\omega_{ie}\cos L + 2V_E/(R_N+h),\ 2V_N/(R_M+h),\ 0]",
-    "F23": r"(f^n\times) = [[0, -f_U, f_N], [f_U, 0, -f_E], [-f_N, f_E, 0]]",
-    "F32": r"columns A_xy, A_yx, A_xz of C_b^n\,\partial(\delta A f^b): [-C_{\cdot 3} f_x,\ C_{\cdot 3} f_y,\ C_{\cdot 2} f_x]",
-    "F33": r"columns A_zx, A_yz, A_zy: [-C_{\cdot 2} f_z,\ -C_{\cdot 1} f_y,\ C_{\cdot 1} f_z]",
-    "F43": r"F43(2,1) = -\omega_{ie}\sin L - V_E\tan L/(R_N+h)",
-    "F52": r"columns G_xy, G_yx, G_xz: [-C_{\cdot 3}\omega_x,\ C_{\cdot 3}\omega_y,\ C_{\cdot 2}\omega_x]",
-    "F53": r"columns G_zx, G_yz, G_zy: [-C_{\cdot 2}\omega_z,\ -C_{\cdot 1}\omega_y,\ C_{\cdot 1}\omega_z]",
-}
-"""Corrected expressions of the Table 2-2 blocks whose printed form differs (see
-:func:`table_2_2_corrected`), in LaTeX; the chapter renders them.
-
-:meta hide-value:
-"""
 
 
 def table_2_2_verified(model, point) -> dict:

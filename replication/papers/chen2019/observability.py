@@ -69,7 +69,7 @@ __all__ = ["observability_matrix", "stripped_observability_matrix", "total_obser
            "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
            "covariance_observability", "segment_bounds", "AMBIGUOUS", "spearman", "CHEN2019_MANEUVERS", "Maneuver",
            "chen2019_maneuvers", "degrees_table", "covariance_table", "rank_metrics", "best_scenario_counts", "unbanked", "coordinated", "sweep",
-           "verdict_under", "compare_verdicts"]
+           "verdict_under"]
 
 
 # ----------------------------------------------------------------------------- validation
@@ -1198,7 +1198,7 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
         states) and ``observable <scenario>`` (the number of states above the rank tolerance, the
         bar count of chen2019 Fig. 2-4).  ``table.attrs["tables"]`` keeps each variant's degrees
         table (states of ``reference``), with its ``rank_tol`` and ``ambiguity`` attributes, for
-        :func:`compare_verdicts`.
+        :func:`replication.papers.chen2019.findings.compare_verdicts`.
 
     Raises
     ------
@@ -1286,142 +1286,3 @@ def verdict_under(printed_value: float, degree: float, rank_tol: float, ambiguit
     return vp, vo, bool(vp == vo or float(ambiguity) <= AMBIGUOUS)
 
 
-def _stored_degree(table, state, scenario) -> float:
-    """A degree to 6 significant digits, or 0 when it is round-off (see :func:`verdict_under`)."""
-    d = float(table.loc[state, scenario])
-    return 0.0 if d <= ROUND_OFF_MARGIN * table.attrs["rank_tol"][scenario] else float(f"{d:.6g}")
-
-
-def _word(observable: bool) -> str:
-    return "observable" if observable else "unobservable"
-
-
-def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain: dict, symbols=None,
-                     ruled_out=(), level_combinations=LEVEL_COMBINATIONS, before="before maneuver",
-                     printed_threshold: float = 1e-5):
-    """The status of every verdict of an observability table under its main reading, and the
-    readings ledger that supports it (chen2019 Table 2-3; CONTRIBUTING.md, "Readings and the main
-    reading").
-
-    Parameters
-    ----------
-    printed : pandas.DataFrame
-        The printed degrees (rows: states, columns: scenarios), dimensionless.
-    readings : dict
-        Reading name → degrees table of the same shape with ``attrs["rank_tol"]`` and
-        ``attrs["ambiguity"]`` (:func:`degrees_table`, or ``sweep(...).attrs["tables"]``).
-    main : str
-        The main reading, a key of ``readings``.
-    exact : dict
-        ``(state, scenario)`` → bool: the second computation's verdict (exact null-space
-        criterion) under the main reading.
-    explain : dict
-        State → the physical reason a verdict differs (one line).
-    symbols : dict, optional
-        State → printed symbol used in the quantities (default: the state name).
-    ruled_out : iterable of str
-        Prefixes of readings that printed evidence excludes: shown in the ledger, never used to
-        reach the print.
-    level_combinations : set of str
-        States observable in level flight only in a combination (scenario ``before``).
-    before : str
-        The column of the straight, level scenario.
-    printed_threshold : float
-        A printed degree above it is *observable*.
-
-    Returns
-    -------
-    main_rows, ledger_rows : list of dict
-        Rows for :func:`replication.registry.reproduction.compare`.  A value whose verdict differs under the
-        main reading is ``not-reproduced`` only when it is decided (not ambiguous, not a level
-        combination), the second computation agrees with the main reading, and no reading that is
-        not ruled out gives the printed verdict; otherwise ``qualitative`` with the reason.  A value
-        without a verdict carries no reproduced degree.  The ledger holds, for every reading, the
-        Spearman rank correlation per scenario (a statistic of agreement with the printed ranks, not
-        a printed value) and its verdict on every value whose verdict under the main reading differs
-        from the print (the values whose status the ledger decides).
-    """
-    _table(printed, "printed")
-    nonnegative(printed_threshold, "printed_threshold")
-    if not isinstance(readings, dict) or not readings:
-        raise TypeError(f"readings must be a non-empty dict {{reading: degrees table}}, got {type(readings).__name__}")
-    if main not in readings:
-        raise ValueError(f"main reading {main!r} is not one of the readings {list(readings)}")
-    for r, t in readings.items():
-        _table(t, f"readings[{r!r}]")
-        if not (set(printed.index) <= set(t.index) and set(printed.columns) <= set(t.columns)):
-            raise ValueError(f"readings[{r!r}] must hold every state and scenario of printed")
-        if not all(c in t.attrs.get("rank_tol", {}) and c in t.attrs.get("ambiguity", {}) for c in printed.columns):
-            raise ValueError(f"readings[{r!r}] needs attrs['rank_tol'] and attrs['ambiguity'] for every scenario "
-                             "(observability.degrees_table)")
-    if not isinstance(exact, dict):
-        raise TypeError(f"exact must be a dict {{(state, scenario): observable}}, got {type(exact).__name__}")
-    missing = [(s, c) for s in printed.index for c in printed.columns if (s, c) not in exact]
-    if missing:
-        raise ValueError(f"exact has no verdict of the second computation for {missing[:3]} (one per state and "
-                         "scenario of printed)")
-    sym = symbols or {s: s for s in printed.index}
-    ruled = tuple(ruled_out)
-    excluded = {r for r in readings if any(r.startswith(k) for k in ruled)}
-    if main in excluded:
-        raise ValueError(f"the main reading {main!r} is itself ruled out")
-
-    def decide(r, s, c):
-        t = readings[r]
-        return verdict_under(printed.loc[s, c], t.loc[s, c], t.attrs["rank_tol"][c], t.attrs["ambiguity"][c][s],
-                             printed_threshold=printed_threshold)
-
-    main_rows, differ = [], []
-    for s in printed.index:
-        for c in printed.columns:
-            vp, vo, decided = decide(main, s, c)
-            t, q = readings[main], f"{sym[s]} | {c}"
-            says = f"printed {_word(vp)}, reproduced {_word(vo)}"
-            value = _stored_degree(t, s, c)
-            ex = exact[(s, c)]
-            if vp != vo:
-                differ.append((s, c))
-            if vp == vo:
-                status, note = "qualitative", f"verdict agrees ({_word(vp)}); magnitudes depend on unstated choices" + (
-                    "" if ex == vp else f"; alone it is {_word(ex)} by the exact null-space criterion (second computation)")
-            elif not decided:
-                status, value = "qualitative", None
-                note = (f"no verdict ({says}): the state lies almost equally in two singular subspaces (projection ratio "
-                        f"{t.attrs['ambiguity'][c][s]:.2f}), so the assignment rule, not the model, decides")
-            elif c == before and s in level_combinations and not ex:
-                status, value = "qualitative", None
-                note = (f"no verdict ({says}): {explain[s]}; alone each member is unobservable (exact null-space "
-                        "criterion, second computation) and the member an SVD names depends on the scaling")
-            elif ex == vp:
-                status, note = "qualitative", (f"{says} with this chapter's rank tolerance; the exact null-space criterion "
-                                               f"(second computation) agrees with the print: {explain[s]}")
-            else:
-                reach = [r for r in readings if r not in excluded and r != main
-                         and (lambda v: v[0] == v[1] or not v[2])(decide(r, s, c))]
-                if reach:
-                    status, note = "qualitative", (f"{says} under the main reading, but the reading '{reach[0]}' of the "
-                                                   f"ledger does not contradict the print: {explain[s]}")
-                else:
-                    status, note = "not-reproduced", (f"{says} under every reading of the ledger not ruled out by the "
-                                                      f"print (the exact null-space criterion agrees): {explain[s]}")
-            main_rows.append(dict(quantity=q, unit="1", paper=printed.loc[s, c], reproduced=value, status=status,
-                                  note=note))
-
-    ledger = []
-    for r, t in readings.items():
-        tag = " (ruled out by the print)" if r in excluded else ""
-        for c in printed.columns:
-            rho = spearman(printed[c].to_numpy(float), t[c].to_numpy(float))
-            ledger.append(dict(quantity=f"{r} | Spearman ρ with the printed ranks, {c}", unit="1", paper=None,
-                               paper_text="ranks of the printed column", reproduced=round(float(rho), 2),
-                               status="qualitative" if rho >= 0.7 else "not-reproduced",
-                               note=f"a statistic of agreement, not a printed value: accepted when ρ ≥ 0.7{tag}"))
-        for s, c in differ:
-            vp, vo, decided = decide(r, s, c)
-            ok = vp == vo or not decided
-            ledger.append(dict(quantity=f"{r} | {sym[s]} | {c}", unit="1", paper=printed.loc[s, c],
-                               reproduced=_stored_degree(t, s, c) if decided else None,
-                               status="qualitative" if ok else "not-reproduced",
-                               note=("verdict agrees" if vp == vo else "no verdict (ambiguous assignment)" if ok
-                                     else f"SVD verdict: printed {_word(vp)}, reproduced {_word(vo)}") + tag))
-    return main_rows, ledger

@@ -73,7 +73,7 @@ __all__ = ["SimulationSetup", "table_4_41_setup", "MISALIGNMENT_UNITS", "MARKOV_
            "segment_mask", "survey_line_mask", "rms_with_ci", "improvement_percent",
            "improvement_with_ci", "paired_improvement", "single_flight_interval", "runs_for_half_width", "rms_and_sd",
            "printed_improvements",
-           "total_bias_estimates", "FIGURE_4_14_QUANTITIES", "figure_4_14_estimates", "figure_4_14_ledger",
+           "total_bias_estimates", "FIGURE_4_14_QUANTITIES", "figure_4_14_estimates",
            "figure_4_14_retained_sigma", "display_scales"]
 
 MISALIGNMENT_UNITS = {"arcsec": ARCSEC, "arcmin": ARCMIN, "mrad": 1e-3}
@@ -1564,56 +1564,6 @@ def figure_4_14_estimates(result: BatchResult, *, smoothed: bool = False, window
             parts.append(np.abs(x[:, last]).mean(1) / scales[q])
         out[q] = np.concatenate(parts, axis=-1)
     return out
-
-
-def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1000.0):
-    """Readings ledger of the ranges stated after chen2019 Fig. 4-14.
-
-    A run matches a range when the window-mean abs(estimate) of every axis lies inside it; a
-    reading reaches the print when at least half of its runs match (fixed before looking: one
-    flight is one realisation, so the print is matched by a typical run, not by a lucky one).
-
-    Parameters
-    ----------
-    readings : dict
-        Label -> ``(result, smoothed, misalignment_unit)``: a 45-state :class:`BatchResult`, bool,
-        display unit of the misalignments [rad].
-    claim : pandas.DataFrame
-        The printed ranges (``chen2019-claim-figure-4-14-ranges``), indexed by quantity, columns
-        ``value, unit, lower, upper``.
-    window : float
-        Seconds at the end of the flight over which abs(estimate) is averaged [s].
-
-    Returns
-    -------
-    rows : list of dict
-        Rows for :func:`replication.registry.reproduction.compare` (``quantity``, ``unit``,
-        ``paper``, ``reproduced`` (the runs' range as text), ``status``, ``note``).
-    reached : dict
-        (label, quantity) -> True when the reading reaches the print.
-
-    Raises
-    ------
-    ValueError
-        When ``readings`` is empty or a reading is not a 3-tuple.
-    """
-    if not isinstance(readings, dict) or not readings:
-        raise ValueError("readings must map a label to (result, smoothed, misalignment_unit)")
-    rows, reached = [], {}
-    for label, spec in readings.items():
-        if not (isinstance(spec, tuple) and len(spec) == 3):
-            raise ValueError(f"reading {label!r} must be (result, smoothed, misalignment_unit)")
-        result, smoothed, unit = spec
-        est = figure_4_14_estimates(result, smoothed=smoothed, window=window, misalignment_unit=unit)
-        for q, v in est.items():
-            lo, hi = float(claim.loc[q, "lower"]), float(claim.loc[q, "upper"])
-            inside = np.all((v >= lo) & (v <= hi), axis=1)
-            ok = bool(inside.mean() >= 0.5)
-            reached[(label, q)] = ok
-            rows.append(dict(quantity=f"{label} | {q}", unit=claim.loc[q, "unit"], paper=claim.loc[q, "value"],
-                             reproduced=f"{v.min():.2g}~{v.max():.2g}", status="analog" if ok else "not-reproduced",
-                             note=f"runs with every axis inside: {int(inside.sum())} of {inside.size}"))
-    return rows, reached
 
 
 def figure_4_14_retained_sigma(result: BatchResult, *, misalignment_unit: float = ARCSEC) -> pd.DataFrame:

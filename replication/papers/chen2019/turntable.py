@@ -16,7 +16,8 @@ closed-loop filter and RTS smoother of :mod:`replication.papers.chen2019.simulat
 * :func:`error_std` — the statistic the tables print: per run, the standard deviation over time
   of the smoothed pitch, roll, heading (°), latitude, longitude, height (m) and east, north, up
   velocity (m/s) errors; :func:`summary` — Monte-Carlo mean, spread, extremes;
-* :func:`ordering_rows` — the comparisons between experiments that the printed tables show.
+* the comparisons between experiments that the printed tables show are decided in
+  :func:`replication.papers.chen2019.findings.ordering_rows`.
 
 The aiding measurement (the print does not say what the filter used on the table): the table
 stands still at a surveyed point, so the filter receives, at ``reference_rate_hz`` (default
@@ -39,7 +40,7 @@ from replication.nav.units import DEG, DEG_PER_H, G0
 from replication.papers.chen2019 import simulation as S
 
 __all__ = ["QUANTITIES", "UNITS", "SITE", "tested_imu_setup", "scenario", "run_scenario", "error_std",
-           "summary", "ordering_rows"]
+           "summary"]
 
 QUANTITIES = ("smoothed pitch error STD", "smoothed roll error STD", "smoothed heading error STD",
               "smoothed latitude error STD", "smoothed longitude error STD", "smoothed height error STD",
@@ -285,70 +286,3 @@ def summary(per_run) -> dict:
     return dict(mean=a.mean(0), sd=a.std(0, ddof=1), min=a.min(0), max=a.max(0))
 
 
-def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indices=(1, 2, 5, 8)):
-    """Comparison rows for the orderings between two experiments the printed tables show.
-
-    For each index i: the printed ratio paper_exp[i] / paper_ref[i] and the ratio of the
-    Monte-Carlo means.  Status ``qualitative`` when the simulated means differ in the printed
-    direction by more than two standard errors of their difference (the ordering is reproduced);
-    ``not-reproduced`` otherwise (opposite direction, no significant difference, or equal printed
-    values).
-
-    Parameters
-    ----------
-    paper_exp : array_like, shape (9,)
-        The nine printed values of the experiment, in :data:`QUANTITIES` order and :data:`UNITS`.
-    paper_ref : array_like, shape (9,)
-        The nine printed values of the reference experiment (positive).
-    runs_exp : array_like, shape (runs, 9)
-        The simulated per-run values of the experiment (:func:`error_std`), at least two runs.
-    runs_ref : array_like, shape (runs, 9)
-        The simulated per-run values of the reference experiment (independent runs, positive).
-    label : str
-        Names the reference experiment in the quantity, e.g. ``"experiment 1"``.
-    indices : sequence of int
-        Positions in :data:`QUANTITIES` (0 ... 8) to compare.
-
-    Returns
-    -------
-    rows : list of dict
-        One row per index for :func:`replication.registry.reproduction.compare`: ``quantity``,
-        ``unit`` (``"1"``, the ratios are dimensionless), ``paper`` (printed ratio), ``reproduced``
-        (ratio of the simulated means), ``status``, ``note``.
-
-    Raises
-    ------
-    ValueError
-        When the shapes do not match, fewer than two runs are given, a reference value is not
-        positive or an index lies outside 0 ... 8.
-    """
-    pe, pr = (np.asarray(x, float) for x in (paper_exp, paper_ref))
-    re_, rr = (np.asarray(x, float) for x in (runs_exp, runs_ref))
-    k = len(QUANTITIES)
-    if pe.shape != (k,) or pr.shape != (k,):
-        raise ValueError(f"paper_exp and paper_ref need {k} values in QUANTITIES order")
-    if re_.ndim != 2 or rr.ndim != 2 or re_.shape[1] != k or rr.shape[1] != k or min(len(re_), len(rr)) < 2:
-        raise ValueError(f"runs_exp and runs_ref must be runs × {k} with at least two runs each")
-    if np.any(pr <= 0) or np.any(rr <= 0):
-        raise ValueError("reference values must be positive")
-    me, mr = re_.mean(0), rr.mean(0)
-    se = np.sqrt(re_.var(0, ddof=1) / len(re_) + rr.var(0, ddof=1) / len(rr))
-    rows = []
-    for i in indices:
-        if not 0 <= int(i) < k:
-            raise ValueError(f"index {i} outside 0..{k - 1}")
-        p, s, d = pe[i] / pr[i], me[i] / mr[i], me[i] - mr[i]
-        name = QUANTITIES[i].replace("smoothed ", "").replace(" STD", "")
-        ok = p != 1 and d * (p - 1) > 0 and abs(d) > 2 * se[i]
-        if ok:
-            note = "ordering reproduced (difference > 2 standard errors; magnitudes of an analog)"
-        elif p == 1:
-            note = "the printed values are equal: no ordering to reproduce"
-        elif abs(d) <= 2 * se[i]:
-            note = f"no significant simulated difference ({d:.2g} within 2 standard errors {2 * se[i]:.2g})"
-        else:
-            note = "simulated ordering opposite to the printed one"
-        rows.append(dict(quantity=f"{name} STD ratio to {label}", unit="1", paper=round(float(p), 3),
-                         reproduced=round(float(s), 3), status="qualitative" if ok else "not-reproduced",
-                         note=note))
-    return rows
