@@ -37,7 +37,6 @@ PENDING: set[str] = {
     "replication.nav.timeseries",
     "replication.nav.trajectory",
     "replication.nav.units",
-    "replication.papers.an2021.transfer",
     "replication.papers.chen2019.calibration",
     "replication.papers.chen2019.error_effects",
     "replication.papers.chen2019.gravity",
