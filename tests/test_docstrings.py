@@ -45,7 +45,6 @@ PENDING: set[str] = {
     "replication.papers.chen2019.simulation",
     "replication.papers.chen2019.turntable",
     "replication.papers.duan2023.airdata",
-    "replication.papers.fang2020.polar",
     "replication.registry.book",
     "replication.registry.reproduction",
 }
