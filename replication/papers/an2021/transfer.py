@@ -533,7 +533,7 @@ def symbolic_system_matrix(motion="general"):
     Returns
     -------
     a : sympy.Matrix, shape (7, 7)
-        A in the symbols of :data:`SYMBOLS`, states :data:`STATES`.
+        A in the symbols of ``SYMBOLS``, states :data:`STATES`.
 
     Raises
     ------
@@ -582,7 +582,7 @@ def symbolic_error_model_from_vectors():
     Returns
     -------
     a : sympy.Matrix, shape (7, 7)
-        The Jacobian of the right-hand sides at zero error, in the symbols of :data:`SYMBOLS`,
+        The Jacobian of the right-hand sides at zero error, in the symbols of ``SYMBOLS``,
         states :data:`STATES`.
     """
     R, g, w, L = (SYMBOLS[k] for k in ("R", "g", "omega_ie", "L"))
@@ -647,7 +647,7 @@ def symbolic_transfer_functions(motion):
     Raises
     ------
     ValueError
-        If ``motion`` is not one of :data:`MOTIONS`.
+        If ``motion`` is not one of ``MOTIONS``.
     """
     choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     s, L = SYMBOLS["s"], SYMBOLS["L"]
@@ -702,7 +702,7 @@ def printed_namespace():
     Returns
     -------
     namespace : dict of str
-        The symbols of :data:`SYMBOLS` except s, the aliases ``w_ie`` (ω_ie) and ``w_s`` (ω_s),
+        The symbols of ``SYMBOLS`` except s, the aliases ``w_ie`` (ω_ie) and ``w_s`` (ω_s),
         and the functions ``sin``, ``cos``, ``tan``, ``sec``, ``sqrt`` and the constant ``pi``.
     """
     ns = {k: v for k, v in SYMBOLS.items() if k != "s"}
@@ -724,12 +724,12 @@ def parse_printed(text):
     Returns
     -------
     expr : sympy.Expr
-        The expression in the symbols of :data:`SYMBOLS`, ω_s replaced by sqrt(g/R).
+        The expression in the symbols of ``SYMBOLS``, ω_s replaced by sqrt(g/R).
 
     Raises
     ------
     ValueError
-        If ``text`` is empty or not a string, or contains a symbol outside :data:`SYMBOLS`.
+        If ``text`` is empty or not a string, or contains a symbol outside ``SYMBOLS``.
     """
     if not isinstance(text, str) or not text.strip():
         raise ValueError("a printed expression must be a non-empty string")
@@ -755,7 +755,7 @@ def evaluate_at(expr, lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None
     Parameters
     ----------
     expr : sympy.Expr or str
-        A closed form in the symbols of :data:`SYMBOLS` (without s).
+        A closed form in the symbols of ``SYMBOLS`` (without s).
     lat : float
         Latitude L [rad], |L| < 90°.
     v_east : float, default 0.0
@@ -799,7 +799,7 @@ def evaluate(expr, lat, speed, motion, *, radius=None, gravity=None, digits=30):
     Parameters
     ----------
     expr : sympy.Expr or str
-        A closed form in the symbols of :data:`SYMBOLS` (without s).
+        A closed form in the symbols of ``SYMBOLS`` (without s).
     lat : float
         Latitude L [rad], |L| < 90°.
     speed : float
@@ -835,7 +835,7 @@ def is_identity(expr_a, expr_b):
     Parameters
     ----------
     expr_a, expr_b : sympy.Expr or str
-        Closed forms in the symbols of :data:`SYMBOLS`.
+        Closed forms in the symbols of ``SYMBOLS``.
 
     Returns
     -------
@@ -1198,8 +1198,8 @@ class NoiseSettings:
 
         Parameters
         ----------
-        **factors : float
-            Field name → dimensionless multiplier.
+        factors : float
+            Keyword arguments: field name → dimensionless multiplier.
 
         Returns
         -------

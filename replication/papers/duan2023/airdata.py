@@ -566,7 +566,7 @@ def derived_coefficients(reading: str = "B"):
     Raises
     ------
     ValueError
-        If ``reading`` is not one of :data:`READINGS`.
+        If ``reading`` is not one of ``READINGS``.
     """
     if reading not in READINGS:
         raise ValueError(f"reading must be one of {READINGS}")
@@ -845,7 +845,7 @@ def consistency_count(paper, state: str = "climb"):
     Returns
     -------
     counts : dict of str to int
-        Reading (:data:`READINGS`) → number of comparable elements that do not match
+        Reading (``READINGS``) → number of comparable elements that do not match
         (:func:`check_elements`).
     """
     out = {}
@@ -1292,8 +1292,8 @@ class AirdataSetup:
             ``rp.load_paper("duan2023-claim-simulation-setup")``: correction interval [s], gyro drifts
             [°/h], accelerometer bias and random drift [μg], ADS error [m], initial velocity [m/s] and
             position [m] errors.
-        **overrides : float, str, bool or tuple
-            :class:`AirdataSetup` fields to set instead.
+        overrides : float, str, bool or tuple
+            Keyword arguments: ``AirdataSetup`` fields to set instead.
 
         Returns
         -------
@@ -1476,7 +1476,7 @@ def error_correction_step(origin, state, h_ads, setup):
 def run_error_correction(traj, dth, dv, ads, setup, *, every: int = 50):
     """The proposed SINS/ADS: strapdown corrected every ``setup.correction_interval`` seconds.
 
-    Each interval ends with :func:`error_correction_step` (duan2023 §2, eq. (22) applied as a
+    Each interval ends with ``error_correction_step`` (duan2023 §2, eq. (22) applied as a
     feedback reset); the corrected state is recorded at the interval's last sample.
 
     Parameters
@@ -1500,7 +1500,7 @@ def run_error_correction(traj, dth, dv, ads, setup, *, every: int = 50):
         The recorded navigation states at the samples ``rec.idx`` (shape (m,)): ``rec.st``
         (m, 6) = latitude, longitude [rad], height [m], v_E, v_N, v_U [m/s], and ``rec.C``
         (m, 3, 3) C_b^n.
-        ``rec.infos`` lists the ``info`` dict of every correction (:func:`error_correction_step`)
+        ``rec.infos`` lists the ``info`` dict of every correction (``error_correction_step``)
         with its time ``t`` [s].
     """
     rec = _Recorder(traj, every)
@@ -1536,7 +1536,7 @@ def correction_experiment_flight(kind: str = "cruise", *, dt: float = 0.02):
     Parameters
     ----------
     kind : {"cruise", "accelerate", "decelerate"}, default "cruise"
-        Flight state (:data:`EXPERIMENT_KINDS`).
+        Flight state (``EXPERIMENT_KINDS``).
     dt : float, default 0.02
         Sampling interval [s].
 
@@ -1566,7 +1566,7 @@ def correction_experiment(traj, *, tilt: float = 0.0, dh0: float = 0.0, dvu0: fl
     convention of eq. (1), Ĉ = exp(-φ×) C; tilt > 0 turns the computed frame nose-down), a height
     error ``dh0`` and an up-velocity error ``dvu0`` — and integrates the exact (error-free) IMU
     increments of ``traj`` for ``interval`` s.  The ADS height is the true one (no noise), the
-    gate is off, and :func:`error_correction_step` is applied once with ``attitude_sign``.
+    gate is off, and ``error_correction_step`` is applied once with ``attitude_sign``.
 
     Parameters
     ----------
@@ -1581,7 +1581,7 @@ def correction_experiment(traj, *, tilt: float = 0.0, dh0: float = 0.0, dvu0: fl
     interval : float, default 30.0
         Correction interval [s].
     attitude_sign : {-1.0, 1.0, 0.0}, default -1.0
-        Sign of the misalignment term of eq. (22) (:class:`AirdataSetup`): -1 as printed, φ + φ^c;
+        Sign of the misalignment term of eq. (22) (``AirdataSetup``): -1 as printed, φ + φ^c;
         +1 the attitude turned with the vectors as eq. (5) states, φ - φ^c; 0 no attitude term.
     k0 : int, default 0
         Sample at which the interval starts.
@@ -1655,7 +1655,7 @@ def bias_experiment(accel_bias_up: float, *, n_intervals: int = 10, interval: fl
     interval : float, default 30.0
         Correction interval T [s].
     attitude_sign : {-1.0, 1.0, 0.0}, default -1.0
-        Sign of the misalignment term of eq. (22) (:class:`AirdataSetup`): -1 as printed, φ + φ^c;
+        Sign of the misalignment term of eq. (22) (``AirdataSetup``): -1 as printed, φ + φ^c;
         +1 the attitude turned with the vectors as eq. (5) states, φ - φ^c; 0 no attitude term.
     speed : float, default 200.0
         Cruise speed V [m/s].
@@ -1705,15 +1705,15 @@ EXPERIMENT_CASES = (("cruise", "tilt", 1e-3), ("cruise", "dh0", 10.0), ("cruise"
 
 
 def correction_experiment_table(cases=EXPERIMENT_CASES, signs=(-1.0, 1.0)):
-    """:func:`correction_experiment` for each (flight, injected error, value) and attitude sign.
+    """``correction_experiment`` for each (flight, injected error, value) and attitude sign.
 
     Parameters
     ----------
     cases : sequence of (str, str, float), default EXPERIMENT_CASES
-        (flight kind of :func:`correction_experiment_flight`, injected error ``"tilt"`` [rad],
+        (flight kind of ``correction_experiment_flight``, injected error ``"tilt"`` [rad],
         ``"dh0"`` [m] or ``"dvu0"`` [m/s], value).
     signs : sequence of float, default (-1.0, 1.0)
-        Attitude signs tried (:class:`AirdataSetup`).
+        Attitude signs tried (``AirdataSetup``).
 
     Returns
     -------
@@ -1883,7 +1883,7 @@ def navigation_errors(traj, rec):
     traj : replication.nav.trajectory.Trajectory
         The true flight (N increments, N + 1 samples).
     rec : _Recorder
-        Recorded states of :func:`run_pure_sins`, :func:`run_error_correction` or the literature
+        Recorded states of ``run_pure_sins``, ``run_error_correction`` or the literature
         filter.
 
     Returns
@@ -1908,17 +1908,17 @@ SYSTEMS = ("SINS", "literature SINS/ADS", "proposed SINS/ADS")
 
 @dataclass
 class MonteCarlo:
-    """Error histories of the three systems of :func:`simulate`.
+    """Error histories of the three systems of ``simulate``.
 
     Attributes
     ----------
     t : numpy.ndarray, shape (m,)
         Record times [s].
     errors : dict
-        System (:data:`SYSTEMS`) → {``"enu"``: position error east, north, up [m], ``"v"``:
+        System (``SYSTEMS``) → {``"enu"``: position error east, north, up [m], ``"v"``:
         velocity error [m/s], ``"phi"``: misalignment [rad]}, each an array of shape (runs, m, 3).
     infos : list of list of dict
-        Per run, the correction records of the proposed SINS/ADS (:func:`run_error_correction`).
+        Per run, the correction records of the proposed SINS/ADS (``run_error_correction``).
     setup : AirdataSetup
         The simulation parameters.
     seed : int
@@ -1995,7 +1995,7 @@ def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, e
     every : int, default 50
         Record every ``every``-th sample.
     systems : sequence of str, default SYSTEMS
-        The systems simulated (a subset of :data:`SYSTEMS`).
+        The systems simulated (a subset of ``SYSTEMS``).
     gains_pack : tuple, optional
         Precomputed gains of the literature filter (output of ``literature_gains``); computed when
         that system is simulated and none is given.
@@ -2050,18 +2050,18 @@ def table1_rows(mc: MonteCarlo, paper, statistic: str = "max", until: float | No
     Parameters
     ----------
     mc : MonteCarlo
-        Output of :func:`simulate` (the three systems).
+        Output of ``simulate`` (the three systems).
     paper : PaperTable
         ``rp.load_paper("duan2023-table-1")``.
     statistic : {"max", "final", "rms"}, default "max"
-        Reduction over the flight (:meth:`MonteCarlo.summary`).
+        Reduction over the flight (``MonteCarlo.summary``).
     until : float, optional
         Reduce over t ≤ ``until`` [s] only.
 
     Returns
     -------
     rows : list of dict
-        One per system and quantity (:data:`TABLE1_UNITS`): ``system``, ``quantity``, ``unit``
+        One per system and quantity (``TABLE1_UNITS``): ``system``, ``quantity``, ``unit``
         (deg, m/s, km), ``paper``, ``mean``, ``std`` (ddof = 1; 0 for one run), ``lo``, ``hi``,
         in ``unit``.
     """
@@ -2170,14 +2170,14 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
     Parameters
     ----------
     mc : MonteCarlo
-        Output of :func:`simulate` (the three systems).
+        Output of ``simulate`` (the three systems).
     paper : PaperTable
         ``rp.load_paper("duan2023-table-1")``.
     until : float
         End of the cruise [s]: the proposed method's maximum before the final deceleration is
         reported beside the maximum over the flight.
     ideal : dict of str to float
-        The pure SINS with ideal sensors (:func:`pure_sins_initial_errors_only`).
+        The pure SINS with ideal sensors (``pure_sins_initial_errors_only``).
 
     Returns
     -------
@@ -2233,7 +2233,7 @@ def claim_checks(mc: MonteCarlo):
     Parameters
     ----------
     mc : MonteCarlo
-        Output of :func:`simulate` (the three systems).
+        Output of ``simulate`` (the three systems).
 
     Returns
     -------
@@ -2289,7 +2289,7 @@ def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7,
         Simulation parameters.
         The base setting.
     changes : iterable of dict
-        Each a dict of :class:`AirdataSetup` fields to change.
+        Each a dict of ``AirdataSetup`` fields to change.
     n_runs : int, default 3
         Runs per setting.
     seed : int, default 7
@@ -2394,7 +2394,7 @@ def diagnostic_runs(traj, setup: AirdataSetup, diagnostics=None, *, n_runs: int 
                     seed: int = 2023) -> dict:
     """Monte Carlo of the proposed SINS/ADS under each diagnostic change of ``setup``.
 
-    The runs draw from ``SeedSequence(seed)`` as :func:`simulate` does, so with the main run's
+    The runs draw from ``SeedSequence(seed)`` as ``simulate`` does, so with the main run's
     seed they share its noise (common random numbers).
 
     Parameters
@@ -2405,7 +2405,7 @@ def diagnostic_runs(traj, setup: AirdataSetup, diagnostics=None, *, n_runs: int 
         Simulation parameters.
         The base setting.
     diagnostics : dict of str to dict, optional
-        Label → dict of :class:`AirdataSetup` fields (default :data:`BIAS_DIAGNOSTICS`).
+        Label → dict of ``AirdataSetup`` fields (default :data:`BIAS_DIAGNOSTICS`).
     n_runs : int, default 20
         Runs per diagnostic, at least 2.
     seed : int, default 2023
@@ -2630,7 +2630,7 @@ def eq1_checks(point):
     Parameters
     ----------
     point : replication.nav.errors.NavPoint
-        The navigation state at which the model is linearized (:func:`sins_error_matrix`).
+        The navigation state at which the model is linearized (``sins_error_matrix``).
 
     Returns
     -------

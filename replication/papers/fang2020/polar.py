@@ -1079,8 +1079,8 @@ def fang2020_scenario(case, **changes):
     ----------
     case : {1, 2}
         The case of fang2020 §3.
-    **changes : float, tuple, bool or str
-        :class:`Scenario` fields to override (e.g. noise levels).
+    changes : float, tuple, bool or str
+        Keyword arguments: :class:`Scenario` fields to override (e.g. noise levels).
 
     Returns
     -------
@@ -1568,8 +1568,8 @@ def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, continued_run
         Runs continued also without compensation (:func:`simulate`).
     continued_runs : int, optional
         Runs integrated past the second fix (default: every run; see :func:`simulate`).
-    **changes : float, tuple, bool or str
-        :class:`Scenario` fields to override (for sensitivity checks).
+    changes : float, tuple, bool or str
+        Keyword arguments: :class:`Scenario` fields to override (for sensitivity checks).
 
     Returns
     -------
