@@ -37,10 +37,7 @@ PENDING: set[str] = {
     "replication.nav.timeseries",
     "replication.nav.trajectory",
     "replication.nav.units",
-    "replication.papers.an2021.transfer",
     "replication.papers.duan2023.airdata",
-    "replication.papers.fang2020.polar",
-    "replication.papers.plots",
     "replication.registry.book",
     "replication.registry.reproduction",
 }

@@ -25,10 +25,37 @@ __all__ = ["state_estimates", "airdata_error_histories", "polar_error_histories"
 
 
 def state_estimates(result: sim.BatchResult, run: int = 0, *, ncols: int = 5, every: int = 10):
-    """chen2019 Fig. 4-14 analog: every state of ``result.model`` for one run — navigation
-    states: the error of the filtered solution with its ±3σ band; sensor states: the filtered
-    and smoothed estimates, the true value, and ±3σ of the filter around the true value.
-    Returns the matplotlib figure."""
+    """chen2019 Fig. 4-14 analog: every state of ``result.model`` for one run.
+
+    Navigation states (the first nine): the error of the filtered solution with its ±3σ band;
+    sensor states: the filtered and smoothed estimates, the true value, and ±3σ of the filter
+    around the true value.  Each panel is in the display unit of
+    :func:`replication.papers.chen2019.simulation.display_scales` (positions m, velocities m/s,
+    attitude ″, sensor states in the paper's units); the time axis is in minutes.
+
+    Parameters
+    ----------
+    result : replication.papers.chen2019.simulation.BatchResult
+        Output of :func:`replication.papers.chen2019.simulation.run_batch`.
+    run : int, default 0
+        Index of the Monte-Carlo run shown, ``0 <= run < result.n_runs``.
+    ncols : int, default 5
+        Panels per row of the grid (one panel per state).
+    every : int, default 10
+        Plot every ``every``-th recorded epoch.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        The grid of panels, one per state, titled with the chen2019 symbol and the unit.
+
+    Raises
+    ------
+    TypeError
+        If ``result`` is not a ``BatchResult``.
+    ValueError
+        If ``run`` is outside ``0 .. result.n_runs - 1``.
+    """
     if not isinstance(result, sim.BatchResult):
         raise TypeError("result must be a BatchResult from run_batch")
     if not 0 <= run < result.n_runs:
@@ -66,7 +93,37 @@ def state_estimates(result: sim.BatchResult, run: int = 0, *, ncols: int = 5, ev
 
 
 def airdata_error_histories(mc: ad.MonteCarlo, quantity: str, *, scale=1.0, unit="", axes_labels=("E", "N", "U")):
-    """duan2023 Figs. 3-5 analog (``replication.papers.duan2023.airdata.simulate``): per axis, the run-mean of each system with a ±1σ band (one panel per axis)."""
+    """duan2023 Figs. 3-5 analog: per axis, the run mean of each system with a ±1σ band.
+
+    One panel per axis (symmetric-log vertical scale), one curve per system of
+    ``replication.papers.duan2023.airdata.SYSTEMS``, time in minutes
+    (``replication.papers.duan2023.airdata.simulate``).
+
+    Parameters
+    ----------
+    mc : replication.papers.duan2023.airdata.MonteCarlo
+        The Monte Carlo of the three systems; ``mc.errors[system][quantity]`` has shape
+        (runs, records, 3).
+    quantity : {"phi", "v", "enu"}
+        Which error history: misalignment φ (rad), velocity error (m/s) or position error (m,
+        east, north, up).
+    scale : float, default 1.0
+        Factor from the stored SI unit to the plotted one (e.g. ``1 / units.ARCSEC`` for φ in ″).
+    unit : str, default ""
+        Unit shown in the axis labels (the unit after ``scale``).
+    axes_labels : tuple of str, default ("E", "N", "U")
+        Labels of the three axes (panels).
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        Three panels (one per axis), sharing the time axis.
+
+    Raises
+    ------
+    ValueError
+        If ``quantity`` is not one of "phi", "v", "enu".
+    """
     if quantity not in ("phi", "v", "enu"):
         raise ValueError("quantity must be 'phi', 'v' or 'enu'")
     fig, axs = plt.subplots(3, 1, figsize=(7, 6.5), sharex=True)
@@ -92,8 +149,34 @@ _PANELS = {
 
 
 def polar_error_histories(result, kind, *, run=0, title=None):
-    """fang2020 Figs. 4-6 / 8-10 equivalents (:func:`replication.papers.fang2020.polar.simulate`): error histories of one run, calibrated (solid) and reset
-    only (dashed), with the fix times marked.  ``kind``: "attitude", "velocity" or "position"."""
+    """fang2020 Figs. 4-6 / 8-10 equivalents: error histories of one run.
+
+    The calibrated run (solid) and its reset-only continuation (dashed) of
+    :func:`replication.papers.fang2020.polar.simulate`, with the fix times marked (dotted); time in
+    hours.  Panels by ``kind``: "attitude" — grid φ_E, φ_N, φ_U in ″; "velocity" — grid δV_E,
+    δV_N in m/s; "position" — ECEF δx, δy, δz in km.
+
+    Parameters
+    ----------
+    result : replication.papers.fang2020.polar.SimulationResult
+        Output of :func:`replication.papers.fang2020.polar.simulate`.
+    kind : {"attitude", "velocity", "position"}
+        Which errors are shown.
+    run : int, default 0
+        Index of the run; it must have a reset-only continuation (``run < reset_only_runs``).
+    title : str, optional
+        Title of the first panel.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        One panel per component, sharing the time axis.
+
+    Raises
+    ------
+    ValueError
+        If ``kind`` is unknown or run ``run`` has no reset-only continuation.
+    """
     if kind not in _PANELS:
         raise ValueError(f"kind must be one of {sorted(_PANELS)}")
     if result.errors_reset_only.shape[0] <= run:
@@ -117,8 +200,28 @@ def polar_error_histories(result, kind, *, run=0, title=None):
 
 
 def polar_drift_estimates(result, *, axis="X", paper_mean=None, estimators=polar.ESTIMATORS):
-    """fang2020 Fig. 7 equivalent: the per-run drift estimates of one body axis (°/h), with the true drift
-    and, if given, the paper's mean."""
+    """fang2020 Fig. 7 equivalent: the per-run drift estimates of one body axis.
+
+    One marker per run and estimator, with the true drift of the scenario and, if given, the
+    paper's mean as horizontal lines; drifts in °/h.
+
+    Parameters
+    ----------
+    result : replication.papers.fang2020.polar.SimulationResult
+        Output of :func:`replication.papers.fang2020.polar.simulate`; ``result.estimates[name]``
+        has shape (runs, 3), rad/s.
+    axis : {"X", "Y", "Z"}, default "X"
+        Body axis shown.
+    paper_mean : float, optional
+        The paper's mean drift estimate of that axis (°/h), drawn as a dashed line.
+    estimators : tuple of str, default ``replication.papers.fang2020.polar.ESTIMATORS``
+        Estimators shown (keys of ``result.estimates``).
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        The estimates against the run number (1 .. runs).
+    """
     j = "XYZ".index(axis)
     fig, ax = plt.subplots(figsize=(7.0, 3.2))
     n = result.estimates[estimators[0]].shape[0]

@@ -91,11 +91,33 @@ def _check_motion(lat, v_east, v_north):
 
 
 def earth_parameters(lat, radius=None, gravity=None):
-    """The single Earth radius ``R`` (m) and gravity ``g`` (m/s²) of the an2021 model.
+    """The single Earth radius ``R`` and gravity ``g`` of the an2021 model.
 
     an2021 eq. (1) uses one radius R and one g without giving values.  Defaults: the Gaussian
     mean radius of curvature sqrt(R_M R_N) and WGS-84 normal gravity at latitude ``lat``
     (:mod:`replication.nav.earth`).  Pass ``radius`` / ``gravity`` to override.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    radius : float, optional
+        Earth radius R [m] (overrides the default).
+    gravity : float, optional
+        Gravity g [m/s²] (overrides the default).
+
+    Returns
+    -------
+    radius : float
+        R [m].
+    gravity : float
+        g [m/s²].
+
+    Raises
+    ------
+    ValueError
+        If ``lat`` is not a finite latitude below 90° in magnitude, or R or g is not positive and
+        finite.
     """
     lat, _, _ = _check_motion(lat, 0.0, 0.0)
     if radius is None:
@@ -110,7 +132,22 @@ def earth_parameters(lat, radius=None, gravity=None):
 
 
 def schuler_frequency(lat=np.radians(30.0), radius=None, gravity=None):
-    """Schuler frequency ω_s = sqrt(g/R) (rad/s), an2021 §1.1 (below eq. (5))."""
+    """Schuler frequency ω_s = sqrt(g/R), an2021 §1.1 (below eq. (5)).
+
+    Parameters
+    ----------
+    lat : float, default 30° (in radians)
+        Latitude L [rad] at which the default R and g are taken.
+    radius : float, optional
+        Earth radius R [m] (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²] (:func:`earth_parameters`).
+
+    Returns
+    -------
+    omega_s : float
+        Schuler angular frequency [rad/s].
+    """
     r, g = earth_parameters(lat, radius, gravity)
     return math.sqrt(g / r)
 
@@ -120,8 +157,33 @@ def schuler_frequency(lat=np.radians(30.0), radius=None, gravity=None):
 def system_matrix(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None):
     """The 7×7 system matrix A of the SINS error model, an2021 eq. (1).
 
-    Every non-zero element as printed (ENU frame, states ϕ_E, ϕ_N, ϕ_U, δV_E, δV_N, δL, δλ;
-    latitude ``lat`` in radians, velocities in m/s).  Raises ``ValueError`` for |L| ≥ 90°.
+    Every non-zero element as printed (ENU frame, states ϕ_E, ϕ_N, ϕ_U, δV_E, δV_N, δL, δλ).
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float, default 0.0
+        East velocity V_E [m/s].
+    v_north : float, default 0.0
+        North velocity V_N [m/s].
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    a : numpy.ndarray, shape (7, 7)
+        A in SI units of the states (attitude and position errors in rad, velocity errors in m/s,
+        time in s), order :data:`STATES`.
+
+    Raises
+    ------
+    ValueError
+        If ``lat`` is not a finite latitude below 90° in magnitude (the model contains tan L and
+        sec L) or a velocity is not finite or beyond ``replication.nav.earth.SPEED_LIMIT``.
     """
     lat, ve, vn = _check_motion(lat, v_east, v_north)
     r, g = earth_parameters(lat, radius, gravity)
@@ -159,6 +221,12 @@ def input_matrix():
     Not printed in the paper; fixed by its eq. (8) (Ā_{1,8} = Ā_{2,9} = Ā_{3,10} = -1 for the
     gyro drifts, Ā_{4,11} = Ā_{5,12} = 1 for the accelerometer biases):
     B = [[-I_3, 0], [0, I_2], [0, 0]].
+
+    Returns
+    -------
+    b : numpy.ndarray, shape (7, 5)
+        B (dimensionless: gyro drifts [rad/s] enter ϕ̇, accelerometer terms [m/s²] enter δV̇),
+        rows :data:`STATES`, columns :data:`INPUTS`.
     """
     b = np.zeros((7, 5))
     b[0, 0] = b[1, 1] = b[2, 2] = -1.0
@@ -167,7 +235,23 @@ def input_matrix():
 
 
 def output_matrix(n_states=7):
-    """The output matrix H selecting (ϕ_E, ϕ_N), an2021 eq. (2) (n_states=7) or eq. (9) (12)."""
+    """The output matrix H selecting (ϕ_E, ϕ_N), an2021 eq. (2) or eq. (9).
+
+    Parameters
+    ----------
+    n_states : {7, 12}, default 7
+        7 for the SINS error model (eq. (2)), 12 for the integrated-navigation model (eq. (9)).
+
+    Returns
+    -------
+    h : numpy.ndarray, shape (2, n_states)
+        H, with H[0, 0] = H[1, 1] = 1 and zeros elsewhere.
+
+    Raises
+    ------
+    ValueError
+        If ``n_states`` is neither 7 nor 12.
+    """
     if n_states not in (7, 12):
         raise ValueError("n_states must be 7 (eq. (2)) or 12 (eq. (9))")
     h = np.zeros((2, n_states))
@@ -178,7 +262,34 @@ def output_matrix(n_states=7):
 def error_model(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None):
     """The 7-state SINS error model ẋ = Ax + Bu, Y = Hx as a python-control ``StateSpace``.
 
-    an2021 eqs. (1)-(2); inputs :data:`INPUTS`, outputs :data:`OUTPUTS`.
+    an2021 eqs. (1)-(2); A from :func:`system_matrix`, B from :func:`input_matrix`, H from
+    :func:`output_matrix`.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float, default 0.0
+        East velocity V_E [m/s].
+    v_north : float, default 0.0
+        North velocity V_N [m/s].
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    sys : control.StateSpace
+        7 states :data:`STATES`, inputs :data:`INPUTS` (gyro drifts [rad/s], accelerometer
+        minus gravity-disturbance terms [m/s²]), outputs :data:`OUTPUTS` (ϕ_E, ϕ_N [rad]).
+
+    Raises
+    ------
+    ValueError
+        If ``lat`` is not a finite latitude below 90° in magnitude (the model contains tan L and
+        sec L) or a velocity is not finite or beyond ``replication.nav.earth.SPEED_LIMIT``.
     """
     a = system_matrix(lat, v_east, v_north, radius=radius, gravity=gravity)
     return ct.ss(a, input_matrix(), output_matrix(7), 0, states=list(STATES), inputs=list(INPUTS),
@@ -192,6 +303,34 @@ def gravity_to_attitude(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=No
     u_4 = ∇_E - g_dE and u_5 = ∇_N - g_dN, the input columns are -B[:, 3:5].  The longitude
     error δλ feeds nothing (column 7 of A is zero), so by default it is dropped: the 6-state
     system has exactly the same transfer function and no spurious pole/zero pair at s = 0.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float, default 0.0
+        East velocity V_E [m/s].
+    v_north : float, default 0.0
+        North velocity V_N [m/s].
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+    drop_longitude : bool, default True
+        Drop the longitude error δλ (6 states instead of 7).
+
+    Returns
+    -------
+    sys : control.StateSpace
+        Inputs ``g_dE``, ``g_dN`` [m/s²], outputs ϕ_E, ϕ_N [rad]; states the first 6 (or all 7)
+        of :data:`STATES`.
+
+    Raises
+    ------
+    ValueError
+        If ``lat`` is not a finite latitude below 90° in magnitude (the model contains tan L and
+        sec L) or a velocity is not finite or beyond ``replication.nav.earth.SPEED_LIMIT``.
     """
     a = system_matrix(lat, v_east, v_north, radius=radius, gravity=gravity)
     b = -input_matrix()[:, 3:5]
@@ -213,7 +352,26 @@ def _balanced(sys):
 
 
 def siso(sys, pair):
-    """The SISO channel ``pair`` ('phiE/gdN' or 'phiN/gdE') of a (g_dE, g_dN) → (ϕ_E, ϕ_N) system."""
+    """The SISO channel ``pair`` of a (g_dE, g_dN) → (ϕ_E, ϕ_N) system.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        A system with the inputs (g_dE, g_dN) [m/s²] and outputs (ϕ_E, ϕ_N) [rad] in that order
+        (:func:`gravity_to_attitude`, :func:`integrated_gravity_to_attitude`).
+    pair : {"phiE/gdN", "phiN/gdE"}
+        ``"phiE/gdN"``: output ϕ_E, input g_dN; ``"phiN/gdE"``: output ϕ_N, input g_dE.
+
+    Returns
+    -------
+    channel : control.StateSpace
+        One input, one output, the same states as ``sys``; gain in rad/(m/s²).
+
+    Raises
+    ------
+    ValueError
+        If ``pair`` is not one of :data:`PAIRS`.
+    """
     choice(pair, PAIRS, "pair", _NOT_ONE_OF)
     i, j = _PAIR_INDEX[pair]
     return ct.ss(np.asarray(sys.A), np.asarray(sys.B)[:, [j]], np.asarray(sys.C)[[i], :], np.asarray(sys.D)[[i]][:, [j]])
@@ -227,6 +385,27 @@ def common_factor_east_west(lat, v_east, *, radius=None):
     Its roots ±j(ω_ie + V_E sec L / R) are the Earth-rate mode seen by the moving frame:
     ω_ie + V_E/(R cos L) = ω_ie + λ̇ is the rotation rate of the navigation frame about the
     polar axis.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float
+        East velocity V_E [m/s].
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    factor : numpy.ndarray, shape (3,)
+        Coefficients [1, 0, (ω_ie + V_E sec L / R)²] in descending powers of s (s in rad/s, the
+        constant term in rad²/s²).
+
+    Raises
+    ------
+    ValueError
+        If ``lat`` is not a finite latitude below 90° in magnitude (the model contains tan L and
+        sec L) or a velocity is not finite or beyond ``replication.nav.earth.SPEED_LIMIT``.
     """
     lat, ve, _ = _check_motion(lat, v_east, 0.0)
     r, _ = earth_parameters(lat, radius, None)
@@ -254,6 +433,38 @@ def transfer_function(lat, v_east=0.0, v_north=0.0, pair="phiE/gdN", *, radius=N
     exact common factor :func:`common_factor_east_west` is divided out (4th-order eqs. (6)-(7));
     otherwise the full 6th-order form is returned (the near-cancellation of north-south motion is
     kept, as in eqs. (4)-(5)).
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float, default 0.0
+        East velocity V_E [m/s].
+    v_north : float, default 0.0
+        North velocity V_N [m/s].
+    pair : {"phiE/gdN", "phiN/gdE"}, default "phiE/gdN"
+        The transfer function: ϕ_E/g_dN or ϕ_N/g_dE.
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+    minimal : bool, default True
+        Divide out the east-west common factor (only for v_north = 0, v_east ≠ 0).
+
+    Returns
+    -------
+    tf : control.TransferFunction
+        SISO, from the gravity disturbance [m/s²] to the attitude error [rad] (gain in
+        rad/(m/s²)), s in rad/s, monic denominator of degree 6 (4 after the cancellation) and
+        relative degree 2.
+
+    Raises
+    ------
+    ValueError
+        If ``pair`` is unknown, or for the latitude and velocities as :func:`system_matrix`.
+    ArithmeticError
+        If numerator or denominator is not divisible by the east-west common factor.
     """
     choice(pair, PAIRS, "pair", _NOT_ONE_OF)
     lat, v_east, v_north = _check_motion(lat, v_east, v_north)
@@ -283,7 +494,20 @@ def transfer_function(lat, v_east=0.0, v_north=0.0, pair="phiE/gdN", *, radius=N
 
 
 def polynomial_coefficients(tf):
-    """``(num, den)`` coefficient dicts {power: value} of a SISO tf, denominator made monic."""
+    """Numerator and denominator coefficients of a SISO transfer function, denominator made monic.
+
+    Parameters
+    ----------
+    tf : control.TransferFunction
+        A SISO transfer function (e.g. :func:`transfer_function`).
+
+    Returns
+    -------
+    num : dict of int to float
+        {power of s: coefficient} of the numerator, divided by the leading denominator coefficient.
+    den : dict of int to float
+        {power of s: coefficient} of the monic denominator.
+    """
     num = np.atleast_1d(np.squeeze(tf.num[0][0])).astype(float)
     den = np.atleast_1d(np.squeeze(tf.den[0][0])).astype(float)
     lead = den[0]
@@ -301,7 +525,20 @@ SYMBOLS.update({name: sp.Symbol(name, positive=True) for name in ("R", "g", "ome
 def symbolic_system_matrix(motion="general"):
     """an2021 eq. (1) matrix A with sympy symbols (R, g, omega_ie, L, V_E, V_N).
 
-    ``motion``: 'general', 'north-south' (V_E = 0) or 'east-west' (V_N = 0).
+    Parameters
+    ----------
+    motion : {"general", "north-south", "east-west"}, default "general"
+        "north-south" sets V_E = 0, "east-west" sets V_N = 0.
+
+    Returns
+    -------
+    a : sympy.Matrix, shape (7, 7)
+        A in the symbols of ``SYMBOLS``, states :data:`STATES`.
+
+    Raises
+    ------
+    ValueError
+        If ``motion`` is not one of the three.
     """
     if motion not in ("general",) + MOTIONS:
         raise ValueError(f"motion must be 'general' or one of {MOTIONS}")
@@ -341,6 +578,12 @@ def symbolic_error_model_from_vectors():
     + ∇ - g_d, δL̇ = δV_N/R, δλ̇ = δV_E sec L / R + V_E tan L sec L δL / R, with level
     unaccelerated motion (f^n = (0, 0, g), V_U = 0, δV_U = 0, height fixed).  Used to check
     every printed element of an2021 eq. (1).
+
+    Returns
+    -------
+    a : sympy.Matrix, shape (7, 7)
+        The Jacobian of the right-hand sides at zero error, in the symbols of ``SYMBOLS``,
+        states :data:`STATES`.
     """
     R, g, w, L = (SYMBOLS[k] for k in ("R", "g", "omega_ie", "L"))
     ve, vn = SYMBOLS["V_E"], SYMBOLS["V_N"]
@@ -387,9 +630,24 @@ def symbolic_transfer_functions(motion):
     Derived from H(Is - A)^{-1}(-B) with the symbolic A (δλ dropped: column 7 of A is zero) by
     Cramer's rule (adjugate / determinant).  For east-west motion the exact common factor of
     numerator and denominator, s² + (ω_ie + V_E sec L / R)², is cancelled; for north-south
-    motion numerator and denominator are coprime.  Returns ``{pair: (num, den, common)}`` with
-    ``num``, ``den`` sympy ``Poly`` in s (den monic, coefficients in R, g, omega_ie, L and the
-    speed) and ``common`` the cancelled factor (1 when none).
+    motion numerator and denominator are coprime.  Cached.
+
+    Parameters
+    ----------
+    motion : {"north-south", "east-west"}
+        North-south motion (V_E = 0, eqs. (4)-(5)) or east-west motion (V_N = 0, eqs. (6)-(7)).
+
+    Returns
+    -------
+    closed_forms : dict
+        ``{pair: (num, den, common)}`` for both :data:`PAIRS`: ``num``, ``den`` sympy ``Poly`` in
+        s (den monic, coefficients in R, g, omega_ie, L and the speed) and ``common`` the cancelled
+        factor (1 when none).
+
+    Raises
+    ------
+    ValueError
+        If ``motion`` is not one of ``MOTIONS``.
     """
     choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     s, L = SYMBOLS["s"], SYMBOLS["L"]
@@ -421,12 +679,32 @@ def symbolic_transfer_functions(motion):
 
 
 def coefficient(poly, power):
-    """The coefficient of s**power of a sympy ``Poly`` (0 when absent)."""
+    """The coefficient of s**power of a sympy ``Poly`` (0 when absent).
+
+    Parameters
+    ----------
+    poly : sympy.Poly
+        A polynomial in the symbol ``SYMBOLS["s"]``.
+    power : int
+        Power of s.
+
+    Returns
+    -------
+    coeff : sympy.Expr
+        The coefficient (``0`` when the power is absent).
+    """
     return poly.coeff_monomial(SYMBOLS["s"] ** power)
 
 
 def printed_namespace():
-    """The names allowed in a transcribed closed-form expression (see :func:`parse_printed`)."""
+    """The names allowed in a transcribed closed-form expression (see :func:`parse_printed`).
+
+    Returns
+    -------
+    namespace : dict of str
+        The symbols of ``SYMBOLS`` except s, the aliases ``w_ie`` (ω_ie) and ``w_s`` (ω_s),
+        and the functions ``sin``, ``cos``, ``tan``, ``sec``, ``sqrt`` and the constant ``pi``.
+    """
     ns = {k: v for k, v in SYMBOLS.items() if k != "s"}
     ns.update({"w_ie": SYMBOLS["omega_ie"], "w_s": SYMBOLS["omega_s"], "sin": sp.sin, "cos": sp.cos,
                "tan": sp.tan, "sec": sp.sec, "sqrt": sp.sqrt, "pi": sp.pi})
@@ -437,6 +715,21 @@ def parse_printed(text):
     """Parse a printed closed form transcribed in Python syntax (``w_ie``, ``w_s``, ``V_N``...).
 
     ``w_s`` is the Schuler frequency and is replaced by sqrt(g/R) (an2021, below eq. (5)).
+
+    Parameters
+    ----------
+    text : str
+        The expression, in the names of :func:`printed_namespace`.
+
+    Returns
+    -------
+    expr : sympy.Expr
+        The expression in the symbols of ``SYMBOLS``, ω_s replaced by sqrt(g/R).
+
+    Raises
+    ------
+    ValueError
+        If ``text`` is empty or not a string, or contains a symbol outside ``SYMBOLS``.
     """
     if not isinstance(text, str) or not text.strip():
         raise ValueError("a printed expression must be a non-empty string")
@@ -454,10 +747,39 @@ def _lambdified(expr):
 
 
 def evaluate_at(expr, lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None, digits=30):
-    """Evaluate a closed form at latitude ``lat`` (rad) and velocity (v_east, v_north) (m/s).
+    """Evaluate a closed form at latitude ``lat`` and velocity (v_east, v_north).
 
     mpmath with ``digits`` digits, so that the cancellations inside the printed forms do not lose
-    precision; R and g from :func:`earth_parameters`.
+    precision; R and g from :func:`earth_parameters`, ω_ie = ``replication.nav.earth.OMEGA_IE``.
+
+    Parameters
+    ----------
+    expr : sympy.Expr or str
+        A closed form in the symbols of ``SYMBOLS`` (without s).
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float, default 0.0
+        East velocity V_E [m/s].
+    v_north : float, default 0.0
+        North velocity V_N [m/s].
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+    digits : int, default 30
+        Working precision of mpmath (decimal digits).
+
+    Returns
+    -------
+    value : float
+        The value, in the SI unit of the expression.
+
+    Raises
+    ------
+    ValueError
+        If ``lat`` is not a finite latitude below 90° in magnitude (the model contains tan L and
+        sec L) or a velocity is not finite or beyond ``replication.nav.earth.SPEED_LIMIT``.
     """
 
     lat, v_east, v_north = _check_motion(lat, v_east, v_north)
@@ -470,9 +792,37 @@ def evaluate_at(expr, lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None
 
 
 def evaluate(expr, lat, speed, motion, *, radius=None, gravity=None, digits=30):
-    """Evaluate a closed form for ``motion`` at latitude ``lat`` (rad) and ``speed`` (m/s).
+    """Evaluate a closed form for ``motion`` at latitude ``lat`` and ``speed``.
 
     ``speed`` is V_N for north-south motion and V_E for east-west motion (:func:`evaluate_at`).
+
+    Parameters
+    ----------
+    expr : sympy.Expr or str
+        A closed form in the symbols of ``SYMBOLS`` (without s).
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    speed : float
+        V_N (north-south) or V_E (east-west) [m/s].
+    motion : {"north-south", "east-west"}
+        North-south motion (V_E = 0, eqs. (4)-(5)) or east-west motion (V_N = 0, eqs. (6)-(7)).
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+    digits : int, default 30
+        Working precision of mpmath (decimal digits).
+
+    Returns
+    -------
+    value : float
+        The value, in the SI unit of the expression.
+
+    Raises
+    ------
+    ValueError
+        If ``motion`` is unknown, or for the latitude and speed as :func:`evaluate_at`.
     """
     choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     ve, vn = (0.0, speed) if motion == "north-south" else (speed, 0.0)
@@ -480,17 +830,49 @@ def evaluate(expr, lat, speed, motion, *, radius=None, gravity=None, digits=30):
 
 
 def is_identity(expr_a, expr_b):
-    """True when two closed forms are algebraically identical (for |L| < 90°)."""
+    """True when two closed forms are algebraically identical (for |L| < 90°).
+
+    Parameters
+    ----------
+    expr_a, expr_b : sympy.Expr or str
+        Closed forms in the symbols of ``SYMBOLS``.
+
+    Returns
+    -------
+    identical : bool
+        Whether the numerator of their difference, written in cos L, simplifies to zero.
+    """
     c = sp.Symbol("c", positive=True)
     diff = _trig_to_cos(sp.sympify(expr_a) - sp.sympify(expr_b), c)
     return sp.simplify(sp.expand(sp.numer(sp.together(diff)))) == 0
 
 
 def coefficient_location(name, motion):
-    """Where a printed coefficient lives: ``(pair, 'num'|'den', power)`` (an2021 eqs. (4)-(7)).
+    """Where a printed coefficient lives (an2021 eqs. (4)-(7)).
 
     n_1k: numerator of ϕ_E/g_dN, n_2k: numerator of ϕ_N/g_dE, d_k: the shared denominator; k is
     the power of s.
+
+    Parameters
+    ----------
+    name : str
+        Coefficient name, ``"n_1k"``, ``"n_2k"`` or ``"d_k"`` (k a digit).
+    motion : {"north-south", "east-west"}
+        North-south motion (V_E = 0, eqs. (4)-(5)) or east-west motion (V_N = 0, eqs. (6)-(7)).
+
+    Returns
+    -------
+    pair : str
+        The transfer function, one of :data:`PAIRS` (``"phiE/gdN"`` for d_k).
+    part : {"num", "den"}
+        Numerator or denominator.
+    power : int
+        Power k of s.
+
+    Raises
+    ------
+    ValueError
+        If ``motion`` is unknown or ``name`` does not follow the pattern.
     """
     choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
 
@@ -512,6 +894,23 @@ def derived_coefficient(name, motion):
     (eqs. (6)-(7)): the printed polynomials share an arbitrary common scale (d_4 = 2R³cos²L), so
     the derived closed form is returned monic, to be compared with the printed coefficient
     divided by the printed d_4 (see :func:`printed_in_derived_normalization`).
+
+    Parameters
+    ----------
+    name : str
+        Coefficient name (:func:`coefficient_location`).
+    motion : {"north-south", "east-west"}
+        North-south motion (V_E = 0, eqs. (4)-(5)) or east-west motion (V_N = 0, eqs. (6)-(7)).
+
+    Returns
+    -------
+    coeff : sympy.Expr
+        The coefficient of :func:`symbolic_transfer_functions` (denominator monic).
+
+    Raises
+    ------
+    ValueError
+        If ``name`` or ``motion`` is not valid (:func:`coefficient_location`).
     """
     pair, part, power = coefficient_location(name, motion)
     num, den, _ = symbolic_transfer_functions(motion)[pair]
@@ -521,10 +920,30 @@ def derived_coefficient(name, motion):
 def printed_in_derived_normalization(name, printed, motion):
     """A printed coefficient expression in the normalization of :func:`derived_coefficient`.
 
-    ``printed`` maps coefficient names to transcribed expressions (:func:`parse_printed`).  For
-    east-west motion every coefficient is divided by the printed d_4; for d_4 itself (d_4/d_4 = 1
-    would be vacuous) the printed leading ratio n_12/d_4 is returned, to be compared with the
-    derived monic n_12 = 1/R (the δV_N → ϕ_E path).
+    For east-west motion every coefficient is divided by the printed d_4; for d_4 itself
+    (d_4/d_4 = 1 would be vacuous) the printed leading ratio n_12/d_4 is returned, to be compared
+    with the derived monic n_12 = 1/R (the δV_N → ϕ_E path).
+
+    Parameters
+    ----------
+    name : str
+        Coefficient name (:func:`coefficient_location`).
+    printed : mapping of str to str
+        Coefficient names to transcribed expressions (:func:`parse_printed`); for east-west motion
+        it must contain ``"d_4"`` (and ``"n_12"`` when ``name`` is ``"d_4"``).
+    motion : {"north-south", "east-west"}
+        North-south motion (V_E = 0, eqs. (4)-(5)) or east-west motion (V_N = 0, eqs. (6)-(7)).
+
+    Returns
+    -------
+    expr : sympy.Expr
+        The printed expression (north-south), divided by the printed d_4 (east-west), or n_12/d_4
+        for ``name="d_4"`` (east-west).
+
+    Raises
+    ------
+    ValueError
+        If ``motion`` is unknown or an expression does not parse (:func:`parse_printed`).
     """
     choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     expr = parse_printed(printed[name])
@@ -539,13 +958,37 @@ def printed_in_derived_normalization(name, printed, motion):
 def coefficient_checks(printed, motion, points, *, radius=None, gravity=None):
     """Printed vs derived (sympy) vs numerical (python-control) value of every printed coefficient.
 
-    an2021 eqs. (4)-(5) (``motion='north-south'``) or (6)-(7) (``'east-west'``).  ``printed``
-    maps names (n_10 ... d_5) to transcribed expressions; ``points`` is a list of (lat, speed)
-    pairs (radians, m/s).  Returns a ``DataFrame`` with one row per coefficient: ``identical``
-    (the printed and derived closed forms are algebraically equal), the largest relative
-    printed-vs-derived and numerical-vs-derived differences over the points, and the values at
-    the first point.  For east-west motion the d_4 row compares n_12/d_4 (see
-    :func:`printed_in_derived_normalization`).
+    an2021 eqs. (4)-(5) (``motion='north-south'``) or (6)-(7) (``'east-west'``).  For east-west
+    motion the d_4 row compares n_12/d_4 (see :func:`printed_in_derived_normalization`).
+
+    Parameters
+    ----------
+    printed : mapping of str to str
+        Coefficient names (n_10 ... d_5) to transcribed expressions (:func:`parse_printed`).
+    motion : {"north-south", "east-west"}
+        North-south motion (V_E = 0, eqs. (4)-(5)) or east-west motion (V_N = 0, eqs. (6)-(7)).
+    points : sequence of (float, float)
+        (lat [rad], speed [m/s]) pairs at which the forms are evaluated; at least one.
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    checks : pandas.DataFrame
+        One row per coefficient of ``printed``: ``coefficient``, ``pair``, ``part`` ("num" or
+        "den"), ``power`` (of s), ``identical`` (bool: the printed and derived closed forms are
+        algebraically equal), ``printed_at_first``, ``derived_at_first``, ``numerical_at_first``
+        (values at the first point, SI units of the coefficient with s in rad/s), and
+        ``max_rel_printed_vs_derived``, ``max_rel_numerical_vs_derived`` (largest relative
+        differences over the points where the derived value is non-zero, dimensionless).
+
+    Raises
+    ------
+    ValueError
+        If ``motion`` is unknown or ``points`` is empty.
     """
     choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     if not points:
@@ -591,14 +1034,39 @@ ROOT_REAL_TOL = 1e-6
 def pole_zero_grid(motion, lats_deg, speeds, *, radius=None, gravity=None):
     """Poles and zeros of eqs. (4)-(5) or (6)-(7) over a grid of latitude and speed (Figs. 2-3).
 
-    Returns a long ``DataFrame`` with columns lat_deg, speed, pair, kind ('pole'/'zero'),
-    family (1 = largest |Im|; conjugates share a family), real, imag.  Families follow the
-    paper's numbering: p1,p2 / p3,p4 / p5,p6 and z11,z12 / z13,z14 by decreasing frequency.
+    Families follow the paper's numbering: p1,p2 / p3,p4 / p5,p6 and z11,z12 / z13,z14 by
+    decreasing frequency.
 
     The undamped INS has its poles on the imaginary axis, several of them nearly double, where a
     polynomial root finder is accurate to about sqrt(eps)|z| ~ 1.5e-8 |z|: real parts smaller
     than ``ROOT_REAL_TOL`` |z| are that round-off and are returned as 0 (otherwise they change
     from one BLAS/SIMD code path to another).
+
+    Parameters
+    ----------
+    motion : {"north-south", "east-west"}
+        North-south motion (V_E = 0, eqs. (4)-(5)) or east-west motion (V_N = 0, eqs. (6)-(7)).
+    lats_deg : float or array_like, shape (n_lat,)
+        Latitudes [°].
+    speeds : float or array_like, shape (n_speed,)
+        Speeds V_N (north-south) or V_E (east-west) [m/s].
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    grid : pandas.DataFrame
+        Long format, one row per root: ``lat_deg`` [°], ``speed`` [m/s], ``pair``, ``kind``
+        ('pole'/'zero'), ``family`` (1 = largest |Im|; conjugates share a family), ``real`` and
+        ``imag`` [rad/s].
+
+    Raises
+    ------
+    ValueError
+        If ``motion`` is unknown, or for a latitude or speed as :func:`system_matrix`.
     """
     choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     rows = []
@@ -619,8 +1087,18 @@ def pole_zero_grid(motion, lats_deg, speeds, *, radius=None, gravity=None):
 def family_spread(grid):
     """Spread of each pole/zero family over the grid ("concentrated", an2021 §2).
 
-    For every (pair, kind, family): the median natural frequency |p|, its relative range
-    (max - min)/median, and the largest |Re p| relative to the median |p|.
+    Parameters
+    ----------
+    grid : pandas.DataFrame
+        Output of :func:`pole_zero_grid` (only the roots with Im ≥ 0 are used).
+
+    Returns
+    -------
+    spread : pandas.DataFrame
+        One row per (``pair``, ``kind``, ``family``): ``median_abs``, ``min_abs``, ``max_abs`` (the
+        natural frequency |p| over the grid [rad/s]), ``max_abs_real`` (largest |Re p| [rad/s]),
+        ``relative_range`` ((max - min)/median of |p|) and ``real_over_abs`` (largest |Re p| over
+        the median |p|), the last two dimensionless.
     """
     g = grid[grid["imag"] >= 0].copy()
     g["abs"] = np.hypot(g["real"], g["imag"])
@@ -637,7 +1115,34 @@ def cancellation_distance(lat, speed, motion, pair, *, radius=None, gravity=None
 
     These are p5,p6 and z13,z14 (z23,z24) of an2021 §2, the Earth-rate mode: the pair the paper
     calls cancellable.  Zero means exact cancellation (east-west motion, and north-south motion
-    at rest); for north-south motion it grows with |V_N|.
+    at rest); for north-south motion it grows with |V_N|.  Computed on the full 6th-order form
+    (:func:`transfer_function` with ``minimal=False``).
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    speed : float
+        V_N (north-south) or V_E (east-west) [m/s].
+    motion : {"north-south", "east-west"}
+        North-south motion (V_E = 0, eqs. (4)-(5)) or east-west motion (V_N = 0, eqs. (6)-(7)).
+    pair : {"phiE/gdN", "phiN/gdE"}
+        The transfer function.
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    distance : float
+        |p - z| / |p| (dimensionless) for the pole and zero of smallest modulus with Im ≥ 0.
+
+    Raises
+    ------
+    ValueError
+        If ``motion`` or ``pair`` is unknown, or for the latitude and speed as :func:`system_matrix`.
     """
     choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
     ve, vn = (0.0, speed) if motion == "north-south" else (speed, 0.0)
@@ -653,9 +1158,26 @@ def cancellation_distance(lat, speed, motion, pair, *, radius=None, gravity=None
 class NoiseSettings:
     """Noise of the integrated-navigation filter of an2021 eq. (8) (not printed in the paper).
 
-    gyro_arw (rad/√s), accel_vrw (m/s²/√Hz = m/s/√s): white noise on ϕ and δV;
-    gyro_bias_rw (rad/s/√s), accel_bias_rw (m/s²/√s): random walk of the constant-bias states;
-    position_sigma (m, per axis) at position_rate (Hz): the position fix.
+    Attributes
+    ----------
+    gyro_arw : float
+        Gyro angle random walk, white noise on ϕ [rad/√s]; non-negative.
+    accel_vrw : float
+        Accelerometer velocity random walk, white noise on δV [m/s²/√Hz = m/s/√s]; non-negative.
+    gyro_bias_rw : float
+        Random walk of the constant gyro-drift states [rad/s/√s]; non-negative.
+    accel_bias_rw : float
+        Random walk of the constant accelerometer-bias states [m/s²/√s]; non-negative.
+    position_sigma : float
+        Standard deviation of the position fix, per axis [m]; positive.
+    position_rate : float, default 1.0
+        Rate of the position fix [Hz]; positive.
+
+    Raises
+    ------
+    ValueError
+        If a noise level is negative or not finite, or ``position_sigma`` or ``position_rate`` is
+        not positive.
     """
 
     gyro_arw: float
@@ -672,7 +1194,18 @@ class NoiseSettings:
             _positive(getattr(self, name), name, "{name} must be finite and positive, got {value}")
 
     def scaled(self, **factors):
-        """A copy with some fields multiplied by factors, e.g. ``scaled(accel_vrw=10)``."""
+        """A copy with some fields multiplied by factors, e.g. ``scaled(accel_vrw=10)``.
+
+        Parameters
+        ----------
+        factors : float
+            Keyword arguments: field name → dimensionless multiplier.
+
+        Returns
+        -------
+        noise : NoiseSettings
+            The copy (validated again).
+        """
         return replace(self, **{k: getattr(self, k) * f for k, f in factors.items()})
 
 
@@ -689,10 +1222,42 @@ bias random walks 0.001 °/h and 1 μg per √h) with a 1 Hz, 5 m (per axis) pos
 
 
 def integrated_model(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None):
-    """Ā (12×12), B (12×2, inputs g_dE, g_dN), C (2×12, z = (δL, δλ)), H̄ (2×12), an2021 eqs. (8)-(9).
+    """The matrices of the integrated-navigation model, an2021 eqs. (8)-(9).
 
     Ā_{1:7,1:7} = A, Ā_{1,8} = Ā_{2,9} = Ā_{3,10} = -1, Ā_{4,11} = Ā_{5,12} = 1;
     B_{4,1} = B_{5,2} = -1; C_{1,6} = C_{2,7} = 1; H̄_{1,1} = H̄_{2,2} = 1.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float, default 0.0
+        East velocity V_E [m/s].
+    v_north : float, default 0.0
+        North velocity V_N [m/s].
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    a : numpy.ndarray, shape (12, 12)
+        Ā, states :data:`STATES_12` (the 7 error states, gyro drifts [rad/s], accelerometer
+        biases [m/s²]), SI units.
+    b : numpy.ndarray, shape (12, 2)
+        B, inputs g_dE, g_dN [m/s²].
+    c : numpy.ndarray, shape (2, 12)
+        C, measurement z = (δL, δλ) [rad].
+    h : numpy.ndarray, shape (2, 12)
+        H̄, output (ϕ_E, ϕ_N) [rad].
+
+    Raises
+    ------
+    ValueError
+        If ``lat`` is not a finite latitude below 90° in magnitude (the model contains tan L and
+        sec L) or a velocity is not finite or beyond ``replication.nav.earth.SPEED_LIMIT``.
     """
     a = np.zeros((12, 12))
     a[:7, :7] = system_matrix(lat, v_east, v_north, radius=radius, gravity=gravity)
@@ -706,10 +1271,36 @@ def integrated_model(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None)
 
 
 def noise_matrices(lat, noise: NoiseSettings, *, radius=None, gravity=None):
-    """Continuous process-noise PSD Q (12×12) and measurement-noise PSD R_c (2×2) for eq. (8).
+    """Continuous process-noise PSD Q and measurement-noise PSD R_c for eq. (8).
 
     Q = diag(ARW² ×3, VRW² ×2, 0, 0, bias-RW² ×5); the position fix of σ metres at f Hz becomes
-    the continuous PSD R_c = (σ/R)²/f for δL and (σ/(R cos L))²/f for δλ (rad² s).
+    the continuous PSD R_c = (σ/R)²/f for δL and (σ/(R cos L))²/f for δλ.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    noise : NoiseSettings
+        The noise levels.
+    radius : float, optional
+        Earth radius R [m] converting the fix σ to radians; default as :func:`earth_parameters`.
+    gravity : float, optional
+        Gravity g [m/s²], only validated (:func:`earth_parameters`); it does not enter Q or R_c.
+
+    Returns
+    -------
+    q : numpy.ndarray, shape (12, 12)
+        Diagonal process-noise PSD, states :data:`STATES_12`: rad²/s (attitude), m²/s³
+        (velocity), 0 (position), rad²/s³ (gyro drifts), m²/s⁵ (accelerometer biases).
+    rc : numpy.ndarray, shape (2, 2)
+        Diagonal measurement-noise PSD of (δL, δλ) [rad² s].
+
+    Raises
+    ------
+    TypeError
+        If ``noise`` is not a :class:`NoiseSettings`.
+    ValueError
+        For the latitude as :func:`earth_parameters`.
     """
     if not isinstance(noise, NoiseSettings):
         raise TypeError("noise must be a NoiseSettings")
@@ -729,10 +1320,34 @@ _STATE_SCALE_12 = np.array([1e-5] * 3 + [0.1] * 2 + [1e-6] * 2 + [1e-8] * 3 + [1
 
 
 def observable_decomposition(a, c, *, time_scale=1e3, rtol=1e-9, min_gap=1e4):
-    """Orthonormal bases (V_o, V_u) of the observable subspace and unobservable subspace of (A, C).
+    """Orthonormal bases (V_o, V_u) of the observable and unobservable subspaces of (A, C).
 
-    From the SVD of the observability matrix of (A·time_scale, C).  Raises ``ValueError`` when
-    the singular values show no clear gap (``min_gap``) at the rank threshold ``rtol``.
+    From the SVD of the observability matrix of (A·time_scale, C).
+
+    Parameters
+    ----------
+    a : array_like, shape (n, n)
+        System matrix A [1/s for a continuous model].
+    c : array_like, shape (m, n)
+        Measurement matrix C.
+    time_scale : float, default 1e3
+        Time scale [s] that makes A·time_scale of order one.
+    rtol : float, default 1e-9
+        Rank threshold, relative to the largest singular value.
+    min_gap : float, default 1e4
+        Smallest acceptable ratio of the last retained to the first discarded singular value.
+
+    Returns
+    -------
+    v_o : numpy.ndarray, shape (n, r)
+        Orthonormal basis of the observable subspace (r the observability rank).
+    v_u : numpy.ndarray, shape (n, n - r)
+        Orthonormal basis of the unobservable subspace.
+
+    Raises
+    ------
+    ValueError
+        When the singular values show no clear gap (``min_gap``) at the rank threshold ``rtol``.
     """
     a, c = np.asarray(a, float), np.asarray(c, float)
     n = a.shape[0]
@@ -755,6 +1370,30 @@ def steady_state_gain(a, c, q, rc, *, state_scale=None):
     cross-covariance P_uo solves the Sylvester equation
     A_uu P_uo + P_uo (A_oo - K_o C_o)ᵀ = -(A_uo P_oo + Q_uo), and K = P Cᵀ R_c⁻¹ (P_uu does not
     enter the gain).  When (A, C) is observable this is the usual ``control.lqe`` gain.
+
+    Parameters
+    ----------
+    a : array_like, shape (n, n)
+        System matrix A (SI units, time in s).
+    c : array_like, shape (m, n)
+        Measurement matrix C.
+    q : array_like, shape (n, n)
+        Process-noise PSD Q (state units squared per second).
+    rc : array_like, shape (m, m)
+        Measurement-noise PSD R_c (measurement units squared times s), positive definite.
+    state_scale : array_like, shape (n,), optional
+        Typical magnitude of each state (its unit) used to balance the problem; default ones.
+
+    Returns
+    -------
+    k : numpy.ndarray, shape (n, m)
+        Continuous gain K (state units per measurement unit per second).
+
+    Raises
+    ------
+    ValueError
+        If the shapes do not match, R_c is not positive definite, or the observability rank is
+        ambiguous (:func:`observable_decomposition`).
     """
     a, c, q, rc = (np.asarray(m, float) for m in (a, c, q, rc))
     n = a.shape[0]
@@ -785,9 +1424,31 @@ def kalman_gain_by_iteration(a, c, q, rc, *, dt, steps, p0):
     """Gain of the discrete Kalman filter after ``steps`` predict/update cycles from P0.
 
     The time-varying filter whose limit :func:`steady_state_gain` computes (discretized with the
-    matrix exponential and Van Loan's method); returns the continuous-equivalent gain K_d / dt.
-    Used in the tests to check the steady-state gain independently
+    matrix exponential and Van Loan's method, measurement variance R_c/dt).  Used in the tests to
+    check the steady-state gain independently
     (``test_steady_state_gain_is_limit_of_the_time_varying_discrete_filter``).
+
+    Parameters
+    ----------
+    a : array_like, shape (n, n)
+        System matrix A (SI units, time in s).
+    c : array_like, shape (m, n)
+        Measurement matrix C.
+    q : array_like, shape (n, n)
+        Process-noise PSD Q.
+    rc : array_like, shape (m, m)
+        Measurement-noise PSD R_c (measurement units squared times s).
+    dt : float
+        Filter step [s].
+    steps : int
+        Number of predict/update cycles (at least 1).
+    p0 : array_like, shape (n, n)
+        Initial covariance P0.
+
+    Returns
+    -------
+    k : numpy.ndarray, shape (n, m)
+        The continuous-equivalent gain K_d / dt (state units per measurement unit per second).
     """
     a, c, q, rc, p = (np.asarray(m, float) for m in (a, c, q, rc, p0))
     n = a.shape[0]
@@ -812,7 +1473,35 @@ def integrated_gravity_to_attitude(lat, v_east=0.0, v_north=0.0, noise: NoiseSet
                                    radius=None, gravity=None, gain=None):
     """The closed loop H̄(Is - Ā + KC)^{-1}B from (g_dE, g_dN) to (ϕ_E, ϕ_N), an2021 eq. (10).
 
-    ``gain`` defaults to :func:`steady_state_gain` for ``noise``.  Returns a ``StateSpace``.
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float, default 0.0
+        East velocity V_E [m/s].
+    v_north : float, default 0.0
+        North velocity V_N [m/s].
+    noise : NoiseSettings, default NAVIGATION_GRADE
+        Filter noise from which the steady-state gain is computed (ignored when ``gain`` is given).
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+    gain : array_like, shape (12, 2), optional
+        Kalman gain K [state units per rad per s]; default :func:`steady_state_gain` for
+        ``noise``.
+
+    Returns
+    -------
+    sys : control.StateSpace
+        12 states :data:`STATES_12`, inputs ``g_dE``, ``g_dN`` [m/s²], outputs :data:`OUTPUTS`
+        (ϕ_E, ϕ_N [rad]).
+
+    Raises
+    ------
+    ValueError
+        If ``gain`` is not 12×2, or for the latitude and velocities as :func:`system_matrix`.
     """
     a, b, c, h = integrated_model(lat, v_east, v_north, radius=radius, gravity=gravity)
     if gain is None:
@@ -828,7 +1517,29 @@ def integrated_gravity_to_attitude(lat, v_east=0.0, v_north=0.0, noise: NoiseSet
 # --------------------------------------------------------------------------- frequency response
 
 def frequency_response(sys, omega, pair=None):
-    """Complex frequency response G(jω) of a SISO system, or of channel ``pair`` of a 2×2 one."""
+    """Complex frequency response G(jω) of a SISO system, or of channel ``pair`` of a 2×2 one.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        A system from (g_dE, g_dN) [m/s²] to (ϕ_E, ϕ_N) [rad] (two inputs, two outputs, e.g.
+        :func:`gravity_to_attitude`, :func:`integrated_gravity_to_attitude`), or a SISO system
+        when ``pair`` is None.
+    omega : float or array_like
+        Angular frequencies ω [rad/s], positive and finite; any shape.
+    pair : {"phiE/gdN", "phiN/gdE"}, optional
+        Channel of a two-input, two-output ``sys`` (:func:`siso`); None for a SISO ``sys``.
+
+    Returns
+    -------
+    g : numpy.ndarray of complex, shape of ``omega``
+        G(jω), in the unit of the system's gain (rad/(m/s²) for a gravity-to-attitude channel).
+
+    Raises
+    ------
+    ValueError
+        If a frequency is not positive and finite, or ``pair`` is unknown.
+    """
     omega = np.asarray(omega, dtype=float)
     if np.any(omega <= 0) or not np.all(np.isfinite(omega)):
         raise ValueError("frequencies must be positive and finite (rad/s)")
@@ -850,6 +1561,27 @@ def dc_gain(sys, pair=None, *, rtol=1e-6):
     an eigenvalue at round-off distance from zero, e.g. an2021's filter with no bias random walk)
     leaves an error ~ε/ω that grows towards ω → 0; the values then disagree and a ``ValueError``
     says so instead of returning a wrong gain.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        A system from (g_dE, g_dN) [m/s²] to (ϕ_E, ϕ_N) [rad] (two inputs, two outputs, e.g.
+        :func:`gravity_to_attitude`, :func:`integrated_gravity_to_attitude`), or a SISO system
+        when ``pair`` is None.
+    pair : {"phiE/gdN", "phiN/gdE"}, optional
+        Channel of a two-input, two-output ``sys`` (:func:`siso`); None for a SISO ``sys``.
+    rtol : float, default 1e-6
+        Relative agreement required of the three values.
+
+    Returns
+    -------
+    g0 : float
+        G(0), in the unit of the system's gain (rad/(m/s²) for a gravity-to-attitude channel).
+
+    Raises
+    ------
+    ValueError
+        If the three values disagree by more than ``rtol`` (the DC gain is not determined).
     """
     if pair is not None:
         sys = siso(sys, pair)
@@ -870,8 +1602,36 @@ def _db(sys, w):
 def proportional_band_edge(sys, pair=None, *, deviation_db=3.0, w_min=1e-7, w_max=10.0, n=4000):
     """Upper edge of the band in which G(jω) stays a proportional element (an2021 §4, 7e-4 rad/s).
 
-    The lowest ω at which |G(jω)| departs from |G(0)| by ``deviation_db`` dB (either way),
-    located on a log grid and refined with Brent's method.
+    The lowest ω at which |G(jω)| departs from |G(0)| (:func:`dc_gain`) by ``deviation_db`` dB
+    (either way), located on a log grid and refined with Brent's method.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        A system from (g_dE, g_dN) [m/s²] to (ϕ_E, ϕ_N) [rad] (two inputs, two outputs, e.g.
+        :func:`gravity_to_attitude`, :func:`integrated_gravity_to_attitude`), or a SISO system
+        when ``pair`` is None.
+    pair : {"phiE/gdN", "phiN/gdE"}, optional
+        Channel of a two-input, two-output ``sys`` (:func:`siso`); None for a SISO ``sys``.
+    deviation_db : float, default 3.0
+        Departure from the DC gain [dB].
+    w_min : float, default 1e-7
+        Lower end of the search grid [rad/s].
+    w_max : float, default 10.0
+        Upper end of the search grid [rad/s].
+    n : int, default 4000
+        Points of the logarithmic search grid.
+
+    Returns
+    -------
+    omega : float
+        The band edge [rad/s] (``w_min`` if the response departs already there).
+
+    Raises
+    ------
+    ValueError
+        If the response never departs from its DC value by ``deviation_db`` on the grid, or the
+        DC gain is not determined (:func:`dc_gain`).
     """
     if pair is not None:
         sys = siso(sys, pair)
@@ -893,6 +1653,36 @@ def cutoff_frequency(sys, pair=None, *, reference=None, drop_db=3.0, w_min=1e-7,
     The reference is |G(0)| by default; pass ``reference=1/g`` (the static tilt gain of
     eqs. (11)-(12)) for the integrated mode, whose very-low-frequency gain depends on the
     gyro-bias process noise.  The highest crossing on a log grid, refined with Brent's method.
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        A system from (g_dE, g_dN) [m/s²] to (ϕ_E, ϕ_N) [rad] (two inputs, two outputs, e.g.
+        :func:`gravity_to_attitude`, :func:`integrated_gravity_to_attitude`), or a SISO system
+        when ``pair`` is None.
+    pair : {"phiE/gdN", "phiN/gdE"}, optional
+        Channel of a two-input, two-output ``sys`` (:func:`siso`); None for a SISO ``sys``.
+    reference : float, optional
+        Reference gain (its absolute value is used), in the unit of the system's gain
+        (rad/(m/s²)); default |G(0)| (:func:`dc_gain`).
+    drop_db : float, default 3.0
+        Drop below the reference [dB].
+    w_min : float, default 1e-7
+        Lower end of the search grid [rad/s].
+    w_max : float, default 10.0
+        Upper end of the search grid [rad/s].
+    n : int, default 4000
+        Points of the logarithmic search grid.
+
+    Returns
+    -------
+    omega_c : float
+        Cut-off angular frequency [rad/s].
+
+    Raises
+    ------
+    ValueError
+        If the reference gain is not positive or no cut-off lies inside the grid.
     """
     if pair is not None:
         sys = siso(sys, pair)
@@ -911,7 +1701,33 @@ def cutoff_frequency(sys, pair=None, *, reference=None, drop_db=3.0, w_min=1e-7,
 
 
 def loglog_slope(sys, w_lo, w_hi, pair=None, n=200):
-    """Least-squares slope of 20 log10|G(jω)| against log10 ω on [w_lo, w_hi] (dB/decade)."""
+    """Least-squares slope of 20 log10|G(jω)| against log10 ω on [w_lo, w_hi].
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        A system from (g_dE, g_dN) [m/s²] to (ϕ_E, ϕ_N) [rad] (two inputs, two outputs, e.g.
+        :func:`gravity_to_attitude`, :func:`integrated_gravity_to_attitude`), or a SISO system
+        when ``pair`` is None.
+    w_lo : float
+        Lower end of the band [rad/s], positive.
+    w_hi : float
+        Upper end of the band [rad/s], above ``w_lo``.
+    pair : {"phiE/gdN", "phiN/gdE"}, optional
+        Channel of a two-input, two-output ``sys`` (:func:`siso`); None for a SISO ``sys``.
+    n : int, default 200
+        Points of the logarithmic grid over the band.
+
+    Returns
+    -------
+    slope : float
+        Slope [dB/decade].
+
+    Raises
+    ------
+    ValueError
+        Unless 0 < w_lo < w_hi.
+    """
     if not (0 < w_lo < w_hi):
         raise ValueError("need 0 < w_lo < w_hi")
     if pair is not None:
@@ -924,12 +1740,46 @@ def noise_sensitivity(lat, v_east, v_north, base: NoiseSettings, factors, pair="
                       slope_band=(0.05, 0.5), n=1000, radius=None, gravity=None):
     """Cut-off frequency and high-band slope of eq. (10) when one noise setting is scaled.
 
-    ``factors`` maps a :class:`NoiseSettings` field to the multipliers to try, e.g.
-    ``{"gyro_arw": [0.1, 1, 10]}``; every other field stays at ``base``.  Returns a
-    ``DataFrame`` (setting, factor, value, cutoff, slope, dc) for ``pair``; ``cutoff`` is
-    relative to the static tilt gain 1/g, ``slope`` the :func:`loglog_slope` over ``slope_band``
-    and ``dc`` the zero-frequency gain times g (1 when the filter keeps the static tilt).  an2021 does not print its filter noise: this is
-    the sensitivity of Figs. 5-6 and Table 1 to that unstated choice.
+    Every field other than the one scaled stays at ``base``.  an2021 does not print its filter
+    noise: this is the sensitivity of Figs. 5-6 and Table 1 to that unstated choice.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float
+        East velocity V_E [m/s].
+    v_north : float
+        North velocity V_N [m/s].
+    base : NoiseSettings
+        The setting that is varied one field at a time.
+    factors : mapping of str to sequence of float
+        :class:`NoiseSettings` field → the multipliers to try, e.g. ``{"gyro_arw": [0.1, 1, 10]}``.
+    pair : {"phiE/gdN", "phiN/gdE"}, default "phiE/gdN"
+        The channel analysed.
+    slope_band : tuple of float, default (0.05, 0.5)
+        Band (w_lo, w_hi) [rad/s] of the :func:`loglog_slope`.
+    n : int, default 1000
+        Points of the cut-off search grid (:func:`cutoff_frequency`).
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per field and factor: ``setting`` (field name), ``factor``, ``value`` (the scaled
+        noise level in the field's unit), ``cutoff`` (:func:`cutoff_frequency` relative to the
+        static tilt gain 1/g [rad/s]), ``slope`` [dB/decade] and ``dc`` (the zero-frequency gain
+        times g, dimensionless: 1 when the filter keeps the static tilt).
+
+    Raises
+    ------
+    ValueError
+        If a key of ``factors`` is not a :class:`NoiseSettings` field, or a cut-off or DC gain is
+        not determined.
     """
     _, g = earth_parameters(lat, radius, gravity)
     rows = []
@@ -947,7 +1797,42 @@ def noise_sensitivity(lat, v_east, v_north, base: NoiseSettings, factors, pair="
 
 def cutoff_grid(lat, v_east, v_north, base: NoiseSettings, field_a, factors_a, field_b, factors_b,
                 pair="phiE/gdN", *, n=1000, radius=None, gravity=None):
-    """Cut-off frequency (relative to 1/g) of eq. (10) on a grid of two scaled noise settings."""
+    """Cut-off frequency (relative to 1/g) of eq. (10) on a grid of two scaled noise settings.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float
+        East velocity V_E [m/s].
+    v_north : float
+        North velocity V_N [m/s].
+    base : NoiseSettings
+        The setting that is varied.
+    field_a : str
+        First :class:`NoiseSettings` field scaled (rows).
+    factors_a : sequence of float, length n_a
+        Multipliers of ``field_a``.
+    field_b : str
+        Second field scaled (columns).
+    factors_b : sequence of float, length n_b
+        Multipliers of ``field_b``.
+    pair : {"phiE/gdN", "phiN/gdE"}, default "phiE/gdN"
+        The channel analysed.
+    n : int, default 1000
+        Points of the cut-off search grid (:func:`cutoff_frequency`).
+    radius : float, optional
+        Earth radius R [m]; default: the Gaussian mean radius sqrt(R_M R_N) at ``lat``
+        (:func:`earth_parameters`).
+    gravity : float, optional
+        Gravity g [m/s²]; default: WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    grid : pandas.DataFrame, shape (n_a, n_b)
+        Cut-off frequencies [rad/s]; index ``factors_a`` named ``field_a``, columns ``factors_b``
+        named ``field_b``.
+    """
     _, g = earth_parameters(lat, radius, gravity)
     out = np.empty((len(factors_a), len(factors_b)))
     for i, fa in enumerate(factors_a):
@@ -960,7 +1845,25 @@ def cutoff_grid(lat, v_east, v_north, base: NoiseSettings, field_a, factors_a, f
 
 
 def wavelength(speed, omega):
-    """Spatial wavelength λ_g = 2π v / ω (m) of a disturbance met at time frequency ω, an2021 eq. (13)."""
+    """Spatial wavelength λ_g = 2π v / ω of a disturbance met at time frequency ω, an2021 eq. (13).
+
+    Parameters
+    ----------
+    speed : float or array_like
+        Speed v [m/s] (its absolute value is used).
+    omega : float or array_like
+        Angular time frequency ω [rad/s], positive; broadcast against ``speed``.
+
+    Returns
+    -------
+    wavelength : numpy.ndarray
+        λ_g [m], the broadcast shape of ``speed`` and ``omega``.
+
+    Raises
+    ------
+    ValueError
+        If a frequency is not positive.
+    """
     speed, omega = np.asarray(speed, float), np.asarray(omega, float)
     if np.any(omega <= 0):
         raise ValueError("the time frequency ω must be positive (rad/s)")
@@ -968,9 +1871,23 @@ def wavelength(speed, omega):
 
 
 def attitude_error_per_disturbance(disturbance, lat=np.radians(30.0), *, gravity=None):
-    """Static horizontal attitude error ϕ = g_d / g (rad) for a horizontal disturbance (m/s²).
+    """Static horizontal attitude error ϕ = g_d / g for a horizontal gravity disturbance.
 
     The DC gain of eqs. (4)-(7) and (11)-(12): |ϕ_E/g_dN| = |ϕ_N/g_dE| = 1/g.
+
+    Parameters
+    ----------
+    disturbance : float or array_like
+        Horizontal gravity disturbance g_d [m/s²].
+    lat : float, default 30° (in radians)
+        Latitude L [rad] of the default gravity.
+    gravity : float, optional
+        Gravity g [m/s²]; default WGS-84 normal gravity at ``lat`` (:func:`earth_parameters`).
+
+    Returns
+    -------
+    phi : numpy.ndarray
+        Attitude error ϕ [rad], the shape of ``disturbance``.
     """
     _, g = earth_parameters(lat, None, gravity)
     return np.asarray(disturbance, float) / g
@@ -981,17 +1898,50 @@ def attitude_error_per_disturbance(disturbance, lat=np.radians(30.0), *, gravity
 def time_domain_response(lat, v_east, v_north, noise: NoiseSettings, omegas, *, pair="phiE/gdN", settle=60000.0,
                          periods=3, P0_scale=1e2):
     """Attitude-error response of the *discrete, time-varying* Kalman filter of an2021 eq. (8) to a
-    sinusoidal gravity disturbance: a second computation of |G(jω)| and its phase that shares only
-    Ā, B, C, H̄ of eqs. (8)-(9) with :func:`integrated_gravity_to_attitude`.
+    sinusoidal gravity disturbance.
 
-    The filter runs at the position-fix rate: Φ, Q_d by Van Loan (:func:`replication.nav.kalman.van_loan`),
-    the covariance recursion (:func:`replication.nav.kalman.predict`/``update``) from a prior of
-    ``P0_scale`` × the state scale for ``settle`` seconds, which gives the discrete steady-state
-    gain K_d without any Riccati solver; the corrected error e_{k+1} = (I - K_d C)(Φ e_k + Γ u_k)
-    is then driven by u = sin ωt in the input of ``pair`` (Γ = ∫Φ(s)ds B) and the amplitude and
-    phase of H̄ e are fitted by least squares over the last ``periods`` periods, after ten time
-    constants of the slowest damped mode.
-    Returns a DataFrame (omega, gain, phase_deg) with gain in rad/(m/s²).
+    A second computation of |G(jω)| and its phase that shares only Ā, B, C, H̄ of eqs. (8)-(9)
+    with :func:`integrated_gravity_to_attitude`.  The filter runs at the position-fix rate: Φ, Q_d
+    by Van Loan (:func:`replication.nav.kalman.van_loan`), the covariance recursion
+    (:func:`replication.nav.kalman.predict`/``update``) from a prior of ``P0_scale`` × the state
+    scale for ``settle`` seconds, which gives the discrete steady-state gain K_d without any
+    Riccati solver; the corrected error e_{k+1} = (I - K_d C)(Φ e_k + Γ u_k) is then driven by
+    u = sin ωt in the input of ``pair`` (Γ = ∫Φ(s)ds B) and the amplitude and phase of H̄ e are
+    fitted by least squares over the last ``periods`` periods, after ten time constants of the
+    slowest damped mode.  R and g are the defaults of :func:`earth_parameters`.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad], |L| < 90°.
+    v_east : float
+        East velocity V_E [m/s].
+    v_north : float
+        North velocity V_N [m/s].
+    noise : NoiseSettings
+        Filter noise; its ``position_rate`` sets the filter step.
+    omegas : float or array_like, shape (k,)
+        Angular frequencies ω of the disturbance [rad/s], positive with ω dt ≤ 0.5.
+    pair : {"phiE/gdN", "phiN/gdE"}, default "phiE/gdN"
+        The channel driven and observed.
+    settle : float, default 60000.0
+        Duration [s] of the covariance recursion that settles the gain.
+    periods : int, default 3
+        Periods of the sinusoid over which amplitude and phase are fitted.
+    P0_scale : float, default 1e2
+        Prior standard deviations in multiples of the typical state magnitudes.
+
+    Returns
+    -------
+    response : pandas.DataFrame
+        One row per frequency: ``omega`` [rad/s], ``gain`` [rad/(m/s²)] and ``phase_deg`` [°].
+
+    Raises
+    ------
+    ValueError
+        If ``pair`` is unknown or a frequency is not positive or not well below the fix rate.
+    TypeError
+        If ``noise`` is not a :class:`NoiseSettings`.
     """
 
 

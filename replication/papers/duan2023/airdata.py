@@ -94,7 +94,7 @@ PITCH_FORMS = ("printed", "fixed-S", "equal-length", "equal-length-linear")
 
 
 def pitch_correction(s, h, dh, *, form: str = "printed"):
-    """Pitch correction φ^c = θ_1 - θ_2 of the displacement vector (rad), duan2023 eqs. (2)-(4).
+    """Pitch correction φ^c = θ_1 - θ_2 of the displacement vector, duan2023 eqs. (2)-(4).
 
     θ_2 = atan(h/S) is the SINS pitch of the displacement (eq. (3)), θ_1 = atan((h+δh^c)/S^c)
     the SINS/ADS one (eq. (2)).  ``form``:
@@ -108,6 +108,28 @@ def pitch_correction(s, h, dh, *, form: str = "printed"):
 
     The printed form is the first-order term of ``"fixed-S"``; it differs from the first-order
     term of ``"equal-length"`` by the factor cos²θ_2 = S²/(S²+h²) (a relative O(h²/S²) term).
+
+    Parameters
+    ----------
+    s : float or array_like
+        Horizontal displacement S over the interval [m], positive.
+    h : float or array_like
+        Up component h of the SINS displacement over the interval [m].
+    dh : float or array_like
+        δh^c, ADS height minus SINS height at the end of the interval [m].
+    form : {"printed", "fixed-S", "equal-length", "equal-length-linear"}, default "printed"
+        Which form of φ^c (above).
+
+    Returns
+    -------
+    phi_c : numpy.ndarray
+        φ^c [rad], the broadcast shape of ``s``, ``h``, ``dh``.
+
+    Raises
+    ------
+    ValueError
+        If ``form`` is unknown, an input is not finite, S is not positive, or (``"equal-length"``)
+        |h + δh^c| exceeds the displacement length.
     """
     choice(form, PITCH_FORMS, "form")
     s, h, dh = _arr(s, "S"), _arr(h, "h"), _arr(dh, "dh")
@@ -131,6 +153,23 @@ def rotation_axis(sx, sy):
 
     It is horizontal and perpendicular to the horizontal displacement, oriented so that a
     positive rotation raises the displacement towards Up: u = e_S × e_U.
+
+    Parameters
+    ----------
+    sx : float or array_like
+        East component S_x of the SINS horizontal displacement over the interval [m].
+    sy : float or array_like
+        North component S_y [m]; S = √(S_x² + S_y²) must be at least 1 mm.
+
+    Returns
+    -------
+    u : numpy.ndarray, shape (..., 3)
+        Unit vector (east, north, up), the broadcast shape of ``sx``, ``sy`` + (3,).
+
+    Raises
+    ------
+    ValueError
+        If S is below 1 mm (the axis is undefined) or an input is not finite.
     """
     sx, sy, s = _horizontal(sx, sy)
     return np.stack([sy / s, -sx / s, np.zeros_like(s)], axis=-1)
@@ -143,7 +182,26 @@ def _skew(v):
 
 
 def rodrigues(u, angle):
-    """D = I + sin φ (u×) + (1 - cos φ)(u×)², the rotation of duan2023 eq. (5) (u unit, φ rad)."""
+    """D = I + sin φ (u×) + (1 - cos φ)(u×)², the rotation of duan2023 eq. (5).
+
+    Parameters
+    ----------
+    u : array_like, shape (..., 3)
+        Unit rotation axis.
+    angle : float or array_like, shape (...)
+        Rotation angle φ [rad].
+
+    Returns
+    -------
+    d : numpy.ndarray, shape (..., 3, 3)
+        The rotation matrix D.
+
+    Raises
+    ------
+    ValueError
+        If ``u`` does not have a last axis of 3, is not a unit vector (to 1e-9), or an input is
+        not finite.
+    """
     u = _arr(u, "u")
     if u.shape[-1] != 3:
         raise ValueError(f"u must have a last axis of length 3, got shape {u.shape}")
@@ -158,7 +216,23 @@ def rotation_vector_from_dcm(d):
     """Rotation vector from a DCM by the formula printed as duan2023 eq. (5).
 
     (φ×) = φ / (2 sin φ) (D - Dᵀ) with cos φ = (tr D - 1)/2; valid for 0 ≤ φ < π, with the
-    limit φ/(2 sin φ) → 1/2 at φ = 0.  Returns φ u (the vector whose norm is the angle).
+    limit φ/(2 sin φ) → 1/2 at φ = 0.
+
+    Parameters
+    ----------
+    d : array_like, shape (..., 3, 3)
+        Rotation matrix D.
+
+    Returns
+    -------
+    phi : numpy.ndarray, shape (..., 3)
+        φ u, the rotation vector whose norm is the angle [rad].
+
+    Raises
+    ------
+    ValueError
+        If ``d`` does not have trailing shape (3, 3), is not finite, or rotates by π (to 1e-6 rad),
+        where eq. (5) is singular.
     """
     d = _arr(d, "D")
     if d.shape[-2:] != (3, 3):
@@ -173,12 +247,37 @@ def rotation_vector_from_dcm(d):
 
 
 def misalignment_correction(sx, sy, h, dh, *, printed_half: bool = False, form: str = "printed"):
-    """East/north misalignment correction [φ_E^c, φ_N^c] (rad), duan2023 eq. (6).
+    """East/north misalignment correction [φ_E^c, φ_N^c], duan2023 eq. (6).
 
     φ^c u with φ^c from eq. (4) (``form``, see :func:`pitch_correction`) and u from eq. (5):
     φ_E^c = S_y δh^c/(S² + h²), φ_N^c = -S_x δh^c/(S² + h²).  The printed eq. (6) has an extra
     factor 1/2 (``printed_half=True`` reproduces it); the rotation-vector formula (5) gives
     exactly φ^c u, and the paper's own eq. (7) is the derivative of the expression without it.
+
+    Parameters
+    ----------
+    sx : float or array_like
+        East component S_x of the SINS horizontal displacement over the interval [m].
+    sy : float or array_like
+        North component S_y [m]; S = √(S_x² + S_y²) must be at least 1 mm.
+    h : float or array_like
+        Up component h of the SINS displacement over the interval [m].
+    dh : float or array_like
+        δh^c, ADS height minus SINS height at the end of the interval [m].
+    printed_half : bool, default False
+        Apply the extra factor 1/2 printed in eq. (6).
+    form : {"printed", "fixed-S", "equal-length", "equal-length-linear"}, default "printed"
+        Form of the pitch correction φ^c (:func:`pitch_correction`).
+
+    Returns
+    -------
+    phi_c : numpy.ndarray, shape (..., 2)
+        [φ_E^c, φ_N^c] [rad].
+
+    Raises
+    ------
+    ValueError
+        If S is below 1 mm or as :func:`pitch_correction`.
     """
     sx, sy, s = _horizontal(sx, sy)
     phi = pitch_correction(s, h, dh, form=form)
@@ -188,12 +287,38 @@ def misalignment_correction(sx, sy, h, dh, *, printed_half: bool = False, form: 
 
 
 def velocity_correction(sx, sy, h, speed, dh, *, form: str = "printed"):
-    """Velocity correction [δV_E^c, δV_N^c, δV_U^c] (m/s), duan2023 eqs. (11)-(13).
+    """Velocity correction [δV_E^c, δV_N^c, δV_U^c], duan2023 eqs. (11)-(13).
 
     δV_U^c = φ^c V cos θ_2 = S² V δh^c/(S² + h²)^{3/2} (eq. (13), with φ^c of eq. (4)) and
-    [δV_E^c, δV_N^c] = -[S_x, S_y] h/S² δV_U^c (eq. (11)).  ``speed`` is the norm of V (assumption 4:
-    unchanged by the correction).  Eq. (12) prints δV_U^c = φ^c V, without the cos θ_2 that
-    eq. (13) contains; this function follows eq. (13), the first-order geometry.
+    [δV_E^c, δV_N^c] = -[S_x, S_y] h/S² δV_U^c (eq. (11)).  Eq. (12) prints δV_U^c = φ^c V,
+    without the cos θ_2 that eq. (13) contains; this function follows eq. (13), the first-order
+    geometry.
+
+    Parameters
+    ----------
+    sx : float or array_like
+        East component S_x of the SINS horizontal displacement over the interval [m].
+    sy : float or array_like
+        North component S_y [m]; S = √(S_x² + S_y²) must be at least 1 mm.
+    h : float or array_like
+        Up component h of the SINS displacement over the interval [m].
+    speed : float or array_like
+        Norm V of the SINS velocity [m/s], non-negative (assumption 4: unchanged by the
+        correction).
+    dh : float or array_like
+        δh^c, ADS height minus SINS height at the end of the interval [m].
+    form : {"printed", "fixed-S", "equal-length", "equal-length-linear"}, default "printed"
+        Form of the pitch correction φ^c (:func:`pitch_correction`).
+
+    Returns
+    -------
+    dv_c : numpy.ndarray, shape (..., 3)
+        [δV_E^c, δV_N^c, δV_U^c] [m/s].
+
+    Raises
+    ------
+    ValueError
+        If S is below 1 mm, ``speed`` is negative, or as :func:`pitch_correction`.
     """
     sx, sy, s = _horizontal(sx, sy)
     h, speed = _arr(h, "h"), _arr(speed, "speed")
@@ -205,10 +330,31 @@ def velocity_correction(sx, sy, h, speed, dh, *, form: str = "printed"):
 
 
 def displacement_correction(sx, sy, h, dh):
-    """Horizontal displacement correction [δS_x^c, δS_y^c] (m), duan2023 eqs. (16)-(19).
+    """Horizontal displacement correction [δS_x^c, δS_y^c], duan2023 eqs. (16)-(19).
 
     δS^c = -(h/S) δh^c (eq. (18), the first-order solution of eq. (17)), distributed along the
     unchanged horizontal direction (assumption 2): δS_x^c = (S_x/S) δS^c, δS_y^c = (S_y/S) δS^c.
+
+    Parameters
+    ----------
+    sx : float or array_like
+        East component S_x of the SINS horizontal displacement over the interval [m].
+    sy : float or array_like
+        North component S_y [m]; S = √(S_x² + S_y²) must be at least 1 mm.
+    h : float or array_like
+        Up component h of the SINS displacement over the interval [m].
+    dh : float or array_like
+        δh^c, ADS height minus SINS height at the end of the interval [m].
+
+    Returns
+    -------
+    ds_c : numpy.ndarray, shape (..., 2)
+        [δS_x^c, δS_y^c] (east, north) [m].
+
+    Raises
+    ------
+    ValueError
+        If S is below 1 mm or an input is not finite.
     """
     sx, sy, s = _horizontal(sx, sy)
     ds = -_arr(h, "h") / s * _arr(dh, "dh")
@@ -216,11 +362,34 @@ def displacement_correction(sx, sy, h, dh):
 
 
 def position_correction(lat, height, dsx, dsy, dh):
-    """Position correction [δL^c, δλ^c, δh^c] (rad, rad, m) from displacement corrections.
+    """Position correction [δL^c, δλ^c, δh^c] from displacement corrections.
 
     δL^c = δS_y^c/(R_M + h), δλ^c = δS_x^c/((R_N + h) cos L) — the standard relations; the text
     under duan2023 eq. (19) prints them with the metric factors exchanged (see
     :func:`check_elements`).
+
+    Parameters
+    ----------
+    lat : float or array_like
+        Latitude L [rad], below ``replication.nav.earth.POLAR_LIMIT_DEG`` in magnitude.
+    height : float or array_like
+        Height h [m].
+    dsx : float or array_like
+        East displacement correction δS_x^c [m].
+    dsy : float or array_like
+        North displacement correction δS_y^c [m].
+    dh : float or array_like
+        Height correction δh^c [m].
+
+    Returns
+    -------
+    dp_c : numpy.ndarray, shape (..., 3)
+        [δL^c [rad], δλ^c [rad], δh^c [m]].
+
+    Raises
+    ------
+    ValueError
+        If a latitude is beyond ±90° or within the polar limit, or an input is not finite.
     """
     lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
     height = _arr(height, "height")
@@ -233,9 +402,40 @@ def correction_vector(sx, sy, h, speed, dh, lat, height, *, printed_half: bool =
                       form: str = "printed"):
     """The correction X^C = [φ_E^c, φ_N^c, 0, δV^c (3), δL^c, δλ^c, δh^c] of duan2023 eq. (22).
 
-    All components are the first-order coefficients of eqs. (6), (11)-(13), (19) times δh^c
-    (``dh``: ADS height minus SINS height at the end of the interval).  SINS/ADS error =
-    SINS error + X^C (eq. (22)).
+    All components are the first-order coefficients of eqs. (6), (11)-(13), (19) times δh^c.
+    SINS/ADS error = SINS error + X^C (eq. (22)).
+
+    Parameters
+    ----------
+    sx : float or array_like
+        East component S_x of the SINS horizontal displacement over the interval [m].
+    sy : float or array_like
+        North component S_y [m]; S = √(S_x² + S_y²) must be at least 1 mm.
+    h : float or array_like
+        Up component h of the SINS displacement over the interval [m].
+    speed : float or array_like
+        Norm V of the SINS velocity [m/s].
+    dh : float or array_like
+        δh^c, ADS height minus SINS height at the end of the interval [m].
+    lat : float or array_like
+        SINS latitude L [rad] at the end of the interval.
+    height : float or array_like
+        SINS height [m] at the end of the interval.
+    printed_half : bool, default False
+        Apply the extra factor 1/2 printed in eq. (6).
+    form : {"printed", "fixed-S", "equal-length", "equal-length-linear"}, default "printed"
+        Form of the pitch correction φ^c (:func:`pitch_correction`).
+
+    Returns
+    -------
+    x_c : numpy.ndarray, shape (..., 9)
+        [φ_E^c, φ_N^c, 0 [rad]; δV_E^c, δV_N^c, δV_U^c [m/s]; δL^c, δλ^c [rad]; δh^c [m]].
+
+    Raises
+    ------
+    ValueError
+        As :func:`misalignment_correction`, :func:`velocity_correction` and
+        :func:`position_correction`.
     """
     phi = misalignment_correction(sx, sy, h, dh, printed_half=printed_half, form=form)
     dv = velocity_correction(sx, sy, h, speed, dh, form=form)
@@ -249,9 +449,33 @@ def exact_correction(sx, sy, h, v_enu, dh):
 
     The SINS displacement d = [S_x, S_y, h] is turned about u (eq. (5)) by the angle that makes
     its up component h + δh^c while keeping its length (assumptions 1-2, eq. (17) exactly);
-    the velocity is turned by the same rotation (assumption 4).  Returns a dict with ``angle``
-    (φ^c), ``phi`` (rotation vector, eq. (5) log map), ``dv`` (V^c - V), ``dS`` (S^c - S),
-    ``dSxy`` (horizontal displacement change), ``d_new`` and ``D``.
+    the velocity is turned by the same rotation (assumption 4).
+
+    Parameters
+    ----------
+    sx : float or array_like
+        East component S_x of the SINS horizontal displacement over the interval [m].
+    sy : float or array_like
+        North component S_y [m]; S = √(S_x² + S_y²) must be at least 1 mm.
+    h : float or array_like
+        Up component h of the SINS displacement over the interval [m].
+    v_enu : array_like, shape (..., 3)
+        SINS velocity (east, north, up) [m/s].
+    dh : float or array_like
+        δh^c, ADS height minus SINS height at the end of the interval [m].
+
+    Returns
+    -------
+    correction : dict of numpy.ndarray
+        ``angle`` φ^c [rad], shape (...); ``phi`` rotation vector (eq. (5) log map) [rad],
+        (..., 3); ``dv`` V^c - V [m/s], (..., 3); ``dS`` S^c - S [m], (...); ``dSxy`` horizontal
+        displacement change [m], (..., 2); ``d_new`` the turned displacement [m], (..., 3); ``D``
+        the rotation, (..., 3, 3).
+
+    Raises
+    ------
+    ValueError
+        If S is below 1 mm, an input is not finite, or |h + δh^c| exceeds the displacement length.
     """
     sx, sy, s = _horizontal(sx, sy)
     h, dh = _arr(h, "h"), _arr(dh, "dh")
@@ -323,10 +547,26 @@ def derived_coefficients(reading: str = "B"):
     * δS = -(h/S) δh^c (first-order solution of eq. (17)), δS_{x,y} = (S_{x,y}/S) δS;
     * δL = δS_y/R_Mh, δλ = δS_x/(R_Nh cos L), δh = δh^c.
 
-    ``reading`` fixes the position-state order of eqs. (20)-(21): ``"A"`` [δL, δλ] = [lat, lon]
-    (symbols as in eq. (1)), ``"B"`` [lon, lat] (the words 经-纬-高 next to δp^c).  Returns a dict
-    state → sympy coefficient, plus ``"phi"`` (eq. (4)), ``"dS"`` (eq. (18)), ``"dS_x"``,
-    ``"dS_y"``, ``"dV_U/phi"`` (eq. (12)) and ``"dV_E/dV_U"``, ``"dV_N/dV_U"`` (eq. (11)).
+    Cached.
+
+    Parameters
+    ----------
+    reading : {"A", "B"}, default "B"
+        The position-state order of eqs. (20)-(21): ``"A"`` [δL, δλ] = [lat, lon] (symbols as in
+        eq. (1)), ``"B"`` [lon, lat] (the words 经-纬-高 next to δp^c).
+
+    Returns
+    -------
+    coefficients : dict of str to sympy.Expr
+        State of :data:`STATE_NAMES` → coefficient of δh^c (in the kinematic symbols S_x, S_y, h
+        [m], V_E, V_N, V_U [m/s], L [rad], R_Mh, R_Nh [m]), plus ``"phi"`` (eq. (4)), ``"dS"``
+        (eq. (18)), ``"dS_x"``, ``"dS_y"``, ``"dV_U/phi"`` (eq. (12)), ``"dV_E/dV_U"``,
+        ``"dV_N/dV_U"`` (eq. (11)), ``"dS_x/dS"`` and ``"dS_y/dS"``.
+
+    Raises
+    ------
+    ValueError
+        If ``reading`` is not one of ``READINGS``.
     """
     if reading not in READINGS:
         raise ValueError(f"reading must be one of {READINGS}")
@@ -356,9 +596,26 @@ def derived_coefficients(reading: str = "B"):
 def reference_state(kind: str = "climb"):
     """A kinematic state satisfying eq. (8) (displacement ∥ velocity, straight flight), for checks.
 
-    ``"climb"``: 30 s at 180 m/s on heading 30°, flight-path angle 3°, along-track acceleration
-    0.5 m/s², 45°N, 3000 m — every printed term is non-zero.  ``"level"``: the same with a
-    flight-path angle of 0 (h = 0, V_U = 0).
+    30 s at 180 m/s on heading 30°, along-track acceleration 0.5 m/s², 45°N, 3000 m, with a
+    flight-path angle of 3° (``"climb"``: every printed term is non-zero), 0 (``"level"``: h = 0,
+    V_U = 0) or 15° (``"steep"``).
+
+    Parameters
+    ----------
+    kind : {"climb", "level", "steep"}, default "climb"
+        Flight-path angle 3°, 0° or 15°.
+
+    Returns
+    -------
+    state : dict of str to float
+        ``Sx``, ``Sy``, ``h`` (displacement [m]), ``VE``, ``VN``, ``VU`` (velocity [m/s]),
+        ``AE``, ``AN``, ``AU`` (acceleration [m/s²]), ``L`` (latitude [rad]), ``RMh``, ``RNh``
+        (R_M + h, R_N + h [m]).
+
+    Raises
+    ------
+    ValueError
+        If ``kind`` is unknown.
     """
     kinds = {"climb": 3.0, "level": 0.0, "steep": 15.0}
     if kind not in kinds:
@@ -383,7 +640,23 @@ def _evaluate(expr, state):
 def printed_elements(paper, reading: str = "B"):
     """The printed coefficients of ``duan2023-eq-22`` parsed into sympy, β resolved by ``reading``.
 
-    Returns a list of dicts with the CSV fields plus ``expr`` (sympy, kinematic symbols only).
+    Parameters
+    ----------
+    paper : PaperTable
+        ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
+    reading : {"A", "B"}, default "B"
+        Reading of β and of the position-state order (:func:`derived_coefficients`).
+
+    Returns
+    -------
+    elements : list of dict
+        One per CSV row: its fields (``quantity``, ``unit``, ``value``, ``equation``, ``row``,
+        ``col``, ...) plus ``expr`` (sympy, kinematic symbols only).
+
+    Raises
+    ------
+    ValueError
+        If ``reading`` is unknown or a printed element does not parse (the row is named).
     """
     from sympy.parsing.sympy_parser import parse_expr
 
@@ -463,10 +736,26 @@ def _frame_row(e, paper_v, derived_v, derived_expr):
 def check_elements(paper, reading: str = "B", state: str = "climb", rel_tol: float = 1e-9):
     """Every printed element of ``duan2023-eq-22`` against its re-derivation at a reference state.
 
-    Returns a pandas DataFrame (quantity, unit, equation, row, col, printed, paper (printed value
-    at the state), derived (re-derived value), derived_expr, match (abs(paper - derived) ≤
-    rel_tol·max(abs(paper), abs(derived), tiny)), comparable (False for elements of eqs. (14)-(15), whose split over the
-    states is not unique — checked row-wise by :func:`manifold_residuals`)).
+    Parameters
+    ----------
+    paper : PaperTable
+        ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
+    reading : {"A", "B"}, default "B"
+        Reading of β and of the position-state order (:func:`derived_coefficients`).
+    state : {"climb", "level", "steep"}, default "climb"
+        Reference state (:func:`reference_state`).
+    rel_tol : float, default 1e-9
+        Relative tolerance of ``match``.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per printed element: ``quantity``, ``unit``, ``equation``, ``row``, ``col``,
+        ``printed`` (the printed text), ``paper`` (printed value at the state, in ``unit``),
+        ``derived`` (re-derived value, or None), ``derived_expr`` (text), ``comparable`` (False for
+        elements of eqs. (14)-(15), whose split over the states is not unique — checked row-wise by
+        :func:`manifold_residuals` — and where no unique derived form exists) and ``match``
+        (abs(paper - derived) ≤ rel_tol·max(abs(paper), abs(derived), tiny)).
     """
 
     st = reference_state(state)
@@ -496,10 +785,26 @@ def manifold_residuals(paper, reading: str = "B", states=("climb", "level"), con
 
     On the correction manifold every state is its coefficient times δh^c, so a printed row
     ẋ_i = Σ_j M_ij x_j is right when Σ_j M_ij a_j equals d/dt a_i (per unit δh^c) — whatever
-    split over the columns the authors chose.  Two readings of the time derivative:
-    ``"C1"`` δḣ^c = δV_U^c (as eqs. (7) and (20) row 3 state), ``"C2"`` δh^c constant within the
-    interval.  Returns a DataFrame: equation, row, state, convention, printed (Σ M a), derived
-    (d a/dt), rel_residual.
+    split over the columns the authors chose.
+
+    Parameters
+    ----------
+    paper : PaperTable
+        ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
+    reading : {"A", "B"}, default "B"
+        Reading of β and of the position-state order (:func:`derived_coefficients`).
+    states : tuple of str, default ("climb", "level")
+        Reference states (:func:`reference_state`).
+    conventions : tuple of str, default ("C1", "C2")
+        Readings of the time derivative: ``"C1"`` δḣ^c = δV_U^c (as eqs. (7) and (20) row 3
+        state), ``"C2"`` δh^c constant within the interval.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per equation, row, state and convention: ``equation``, ``row``, ``state``,
+        ``convention``, ``printed`` (Σ M a), ``derived`` (d a/dt), both per unit δh^c in the unit
+        of the row's rate, and ``rel_residual`` (dimensionless; 0 when both are below 1e-14).
     """
 
     dc = derived_coefficients(reading)
@@ -528,7 +833,21 @@ def consistency_count(paper, state: str = "climb"):
     """Number of comparable printed elements that disagree with the derivation, per reading.
 
     The reading with fewer disagreements is the one the chapter adopts (it is the more
-    economical explanation of the print)."""
+    economical explanation of the print).
+
+    Parameters
+    ----------
+    paper : PaperTable
+        ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
+    state : {"climb", "level", "steep"}, default "climb"
+        Reference state (:func:`reference_state`).
+
+    Returns
+    -------
+    counts : dict of str to int
+        Reading (``READINGS``) → number of comparable elements that do not match
+        (:func:`check_elements`).
+    """
     out = {}
     for rd in READINGS:
         df = check_elements(paper, rd, state)
@@ -545,7 +864,26 @@ def interval_motion(state: str = "climb", interval: float = 30.0):
     v(τ) = v̄ + a (τ - T/2) with the reference speed v̄ as mean speed, d(τ) = (v̄ - aT/2) τ e + a τ²/2 e.
     At T = 30 s the displacement is the reference one (5.4 km); the end speed is v̄ + aT/2 (the
     reference state's speed × 30 s ignores its acceleration).  L, R_Mh, R_Nh are held, as in
-    ``_ddt``.  Returns ``f(tau) -> dict`` over the kinematic symbols.
+    ``_ddt``.
+
+    Parameters
+    ----------
+    state : {"climb", "level", "steep"}, default "climb"
+        Reference state (:func:`reference_state`) that sets direction, mean speed and acceleration.
+    interval : float, default 30.0
+        Interval length T [s], positive.
+
+    Returns
+    -------
+    at : callable
+        ``at(tau) -> dict``: the kinematic values at τ [s], keys as :func:`reference_state`
+        (``Sx``, ``Sy``, ``h`` [m], ``VE``, ``VN``, ``VU`` [m/s], ``AE``, ``AN``, ``AU`` [m/s²],
+        ``L`` [rad], ``RMh``, ``RNh`` [m]).
+
+    Raises
+    ------
+    ValueError
+        If ``interval`` is not positive.
     """
     if not interval > 0:
         raise ValueError("interval must be positive (seconds)")
@@ -714,10 +1052,26 @@ def sins_error_matrix(point):
         M_vp = (v^n ×)(2 ∂ω_ie/∂p + ∂ω_en/∂p) + ∂g^n/∂p,  M_pφ = 0,
         M_pv = [[0, 1/R_Mh, 0], [sec L/R_Nh, 0, 0], [0, 0, 1]],  M_pp = ∂ṗ/∂p,
 
-    with the forcing -C_b^n δω_ib^b (attitude) and +C_b^n δf^b (velocity).  Returns a dict with
-    ``F`` (9×9), ``G_gyro`` and ``G_accel`` (9×3 forcing of a body-frame gyro / accelerometer
-    error) and the nine blocks ``M_phiphi`` ... ``M_pp``.  ``point`` is an
-    :class:`replication.nav.errors.NavPoint`.
+    with the forcing -C_b^n δω_ib^b (attitude) and +C_b^n δf^b (velocity).
+
+    Parameters
+    ----------
+    point : replication.nav.errors.NavPoint
+        The navigation state at which the model is linearized.
+
+    Returns
+    -------
+    matrices : dict of str to numpy.ndarray
+        ``F`` (9, 9), the system matrix in SI units of the states (φ [rad], δv [m/s], δL, δλ
+        [rad], δh [m]; time in s); ``G_gyro`` and ``G_accel`` (9, 3), the forcing of a body-frame
+        gyro error [rad/s] and accelerometer error [m/s²]; and the nine (3, 3) blocks
+        ``M_phiphi``, ``M_phiv``, ``M_phip``, ``M_vphi``, ``M_vv``, ``M_vp``, ``M_pphi``, ``M_pv``,
+        ``M_pp``.
+
+    Raises
+    ------
+    TypeError
+        If ``point`` is not a ``NavPoint``.
     """
 
     if not isinstance(point, NavPoint):
@@ -739,7 +1093,19 @@ def sins_error_matrix(point):
 
 @dataclass
 class AirData:
-    """Air-data measurements at the sample instants: barometric height (m) and true airspeed (m/s)."""
+    """Air-data measurements at the sample instants of a trajectory.
+
+    Attributes
+    ----------
+    height : numpy.ndarray, shape (N + 1,)
+        Barometric height [m].
+    airspeed : numpy.ndarray, shape (N + 1,)
+        True airspeed [m/s].
+    sigma_height : float
+        Standard deviation of the height noise [m].
+    sigma_airspeed : float
+        Standard deviation of the airspeed noise [m/s].
+    """
 
     height: np.ndarray
     airspeed: np.ndarray
@@ -755,6 +1121,31 @@ def ads_measurements(traj, *, sigma_height: float = 1.0, sigma_airspeed: float =
     airspeed = |v^n - wind| + n_V, n_V ~ N(0, σ_V²) white (not given by duan2023: this
     package's choice, stated in the chapter).  The default wind is zero (the paper mentions the
     steady-airflow, low-frequency-wind condition of refs. [15-17]).
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    sigma_height : float, default 1.0
+        σ_h of the height noise [m], non-negative.
+    sigma_airspeed : float, default 0.5
+        σ_V of the airspeed noise [m/s], non-negative.
+    height_bias : float, default 0.0
+        Constant height error [m].
+    wind_enu : array_like, shape (3,), default (0, 0, 0)
+        Wind velocity (east, north, up) [m/s].
+    rng : numpy.random.Generator or int, optional
+        Random generator or seed (``numpy.random.default_rng``).
+
+    Returns
+    -------
+    ads : AirData
+        Height [m] and airspeed [m/s] at the N + 1 samples of ``traj``.
+
+    Raises
+    ------
+    ValueError
+        If a noise level is negative.
     """
     if sigma_height < 0 or sigma_airspeed < 0:
         raise ValueError("sigma_height and sigma_airspeed cannot be negative")
@@ -778,7 +1169,28 @@ def duan2023_flight(*, dt: float = 0.02, start_speed: float = 10.0, height0: flo
     (120 s), 1300 s straight, a 300-s descent of ``climb`` m and a 120-s deceleration back to
     ``start_speed`` ("起飞加速阶段与降落减速阶段").  The cruise speed
     V_c = (729 km - 120 s · start_speed) / 3660 s makes the along-track range exactly 729 km
-    (≈ 198.9 m/s with the defaults).  Returns a :class:`replication.nav.trajectory.Trajectory`.
+    (≈ 198.9 m/s with the defaults).  Start at 45°N, 110°E.
+
+    Parameters
+    ----------
+    dt : float, default 0.02
+        Sampling interval [s].
+    start_speed : float, default 10.0
+        Speed at take-off and landing [m/s], in (0, 100).
+    height0 : float, default 500.0
+        Start height [m].
+    climb : float, default 3000.0
+        Height gained in the climb and lost in the descent [m].
+
+    Returns
+    -------
+    traj : replication.nav.trajectory.Trajectory
+        The flight, sampled every ``dt``.
+
+    Raises
+    ------
+    ValueError
+        If ``start_speed`` is outside (0, 100) m/s.
     """
 
     if not (0 < start_speed < 100):
@@ -802,14 +1214,53 @@ class AirdataSetup:
     white noise whose 1-s average has the printed 1σ (PSD = σ² · 1 s); initial attitude error 0;
     airspeed noise 0.5 m/s; the Kalman filter of refs. [15-17] updates at 1 Hz.
 
-    ``attitude_sign`` reads the misalignment term of eq. (22) in the convention that the forcing
-    -C_b^n δω_ib^b of eq. (1) fixes (ref. [21]: Ĉ = exp(-φ×) C): -1 (default) is eq. (22) as printed,
-    φ_S/A = φ + φ^c u, i.e. the attitude turned by -φ^c u; +1 turns the attitude with the vectors as
-    eq. (5) turns the displacement and the velocity (φ_S/A = φ - φ^c u); 0 leaves it out.
-    ``threshold`` (1/s) gates Ṡ/S, ``gate`` says what a gated interval does.
-    ``accel_bias_axes`` scales the constant accelerometer bias per body axis (x right, y forward,
-    z up): (1, 1, 1) is the printed bias on every axis, (1, 1, 0) removes the up (z) bias only —
-    a diagnostic of this package, not a reading of duan2023 §3.
+    Attributes
+    ----------
+    correction_interval : float, default 30.0
+        Correction interval T of the proposed method [s], positive.
+    gyro_bias : float, default 0.01 °/h
+        Gyro constant drift on every body axis [rad/s].
+    gyro_random : float, default 0.01 °/h
+        Gyro random drift: 1σ of the 1-s average of the white noise [rad/s].
+    accel_bias : float, default 100 μg
+        Accelerometer constant bias [m/s²] (per axis, scaled by ``accel_bias_axes``).
+    accel_random : float, default 100 μg
+        Accelerometer random drift: 1σ of the 1-s average [m/s²].
+    sigma_height : float, default 1.0
+        ADS height noise σ_h [m].
+    sigma_airspeed : float, default 0.5
+        ADS airspeed noise σ_V [m/s] (this package's choice).
+    initial_velocity_error : float, default 0.1
+        Initial velocity error on each of E, N, U [m/s].
+    initial_position_error : float, default 10.0
+        Initial position error on each of E, N, U [m].
+    filter_interval : float, default 1.0
+        Update interval of the literature Kalman filter [s], positive.
+    markov_tau : float, default 300.0
+        Correlation time τ of the first-order Markov air-data error states [s].
+    threshold : float, default 1.5/30
+        Gate on Ṡ/S [1/s], positive: an interval with Ṡ/S above it is gated.
+    gate : {"skip", "height-only", "none"}, default "skip"
+        What a gated interval does: no correction, the height reset only (the paper's remedy), or
+        never gate.
+    attitude_sign : {-1.0, 1.0, 0.0}, default -1.0
+        Reads the misalignment term of eq. (22) in the convention that the forcing
+        -C_b^n δω_ib^b of eq. (1) fixes (ref. [21]: Ĉ = exp(-φ×) C): -1 is eq. (22) as printed,
+        φ_S/A = φ + φ^c u, i.e. the attitude turned by -φ^c u; +1 turns the attitude with the
+        vectors as eq. (5) turns the displacement and the velocity (φ_S/A = φ - φ^c u); 0 leaves it
+        out.
+    printed_half : bool, default False
+        Apply the extra factor 1/2 printed in eq. (6) (:func:`misalignment_correction`).
+    accel_bias_axes : tuple of float, default (1.0, 1.0, 1.0)
+        Factors on the constant accelerometer bias per body axis (x right, y forward, z up):
+        (1, 1, 1) is the printed bias on every axis, (1, 1, 0) removes the up (z) bias only — a
+        diagnostic of this package, not a reading of duan2023 §3.
+
+    Raises
+    ------
+    ValueError
+        If an interval or the threshold is not positive, ``gate`` or ``attitude_sign`` is not one
+        of the allowed values, or ``accel_bias_axes`` is not three finite factors.
     """
 
     correction_interval: float = 30.0
@@ -831,7 +1282,24 @@ class AirdataSetup:
 
     @classmethod
     def from_paper(cls, paper_setup, **overrides):
-        """Printed values from ``duan2023-claim-simulation-setup`` (units converted), plus overrides."""
+        """Printed values from ``duan2023-claim-simulation-setup`` (units converted), plus overrides.
+
+        The threshold is set to 1.5 / correction interval unless overridden.
+
+        Parameters
+        ----------
+        paper_setup : PaperTable
+            ``rp.load_paper("duan2023-claim-simulation-setup")``: correction interval [s], gyro drifts
+            [°/h], accelerometer bias and random drift [μg], ADS error [m], initial velocity [m/s] and
+            position [m] errors.
+        overrides : float, str, bool or tuple
+            Keyword arguments: ``AirdataSetup`` fields to set instead.
+
+        Returns
+        -------
+        setup : AirdataSetup
+            The printed setup in SI units with the overrides.
+        """
 
         v = paper_setup.value
         kw = dict(correction_interval=v("correction interval"), gyro_bias=v("gyro constant drift") * DEG_PER_H,
@@ -918,7 +1386,31 @@ def _end_state(sol):
 
 
 def run_pure_sins(traj, dth, dv, setup, *, every: int = 50):
-    """Pure SINS: strapdown with a free vertical channel from the perturbed initial state."""
+    """Pure SINS: strapdown with a free vertical channel from the perturbed initial state.
+
+    The initial state is the true one plus ``setup.initial_velocity_error`` and
+    ``setup.initial_position_error`` on each of E, N, U (no attitude error).
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    dth : numpy.ndarray, shape (N, 3)
+        Gyro angle increments Δθ per sample interval, body axes [rad] (with the sensor errors).
+    dv : numpy.ndarray, shape (N, 3)
+        Accelerometer velocity increments Δv per sample interval, body axes [m/s].
+    setup : AirdataSetup
+        Simulation parameters.
+    every : int, default 50
+        Record every ``every``-th sample.
+
+    Returns
+    -------
+    rec : _Recorder
+        The recorded navigation states at the samples ``rec.idx`` (shape (m,)): ``rec.st``
+        (m, 6) = latitude, longitude [rad], height [m], v_E, v_N, v_U [m/s], and ``rec.C``
+        (m, 3, 3) C_b^n.
+    """
     rec = _Recorder(traj, every)
     sol, ks, st, C = _segment(traj.t, dth, dv, 0, traj.n, _initial_state(traj, setup), every)
     rec.put(ks, st, C)
@@ -928,12 +1420,31 @@ def run_pure_sins(traj, dth, dv, setup, *, every: int = 50):
 def error_correction_step(origin, state, h_ads, setup):
     """One correction of the proposed method (duan2023 eqs. (4)-(22)) applied to a SINS state.
 
-    ``origin`` is the SINS position (lat, lon, h) at the start of the interval (point o of
-    Fig. 1), ``state`` the SINS :class:`~replication.nav.strapdown.NavState` at its end, ``h_ads``
-    the ADS height then.  Returns (corrected state, info dict with S, Ṡ/S, δh^c, gated, X^C).
     Gate (duan2023 §3): when Ṡ/S > ``setup.threshold`` the interval is either not corrected
     (``gate="skip"``: the step-like height error of Fig. 5) or only its height is reset
-    (``"height-only"``: the remedy the paper proposes).
+    (``"height-only"``: the remedy the paper proposes).  The attitude is turned by
+    ``setup.attitude_sign`` · [φ_E^c, φ_N^c, 0] (Ĉ = exp(-φ×) C of eq. (1)).
+
+    Parameters
+    ----------
+    origin : tuple of float
+        SINS position (lat [rad], lon [rad], h [m]) at the start of the interval (point o of
+        Fig. 1).
+    state : replication.nav.strapdown.NavState
+        SINS state at the end of the interval.
+    h_ads : float
+        ADS height at the end of the interval [m].
+    setup : AirdataSetup
+        ``threshold``, ``gate``, ``attitude_sign`` and ``printed_half`` are used.
+
+    Returns
+    -------
+    corrected : replication.nav.strapdown.NavState
+        The corrected state (``state`` itself when the interval is skipped).
+    info : dict
+        ``S`` horizontal displacement [m], ``ratio`` Ṡ/S [1/s], ``dh`` δh^c [m], ``gated``
+        (bool) and ``X`` the correction X^C of eq. (22), shape (9,) (zeros when gated;
+        :func:`correction_vector`).
     """
 
     lat0, lon0, h0 = origin
@@ -963,8 +1474,35 @@ def error_correction_step(origin, state, h_ads, setup):
 
 
 def run_error_correction(traj, dth, dv, ads, setup, *, every: int = 50):
-    """The proposed SINS/ADS: strapdown, corrected every ``setup.correction_interval`` seconds
-    by :func:`error_correction_step` (duan2023 §2, eq. (22) applied as a feedback reset)."""
+    """The proposed SINS/ADS: strapdown corrected every ``setup.correction_interval`` seconds.
+
+    Each interval ends with ``error_correction_step`` (duan2023 §2, eq. (22) applied as a
+    feedback reset); the corrected state is recorded at the interval's last sample.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    dth : numpy.ndarray, shape (N, 3)
+        Gyro angle increments Δθ per sample interval, body axes [rad] (with the sensor errors).
+    dv : numpy.ndarray, shape (N, 3)
+        Accelerometer velocity increments Δv per sample interval, body axes [m/s].
+    ads : AirData
+        ADS measurements at the samples of ``traj``.
+    setup : AirdataSetup
+        Simulation parameters.
+    every : int, default 50
+        Record every ``every``-th sample.
+
+    Returns
+    -------
+    rec : _Recorder
+        The recorded navigation states at the samples ``rec.idx`` (shape (m,)): ``rec.st``
+        (m, 6) = latitude, longitude [rad], height [m], v_E, v_N, v_U [m/s], and ``rec.C``
+        (m, 3, 3) C_b^n.
+        ``rec.infos`` lists the ``info`` dict of every correction (``error_correction_step``)
+        with its time ``t`` [s].
+    """
     rec = _Recorder(traj, every)
     ep = _epochs(traj, setup.correction_interval)
     state = _initial_state(traj, setup)
@@ -993,7 +1531,24 @@ def correction_experiment_flight(kind: str = "cruise", *, dt: float = 0.02):
 
     ``"cruise"``: 200 m/s; ``"accelerate"``: 100 → 160 m/s; ``"decelerate"``: 160 → 100 m/s
     (raised-cosine speed change over the 60 s: mean along-track acceleration ±1 m/s² over the
-    first 30 s).  Returns a :class:`replication.nav.trajectory.Trajectory`.
+    first 30 s).
+
+    Parameters
+    ----------
+    kind : {"cruise", "accelerate", "decelerate"}, default "cruise"
+        Flight state (``EXPERIMENT_KINDS``).
+    dt : float, default 0.02
+        Sampling interval [s].
+
+    Returns
+    -------
+    traj : replication.nav.trajectory.Trajectory
+        The 60-s flight.
+
+    Raises
+    ------
+    ValueError
+        If ``kind`` is unknown.
     """
 
     choice(kind, EXPERIMENT_KINDS, "kind")
@@ -1007,17 +1562,43 @@ def correction_experiment(traj, *, tilt: float = 0.0, dh0: float = 0.0, dvu0: fl
     """One correction of the proposed method (duan2023 eqs. (4)-(22)) on a controlled SINS error.
 
     The SINS starts from the true state at sample ``k0`` with known errors — a pitch tilt
-    ``tilt`` (rad) about the cross-track axis u = e_S × e_U of eq. (5) (misalignment φ = tilt·u in
-    the convention of eq. (1), Ĉ = exp(-φ×) C; tilt > 0 turns the computed frame nose-down), a
-    height error ``dh0`` (m) and an up-velocity error ``dvu0`` (m/s) — and integrates the exact
-    (error-free) IMU increments of ``traj`` for ``interval`` s.  The ADS height is the true one
-    (no noise), the gate is off, and :func:`error_correction_step` is applied once with
-    ``attitude_sign`` (-1: eq. (22) as printed, φ + φ^c; +1: the attitude turned with the vectors as
-    eq. (5) states, φ - φ^c; 0: no attitude term).
+    ``tilt`` about the cross-track axis u = e_S × e_U of eq. (5) (misalignment φ = tilt·u in the
+    convention of eq. (1), Ĉ = exp(-φ×) C; tilt > 0 turns the computed frame nose-down), a height
+    error ``dh0`` and an up-velocity error ``dvu0`` — and integrates the exact (error-free) IMU
+    increments of ``traj`` for ``interval`` s.  The ADS height is the true one (no noise), the
+    gate is off, and ``error_correction_step`` is applied once with ``attitude_sign``.
 
-    Returns a dict of errors at the end of the interval, ``_before`` and ``_after`` the correction:
-    ``tilt`` (component of φ along u, rad), ``dh`` (m), ``dvu`` (m/s), ``dvs`` (along-track
-    velocity, m/s); plus ``dhc`` (δh^c, m), ``S`` (m), ``phic`` (φ^c·u, rad) and ``dhc_over_S``.
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    tilt : float, default 0.0
+        Initial tilt about u [rad].
+    dh0 : float, default 0.0
+        Initial height error [m].
+    dvu0 : float, default 0.0
+        Initial up-velocity error [m/s].
+    interval : float, default 30.0
+        Correction interval [s].
+    attitude_sign : {-1.0, 1.0, 0.0}, default -1.0
+        Sign of the misalignment term of eq. (22) (``AirdataSetup``): -1 as printed, φ + φ^c;
+        +1 the attitude turned with the vectors as eq. (5) states, φ - φ^c; 0 no attitude term.
+    k0 : int, default 0
+        Sample at which the interval starts.
+
+    Returns
+    -------
+    errors : dict of str to float
+        Errors at the end of the interval, ``_before`` and ``_after`` the correction: ``tilt``
+        (component of φ along u [rad]), ``dh`` [m], ``dvu`` [m/s], ``dvs`` (along-track velocity
+        [m/s]); plus ``dhc`` (δh^c [m]), ``S`` [m], ``phic`` (φ^c·u [rad]) and ``dhc_over_S``
+        (δh^c/S, dimensionless).
+
+    Raises
+    ------
+    ValueError
+        If ``attitude_sign`` is not ±1 or 0, an injected error is not finite, or the interval does
+        not fit in the trajectory.
     """
 
     if attitude_sign not in (1.0, -1.0, 0.0):
@@ -1059,14 +1640,40 @@ def bias_experiment(accel_bias_up: float, *, n_intervals: int = 10, interval: fl
                     attitude_sign: float = -1.0, speed: float = 200.0, dt: float = 0.05):
     """Repeated corrections (duan2023 eq. (22)) of a SINS whose only error is an up accelerometer bias.
 
-    Level cruise at ``speed`` (45°N, 3000 m), exact ADS height, gate off, ``n_intervals``
-    corrections.  With the height reset and δV_U^c = δh^c/T (level flight) the up-velocity error
-    after a correction settles at bT/2 and every later interval ends with δh^c = -bT² (b the bias):
-    a height discrepancy of constant sign, which eq. (6) turns into a tilt increment of size bT/V
-    per interval — a tilt that grows linearly, about b/V rad/s.  Returns a dict of arrays over the
-    corrections: ``dhc`` (m), ``tilt`` (rad, along u after each correction) and the predictions
-    ``dhc_steady`` = -bT² and ``tilt_step`` = -attitude_sign · dhc_steady/(V T) (the tilt change
-    per interval, signed as the correction applies it).
+    Level cruise at ``speed`` (45°N, 3000 m, heading 0.5 rad), exact ADS height, gate off,
+    ``n_intervals`` corrections.  With the height reset and δV_U^c = δh^c/T (level flight) the
+    up-velocity error after a correction settles at bT/2 and every later interval ends with
+    δh^c = -bT² (b the bias): a height discrepancy of constant sign, which eq. (6) turns into a
+    tilt increment of size bT/V per interval — a tilt that grows linearly, about b/V rad/s.
+
+    Parameters
+    ----------
+    accel_bias_up : float
+        Up accelerometer bias b [m/s²].
+    n_intervals : int, default 10
+        Number of corrections, at least 2.
+    interval : float, default 30.0
+        Correction interval T [s].
+    attitude_sign : {-1.0, 1.0, 0.0}, default -1.0
+        Sign of the misalignment term of eq. (22) (``AirdataSetup``): -1 as printed, φ + φ^c;
+        +1 the attitude turned with the vectors as eq. (5) states, φ - φ^c; 0 no attitude term.
+    speed : float, default 200.0
+        Cruise speed V [m/s].
+    dt : float, default 0.05
+        Sampling interval [s].
+
+    Returns
+    -------
+    result : dict
+        ``dhc`` (n_intervals,) δh^c at each correction [m]; ``tilt`` (n_intervals,) tilt along u
+        after each correction [rad]; the predictions ``dhc_steady`` = -bT² [m] and ``tilt_step``
+        = -attitude_sign · dhc_steady/(V T) [rad] (the tilt change per interval, signed as the
+        correction applies it).
+
+    Raises
+    ------
+    ValueError
+        If ``n_intervals`` is below 2.
     """
 
     if n_intervals < 2:
@@ -1098,10 +1705,27 @@ EXPERIMENT_CASES = (("cruise", "tilt", 1e-3), ("cruise", "dh0", 10.0), ("cruise"
 
 
 def correction_experiment_table(cases=EXPERIMENT_CASES, signs=(-1.0, 1.0)):
-    """:func:`correction_experiment` for each (flight, injected error, value) and attitude sign.
+    """``correction_experiment`` for each (flight, injected error, value) and attitude sign.
 
-    Returns a DataFrame: flight, injected, value, sign, dh^c (m), φ^c·u (mrad), tilt before/after
-    (mrad), up-velocity error before/after (m/s), along-track velocity error (m/s).
+    Parameters
+    ----------
+    cases : sequence of (str, str, float), default EXPERIMENT_CASES
+        (flight kind of ``correction_experiment_flight``, injected error ``"tilt"`` [rad],
+        ``"dh0"`` [m] or ``"dvu0"`` [m/s], value).
+    signs : sequence of float, default (-1.0, 1.0)
+        Attitude signs tried (``AirdataSetup``).
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per case and sign: ``flight``, ``injected``, ``value``, ``sign``, ``dh^c (m)``,
+        ``phi^c.u (mrad)``, ``tilt before (mrad)``, ``tilt after (mrad)``, ``dV_U before (m/s)``,
+        ``dV_U after (m/s)``, ``dV_S (m/s)`` (along-track velocity error after the correction).
+
+    Raises
+    ------
+    ValueError
+        If an injected error is not one of the three.
     """
 
     flights = {}
@@ -1124,9 +1748,23 @@ def schuler_response(tilt, lat=np.radians(45.0), height: float = 0.0):
 
     With M_vφ = (f^n ×), f^n ≈ g e_U, and M_φv ≈ 1/R, a tilt φ_0 at t = 0 (no other error)
     gives the undamped Schuler oscillation φ = φ_0 cos ω_s t, |δv| = √(gR) φ_0 |sin ω_s t|,
-    |δp| = R φ_0 (1 - cos ω_s t), ω_s = √(g/R), R = √(R_M R_N) + h.  Returns a dict with
-    ``velocity_amplitude`` (m/s), ``position_peak`` (m, 2Rφ_0), ``period`` (s) and
-    ``velocity_rate`` g φ_0 (m/s², the initial slope of |δv|).
+    |δp| = R φ_0 (1 - cos ω_s t), ω_s = √(g/R), R = √(R_M R_N) + h.
+
+    Parameters
+    ----------
+    tilt : float or array_like
+        Tilt φ_0 [rad].
+    lat : float, default 45° (in radians)
+        Latitude [rad].
+    height : float, default 0.0
+        Height h [m].
+
+    Returns
+    -------
+    response : dict
+        ``velocity_amplitude`` √(gR)|φ_0| [m/s], ``position_peak`` 2R|φ_0| [m] (shape of
+        ``tilt``), ``period`` 2π/ω_s [s] and ``velocity_rate`` g|φ_0| [m/s², the initial slope of
+        |δv|].
     """
     tilt = _arr(tilt, "tilt")
     lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
@@ -1238,8 +1876,22 @@ def run_literature(traj, dth, dv, ads, setup, gains_pack, *, every: int = 50):
 
 
 def navigation_errors(traj, rec):
-    """Errors of recorded states against the truth: dict with ``t``, ``enu`` (m), ``v`` (m/s),
-    ``phi`` (rad, Ĉ = exp(-φ×) C) on the recorder's grid."""
+    """Errors of recorded states against the truth, on the recorder's grid.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    rec : _Recorder
+        Recorded states of ``run_pure_sins``, ``run_error_correction`` or the literature
+        filter.
+
+    Returns
+    -------
+    errors : dict of numpy.ndarray
+        ``t`` (m,) record times [s]; ``enu`` (m, 3) position error east, north, up [m]; ``v``
+        (m, 3) velocity error [m/s]; ``phi`` (m, 3) misalignment [rad] (Ĉ = exp(-φ×) C).
+    """
 
     i = rec.idx
     rm, rn = earth.radii(traj.lat[i])
@@ -1256,7 +1908,22 @@ SYSTEMS = ("SINS", "literature SINS/ADS", "proposed SINS/ADS")
 
 @dataclass
 class MonteCarlo:
-    """Error histories of the three systems: arrays runs × grid × 3 per system and quantity."""
+    """Error histories of the three systems of ``simulate``.
+
+    Attributes
+    ----------
+    t : numpy.ndarray, shape (m,)
+        Record times [s].
+    errors : dict
+        System (``SYSTEMS``) → {``"enu"``: position error east, north, up [m], ``"v"``:
+        velocity error [m/s], ``"phi"``: misalignment [rad]}, each an array of shape (runs, m, 3).
+    infos : list of list of dict
+        Per run, the correction records of the proposed SINS/ADS (``run_error_correction``).
+    setup : AirdataSetup
+        The simulation parameters.
+    seed : int
+        Seed of the ``SeedSequence`` the runs spawn from.
+    """
 
     t: np.ndarray
     errors: dict
@@ -1265,9 +1932,26 @@ class MonteCarlo:
     seed: int
 
     def summary(self, statistic: str = "max", until: float | None = None):
-        """Per run and system: misalignment (°), velocity error (m/s), position error (km) — the
-        3-axis norm, reduced over the flight (or over t ≤ ``until`` s) by ``statistic`` ("max",
-        "final" or "rms")."""
+        """Per run and system: the flight summary of the 3-axis error norms.
+
+        Parameters
+        ----------
+        statistic : {"max", "final", "rms"}, default "max"
+            Reduction over the flight (NaN ignored for max and rms).
+        until : float, optional
+            Reduce over t ≤ ``until`` [s] only.
+
+        Returns
+        -------
+        table : pandas.DataFrame
+            One row per system and run: ``system``, ``run``, ``misalignment`` [°], ``velocity error``
+            [m/s], ``position error`` [km].
+
+        Raises
+        ------
+        ValueError
+            If ``statistic`` is unknown or ``until`` lies before the first record.
+        """
 
         if statistic not in ("max", "final", "rms"):
             raise ValueError("statistic must be 'max', 'final' or 'rms'")
@@ -1297,6 +1981,34 @@ def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, e
     Each run draws IMU white noise, ADS height and airspeed noise from its own generator
     (``SeedSequence(seed).spawn(n_runs)``); the three systems of a run share the same draws
     (common random numbers).  The literature filter's gains are computed once along the truth.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    setup : AirdataSetup
+        Simulation parameters.
+    n_runs : int, default 10
+        Number of runs, at least 1.
+    seed : int, default 2023
+        Seed of the ``SeedSequence``.
+    every : int, default 50
+        Record every ``every``-th sample.
+    systems : sequence of str, default SYSTEMS
+        The systems simulated (a subset of ``SYSTEMS``).
+    gains_pack : tuple, optional
+        Precomputed gains of the literature filter (output of ``literature_gains``); computed when
+        that system is simulated and none is given.
+
+    Returns
+    -------
+    mc : MonteCarlo
+        The error histories.
+
+    Raises
+    ------
+    ValueError
+        If ``n_runs`` is below 1 or a system is unknown.
     """
     if n_runs < 1:
         raise ValueError("n_runs must be at least 1")
@@ -1331,8 +2043,28 @@ def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, e
 # =========================================================================== 5. chapter helpers
 
 def table1_rows(mc: MonteCarlo, paper, statistic: str = "max", until: float | None = None):
-    """Rows of duan2023 Table 1: paper vs the Monte-Carlo mean, std and two-sided 95 % Student-t
-    interval of the mean (``lo``, ``hi``) of ``statistic`` (over t ≤ ``until`` if given)."""
+    """Rows of duan2023 Table 1: paper vs the Monte-Carlo mean, std and 95 % interval of the mean.
+
+    The interval is the two-sided Student-t interval of the mean (:func:`mean_interval`).
+
+    Parameters
+    ----------
+    mc : MonteCarlo
+        Output of ``simulate`` (the three systems).
+    paper : PaperTable
+        ``rp.load_paper("duan2023-table-1")``.
+    statistic : {"max", "final", "rms"}, default "max"
+        Reduction over the flight (``MonteCarlo.summary``).
+    until : float, optional
+        Reduce over t ≤ ``until`` [s] only.
+
+    Returns
+    -------
+    rows : list of dict
+        One per system and quantity (``TABLE1_UNITS``): ``system``, ``quantity``, ``unit``
+        (deg, m/s, km), ``paper``, ``mean``, ``std`` (ddof = 1; 0 for one run), ``lo``, ``hi``,
+        in ``unit``.
+    """
 
     s = mc.summary(statistic, until=until)
     rows = []
@@ -1350,8 +2082,31 @@ TABLE1_UNITS = {"misalignment": "deg", "velocity error": "m/s", "position error"
 
 
 def mean_interval(x, level: float = 0.95):
-    """Mean of the runs ``x`` and the two-sided Student-t interval of the mean at ``level``:
-    (mean, lo, hi) with half-width t_{(1+level)/2, n-1} · s / √n (NaN half-width for one run)."""
+    """Mean of the runs ``x`` and the two-sided Student-t interval of the mean at ``level``.
+
+    The half-width is t_{(1+level)/2, n-1} · s / √n (NaN for one run).
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Run values, finite, at least one.
+    level : float, default 0.95
+        Confidence level, in (0, 1).
+
+    Returns
+    -------
+    mean : float
+        Mean of ``x``.
+    lo : float
+        Lower end of the interval (unit of ``x``).
+    hi : float
+        Upper end of the interval.
+
+    Raises
+    ------
+    ValueError
+        If ``x`` is not a non-empty 1-D array of finite values or ``level`` is outside (0, 1).
+    """
 
     x = np.asarray(x, dtype=float)
     if x.ndim != 1 or len(x) < 1 or not np.all(np.isfinite(x)):
@@ -1363,9 +2118,24 @@ def mean_interval(x, level: float = 0.95):
 
 
 def pure_sins_initial_errors_only(traj, setup: AirdataSetup) -> dict:
-    """Pure SINS driven by the printed initial errors alone (every sensor error zero): final
-    misalignment (°), velocity error (m/s) and position error (km), 3-axis norms — the reading
-    under which duan2023 Table 1's pure-SINS column is computed if its sensors were ideal."""
+    """Pure SINS driven by the printed initial errors alone (every sensor error zero).
+
+    The reading under which duan2023 Table 1's pure-SINS column is computed if its sensors were
+    ideal.
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    setup : AirdataSetup
+        Simulation parameters.
+        Its initial errors are used; its sensor errors are set to zero.
+
+    Returns
+    -------
+    final : dict of str to float
+        Final 3-axis norms: ``misalignment`` [°], ``velocity error`` [m/s], ``position error`` [km].
+    """
 
     ideal = replace(setup, gyro_bias=0.0, gyro_random=0.0, accel_bias=0.0, accel_random=0.0)
     dth, dv = _corrupt(traj, ideal, np.random.default_rng(0))  # zero noise: the draws do not enter
@@ -1385,11 +2155,10 @@ PROPOSED_REASON = (
 
 
 def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> list[dict]:
-    """Rows of duan2023 Table 1 for :func:`replication.registry.reproduction.compare`, with the statuses of
-    the written criteria (CONTRIBUTING.md, "Statuses") and the 95 % interval of every Monte-Carlo
-    mean in the note.  ``until``: end of the cruise (s; the proposed method's maximum before the
-    final deceleration is reported beside the maximum over the flight); ``ideal``: the pure SINS
-    with ideal sensors (:func:`pure_sins_initial_errors_only`).
+    """Rows of duan2023 Table 1 for :func:`replication.registry.reproduction.compare`.
+
+    With the statuses of the written criteria (CONTRIBUTING.md, "Statuses") and the 95 % interval
+    of every Monte-Carlo mean in the note:
 
     * proposed SINS/ADS: not reproduced where the whole interval lies above ten times the print;
     * pure SINS misalignment: not reproduced (no reading reaches the print);
@@ -1397,6 +2166,25 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
       print within 5 % while the printed sensor errors give more than twice it;
     * literature SINS/ADS (refs. [15-17], unspecified in duan2023): unverifiable when the stand-in
       lies more than ten times from the print, analog otherwise.
+
+    Parameters
+    ----------
+    mc : MonteCarlo
+        Output of ``simulate`` (the three systems).
+    paper : PaperTable
+        ``rp.load_paper("duan2023-table-1")``.
+    until : float
+        End of the cruise [s]: the proposed method's maximum before the final deceleration is
+        reported beside the maximum over the flight.
+    ideal : dict of str to float
+        The pure SINS with ideal sensors (``pure_sins_initial_errors_only``).
+
+    Returns
+    -------
+    rows : list of dict
+        One per system and quantity: ``quantity`` ("<system> / <quantity>"), ``unit``, ``paper``,
+        ``reproduced`` (run mean of the flight maxima, or the ideal-sensor value for an
+        inconsistent row, in ``unit``), ``status`` and ``note``.
     """
     early = {(r["system"], r["quantity"]): r for r in table1_rows(mc, paper, until=until)}
     n = len(mc.summary("max")) // len(SYSTEMS)
@@ -1431,7 +2219,7 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
 
 
 def claim_checks(mc: MonteCarlo):
-    """The qualitative statements of duan2023 §3 evaluated on a Monte Carlo (dict of numbers/bools).
+    """The qualitative statements of duan2023 §3 evaluated on a Monte Carlo.
 
     * ordering — per quantity, is proposed < literature < SINS (run means of the flight maxima)?
     * literature E/N velocity vs position — literature's max horizontal velocity error below the
@@ -1441,6 +2229,19 @@ def claim_checks(mc: MonteCarlo):
     * step — the largest |δh^c| met at a correction epoch over the median one (gated intervals let
       the height error grow, then it is removed in one step);
     * spatial — final 3-D position error of proposed vs literature.
+
+    Parameters
+    ----------
+    mc : MonteCarlo
+        Output of ``simulate`` (the three systems).
+
+    Returns
+    -------
+    checks : dict of str to bool or float
+        ``ordering <quantity>`` (bool); the run-mean maximum horizontal velocity errors [m/s] and
+        position errors [km] of the literature and proposed systems; ``start-up |phi^c| / cruise
+        median`` and ``max |dh^c| / cruise median`` (medians over the runs, dimensionless);
+        ``gated corrections per run``; the final 3-D position errors [km] of both.
     """
     s = mc.summary("max").groupby("system").mean(numeric_only=True)
     out = {}
@@ -1475,14 +2276,38 @@ def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7,
           progress=None):
     """Sensitivity of the proposed method: one Monte Carlo per dict of ``changes`` to ``setup``.
 
-    Returns a DataFrame with the changed values and the run-mean of the flight maxima and the
-    final values (misalignment °, velocity m/s, position km) and the gated corrections per run.
+    Each setting is its own Monte Carlo with the same ``seed``, so with ``executor`` or
+    ``chunk_runs`` the settings are computed in chunks of ``chunk_runs`` settings, one picklable
+    task each (:func:`replication.nav.parallel.run_chunks`), the rows in the order of
+    ``changes``, equal to the in-process ones bit for bit.
 
-    Each setting is its own Monte Carlo with the same ``seed``, so with ``executor`` (any
-    ``concurrent.futures.Executor``) or ``chunk_runs`` the settings are computed in chunks of
-    ``chunk_runs`` settings, one picklable task each (:func:`replication.nav.parallel.run_chunks`),
-    the rows in the order of ``changes``, equal to the in-process ones bit for bit; ``progress``:
-    progress bar of the finished settings (``None``: on unless ``REPLICATION_PROGRESS=0``).
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    setup : AirdataSetup
+        Simulation parameters.
+        The base setting.
+    changes : iterable of dict
+        Each a dict of ``AirdataSetup`` fields to change.
+    n_runs : int, default 3
+        Runs per setting.
+    seed : int, default 7
+        Seed of every setting's Monte Carlo.
+    executor : concurrent.futures.Executor, optional
+        Executor on which the chunks run (:func:`replication.nav.parallel.run_chunks`); with
+        ``chunk_runs`` None as well, everything runs in process.
+    chunk_runs : int, optional
+        Settings per picklable task.
+    progress : bool, optional
+        Progress bar of the finished settings (``None``: on unless ``REPLICATION_PROGRESS=0``).
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per setting: the changed fields, ``max misalignment (deg)``, ``max velocity error
+        (m/s)``, ``max position error (km)`` (run means of the flight maxima), ``final position
+        error (km)`` and ``gated per run``.
     """
     changes = list(changes)
     if executor is None and chunk_runs is None:
@@ -1569,9 +2394,32 @@ def diagnostic_runs(traj, setup: AirdataSetup, diagnostics=None, *, n_runs: int 
                     seed: int = 2023) -> dict:
     """Monte Carlo of the proposed SINS/ADS under each diagnostic change of ``setup``.
 
-    ``diagnostics``: label → dict of ``AirdataSetup`` fields (default :data:`BIAS_DIAGNOSTICS`).
-    The runs draw from ``SeedSequence(seed)`` as ``simulate`` does, so with the main run's seed
-    they share its noise (common random numbers).  Returns label → ``MonteCarlo``.
+    The runs draw from ``SeedSequence(seed)`` as ``simulate`` does, so with the main run's
+    seed they share its noise (common random numbers).
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    setup : AirdataSetup
+        Simulation parameters.
+        The base setting.
+    diagnostics : dict of str to dict, optional
+        Label → dict of ``AirdataSetup`` fields (default :data:`BIAS_DIAGNOSTICS`).
+    n_runs : int, default 20
+        Runs per diagnostic, at least 2.
+    seed : int, default 2023
+        Seed of the ``SeedSequence``.
+
+    Returns
+    -------
+    runs : dict of str to MonteCarlo
+        Label → the Monte Carlo of the proposed SINS/ADS.
+
+    Raises
+    ------
+    ValueError
+        If ``diagnostics`` is empty or not a dict, or ``n_runs`` is below 2.
     """
     diagnostics = BIAS_DIAGNOSTICS if diagnostics is None else diagnostics
     if not isinstance(diagnostics, dict) or not diagnostics:
@@ -1593,6 +2441,27 @@ def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> lis
     of its interval lies above (1 + tolerance) × the printed proposed-method value.  ``qualitative``
     where it holds; ``not-reproduced`` (the statement fails: the removed bias is what separates the
     analog from the print) where it does not.
+
+    Parameters
+    ----------
+    diagnostics : dict of str to MonteCarlo
+        Output of :func:`diagnostic_runs` (at least two runs each).
+    table1 : PaperTable
+        ``rp.load_paper("duan2023-table-1")``.
+    digits : int, default 2
+        Significant digits of ``reproduced`` and of the note's numbers.
+
+    Returns
+    -------
+    rows : list of dict
+        One per diagnostic and quantity: ``quantity`` ("diagnostic: <label> | proposed SINS/ADS /
+        <quantity>"), ``unit`` (deg, m/s, km), ``paper`` (empty), ``reproduced``, ``digits``,
+        ``status`` and ``note``.
+
+    Raises
+    ------
+    ValueError
+        If ``diagnostics`` is empty or a diagnostic has fewer than two runs.
     """
     if not isinstance(diagnostics, dict) or not diagnostics:
         raise ValueError("diagnostics must be a non-empty dict: label -> MonteCarlo of diagnostic_runs")
@@ -1667,11 +2536,30 @@ _REMARKS = {
 
 
 def eq22_rows(paper, reading: str = "B", state: str = "climb"):
-    """Comparison rows for ``duan2023-eq-22``: every comparable printed element (value at the
-    reference state vs the re-derivation, relative tolerance 1e-9 — the two are symbolic
-    expressions, so only round-off may separate them) and the rows of eqs. (14)-(15), whose
-    split over the states is not unique, checked on the correction manifold (convention C1,
-    δḣ^c = δV_U^c, the one eqs. (7) and (20) use)."""
+    """Comparison rows for ``duan2023-eq-22``.
+
+    Every comparable printed element (value at the reference state vs the re-derivation, relative
+    tolerance 1e-9 — the two are symbolic expressions, so only round-off may separate them) and
+    the rows of eqs. (14)-(15), whose split over the states is not unique, checked on the
+    correction manifold (convention C1, δḣ^c = δV_U^c, the one eqs. (7) and (20) use).
+
+    Parameters
+    ----------
+    paper : PaperTable
+        ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
+    reading : {"A", "B"}, default "B"
+        Reading of β and of the position-state order (:func:`derived_coefficients`).
+    state : {"climb", "level", "steep"}, default "climb"
+        Reference state (:func:`reference_state`).
+
+    Returns
+    -------
+    rows : list of dict
+        For :func:`replication.registry.reproduction.compare`: ``quantity``, ``unit``, ``paper``,
+        ``reproduced`` (values at the state in ``unit``), ``tolerance`` 1e-9, ``tolerance_kind``
+        "rel", and for the flagged elements ``status`` (erratum or inconsistent), ``note`` and,
+        for errata, ``evidence`` and ``corrected``.
+    """
     df = check_elements(paper, reading, state)
     rows = []
     for _, r in df[df["comparable"]].iterrows():
@@ -1700,12 +2588,28 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
 
 
 def eq22_readings_rows(paper, state: str = "climb"):
-    """Readings ledger of the blamed elements of duan2023 eqs. (4)-(21): every element that the
-    adopted reading B flags (erratum or inconsistency), compared with the re-derivation under
-    both readings of the position rows (A: β from east, δp = latitude, longitude, height; B: β
-    the heading from north, δp = longitude, latitude, height), relative tolerance 1e-9 (symbolic
-    expressions: only round-off separates them).  An element reproduced under reading A is a
-    matter of convention, not a misprint."""
+    """Readings ledger of the blamed elements of duan2023 eqs. (4)-(21).
+
+    Every element that the adopted reading B flags (erratum or inconsistency), compared with the
+    re-derivation under both readings of the position rows (A: β from east, δp = latitude,
+    longitude, height; B: β the heading from north, δp = longitude, latitude, height), relative
+    tolerance 1e-9 (symbolic expressions: only round-off separates them).  An element reproduced
+    under reading A is a matter of convention, not a misprint.
+
+    Parameters
+    ----------
+    paper : PaperTable
+        ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
+    state : {"climb", "level", "steep"}, default "climb"
+        Reference state (:func:`reference_state`).
+
+    Returns
+    -------
+    rows : list of dict
+        One per blamed element and reading: ``quantity`` ("reading A | <element>" or "reading B |
+        <element>"), ``unit``, ``paper``, ``reproduced``, ``tolerance`` 1e-9, ``tolerance_kind``
+        "rel" and ``note``.
+    """
     da = check_elements(paper, "A", state).set_index("quantity")
     db = check_elements(paper, "B", state).set_index("quantity")
     blamed = [q for q in db.index if db.loc[q, "comparable"] and not db.loc[q, "match"]]
@@ -1721,10 +2625,25 @@ def eq22_readings_rows(paper, state: str = "climb"):
 
 
 def eq1_checks(point):
-    """Structure of duan2023 eq. (1) from the navigation core: largest |M_pφ|, the scalar k with
-    G_gyro = k C_b^n (attitude rows), G_accel = k C_b^n (velocity rows), largest position forcing,
-    and the largest difference between the analytic F and the numerical Jacobian of the
-    mechanization (relative to the largest element of each column)."""
+    """Structure of duan2023 eq. (1) from the navigation core.
+
+    Parameters
+    ----------
+    point : replication.nav.errors.NavPoint
+        The navigation state at which the model is linearized (``sins_error_matrix``).
+
+    Returns
+    -------
+    checks : dict of str to float
+        ``block (p; phi) largest element`` (largest |M_pφ|, in the units of F);
+        ``gyro forcing coefficient of C_b^n`` (the scalar k with G_gyro = k C_b^n in the attitude
+        rows) and ``gyro forcing residual``; ``accelerometer forcing coefficient of C_b^n`` (k with
+        G_accel = k C_b^n in the velocity rows) and ``accelerometer forcing residual``;
+        ``position forcing largest element`` (largest element of the position rows of G_gyro and
+        G_accel); ``F vs numerical Jacobian (max column-relative difference)`` (the analytic F
+        against the numerical Jacobian of the mechanization, relative to the largest element of
+        each column, dimensionless).
+    """
 
     m = sins_error_matrix(point)
     C = np.asarray(point.C_bn, float)

@@ -68,6 +68,21 @@ def grid_frame(r):
     G_N is the intersection of the local horizontal plane with the plane through the point
     parallel to the prime-meridian plane, G_N ∝ G_U × e_y; G_E = G_N × G_U.  Regular at the poles;
     undefined only where G_U = ±e_y (λ = ±90° on the equator).
+
+    Parameters
+    ----------
+    r : array_like, shape (..., 3)
+        ECEF position [m].
+
+    Returns
+    -------
+    c_e_g : numpy.ndarray, shape (..., 3, 3)
+        C_e^G (rows G_E, G_N, G_U in ECEF components).
+
+    Raises
+    ------
+    ValueError
+        If ``r`` is not finite with a last axis of 3, or the vertical is ±e_y.
     """
     r = vector3(r, "r (ECEF position, m)")
     q = r / np.array([earth.A**2, earth.A**2, earth.B**2])
@@ -75,7 +90,23 @@ def grid_frame(r):
 
 
 def grid_frame_sphere(r):
-    """C_e^G of the spherical Earth used in fang2020 §2.2 (normal r/‖r‖)."""
+    """C_e^G of the spherical Earth used in fang2020 §2.2 (normal r/‖r‖).
+
+    Parameters
+    ----------
+    r : array_like, shape (..., 3)
+        ECEF position on the sphere [m].
+
+    Returns
+    -------
+    c_e_g : numpy.ndarray, shape (..., 3, 3)
+        C_e^G (rows G_E, G_N, G_U in ECEF components), G_U = r/‖r‖.
+
+    Raises
+    ------
+    ValueError
+        If ``r`` is not finite with a last axis of 3, or r/‖r‖ is ±e_y.
+    """
     r = vector3(r, "r (position on the sphere, m)")
     return _frame_from_normal(r / np.linalg.norm(r, axis=-1, keepdims=True))
 
@@ -95,6 +126,23 @@ def grid_azimuth(lat, lon):
     """Grid azimuth σ, the angle from geographic north to grid north (fang2020 eq. (8)).
 
     sin σ = sin L sin λ / √(1 - cos²L sin²λ), cos σ = cos λ / √(1 - cos²L sin²λ).
+
+    Parameters
+    ----------
+    lat : float or array_like
+        Latitude L [rad], |L| ≤ 90°.
+    lon : float or array_like
+        Longitude λ [rad].
+
+    Returns
+    -------
+    sigma : numpy.ndarray
+        σ [rad] in (-π, π], the broadcast shape of ``lat`` and ``lon``.
+
+    Raises
+    ------
+    ValueError
+        If a latitude lies beyond ±90° or an angle is not finite.
     """
     lat = earth.check_latitude(lat)
     lon = _angle(lon, "lon")
@@ -102,7 +150,19 @@ def grid_azimuth(lat, lon):
 
 
 def geographic_to_grid(sigma):
-    """C_g^G: geographic (E, N, U) to grid components, fang2020 eq. (2)."""
+    """C_g^G: geographic (E, N, U) to grid components, fang2020 eq. (2).
+
+    Parameters
+    ----------
+    sigma : float or array_like
+        Grid azimuth σ [rad] (:func:`grid_azimuth`).
+
+    Returns
+    -------
+    c_g_g : numpy.ndarray, shape sigma.shape + (3, 3)
+        The rotation by σ about the common vertical, [[cos σ, -sin σ, 0], [sin σ, cos σ, 0],
+        [0, 0, 1]].
+    """
     s = _angle(sigma, "sigma")
     c, sn = np.cos(s), np.sin(s)
     z, o = np.zeros_like(s), np.ones_like(s)
@@ -110,8 +170,20 @@ def geographic_to_grid(sigma):
 
 
 def oepq_frame(lon):
-    """C_e^OEPQ: rows E (east, tangent to the parallel), P (parallel to the polar axis) and
-    Q = E × P in ECEF (fang2020 §2.1)."""
+    """C_e^OEPQ: the OEPQ axes in ECEF (fang2020 §2.1).
+
+    Rows E (east, tangent to the parallel), P (parallel to the polar axis) and Q = E × P.
+
+    Parameters
+    ----------
+    lon : float or array_like
+        Longitude λ [rad].
+
+    Returns
+    -------
+    c_e_oepq : numpy.ndarray, shape lon.shape + (3, 3)
+        C_e^OEPQ (rows E, P, Q in ECEF components).
+    """
     lon = _angle(lon, "lon")
     s, c = np.sin(lon), np.cos(lon)
     z, o = np.zeros_like(lon), np.ones_like(lon)
@@ -119,7 +191,25 @@ def oepq_frame(lon):
 
 
 def oepq_to_grid(lat, sigma):
-    """C_OEPQ^G = C_g^G(σ) R_x(L), fang2020 eq. (16)."""
+    """C_OEPQ^G = C_g^G(σ) R_x(L), fang2020 eq. (16).
+
+    Parameters
+    ----------
+    lat : float or array_like
+        Latitude L [rad], |L| ≤ 90°.
+    sigma : float or array_like
+        Grid azimuth σ [rad] (:func:`grid_azimuth`).
+
+    Returns
+    -------
+    c_oepq_g : numpy.ndarray, shape (..., 3, 3)
+        C_OEPQ^G, the broadcast shape of ``lat`` and ``sigma`` + (3, 3).
+
+    Raises
+    ------
+    ValueError
+        If a latitude lies beyond ±90° or ``sigma`` is not finite.
+    """
     lat = earth.check_latitude(lat)
     sigma = _angle(sigma, "sigma")
     c, s = np.cos(lat), np.sin(lat)
@@ -132,6 +222,24 @@ def computer_frame_angle(dlat, dlon, dsigma, lat, sigma):
     """θ in grid components for position errors (δL, δλ) and grid-azimuth error δσ, eq. (2).
 
     θ^g = [-δL, δλ cos L, δλ sin L - δσ], θ = C_g^G θ^g.
+
+    Parameters
+    ----------
+    dlat : float or array_like
+        Latitude error δL [rad].
+    dlon : float or array_like
+        Longitude error δλ [rad].
+    dsigma : float or array_like
+        Grid-azimuth error δσ [rad].
+    lat : float or array_like
+        Latitude L [rad], |L| ≤ 90°.
+    sigma : float or array_like
+        Grid azimuth σ [rad] (:func:`grid_azimuth`).
+
+    Returns
+    -------
+    theta : numpy.ndarray, shape (..., 3)
+        θ [rad] in grid components (E, N, U), the broadcast shape of the inputs + (3,).
     """
     lat = earth.check_latitude(lat)
     th_g = np.stack(np.broadcast_arrays(-np.asarray(dlat, float), np.asarray(dlon, float) * np.cos(lat),
@@ -140,7 +248,22 @@ def computer_frame_angle(dlat, dlon, dsigma, lat, sigma):
 
 
 def sphere_point(lat, lon, radius):
-    """(x, y, z) = R (cos L cos λ, cos L sin λ, sin L) — the spherical Earth of fang2020 eq. (6)."""
+    """(x, y, z) = R (cos L cos λ, cos L sin λ, sin L) — the spherical Earth of fang2020 eq. (6).
+
+    Parameters
+    ----------
+    lat : float or array_like
+        Latitude L [rad], |L| ≤ 90°.
+    lon : float or array_like
+        Longitude λ [rad].
+    radius : float
+        Sphere radius R [m], positive.
+
+    Returns
+    -------
+    r : numpy.ndarray, shape (..., 3)
+        ECEF position [m], the broadcast shape of ``lat`` and ``lon`` + (3,).
+    """
     lat = earth.check_latitude(lat)
     lon = _angle(lon, "lon")
     radius = positive(radius, "radius")
@@ -149,13 +272,40 @@ def sphere_point(lat, lon, radius):
 
 
 def gaussian_radius(lat):
-    """Gaussian mean radius √(R_M R_N) (m): the sphere osculating WGS-84 at latitude ``lat``."""
+    """Gaussian mean radius √(R_M R_N): the sphere osculating WGS-84 at latitude ``lat``.
+
+    Parameters
+    ----------
+    lat : float or array_like
+        Latitude L [rad], |L| ≤ 90°.
+
+    Returns
+    -------
+    radius : numpy.ndarray
+        √(R_M R_N) [m], the shape of ``lat``.
+    """
     rm, rn = earth.radii(lat)
     return np.sqrt(rm * rn)
 
 
 def grid_heading(c_b_g):
-    """Grid heading (rad, clockwise from grid north) of the body forward axis; C_b^G given."""
+    """Grid heading of the body forward axis, clockwise from grid north, from C_b^G.
+
+    Parameters
+    ----------
+    c_b_g : array_like, shape (..., 3, 3)
+        C_b^G (body axes right, forward, up).
+
+    Returns
+    -------
+    heading : numpy.ndarray, shape (...)
+        Grid heading [rad] in (-π, π].
+
+    Raises
+    ------
+    ValueError
+        If ``c_b_g`` does not have trailing shape (3, 3).
+    """
     c = np.asarray(c_b_g, dtype=float)
     if c.shape[-2:] != (3, 3):
         raise ValueError(f"C_b^G must be (..., 3, 3), got {c.shape}")
@@ -163,13 +313,45 @@ def grid_heading(c_b_g):
 
 
 def attitude_from_euler(heading, pitch, roll):
-    """C_b^G = R_z(-heading) R_x(pitch) R_y(roll) (body axes right, forward, up), the convention of
-    :func:`replication.nav.rotations.euler_to_dcm` applied to grid angles."""
+    """C_b^G = R_z(-heading) R_x(pitch) R_y(roll) from grid Euler angles.
+
+    Body axes right, forward, up: the convention of
+    :func:`replication.nav.rotations.euler_to_dcm` applied to grid angles.
+
+    Parameters
+    ----------
+    heading : float or array_like
+        Grid heading, clockwise from grid north [rad].
+    pitch : float or array_like
+        Pitch [rad], within ±90°.
+    roll : float or array_like
+        Roll [rad].
+
+    Returns
+    -------
+    c_b_g : numpy.ndarray, shape (..., 3, 3)
+        C_b^G, the broadcast shape of the angles + (3, 3).
+    """
     return rotations.euler_to_dcm(heading, pitch, roll)
 
 
 def euler_from_attitude(c_b_g):
-    """(heading, pitch, roll) of C_b^G, heading wrapped to (-π, π] (grid angles)."""
+    """(heading, pitch, roll) of C_b^G, heading wrapped to (-π, π] (grid angles).
+
+    Parameters
+    ----------
+    c_b_g : array_like, shape (..., 3, 3)
+        C_b^G, a rotation matrix (body axes right, forward, up).
+
+    Returns
+    -------
+    heading : numpy.ndarray, shape (...)
+        Grid heading [rad] in (-π, π].
+    pitch : numpy.ndarray, shape (...)
+        Pitch [rad].
+    roll : numpy.ndarray, shape (...)
+        Roll [rad] in (-π, π].
+    """
     h, p, r = rotations.dcm_to_euler(c_b_g)
     return np.angle(np.exp(1j * h)), p, r
 
@@ -179,10 +361,28 @@ def euler_from_attitude(c_b_g):
 def n_matrix(r, radius=None, *, printed=False):
     """N of fang2020 eq. (15): [δx, δy, φ_z]ᵀ = N [ψ_x, ψ_y, ψ_z]ᵀ (grid components of ψ).
 
-    ``r`` = (x, y, z) on the sphere of radius ``radius`` (default ‖r‖).  The printed (2,2) entry
-    -Rz/√(x²+z²) contradicts the paper's own eq. (11) (δy = -√(x²+z²) ψ_y) and its eq. (17) for M;
-    ``printed=False`` (default) returns the corrected N with N₂₂ = -√(x²+z²), ``printed=True``
-    the matrix as printed.
+    The printed (2,2) entry -Rz/√(x²+z²) contradicts the paper's own eq. (11)
+    (δy = -√(x²+z²) ψ_y) and its eq. (17) for M; ``printed=False`` (default) returns the corrected
+    N with N₂₂ = -√(x²+z²), ``printed=True`` the matrix as printed.
+
+    Parameters
+    ----------
+    r : array_like, shape (..., 3)
+        (x, y, z) on the sphere [m] (ECEF).
+    radius : float, optional
+        Sphere radius R [m]; default ‖r‖.
+    printed : bool, default False
+        Return the printed N₂₂ instead of the corrected one.
+
+    Returns
+    -------
+    n : numpy.ndarray, shape (..., 3, 3)
+        N; rows 1-2 in m/rad (δx, δy), row 3 dimensionless (φ_z).
+
+    Raises
+    ------
+    ValueError
+        On the equator (z = 0), where N is singular, or for an invalid ``r`` or ``radius``.
     """
     r = vector3(r, "r (sphere point, m)")
     x, y, z = r[..., 0], r[..., 1], r[..., 2]
@@ -200,7 +400,25 @@ def n_matrix(r, radius=None, *, printed=False):
 def m_matrix(r, radius=None):
     """M of fang2020 eq. (17), closed form as printed: P = [δx, δy, φ_z]ᵀ = M ψ_OEPQ.
 
-    ``r`` on the sphere of radius ``radius`` (default ‖r‖).  Equals (corrected N) · C_OEPQ^G.
+    Equals (corrected N) · C_OEPQ^G.
+
+    Parameters
+    ----------
+    r : array_like, shape (..., 3)
+        (x, y, z) on the sphere [m] (ECEF).
+    radius : float, optional
+        Sphere radius R [m]; default ‖r‖.
+
+    Returns
+    -------
+    m : numpy.ndarray, shape (..., 3, 3)
+        M; rows 1-2 in m/rad (δx, δy), row 3 dimensionless (φ_z).
+
+    Raises
+    ------
+    ValueError
+        On the polar axis (x = y = 0: M needs the longitude) or the equator (z = 0), or for an
+        invalid ``r`` or ``radius``.
     """
     r = vector3(r, "r (sphere point, m)")
     x, y, z = r[..., 0], r[..., 1], r[..., 2]
@@ -222,11 +440,23 @@ default step, from 1°N to the pole: a residual below it is differentiation nois
 
 
 def p_equation_step(z, radius):
-    """Central-difference step (m) of :func:`p_equation_numeric` at height ``z`` above the equator.
+    """Central-difference step of :func:`p_equation_numeric` at height ``z`` above the equator.
 
     The truncation error of the grid-frame rotation grows like (h R / z²)² and the round-off like
     ε R / h; h = 5e-6 z² / R balances them (≈1 m at 10°N, ≈30 m near the pole), leaving a
     relative error ≲ 1e-9 except within a few degrees of the equator.
+
+    Parameters
+    ----------
+    z : float
+        ECEF z coordinate of the point on the sphere [m].
+    radius : float
+        Sphere radius R [m].
+
+    Returns
+    -------
+    step : float
+        max(5e-6 z²/R, 1e-3) [m].
     """
     return max(5e-6 * z * z / radius, 1e-3)
 
@@ -240,7 +470,25 @@ def p_equation_numeric(lat, lon, radius, step=None):
     φ_x = φ_y = 0 (eq. (3)) ψ_x = -θ_x, ψ_y = -θ_y and φ_z = ψ_z + θ_z, so central differences give
     ∂(ψ_x, ψ_y, θ_z)/∂(δx, δy), whose inverse is N.  C_OEPQ^G = C_e^G (C_e^OEPQ)ᵀ from the axis
     definitions.  The default step balances truncation against round-off (:func:`p_equation_step`);
-    the result is then accurate to ``P_EQUATION_ACCURACY``.  Returns (N, C).
+    the result is then accurate to ``P_EQUATION_ACCURACY``.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude L [rad] of the point on the sphere.
+    lon : float
+        Longitude λ [rad].
+    radius : float
+        Sphere radius R [m], positive.
+    step : float, optional
+        Central-difference step [m]; default :func:`p_equation_step`.
+
+    Returns
+    -------
+    n : numpy.ndarray, shape (3, 3)
+        N of eq. (15) (rows 1-2 in m/rad, row 3 dimensionless).
+    c : numpy.ndarray, shape (3, 3)
+        C_OEPQ^G of eq. (16).
     """
     lat = float(earth.check_latitude(lat))
     lon = float(_angle(lon, "lon"))
@@ -269,7 +517,22 @@ def p_equation_numeric(lat, lon, radius, step=None):
 
 
 def psi_from_p(p, r, radius=None):
-    """ψ_OEPQ = M⁻¹ P (fang2020 eq. (17) inverted)."""
+    """ψ_OEPQ = M⁻¹ P (fang2020 eq. (17) inverted).
+
+    Parameters
+    ----------
+    p : array_like, shape (..., 3)
+        P = (δx [m], δy [m], φ_z [rad]).
+    r : array_like, shape (..., 3)
+        (x, y, z) on the sphere [m] (ECEF), where M is evaluated.
+    radius : float, optional
+        Sphere radius R [m]; default ‖r‖.
+
+    Returns
+    -------
+    psi : numpy.ndarray, shape (..., 3)
+        ψ [rad] in OEPQ components.
+    """
     p = vector3(p, "P = (δx, δy, φ_z)")
     m = m_matrix(r, radius)
     return np.linalg.solve(m, p[..., None])[..., 0]
@@ -278,20 +541,58 @@ def psi_from_p(p, r, radius=None):
 # =============================================================================== ψ equation (18)-(24)
 
 def psi_system_matrix(omega=OMEGA):
-    """A of ψ̇ = A ψ + ε in OEPQ components (fang2020 eq. (24)): rows (0,0,-Ω), (0,0,0), (Ω,0,0)."""
+    """A of ψ̇ = A ψ + ε in OEPQ components (fang2020 eq. (24)): rows (0,0,-Ω), (0,0,0), (Ω,0,0).
+
+    Parameters
+    ----------
+    omega : float, default OMEGA
+        Earth rate Ω [rad/s].
+
+    Returns
+    -------
+    a : numpy.ndarray, shape (3, 3)
+        A [rad/s].
+    """
     omega = float(omega)
     return np.array([[0.0, 0.0, -omega], [0.0, 0.0, 0.0], [omega, 0.0, 0.0]])
 
 
 def transition_t(a):
-    """T(t_{n+1}, t_n) of fang2020 eq. (25), a = Ω(t_{n+1} - t_n): the ψ-equation transition matrix."""
+    """T(t_{n+1}, t_n) of fang2020 eq. (25): the ψ-equation transition matrix exp(Aτ).
+
+    Parameters
+    ----------
+    a : float
+        a = Ω(t_{n+1} - t_n) [rad].
+
+    Returns
+    -------
+    t : numpy.ndarray, shape (3, 3)
+        T, [[cos a, 0, -sin a], [0, 1, 0], [sin a, 0, cos a]].
+    """
     a = float(_angle(a, "a"))
     c, s = np.cos(a), np.sin(a)
     return np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
 
 
 def input_u(a):
-    """U(t_{n+1}, t_n) of fang2020 eq. (25) = Ω ∫₀^τ T(s) ds, a = Ωτ."""
+    """U(t_{n+1}, t_n) of fang2020 eq. (25) = Ω ∫₀^τ T(s) ds, a = Ωτ.
+
+    Parameters
+    ----------
+    a : float
+        a = Ωτ [rad], positive.
+
+    Returns
+    -------
+    u : numpy.ndarray, shape (3, 3)
+        U (dimensionless), [[sin a, 0, cos a - 1], [0, a, 0], [1 - cos a, 0, sin a]].
+
+    Raises
+    ------
+    ValueError
+        If ``a`` is not positive (the second fix must follow the first).
+    """
     a = float(_angle(a, "a"))
     if a <= 0:
         raise ValueError("a = Ω(t_{n+1} - t_n) must be positive: the second fix must follow the first")
@@ -300,7 +601,24 @@ def input_u(a):
 
 
 def propagate_psi(psi0, eps, tau, omega=OMEGA):
-    """Exact solution of eq. (24): ψ(τ) = T ψ(0) + U ε / Ω for a constant platform drift ε."""
+    """Exact solution of eq. (24): ψ(τ) = T ψ(0) + U ε / Ω for a constant platform drift ε.
+
+    Parameters
+    ----------
+    psi0 : array_like, shape (..., 3)
+        ψ(0) [rad] in OEPQ components.
+    eps : array_like, shape (..., 3)
+        Constant platform drift ε [rad/s] in OEPQ components.
+    tau : float
+        Elapsed time τ [s], positive.
+    omega : float, default OMEGA
+        Earth rate Ω [rad/s].
+
+    Returns
+    -------
+    psi : numpy.ndarray, shape (..., 3)
+        ψ(τ) [rad] in OEPQ components.
+    """
     psi0 = vector3(psi0, "psi0")
     eps = vector3(eps, "eps")
     tau = positive(tau, "tau (s)")
@@ -328,6 +646,25 @@ def b_matrix(lat, sigma, convention="gyro-error"):
 
         ``convention="gyro-error"``: B = -C_OEPQ^G   (ε_b = gyro output minus true rate),
         ``convention="platform-drift"``: B = +C_OEPQ^G (ε_b = platform drift rate, gimballed).
+
+    Parameters
+    ----------
+    lat : float or array_like
+        Latitude L [rad], |L| ≤ 90°.
+    sigma : float or array_like
+        Grid azimuth σ [rad] (:func:`grid_azimuth`).
+    convention : {"gyro-error", "platform-drift"}, default "gyro-error"
+        Meaning of ε (:data:`DRIFT_CONVENTIONS`, :func:`b_matrix`).
+
+    Returns
+    -------
+    b : numpy.ndarray, shape (..., 3, 3)
+        B = ∓C_OEPQ^G (dimensionless).
+
+    Raises
+    ------
+    ValueError
+        If ``convention`` is unknown, or for ``lat`` and ``sigma`` as :func:`oepq_to_grid`.
     """
     choice(convention, DRIFT_CONVENTIONS, "convention")
     c = oepq_to_grid(lat, sigma)
@@ -339,18 +676,49 @@ def two_point_drift(p2, r2, c_b_g, tau, *, p1=None, r1=None, mean_c_b_e=None,
     """Gyro constant drift in the body frame from two fixes, fang2020 eqs. (25)-(27).
 
     ε_b = C_G^b B Ω U⁻¹ [M⁻¹(t_{n+1}) P(t_{n+1}) - T M⁻¹(t_n) P(t_n)]        (26)
-    with P(t_n⁺) = 0 after the first reset (``p1=None``) giving eq. (27).
+    with P(t_n⁺) = 0 after the first reset (``p1=None``) giving eq. (27).  B from :func:`b_matrix`.
+    ψ(t_n) is rotated from OEPQ at the first fix into OEPQ at the second (about P).
 
-    ``p2`` (``p1``): P = (δx, δy in m, φ_z in rad) observed at the fix, computed minus reference;
-    ``r2`` (``r1``): ECEF position of the fix (m), mapped to the osculating sphere (Gaussian radius
-    unless ``radius`` is given) where M of eq. (17) is evaluated; ``c_b_g``: C_b^G at t_{n+1}
-    (its transpose is the printed C_G^b); ``tau`` = t_{n+1} - t_n (s); B from :func:`b_matrix`.
+    With ``mean_c_b_e``: the ψ equation integrates ε_OEPQ(t) = C_b^OEPQ(t) ε_b, so for a rocking
+    ship the attitude that inverts it is the mean ⟨C_b^OEPQ⟩ = C_e^OEPQ(λ_{n+1}) ⟨C_b^e⟩, not the
+    attitude at one instant; then ε_b = s ⟨C_b^OEPQ⟩⁻¹ Ω U⁻¹[...] (s = -1 for gyro errors), which
+    equals eq. (27) for a ship holding a constant attitude.  Works on batches (leading axes).
 
-    ``mean_c_b_e`` (optional): the interval mean of C_b^e over [t_n, t_{n+1}].  The ψ equation
-    integrates ε_OEPQ(t) = C_b^OEPQ(t) ε_b, so for a rocking ship the attitude that inverts it is the
-    mean ⟨C_b^OEPQ⟩ = C_e^OEPQ(λ_{n+1}) ⟨C_b^e⟩, not the attitude at one instant; when given,
-    ε_b = s ⟨C_b^OEPQ⟩⁻¹ Ω U⁻¹[...] (s = -1 for gyro errors), which equals eq. (27) for a ship
-    holding a constant attitude.  Works on batches (leading axes).  Returns ε_b (rad/s).
+    Parameters
+    ----------
+    p2 : array_like, shape (..., 3)
+        P(t_{n+1}) = (δx [m], δy [m], φ_z [rad]) observed at the second fix, computed minus
+        reference.
+    r2 : array_like, shape (..., 3)
+        ECEF position of the second fix [m], mapped to the osculating sphere where M of eq. (17)
+        is evaluated.
+    c_b_g : array_like, shape (..., 3, 3)
+        C_b^G at t_{n+1} (its transpose is the printed C_G^b); not used when ``mean_c_b_e`` is
+        given.
+    tau : float
+        t_{n+1} - t_n [s], positive.
+    p1 : array_like, shape (..., 3), optional
+        P(t_n) at the first fix (eq. (26)); None: P(t_n⁺) = 0 (eq. (27)).  Give it with ``r1``.
+    r1 : array_like, shape (..., 3), optional
+        ECEF position of the first fix [m]; given together with ``p1``.
+    mean_c_b_e : array_like, shape (..., 3, 3), optional
+        The interval mean ⟨C_b^e⟩ over [t_n, t_{n+1}].
+    convention : {"gyro-error", "platform-drift"}, default "gyro-error"
+        Meaning of ε (:data:`DRIFT_CONVENTIONS`, :func:`b_matrix`).
+    radius : float, optional
+        Sphere radius [m] on which M is evaluated; default the Gaussian radius at each fix
+        (:func:`gaussian_radius`).
+
+    Returns
+    -------
+    eps_b : numpy.ndarray, shape (..., 3)
+        Gyro constant drift ε_b [rad/s] in body axes (x right, y forward, z up).
+
+    Raises
+    ------
+    ValueError
+        If only one of ``p1``, ``r1`` is given, ``convention`` is unknown, ``tau`` is not positive
+        or an array has the wrong shape.
     """
     p2 = vector3(p2, "p2")
     r2 = vector3(r2, "r2 (ECEF, m)")
@@ -376,8 +744,37 @@ def two_point_drift(p2, r2, c_b_g, tau, *, p1=None, r1=None, mean_c_b_e=None,
 
 
 def drift_from_psi(dpsi, lat, lon, c_b_g, tau, *, mean_c_b_e=None, convention="gyro-error"):
-    """ε_b = C_G^b B Ω U⁻¹ Δψ, fang2020 eq. (25), with Δψ = ψ(t_{n+1}) - T ψ(t_n) in OEPQ
-    components at (``lat``, ``lon``) of the second fix; see :func:`two_point_drift`."""
+    """ε_b = C_G^b B Ω U⁻¹ Δψ, fang2020 eq. (25); see :func:`two_point_drift`.
+
+    Δψ = ψ(t_{n+1}) - T ψ(t_n) in OEPQ components at the second fix.
+
+    Parameters
+    ----------
+    dpsi : array_like, shape (..., 3)
+        Δψ [rad] in OEPQ components at (``lat``, ``lon``).
+    lat : float or array_like
+        Latitude of the second fix [rad].
+    lon : float or array_like
+        Longitude of the second fix [rad].
+    c_b_g : array_like, shape (..., 3, 3)
+        C_b^G at the second fix; not used when ``mean_c_b_e`` is given.
+    tau : float
+        t_{n+1} - t_n [s], positive.
+    mean_c_b_e : array_like, shape (..., 3, 3), optional
+        Interval mean ⟨C_b^e⟩ that replaces the attitude at the fix (:func:`two_point_drift`).
+    convention : {"gyro-error", "platform-drift"}, default "gyro-error"
+        Meaning of ε (:data:`DRIFT_CONVENTIONS`, :func:`b_matrix`).
+
+    Returns
+    -------
+    eps_b : numpy.ndarray, shape (..., 3)
+        Gyro constant drift ε_b [rad/s] in body axes.
+
+    Raises
+    ------
+    ValueError
+        If ``convention`` is unknown, ``tau`` is not positive or an array has the wrong shape.
+    """
     rhs = vector3(dpsi, "dpsi")
     tau = positive(tau, "tau (s)")
     choice(convention, DRIFT_CONVENTIONS, "convention")
@@ -409,7 +806,14 @@ def _psi_at(p, lat, lon, rad):
 # =============================================================================== damping (eq. (1))
 
 def damping_network():
-    """H_y(s) = (s + 8.5e-4)(s + 9.412e-2) / ((s + 8.0e-3)(s + 1.0e-2)), fang2020 eq. (1)."""
+    """H_y(s) = (s + 8.5e-4)(s + 9.412e-2) / ((s + 8.0e-3)(s + 1.0e-2)), fang2020 eq. (1).
+
+    Returns
+    -------
+    h_y : control.TransferFunction
+        The external horizontal damping network (s in rad/s, dimensionless gain), zeros
+        :data:`DAMPING_ZEROS`, poles :data:`DAMPING_POLES`.
+    """
     import control as ct
 
     return ct.tf(np.poly(DAMPING_ZEROS), np.poly(DAMPING_POLES))
@@ -420,7 +824,21 @@ def schuler_loop(damped=True, *, radius=None, gravity=None):
 
     δV̇_N = g φ_E + ∇_N,  φ̇_E = -H_y(s) δV_N / R  (δV_N through the damping network when
     ``damped``, H = 1 otherwise): φ_E/∇_N = -H/R / (s² + ω_s² H), ω_s² = g/R.  The characteristic
-    polynomial s² + ω_s² H_y(s) is the same for the east channel.  Defaults: R = a, g = γ(85°).
+    polynomial s² + ω_s² H_y(s) is the same for the east channel.
+
+    Parameters
+    ----------
+    damped : bool, default True
+        Pass δV_N through H_y (:func:`damping_network`); otherwise H = 1.
+    radius : float, optional
+        Earth radius R [m]; default the WGS-84 semi-major axis a.
+    gravity : float, optional
+        Gravity g [m/s²]; default WGS-84 normal gravity γ at 85° latitude.
+
+    Returns
+    -------
+    loop : control.TransferFunction
+        φ_E/∇_N [rad/(m/s²)], s in rad/s (minimal realization).
     """
     import control as ct
 
@@ -435,10 +853,22 @@ def schuler_loop(damped=True, *, radius=None, gravity=None):
 def damping_analysis(*, radius=None, gravity=None):
     """Poles/zeros of H_y and of the Schuler loop with and without damping (python-control).
 
-    Returns a dict with the network's zeros, poles and DC gain, and for the undamped and damped
-    loops the closed-loop poles, their natural frequencies and damping ratios (``control.damp``),
-    the Schuler period, and the 2 % settling time of the tilt's step response to an accelerometer
-    bias (``control.step_info``; infinite for the undamped loop, whose poles are on the axis).
+    Parameters
+    ----------
+    radius : float, optional
+        Earth radius R [m]; default the WGS-84 semi-major axis a (:func:`schuler_loop`).
+    gravity : float, optional
+        Gravity g [m/s²]; default WGS-84 normal gravity at 85° latitude.
+
+    Returns
+    -------
+    analysis : dict
+        ``zeros``, ``poles`` (numpy.ndarray, shape (2,), [rad/s], sorted) and ``dc_gain`` (float)
+        of the network; ``"undamped"`` and ``"damped"``: dicts with the closed-loop ``poles``
+        (complex [rad/s]), their natural frequencies ``wn`` [rad/s] and damping ratios ``zeta``
+        (``control.damp``), and ``settling_time`` [s], the 2 % settling time of the tilt's step
+        response to an accelerometer bias (``control.step_info``; infinite for the undamped loop,
+        whose poles are on the axis); ``schuler_period`` 2π√(R/g) [s].
     """
     import control as ct
 
@@ -462,7 +892,18 @@ def damping_analysis(*, radius=None, gravity=None):
 
 
 def discretize_damping(dt):
-    """Tustin (bilinear) discretization of H_y at step ``dt`` (s): (b0, b1, b2, a1, a2), a0 = 1."""
+    """Tustin (bilinear) discretization of H_y at step ``dt``.
+
+    Parameters
+    ----------
+    dt : float
+        Sampling step [s], positive.
+
+    Returns
+    -------
+    coef : numpy.ndarray, shape (5,)
+        (b0, b1, b2, a1, a2) of the discrete filter, normalized to a0 = 1.
+    """
     import control as ct
 
     dt = positive(dt, "dt (s)")
@@ -483,12 +924,60 @@ POSITION_VELOCITIES = ("damped", "undamped")
 class Scenario:
     """One simulation case of fang2020 §3 (SI units inside; printed units in the constructor).
 
-    ``position_velocity``: ``"damped"`` integrates the position with the damped velocity V_c that
-    also commands the platform (eq. (18) presupposes it), ``"undamped"`` with the free-inertial V
-    (then an (H_y - 1)δV/R term enters the P equation); see :data:`POSITION_VELOCITIES`.
-    ``rocking_phase``: ``None`` draws the pitch/roll/yaw rocking phases at random for every
-    Monte-Carlo run; three numbers fix them for all runs (then only the sensor noise varies; with
-    zero phases the rocking angles vanish at every multiple of 252 s, e.g. at both fixes' 3.5 h).
+    Attributes
+    ----------
+    track : {"parallel-east", "meridian-north"}
+        Eastward along the parallel of ``lat0``, or northward along the meridian (across the pole).
+    lat0 : float
+        Start latitude [rad].
+    lon0 : float
+        Start longitude [rad].
+    speed : float, default 10.0
+        Ground speed [m/s], non-negative.
+    heading_offset : float, default 0.0
+        Mean heading relative to the track direction [rad].
+    duration : float, default 10 h
+        Simulated time [s].
+    rate_hz : float, default 100.0
+        IMU and integration rate [Hz].
+    fix_times : tuple of float, default (2 h, 3.5 h)
+        The two fix times [s], 0 < t_1 < t_2 ≤ ``duration``.
+    fix_position_error : tuple of float, default (5, 5, 5)
+        Constant error of the position fix, ECEF x, y, z [m] (as printed).
+    fix_heading_error : float, default 6″
+        Error of the heading reference at a fix [rad].
+    gyro_drift : tuple of float, default 0.01 °/h on each axis
+        Gyro constant drift, body x, y, z [rad/s].
+    accel_bias : tuple of float, default 1e-4 g on each axis
+        Accelerometer constant bias, body x, y, z [m/s²].
+    gyro_white : float, default 0.001 °/h
+        Gyro white noise, 1σ per sample [rad/s] (this package's choice).
+    accel_white : float, default 1e-5 g
+        Accelerometer white noise, 1σ per sample [m/s²] (this package's choice).
+    initial_attitude_error : tuple of float, default (6″, 6″, 6′)
+        Initial roll, pitch, heading errors [rad].
+    rocking_amplitude : tuple of float, default (3°, 5°, 4°)
+        Pitch, roll, yaw rocking amplitudes [rad].
+    rocking_period : tuple of float, default (7, 9, 12)
+        Pitch, roll, yaw rocking periods [s], positive.
+    damping : bool, default True
+        Apply the external horizontal damping H_y of eq. (1).
+    position_velocity : {"damped", "undamped"}, default "damped"
+        ``"damped"`` integrates the position with the damped velocity V_c that also commands the
+        platform (eq. (18) presupposes it), ``"undamped"`` with the free-inertial V (then an
+        (H_y - 1)δV/R term enters the P equation); see :data:`POSITION_VELOCITIES`.
+    rocking_phase : tuple of float or None, default None
+        Pitch, roll, yaw rocking phases [rad].  ``None`` draws them at random for every
+        Monte-Carlo run; three numbers fix them for all runs (then only the sensor noise varies;
+        with zero phases the rocking angles vanish at every multiple of 252 s, e.g. at both fixes'
+        3.5 h).
+
+    Raises
+    ------
+    ValueError
+        If a field is out of its range (unknown track or position velocity, fix times outside
+        (0, duration], non-positive rate, duration or rocking period, negative speed or noise, a
+        triple without three values, a parallel track within 0.1° of the pole).
     """
 
     track: str                      # "parallel-east" or "meridian-north"
@@ -538,16 +1027,40 @@ class Scenario:
 
     @property
     def dt(self):
+        """Integration step 1/``rate_hz`` [s]."""
         return 1.0 / self.rate_hz
 
     def steps(self, t):
+        """Number of integration steps in the time ``t``.
+
+        Parameters
+        ----------
+        t : float
+            Time [s], a multiple of the step 1/``rate_hz``.
+
+        Returns
+        -------
+        k : int
+            t · ``rate_hz``.
+
+        Raises
+        ------
+        ValueError
+            If ``t`` is not a multiple of the step (to 1e-6 of a step).
+        """
         k = t * self.rate_hz
         if abs(k - round(k)) > 1e-6:
             raise ValueError(f"time {t} s is not a multiple of the step 1/{self.rate_hz} s")
         return int(round(k))
 
     def trajectory_rate(self):
-        """λ̇ (parallel track) or L̇ (meridian track) in rad/s."""
+        """Rate of the along-track coordinate: λ̇ (parallel track) or L̇ (meridian track).
+
+        Returns
+        -------
+        rate : float
+            V / (R_N(L0) cos L0) for the parallel track, V / R_M(pole) for the meridian track [rad/s].
+        """
         if self.track == "parallel-east":
             _, rn = earth.radii(self.lat0)
             return self.speed / (float(rn) * np.cos(self.lat0))
@@ -556,9 +1069,29 @@ class Scenario:
 
 
 def fang2020_scenario(case, **changes):
-    """Case 1 (85°N 18°E, east 10 m/s along the parallel, heading 90° ± 4° yaw rocking) or
-    case 2 (88.868°N 168°E, north 10 m/s along the meridian across the pole, heading 0°, pitch
-    and roll rocking only) of fang2020 §3.  ``changes`` override fields (e.g. noise levels)."""
+    """The simulation cases of fang2020 §3.
+
+    Case 1: 85°N 18°E, east 10 m/s along the parallel, heading 90° ± 4° yaw rocking.  Case 2:
+    88.868°N 168°E, north 10 m/s along the meridian across the pole, heading 0°, pitch and roll
+    rocking only.
+
+    Parameters
+    ----------
+    case : {1, 2}
+        The case of fang2020 §3.
+    changes : float, tuple, bool or str
+        Keyword arguments: :class:`Scenario` fields to override (e.g. noise levels).
+
+    Returns
+    -------
+    scenario : Scenario
+        The case with the overrides.
+
+    Raises
+    ------
+    ValueError
+        If ``case`` is neither 1 nor 2, or an override is out of range.
+    """
     if case == 1:
         sc = Scenario("parallel-east", np.radians(85.0), np.radians(18.0))
     elif case == 2:
@@ -585,7 +1118,26 @@ def _traj_params(sc, phases):
 
 
 def true_state(sc, t, phases):
-    """True C_b^e, r^e, ṙ^e of runs with rocking ``phases`` (n×3) at time ``t`` (s)."""
+    """True C_b^e, r^e, ṙ^e of runs with rocking ``phases`` at time ``t``.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The simulation case.
+    t : float
+        Time since the start [s].
+    phases : array_like, shape (n, 3) or (3,)
+        Rocking phases (pitch, roll, yaw) [rad] of the n runs.
+
+    Returns
+    -------
+    c_b_e : numpy.ndarray, shape (n, 3, 3)
+        True attitude C_b^e.
+    r_e : numpy.ndarray, shape (n, 3)
+        True ECEF position [m].
+    v_e : numpy.ndarray, shape (n, 3)
+        True ECEF velocity ṙ^e [m/s].
+    """
     traj = _traj_params(sc, np.atleast_2d(phases))
     n = traj.shape[0]
     cbe, re, rde = np.empty((n, 3, 3)), np.empty((n, 3)), np.empty((n, 3))
@@ -596,7 +1148,33 @@ def true_state(sc, t, phases):
 
 @dataclass
 class SimulationResult:
-    """Output of :func:`simulate` (errors: computed minus true; SI units)."""
+    """Output of :func:`simulate` (errors: computed minus true; SI units).
+
+    Attributes
+    ----------
+    scenario : Scenario
+        The simulated case.
+    t : numpy.ndarray, shape (n_rec,)
+        Record times [s].
+    errors : numpy.ndarray, shape (runs, n_rec, 8)
+        Errors of the calibrated runs (drift compensated after the second fix), columns
+        ``fields``: platform attitude error φ_E, φ_N, φ_U about the grid axes [rad], grid
+        horizontal velocity error δv_E, δv_N [m/s], ECEF position error δx, δy, δz [m].  NaN after
+        the second fix for runs beyond ``continued_runs``.
+    errors_reset_only : numpy.ndarray, shape (reset_only_runs, n_rec, 8)
+        The same for the first runs continued after the second fix with the reset but without
+        compensation.
+    estimates : dict of str to numpy.ndarray
+        Estimator name (:data:`ESTIMATORS`) → drift estimates, shape (runs, 3), body axes [rad/s].
+    p2 : numpy.ndarray, shape (runs, 3)
+        Observation P = (δx [m], δy [m], φ_z [rad]) at the second fix.
+    phases : numpy.ndarray, shape (runs, 3)
+        Rocking phases (pitch, roll, yaw) [rad].
+    fields : tuple of str
+        Names of the error columns (``_polar_kernels.REC_FIELDS``).
+    extra : dict
+        Room for further outputs (empty from :func:`simulate`).
+    """
 
     scenario: Scenario
     t: np.ndarray                   # record times (s)
@@ -664,6 +1242,26 @@ def true_psi(sc, t, phases, cbp, r):
 
     φ from C_b^p (C_b^G)ᵀ = I - [φ×], θ from C_e^G(r) C_G^e(r_true) = I - [θ×] (exact small
     angles, no P-equation approximation); returned in OEPQ components at the true longitude.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The simulation case.
+    t : float
+        Time since the start [s].
+    phases : array_like, shape (n, 3) or (3,)
+        Rocking phases (pitch, roll, yaw) [rad] of the n runs.
+    cbp : array_like, shape (n, 3, 3)
+        The navigator's C_b^p (platform = computed grid frame).
+    r : array_like, shape (n, 3)
+        The navigator's ECEF position [m].
+
+    Returns
+    -------
+    psi : numpy.ndarray, shape (n, 3)
+        ψ [rad] in OEPQ components at the true longitude.
+    r_true : numpy.ndarray, shape (n, 3)
+        True ECEF position [m].
     """
     cbe, re, _ = true_state(sc, t, phases)
     g_true = grid_frame(re)
@@ -693,7 +1291,31 @@ def _run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
 
 
 def run_segment(sc, k0, k1, traj, sens, state, *, record_every_steps=None):
-    """Advance the grid INS ``state`` (dict from :func:`initial_state`) from step k0 to k1."""
+    """Advance the grid INS ``state`` from step k0 to k1 (in place; nothing is recorded).
+
+    Parameters
+    ----------
+    sc : Scenario
+        The simulation case.
+    k0 : int
+        First step (time k0/``sc.rate_hz``).
+    k1 : int
+        Last step.
+    traj : numpy.ndarray, shape (n, N_TRAJ)
+        Trajectory parameters of the n runs (:func:`initial_state`).
+    sens : numpy.ndarray, shape (n, N_SENS)
+        Sensor parameters of the n runs (:func:`initial_state`).
+    state : dict
+        Navigator state of :func:`initial_state`, updated in place.
+    record_every_steps : int, optional
+        Record stride passed to the kernel; default k1 - k0.  No record is kept, so it does not
+        change the result.
+
+    Returns
+    -------
+    state : dict
+        The same ``state`` object, advanced to step k1.
+    """
     rec = np.zeros((traj.shape[0], 0, _k.N_REC))
     _run_grid(k0, k1, sc.dt, traj, sens, state["cbp"], state["vg"], state["r"], state["damp"],
               state["comp"], state["rng"], state["acc_e"], state["acc_i"], discretize_damping(sc.dt),
@@ -702,7 +1324,33 @@ def run_segment(sc, k0, k1, traj, sens, state, *, record_every_steps=None):
 
 
 def initial_state(sc, n_runs, seed):
-    """Trajectory/sensor parameters and the initial navigator state of ``n_runs`` runs."""
+    """Trajectory/sensor parameters and the initial navigator state of ``n_runs`` runs.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The simulation case.
+    n_runs : int
+        Number of Monte-Carlo runs n.
+    seed : int or None
+        Seed of ``numpy.random.default_rng``: the rocking phases (drawn even when
+        ``sc.rocking_phase`` fixes them) and one noise seed per run.
+
+    Returns
+    -------
+    phases : numpy.ndarray, shape (n, 3)
+        Rocking phases (pitch, roll, yaw) [rad].
+    traj : numpy.ndarray, shape (n, N_TRAJ)
+        Trajectory parameters (``_polar_kernels.TRAJ_FIELDS``).
+    sens : numpy.ndarray, shape (n, N_SENS)
+        Sensor parameters (``_polar_kernels.SENS_FIELDS``): gyro drift [rad/s], accelerometer bias
+        [m/s²], white-noise levels.
+    state : dict
+        ``cbp`` (n, 3, 3) C_b^p with the initial attitude errors, ``vg`` (n, 3) grid velocity
+        [m/s], ``r`` (n, 3) ECEF position [m], ``damp`` (n, 2, 2) damping-filter memory, ``comp``
+        (n, 3) drift compensation [rad/s], ``rng`` (n,) uint64 noise seeds, ``acc_e``, ``acc_i``
+        (n, 3, 3) attitude accumulators.
+    """
     rng = np.random.default_rng(seed)
     phases = rng.uniform(0, 2 * np.pi, (n_runs, 3))
     if sc.rocking_phase is not None:
@@ -727,12 +1375,41 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     of :data:`ESTIMATORS` (``"printed"``: eq. (27) with the instantaneous C_G^b; ``"mean-attitude"``:
     the interval-mean attitude, see :func:`two_point_drift`), resets, and the runs continue with
     the ``estimator`` estimate subtracted from the gyro outputs.  The first ``reset_only_runs``
-    runs are continued a second time without compensation (the paper's dashed curves).
-    ``heading_observation``: ``"misalignment"`` observes the platform azimuth misalignment φ_z of
-    the P equation, ``"euler"`` the difference of grid-heading Euler angles (:data:`HEADING_OBSERVATIONS`).
-    ``continued_runs``: how many runs (the first ones) are integrated past the second fix (default:
-    all); the records of the others are NaN from it on.  Every run has its own random stream, so
-    the continued runs are the same whatever this number.
+    runs are continued a second time without compensation (the paper's dashed curves).  Every run
+    has its own random stream, so the continued runs are the same whatever ``continued_runs``.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The simulation case.
+    n_runs : int
+        Number of Monte-Carlo runs, positive.
+    seed : int or None
+        Seed of the rocking phases and of the per-run noise streams (:func:`initial_state`).
+    record_every : float, default 10.0
+        Record interval [s]; a multiple of the step, and the fix times multiples of it.
+    reset_only_runs : int, default 1
+        Runs (the first ones) continued also without compensation, in [0, n_runs].
+    estimator : {"printed", "mean-attitude"}, default "printed"
+        Estimate subtracted from the gyro outputs after the second fix.
+    heading_observation : {"misalignment", "euler"}, default "misalignment"
+        ``"misalignment"`` observes the platform azimuth misalignment φ_z of the P equation,
+        ``"euler"`` the difference of grid-heading Euler angles (:data:`HEADING_OBSERVATIONS`).
+    continued_runs : int, optional
+        How many runs (the first ones) are integrated past the second fix, in [0, n_runs]
+        (default: all); the records of the others are NaN from it on.
+
+    Returns
+    -------
+    result : SimulationResult
+        Error histories, drift estimates of every estimator, the observation at the second fix
+        and the rocking phases.
+
+    Raises
+    ------
+    ValueError
+        If an argument is out of range, ``record_every`` or a fix time is not a multiple of the
+        step, or a fix time is not a multiple of ``record_every``.
     """
     if heading_observation not in HEADING_OBSERVATIONS:
         raise ValueError(f"heading_observation must be one of {HEADING_OBSERVATIONS}")
@@ -798,9 +1475,27 @@ def ecef_reference_comparison(sc, duration, *, seed=0, record_every=60.0):
     """Run the grid-frame INS (damping off) and an ECEF-frame INS on identical IMU data.
 
     Both start from the same state (true position and velocity, ``sc``'s initial attitude errors)
-    and integrate the same sensor model (drift, bias, white noise with the same random stream).
-    Returns a dict of time (s), ECEF positions of both (runs × records × 3), ECEF velocities and
-    the angle between their attitudes (rad), plus the true positions.
+    and integrate the same sensor model (drift, bias, white noise with the same random stream); one
+    run.
+
+    Parameters
+    ----------
+    sc : Scenario
+        The simulation case.
+    duration : float
+        Simulated time [s], positive, a multiple of the step.
+    seed : int, default 0
+        Seed of the rocking phases and the noise stream.
+    record_every : float, default 60.0
+        Record interval [s], a multiple of the step.
+
+    Returns
+    -------
+    comparison : dict of numpy.ndarray
+        ``t`` (n_rec,) record times [s]; ``pos_grid``, ``pos_ecef`` (n_rec, 3) ECEF positions of
+        the grid and the ECEF INS [m]; ``vel_grid``, ``vel_ecef`` (n_rec, 3) their ECEF velocities
+        [m/s]; ``attitude_angle`` (n_rec,) angle between their attitudes [rad]; ``pos_true``
+        (n_rec, 3) true ECEF positions [m].
     """
     duration = positive(duration, "duration (s)")
     sc = replace(sc, damping=False)
@@ -859,10 +1554,27 @@ fixes; eq. (27) with the attitude at the second fix (``estimator="printed"``).""
 def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, continued_runs=None, **changes):
     """The 20-run Monte Carlo of fang2020 §3 for case 1 (Table 1) or case 2 (Table 2).
 
-    Full fidelity: 10 h at 100 Hz, fixes at 2 h and 3.5 h, under :data:`FANG2020_READING`;
-    ``changes`` override scenario fields (for sensitivity checks).  Returns a
-    :class:`SimulationResult`.  ``continued_runs``: runs integrated past the second fix (default:
-    every run; see :func:`simulate`).
+    Full fidelity: 10 h at 100 Hz, fixes at 2 h and 3.5 h, under :data:`FANG2020_READING`.
+
+    Parameters
+    ----------
+    case : {1, 2}
+        The case of fang2020 §3 (:func:`fang2020_scenario`).
+    n_runs : int, default 20
+        Number of Monte-Carlo runs.
+    seed : int, optional
+        Seed; default :data:`FANG2020_SEEDS` of the case.
+    reset_only_runs : int, default 1
+        Runs continued also without compensation (:func:`simulate`).
+    continued_runs : int, optional
+        Runs integrated past the second fix (default: every run; see :func:`simulate`).
+    changes : float, tuple, bool or str
+        Keyword arguments: :class:`Scenario` fields to override (for sensitivity checks).
+
+    Returns
+    -------
+    result : SimulationResult
+        The Monte Carlo (:func:`simulate`).
     """
     sc = fang2020_scenario(case, **{**FANG2020_READING, **changes})
     return simulate(sc, n_runs, FANG2020_SEEDS[case] if seed is None else seed,
@@ -870,7 +1582,25 @@ def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, continued_run
 
 
 def drift_summary(result, estimator="printed"):
-    """Mean and sample standard deviation (ddof = 1) of the drift estimates per body axis, °/h."""
+    """Mean and sample standard deviation (ddof = 1) of the drift estimates per body axis.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        Output of :func:`simulate`.
+    estimator : str, default "printed"
+        Key of ``result.estimates`` (:data:`ESTIMATORS`).
+
+    Returns
+    -------
+    summary : dict of str to (float, float)
+        ``"X"``, ``"Y"``, ``"Z"`` → (mean, standard deviation) [°/h]; ddof = 0 for a single run.
+
+    Raises
+    ------
+    ValueError
+        If ``estimator`` is not in ``result.estimates``.
+    """
     if estimator not in result.estimates:
         raise ValueError(f"unknown estimator {estimator!r}; have {sorted(result.estimates)}")
     est = result.estimates[estimator] / units.DEG_PER_H
@@ -883,9 +1613,24 @@ def drift_summary(result, estimator="printed"):
 def p_equation_check(lats, lons, radius):
     """Per point: N (corrected) and the printed N, M of (17) against numerical differentiation.
 
-    Columns: latitude (°), longitude (°), max relative error of the corrected N and of the printed
-    N (row-scaled), relative error of the printed N₂₂, max relative error of the printed M against
-    N_num · C_num, and of C_OEPQ^G (16) against the axis definitions.
+    Parameters
+    ----------
+    lats : float or array_like, shape (k,)
+        Latitudes [rad] (not on the equator).
+    lons : float or array_like, shape (k,)
+        Longitudes [rad], paired with ``lats``.
+    radius : float
+        Sphere radius [m].
+
+    Returns
+    -------
+    check : pandas.DataFrame
+        One row per point: ``lat_deg``, ``lon_deg`` [°]; ``N corrected``, ``N printed`` (largest
+        relative error of the corrected and the printed N against :func:`p_equation_numeric`, each
+        row scaled by its largest element); ``N22 printed`` (relative error of the printed N₂₂);
+        ``M printed`` (largest error of the printed M against N_num · C_num, relative to the
+        largest element); ``C (16)`` (largest absolute difference of C_OEPQ^G of eq. (16) from
+        the axis definitions).  All dimensionless.
     """
 
     rows = []
@@ -905,15 +1650,37 @@ def p_equation_check(lats, lons, radius):
 
 
 def sensitivity(case, variants, *, n_runs=4, seed=None, executor=None, chunk_runs=None, progress=None):
-    """Drift-estimate summaries (°/h) of short runs (to the second fix) for scenario ``variants``
-    (name → dict of scenario overrides, plus optionally ``heading_observation``); one row per
-    variant and estimator.
+    """Drift-estimate summaries of short runs (to the second fix) for scenario ``variants``.
 
-    Each variant is its own Monte Carlo with its own seed, so with ``executor`` (any
-    ``concurrent.futures.Executor``) or ``chunk_runs`` the variants are computed in chunks of
-    ``chunk_runs`` variants, one picklable task each (:func:`replication.nav.parallel.run_chunks`),
-    and the rows come back in the variants' order, equal to the in-process ones bit for bit;
-    ``progress``: progress bar of the finished variants (``None``: on unless ``REPLICATION_PROGRESS=0``).
+    Each variant is its own Monte Carlo with its own seed, so with ``executor`` or ``chunk_runs``
+    the variants are computed in chunks of ``chunk_runs`` variants, one picklable task each
+    (:func:`replication.nav.parallel.run_chunks`), and the rows come back in the variants' order,
+    equal to the in-process ones bit for bit.
+
+    Parameters
+    ----------
+    case : {1, 2}
+        The case of fang2020 §3.
+    variants : dict of str to dict
+        Variant name → :class:`Scenario` overrides, plus optionally ``heading_observation``
+        (:func:`simulate`).
+    n_runs : int, default 4
+        Runs per variant.
+    seed : int, optional
+        Seed of every variant; default :data:`FANG2020_SEEDS` of the case.
+    executor : concurrent.futures.Executor, optional
+        Executor on which the chunks run (:func:`replication.nav.parallel.run_chunks`); with
+        ``chunk_runs`` None as well, everything runs in process.
+    chunk_runs : int, optional
+        Variants per picklable task.
+    progress : bool, optional
+        Progress bar of the finished variants (``None``: on unless ``REPLICATION_PROGRESS=0``).
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per variant and estimator: ``variant``, ``estimator``, ``runs``, ``X mean``, ``Y mean``, ``Z mean``, ``X std``, ``Y std``,
+        ``Z std`` (drift estimates per body axis [°/h], std with ddof = 1).
     """
     items = list(variants.items())
     if executor is None and chunk_runs is None:
@@ -955,12 +1722,42 @@ draw that leaves the ship level at the fixes)."""
 
 
 def readings_ledger(case, *, n_runs=8, shared_draws=3, seed=None, executor=None, chunk_runs=None, progress=None):
-    """Drift-estimate summaries of every reading of :data:`READINGS`, of ``shared_draws`` random
-    rocking-phase sets shared by all runs (damped position) and of the three other sign patterns
-    of the horizontal accelerometer biases (not printed) under :data:`FANG2020_READING`, for both
-    estimators: short runs to the second fix (:func:`sensitivity`).  Columns as
-    :func:`sensitivity`, with ``reading`` for ``variant``; ``executor``, ``chunk_runs``, ``progress``
-    as there (the readings in chunks, the same rows bit for bit)."""
+    """Drift-estimate summaries of every open reading of fang2020 §3, for both estimators.
+
+    The readings of :data:`READINGS`, ``shared_draws`` random rocking-phase sets shared by all
+    runs (damped position) and the three other sign patterns of the horizontal accelerometer
+    biases (not printed) under :data:`FANG2020_READING`: short runs to the second fix
+    (:func:`sensitivity`, the readings in chunks with the same rows bit for bit).
+
+    Parameters
+    ----------
+    case : {1, 2}
+        The case of fang2020 §3.
+    n_runs : int, default 8
+        Runs per reading.
+    shared_draws : int, default 3
+        Number of random phase sets shared by all runs, non-negative.
+    seed : int, optional
+        Seed of the runs (the phase sets draw from seed + 1); default :data:`FANG2020_SEEDS`.
+    executor : concurrent.futures.Executor, optional
+        Executor on which the chunks run (:func:`replication.nav.parallel.run_chunks`); with
+        ``chunk_runs`` None as well, everything runs in process.
+    chunk_runs : int, optional
+        Variants per picklable task.
+    progress : bool, optional
+        Progress bar of the finished variants (``None``: on unless ``REPLICATION_PROGRESS=0``).
+
+    Returns
+    -------
+    ledger : pandas.DataFrame
+        One row per reading and estimator: ``reading``, ``estimator``, ``runs``, ``X mean``, ``Y mean``, ``Z mean``, ``X std``, ``Y std``,
+        ``Z std`` (drift estimates per body axis [°/h], std with ddof = 1).
+
+    Raises
+    ------
+    ValueError
+        If ``shared_draws`` is not a non-negative integer.
+    """
     if not isinstance(shared_draws, (int, np.integer)) or shared_draws < 0:
         raise ValueError("shared_draws must be a non-negative integer")
     variants = dict(READINGS)
