@@ -51,8 +51,8 @@ def _public_modules():
 
 
 def _plain(obj):
-    """The Python function behind a numba dispatcher, else the object."""
-    return getattr(obj, "py_func", obj)
+    """The Python function behind a numba dispatcher or a ``functools`` cache, else the object."""
+    return getattr(obj, "py_func", None) or getattr(obj, "__wrapped__", None) or obj
 
 
 def _returns_value(func) -> bool:
