@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from replication.nav import closedloop, earth, errors, kalman, rotations, sensors, strapdown, timeseries, trajectory
 from replication.nav.units import DEG
 from replication.papers.an2021 import transfer
-from replication.papers.chen2019 import calibration, findings, models, observability
+from replication.papers.chen2019 import calibration, findings, models, observability, simulation
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
 I3 = np.eye(3)
@@ -242,6 +242,21 @@ PROBES += [
     ("compare_verdicts(printed with NaN)", "printed",
      lambda: findings.compare_verdicts(_deg_table((np.nan, 0.0, 0.0)), {"m": _deg_table()}, "m", exact=_EXACT,
                                             explain={})),
+    ("kalman_gain_by_iteration(steps = 0)", "steps",
+     lambda: transfer.kalman_gain_by_iteration(-np.eye(2), np.eye(2), np.eye(2), np.eye(2), dt=1.0, steps=0, p0=np.eye(2))),
+    ("kalman_gain_by_iteration(c of the wrong width)", "c",
+     lambda: transfer.kalman_gain_by_iteration(-np.eye(2), np.eye(3), np.eye(2), np.eye(3), dt=1.0, steps=3,
+                                               p0=np.eye(2))),
+    ("kalman_gain_by_iteration(dt = 0)", "dt",
+     lambda: transfer.kalman_gain_by_iteration(-np.eye(2), np.eye(2), np.eye(2), np.eye(2), dt=0.0, steps=3, p0=np.eye(2))),
+    ("NoiseSettings.scaled(unknown field)", "gyro_typo", lambda: transfer.NoiseSettings(1e-6, 1e-4, 1e-8, 1e-6, 10.0).scaled(gyro_typo=2.0)),
+    ("fraction_in_band(prob = 1.5)", "prob", lambda: simulation.fraction_in_band(np.ones((3, 4)), 3, prob=1.5)),
+    ("fraction_in_band(mask of the wrong length)", "mask",
+     lambda: simulation.fraction_in_band(np.ones((3, 4)), 3, mask=np.ones(5, bool))),
+    ("rms_with_ci(prob = 0)", "prob", lambda: simulation.rms_with_ci(np.ones((3, 4)), np.ones(4, bool), prob=0.0)),
+    ("rms_with_ci(mask of the wrong length)", "mask", lambda: simulation.rms_with_ci(np.ones((3, 4)), np.ones(2, bool))),
+    ("table_2_2_differences(model = 'model_45')", "ErrorModel",
+     lambda: models.table_2_2_differences("model_45", models.table_2_2_reference_point())),
     ("closed_loop(P0 = -I)", "P0", lambda: _closed_loop(P0=-np.eye(15))),
     ("closed_loop(P0 with NaN)", "P0", lambda: _closed_loop(P0=np.diag([np.nan] + [1.0] * 14))),
     ("closed_loop(vertical = 'up')", "vertical", lambda: _closed_loop(vertical="up")),

@@ -380,3 +380,11 @@ def test_time_domain_filter_reproduces_the_transfer_function():
     assert np.max(np.abs(dphase)) < 2.0
     with pytest.raises(ValueError, match="well below the fix rate"):
         tr.time_domain_response(lat, 0.0, v, tr.NAVIGATION_GRADE, [1.0], settle=10.0)
+
+
+def test_relative_difference_counts_a_derived_zero():
+    """A coefficient derived as zero but printed non-zero is an infinite relative difference."""
+    from replication.papers.an2021.transfer import _relative_difference
+    assert _relative_difference(2.0, 1.0) == 1.0
+    assert _relative_difference(0.5, 0.0) == math.inf
+    assert _relative_difference(0.0, 0.0) == 0.0

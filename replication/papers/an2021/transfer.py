@@ -32,7 +32,7 @@ from __future__ import annotations
 import functools
 import math
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 import control as ct
 import mpmath
@@ -45,6 +45,9 @@ from scipy.signal import dlsim
 
 from replication.nav import earth
 from replication.nav._validate import choice
+from replication.nav._validate import covariance as _covariance
+from replication.nav._validate import finite_array as _finite_array
+from replication.nav._validate import integer as _integer
 from replication.nav._validate import nonnegative as _nonnegative
 from replication.nav._validate import numeric as _numeric
 from replication.nav._validate import positive as _positive
@@ -955,6 +958,14 @@ def printed_in_derived_normalization(name, printed, motion):
     return expr / d4
 
 
+def _relative_difference(value: float, reference: float) -> float:
+    """|value - reference| / |reference|; a zero reference against a non-zero value is an infinite
+    relative difference (not none), two zeros none."""
+    if reference != 0:
+        return abs(value - reference) / abs(reference)
+    return math.inf if value != 0 else 0.0
+
+
 def coefficient_checks(printed, motion, points, *, radius=None, gravity=None):
     """Printed vs derived (sympy) vs numerical (python-control) value of every printed coefficient.
 
@@ -1013,9 +1024,7 @@ def coefficient_checks(printed, motion, points, *, radius=None, gravity=None):
             p = evaluate(shown, lat, v, motion, radius=radius, gravity=gravity)
             num, den = tfs[(lat, v, pair)]
             x = (num if part == "num" else den).get(power, 0.0)
-            if d != 0:
-                rel_p = max(rel_p, abs(p - d) / abs(d))
-                rel_n = max(rel_n, abs(x - d) / abs(d))
+            rel_p, rel_n = max(rel_p, _relative_difference(p, d)), max(rel_n, _relative_difference(x, d))
             if first is None:
                 first = (p, d, x)
         rows.append(dict(coefficient=name, pair=pair, part=part, power=power, identical=bool(identical),
@@ -1206,6 +1215,10 @@ class NoiseSettings:
         noise : NoiseSettings
             The copy (validated again).
         """
+        names = [f.name for f in fields(self)]
+        unknown = [k for k in factors if k not in names]
+        if unknown:
+            raise ValueError(f"unknown noise setting(s) {unknown}: the fields are {names}")
         return replace(self, **{k: getattr(self, k) * f for k, f in factors.items()})
 
 
@@ -1450,8 +1463,16 @@ def kalman_gain_by_iteration(a, c, q, rc, *, dt, steps, p0):
     k : numpy.ndarray, shape (n, m)
         The continuous-equivalent gain K_d / dt (state units per measurement unit per second).
     """
-    a, c, q, rc, p = (np.asarray(m, float) for m in (a, c, q, rc, p0))
+    a = _finite_array(a, "a")
+    if a.ndim != 2 or a.shape[0] != a.shape[1]:
+        raise ValueError(f"a must be a square matrix (n, n), got shape {a.shape}")
     n = a.shape[0]
+    c = _finite_array(c, "c")
+    if c.ndim != 2 or c.shape[1] != n:
+        raise ValueError(f"c must have shape (m, {n}) to match a, got {c.shape}")
+    q, rc, p = _covariance(q, "q", n), _covariance(rc, "rc", c.shape[0]), _covariance(p0, "p0", n)
+    dt = _positive(dt, "dt")
+    steps = _integer(steps, "steps", minimum=1)
     m = np.zeros((2 * n, 2 * n))
     m[:n, :n], m[:n, n:], m[n:, n:] = -a, q, a.T
     e = sla.expm(m * dt)
@@ -1833,6 +1854,8 @@ def cutoff_grid(lat, v_east, v_north, base: NoiseSettings, field_a, factors_a, f
         Cut-off frequencies [rad/s]; index ``factors_a`` named ``field_a``, columns ``factors_b``
         named ``field_b``.
     """
+    if field_a == field_b:
+        raise ValueError(f"field_a and field_b must be two different settings, both are {field_a!r}")
     _, g = earth_parameters(lat, radius, gravity)
     out = np.empty((len(factors_a), len(factors_b)))
     for i, fa in enumerate(factors_a):

@@ -30,7 +30,7 @@ import pandas as pd
 from replication.nav import trajectory as tr
 from replication.nav.sensors import ImuErrors, TriadErrors, apply_imu_errors
 from replication.nav.strapdown import mechanize
-from replication.nav.units import DEG
+from replication.nav.units import ARCSEC, DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G, PPM, UG_PER_SQRT_HZ
 
 __all__ = ["consequence_flight", "single_errors", "error_features", "error_effects", "classify", "CONSEQUENCE_RULES"]
 
@@ -95,11 +95,11 @@ def single_errors(*, gyro_bias_deg_h=0.01, accel_bias_ug=100.0, scale_ppm=100.0,
     """
     d = {}
     for triad in ("gyro", "accel"):
-        bias = np.full(3, gyro_bias_deg_h * DEG / 3600.0 if triad == "gyro" else accel_bias_ug * 9.80665e-6)
-        white = np.full(3, (gyro_white_deg_rt_h * DEG / 60.0) ** 2 if triad == "gyro"
-                        else (accel_white_ug_rt_hz * 9.80665e-6) ** 2)
-        one = {"bias": TriadErrors(bias=bias), "scale factor": TriadErrors(scale=np.full(3, scale_ppm * 1e-6)),
-               "misalignment": TriadErrors(misalignment=np.full(6, misalignment_arcsec * np.pi / 648000.0)),
+        bias = np.full(3, gyro_bias_deg_h * DEG_PER_H if triad == "gyro" else accel_bias_ug * MICRO_G)
+        white = np.full(3, (gyro_white_deg_rt_h * DEG_PER_SQRT_H) ** 2 if triad == "gyro"
+                        else (accel_white_ug_rt_hz * UG_PER_SQRT_HZ) ** 2)
+        one = {"bias": TriadErrors(bias=bias), "scale factor": TriadErrors(scale=np.full(3, scale_ppm * PPM)),
+               "misalignment": TriadErrors(misalignment=np.full(6, misalignment_arcsec * ARCSEC)),
                "random noise": TriadErrors(white_psd=white)}
         for cls, e in one.items():
             d[(cls, triad)] = ImuErrors(gyro=e) if triad == "gyro" else ImuErrors(accel=e)

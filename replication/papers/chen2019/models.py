@@ -991,7 +991,7 @@ def table_2_2_differences(model, point, *, rtol=1e-6, floor=1e-8) -> list:
         One per element of every block of :data:`TABLE_2_2_BLOCKS`: ``block`` (str), ``row``,
         ``col`` (int, 1-based), ``printed``, ``verified`` (float, SI units), ``differs`` (bool).
     """
-    F = model.F(point)
+    F = _check_model(model).F(point)
     s = model.slices
     ta = -1.0 / F[s["accel_markov"], s["accel_markov"]][0, 0]
     tg = -1.0 / F[s["gyro_markov"], s["gyro_markov"]][0, 0]

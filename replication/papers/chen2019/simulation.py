@@ -60,7 +60,7 @@ from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import errors as E
 from replication.nav import parallel as PAR
-from replication.nav._validate import choice
+from replication.nav._validate import choice, probability
 from replication.nav.rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from replication.nav.sensors import gauss_markov_coefficients, gauss_markov_recursion, lever_arm_offset, misalignment_matrix
 from replication.nav.trajectory import chen2019_flight, generate
@@ -1072,6 +1072,9 @@ def fraction_in_band(nees, dof, prob: float = 0.95, mask=None):
         When an epoch has fewer than one degree of freedom.
     """
     nees = np.asarray(nees, float)
+    if nees.ndim != 2 or nees.shape[0] < 1:
+        raise ValueError(f"nees must be runs × epochs, got shape {nees.shape}")
+    prob = probability(prob, "prob")
     R_ = nees.shape[0]
     dof = np.broadcast_to(np.asarray(dof), nees.shape[1:]).astype(int)
     if np.any(dof < 1):
@@ -1082,7 +1085,11 @@ def fraction_in_band(nees, dof, prob: float = 0.95, mask=None):
     mean = nees.mean(0)
     inside = (mean >= lo) & (mean <= hi)
     if mask is not None:
-        inside = inside[np.asarray(mask, bool)]
+        mask = np.asarray(mask, bool)
+        if mask.shape != inside.shape or not mask.any():
+            raise ValueError(f"mask must select at least one of the {inside.size} epochs (shape {inside.shape}), "
+                             f"got shape {mask.shape}")
+        inside = inside[mask]
     return float(inside.mean()), mean, lo, hi
 
 
@@ -1195,6 +1202,9 @@ def rms_with_ci(err, mask, prob: float = 0.95, remove_mean: bool = False):
     """
     err = np.asarray(err, float)
     mask = np.asarray(mask, bool)
+    prob = probability(prob, "prob")
+    if err.ndim < 2 or mask.shape != err.shape[1:2]:
+        raise ValueError(f"err must be runs × epochs (× ...) and mask one bool per epoch, got {err.shape} and {mask.shape}")
     if not mask.any():
         raise ValueError("the mask selects no epoch")
     sel = err[:, mask]

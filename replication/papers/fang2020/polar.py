@@ -1290,7 +1290,7 @@ def _run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
                 rec, rec_every, acc_every, 1 if shared else 0, tin, trec)
 
 
-def run_segment(sc, k0, k1, traj, sens, state, *, record_every_steps=None):
+def run_segment(sc, k0, k1, traj, sens, state):
     """Advance the grid INS ``state`` from step k0 to k1 (in place; nothing is recorded).
 
     Parameters
@@ -1307,9 +1307,6 @@ def run_segment(sc, k0, k1, traj, sens, state, *, record_every_steps=None):
         Sensor parameters of the n runs (:func:`initial_state`).
     state : dict
         Navigator state of :func:`initial_state`, updated in place.
-    record_every_steps : int, optional
-        Record stride passed to the kernel; default k1 - k0.  No record is kept, so it does not
-        change the result.
 
     Returns
     -------
@@ -1319,7 +1316,7 @@ def run_segment(sc, k0, k1, traj, sens, state, *, record_every_steps=None):
     rec = np.zeros((traj.shape[0], 0, _k.N_REC))
     _run_grid(k0, k1, sc.dt, traj, sens, state["cbp"], state["vg"], state["r"], state["damp"],
               state["comp"], state["rng"], state["acc_e"], state["acc_i"], discretize_damping(sc.dt),
-              1 if sc.damping else 0, _pos_flag(sc), rec, record_every_steps or max(k1 - k0, 1), 10)
+              1 if sc.damping else 0, _pos_flag(sc), rec, max(k1 - k0, 1), 10)
     return state
 
 
