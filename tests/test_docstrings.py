@@ -27,7 +27,6 @@ PENDING: set[str] = {
     "replication.crosschecks.chen2019_model_comparison",
     "replication.crosschecks.fang2020",
     "replication.nav.closedloop",
-    "replication.nav.kalman",
     "replication.nav.parallel",
     "replication.nav.strapdown",
     "replication.nav.timeseries",
