@@ -29,7 +29,6 @@ PENDING: set[str] = {
     "replication.nav.closedloop",
     "replication.nav.parallel",
     "replication.nav.strapdown",
-    "replication.nav.trajectory",
     "replication.papers.an2021.transfer",
     "replication.papers.chen2019.calibration",
     "replication.papers.chen2019.error_effects",
