@@ -25,7 +25,6 @@ import replication
 PENDING: set[str] = {
     "replication.crosschecks.chen2019_gravity_compensation",
     "replication.crosschecks.chen2019_model_comparison",
-    "replication.crosschecks.fang2020",
     "replication.nav.closedloop",
     "replication.nav.parallel",
     "replication.nav.strapdown",
