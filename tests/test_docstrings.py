@@ -24,7 +24,6 @@ import replication
 # modules whose docstrings have not yet been brought to the numpydoc form; the list only shrinks
 PENDING: set[str] = {
     "replication.crosschecks.chen2019_gravity_compensation",
-    "replication.crosschecks.chen2019_model_comparison",
     "replication.nav.closedloop",
     "replication.nav.parallel",
     "replication.nav.strapdown",
