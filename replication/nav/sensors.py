@@ -66,7 +66,7 @@ def markov_sigma_from_driving_psd(q_drive, tau):
     ----------
     q_drive : float or array_like, shape (...)
         Driving white-noise intensity q [x²/s for a process x, e.g. (rad/s)²/s for a gyro drift];
-    non-negative.
+        non-negative.
     tau : float
         Correlation time τ [s], positive.
 
