@@ -62,7 +62,7 @@ _MIS_LABELS = ("xy", "yx", "xz", "zx", "yz", "zy")
 
 
 def nav_block_labels():
-    """Labels of the 9 navigation error states, :data:`NAV_LABELS` as a list.
+    """Labels of the 9 navigation error states, ``NAV_LABELS`` as a list.
 
     Returns
     -------
@@ -290,7 +290,7 @@ class ErrorModel:
 
     @property
     def labels(self) -> list:
-        """State labels: :data:`NAV_LABELS`, then ``"<block>.<label>"`` for each block component."""
+        """State labels: ``NAV_LABELS``, then ``"<block>.<label>"`` for each block component."""
         out = list(NAV_LABELS)
         for b in self.blocks:
             out += [f"{b.name}.{lab}" for lab in b.labels]

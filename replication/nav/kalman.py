@@ -428,7 +428,7 @@ class ClosedLoopResult:
         ----------
         name : str
             Block name or navigation slice (``"position"``, ``"velocity"``, ``"attitude"``, ``"nav"``)
-            of :attr:`ErrorModel.slices`.
+            of :attr:`replication.nav.errors.ErrorModel.slices`.
 
         Returns
         -------

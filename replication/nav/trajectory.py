@@ -92,7 +92,7 @@ class Segment:
         raise NotImplementedError
 
     def label(self):
-        """Name of the segment in :attr:`Trajectory.segments`.
+        """Name of the segment in ``Trajectory.segments``.
 
         Returns
         -------
