@@ -1,4 +1,4 @@
-"""The book's small Sphinx extensions (book/_ext): figure alt text and Chinese search terms."""
+"""The book's small Sphinx extensions (book/_ext): figure alt text, Chinese search terms, numpydoc scope."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "book" / "_ext")
 
 from cjk_search import SearchEnglishCJK, cjk_terms  # noqa: E402
 from figure_alt import MAX_CHARS, first_sentence  # noqa: E402
+from napoleon_scope import process_docstring  # noqa: E402
 
 
 def test_first_sentence_skips_the_periods_of_abbreviations():
@@ -39,3 +40,21 @@ def test_chinese_runs_are_indexed_whole_and_as_bigrams():
     words = SearchEnglishCJK({}).split("the 逆序检验 (reverse arrangement test) and 截尾")
     assert {"逆序检验", "逆序", "检验", "截尾", "reverse", "test"} <= set(words)
     assert words.count("截尾") == 1           # a two-character run is its own only window
+
+
+def test_napoleon_renders_sections_of_functions_and_leaves_constants_plain():
+    from types import SimpleNamespace
+
+    from sphinx.ext.napoleon import Config
+
+    app = SimpleNamespace(config=Config(napoleon_google_docstring=False, napoleon_numpy_docstring=True,
+                                        napoleon_use_param=False, napoleon_use_rtype=False))
+    const = ["Ellipsoidal heights (m) accepted by the functions: from the trench to space."]
+    lines = list(const)
+    process_docstring(app, "data", "m.HEIGHT_RANGE", None, {}, lines)
+    assert lines == const                      # no ":type: Ellipsoidal heights (m) ..."
+    lines = ["Radii.", "", "Parameters", "----------", "lat : float", "    Latitude [rad].",
+             "", "Returns", "-------", "r : float", "    Radius [m]."]
+    process_docstring(app, "function", "m.radii", None, {}, lines)
+    text = "\n".join(lines)
+    assert ":Parameters: **lat** (*float*)" in text and ":returns: **r** (*float*)" in text

@@ -23,20 +23,9 @@ import replication
 
 # modules whose docstrings have not yet been brought to the numpydoc form; the list only shrinks
 PENDING: set[str] = {
-    "replication.crosschecks.chen2019_gravity_compensation",
-    "replication.crosschecks.chen2019_model_comparison",
-    "replication.crosschecks.fang2020",
     "replication.nav.closedloop",
-    "replication.nav.earth",
-    "replication.nav.errors",
-    "replication.nav.kalman",
     "replication.nav.parallel",
-    "replication.nav.rotations",
-    "replication.nav.sensors",
     "replication.nav.strapdown",
-    "replication.nav.timeseries",
-    "replication.nav.trajectory",
-    "replication.nav.units",
     "replication.papers.duan2023.airdata",
     "replication.registry.book",
     "replication.registry.reproduction",

@@ -82,6 +82,52 @@ class VerticalChannel:
     Not printed, the analog's stated assumptions: 30 m/s, field σ₀ = 30 mGal and D = 10 km at the
     ground, white accelerometer noise 10 μg/√Hz, a 100 s low-pass on the direct difference.
     Initial filter uncertainties (0.1 m, 0.03 m/s) are the GNSS accuracies (a choice).
+
+    Attributes
+    ----------
+    flight_time : float
+        Length of the flight [s], default 7200.
+    gnss_interval : float
+        GNSS fix interval [s], default 0.1.
+    sigma_height : float
+        GNSS height σ [m], default 0.1.
+    sigma_velocity : float
+        GNSS vertical-velocity σ [m/s], default 0.03.
+    accel_noise : float
+        Accelerometer white noise [m/s²/√Hz], default 10 μg/√Hz.
+    accel_bias : float
+        Vertical accelerometer bias σ [m/s²], default 50 μg.
+    speed : float
+        Ground speed [m/s], default 30.
+    field_sigma_ground : float
+        σ₀ of the vertical disturbance at the ground [m/s²], default 30 mGal.
+    correlation_length : float
+        Correlation length D of the field at the ground [m], default 10 000.
+    flight_height : float
+        Flight height above the ground [m], default 500.
+    lowpass_period : float
+        Period of the low-pass of the direct difference [s], default 100 (time constant
+        period/2π).
+    n_photos : int
+        Number of photo epochs, default 135.
+    gravity_gradient : float
+        2γ/R of the vertical channel [1/s²], ≥ 0; default 2 γ_e / a.
+    initial_height : float
+        Initial height σ of the filter [m], default 0.1.
+    initial_velocity : float
+        Initial vertical-velocity σ [m/s], default 0.03.
+    n_lines : int
+        Number of flight lines (strips), default 4.
+    line_spacing : float
+        Distance between strips [m], default 500.
+    turn_time : float
+        Duration of each turn between strips [s], default 60.
+
+    Raises
+    ------
+    ValueError
+        For a non-number, a non-positive value (a negative ``gravity_gradient``), non-integer
+        counts, or inconsistent times.
     """
 
     flight_time: float = 7200.0
@@ -148,6 +194,18 @@ def field_variance_ratio(correlation_length: float, flight_height: float) -> flo
     σ_h²/σ₀² = ∫₀^∞ x e^{-2xh/D} (1+x²)^{-3/2} dx  (the Hankel transform of exp(-r/D) weighted by
     the upward-continuation operator e^{-κh} applied to both points).  Supports the disturbance
     term δg^n of chen2019 eq. (3-15) with the chapter's field.
+
+    Parameters
+    ----------
+    correlation_length : float
+        Correlation length D at the ground [m], positive.
+    flight_height : float
+        Height h above the ground [m], ≥ 0.
+
+    Returns
+    -------
+    ratio : float
+        σ_h²/σ₀² (dimensionless, ≤ 1).
     """
     D = _positive(correlation_length, "correlation_length")
     h = _nonnegative(flight_height, "flight_height")
@@ -159,7 +217,21 @@ def along_track_correlation(lag_m, correlation_length: float, flight_height: flo
     """Normalised along-track correlation ρ(r) of the upward-continued vertical disturbance.
 
     ρ(r) = ∫ x J₀(xr/D) e^{-2xh/D} (1+x²)^{-3/2} dx / ∫ x e^{-2xh/D} (1+x²)^{-3/2} dx; at h = 0
-    it is exp(-r/D).  ``lag_m`` in metres (scalar or array, >= 0).
+    it is exp(-r/D) (h must be positive here).
+
+    Parameters
+    ----------
+    lag_m : float or array_like, shape (...)
+        Horizontal distance r [m], ≥ 0.
+    correlation_length : float
+        Correlation length D at the ground [m], positive.
+    flight_height : float
+        Height h above the ground [m], positive.
+
+    Returns
+    -------
+    rho : float or ndarray, shape (...)
+        ρ(r), a float for a scalar ``lag_m``.
     """
     D = _positive(correlation_length, "correlation_length")
     h = _positive(flight_height, "flight_height")
@@ -183,11 +255,21 @@ def _smoothed_gm_correlation(t, beta, tc):
 
 
 def fit_continued_shape(setup: VerticalChannel | None = None) -> dict:
-    """Two-state shaping filter (GM rate β, low-pass time constant T_c) fitted to the
-    along-track correlation of the continued field, lags 0..3D flown at the setup's speed.
+    """Two-state shaping filter fitted to the along-track correlation of the continued field.
 
-    Returns ``beta``, ``tc`` and ``rms_misfit`` (of the correlation); the fitted process is given
-    the variance of the continued field.  Used for δg_U of chen2019 eq. (3-15).
+    A Gauss-Markov process of rate β through a first-order low-pass of time constant T_c, fitted
+    on lags 0..3D flown at the setup's speed; the fitted process is given the variance of the
+    continued field.  Used for δg_U of chen2019 eq. (3-15).
+
+    Parameters
+    ----------
+    setup : VerticalChannel or None, optional
+        Settings; default ``VerticalChannel()``.
+
+    Returns
+    -------
+    fit : dict of str to float
+        ``beta`` [1/s], ``tc`` [s] and ``rms_misfit`` (of the correlation, dimensionless).
     """
     p = _check_setup(setup)
     lags = np.linspace(0.0, 3.0 * p.correlation_length, 61)
@@ -236,11 +318,25 @@ def _disturbance_block(shape, p: VerticalChannel):
 
 
 def filter_model(method: str, setup: VerticalChannel | None = None) -> dict:
-    """Discrete filter model of the vertical channel: chen2019 eq. (3-17) restricted to
-    [δh, δV_U, ∇_bz] (+ δg_U for ``"state"``), measurement (3-18) rows δh and δV_U.
+    """Discrete filter model of the vertical channel.
 
-    The filter's F is the printed one (no 2γ/R term); ∇_bz is a random constant; δg_U, when
-    augmented, is a first-order Gauss-Markov process with the field's variance and τ = D/v.
+    chen2019 eq. (3-17) restricted to [δh, δV_U, ∇_bz] (+ δg_U for ``"state"``), measurement
+    (3-18) rows δh and δV_U.  The filter's F is the printed one (no 2γ/R term); ∇_bz is a random
+    constant; δg_U, when augmented, is a first-order Gauss-Markov process with the field's
+    variance and τ = D/v.
+
+    Parameters
+    ----------
+    method : {"normal", "direct", "state"}
+        The compensation method (:data:`METHODS`).
+    setup : VerticalChannel or None, optional
+        Settings; default ``VerticalChannel()``.
+
+    Returns
+    -------
+    model : dict of str to ndarray
+        ``Phi`` and ``Q`` (n × n, n = 3 or 4) over one GNSS interval, ``H`` (2 × n), ``R`` (2 × 2,
+        m² and (m/s)²) and ``P0`` (n × n), SI state units [m, m/s, m/s², m/s²].
     """
     choice(method, METHODS, "method")
     p = _check_setup(setup)
@@ -274,10 +370,26 @@ def truth_model(method: str, shape: str = "gauss-markov", setup: VerticalChannel
     chen2019 eqs. (3-14), (3-15) (vertical), (3-7)/(3-8) for the direct difference, (3-18) for the
     measurement.  ``C`` maps a filter correction onto the truth state (x ← x - C K z).
 
-    ``disturbance="state"`` carries δg_U as shaping-filter states (stationary process in time);
-    ``disturbance="input"`` leaves it out of the state and returns ``Gamma``, the discrete input
-    vector of a δg_U held over one GNSS interval, for a disturbance given by its covariance along
-    the actual flight lines (:func:`geometry_height_rms`).
+    Parameters
+    ----------
+    method : {"normal", "direct", "state"}
+        The compensation method.
+    shape : {"gauss-markov", "continued"}, optional
+        Shaping filter of the disturbance (:data:`SHAPES`), default ``"gauss-markov"``.
+    setup : VerticalChannel or None, optional
+        Settings; default ``VerticalChannel()``.
+    disturbance : {"state", "input"}, optional
+        ``"state"`` (default) carries δg_U as shaping-filter states (stationary process in time);
+        ``"input"`` leaves it out of the state and returns ``Gamma``, the discrete input vector of a
+        δg_U held over one GNSS interval, for a disturbance given by its covariance along the actual
+        flight lines (:func:`geometry_height_rms`).
+
+    Returns
+    -------
+    model : dict of str to ndarray
+        ``Phi``, ``Q`` (n × n) over one GNSS interval, ``H`` (2 × n), ``R`` (2 × 2), ``C``
+        (n × n_filter), ``P0`` (n × n) and ``Gamma`` (n,) [state units per m/s²; zeros for
+        ``"state"``].
     """
     choice(method, METHODS, "method")
     choice(shape, SHAPES, "shape")
@@ -374,8 +486,26 @@ def height_error_history(cases, setup: VerticalChannel | None = None, disturbanc
 
     All cases run in one batched recursion at the GNSS rate: the filter's Riccati recursion gives
     K_k; the truth covariance follows  P⁻ = Φ_t P Φ_tᵀ + Q_t,  P⁺ = A P⁻ Aᵀ + C K R_t Kᵀ Cᵀ with
-    A = I - C K H_t (Gelb 1974, §7.2; closed loop).  Returns ``time`` (s), ``sigma_h`` (cases × epochs,
-    after each update) and ``filter_sigma_h`` (the filter's own claim).
+    A = I - C K H_t (Gelb 1974, §7.2; closed loop).
+
+    Parameters
+    ----------
+    cases : iterable of tuple of (str, str)
+        (method, shape) pairs of :data:`METHODS` and :data:`SHAPES`, at least one.
+    setup : VerticalChannel or None, optional
+        Settings; default ``VerticalChannel()``.
+    disturbance : {"state", "input"}, optional
+        How the truth carries δg_U (:func:`truth_model`), default ``"state"``.
+    keep_gains : bool, optional
+        Also return the gains and truth matrices (for :func:`geometry_height_rms`), default False.
+
+    Returns
+    -------
+    history : dict
+        ``time`` [s], shape (steps,); ``sigma_h`` [m], shape (cases, steps), after each update;
+        ``filter_sigma_h`` [m] (the filter's own claim); ``cases``; with ``keep_gains`` also
+        ``gains`` (cases, steps, 4, 2), ``Phi``, ``H``, ``C`` and ``Gamma`` of the truth, padded
+        to a common size.
     """
     p = _check_setup(setup)
     cases = list(cases)
@@ -433,8 +563,22 @@ def height_error_history(cases, setup: VerticalChannel | None = None, disturbanc
 
 
 def photo_rms(history: dict, setup: VerticalChannel | None = None) -> np.ndarray:
-    """Expected RMS of the height error over the photo epochs (n_photos evenly over the lines):
-    sqrt(mean of the true variance at those epochs), the statistic of chen2019 Table 4-50."""
+    """Expected RMS of the height error over the photo epochs (n_photos evenly over the lines).
+
+    sqrt(mean of the true variance at those epochs), the statistic of chen2019 Table 4-50.
+
+    Parameters
+    ----------
+    history : dict
+        The result of :func:`height_error_history` (``time`` and ``sigma_h`` are read).
+    setup : VerticalChannel or None, optional
+        Settings (photo epochs); default ``VerticalChannel()``.
+
+    Returns
+    -------
+    rms : ndarray, shape (cases,)
+        Photo-epoch RMS [m] per case.
+    """
     p = _check_setup(setup)
     if not isinstance(history, dict) or "sigma_h" not in history or "time" not in history:
         raise ValueError("history must be the dict returned by height_error_history")
@@ -443,9 +587,21 @@ def photo_rms(history: dict, setup: VerticalChannel | None = None) -> np.ndarray
 
 
 def predicted_height_rms(setup: VerticalChannel | None = None, shapes=SHAPES) -> dict:
-    """Predicted height RMS (m) of the three methods of chen2019 Table 4-50 for each disturbance
-    shape: ``{(method, shape): {"rms": true photo-epoch RMS, "filter_rms": the filter's own
-    claim}}``."""
+    """Predicted height RMS of the three methods of chen2019 Table 4-50 for each disturbance shape.
+
+    Parameters
+    ----------
+    setup : VerticalChannel or None, optional
+        Settings; default ``VerticalChannel()``.
+    shapes : iterable of str, optional
+        Shapes of :data:`SHAPES`, default both.
+
+    Returns
+    -------
+    rms : dict
+        ``{(method, shape): {"rms": true photo-epoch RMS [m], "filter_rms": the filter's own
+        claim [m]}}``.
+    """
     p = _check_setup(setup)
     shapes = tuple(shapes)
     for s in shapes:
@@ -464,7 +620,18 @@ def _line_time(p: VerticalChannel) -> float:
 
 
 def photo_times(setup: VerticalChannel | None = None) -> np.ndarray:
-    """Photo epochs (s): n_photos evenly spread over the time spent on the flight lines."""
+    """Photo epochs: n_photos evenly spread over the time spent on the flight lines.
+
+    Parameters
+    ----------
+    setup : VerticalChannel or None, optional
+        Settings; default ``VerticalChannel()``.
+
+    Returns
+    -------
+    t : ndarray, shape (n_photos,)
+        Photo times since the start [s], turns skipped.
+    """
     p = _check_setup(setup)
     tl = _line_time(p)
     s = (np.arange(p.n_photos) + 0.5) * p.n_lines * tl / p.n_photos      # line time elapsed
@@ -473,9 +640,23 @@ def photo_times(setup: VerticalChannel | None = None) -> np.ndarray:
 
 
 def flight_positions(t, setup: VerticalChannel | None = None) -> np.ndarray:
-    """Horizontal position (m, along-line x and cross-line y) at times ``t``: n_lines east-west
-    strips of equal duration, flown alternately in opposite directions, line_spacing apart,
-    joined by turns of turn_time (cross-line move at the line end)."""
+    """Horizontal position at times ``t`` along the flight plan.
+
+    n_lines east-west strips of equal duration, flown alternately in opposite directions,
+    line_spacing apart, joined by turns of turn_time (cross-line move at the line end).
+
+    Parameters
+    ----------
+    t : float or array_like, shape (...)
+        Times within the flight [s].
+    setup : VerticalChannel or None, optional
+        Settings; default ``VerticalChannel()``.
+
+    Returns
+    -------
+    xy : ndarray, shape (..., 2)
+        Along-line x and cross-line y [m].
+    """
     p = _check_setup(setup)
     t = np.asarray(t, dtype=float)
     if not np.all(np.isfinite(t)) or np.any(t < 0) or np.any(t > p.flight_time * (1 + 1e-9)):
@@ -496,18 +677,32 @@ def flight_positions(t, setup: VerticalChannel | None = None) -> np.ndarray:
 
 
 def geometry_height_rms(setup: VerticalChannel | None = None, shapes=SHAPES, bin_seconds: float = 5.0) -> dict:
-    """Predicted photo-epoch height RMS of the three methods with the disturbance given by its
-    spatial covariance along the real flight plan (strips re-flown over the same ground).
+    """Predicted photo-epoch height RMS with the disturbance given along the real flight plan.
 
-    The closed-loop filter is linear (chen2019 eqs. 3-14, 3-15, 3-17, 3-18), so the height error is
-    a noise part (covariance recursion without δg_U) plus Σ_k g_j(k) δg_U(t_k), g_j the response of
-    the photo-j height error to the disturbance at step k (adjoint recursion with the filter's gains).
-    Then Var_j = noise_j + g_jᵀ C_δg g_j, C_δg(a, b) = σ_h² ρ(|r_a - r_b|) from the field's isotropic
-    covariance (``"continued"``: the upward-continued exponential; ``"gauss-markov"``: exp(-r/D)).
-    δg_U is binned in ``bin_seconds`` (it varies on ≥ 50 s scales).  The disturbance-free methods
-    use the same filters as :func:`predicted_height_rms`; method 3 augments the GM model.
-    Returns ``{(method, shape): {"rms", "run_sd"}}``; ``run_sd`` is the standard deviation of one
-    flight's photo RMS over field realizations (the noise part's scatter is neglected).
+    The disturbance is given by its spatial covariance along the strips, re-flown over the same
+    ground.  The closed-loop filter is linear (chen2019 eqs. 3-14, 3-15, 3-17, 3-18), so the
+    height error is a noise part (covariance recursion without δg_U) plus Σ_k g_j(k) δg_U(t_k),
+    g_j the response of the photo-j height error to the disturbance at step k (adjoint recursion
+    with the filter's gains).  Then Var_j = noise_j + g_jᵀ C_δg g_j, C_δg(a, b) = σ_h²
+    ρ(|r_a - r_b|) from the field's isotropic covariance (``"continued"``: the upward-continued
+    exponential; ``"gauss-markov"``: exp(-r/D)).  The disturbance-free methods use the same
+    filters as :func:`predicted_height_rms`; method 3 augments the GM model.
+
+    Parameters
+    ----------
+    setup : VerticalChannel or None, optional
+        Settings; default ``VerticalChannel()``.
+    shapes : iterable of str, optional
+        Shapes of :data:`SHAPES` (the field's covariance), default both.
+    bin_seconds : float, optional
+        δg_U is binned in ``bin_seconds`` [s] (it varies on ≥ 50 s scales), between one GNSS
+        interval and 30 s; default 5.
+
+    Returns
+    -------
+    rms : dict
+        ``{(method, shape): {"rms": [m], "run_sd": [m]}}``; ``run_sd`` is the standard deviation
+        of one flight's photo RMS over field realizations (the noise part's scatter is neglected).
     """
     p = _check_setup(setup)
     shapes = tuple(shapes)
@@ -572,9 +767,50 @@ class LevelChannel:
     Printed in chen2019: GNSS 10 Hz, 0.1 m and 0.03 m/s, gyro bias 0.01 °/h, accelerometer bias
     50 μg (Table 4-46), 2 h over four strips (Table 4-47), 135 photos.  The analog's stated
     assumptions: 30 m/s, 60 s turns, white noise 0.003 °/√h and 10 μg/√Hz, initial tilt 1e-4 rad
-    (the chapter's attitude_sd), GNSS initial accuracies.  ``step``: the analysis steps at 1 s and
-    processes the ten fixes of a step as one with R/10 (the same information per unit time; the
-    fastest dynamics are the field's correlation time D/v ≥ 60 s).
+    (the chapter's attitude_sd), GNSS initial accuracies.
+
+    Attributes
+    ----------
+    flight_time : float
+        Length of the flight [s], default 7200.
+    n_lines : int
+        Number of strips, default 4.
+    turn_time : float
+        Duration of each turn [s], default 60.
+    speed : float
+        Ground speed [m/s], default 30.
+    n_photos : int
+        Number of photo epochs, default 135.
+    gnss_interval : float
+        GNSS fix interval [s], default 0.1.
+    sigma_position : float
+        GNSS horizontal position σ [m], default 0.1.
+    sigma_velocity : float
+        GNSS velocity σ [m/s], default 0.03.
+    accel_noise : float
+        Accelerometer white noise [m/s²/√Hz], default 10 μg/√Hz.
+    gyro_noise : float
+        Gyro angle random walk [rad/√s], default 0.003 °/√h.
+    accel_bias : float
+        Accelerometer bias σ [m/s²], default 50 μg.
+    gyro_bias : float
+        Gyro bias σ [rad/s], default 0.01 °/h.
+    initial_tilt : float
+        Initial tilt σ [rad], default 1e-4.
+    gravity : float
+        g of the Schuler loop [m/s²], default γ_e.
+    earth_radius : float
+        R of the Schuler loop [m], default the WGS-84 a.
+    step : float
+        Analysis step [s], between one GNSS interval and 10 s; default 1.  The ten fixes of a
+        step are processed as one with R/10 (the same information per unit time; the fastest
+        dynamics are the field's correlation time D/v ≥ 60 s).
+
+    Raises
+    ------
+    ValueError
+        For a value that is not a finite positive number, non-integer counts or a step out of
+        range.
     """
 
     flight_time: float = 7200.0
@@ -625,18 +861,31 @@ def _level_matrices(sign: float, sigma_h: float, tau: float, p: LevelChannel):
 
 
 def level_attitude_rms(sigmas_h, correlation_lengths, setup: LevelChannel | None = None) -> dict:
-    """Expected photo-epoch RMS of the level attitude (pitch along track, roll across: the same
-    law) for the normal-gravity filter and for a filter given the field's true statistics.
+    """Expected photo-epoch RMS of the level attitude for two filters.
 
-    Truth: the equations of ``_level_matrices`` with the horizontal disturbance a first-order Gauss-Markov
-    process of σ ``sigma_h`` (m/s², at flight height) and correlation time D/v.  Filters
-    (closed loop, chen2019 eq. (3-18) position and velocity rows): ``"normal"`` leaves δg out
-    (eq. (3-1) gravity only, the 15-state filter); ``"informed"`` carries δg with the truth's
-    own law, the best any method-3 filter can do in this model (its P is the true error
-    covariance).  The true covariance of each closed loop follows Gelb (1974) §7.2 as in
-    :func:`height_error_history`.  All cases run in one batched recursion.
+    Pitch along track and roll across follow the same law.  Truth: the level rows of chen2019
+    eq. (3-15) with f^n = (0, 0, g), Schuler coupling φ̇ = δv/R and no Earth rate,
+    δv̇ = -g φ + s ∇ + δg + w_a, φ̇ = δv/R - s ε + w_g, with the horizontal disturbance a
+    first-order Gauss-Markov process of σ ``sigma_h`` and correlation time D/v (s = ±1 the strip
+    heading).  Filters (closed loop, chen2019 eq. (3-18) position and velocity rows):
+    ``"normal"`` leaves δg out (eq. (3-1) gravity only, the 15-state filter); ``"informed"``
+    carries δg with the truth's own law, the best any method-3 filter can do in this model (its P
+    is the true error covariance).  The true covariance of each closed loop follows Gelb (1974)
+    §7.2 as in :func:`height_error_history`.  All cases run in one batched recursion.
 
-    Returns ``{(sigma_h, D): {"normal": rms_rad, "informed": rms_rad}}``.
+    Parameters
+    ----------
+    sigmas_h : float or array_like, shape (k,)
+        Horizontal disturbance σ at flight height [m/s²], positive.
+    correlation_lengths : float or array_like, shape (l,)
+        Correlation lengths D [m], positive.
+    setup : LevelChannel or None, optional
+        Settings; default ``LevelChannel()``.
+
+    Returns
+    -------
+    rms : dict
+        ``{(sigma_h, D): {"normal": rms [rad], "informed": rms [rad]}}``.
     """
     p = setup if setup is not None else LevelChannel()
     if not isinstance(p, LevelChannel):
@@ -698,13 +947,34 @@ def level_attitude_rms(sigmas_h, correlation_lengths, setup: LevelChannel | None
 
 def required_disturbance(gains_percent, correlation_lengths, setup: LevelChannel | None = None,
                          sigmas_h=None) -> dict:
-    """Horizontal disturbance σ (m/s², at flight height) at which the informed filter of
-    :func:`level_attitude_rms` improves the level attitude over the normal-gravity filter by each
-    of ``gains_percent``, for each correlation length: the smallest field for which a printed
-    method-3 gain becomes reachable in this model.  The gain 100 (1 - informed/normal) is
-    evaluated on ``sigmas_h`` (default 5-640 mGal, log-spaced) and interpolated in log σ.
+    """Horizontal disturbance σ at which a printed method-3 level-attitude gain becomes reachable.
 
-    Returns ``{D: {"sigma_h": {gain: σ or nan if not reached}, "grid": [(σ, normal, informed)]}}``.
+    The informed filter of :func:`level_attitude_rms` improves the level attitude over the
+    normal-gravity filter by each of ``gains_percent``, for each correlation length: the smallest
+    field for which a printed method-3 gain becomes reachable in this model.  The gain
+    100 (1 - informed/normal) is evaluated on ``sigmas_h`` and interpolated in log σ.
+
+    Parameters
+    ----------
+    gains_percent : float or array_like, shape (k,)
+        Gains [%], strictly between 0 and 100.
+    correlation_lengths : float or array_like, shape (l,)
+        Correlation lengths D [m].
+    setup : LevelChannel or None, optional
+        Settings; default ``LevelChannel()``.
+    sigmas_h : array_like, shape (m,), optional
+        Grid of disturbance σ [m/s²]; default 5-640 mGal, 15 values log-spaced.
+
+    Returns
+    -------
+    required : dict
+        ``{D: {"sigma_h": {gain: σ [m/s²] or nan if not reached}, "grid": [(σ, normal, informed)]}}``
+        with the level-attitude RMS of the grid in radians.
+
+    Raises
+    ------
+    RuntimeError
+        When the gain is not monotonic in σ on the grid.
     """
     gains = [float(g) for g in np.atleast_1d(gains_percent)]
     if any(not (0.0 < g < 100.0) for g in gains):

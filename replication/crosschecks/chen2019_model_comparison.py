@@ -88,8 +88,55 @@ GNSS_INTERVAL = 1.0 / 20.0
 
 @dataclass(frozen=True)
 class Settings:
-    """Sensor, GNSS and prior settings (SI units).  Defaults: chen2019 Table 4-41 plus the
-    simulation chapter's stated choices for what the print leaves open."""
+    """Sensor, GNSS and prior settings (SI units).
+
+    Defaults: chen2019 Table 4-41 plus the simulation chapter's stated choices for what the print
+    leaves open.
+
+    Attributes
+    ----------
+    gyro_white_psd : float
+        Gyro white-noise intensity q_g of eq. (2-5) [rad²/s = (rad/s)²/Hz], default (0.01 °/h)²/Hz.
+    accel_white_psd : float
+        Accelerometer white-noise intensity q_a [(m/s²)²·s], default (50 μg)²/Hz.
+    gyro_const : float
+        Gyro random constant ε_b, standard deviation [rad/s], default 0.01 °/h.
+    accel_const : float
+        Accelerometer random constant ∇_b [m/s²], default 50 μg.
+    gyro_markov_sigma : float
+        Stationary σ of the gyro Markov drift ε_m [rad/s], default 0.01 °/h.
+    gyro_markov_tau : float
+        Its correlation time [s], default 300.
+    accel_markov_sigma : float
+        Stationary σ of the accelerometer Markov bias ∇_m [m/s²], default 50 μg.
+    accel_markov_tau : float
+        Its correlation time [s], default 2.5 h.
+    scale_factor : float
+        Scale-factor errors δK_g, δK_a of eq. (2-6) (dimensionless), default 1e-5.
+    misalignment : float
+        Non-orthogonality angles δG, δA of eq. (2-9) [rad], default 1.5″.
+    gravity_sigma : float
+        Gravity-disturbance σ per axis, eq. (2-12) [m/s²], default 10 mGal.
+    gravity_tau : float
+        Its correlation time [s], default 300.
+    lever_nominal : tuple of float
+        Lever arm P_SINS^b of eq. (2-13), body axes [m], default (0.3, 0.8, 1.5).
+    lever_sigma : float
+        Its uncertainty per axis [m], default 0.05.
+    random_walk_time : float
+        Time [s] over which the 36-state random walks reach the constants' σ, default the
+        5100-s flight.
+    gnss_pos_sigma : tuple of float
+        GNSS position σ (E, N, U) per 20-Hz fix [m], default (0.03, 0.03, 0.1).
+    gnss_vel_sigma : float
+        GNSS velocity σ per 20-Hz fix [m/s], default 0.03.
+    init_pos_sigma : tuple of float
+        Initial position σ (E, N, U) [m], default (0.03, 0.03, 0.1).
+    init_vel_sigma : float
+        Initial velocity σ [m/s], default 0.03.
+    init_att_sigma : tuple of float
+        Initial attitude σ (E, N, U) [rad], default (20″, 20″, 3′).
+    """
 
     gyro_white_psd: float = (0.01 * DEG_PER_H) ** 2            # eq. (2-5) q_g, rad²/s
     accel_white_psd: float = (50.0 * MICRO_G) ** 2             # eq. (2-5) q_a, (m/s²)²·s
@@ -140,7 +187,18 @@ TRUTH_MODEL = "45"
 
 
 def model_indices(model: str) -> np.ndarray:
-    """Indices of ``model``'s states in the superset layout (chen2019 eq. (2-14) order)."""
+    """Indices of ``model``'s states in the superset layout (chen2019 eq. (2-14) order).
+
+    Parameters
+    ----------
+    model : {"15", "36", "45"}
+        The filter model.
+
+    Returns
+    -------
+    idx : ndarray of int, shape (n_model,)
+        Its states' positions in the superset state.
+    """
     choice(model, sorted(MODEL_BLOCKS), "model")
     return np.concatenate([np.arange(N_SUPER)[_SL[b]] for b in MODEL_BLOCKS[model]])
 
@@ -167,7 +225,25 @@ def _misalignment_jacobian(u):
 # Trajectory (chen2019 Table 4-42)
 # ---------------------------------------------------------------------------------------------
 def heading_profile(t):
-    """Heading ψ (rad, clockwise from north) and rate ψ̇ (rad/s) of the Table 4-42 flight."""
+    """Heading ψ and rate ψ̇ of the Table 4-42 flight.
+
+    Parameters
+    ----------
+    t : float or array_like, shape (n,)
+        Time since the start [s], within [0, 5100].
+
+    Returns
+    -------
+    psi : ndarray, shape (n,)
+        Heading [rad], clockwise from north.
+    rate : ndarray, shape (n,)
+        Turn rate ψ̇ [rad/s].
+
+    Raises
+    ------
+    ValueError
+        For a time outside the flight.
+    """
     t = np.asarray(t, dtype=float)
     if np.any(~np.isfinite(t)) or np.any(t < 0.0) or np.any(t > FLIGHT_END):
         raise ValueError(f"t must lie in [0, {FLIGHT_END}] s")
@@ -190,6 +266,25 @@ def heading_profile(t):
 
 @dataclass
 class FlightPoint:
+    """A sample of the Table 4-42 flight at which F and H are evaluated.
+
+    Attributes
+    ----------
+    lat : float
+        Geodetic latitude [rad].
+    h : float
+        Ellipsoidal height [m].
+    v : ndarray, shape (3,)
+        Velocity (East, North, Up) [m/s].
+    c_bn : ndarray, shape (3, 3)
+        C_b^n, body x right / y forward / z up.
+    f_b : ndarray, shape (3,)
+        Specific force in body axes [m/s²].
+    w_ib_b : ndarray, shape (3,)
+        Body rate with respect to inertial space [rad/s].
+    w_nb_b : ndarray, shape (3,)
+        Body rate with respect to the navigation frame [rad/s].
+    """
     lat: float
     h: float
     v: np.ndarray          # ENU velocity
@@ -200,9 +295,20 @@ class FlightPoint:
 
 
 def flight(dt: float = 1.0):
-    """Sample the Table 4-42 flight every ``dt`` seconds: list of (t, FlightPoint).
+    """Sample the Table 4-42 flight every ``dt`` seconds.
 
     Coordinated level turns at constant speed and height: bank tan γ = V ψ̇ / g, pitch 0.
+
+    Parameters
+    ----------
+    dt : float, optional
+        Sampling interval [s] in (0, 10], a multiple of the 0.05-s GNSS interval dividing the
+        5100-s flight; default 1.
+
+    Returns
+    -------
+    points : list of tuple of (float, FlightPoint)
+        (t [s], point) for t = 0, dt, ..., 5100.
     """
     dt = _check_dt(dt)
     n = int(round(FLIGHT_END / dt))
@@ -237,7 +343,20 @@ def flight(dt: float = 1.0):
 # Error model (chen2019 eqs. (2-10), (2-12), (2-13), (2-15))
 # ---------------------------------------------------------------------------------------------
 def system_matrix(p: FlightPoint, s: Settings = Settings()) -> np.ndarray:
-    """Continuous-time F of the superset state (chen2019 eq. (2-15) with eq. (2-10) inserted)."""
+    """Continuous-time F of the superset state (chen2019 eq. (2-15) with eq. (2-10) inserted).
+
+    Parameters
+    ----------
+    p : FlightPoint
+        Where F is evaluated.
+    s : Settings, optional
+        Correlation times of the Markov states; default ``Settings()``.
+
+    Returns
+    -------
+    F : ndarray, shape (N_SUPER, N_SUPER)
+        δẋ = F δx [1/s in state units] for all states of all three models.
+    """
     rm, rn = radii(p.lat)
     rm, rn = rm + p.h, rn + p.h
     lat = p.lat
@@ -293,8 +412,23 @@ def system_matrix(p: FlightPoint, s: Settings = Settings()) -> np.ndarray:
 
 
 def measurement_matrix(p: FlightPoint, s: Settings = Settings()) -> np.ndarray:
-    """H of the GNSS position (E, N, U in m) and velocity fix referred with the lever arm,
-    chen2019 eq. (2-13); z = INS-predicted antenna position/velocity − GNSS."""
+    """H of the GNSS position and velocity fix referred with the lever arm, chen2019 eq. (2-13).
+
+    z = INS-predicted antenna position/velocity − GNSS: position (E, N, U) [m], velocity (E, N, U)
+    [m/s].
+
+    Parameters
+    ----------
+    p : FlightPoint
+        Where H is evaluated.
+    s : Settings, optional
+        The nominal lever arm; default ``Settings()``.
+
+    Returns
+    -------
+    H : ndarray, shape (6, N_SUPER)
+        Measurement matrix of the superset state.
+    """
     rm, rn = radii(p.lat)
     l_nom = np.asarray(s.lever_nominal, dtype=float)
     H = np.zeros((6, N_SUPER))
@@ -310,7 +444,20 @@ def measurement_matrix(p: FlightPoint, s: Settings = Settings()) -> np.ndarray:
 
 
 def process_psd(model: str, s: Settings = Settings()) -> np.ndarray:
-    """Diagonal white-noise intensity (G Q G^T) of ``model`` (chen2019 eqs. (2-5), (2-12))."""
+    """Diagonal white-noise intensity (G Q G^T) of ``model`` (chen2019 eqs. (2-5), (2-12)).
+
+    Parameters
+    ----------
+    model : {"15", "36", "45"}
+        The model.
+    s : Settings, optional
+        Noise settings; default ``Settings()``.
+
+    Returns
+    -------
+    GQGt : ndarray, shape (n_model, n_model)
+        Intensities in the model's state order [state unit²/s].
+    """
     q = np.zeros(N_SUPER)
     q[_SL["vel"]] = s.accel_white_psd
     q[_SL["att"]] = s.gyro_white_psd
@@ -330,7 +477,20 @@ def process_psd(model: str, s: Settings = Settings()) -> np.ndarray:
 
 
 def initial_covariance(model: str, s: Settings = Settings()) -> np.ndarray:
-    """Prior covariance P_0 of ``model`` (chen2019 Table 4-41 and the chapter's initial errors)."""
+    """Prior covariance P_0 of ``model`` (chen2019 Table 4-41 and the chapter's initial errors).
+
+    Parameters
+    ----------
+    model : {"15", "36", "45"}
+        The model.
+    s : Settings, optional
+        Prior settings; default ``Settings()``.
+
+    Returns
+    -------
+    P0 : ndarray, shape (n_model, n_model)
+        Diagonal, state units squared (the random-walk states start at zero).
+    """
     rm, rn = radii(LAT0)
     sig = np.zeros(N_SUPER)
     pe, pn, pu = s.init_pos_sigma
@@ -375,7 +535,20 @@ def _euler_variances(p_att: np.ndarray, psi: float):
 
 @dataclass
 class Result:
-    """Predicted attitude σ (degrees) of one filter model, RMS over the survey lines."""
+    """Predicted attitude σ of one filter model, RMS over the survey lines.
+
+    Attributes
+    ----------
+    model : str
+        The filter model.
+    true_sigma_deg : dict of str to float
+        ``heading``, ``pitch``, ``roll`` σ [deg] of the true error covariance (against the
+        45-source truth).
+    own_sigma_deg : dict of str to float
+        The same from the filter's own Riccati P [deg].
+    seconds : float
+        CPU time of the analysis [s] (shared equally by the models of one pass).
+    """
 
     model: str
     true_sigma_deg: dict = field(default_factory=dict)   # true error covariance (vs. 45-source truth)
@@ -392,8 +565,23 @@ def analyse(model: str, *, dt: float = 1.0, settings: Settings = Settings(),
     [truth error (``truth`` model), filter estimate] driven by the same gains:
     Y⁻ = diag(Φ_t, Φ_f) Y⁺ diag(Φ_t, Φ_f)ᵀ + diag(Q_t, 0),
     Y⁺ = B Y⁻ Bᵀ + [0; K] R [0; K]ᵀ with B = [[I, 0], [K H_t, I − K H_f]].
-    The attitude error is φ_truth − φ̂.  Returns heading/pitch/roll σ in degrees as
-    sqrt(mean variance) over the survey-line epochs.
+    The attitude error is φ_truth − φ̂.
+
+    Parameters
+    ----------
+    model : {"15", "36", "45"}
+        The filter model.
+    dt : float, optional
+        Step [s] (see :func:`flight`), default 1.
+    settings : Settings, optional
+        Settings of truth and filter; default ``Settings()``.
+    truth : {"15", "36", "45"}, optional
+        The truth model, default ``"45"``.
+
+    Returns
+    -------
+    result : Result
+        Heading/pitch/roll σ in degrees as sqrt(mean variance) over the survey-line epochs.
     """
     dt = _check_dt(dt)
     if not isinstance(settings, Settings):
@@ -489,7 +677,20 @@ def _recursion(models, dt, settings, truth, q_scale=None):
 
 
 def compare(models=("15", "36", "45"), *, dt: float = 1.0) -> dict:
-    """:func:`analyse` for each model, in one pass over the flight; returns {model: Result}."""
+    """:func:`analyse` for each model, in one pass over the flight.
+
+    Parameters
+    ----------
+    models : sequence of str, optional
+        Models to analyse, default ("15", "36", "45").
+    dt : float, optional
+        Step [s], default 1.
+
+    Returns
+    -------
+    results : dict of str to Result
+        {model: Result}.
+    """
     models = tuple(models)
     if not models:
         raise ValueError("models must not be empty")
@@ -500,11 +701,27 @@ def compare(models=("15", "36", "45"), *, dt: float = 1.0) -> dict:
 
 
 def disturbance_sweep(sigmas_mgal=(0.0, 10.0, 30.0, 60.0), models=("36", "45"), *, dt: float = 5.0) -> dict:
-    """The true attitude σ of ``models`` as the gravity disturbance of the truth (eq. (2-12),
-    per axis, correlation time 300 s) grows; the 45-state filter models it with the same σ.
-    Returns {σ in mGal: {model: Result}}.  ``dt`` 5 s: the GNSS information per unit time is
-    kept (R scaled); the σ move by about 1e-3 relative from 1-s steps and the 45-against-36
-    percentages by at most 0.2 points (0, 10 and 60 mGal compared)."""
+    """The true attitude σ of ``models`` as the gravity disturbance of the truth grows.
+
+    The disturbance follows eq. (2-12), per axis, correlation time 300 s; the 45-state filter
+    models it with the same σ.  ``dt`` 5 s: the GNSS information per unit time is kept (R
+    scaled); the σ move by about 1e-3 relative from 1-s steps and the 45-against-36 percentages
+    by at most 0.2 points (0, 10 and 60 mGal compared).
+
+    Parameters
+    ----------
+    sigmas_mgal : sequence of float, optional
+        Disturbance σ per axis [mGal], non-negative; default (0, 10, 30, 60).
+    models : sequence of str, optional
+        Filter models, default ("36", "45").
+    dt : float, optional
+        Step [s], default 5.
+
+    Returns
+    -------
+    results : dict of float to dict of str to Result
+        {σ in mGal: {model: Result}}.
+    """
     models = tuple(models)
     if not models:
         raise ValueError("models must not be empty")
@@ -522,12 +739,29 @@ def disturbance_sweep(sigmas_mgal=(0.0, 10.0, 30.0, 60.0), models=("36", "45"), 
 
 def tuning_sweep(factors=(0.1, 1.0, 10.0, 100.0), *, model: str = "15", reference: str = "45",
                  dt: float = 5.0) -> dict:
-    """The true attitude σ of the ``model`` filter when its process-noise intensity (eq. (2-5)
-    and its Markov/random-walk drivers) is multiplied by each factor — a tuning, the truth
-    unchanged — beside the ``reference`` filter as specified.  The literal 15-state filter is
-    overconfident in tilt (its own P far below its true error): how much the 45-state model
-    gains over it depends on how it is tuned.  Returns {"reference": Result, factor: Result}.
-    ``dt`` as in :func:`disturbance_sweep`."""
+    """The true attitude σ of the ``model`` filter under a scaled process noise.
+
+    Its process-noise intensity (eq. (2-5) and its Markov/random-walk drivers) is multiplied by
+    each factor — a tuning, the truth unchanged — beside the ``reference`` filter as specified.
+    The literal 15-state filter is overconfident in tilt (its own P far below its true error):
+    how much the 45-state model gains over it depends on how it is tuned.
+
+    Parameters
+    ----------
+    factors : sequence of float, optional
+        Positive multipliers of the filter's process noise, default (0.1, 1, 10, 100).
+    model : {"15", "36", "45"}, optional
+        The tuned model, default ``"15"``.
+    reference : {"15", "36", "45"}, optional
+        The untuned comparison filter, default ``"45"``.
+    dt : float, optional
+        Step [s] as in :func:`disturbance_sweep`, default 5.
+
+    Returns
+    -------
+    results : dict
+        ``{"reference": Result, factor: Result, ...}``.
+    """
     model_indices(model)
     model_indices(reference)
     dt = _check_dt(dt)

@@ -126,9 +126,21 @@ CASES = {
 
 # --------------------------------------------------------------------------- frames
 def grid_axes(r):
-    """Grid-frame axes [G_E, G_N, G_U] as the columns of a 3x3 matrix in ECEF (fang2020 §2.1,
-    Fig. 2): G_U the local vertical, G_N the horizontal direction parallel to the prime-meridian
-    plane (agreeing with geographic north at λ = 0, eq. (8)), G_E = G_N × G_U."""
+    """Grid-frame axes [G_E, G_N, G_U] as the columns of a 3x3 matrix in ECEF (fang2020 §2.1, Fig. 2).
+
+    G_U the local vertical, G_N the horizontal direction parallel to the prime-meridian plane
+    (agreeing with geographic north at λ = 0, eq. (8)), G_E = G_N × G_U.
+
+    Parameters
+    ----------
+    r : array_like, shape (3,)
+        ECEF position [m] (spherical Earth: the vertical is r/|r|).
+
+    Returns
+    -------
+    A : ndarray, shape (3, 3)
+        Columns G_E, G_N, G_U in ECEF components: the DCM from grid to ECEF.
+    """
     r = np.asarray(r, dtype=float)
     u = r / np.linalg.norm(r)
     gn = np.array([-u[2], 0.0, u[0]])
@@ -138,9 +150,23 @@ def grid_axes(r):
 
 
 def theta_jacobian(r, step=1.0):
-    """Linear map ``θ = J δr``: misalignment (ECEF components) of the grid frame at ``r + δr``
-    against the grid frame at ``r`` (fang2020 eq. (2), θ), by central differences of
-    :func:`grid_axes`; ``A(r+δr) ≈ (I + [θ×]) A(r)``."""
+    """Linear map ``θ = J δr`` of fang2020 eq. (2), θ.
+
+    θ is the misalignment (ECEF components) of the grid frame at ``r + δr`` against the grid
+    frame at ``r``, by central differences of :func:`grid_axes`; ``A(r+δr) ≈ (I + [θ×]) A(r)``.
+
+    Parameters
+    ----------
+    r : array_like, shape (3,)
+        ECEF position [m].
+    step : float, optional
+        Central-difference step [m], default 1.
+
+    Returns
+    -------
+    J : ndarray, shape (3, 3)
+        dθ/dδr [rad/m].
+    """
     r = np.asarray(r, dtype=float)
     a0 = grid_axes(r)
     jac = np.zeros((3, 3))
@@ -164,12 +190,25 @@ def _lat_lon_sigma(r):
 
 
 def n_matrix(r, *, as_printed=False):
-    """N of fang2020 eq. (15) at ECEF position ``r`` (m).
+    """N of fang2020 eq. (15) at ECEF position ``r``.
 
     The printed eq. (15) repeats ``-Rz/sqrt(x²+z²)`` in row 2; eq. (11), from which (15) is
     assembled, has ``δy = -sqrt(x²+z²) ψ_y``, and the printed closed form of M after eq. (17)
-    equals ``N C_OEPQ^G`` with the eq. (11) entry.  The eq. (11) entry is the default;
-    ``as_printed=True`` gives the row as printed in (15)."""
+    equals ``N C_OEPQ^G`` with the eq. (11) entry.  The eq. (11) entry is the default.
+
+    Parameters
+    ----------
+    r : array_like, shape (3,)
+        ECEF position [m].
+    as_printed : bool, optional
+        Give the row-2 entry as printed in (15), default False.
+
+    Returns
+    -------
+    N : ndarray, shape (3, 3)
+        Maps the OEPQ attitude error [rad] to [δx [m], δy [m], φ_z [rad]]; rows 1-2 in metres
+        per radian.
+    """
     x, y, z = np.asarray(r, dtype=float)
     s = np.sqrt(x * x + z * z)
     rr = np.linalg.norm(r)
@@ -180,8 +219,21 @@ def n_matrix(r, *, as_printed=False):
 
 
 def c_oepq_to_grid(r):
-    """C_OEPQ^G of fang2020 eq. (16) at ECEF position ``r``: C_g^G(σ) times the rotation by L
-    about E taking the OEPQ axes (E east, P polar axis, Q = E × P) to geographic ENU."""
+    """C_OEPQ^G of fang2020 eq. (16) at ECEF position ``r``.
+
+    C_g^G(σ) times the rotation by L about E taking the OEPQ axes (E east, P polar axis,
+    Q = E × P) to geographic ENU.
+
+    Parameters
+    ----------
+    r : array_like, shape (3,)
+        ECEF position [m].
+
+    Returns
+    -------
+    C : ndarray, shape (3, 3)
+        The DCM from OEPQ to the grid frame.
+    """
     lat, _, sigma = _lat_lon_sigma(np.asarray(r, dtype=float))
     cs, ss, cl, sl = np.cos(sigma), np.sin(sigma), np.cos(lat), np.sin(lat)
     cg = np.array([[cs, -ss, 0.0], [ss, cs, 0.0], [0.0, 0.0, 1.0]])
@@ -190,14 +242,39 @@ def c_oepq_to_grid(r):
 
 
 def m_matrix(r, *, n_as_printed=False):
-    """M = N C_OEPQ^G of fang2020 eq. (17) at ECEF position ``r`` (equal to the printed closed
-    form, :func:`m_matrix_printed`, with the eq. (11) entry of N; see :func:`n_matrix`)."""
+    """M = N C_OEPQ^G of fang2020 eq. (17) at ECEF position ``r``.
+
+    Equal to the printed closed form (:func:`m_matrix_printed`) with the eq. (11) entry of N; see
+    :func:`n_matrix`.
+
+    Parameters
+    ----------
+    r : array_like, shape (3,)
+        ECEF position [m].
+    n_as_printed : bool, optional
+        Use N with the row-2 entry as printed in (15), default False.
+
+    Returns
+    -------
+    M : ndarray, shape (3, 3)
+        Maps the grid-frame attitude error [rad] to P = [δx [m], δy [m], φ_z [rad]].
+    """
     return n_matrix(r, as_printed=n_as_printed) @ c_oepq_to_grid(r)
 
 
 def m_matrix_printed(r):
-    """The closed form of M printed after fang2020 eq. (17), for comparison with
-    :func:`m_matrix`."""
+    """The closed form of M printed after fang2020 eq. (17), for comparison with :func:`m_matrix`.
+
+    Parameters
+    ----------
+    r : array_like, shape (3,)
+        ECEF position [m].
+
+    Returns
+    -------
+    M : ndarray, shape (3, 3)
+        The printed M.
+    """
     x, y, z = np.asarray(r, dtype=float)
     rr = np.linalg.norm(r)
     rho = np.hypot(x, y)
@@ -208,23 +285,65 @@ def m_matrix_printed(r):
 
 
 def u_matrix(a):
-    """U(t_{n+1}, t_n) of fang2020 eq. (25) for ``a = Ω (t_{n+1} - t_n)``."""
+    """U(t_{n+1}, t_n) of fang2020 eq. (25) for ``a = Ω (t_{n+1} - t_n)``.
+
+    Parameters
+    ----------
+    a : float
+        Earth-rotation angle Ω (t_{n+1} - t_n) [rad].
+
+    Returns
+    -------
+    U : ndarray, shape (3, 3)
+        [[sin a, 0, cos a - 1], [0, a, 0], [1 - cos a, 0, sin a]].
+    """
     s, c = np.sin(a), np.cos(a)
     return np.array([[s, 0.0, c - 1.0], [0.0, a, 0.0], [1.0 - c, 0.0, s]])
 
 
 def t_matrix(a):
-    """T(t_{n+1}, t_n) of fang2020 eq. (25)."""
+    """T(t_{n+1}, t_n) of fang2020 eq. (25).
+
+    Parameters
+    ----------
+    a : float
+        Earth-rotation angle Ω (t_{n+1} - t_n) [rad].
+
+    Returns
+    -------
+    T : ndarray, shape (3, 3)
+        [[cos a, 0, -sin a], [0, 1, 0], [sin a, 0, cos a]].
+    """
     s, c = np.sin(a), np.cos(a)
     return np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
 
 
 def two_point_estimate(p, r2, c_b_grid, dt):
-    """Body-frame gyro drift (rad/s) from fang2020 eq. (27):
+    """Body-frame gyro drift from fang2020 eq. (27).
+
     ``ε_b = C_G^b B Ω U^{-1}(t2, t1) M^{-1} P(t2)``, with ``B = C_OEPQ^G`` (reading 1).
 
-    ``p`` = [δx, δy, φ_z] at t2 (m, m, rad); ``r2`` true ECEF position at t2 (m);
-    ``c_b_grid`` = C_b^G at t2; ``dt = t2 - t1`` (s)."""
+    Parameters
+    ----------
+    p : array_like, shape (3,)
+        P(t2) = [δx, δy, φ_z] at t2 (m, m, rad).
+    r2 : array_like, shape (3,)
+        True ECEF position at t2 [m].
+    c_b_grid : array_like, shape (3, 3)
+        C_b^G at t2.
+    dt : float
+        t2 - t1 [s], positive.
+
+    Returns
+    -------
+    eps_b : ndarray, shape (3,)
+        Platform drift in body axes [rad/s].
+
+    Raises
+    ------
+    ValueError
+        For a P(t2) that is not three finite numbers or a non-positive ``dt``.
+    """
     p = np.asarray(p, dtype=float)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
         raise ValueError("P(t2) must be three finite numbers [δx, δy, φ_z]")
@@ -238,8 +357,21 @@ def two_point_estimate(p, r2, c_b_grid, dt):
 
 # --------------------------------------------------------------------------- damping network
 def damping_network():
-    """H_y(s) of fang2020 §1 as ``H = 1 + (β1 s + β0)/(s² + α1 s + α0)``; returns
-    (α1, α0, β1, β0)."""
+    """H_y(s) of fang2020 §1 as ``H = 1 + (β1 s + β0)/(s² + α1 s + α0)``.
+
+    From the printed zeros and poles of :data:`PAPER`.
+
+    Returns
+    -------
+    alpha1 : float
+        α1 [1/s].
+    alpha0 : float
+        α0 [1/s²].
+    beta1 : float
+        β1 [1/s].
+    beta0 : float
+        β0 [1/s²].
+    """
     (za, zb), (pc, pd) = PAPER["damping"]["zeros"], PAPER["damping"]["poles"]
     return pc + pd, pc * pd, za + zb - pc - pd, za * zb - pc * pd
 
@@ -291,18 +423,54 @@ def _rhs(t, y, traj, eps_b, bias_b, g, coeffs):
 def propagate(case, *, t1_h=2.0, t2_h=3.5, drift_deg_h=0.01, bias_g=1e-4,
               attitude_arcsec=(6.0, 6.0, 360.0), speed=10.0, reset="grid-attitude",
               drift_convention="gyro-output", rtol=1e-10):
-    """Propagate the linear error model (fang2020 eqs. (1), (21)-(23) with the damping network
-    of §1) for ``case`` 1 or 2 from t = 0 to t2 with the reset at t1 (reading 2).
+    """Propagate the linear error model of fang2020 for ``case`` 1 or 2.
 
-    ``reset`` selects what the fix at t1 does to the attitude error: ``"grid-attitude"``
-    (reading 2, the default), ``"ecef-attitude"`` (ψ kept, grid heading error zeroed) or
-    ``"ideal"`` (ψ = 0, the assumption behind eq. (27)); the last two are sensitivity checks.
-    ``drift_convention``: ``"gyro-output"`` (reading 5, default: ``drift_deg_h`` is the error of
-    the gyro output of the strapdown system, so the mathematical platform drifts at
-    ``ε = -C_b^e ε_gyro`` in eq. (18)) or ``"platform"`` (``drift_deg_h`` is the ε of eq. (18)).
+    fang2020 eqs. (1), (21)-(23) with the damping network of §1, from t = 0 to t2 with the reset
+    at t1 (reading 2).
 
-    Returns a dict with the true ECEF position ``r2``, ``C_b^G`` at t2 and the error vector
-    ``P(t2) = [δx, δy, φ_z]`` of fang2020 eq. (17)."""
+    Parameters
+    ----------
+    case : {1, 2}
+        The simulation of :data:`CASES`.
+    t1_h : float, optional
+        Time of the first fix [h], default 2.
+    t2_h : float, optional
+        Time of the second fix [h], later than ``t1_h``; default 3.5.
+    drift_deg_h : float, optional
+        Gyro drift on each axis [°/h], default 0.01.
+    bias_g : float, optional
+        Accelerometer bias on each axis [g, 9.80665 m/s²], default 1e-4.
+    attitude_arcsec : array_like, shape (3,), optional
+        Initial misalignment about the body right, forward, up axes [″], default (6, 6, 360)
+        (reading 3).
+    speed : float, optional
+        Ship speed [m/s], default 10.
+    reset : {"grid-attitude", "ecef-attitude", "ideal"}, optional
+        What the fix at t1 does to the attitude error: ``"grid-attitude"`` (reading 2, the
+        default), ``"ecef-attitude"`` (ψ kept, grid heading error zeroed) or ``"ideal"`` (ψ = 0,
+        the assumption behind eq. (27)); the last two are sensitivity checks.
+    drift_convention : {"gyro-output", "platform"}, optional
+        ``"gyro-output"`` (reading 5, default: ``drift_deg_h`` is the error of the gyro output of
+        the strapdown system, so the mathematical platform drifts at ``ε = -C_b^e ε_gyro`` in
+        eq. (18)) or ``"platform"`` (``drift_deg_h`` is the ε of eq. (18)).
+    rtol : float, optional
+        Relative tolerance of the DOP853 integration, default 1e-10.
+
+    Returns
+    -------
+    result : dict
+        ``r2`` the true ECEF position at t2 [m], shape (3,); ``c_b_grid`` C_b^G at t2, shape
+        (3, 3); ``P`` the error vector P(t2) = [δx [m], δy [m], φ_z [rad]] of fang2020 eq. (17);
+        ``psi`` ψ(t2) [rad] and ``dr`` δr(t2) [m], ECEF components; ``t1``, ``t2`` [s]; ``sign``
+        the factor (-1 for ``"gyro-output"``, +1 for ``"platform"``) that turns the platform drift
+        of eq. (27) into the drift estimate.
+
+    Raises
+    ------
+    ValueError
+        For an unknown case, reset or convention, non-positive times or speed, ``t2_h <= t1_h``,
+        or non-finite errors.
+    """
     if case not in CASES:
         raise ValueError(f"case must be 1 or 2, got {case!r}")
     t1_h = positive(t1_h, "t1_h")
@@ -361,11 +529,24 @@ def propagate(case, *, t1_h=2.0, t2_h=3.5, drift_deg_h=0.01, bias_g=1e-4,
 
 
 def drift_estimates(case, **kwargs):
-    """Two-point drift estimates (X, Y, Z body axes, °/h) for fang2020 Table ``case`` (1 or 2):
-    the linear propagation of :func:`propagate` followed by eq. (27)
-    (:func:`two_point_estimate`).  Keyword arguments are passed to :func:`propagate`.  With the
-    default ``drift_convention="gyro-output"`` the estimate of the gyro output error is the
-    negative of the platform drift that eq. (27) returns (reading 5)."""
+    """Two-point drift estimates for fang2020 Table ``case`` (1 or 2).
+
+    The linear propagation of :func:`propagate` followed by eq. (27) (:func:`two_point_estimate`).
+    With the default ``drift_convention="gyro-output"`` the estimate of the gyro output error is
+    the negative of the platform drift that eq. (27) returns (reading 5).
+
+    Parameters
+    ----------
+    case : {1, 2}
+        The simulation of :data:`CASES`.
+    **kwargs : optional
+        Keyword arguments of :func:`propagate`.
+
+    Returns
+    -------
+    estimates : dict of str to float
+        ``{"X": ..., "Y": ..., "Z": ...}``, body axes [°/h].
+    """
     out = propagate(case, **kwargs)
     eps = two_point_estimate(out["P"], out["r2"], out["c_b_grid"], out["t2"] - out["t1"])
     return dict(zip("XYZ", out["sign"] * eps / units.DEG_PER_H))

@@ -60,9 +60,26 @@ documents fly below 10 km)."""
 
 
 def check_height(h, *, name: str = "h"):
-    """Validate an ellipsoidal height in metres; return it as an array.  Raises ``ValueError`` for
-    text, NaN or infinity, and for heights outside :data:`HEIGHT_RANGE` (a value in km or feet, or
-    a latitude passed in its place, is the usual cause)."""
+    """Validate an ellipsoidal height in metres; return it as an array.
+
+    Parameters
+    ----------
+    h : float or array_like, shape (...)
+        Ellipsoidal height [m].
+    name : str, optional
+        Name of the argument in the error messages, default ``"h"``.
+
+    Returns
+    -------
+    h : ndarray, shape (...)
+        The heights as a float array [m].
+
+    Raises
+    ------
+    ValueError
+        For text, NaN or infinity, and for heights outside :data:`HEIGHT_RANGE` (a value in km or
+        feet, or a latitude passed in its place, is the usual cause).
+    """
     h = _numbers(h, name)
     if not np.all(np.isfinite(h)):
         raise ValueError(f"{name} must be finite (got NaN or infinity)")
@@ -82,9 +99,27 @@ so no vehicle navigated inside :data:`HEIGHT_RANGE` exceeds it; a larger value i
 
 
 def check_velocity(v, *, name: str = "v_enu"):
-    """Validate ENU velocities (m/s, last axis of length 3); return them as an array.  Raises
-    ``TypeError`` for text, ``ValueError`` for another shape, NaN or infinity and for a speed
-    above :data:`SPEED_LIMIT`."""
+    """Validate ENU velocities; return them as an array.
+
+    Parameters
+    ----------
+    v : array_like, shape (..., 3)
+        Velocity (East, North, Up) [m/s].
+    name : str, optional
+        Name of the argument in the error messages, default ``"v_enu"``.
+
+    Returns
+    -------
+    v : ndarray, shape (..., 3)
+        The velocities as a float array [m/s].
+
+    Raises
+    ------
+    TypeError
+        For text.
+    ValueError
+        For another shape, NaN or infinity and for a speed above :data:`SPEED_LIMIT`.
+    """
     v = vector3(v, name)
     speed = np.sqrt(np.sum(v * v, axis=-1))
     if np.any(speed > SPEED_LIMIT):
@@ -94,7 +129,25 @@ def check_velocity(v, *, name: str = "v_enu"):
 
 
 def check_longitude(lon, *, name: str = "lon"):
-    """Validate a longitude in radians (any finite value: it is periodic); return it as an array."""
+    """Validate a longitude in radians (any finite value: it is periodic); return it as an array.
+
+    Parameters
+    ----------
+    lon : float or array_like, shape (...)
+        Longitude λ [rad].
+    name : str, optional
+        Name of the argument in the error messages, default ``"lon"``.
+
+    Returns
+    -------
+    lon : ndarray, shape (...)
+        The longitudes as a float array [rad].
+
+    Raises
+    ------
+    ValueError
+        For text, NaN or infinity.
+    """
     lon = _numbers(lon, name)
     if not np.all(np.isfinite(lon)):
         raise ValueError(f"{name} must be finite (radians)")
@@ -104,9 +157,26 @@ def check_longitude(lon, *, name: str = "lon"):
 def check_latitude(lat, *, polar_limit_deg: float | None = None, name: str = "lat"):
     """Validate a latitude in radians; return it as an array.
 
-    Raises ``ValueError`` when any value lies beyond ±90° (a degrees value passed as radians
-    is the usual cause) or, if ``polar_limit_deg`` is given, within the n-frame singularity at
-    the pole (|L| ≥ ``polar_limit_deg``), where tan L and 1/cos L blow up.
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    polar_limit_deg : float or None, optional
+        If given, the latitude [deg] from which on (|L| ≥ ``polar_limit_deg``) values are refused
+        as inside the n-frame singularity at the pole, where tan L and 1/cos L blow up.
+    name : str, optional
+        Name of the argument in the error messages, default ``"lat"``.
+
+    Returns
+    -------
+    lat : ndarray, shape (...)
+        The latitudes as a float array [rad].
+
+    Raises
+    ------
+    ValueError
+        When any value is not a finite number, lies beyond ±90° (a degrees value passed as radians
+        is the usual cause) or, if ``polar_limit_deg`` is given, within the polar limit.
     """
     lat = _numbers(lat, name)
     if not np.all(np.isfinite(lat)):
@@ -127,9 +197,21 @@ def check_latitude(lat, *, polar_limit_deg: float | None = None, name: str = "la
 
 
 def radii(lat):
-    """Meridian and prime-vertical radii of curvature (R_M, R_N) in metres.
+    """Meridian and prime-vertical radii of curvature (R_M, R_N).
 
     R_M (子午圈曲率半径) = a(1-e²)/(1-e² sin²L)^{3/2};  R_N (卯酉圈曲率半径) = a/(1-e² sin²L)^{1/2}.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+
+    Returns
+    -------
+    R_M : ndarray, shape (...)
+        Meridian radius of curvature [m].
+    R_N : ndarray, shape (...)
+        Prime-vertical radius of curvature [m].
     """
     lat = check_latitude(lat)
     s2 = np.sin(lat) ** 2
@@ -138,16 +220,48 @@ def radii(lat):
 
 
 def earth_rate_enu(lat):
-    """Earth rotation rate in the ENU navigation frame, ω_ie^n = [0, ω cos L, ω sin L] (rad/s)."""
+    """Earth rotation rate in the ENU navigation frame, ω_ie^n = [0, ω cos L, ω sin L].
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+
+    Returns
+    -------
+    w_ie_n : ndarray, shape (..., 3)
+        ω_ie^n (East, North, Up) [rad/s].
+    """
     lat = check_latitude(lat)
     z = np.zeros_like(lat)
     return np.stack([z, OMEGA_IE * np.cos(lat), OMEGA_IE * np.sin(lat)], axis=-1)
 
 
 def transport_rate_enu(lat, h, v_enu, *, polar_limit_deg: float = POLAR_LIMIT_DEG):
-    """Transport rate ω_en^n = [-v_N/(R_M+h), v_E/(R_N+h), v_E tan L/(R_N+h)] (rad/s), ENU frame.
+    """Transport rate ω_en^n = [-v_N/(R_M+h), v_E/(R_N+h), v_E tan L/(R_N+h)], ENU frame.
 
     chen2019 eq. (3-2) (the ω_en^n term).  Refuses latitudes inside the polar singularity.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    h : float or array_like, shape (...)
+        Ellipsoidal height [m].
+    v_enu : array_like, shape (..., 3)
+        Velocity (East, North, Up) [m/s].
+    polar_limit_deg : float, optional
+        Latitude [deg] from which on the n frame is refused, default :data:`POLAR_LIMIT_DEG`.
+
+    Returns
+    -------
+    w_en_n : ndarray, shape (..., 3)
+        ω_en^n (East, North, Up) [rad/s].
+
+    Raises
+    ------
+    ValueError
+        For a latitude at or beyond ``polar_limit_deg`` and for invalid heights or velocities.
     """
     lat = check_latitude(lat, polar_limit_deg=polar_limit_deg)
     h = check_height(h)
@@ -158,46 +272,69 @@ def transport_rate_enu(lat, h, v_enu, *, polar_limit_deg: float = POLAR_LIMIT_DE
 
 
 def somigliana(sin2_lat, *, gamma_e: float = GAMMA_E, k: float = K_SOMIGLIANA, e2: float = E2):
-    """Somigliana's closed form of normal gravity on a level ellipsoid (m/s^2).
+    """Somigliana's closed form of normal gravity on a level ellipsoid.
 
     γ_0 = γ_e (1 + k sin²L) / sqrt(1 - e² sin²L)   (NIMA TR8350.2 eq. 4-1), evaluated as written,
     for the WGS-84 constants of this module or for another set of them (a paper's printed ones).
 
     Parameters
     ----------
-    sin2_lat : float or array_like
-        sin²L of the geodetic latitude L (not validated: callers check their latitudes).
+    sin2_lat : float or array_like, shape (...)
+        sin²L of the geodetic latitude L (dimensionless; not validated: callers check their
+        latitudes).
     gamma_e : float, optional
-        Normal gravity at the equator γ_e (m/s^2), default :data:`GAMMA_E`.
+        Normal gravity at the equator γ_e [m/s^2], default :data:`GAMMA_E`.
     k : float, optional
-        Somigliana's constant k = b γ_p / (a γ_e) - 1, default :data:`K_SOMIGLIANA`.
+        Somigliana's constant k = b γ_p / (a γ_e) - 1 (dimensionless), default :data:`K_SOMIGLIANA`.
     e2 : float, optional
-        First eccentricity squared e², default :data:`E2`.
+        First eccentricity squared e² (dimensionless), default :data:`E2`.
 
     Returns
     -------
-    float or numpy.ndarray
-        γ_0 in m/s^2, shaped as ``sin2_lat``.
+    gamma_0 : float or ndarray, shape (...)
+        γ_0 [m/s^2], shaped as ``sin2_lat``.
     """
     return gamma_e * (1.0 + k * sin2_lat) / np.sqrt(1.0 - e2 * sin2_lat)
 
 
 def normal_gravity_ellipsoid(lat):
-    """Somigliana's closed-form normal gravity on the WGS-84 ellipsoid (m/s^2).
+    """Somigliana's closed-form normal gravity on the WGS-84 ellipsoid.
 
     γ_0 = γ_e (1 + k sin²L) / sqrt(1 - e² sin²L)   (NIMA TR8350.2 eq. 4-1; :func:`somigliana`).
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+
+    Returns
+    -------
+    gamma_0 : ndarray, shape (...)
+        Normal gravity on the ellipsoid [m/s^2].
     """
     lat = check_latitude(lat)
     return somigliana(np.sin(lat) ** 2)
 
 
 def normal_gravity(lat, h=0.0):
-    """Normal gravity magnitude at geodetic latitude ``lat`` and ellipsoidal height ``h`` (m/s^2).
+    """Normal gravity magnitude at geodetic latitude ``lat`` and ellipsoidal height ``h``.
 
     Somigliana's closed form on the ellipsoid with the second-order height expansion
     γ_h = γ_0 [1 - 2/a (1 + f + m - 2 f sin²L) h + 3 h²/a²]  (NIMA TR8350.2 eq. 4-3;
     Heiskanen & Moritz eq. 2-215).  This is the reference against which the printed
     chen2019 eq. (3-1) is checked.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    h : float or array_like, shape (...), optional
+        Ellipsoidal height [m], default 0; broadcast with ``lat``.
+
+    Returns
+    -------
+    gamma : ndarray, shape (...)
+        Normal gravity magnitude γ_h [m/s^2].
     """
     lat = check_latitude(lat)
     h = check_height(h)
@@ -221,7 +358,7 @@ def _q_prime(u):
 
 
 def normal_gravity_closed_form(lat, h=0.0):
-    """Normal gravity magnitude of the WGS-84 ellipsoid at any height, in closed form (m/s^2).
+    """Normal gravity magnitude of the WGS-84 ellipsoid at any height, in closed form.
 
     The exact normal field of the level ellipsoid (a, f, GM, ω) in ellipsoidal coordinates
     (u, β): NIMA TR8350.2 §4 (normal gravity above the ellipsoid), Heiskanen & Moritz (1967)
@@ -233,6 +370,18 @@ def normal_gravity_closed_form(lat, h=0.0):
 
     No series truncation: this is the reference for every series form (chen2019 eq. (3-1)).
     On the ellipsoid it equals Somigliana's formula :func:`normal_gravity_ellipsoid`.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    h : float or array_like, shape (...), optional
+        Ellipsoidal height [m], default 0; broadcast with ``lat``.
+
+    Returns
+    -------
+    gamma : ndarray, shape (...)
+        Normal gravity magnitude [m/s^2].
     """
     lat = check_latitude(lat)
     h = _check_height(h)
@@ -274,6 +423,21 @@ class SeriesCoefficients:
 
     ``symbolic[name]`` is the sympy expression it was derived from, ``numeric[name]`` its WGS-84
     value; ``extra`` holds by-products of the derivation (e.g. the h² coefficient at the pole).
+    Indexing ``coefficients[name]`` returns ``numeric[name]``.
+
+    Attributes
+    ----------
+    numeric : dict of str to float
+        WGS-84 value of each term of :data:`SERIES_TERMS` in SI: ``gamma_e`` [m/s^2], ``k1``, ``k2``
+        (dimensionless), ``h1``, ``h1s`` [1/s^2], ``h2`` [1/(m s^2)].
+    symbolic : dict of str to sympy.Expr
+        The sympy expression of each term in the symbols a, f, GM, ω.
+    height_model : str
+        ``"closed-form"`` or ``"tr8350"``, the height expansion the h terms come from.
+    extra : dict of str to float
+        Numeric by-products in SI (``gamma_p`` [m/s^2], ``c1``, ``c2``, ``h2_pole`` or ``h1s_s2``).
+    symbolic_extra : dict of str to sympy.Expr or None
+        Symbolic by-products (``h1_expr``, ``h1s_expr`` of the ``"tr8350"`` model), default None.
     """
 
     numeric: dict
@@ -309,15 +473,28 @@ def normal_gravity_series_coefficients(height_model: str = "closed-form") -> Ser
     k1 = γ_p/γ_e - 1 = (1+k)/√(1-e²) - 1 (the gravity flattening f*), which folds the O(e⁶)
     remainder into k1 as the GRS80/WGS-84 series does.
 
-    Height terms, ``height_model``:
+    Parameters
+    ----------
+    height_model : {"closed-form", "tr8350"}, optional
+        Origin of the height terms:
 
-    * ``"closed-form"`` (default): Taylor coefficients in h of the exact closed form
-      (:func:`normal_gravity_closed_form`, which at the equator and at the pole reduces to a
-      function of u alone): h1 = -∂γ/∂h at the equator, h1s = ∂γ/∂h(pole) - ∂γ/∂h(equator),
-      h2 = ½ ∂²γ/∂h² at the equator;
-    * ``"tr8350"``: the expansion γ_h = γ_0[1 - 2h/a(1 + f + m - 2f sin²L) + 3h²/a²]
-      (NIMA TR8350.2 eq. 4-3, Heiskanen & Moritz 1967 eq. 2-215) multiplied out with the
-      latitude series, keeping terms linear in s in the h term and the constant in h².
+        * ``"closed-form"`` (default): Taylor coefficients in h of the exact closed form
+          (:func:`normal_gravity_closed_form`, which at the equator and at the pole reduces to a
+          function of u alone): h1 = -∂γ/∂h at the equator, h1s = ∂γ/∂h(pole) - ∂γ/∂h(equator),
+          h2 = ½ ∂²γ/∂h² at the equator;
+        * ``"tr8350"``: the expansion γ_h = γ_0[1 - 2h/a(1 + f + m - 2f sin²L) + 3h²/a²]
+          (NIMA TR8350.2 eq. 4-3, Heiskanen & Moritz 1967 eq. 2-215) multiplied out with the
+          latitude series, keeping terms linear in s in the h term and the constant in h².
+
+    Returns
+    -------
+    coefficients : SeriesCoefficients
+        The symbolic and numeric (SI) coefficients; cached per ``height_model``.
+
+    Raises
+    ------
+    ValueError
+        For another ``height_model``.
     """
     if height_model not in ("closed-form", "tr8350"):
         raise ValueError("height_model must be 'closed-form' or 'tr8350'")
@@ -373,12 +550,35 @@ def normal_gravity_series_coefficients(height_model: str = "closed-form") -> Ser
 
 
 def gravity_series_form(lat, h, coefficients, *, third_term: str = "sin2_2L", trailing_L: bool = False):
-    """Evaluate the series form of chen2019 eq. (3-1) with given coefficients (m/s^2).
+    """Evaluate the series form of chen2019 eq. (3-1) with given coefficients.
 
     γ = γ_e(1 + k1 sin²L - k2 X)·[L] - (h1 - h1s sin²L) h + h2 h²,
     X = sin²2L (``third_term="sin2_2L"``, the standard form) or sin²L (``"sin2L"``, as printed);
-    ``trailing_L=True`` multiplies the bracket by L in radians, as printed.  ``coefficients`` is
-    a mapping with the keys of :data:`SERIES_TERMS` in SI units.
+    ``trailing_L=True`` multiplies the bracket by L in radians, as printed.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    h : float or array_like, shape (...)
+        Ellipsoidal height [m]; broadcast with ``lat``.
+    coefficients : mapping of str to float
+        The keys of :data:`SERIES_TERMS` in SI units (``gamma_e`` [m/s^2], ``k1``, ``k2``
+        dimensionless, ``h1``, ``h1s`` [1/s^2], ``h2`` [1/(m s^2)]).
+    third_term : {"sin2_2L", "sin2L"}, optional
+        The third bracket term X, default ``"sin2_2L"``.
+    trailing_L : bool, optional
+        Multiply the bracket by L [rad], as printed; default False.
+
+    Returns
+    -------
+    gamma : ndarray, shape (...)
+        The series value [m/s^2].
+
+    Raises
+    ------
+    ValueError
+        When ``coefficients`` lacks a term or ``third_term`` is unknown.
     """
     lat = check_latitude(lat)
     h = _check_height(h)
@@ -397,11 +597,25 @@ def gravity_series_form(lat, h, coefficients, *, third_term: str = "sin2_2L", tr
 
 
 def normal_gravity_series(lat, h=0.0, coefficients=None):
-    """Normal gravity from the series form with sympy-derived coefficients (m/s^2).
+    """Normal gravity from the series form with sympy-derived coefficients.
 
     γ = γ_e(1 + k1 sin²L - k2 sin²2L) - (h1 - h1s sin²L) h + h2 h², the form chen2019
     eq. (3-1) intends, with the coefficients of :func:`normal_gravity_series_coefficients`
     (closed-form height terms) unless ``coefficients`` is given.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    h : float or array_like, shape (...), optional
+        Ellipsoidal height [m], default 0.
+    coefficients : mapping of str to float or None, optional
+        The terms of :data:`SERIES_TERMS` in SI; default the closed-form WGS-84 coefficients.
+
+    Returns
+    -------
+    gamma : ndarray, shape (...)
+        Normal gravity [m/s^2].
     """
     if coefficients is None:
         coefficients = normal_gravity_series_coefficients().numeric
@@ -422,8 +636,21 @@ EQ_3_1_QUANTITIES = {
 def eq_3_1_coefficients(paper) -> dict:
     """The printed coefficients of chen2019 eq. (3-1) in SI from its paper-value table.
 
-    ``paper`` is the :class:`~replication.registry.reproduction.PaperTable` of ``chen2019-eq-3-1``
-    (printed mantissa × ``si_factor``).
+    Parameters
+    ----------
+    paper : PaperTable
+        The :class:`~replication.registry.reproduction.PaperTable` of ``chen2019-eq-3-1``
+        (printed mantissa × ``si_factor``).
+
+    Returns
+    -------
+    coefficients : dict of str to float
+        The terms of :data:`SERIES_TERMS` in SI units.
+
+    Raises
+    ------
+    ValueError
+        When the table lacks one of the quantities of :data:`EQ_3_1_QUANTITIES`.
     """
     data = paper.data.set_index("quantity")
     out = {}
@@ -435,7 +662,7 @@ def eq_3_1_coefficients(paper) -> dict:
 
 
 def normal_gravity_chen2019_printed(lat, h, coefficients):
-    """chen2019 eq. (3-1) evaluated literally as printed (m/s^2)::
+    """chen2019 eq. (3-1) evaluated literally as printed::
 
         γ = 9.7803253 × (1 + 0.0053022 sin²L - 0.0000058 sin²L) L
             - (3.0877 - 0.0044 sin²L)e-6 h + 0.072e-12 h²
@@ -443,15 +670,43 @@ def normal_gravity_chen2019_printed(lat, h, coefficients):
     with the printed coefficients passed in ``coefficients`` (see
     :func:`eq_3_1_coefficients`).  The trailing factor L (radians) and sin²L in the third
     term are kept exactly as printed so that each defect can be quantified.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    h : float or array_like, shape (...)
+        Ellipsoidal height [m].
+    coefficients : mapping of str to float
+        The terms of :data:`SERIES_TERMS` in SI.
+
+    Returns
+    -------
+    gamma : ndarray, shape (...)
+        The printed formula's value [m/s^2].
     """
     return gravity_series_form(lat, h, coefficients, third_term="sin2L", trailing_L=True)
 
 
 def normal_gravity_chen2019_repaired(lat, h, coefficients):
-    """chen2019 eq. (3-1) with its typographic defects repaired (m/s^2).
+    """chen2019 eq. (3-1) with its typographic defects repaired.
 
     The trailing L is dropped and sin²L in the third term restored to sin²2L; the coefficients
     are those passed in (the printed ones, or corrected ones).
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    h : float or array_like, shape (...)
+        Ellipsoidal height [m].
+    coefficients : mapping of str to float
+        The terms of :data:`SERIES_TERMS` in SI.
+
+    Returns
+    -------
+    gamma : ndarray, shape (...)
+        Normal gravity [m/s^2].
     """
     return gravity_series_form(lat, h, coefficients, third_term="sin2_2L", trailing_L=False)
 
@@ -463,9 +718,31 @@ EQ_3_1_DEFECTS = ("trailing_L", "third_term_sin2L", "k1", "h2")
 def eq_3_1_variant(lat, h, printed, corrected, defects=()):
     """chen2019 eq. (3-1) with only the named ``defects`` (of :data:`EQ_3_1_DEFECTS`) present.
 
-    ``printed`` and ``corrected`` are coefficient mappings; the coefficient defects ``k1`` and
-    ``h2`` take the printed value when present and the corrected one otherwise; all other
-    coefficients are the printed ones.
+    The coefficient defects ``k1`` and ``h2`` take the printed value when present and the
+    corrected one otherwise; all other coefficients are the printed ones.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    h : float or array_like, shape (...)
+        Ellipsoidal height [m].
+    printed : mapping of str to float
+        The printed coefficients (:data:`SERIES_TERMS`, SI).
+    corrected : mapping of str to float
+        Corrected coefficients; only ``k1`` and ``h2`` are read.
+    defects : iterable of str, optional
+        Names from :data:`EQ_3_1_DEFECTS`; default none (the repaired form).
+
+    Returns
+    -------
+    gamma : ndarray, shape (...)
+        The variant's value [m/s^2].
+
+    Raises
+    ------
+    ValueError
+        For an unknown defect name.
     """
     unknown = set(defects) - set(EQ_3_1_DEFECTS)
     if unknown:
@@ -481,9 +758,28 @@ def eq_3_1_variant(lat, h, printed, corrected, defects=()):
 def eq_3_1_defect_effects(lat, h, printed, corrected, reference=None):
     """Size of each defect of chen2019 eq. (3-1) on a grid, in mGal.
 
-    For each defect d: max |γ(only d present) - γ(no defect)| over the grid (``lat`` radians,
-    ``h`` metres, broadcast together).  Also the whole print and the fully corrected form
-    against ``reference`` (default: the closed form).  Returns a dict name → mGal.
+    For each defect d: max |γ(only d present) - γ(no defect)| over the grid.  Also the whole
+    print and the fully corrected form against ``reference``.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad] of the grid.
+    h : float or array_like, shape (...)
+        Ellipsoidal height [m] of the grid, broadcast with ``lat``.
+    printed : mapping of str to float
+        The printed coefficients (:data:`SERIES_TERMS`, SI).
+    corrected : mapping of str to float
+        Corrected coefficients; ``k1`` and ``h2`` are read.
+    reference : float or ndarray, shape (...), optional
+        Reference gravity on the grid [m/s^2]; default the closed form
+        :func:`normal_gravity_closed_form`.
+
+    Returns
+    -------
+    effects : dict of str to float
+        Maximum absolute effect [mGal] of each name of :data:`EQ_3_1_DEFECTS`, plus
+        ``"all defects (literal print) vs closed form"`` and ``"corrected form vs closed form"``.
     """
     lat, h = np.broadcast_arrays(np.asarray(lat, float), np.asarray(h, float))
     ref = normal_gravity_closed_form(lat, h) if reference is None else reference
@@ -497,14 +793,42 @@ def eq_3_1_defect_effects(lat, h, printed, corrected, reference=None):
 
 
 def gravity_enu(lat, h=0.0):
-    """Normal gravity vector in the ENU frame, g^n = [0, 0, -γ(L, h)] (m/s^2)."""
+    """Normal gravity vector in the ENU frame, g^n = [0, 0, -γ(L, h)].
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    h : float or array_like, shape (...), optional
+        Ellipsoidal height [m], default 0.
+
+    Returns
+    -------
+    g_n : ndarray, shape (..., 3)
+        Gravity (East, North, Up) [m/s^2] (:func:`normal_gravity` for γ).
+    """
     g = normal_gravity(lat, h)
     z = np.zeros_like(g)
     return np.stack([z, z, -g], axis=-1)
 
 
 def geodetic_to_ecef(lat, lon, h):
-    """Geodetic (L, λ, h) to ECEF coordinates (m)."""
+    """Geodetic (L, λ, h) to ECEF coordinates.
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude L [rad].
+    lon : float or array_like, shape (...)
+        Longitude λ [rad].
+    h : float or array_like, shape (...)
+        Ellipsoidal height [m].
+
+    Returns
+    -------
+    r : ndarray, shape (..., 3)
+        ECEF position (x, y, z) [m].
+    """
     lat = check_latitude(lat)
     lon = check_longitude(lon)
     h = check_height(h)
@@ -516,7 +840,22 @@ def geodetic_to_ecef(lat, lon, h):
 
 
 def ecef_to_geodetic(r):
-    """ECEF (m) to geodetic (L, λ, h), iterating Bowring's formula to machine precision."""
+    """ECEF to geodetic (L, λ, h), iterating Bowring's formula to machine precision.
+
+    Parameters
+    ----------
+    r : array_like, shape (..., 3)
+        ECEF position (x, y, z) [m].
+
+    Returns
+    -------
+    lat : ndarray, shape (...)
+        Geodetic latitude L [rad].
+    lon : ndarray, shape (...)
+        Longitude λ [rad] in (-π, π].
+    h : ndarray, shape (...)
+        Ellipsoidal height [m].
+    """
     r = vector3(r, "r (ECEF position)")
     x, y, z = r[..., 0], r[..., 1], r[..., 2]
     lon = np.arctan2(y, x)

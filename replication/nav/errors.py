@@ -62,6 +62,13 @@ _MIS_LABELS = ("xy", "yx", "xz", "zx", "yz", "zy")
 
 
 def nav_block_labels():
+    """Labels of the 9 navigation error states, ``NAV_LABELS`` as a list.
+
+    Returns
+    -------
+    labels : list of str
+        ``["dL", "dlon", "dh", "dvE", "dvN", "dvU", "phiE", "phiN", "phiU"]``.
+    """
     return list(NAV_LABELS)
 
 
@@ -69,17 +76,37 @@ def nav_block_labels():
 class StateBlock:
     """One augmented block of the error state.
 
-    * ``name`` — unique key (``"accel_bias"``, ``"gyro_markov"``, ...);
-    * ``labels`` — one label per component;
-    * ``target`` — what it perturbs: ``"accel"`` (f^b), ``"gyro"`` (ω_ib^b), ``"gravity"``
-      (g^n), ``"lever_arm"`` (GNSS antenna offset, measurement only) or ``"none"``;
-    * ``kind`` — coupling B(u) for accel/gyro targets: ``"identity"``, ``"scale"``,
-      ``"misalignment"`` (chen2019 eq. (2-8)) or ``"misalignment-table-2-2"`` (as Table 2-2 prints it);
-    * ``dynamics`` — k×k matrix A of ẋ = A x + w (zeros: random constant);
-    * ``noise_psd`` — k×k intensity of w;
-    * ``output`` — 3×k matrix mapping the block to δg^n (gravity blocks);
-    * ``sd`` — k initial standard deviations (for P0 and for drawing truth values);
-    * ``fd_step`` — finite-difference step for the numerical Jacobian.
+    Attributes
+    ----------
+    name : str
+        Unique key (``"accel_bias"``, ``"gyro_markov"``, ...).
+    labels : tuple of str
+        One label per component; their number k is the block's size.
+    target : {"accel", "gyro", "gravity", "lever_arm", "none"}
+        What it perturbs: ``"accel"`` (f^b), ``"gyro"`` (ω_ib^b), ``"gravity"`` (g^n),
+        ``"lever_arm"`` (GNSS antenna offset, measurement only) or ``"none"``.
+    kind : {"identity", "scale", "misalignment", "misalignment-table-2-2"}
+        Coupling B(u) for accel/gyro targets: ``"identity"``, ``"scale"``, ``"misalignment"``
+        (chen2019 eq. (2-8)) or ``"misalignment-table-2-2"`` (as Table 2-2 prints it); default
+        ``"identity"``.  An identity or scale block has 3 states, a misalignment block 6.
+    dynamics : ndarray, shape (k, k)
+        Matrix A of ẋ = A x + w [1/s] (zeros, the default: random constant).
+    noise_psd : ndarray, shape (k, k)
+        Intensity of w [state unit²/s], symmetric positive semi-definite; default zeros.
+    output : ndarray, shape (3, k) or None
+        Matrix mapping the block to δg^n (gravity blocks; default the first three states);
+        None for other targets.
+    sd : ndarray, shape (k,)
+        Initial standard deviations [state units] (for P0 and for drawing truth values); default
+        zeros.
+    fd_step : float
+        Finite-difference step [state units] for the numerical Jacobian, default 1e-6.
+
+    Raises
+    ------
+    ValueError
+        For an unknown target or kind, a number of labels the kind does not allow, or a matrix of
+        the wrong shape, not finite, or a negative intensity or standard deviation.
     """
 
     name: str
@@ -120,12 +147,31 @@ class StateBlock:
 
     @property
     def size(self):
+        """Number k of states of the block."""
         return len(self.labels)
 
 
 @dataclass
 class NavPoint:
-    """A point of a trajectory at which F is evaluated: nav state and true sensor outputs."""
+    """A point of a trajectory at which F is evaluated: nav state and true sensor outputs.
+
+    Attributes
+    ----------
+    lat : float
+        Geodetic latitude [rad].
+    lon : float
+        Longitude [rad].
+    h : float
+        Ellipsoidal height [m].
+    v_enu : ndarray, shape (3,)
+        Velocity (East, North, Up) [m/s].
+    C_bn : ndarray, shape (3, 3)
+        Attitude DCM C_b^n.
+    f_b : ndarray, shape (3,)
+        Specific force, body axes [m/s²].
+    w_ib_b : ndarray, shape (3,)
+        Angular rate ω_ib^b, body axes [rad/s].
+    """
 
     lat: float
     lon: float
@@ -136,8 +182,25 @@ class NavPoint:
     w_ib_b: np.ndarray
 
     def validate(self, *, name: str = "point"):
-        """Check the fields as :meth:`replication.nav.strapdown.NavState.validate` does, and finite f_b,
-        w_ib_b; raises naming the field (the compiled F checks nothing)."""
+        """Check the fields as :meth:`replication.nav.strapdown.NavState.validate` does.
+
+        Also checks finite f_b and w_ib_b; raises naming the field (the compiled F checks nothing).
+
+        Parameters
+        ----------
+        name : str, optional
+            Name of the point in the error messages, default ``"point"``.
+
+        Returns
+        -------
+        point : NavPoint
+            ``self``, unchanged.
+
+        Raises
+        ------
+        ValueError
+            Naming the first invalid field.
+        """
         NavState.validate(self, name=name)
         vector3(self.f_b, f"{name}.f_b")
         vector3(self.w_ib_b, f"{name}.w_ib_b")
@@ -145,6 +208,20 @@ class NavPoint:
 
     @classmethod
     def from_trajectory(cls, traj, k: int):
+        """The point at sample ``k`` of a trajectory.
+
+        Parameters
+        ----------
+        traj : Trajectory
+            A trajectory (:func:`replication.nav.trajectory.generate`).
+        k : int
+            Sample index.
+
+        Returns
+        -------
+        point : NavPoint
+            Its position, velocity, attitude C_b^n (from ``hpr``), f^b and ω_ib^b at sample ``k``.
+        """
         return cls(float(traj.lat[k]), float(traj.lon[k]), float(traj.h[k]), traj.v_enu[k].copy(),
                    euler_to_dcm(*traj.hpr[k]),
                    traj.f_b[k].copy(), traj.w_ib_b[k].copy())
@@ -154,9 +231,25 @@ class NavPoint:
 class ErrorModel:
     """The 9 navigation errors plus named augmented blocks (see the module docstring).
 
-    Also carries the white-noise intensities of the navigation equations: ``accel_psd`` and
-    ``gyro_psd`` (per axis, (m/s²)²·s and (rad/s)²·s: velocity/angle random walk squared), and
-    the initial navigation standard deviations ``nav_sd`` (9 values, state units).
+    Attributes
+    ----------
+    blocks : tuple of StateBlock
+        The augmented blocks in state order, names unique, at most one lever-arm block; default
+        none.
+    accel_psd : ndarray, shape (3,)
+        White-noise intensity of the accelerometers per axis [(m/s²)²·s]: velocity random walk
+        squared.  One number stands for all three.
+    gyro_psd : ndarray, shape (3,)
+        White-noise intensity of the gyros per axis [(rad/s)²·s]: angle random walk squared.
+    nav_sd : ndarray, shape (9,)
+        Initial navigation standard deviations in state units (δL, δλ [rad], δh [m], δv [m/s],
+        φ [rad]).
+
+    Raises
+    ------
+    ValueError
+        For duplicated block names, more than one lever-arm block, negative intensities or a
+        ``nav_sd`` of another length.
     """
 
     blocks: tuple = ()
@@ -182,6 +275,7 @@ class ErrorModel:
     # -- layout
     @property
     def n(self) -> int:
+        """Number of states, 9 plus the sizes of the blocks."""
         return 9 + sum(b.size for b in self.blocks)
 
     @property
@@ -196,19 +290,48 @@ class ErrorModel:
 
     @property
     def labels(self) -> list:
+        """State labels: ``NAV_LABELS``, then ``"<block>.<label>"`` for each block component."""
         out = list(NAV_LABELS)
         for b in self.blocks:
             out += [f"{b.name}.{lab}" for lab in b.labels]
         return out
 
     def block(self, name) -> StateBlock:
+        """The block named ``name``.
+
+        Parameters
+        ----------
+        name : str
+            Block name.
+
+        Returns
+        -------
+        block : StateBlock
+            The block.
+
+        Raises
+        ------
+        KeyError
+            When the model has no such block.
+        """
         for b in self.blocks:
             if b.name == name:
                 return b
         raise KeyError(f"no block {name!r}; blocks: {[b.name for b in self.blocks]}")
 
     def extend(self, *blocks) -> "ErrorModel":
-        """A new model with ``blocks`` appended (the 15-state model extended to 36/45 states...)."""
+        """A new model with ``blocks`` appended (the 15-state model extended to 36/45 states...).
+
+        Parameters
+        ----------
+        *blocks : StateBlock
+            Blocks to append, in order.
+
+        Returns
+        -------
+        model : ErrorModel
+            The extended model (``self`` is unchanged).
+        """
         return replace(self, blocks=self.blocks + tuple(blocks))
 
     # -- constant parts and kernel encoding
@@ -217,11 +340,11 @@ class ErrorModel:
 
         Returns
         -------
-        fconst, qc : numpy.ndarray
+        fconst, qc : ndarray, shape (n, n)
             The constant part of F (the blocks' dynamics and the gravity output rows) and the
-            process-noise PSD of the blocks (n × n each).
-        tg, kd, st, sz : numpy.ndarray
-            Per block: target and kind codes, first state and size (int64).
+            process-noise PSD of the blocks.
+        tg, kd, st, sz : ndarray of int64, shape (n_blocks,)
+            Per block: target and kind codes, first state and size.
         """
         n = self.n
         fconst = np.zeros((n, n))
@@ -241,13 +364,35 @@ class ErrorModel:
         return fconst, qc, arr(tg), arr(kd), arr(st), arr(sz)
 
     def P0(self) -> np.ndarray:
-        """Diagonal initial covariance from ``nav_sd`` and the blocks' ``sd``."""
+        """Diagonal initial covariance from ``nav_sd`` and the blocks' ``sd``.
+
+        Returns
+        -------
+        P0 : ndarray, shape (n, n)
+            diag(sd²) in state units squared.
+        """
         sd = np.concatenate([self.nav_sd] + [b.sd for b in self.blocks])
         return np.diag(sd**2)
 
     # -- matrices
     def F(self, point: NavPoint) -> np.ndarray:
-        """Continuous error-state matrix at ``point`` (chen2019 eqs. (3-14)-(3-16))."""
+        """Continuous error-state matrix at ``point`` (chen2019 eqs. (3-14)-(3-16)).
+
+        Parameters
+        ----------
+        point : NavPoint
+            Where F is evaluated (latitude inside the polar limit :data:`~replication.nav.earth.POLAR_LIMIT_DEG`).
+
+        Returns
+        -------
+        F : ndarray, shape (n, n)
+            δẋ = F δx [1/s in state units].
+
+        Raises
+        ------
+        ValueError
+            For a latitude within the polar limit or an invalid field of ``point``.
+        """
         earth.check_latitude(point.lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
         point.validate()
         fconst, _, tg, kd, st, sz = self.kernel_encoding()
@@ -258,7 +403,19 @@ class ErrorModel:
         return F
 
     def G_Qc(self, C_bn) -> np.ndarray:
-        """Continuous process-noise intensity G Q Gᵀ (n×n) for attitude C_b^n."""
+        """Continuous process-noise intensity G Q Gᵀ for attitude C_b^n.
+
+        Parameters
+        ----------
+        C_bn : array_like, shape (3, 3)
+            Attitude DCM C_b^n that rotates the sensor noises into the n frame.
+
+        Returns
+        -------
+        GQGt : ndarray, shape (n, n)
+            The blocks' ``noise_psd`` plus C diag(accel_psd) Cᵀ on the velocity rows and
+            C diag(gyro_psd) Cᵀ on the attitude rows [state unit²/s].
+        """
         _, qc, *_ = self.kernel_encoding()
         q = qc.copy()
         C = rotation(C_bn, "C_bn")
@@ -267,12 +424,26 @@ class ErrorModel:
         return q
 
     def numerical_jacobian(self, point: NavPoint, *, steps=None) -> np.ndarray:
-        """Central finite-difference Jacobian of the continuous mechanization
-        (:func:`replication.nav.strapdown.navigation_rates`) with respect to the error state.
+        """Central finite-difference Jacobian of the continuous mechanization.
 
-        Column j perturbs the state by ±ε_j: position/velocity additively, attitude by
-        Ĉ = exp(-ε e_j×) C, sensor blocks through their coupling B(u) on f^b or ω_ib^b, gravity
-        blocks through g^n.  Rows of the augmented blocks are their (constant) dynamics.
+        The mechanization is :func:`replication.nav.strapdown.navigation_rates`; the derivative is
+        taken with respect to the error state.  Column j perturbs the state by ±ε_j:
+        position/velocity additively, attitude by Ĉ = exp(-ε e_j×) C, sensor blocks through their
+        coupling B(u) on f^b or ω_ib^b, gravity blocks through g^n.  Rows of the augmented blocks
+        are their (constant) dynamics.
+
+        Parameters
+        ----------
+        point : NavPoint
+            Where the Jacobian is taken.
+        steps : array_like, shape (n,), optional
+            The steps ε_j in state units; default 1e-5 rad (δL, δλ), 100 m (δh), 1 m/s (δv),
+            1e-4 rad (φ) and each block's ``fd_step``.
+
+        Returns
+        -------
+        J : ndarray, shape (n, n)
+            The Jacobian, comparable with :meth:`F` [1/s in state units].
         """
 
         point.validate()
@@ -332,7 +503,8 @@ class ErrorModel:
         return J
 
     def propagate_linear(self, traj, x0, *, step: int = 10, order: int = 6):
-        """Propagate δx along a trajectory with the linear model δẋ = F(t) δx (chen2019 eqs. (3-14)-(3-16)):
+        """Propagate δx along a trajectory with the linear model δẋ = F(t) δx (chen2019 eqs. (3-14)-(3-16)).
+
         δx_{j+1} = Φ_j δx_j, Φ_j = exp(F̄_j T_j) over intervals of ``step`` samples, T_j their
         duration and F̄_j the mean of F over the interval by Simpson's rule,
         F̄ = [F(t_0) + 4 F(t_½) + F(t_1)] / 6.  For an even ``step`` t_½ is a sample; for an odd
@@ -340,10 +512,30 @@ class ErrorModel:
         for F linear in time), which for ``step=1`` reduces Simpson's rule to the trapezoid
         [F(t_0) + F(t_1)] / 2.  Φ_j by the truncated series of ``order`` terms.
 
-        Parameters: ``traj`` a trajectory (``trajectory.generate``); ``x0`` the initial error
-        state (``self.n`` components, in ``self.labels`` order); ``step`` a positive integer number
-        of samples per interval (an incomplete last interval is dropped).
-        Returns (sample indices, δx (m, n))."""
+        Parameters
+        ----------
+        traj : Trajectory
+            A trajectory (``trajectory.generate``).
+        x0 : array_like, shape (n,)
+            The initial error state, in ``self.labels`` order and state units.
+        step : int, optional
+            Positive number of samples per interval, default 10 (an incomplete last interval is
+            dropped).
+        order : int, optional
+            Number of terms of the series of Φ_j, default 6.
+
+        Returns
+        -------
+        index : ndarray of int, shape (m,)
+            Sample indices 0, step, 2 step, ... of the propagated states.
+        dx : ndarray, shape (m, n)
+            δx at those samples, state units.
+
+        Raises
+        ------
+        ValueError
+            For an ``x0`` of another length or a ``step`` that is not a positive integer.
+        """
         x = np.asarray(x0, float).copy()
         if x.shape != (self.n,):
             raise ValueError(f"x0 must have {self.n} components ({self.labels})")
@@ -393,13 +585,43 @@ def _sd(x, name, n=3):
 
 
 def accel_bias(sd=0.0, *, name="accel_bias", random_walk_psd=0.0):
-    """Accelerometer random constant ∇_b (chen2019 eq. (2-5)), m/s²; optional random walk."""
+    """Accelerometer random constant ∇_b (chen2019 eq. (2-5)); optional random walk.
+
+    Parameters
+    ----------
+    sd : float or array_like, shape (3,), optional
+        Initial standard deviation per axis [m/s²], default 0.
+    name : str, optional
+        Block name, default ``"accel_bias"``.
+    random_walk_psd : float or array_like, shape (3,), optional
+        Intensity of a random walk of the bias [(m/s²)²/s], default 0 (a random constant).
+
+    Returns
+    -------
+    block : StateBlock
+        Three ``identity`` states coupled into f^b.
+    """
     return StateBlock(name, ("x", "y", "z"), "accel", "identity", noise_psd=_diag3(random_walk_psd, "random_walk_psd"),
                       sd=_sd(sd, "sd"), fd_step=1e-2)
 
 
 def gyro_bias(sd=0.0, *, name="gyro_bias", random_walk_psd=0.0):
-    """Gyro random constant drift ε_b (chen2019 eq. (2-5)), rad/s; optional random walk."""
+    """Gyro random constant drift ε_b (chen2019 eq. (2-5)); optional random walk.
+
+    Parameters
+    ----------
+    sd : float or array_like, shape (3,), optional
+        Initial standard deviation per axis [rad/s], default 0.
+    name : str, optional
+        Block name, default ``"gyro_bias"``.
+    random_walk_psd : float or array_like, shape (3,), optional
+        Intensity of a random walk of the drift [(rad/s)²/s], default 0 (a random constant).
+
+    Returns
+    -------
+    block : StateBlock
+        Three ``identity`` states coupled into ω_ib^b.
+    """
     return StateBlock(name, ("x", "y", "z"), "gyro", "identity", noise_psd=_diag3(random_walk_psd, "random_walk_psd"),
                       sd=_sd(sd, "sd"), fd_step=1e-3)
 
@@ -412,22 +634,82 @@ def _markov(target, sigma, tau, name):
 
 
 def accel_markov(sigma, tau, *, name="accel_markov"):
-    """First-order Gauss-Markov accelerometer bias ∇_m (eq. (2-5)); stationary σ, correlation τ."""
+    """First-order Gauss-Markov accelerometer bias ∇_m (eq. (2-5)); stationary σ, correlation τ.
+
+    ẋ = -x/τ + w with intensity 2σ²/τ.
+
+    Parameters
+    ----------
+    sigma : float or array_like, shape (3,)
+        Stationary standard deviation σ per axis [m/s²] (also the initial one).
+    tau : float
+        Correlation time τ [s], positive.
+    name : str, optional
+        Block name, default ``"accel_markov"``.
+
+    Returns
+    -------
+    block : StateBlock
+        Three ``identity`` states coupled into f^b.
+    """
     return _markov("accel", sigma, tau, name)
 
 
 def gyro_markov(sigma, tau, *, name="gyro_markov"):
-    """First-order Gauss-Markov gyro drift ε_m (eq. (2-5)); stationary σ, correlation τ."""
+    """First-order Gauss-Markov gyro drift ε_m (eq. (2-5)); stationary σ, correlation τ.
+
+    ẋ = -x/τ + w with intensity 2σ²/τ.
+
+    Parameters
+    ----------
+    sigma : float or array_like, shape (3,)
+        Stationary standard deviation σ per axis [rad/s] (also the initial one).
+    tau : float
+        Correlation time τ [s], positive.
+    name : str, optional
+        Block name, default ``"gyro_markov"``.
+
+    Returns
+    -------
+    block : StateBlock
+        Three ``identity`` states coupled into ω_ib^b.
+    """
     return _markov("gyro", sigma, tau, name)
 
 
 def accel_scale(sd=0.0, *, name="accel_scale"):
-    """Accelerometer scale-factor errors δK_a (eq. (2-6)), dimensionless."""
+    """Accelerometer scale-factor errors δK_a (eq. (2-6)), dimensionless.
+
+    Parameters
+    ----------
+    sd : float or array_like, shape (3,), optional
+        Initial standard deviation per axis (dimensionless, 1 ppm = 1e-6), default 0.
+    name : str, optional
+        Block name, default ``"accel_scale"``.
+
+    Returns
+    -------
+    block : StateBlock
+        Three ``scale`` states coupled into f^b.
+    """
     return StateBlock(name, ("x", "y", "z"), "accel", "scale", sd=_sd(sd, "sd"), fd_step=1e-3)
 
 
 def gyro_scale(sd=0.0, *, name="gyro_scale"):
-    """Gyro scale-factor errors δK_g (eq. (2-6)), dimensionless."""
+    """Gyro scale-factor errors δK_g (eq. (2-6)), dimensionless.
+
+    Parameters
+    ----------
+    sd : float or array_like, shape (3,), optional
+        Initial standard deviation per axis (dimensionless, 1 ppm = 1e-6), default 0.
+    name : str, optional
+        Block name, default ``"gyro_scale"``.
+
+    Returns
+    -------
+    block : StateBlock
+        Three ``scale`` states coupled into ω_ib^b.
+    """
     return StateBlock(name, ("x", "y", "z"), "gyro", "scale", sd=_sd(sd, "sd"), fd_step=1e-3)
 
 
@@ -437,21 +719,80 @@ def _coupling_kind(coupling):
 
 
 def accel_misalignment(sd=0.0, *, name="accel_misalignment", coupling="eq-2-8"):
-    """Accelerometer non-orthogonality δA (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad,
-    coupled as ``coupling`` says (:data:`MISALIGNMENT_COUPLINGS`)."""
+    """Accelerometer non-orthogonality δA (eqs. (2-8), (2-9)).
+
+    Parameters
+    ----------
+    sd : float or array_like, shape (6,), optional
+        Initial standard deviations of [xy, yx, xz, zx, yz, zy] [rad], default 0.
+    name : str, optional
+        Block name, default ``"accel_misalignment"``.
+    coupling : {"eq-2-8", "table-2-2"}, optional
+        How the six angles couple (:data:`MISALIGNMENT_COUPLINGS`), default ``"eq-2-8"``.
+
+    Returns
+    -------
+    block : StateBlock
+        Six misalignment states coupled into f^b.
+    """
     return StateBlock(name, _MIS_LABELS, "accel", _coupling_kind(coupling), sd=_sd(sd, "sd", 6), fd_step=1e-3)
 
 
 def gyro_misalignment(sd=0.0, *, name="gyro_misalignment", coupling="eq-2-8"):
-    """Gyro non-orthogonality δG (eqs. (2-8), (2-9)): [xy, yx, xz, zx, yz, zy] rad, coupled as
-    ``coupling`` says (:data:`MISALIGNMENT_COUPLINGS`)."""
+    """Gyro non-orthogonality δG (eqs. (2-8), (2-9)).
+
+    Parameters
+    ----------
+    sd : float or array_like, shape (6,), optional
+        Initial standard deviations of [xy, yx, xz, zx, yz, zy] [rad], default 0.
+    name : str, optional
+        Block name, default ``"gyro_misalignment"``.
+    coupling : {"eq-2-8", "table-2-2"}, optional
+        How the six angles couple (:data:`MISALIGNMENT_COUPLINGS`), default ``"eq-2-8"``.
+
+    Returns
+    -------
+    block : StateBlock
+        Six misalignment states coupled into ω_ib^b.
+    """
     return StateBlock(name, _MIS_LABELS, "gyro", _coupling_kind(coupling), sd=_sd(sd, "sd", 6), fd_step=1e-3)
 
 
 def gravity_shaping(sigma, beta, *, name="gravity", dynamics=None, noise_psd=None, output=None, labels=None):
-    """Gravity-disturbance states: chen2019 eq. (2-12) δġ = -β δg + n per ENU axis (stationary σ),
-    or a general shaping filter (``dynamics``, ``noise_psd``, ``output``: e.g. the AR models of
-    chen2019 ch. 3 in state-space form)."""
+    """Gravity-disturbance states: chen2019 eq. (2-12) or a general shaping filter.
+
+    Without ``dynamics``: δġ = -β δg + n per ENU axis with stationary σ (intensity 2βσ²).  With
+    ``dynamics``, ``noise_psd`` and ``output``: a general shaping filter, e.g. the AR models of
+    chen2019 ch. 3 in state-space form.
+
+    Parameters
+    ----------
+    sigma : float or array_like, shape (3,) or (k,)
+        Stationary (initial) standard deviation per state [m/s² for the eq. (2-12) form; the
+        states' unit for a general filter].
+    beta : float or array_like, shape (3,)
+        Inverse correlation time β per ENU axis [1/s], positive; unused with ``dynamics``.
+    name : str, optional
+        Block name, default ``"gravity"``.
+    dynamics : array_like, shape (k, k), optional
+        Shaping-filter matrix A [1/s].
+    noise_psd : array_like, shape (k, k), optional
+        Intensity of its driving noise [state unit²/s], default zeros.
+    output : array_like, shape (3, k), optional
+        Map from the states to δg^n [m/s² per state unit], default the first three states.
+    labels : sequence of str, optional
+        Component labels of a general filter, default ``s0``, ``s1``, ...
+
+    Returns
+    -------
+    block : StateBlock
+        A ``gravity`` block (labels E, N, U for the eq. (2-12) form).
+
+    Raises
+    ------
+    ValueError
+        For a non-positive ``beta`` or inconsistent shapes.
+    """
     if dynamics is None:
         s = _sd(sigma, "sigma")
         b = np.broadcast_to(finite_array(beta, "beta"), (3,))
@@ -466,15 +807,57 @@ def gravity_shaping(sigma, beta, *, name="gravity", dynamics=None, noise_psd=Non
 
 
 def lever_arm(sd=0.0, *, name="lever_arm"):
-    """Lever-arm (spatial synchronisation) error l of the GNSS antenna, chen2019 eq. (2-13), m."""
+    """Lever-arm (spatial synchronisation) error l of the GNSS antenna, chen2019 eq. (2-13).
+
+    Parameters
+    ----------
+    sd : float or array_like, shape (3,), optional
+        Initial standard deviation per body axis [m], default 0.
+    name : str, optional
+        Block name, default ``"lever_arm"``.
+
+    Returns
+    -------
+    block : StateBlock
+        Three constant states entering the GNSS measurement only.
+    """
     return StateBlock(name, ("x", "y", "z"), "lever_arm", sd=_sd(sd, "sd"))
 
 
 def model_15(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e-4, 1e-4, 1e-3),
              accel_bias_sd=0.0, gyro_bias_sd=0.0, accel_psd=0.0, gyro_psd=0.0, lat=0.0, h=0.0) -> ErrorModel:
-    """The classic 15-state model (chen2019 eqs. (3-14)-(3-16)): 9 navigation errors, accelerometer
-    bias ∇_b, gyro drift ε_b.  ``position_sd`` in metres (E, N, U), converted to (δL, δλ, δh)
-    at (``lat``, ``h``); ``attitude_sd`` in rad (E, N, U)."""
+    """The classic 15-state model (chen2019 eqs. (3-14)-(3-16)).
+
+    9 navigation errors, accelerometer bias ∇_b, gyro drift ε_b.  One number stands for the
+    three components of any argument.
+
+    Parameters
+    ----------
+    position_sd : float or array_like, shape (3,), optional
+        Initial position standard deviation (E, N, U) [m], converted to (δL, δλ, δh) at
+        (``lat``, ``h``); default 10 m.
+    velocity_sd : float or array_like, shape (3,), optional
+        Initial velocity standard deviation (E, N, U) [m/s], default 0.1.
+    attitude_sd : float or array_like, shape (3,), optional
+        Initial attitude standard deviation (E, N, U) [rad], default (1e-4, 1e-4, 1e-3).
+    accel_bias_sd : float or array_like, shape (3,), optional
+        Accelerometer bias standard deviation [m/s²], default 0.
+    gyro_bias_sd : float or array_like, shape (3,), optional
+        Gyro drift standard deviation [rad/s], default 0.
+    accel_psd : float or array_like, shape (3,), optional
+        Accelerometer white-noise intensity [(m/s²)²·s], default 0.
+    gyro_psd : float or array_like, shape (3,), optional
+        Gyro white-noise intensity [(rad/s)²·s], default 0.
+    lat : float, optional
+        Geodetic latitude [rad] of the metre-to-radian conversion, default 0.
+    h : float, optional
+        Ellipsoidal height [m] of the conversion, default 0.
+
+    Returns
+    -------
+    model : ErrorModel
+        Nine navigation states plus the blocks ``accel_bias`` and ``gyro_bias``.
+    """
     ps = _sd(position_sd, "position_sd")
     earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG, name="lat")
     earth.check_height(h, name="h")

@@ -61,6 +61,29 @@ def van_loan(F, GQGt, dt):
 
     exp([[-F, GQGᵀ], [0, Fᵀ]] dt) = [[·, Φ⁻¹Q_d], [0, Φᵀ]]  →  Φ = (lower-right)ᵀ,
     Q_d = Φ (upper-right).  Computed with scipy.linalg.expm.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, n)
+        Continuous system matrix [1/s].
+    GQGt : array_like, shape (n, n)
+        Continuous process-noise intensity G Q Gᵀ [state unit²/s], symmetric positive
+        semi-definite.
+    dt : float
+        Time step [s], positive.
+
+    Returns
+    -------
+    Phi : ndarray, shape (n, n)
+        Transition matrix Φ = exp(F dt).
+    Qd : ndarray, shape (n, n)
+        Discrete process-noise covariance Q_d [state unit²], symmetrised.
+
+    Raises
+    ------
+    ValueError
+        For non-square or mismatched matrices, an intensity that is not a covariance, or a
+        non-positive ``dt``.
     """
     F = _square(F, "F")
     Q = covariance(GQGt, "GQGt")
@@ -79,8 +102,29 @@ def van_loan(F, GQGt, dt):
 
 
 def discretize_series(F, GQGt, dt, order: int = 4):
-    """(Φ, Q_d) by the truncated Taylor series of Van Loan's exponential (the compiled filter's
-    discretization; accurate when ‖F dt‖ is small — compare with :func:`van_loan`)."""
+    """(Φ, Q_d) by the truncated Taylor series of Van Loan's exponential.
+
+    The compiled filter's discretization; accurate when ‖F dt‖ is small — compare with
+    :func:`van_loan`.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, n)
+        Continuous system matrix [1/s].
+    GQGt : array_like, shape (n, n)
+        Continuous process-noise intensity G Q Gᵀ [state unit²/s].
+    dt : float
+        Time step [s], positive.
+    order : int, optional
+        Number of terms of the series (≥ 1), default 4.
+
+    Returns
+    -------
+    Phi : ndarray, shape (n, n)
+        Transition matrix Φ.
+    Qd : ndarray, shape (n, n)
+        Discrete process-noise covariance Q_d [state unit²].
+    """
     F = np.ascontiguousarray(_square(F, "F"))
     Q = np.ascontiguousarray(covariance(GQGt, "GQGt"))
     if Q.shape != F.shape:
@@ -94,7 +138,26 @@ def discretize_series(F, GQGt, dt, order: int = 4):
 
 
 def predict(x, P, Phi, Qd):
-    """Time update x⁻ = Φ x, P⁻ = Φ P Φᵀ + Q_d (symmetrised)."""
+    """Time update x⁻ = Φ x, P⁻ = Φ P Φᵀ + Q_d (symmetrised).
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        State estimate.
+    P : array_like, shape (n, n)
+        Its covariance.
+    Phi : array_like, shape (n, n)
+        Transition matrix Φ.
+    Qd : array_like, shape (n, n)
+        Discrete process-noise covariance Q_d.
+
+    Returns
+    -------
+    x : ndarray, shape (n,)
+        Predicted state x⁻.
+    P : ndarray, shape (n, n)
+        Predicted covariance P⁻.
+    """
     x = finite_array(x, "x")
     n = len(np.atleast_1d(x))
     P = covariance(P, "P", n)
@@ -106,9 +169,38 @@ def predict(x, P, Phi, Qd):
 
 
 def update(x, P, z, H, R):
-    """Measurement update in Joseph form.  Returns (x⁺, P⁺, innovation ν, S).
+    """Measurement update in Joseph form.
 
     K = P⁻Hᵀ S⁻¹, S = H P⁻ Hᵀ + R, x⁺ = x⁻ + K ν, P⁺ = (I-KH) P⁻ (I-KH)ᵀ + K R Kᵀ.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Prior state x⁻.
+    P : array_like, shape (n, n)
+        Prior covariance P⁻.
+    z : float or array_like, shape (m,)
+        Measurement.
+    H : array_like, shape (m, n)
+        Measurement matrix (measurements × states).
+    R : float or array_like, shape (m, m)
+        Measurement-noise covariance.
+
+    Returns
+    -------
+    x : ndarray, shape (n,)
+        Posterior state x⁺.
+    P : ndarray, shape (n, n)
+        Posterior covariance P⁺ (symmetrised).
+    nu : ndarray, shape (m,)
+        Innovation ν = z - H x⁻.
+    S : ndarray, shape (m, m)
+        Innovation covariance.
+
+    Raises
+    ------
+    ValueError
+        For shapes that do not match or a P or R that is not a covariance.
     """
     x = finite_array(x, "x")
     P = numeric(P, "P")
@@ -137,9 +229,33 @@ def update(x, P, z, H, R):
 def rts_smoother(x_f, P_f, x_p, P_p, Phi):
     """Rauch-Tung-Striebel fixed-interval smoother.
 
-    Inputs over epochs k = 0..N-1: filtered x_f[k], P_f[k]; predicted x_p[k], P_p[k] (the prior
-    at epoch k, i.e. Φ[k-1] x_f[k-1]; index 0 unused); Phi[k] the transition from k to k+1.
-    Returns (x_s, P_s).  C_k = P_f[k] Φ[k]ᵀ P_p[k+1]⁻¹, x_s[k] = x_f[k] + C_k (x_s[k+1] - x_p[k+1]).
+    C_k = P_f[k] Φ[k]ᵀ P_p[k+1]⁻¹, x_s[k] = x_f[k] + C_k (x_s[k+1] - x_p[k+1]),
+    P_s[k] = P_f[k] + C_k (P_s[k+1] - P_p[k+1]) C_kᵀ.
+
+    Parameters
+    ----------
+    x_f : array_like, shape (N, n)
+        Filtered states x_f[k] at epochs k = 0..N-1.
+    P_f : array_like, shape (N, n, n)
+        Filtered covariances.
+    x_p : array_like, shape (N, n)
+        Predicted states: the prior at epoch k, i.e. Φ[k-1] x_f[k-1] (index 0 unused).
+    P_p : array_like, shape (N, n, n)
+        Predicted covariances (index 0 unused).
+    Phi : array_like, shape (N - 1, n, n)
+        Phi[k] the transition from k to k+1 (more entries are ignored).
+
+    Returns
+    -------
+    x_s : ndarray, shape (N, n)
+        Smoothed states.
+    P_s : ndarray, shape (N, n, n)
+        Smoothed covariances.
+
+    Raises
+    ------
+    ValueError
+        When the inputs do not have one entry per epoch (N - 1 transitions).
     """
     x_f, P_f, x_p, P_p, Phi = (np.asarray(a, float) for a in (x_f, P_f, x_p, P_p, Phi))
     N = len(x_f)
@@ -156,7 +272,27 @@ def rts_smoother(x_f, P_f, x_p, P_p, Phi):
 
 
 def nees(e, P):
-    """Normalised estimation error squared eᵀ P⁻¹ e (batched over leading axes)."""
+    """Normalised estimation error squared eᵀ P⁻¹ e (batched over leading axes).
+
+    Computed on the correlation matrix (P scaled by its diagonal) for conditioning.
+
+    Parameters
+    ----------
+    e : array_like, shape (..., n)
+        Estimation error (estimate minus truth), state units.
+    P : array_like, shape (..., n, n)
+        The filter's covariance of that error, positive diagonal.
+
+    Returns
+    -------
+    nees : ndarray, shape (...)
+        eᵀ P⁻¹ e (dimensionless).
+
+    Raises
+    ------
+    ValueError
+        For mismatched shapes or a non-positive variance.
+    """
     e = finite_array(e, "e")
     P = finite_array(P, "P")
     if P.shape[-2:] != e.shape[-1:] * 2:
@@ -170,14 +306,49 @@ def nees(e, P):
 
 
 def nis(nu, S):
-    """Normalised innovation squared νᵀ S⁻¹ ν."""
+    """Normalised innovation squared νᵀ S⁻¹ ν.
+
+    Parameters
+    ----------
+    nu : array_like, shape (..., m)
+        Innovation ν.
+    S : array_like, shape (..., m, m)
+        Innovation covariance.
+
+    Returns
+    -------
+    nis : ndarray, shape (...)
+        νᵀ S⁻¹ ν (dimensionless).
+    """
     nu = finite_array(nu, "nu")
     S = finite_array(S, "S")
     return np.sum(nu * np.linalg.solve(S, nu[..., None])[..., 0], -1)
 
 
 def chi2_band(dof: int, n_runs: int = 1, prob: float = 0.95):
-    """Two-sided ``prob`` band of the run-averaged NEES/NIS: χ²(n_runs·dof) quantiles / n_runs."""
+    """Two-sided ``prob`` band of the run-averaged NEES/NIS: χ²(n_runs·dof) quantiles / n_runs.
+
+    Parameters
+    ----------
+    dof : int
+        Degrees of freedom of one run's statistic (states for NEES, measurements for NIS), ≥ 1.
+    n_runs : int, optional
+        Number of runs averaged, ≥ 1, default 1.
+    prob : float, optional
+        Probability inside the band, 0 < prob < 1, default 0.95.
+
+    Returns
+    -------
+    lo : float
+        Lower bound of the run-averaged statistic.
+    hi : float
+        Upper bound.
+
+    Raises
+    ------
+    ValueError
+        For ``dof`` or ``n_runs`` below 1 or ``prob`` outside (0, 1).
+    """
     if dof < 1 or n_runs < 1 or not 0 < prob < 1:
         raise ValueError("dof and n_runs must be ≥ 1 and 0 < prob < 1")
     a = (1 - prob) / 2
@@ -191,11 +362,35 @@ def chi2_band(dof: int, n_runs: int = 1, prob: float = 0.95):
 class ClosedLoopResult:
     """Output of :func:`closed_loop`.
 
-    ``solution`` — corrected navigation at every IMU sample (``None`` unless ``store_nav``);
-    at the GNSS epochs ``t_epoch``: ``epoch_state`` (lat, lon, h, vE, vN, vU after feedback),
-    ``epoch_q`` (q_b^n), ``estimates`` (accumulated augmented-state estimates p̂, model layout
-    after the 9 navigation states), ``P_diag``, ``P`` (full, if stored), ``innovations``, ``nis``
-    and ``nees`` (if a truth was given).
+    Epoch arrays have one row per GNSS epoch (m epochs); n is the model's number of states,
+    n_aug = n - 9 the augmented ones.
+
+    Attributes
+    ----------
+    model : ErrorModel
+        The filter's model.
+    t_epoch : ndarray, shape (m,)
+        Times of the GNSS epochs [s].
+    epoch_state : ndarray, shape (m, 6)
+        (lat [rad], lon [rad], h [m], vE, vN, vU [m/s]) after feedback.
+    epoch_q : ndarray, shape (m, 4)
+        Attitude quaternion q_b^n after feedback, scalar first.
+    estimates : ndarray, shape (m, n_aug)
+        Accumulated augmented-state estimates p̂ in the model layout after the 9 navigation states,
+        state units.
+    P_diag : ndarray, shape (m, n)
+        Diagonal of the covariance after each update, state units squared.
+    innovations : ndarray, shape (m, 3) or (m, 6)
+        GNSS innovations INS minus GNSS at the antenna: position (E, N, U) [m] and/or velocity
+        (E, N, U) [m/s], in that order.
+    nis : ndarray, shape (m,)
+        Normalised innovation squared per epoch.
+    nees : ndarray, shape (m,) or None
+        Normalised estimation error squared per epoch when a truth was given, else None.
+    P : ndarray, shape (m, n, n) or None
+        Full covariance per epoch when ``store_P``, else None.
+    solution : NavSolution or None
+        Corrected navigation at every IMU sample when ``store_nav``, else None.
     """
 
     model: ErrorModel
@@ -211,19 +406,60 @@ class ClosedLoopResult:
     solution: NavSolution | None
 
     def estimate(self, name: str) -> np.ndarray:
-        """History of the accumulated estimate of block ``name`` (epochs × block size)."""
+        """History of the accumulated estimate of block ``name``.
+
+        Parameters
+        ----------
+        name : str
+            Block name of the model (an augmented block, not a navigation slice).
+
+        Returns
+        -------
+        p_hat : ndarray, shape (m, k)
+            Epochs × block size, the block's state units.
+        """
         s = self.model.slices[name]
         return self.estimates[:, s.start - 9:s.stop - 9]
 
     def sigma(self, name: str) -> np.ndarray:
+        """History of the filter's standard deviation of a slice of the state.
+
+        Parameters
+        ----------
+        name : str
+            Block name or navigation slice (``"position"``, ``"velocity"``, ``"attitude"``, ``"nav"``)
+            of :attr:`replication.nav.errors.ErrorModel.slices`.
+
+        Returns
+        -------
+        sigma : ndarray, shape (m, k)
+            √diag P per epoch for the slice's k states, state units.
+        """
         s = self.model.slices[name]
         return np.sqrt(self.P_diag[:, s])
 
 
 def true_parameter_vector(model: ErrorModel, errors: ImuErrors | None = None, **blocks) -> np.ndarray:
-    """True values of the augmented states in the model layout: ``accel_bias``/``gyro_bias``/
-    ``accel_scale``/... taken from ``errors`` where the block name says so, overridden by keyword
-    arrays (block name → values)."""
+    """True values of the augmented states in the model layout.
+
+    ``accel_bias``/``gyro_bias``/``accel_scale``/``gyro_scale``/``accel_misalignment``/
+    ``gyro_misalignment`` are taken from ``errors`` where the block name says so, overridden by
+    keyword arrays (block name → values); other blocks stay zero.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The model whose layout is filled.
+    errors : ImuErrors or None, optional
+        Sensor errors in SI units.
+    **blocks : float or array_like, shape (k,)
+        Values of blocks by name, state units.
+
+    Returns
+    -------
+    p : ndarray, shape (n_aug,)
+        The augmented-state truth, n_aug = ``model.n`` - 9.
+    """
     p = np.zeros(model.n - 9)
     src = {}
     if errors is not None:
@@ -287,8 +523,59 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     with antenna position (ENU metres, lever arm of chen2019 eq. (2-13)) and/or velocity, feedback
     of δp, δv, φ and accumulation p̂ += x̂ of the augmented states.
 
-    ``truth`` (a Trajectory on the same samples) with ``true_params`` (augmented-state truth,
-    see :func:`true_parameter_vector`) enables the NEES at every epoch.
+    Parameters
+    ----------
+    t : array_like, shape (N + 1,)
+        IMU sample times [s], strictly increasing.
+    dtheta : array_like, shape (N, 3)
+        Measured angle increments [rad], body axes.
+    dv : array_like, shape (N, 3)
+        Measured velocity increments [m/s], body axes.
+    initial : NavState
+        Initial navigation state (:class:`replication.nav.strapdown.NavState`).
+    gnss : GnssMeasurements
+        GNSS fixes on IMU samples 1..N (``gnss.t == t[gnss.index]``); their ``sigma_pos`` [m] and
+        ``sigma_vel`` [m/s] (positive) set the filter's measurement noise.
+    model : ErrorModel
+        The error-state model.
+    use_position : bool, optional
+        Use the GNSS position, default True.
+    use_velocity : bool, optional
+        Use the GNSS velocity, default True (at least one of the two).
+    P0 : array_like, shape (n, n), optional
+        Initial covariance, state units squared; default ``model.P0()``.
+    vertical : str, optional
+        Vertical-channel mode, a key of ``replication.nav.strapdown.VERTICAL_MODES``; default
+        ``"free"``; other modes need ``h_ref``.
+    h_ref : float or array_like, shape (N + 1,), optional
+        Reference height [m] per IMU sample for the vertical channel.
+    vu_ref : float or array_like, shape (N + 1,), optional
+        Reference vertical velocity [m/s] per IMU sample, default zero.
+    damping_tau : float, optional
+        Time constant [s] of the ``"damped"`` vertical channel, default 100.
+    truth : Trajectory, optional
+        The true trajectory on the same samples; enables the NEES at every epoch.
+    true_params : float or array_like, shape (n_aug,), optional
+        Augmented-state truth for the NEES (see :func:`true_parameter_vector`), default zeros.
+    store_nav : bool, optional
+        Keep the corrected navigation at every IMU sample, default True.
+    store_P : bool, optional
+        Keep the full covariance at every epoch, default False.
+    series_order : int, optional
+        Terms of the series of (Φ, Q_d), default 4.
+
+    Returns
+    -------
+    result : ClosedLoopResult
+        Epoch records, estimates and diagnostics.
+
+    Raises
+    ------
+    TypeError
+        For a ``model``, ``gnss``, ``initial`` or ``truth`` of the wrong type.
+    ValueError
+        For inconsistent samples, GNSS epochs off the IMU samples, no measurement used, an
+        unknown ``vertical`` or a vertical mode without ``h_ref``.
     """
     dtheta, dv = validate_increments(dtheta, dv)
     n = len(dtheta)
@@ -364,7 +651,24 @@ def _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp):
 
 
 def perturb_state(state: NavState, model: ErrorModel, rng=None) -> NavState:
-    """A navigation state with errors drawn from ``model.nav_sd`` (δL, δλ, δh, δv, φ)."""
+    """A navigation state with errors drawn from ``model.nav_sd`` (δL, δλ, δh, δv, φ).
+
+    The attitude error enters as Ĉ_b^n = exp(-φ×) C_b^n.
+
+    Parameters
+    ----------
+    state : NavState
+        The true state.
+    model : ErrorModel
+        Supplies ``nav_sd`` (state units).
+    rng : numpy.random.Generator or int or None, optional
+        Random generator or seed.
+
+    Returns
+    -------
+    state : NavState
+        The perturbed state.
+    """
     rng = np.random.default_rng(rng)
     d = model.nav_sd * rng.standard_normal(9)
     C = rotvec_to_dcm(-d[6:9]) @ state.C_bn
@@ -373,7 +677,27 @@ def perturb_state(state: NavState, model: ErrorModel, rng=None) -> NavState:
 
 @dataclass
 class MonteCarloResult:
-    """Per-run outputs of :func:`monte_carlo` (runs × epochs unless noted)."""
+    """Per-run outputs of :func:`monte_carlo` (runs × epochs unless noted).
+
+    Attributes
+    ----------
+    t_epoch : ndarray, shape (m,)
+        Times of the GNSS epochs [s].
+    nees : ndarray, shape (n_runs, m)
+        NEES of every run at every epoch.
+    nis : ndarray, shape (n_runs, m)
+        NIS of every run at every epoch.
+    final_estimates : ndarray, shape (n_runs, n_aug)
+        Accumulated augmented-state estimates at the last epoch, state units.
+    true_params : ndarray, shape (n_runs, n_aug)
+        The drawn augmented-state truth, state units.
+    final_sigma : ndarray, shape (n_runs, n)
+        √diag P at the last epoch (the covariance of run 0, which leads every run).
+    P_diag_run0 : ndarray, shape (m, n)
+        Diagonal of the covariance at every epoch (first run).
+    n_states : int
+        Number of states n (the degrees of freedom of the NEES).
+    """
 
     t_epoch: np.ndarray
     nees: np.ndarray
@@ -385,10 +709,37 @@ class MonteCarloResult:
     n_states: int
 
     def nees_band(self, prob: float = 0.95):
+        """Two-sided band of the run-averaged NEES (:func:`chi2_band` with n_states, n_runs).
+
+        Parameters
+        ----------
+        prob : float, optional
+            Probability inside the band, default 0.95.
+
+        Returns
+        -------
+        lo : float
+            Lower bound.
+        hi : float
+            Upper bound.
+        """
         return chi2_band(self.n_states, self.nees.shape[0], prob)
 
     def fraction_in_band(self, prob: float = 0.95, skip: int = 0) -> float:
-        """Fraction of epochs (after ``skip``) whose run-averaged NEES lies in its ``prob`` band."""
+        """Fraction of epochs (after ``skip``) whose run-averaged NEES lies in its ``prob`` band.
+
+        Parameters
+        ----------
+        prob : float, optional
+            Probability inside the band, default 0.95.
+        skip : int, optional
+            Number of leading epochs left out, default 0.
+
+        Returns
+        -------
+        fraction : float
+            Share of the epochs in [0, 1].
+        """
         lo, hi = self.nees_band(prob)
         m = self.nees[:, skip:].mean(0)
         return float(np.mean((m >= lo) & (m <= hi)))
@@ -481,14 +832,26 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
         The true motion (:func:`replication.nav.trajectory.generate`).
     model : ErrorModel
         The filter's model; its prior draws the truth of the random constants.
-    n_runs, seed : int
-        Number of runs and the seed of their generators.
-    gnss_rate_hz, sigma_pos, sigma_vel :
-        GNSS fixes (:func:`replication.nav.sensors.gnss_measurements`).
-    vertical, h_ref, vu_ref :
-        Vertical channel, as in :func:`closed_loop`.
-    workers : int
-        Threads for the runs that follow run 0 (within each chunk when chunked).
+    n_runs : int, optional
+        Number of runs, default 20.
+    seed : int, optional
+        Seed (non-negative) of the runs' generators, default 0.
+    gnss_rate_hz : float, optional
+        GNSS fix rate [Hz], default 10 (:func:`replication.nav.sensors.gnss_measurements`).
+    sigma_pos : float or array_like, shape (3,), optional
+        GNSS position noise standard deviation (E, N, U) [m], positive; both the simulated noise
+        and the filter's.
+    sigma_vel : float or array_like, shape (3,), optional
+        GNSS velocity noise standard deviation (E, N, U) [m/s], positive.
+    vertical : str, optional
+        Vertical-channel mode, as in :func:`closed_loop`, default ``"free"`` (``"damped"`` uses a
+        100 s time constant).
+    workers : int, optional
+        Threads for the runs that follow run 0 (within each chunk when chunked), default 2.
+    h_ref : float or array_like, shape (N + 1,), optional
+        Reference height [m] per sample for the vertical channel, as in :func:`closed_loop`.
+    vu_ref : float or array_like, shape (N + 1,), optional
+        Reference vertical velocity [m/s] per sample, default zero.
     executor : concurrent.futures.Executor or None
         Where the chunks run; ``None`` with ``chunk_runs=None``: the one in-process batch.
     chunk_runs : int or None
@@ -500,7 +863,17 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
 
     Returns
     -------
-    MonteCarloResult
+    result : MonteCarloResult
+        Per-run NEES, NIS, final estimates and truth.
+
+    Raises
+    ------
+    TypeError
+        For a ``traj`` or ``model`` of the wrong type.
+    ValueError
+        For invalid counts, rates or noises, or a vertical mode without ``h_ref``.
+    KeyError
+        For a model without an ``accel_bias`` or a ``gyro_bias`` block.
     """
     if not isinstance(traj, Trajectory):
         raise TypeError(f"traj must be a trajectory.Trajectory (trajectory.generate), got {type(traj).__name__}")

@@ -51,7 +51,18 @@ def _quat(q, name="q"):
 
 
 def skew(v):
-    """Skew-symmetric (cross-product) matrix (v×) such that (v×) u = v × u."""
+    """Skew-symmetric (cross-product) matrix (v×) such that (v×) u = v × u.
+
+    Parameters
+    ----------
+    v : array_like, shape (..., 3)
+        Vector(s); any unit (the matrix carries the unit of ``v``).
+
+    Returns
+    -------
+    V : ndarray, shape (..., 3, 3)
+        The matrix (v×).
+    """
     v = _vec3(v, "v")
     z = np.zeros(v.shape[:-1])
     x, y, w = v[..., 0], v[..., 1], v[..., 2]
@@ -63,14 +74,45 @@ def skew(v):
 
 
 def vee(m):
-    """Inverse of :func:`skew` applied to the skew-symmetric part of ``m``."""
+    """Inverse of :func:`skew` applied to the skew-symmetric part of ``m``.
+
+    Parameters
+    ----------
+    m : array_like, shape (..., 3, 3)
+        Matrix; only its skew-symmetric part (m - m^T)/2 is used.
+
+    Returns
+    -------
+    v : ndarray, shape (..., 3)
+        The vector v with (v×) = (m - m^T)/2.
+    """
     m = matrix3(finite_array(m, "m"), "m")
     return 0.5 * np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0],
                            m[..., 1, 0] - m[..., 0, 1]], -1)
 
 
 def euler_to_dcm(heading, pitch, roll):
-    """C_b^n = R_z(-ψ) R_x(θ) R_y(γ) from heading ψ, pitch θ, roll γ (radians), ENU / R-F-U."""
+    """C_b^n = R_z(-ψ) R_x(θ) R_y(γ) from heading ψ, pitch θ, roll γ, ENU / R-F-U.
+
+    Parameters
+    ----------
+    heading : float or array_like, shape (...)
+        Heading ψ [rad], clockwise from north.
+    pitch : float or array_like, shape (...)
+        Pitch θ [rad], nose-up positive, within ±π/2.
+    roll : float or array_like, shape (...)
+        Roll γ [rad], right-wing-down positive.
+
+    Returns
+    -------
+    C_bn : ndarray, shape (..., 3, 3)
+        DCM C_b^n (body to ENU navigation frame), the broadcast shape of the angles plus (3, 3).
+
+    Raises
+    ------
+    ValueError
+        If a pitch exceeds ±90° (e.g. degrees passed instead of radians).
+    """
     h, p, r = np.broadcast_arrays(*(finite_array(a, n) for a, n in ((heading, "heading"), (pitch, "pitch"),
                                                                    (roll, "roll"))))
     if np.any(np.abs(p) > np.pi / 2 + 1e-12):
@@ -95,6 +137,20 @@ def dcm_to_euler(c):
     """(heading, pitch, roll) from C_b^n; heading in [0, 2π), roll in (-π, π].
 
     Near pitch = ±90° heading and roll are not separable (gimbal lock); the sum is kept.
+
+    Parameters
+    ----------
+    c : array_like, shape (..., 3, 3)
+        DCM C_b^n (a rotation matrix).
+
+    Returns
+    -------
+    heading : ndarray, shape (...)
+        Heading ψ [rad] in [0, 2π).
+    pitch : ndarray, shape (...)
+        Pitch θ [rad] in [-π/2, π/2].
+    roll : ndarray, shape (...)
+        Roll γ [rad] in (-π, π].
     """
     c = rotation(c, "c (C_b^n)")
     pitch = np.arcsin(np.clip(c[..., 2, 1], -1.0, 1.0))
@@ -104,7 +160,18 @@ def dcm_to_euler(c):
 
 
 def rotvec_to_dcm(phi):
-    """exp(φ×) by Rodrigues' formula (exact, series-safe near zero)."""
+    """exp(φ×) by Rodrigues' formula (exact, series-safe near zero).
+
+    Parameters
+    ----------
+    phi : array_like, shape (..., 3)
+        Rotation vector φ [rad].
+
+    Returns
+    -------
+    C : ndarray, shape (..., 3, 3)
+        The rotation matrix exp(φ×).
+    """
     phi = _vec3(phi, "phi")
     a2 = np.sum(phi * phi, -1)
     a = np.sqrt(a2)
@@ -118,12 +185,34 @@ def rotvec_to_dcm(phi):
 
 
 def dcm_to_rotvec(c):
-    """Rotation vector φ with exp(φ×) = C, |φ| ≤ π (via the quaternion for accuracy)."""
+    """Rotation vector φ with exp(φ×) = C, |φ| ≤ π (via the quaternion for accuracy).
+
+    Parameters
+    ----------
+    c : array_like, shape (..., 3, 3)
+        Rotation matrix C.
+
+    Returns
+    -------
+    phi : ndarray, shape (..., 3)
+        Rotation vector φ [rad], |φ| ≤ π.
+    """
     return quat_to_rotvec(dcm_to_quat(c))
 
 
 def quat_to_dcm(q):
-    """DCM of a unit scalar-first quaternion (normalised first)."""
+    """DCM of a unit scalar-first quaternion (normalised first).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternion [q0, q1, q2, q3], scalar first; need not be normalised (must be non-zero).
+
+    Returns
+    -------
+    C : ndarray, shape (..., 3, 3)
+        The rotation matrix the quaternion represents (C_b^n for ``q_bn``).
+    """
     q = quat_normalize(q)
     a, b, c, d = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     m = np.empty(q.shape[:-1] + (3, 3))
@@ -140,7 +229,18 @@ def quat_to_dcm(q):
 
 
 def dcm_to_quat(c):
-    """Scalar-first unit quaternion (q0 ≥ 0) of a DCM (Shepperd's method)."""
+    """Scalar-first unit quaternion (q0 ≥ 0) of a DCM (Shepperd's method).
+
+    Parameters
+    ----------
+    c : array_like, shape (..., 3, 3)
+        Rotation matrix.
+
+    Returns
+    -------
+    q : ndarray, shape (..., 4)
+        Unit quaternion [q0, q1, q2, q3] with q0 ≥ 0.
+    """
     c = rotation(c, "c")
     tr = c[..., 0, 0] + c[..., 1, 1] + c[..., 2, 2]
     cand = np.stack([tr, c[..., 0, 0], c[..., 1, 1], c[..., 2, 2]], -1)
@@ -174,7 +274,20 @@ def dcm_to_quat(c):
 
 
 def quat_multiply(p, q):
-    """Hamilton product p ⊗ q (scalar first)."""
+    """Hamilton product p ⊗ q (scalar first).
+
+    Parameters
+    ----------
+    p : array_like, shape (..., 4)
+        Left factor, scalar first.
+    q : array_like, shape (..., 4)
+        Right factor, scalar first.
+
+    Returns
+    -------
+    pq : ndarray, shape (..., 4)
+        The product p ⊗ q (broadcast over leading dimensions).
+    """
     p, q = _quat(p, "p"), _quat(q, "q")
     a1, b1, c1, d1 = (p[..., i] for i in range(4))
     a2, b2, c2, d2 = (q[..., i] for i in range(4))
@@ -187,11 +300,40 @@ def quat_multiply(p, q):
 
 
 def quat_conjugate(q):
+    """Conjugate q* = [q0, -q1, -q2, -q3] (the inverse of a unit quaternion).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternion, scalar first.
+
+    Returns
+    -------
+    q_conj : ndarray, shape (..., 4)
+        The conjugate q*.
+    """
     q = _quat(q)
     return q * np.array([1.0, -1.0, -1.0, -1.0])
 
 
 def quat_normalize(q):
+    """Quaternion scaled to unit norm.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternion, scalar first; must be non-zero.
+
+    Returns
+    -------
+    q_unit : ndarray, shape (..., 4)
+        q / |q|.
+
+    Raises
+    ------
+    ValueError
+        If a quaternion is zero.
+    """
     q = _quat(q)
     n = np.linalg.norm(q, axis=-1, keepdims=True)
     if np.any(n == 0):
@@ -200,7 +342,18 @@ def quat_normalize(q):
 
 
 def rotvec_to_quat(phi):
-    """q = [cos(|φ|/2), sin(|φ|/2) φ/|φ|] (exact)."""
+    """q = [cos(|φ|/2), sin(|φ|/2) φ/|φ|] (exact).
+
+    Parameters
+    ----------
+    phi : array_like, shape (..., 3)
+        Rotation vector φ [rad].
+
+    Returns
+    -------
+    q : ndarray, shape (..., 4)
+        Unit quaternion, scalar first.
+    """
     phi = _vec3(phi, "phi")
     a = np.linalg.norm(phi, axis=-1)
     half = 0.5 * a
@@ -211,7 +364,18 @@ def rotvec_to_quat(phi):
 
 
 def quat_to_rotvec(q):
-    """Rotation vector of a unit quaternion, |φ| ≤ π."""
+    """Rotation vector of a unit quaternion, |φ| ≤ π.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternion, scalar first (normalised first).
+
+    Returns
+    -------
+    phi : ndarray, shape (..., 3)
+        Rotation vector φ [rad], |φ| ≤ π.
+    """
     q = quat_normalize(q)
     q = np.where(q[..., :1] < 0, -q, q)
     s = np.linalg.norm(q[..., 1:], axis=-1)
@@ -223,24 +387,89 @@ def quat_to_rotvec(q):
 
 
 def euler_to_quat(heading, pitch, roll):
+    """Quaternion q_bn of heading ψ, pitch θ, roll γ (the sequence of :func:`euler_to_dcm`).
+
+    Parameters
+    ----------
+    heading : float or array_like, shape (...)
+        Heading ψ [rad], clockwise from north.
+    pitch : float or array_like, shape (...)
+        Pitch θ [rad], nose-up positive, within ±π/2.
+    roll : float or array_like, shape (...)
+        Roll γ [rad], right-wing-down positive.
+
+    Returns
+    -------
+    q_bn : ndarray, shape (..., 4)
+        Unit quaternion of C_b^n, scalar first, q0 ≥ 0.
+    """
     return dcm_to_quat(euler_to_dcm(heading, pitch, roll))
 
 
 def quat_to_euler(q):
+    """(heading, pitch, roll) of a quaternion q_bn (the convention of :func:`dcm_to_euler`).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternion q_bn, scalar first (normalised first).
+
+    Returns
+    -------
+    heading : ndarray, shape (...)
+        Heading ψ [rad] in [0, 2π).
+    pitch : ndarray, shape (...)
+        Pitch θ [rad] in [-π/2, π/2].
+    roll : ndarray, shape (...)
+        Roll γ [rad] in (-π, π].
+    """
     return dcm_to_euler(quat_to_dcm(q))
 
 
 def attitude_error(c_est, c_true):
-    """Misalignment φ^n with Ĉ_b^n = exp(-φ×) C_b^n (≈ (I - φ×) C_b^n), chen2019 eq. (3-16) ψ^n."""
+    """Misalignment φ^n with Ĉ_b^n = exp(-φ×) C_b^n (≈ (I - φ×) C_b^n), chen2019 eq. (3-16) ψ^n.
+
+    Parameters
+    ----------
+    c_est : array_like, shape (..., 3, 3)
+        Estimated DCM Ĉ_b^n.
+    c_true : array_like, shape (..., 3, 3)
+        True DCM C_b^n.
+
+    Returns
+    -------
+    phi : ndarray, shape (..., 3)
+        Misalignment φ^n [rad] in the navigation frame (E, N, U).
+    """
     c_est, c_true = rotation(c_est, "c_est"), rotation(c_true, "c_true")
     e = c_est @ np.swapaxes(c_true, -1, -2)
     return -dcm_to_rotvec(e)
 
 
 def body_rate_from_euler_rates(heading, pitch, roll, heading_rate, pitch_rate, roll_rate):
-    """ω_nb^b (rad/s) of the Euler sequence C_b^n = R_z(-ψ) R_x(θ) R_y(γ).
+    """ω_nb^b of the Euler sequence C_b^n = R_z(-ψ) R_x(θ) R_y(γ).
 
     ω_nb^b = R_y(γ)^T [θ̇ e_x + R_x(θ)^T (-ψ̇ e_z)] + γ̇ e_y.
+
+    Parameters
+    ----------
+    heading : float or array_like, shape (...)
+        Heading ψ [rad]; checked for finiteness only (ω_nb^b does not depend on it).
+    pitch : float or array_like, shape (...)
+        Pitch θ [rad].
+    roll : float or array_like, shape (...)
+        Roll γ [rad].
+    heading_rate : float or array_like, shape (...)
+        ψ̇ [rad/s].
+    pitch_rate : float or array_like, shape (...)
+        θ̇ [rad/s].
+    roll_rate : float or array_like, shape (...)
+        γ̇ [rad/s].
+
+    Returns
+    -------
+    w_nb_b : ndarray, shape (..., 3)
+        Body rate ω_nb^b [rad/s] relative to the navigation frame, body axes (R, F, U).
     """
     finite_array(heading, "heading")
     p, r = np.broadcast_arrays(finite_array(pitch, "pitch"), finite_array(roll, "roll"))
@@ -257,7 +486,18 @@ def body_rate_from_euler_rates(heading, pitch, roll, heading_rate, pitch_rate, r
 
 
 def orthonormalize(c):
-    """Nearest rotation matrix (polar decomposition via SVD)."""
+    """Nearest rotation matrix (polar decomposition via SVD).
+
+    Parameters
+    ----------
+    c : array_like, shape (..., 3, 3)
+        Nearly orthonormal matrix.
+
+    Returns
+    -------
+    C : ndarray, shape (..., 3, 3)
+        The orthonormal matrix U V^T nearest to ``c`` in the Frobenius norm.
+    """
     c = matrix3(finite_array(c, "c"), "c")
     u, _, vt = np.linalg.svd(c)
     return u @ vt

@@ -43,20 +43,71 @@ __all__ = ["TriadErrors", "ImuErrors", "misalignment_matrix", "apply_imu_errors"
 
 
 def misalignment_matrix(theta):
-    """δC_m^s of chen2019 eq. (2-8) from [θ_xy, θ_yx, θ_xz, θ_zx, θ_yz, θ_zy] (rad)."""
+    """δC_m^s of chen2019 eq. (2-8) from the six non-orthogonality angles.
+
+    Parameters
+    ----------
+    theta : float or array_like, shape (6,)
+        [θ_xy, θ_yx, θ_xz, θ_zx, θ_yz, θ_zy] [rad]; one number stands for all six.
+
+    Returns
+    -------
+    dM : ndarray, shape (3, 3)
+        [[0, -θ_yz, θ_zy], [θ_xz, 0, -θ_zx], [-θ_xy, θ_yx, 0]] [rad].
+    """
     xy, yx, xz, zx, yz, zy = components(theta, "misalignment", 6)
     return np.array([[0.0, -yz, zy], [xz, 0.0, -zx], [-xy, yx, 0.0]])
 
 
 def markov_sigma_from_driving_psd(q_drive, tau):
-    """Stationary σ of ẋ = -x/τ + w with driving intensity q: σ² = q τ / 2."""
+    """Stationary σ of ẋ = -x/τ + w with driving intensity q: σ² = q τ / 2.
+
+    Parameters
+    ----------
+    q_drive : float or array_like, shape (...)
+        Driving white-noise intensity q [x²/s for a process x, e.g. (rad/s)²/s for a gyro drift];
+        non-negative.
+    tau : float
+        Correlation time τ [s], positive.
+
+    Returns
+    -------
+    sigma : ndarray, shape (...)
+        Stationary standard deviation σ = sqrt(q τ / 2), in the unit of x.
+    """
     tau = positive(tau, "tau", "the correlation time {name} must be positive (seconds), got {value!r}")
     return np.sqrt(nonnegative_array(q_drive, "q_drive") * tau / 2)
 
 
 @dataclass
 class TriadErrors:
-    """Error parameters of one sensor triad (SI units, see the module docstring)."""
+    """Error parameters of one sensor triad (SI units, see the module docstring).
+
+    chen2019 eq. (2-10); a gyro triad in rad/s-based units, an accelerometer triad in
+    m/s²-based units.  Each field accepts one number standing for all components.
+
+    Attributes
+    ----------
+    bias : ndarray, shape (3,)
+        Random constant x_b [rad/s or m/s²], eq. (2-5).
+    markov_sigma : ndarray, shape (3,)
+        Stationary standard deviation of the first-order Gauss-Markov x_m [rad/s or m/s²],
+        non-negative.
+    markov_tau : float
+        Correlation time τ of the Gauss-Markov process [s], positive; ``np.inf`` (default) for none.
+    white_psd : ndarray, shape (3,)
+        White-noise intensity q [(rad/s)²·s = rad²/s or (m/s²)²·s], non-negative.
+    scale : ndarray, shape (3,)
+        Diagonal scale-factor errors δK (dimensionless, e.g. 10 ppm = 1e-5), eq. (2-6).
+    misalignment : ndarray, shape (6,)
+        Non-orthogonality angles [θ_xy, θ_yx, θ_xz, θ_zx, θ_yz, θ_zy] [rad] of δM, eq. (2-8).
+
+    Raises
+    ------
+    ValueError
+        For a negative ``white_psd`` or ``markov_sigma``, a non-positive ``markov_tau`` or a wrong
+        number of components.
+    """
 
     bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
     markov_sigma: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -84,7 +135,15 @@ class TriadErrors:
 
 @dataclass
 class ImuErrors:
-    """Gyro and accelerometer error parameters (chen2019 eq. (2-10))."""
+    """Gyro and accelerometer error parameters (chen2019 eq. (2-10)).
+
+    Attributes
+    ----------
+    gyro : TriadErrors
+        Gyro triad errors (rad/s-based SI units).
+    accel : TriadErrors
+        Accelerometer triad errors (m/s²-based SI units).
+    """
 
     gyro: TriadErrors = field(default_factory=TriadErrors)
     accel: TriadErrors = field(default_factory=TriadErrors)
@@ -94,8 +153,40 @@ class ImuErrors:
                            gyro_markov_tau_s=np.inf, accel_bias_ug=0.0, accel_white_ug2=0.0,
                            accel_markov_ug=0.0, accel_markov_tau_s=np.inf, scale_ppm=0.0,
                            misalignment_arcsec=0.0):
-        """Parameters in the units the papers print: °/h, (°/h)² per Hz (white-noise intensity),
-        μg, (μg)² per Hz, ppm, arc-seconds."""
+        """Error parameters from the units the papers print.
+
+        °/h, (°/h)² per Hz (white-noise intensity), μg, (μg)² per Hz, ppm, arc-seconds; converted
+        with :mod:`replication.nav.units`.  Each value is one number for the triad or three
+        components (six for the misalignment).
+
+        Parameters
+        ----------
+        gyro_bias_deg_h : float or array_like, shape (3,), optional
+            Gyro bias [°/h].
+        gyro_white_deg2_h2 : float or array_like, shape (3,), optional
+            Gyro white-noise intensity [(°/h)²/Hz].
+        gyro_markov_deg_h : float or array_like, shape (3,), optional
+            Gyro Gauss-Markov stationary σ [°/h].
+        gyro_markov_tau_s : float, optional
+            Gyro Gauss-Markov correlation time [s], default ``np.inf`` (none).
+        accel_bias_ug : float or array_like, shape (3,), optional
+            Accelerometer bias [μg].
+        accel_white_ug2 : float or array_like, shape (3,), optional
+            Accelerometer white-noise intensity [μg²/Hz].
+        accel_markov_ug : float or array_like, shape (3,), optional
+            Accelerometer Gauss-Markov stationary σ [μg].
+        accel_markov_tau_s : float, optional
+            Accelerometer Gauss-Markov correlation time [s], default ``np.inf`` (none).
+        scale_ppm : float or array_like, shape (3,), optional
+            Scale-factor errors [ppm], used for both triads.
+        misalignment_arcsec : float or array_like, shape (6,), optional
+            Non-orthogonality angles [″], used for both triads.
+
+        Returns
+        -------
+        errors : ImuErrors
+            The parameters in SI units.
+        """
         g = TriadErrors(bias=np.asarray(gyro_bias_deg_h, float) * DEG_PER_H,
                         white_psd=deg_per_h2(gyro_white_deg2_h2) if np.ndim(gyro_white_deg2_h2) == 0
                         else np.asarray(gyro_white_deg2_h2, float) * DEG_PER_H**2,
@@ -191,9 +282,33 @@ def _markov_path(n, T, sigma, tau, rng, x0=None):
 
 
 def apply_imu_errors(t, dtheta, dv, errors: ImuErrors, rng=None):
-    """Corrupt ideal increments with chen2019 eq. (2-10) errors.  Returns (dtheta, dv, info).
+    """Corrupt ideal increments with chen2019 eq. (2-10) errors.
 
-    ``info`` holds the realised Markov paths (``gyro_markov``, ``accel_markov``, per interval).
+    On each interval T: Δũ = (I + δK + δM) Δu + x_b T + x̄_m T + n,  n ~ N(0, q T); the
+    Gauss-Markov path is sampled at the median interval and held over each interval.
+
+    Parameters
+    ----------
+    t : array_like, shape (N + 1,)
+        Sample times [s], strictly increasing.
+    dtheta : array_like, shape (N, 3)
+        Ideal angle increments [rad], body axes.
+    dv : array_like, shape (N, 3)
+        Ideal velocity increments [m/s], body axes.
+    errors : ImuErrors
+        Error parameters (SI units).
+    rng : numpy.random.Generator or int or None, optional
+        Random generator or seed (``np.random.default_rng``).
+
+    Returns
+    -------
+    dtheta : ndarray, shape (N, 3)
+        Corrupted angle increments [rad].
+    dv : ndarray, shape (N, 3)
+        Corrupted velocity increments [m/s].
+    info : dict of str to ndarray
+        The realised Markov paths ``gyro_markov`` [rad/s] and ``accel_markov`` [m/s²], each
+        shape (N, 3), one value per interval.
     """
 
     dtheta, dv = validate_increments(dtheta, dv)
@@ -214,9 +329,24 @@ def apply_imu_errors(t, dtheta, dv, errors: ImuErrors, rng=None):
 
 
 def draw_imu_errors(sd: ImuErrors, rng=None) -> ImuErrors:
-    """A realisation of the random-constant parameters: bias, scale and misalignment drawn
-    N(0, σ²) per component from ``sd`` (whose fields hold standard deviations); Markov and
-    white-noise parameters copied."""
+    """A realisation of the random-constant parameters.
+
+    Bias, scale and misalignment are drawn N(0, σ²) per component from ``sd`` (whose fields hold
+    standard deviations); Markov and white-noise parameters are copied.
+
+    Parameters
+    ----------
+    sd : ImuErrors
+        Standard deviations of the random constants (SI units); its Markov and white-noise fields
+        are the values to copy.
+    rng : numpy.random.Generator or int or None, optional
+        Random generator or seed.
+
+    Returns
+    -------
+    errors : ImuErrors
+        One realisation (SI units).
+    """
     rng = np.random.default_rng(rng)
 
     def draw(s: TriadErrors):
@@ -232,7 +362,29 @@ def draw_imu_errors(sd: ImuErrors, rng=None) -> ImuErrors:
 
 @dataclass
 class GnssMeasurements:
-    """GNSS fixes: times, sample indices into the IMU record, antenna position and velocity."""
+    """GNSS fixes: times, sample indices into the IMU record, antenna position and velocity.
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Fix times [s].
+    index : ndarray of int, shape (m,)
+        Index of each fix's sample in the trajectory (IMU) record.
+    lat : ndarray, shape (m,)
+        Antenna geodetic latitude [rad].
+    lon : ndarray, shape (m,)
+        Antenna longitude [rad].
+    h : ndarray, shape (m,)
+        Antenna ellipsoidal height [m].
+    v_enu : ndarray, shape (m, 3)
+        Antenna velocity (East, North, Up) [m/s].
+    sigma_pos : ndarray, shape (3,)
+        Position noise standard deviation (East, North, Up) [m].
+    sigma_vel : ndarray, shape (3,)
+        Velocity noise standard deviation (East, North, Up) [m/s].
+    lever_arm_b : ndarray, shape (3,)
+        Antenna position relative to the IMU centre, body axes (R, F, U) [m].
+    """
 
     t: np.ndarray
     index: np.ndarray
@@ -246,6 +398,7 @@ class GnssMeasurements:
 
     @property
     def position(self):
+        """(lat [rad], lon [rad], h [m]) of each fix, shape (m, 3)."""
         return np.stack([self.lat, self.lon, self.h], -1)
 
 
@@ -254,6 +407,26 @@ def lever_arm_offset(lat, h, C_bn, lever_arm_b, w_eb_b=None):
 
     Position: C_b^n l^b converted to (ΔL, Δλ, Δh); velocity: C_b^n (ω_eb^b × l^b) (the report
     writes C_b^n ω_nb^n P^b; ω_eb^b = ω_ib^b - C_n^b ω_ie^n is the exact rate).
+
+    Parameters
+    ----------
+    lat : float or array_like, shape (...)
+        Geodetic latitude of the IMU [rad].
+    h : float or array_like, shape (...)
+        Ellipsoidal height of the IMU [m].
+    C_bn : array_like, shape (..., 3, 3)
+        Attitude DCM C_b^n.
+    lever_arm_b : float or array_like, shape (3,)
+        Antenna position relative to the IMU centre, body axes [m].
+    w_eb_b : array_like, shape (..., 3), optional
+        Body rate relative to the Earth ω_eb^b [rad/s]; without it no velocity offset is computed.
+
+    Returns
+    -------
+    dpos : ndarray, shape (..., 3)
+        (ΔL [rad], Δλ [rad], Δh [m]).
+    dvel : ndarray, shape (..., 3) or None
+        Velocity offset (East, North, Up) [m/s], None when ``w_eb_b`` is not given.
     """
     lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
     h = earth.check_height(h)
@@ -272,9 +445,34 @@ def gnss_measurements(traj, *, rate_hz: float = 10.0, sigma_pos=(0.03, 0.03, 0.1
                       lever_arm_b=(0.0, 0.0, 0.0), rng=None) -> GnssMeasurements:
     """GNSS antenna position/velocity fixes from a trajectory with white noise.
 
-    ``rate_hz`` must divide the IMU rate (fixes fall on IMU samples).  Noise: ``sigma_pos``
-    (E, N, U metres) and ``sigma_vel`` (m/s), independent white; ``lever_arm_b`` the antenna
-    position in the body frame (chen2019 eq. (2-13)).
+    ``rate_hz`` must divide the IMU rate (fixes fall on IMU samples; the first at the sample
+    after the start).  The antenna is displaced by the lever arm (chen2019 eq. (2-13),
+    :func:`lever_arm_offset`).
+
+    Parameters
+    ----------
+    traj : Trajectory
+        Reference trajectory (:class:`~replication.nav.trajectory.Trajectory`).
+    rate_hz : float, optional
+        Fix rate [Hz], default 10.
+    sigma_pos : float or array_like, shape (3,), optional
+        Position noise standard deviation (East, North, Up) [m], independent white.
+    sigma_vel : float or array_like, shape (3,), optional
+        Velocity noise standard deviation (East, North, Up) [m/s], independent white.
+    lever_arm_b : float or array_like, shape (3,), optional
+        Antenna position in the body frame [m], default zero.
+    rng : numpy.random.Generator or int or None, optional
+        Random generator or seed.
+
+    Returns
+    -------
+    fixes : GnssMeasurements
+        The noisy antenna fixes.
+
+    Raises
+    ------
+    ValueError
+        When ``rate_hz`` does not divide the IMU rate or a standard deviation is negative.
     """
     rate_hz = positive(rate_hz, "rate_hz", "GNSS rate {name} must be a positive finite rate (Hz), got {value!r}")
     sp = nonnegative_array(components(sigma_pos, "sigma_pos"), "sigma_pos")
@@ -303,7 +501,28 @@ def gnss_measurements(traj, *, rate_hz: float = 10.0, sigma_pos=(0.03, 0.03, 0.1
 
 def barometric_height(traj, *, sigma: float = 1.0, bias: float = 0.0, markov_sigma: float = 0.0,
                       markov_tau: float = 600.0, rng=None):
-    """Barometric / air-data height at every sample: h + bias + Gauss-Markov + white noise (m)."""
+    """Barometric / air-data height at every sample: h + bias + Gauss-Markov + white noise.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        Reference trajectory (:class:`~replication.nav.trajectory.Trajectory`).
+    sigma : float, optional
+        White-noise standard deviation [m], default 1.
+    bias : float or array_like, shape (n,), optional
+        Constant bias [m], default 0.
+    markov_sigma : float, optional
+        Stationary standard deviation of the Gauss-Markov term [m], default 0 (none).
+    markov_tau : float, optional
+        Its correlation time [s], default 600; ``np.inf`` for no Gauss-Markov term.
+    rng : numpy.random.Generator or int or None, optional
+        Random generator or seed.
+
+    Returns
+    -------
+    h_baro : ndarray, shape (n,)
+        Measured height at each of the n trajectory samples [m].
+    """
     sigma = nonnegative(sigma, "sigma", "{name} cannot be negative or non-finite (m), got {value!r}")
     markov_sigma = nonnegative(markov_sigma, "markov_sigma", "{name} cannot be negative or non-finite (m), got {value!r}")
     finite_array(bias, "bias")

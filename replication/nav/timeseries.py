@@ -64,7 +64,23 @@ def _series(y, name: str = "y", min_length: int = 3) -> np.ndarray:
 
 
 def ar_coefficients(phi) -> np.ndarray:
-    """AR coefficients [φ_1, ..., φ_p] as a validated 1-D float array (a scalar is AR(1))."""
+    """AR coefficients [φ_1, ..., φ_p] as a validated 1-D float array (a scalar is AR(1)).
+
+    Parameters
+    ----------
+    phi : float or array_like, shape (p,)
+        AR coefficients φ_1..φ_p (dimensionless), finite, at least one.
+
+    Returns
+    -------
+    phi : ndarray, shape (p,)
+        The coefficients as floats.
+
+    Raises
+    ------
+    ValueError
+        For an empty, multi-dimensional or non-finite ``phi``.
+    """
     phi = np.atleast_1d(numeric(phi, "phi"))
     if phi.ndim != 1 or phi.size == 0 or not np.all(np.isfinite(phi)):
         raise ValueError("phi must be a non-empty 1-D array of finite AR coefficients [phi_1, ..., phi_p]")
@@ -78,6 +94,16 @@ def inversion_count(values) -> int:
 
     Note the printed definition counts *larger* later values: an increasing sequence has the
     maximum count m(m-1)/2, a decreasing one has zero.
+
+    Parameters
+    ----------
+    values : array_like, shape (m,)
+        The sequence y_1..y_m (m ≥ 2), finite, any unit.
+
+    Returns
+    -------
+    A : int
+        The inversion count.
     """
     v = numeric(values, "values")
     if v.ndim != 1 or v.size < 2:
@@ -91,6 +117,18 @@ def inversion_moments(m: int) -> tuple[float, float]:
 
     D(A) equals the variance m(m-1)(2m+5)/72 of the number of inversions of a random
     permutation (Kendall's statistic), since m(m-1)(2m+5) = m(2m^2+3m-5).
+
+    Parameters
+    ----------
+    m : int
+        Number of values (segments), ≥ 2.
+
+    Returns
+    -------
+    expected : float
+        E(A).
+    variance : float
+        D(A).
     """
     integer(m, "m", 2, "the number of segments {name} must be an integer >= 2, got {value!r}")
     return m * (m - 1) / 4.0, m * (2 * m**2 + 3 * m - 5) / 72.0
@@ -101,6 +139,16 @@ def inversion_distribution(m: int) -> np.ndarray:
 
     P(A = a) for a = 0..m(m-1)/2 under a uniformly random order, from the generating function
     prod_{k=1}^{m} (1 + x + ... + x^{k-1}) / m!.  An independent check of (E(A), D(A)).
+
+    Parameters
+    ----------
+    m : int
+        Number of values, ≥ 2.
+
+    Returns
+    -------
+    p : ndarray, shape (m(m-1)/2 + 1,)
+        P(A = a) for a = 0, 1, ..., m(m-1)/2.
     """
     integer(m, "m", 2)
     c = np.array([1.0])
@@ -111,7 +159,31 @@ def inversion_distribution(m: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class InversionTest:
-    """Result of the inversion (reverse-order) test of chen2019 §3 step 2."""
+    """Result of the inversion (reverse-order) test of chen2019 §3 step 2.
+
+    Attributes
+    ----------
+    segments : int
+        Number m of segments.
+    means : ndarray, shape (m,)
+        Segment means y_1..y_m, in the unit of the series.
+    count : int
+        Inversion count A.
+    expected : float
+        E(A) = m(m-1)/4.
+    variance : float
+        D(A) = m(2m²+3m-5)/72.
+    statistic : float
+        B = (A + 0.5 - E(A)) / sqrt(D(A)) exactly as printed.
+    critical : float
+        The critical value z_{1-alpha/2} (1.96 at alpha = 0.05).
+    stationary_printed : bool
+        The printed rule: stationary when B < critical.
+    statistic_two_sided : float
+        (|A - E(A)| - 0.5) / sqrt(D(A)) (at least 0): the continuity correction taken toward E(A).
+    stationary : bool
+        The two-sided rule: stationary when the two-sided statistic < critical.
+    """
 
     segments: int
     means: np.ndarray
@@ -119,14 +191,10 @@ class InversionTest:
     expected: float
     variance: float
     statistic: float
-    """B = (A + 0.5 - E(A)) / sqrt(D(A)) exactly as printed."""
     critical: float
     stationary_printed: bool
-    """The printed rule: stationary when B < critical (1.96 at alpha = 0.05)."""
     statistic_two_sided: float
-    """(|A - E(A)| - 0.5) / sqrt(D(A)): the continuity correction taken toward E(A)."""
     stationary: bool
-    """The two-sided rule: stationary when the two-sided statistic < critical."""
 
 
 def inversion_test(y, segments: int, *, alpha: float = 0.05) -> InversionTest:
@@ -141,6 +209,25 @@ def inversion_test(y, segments: int, *, alpha: float = 0.05) -> InversionTest:
     it only detects an *increasing* level (many larger later values); a decreasing trend gives a
     large negative B and passes.  ``stationary`` is the two-sided version |B| < z_{1-alpha/2}
     (with the continuity correction toward E(A)), which is the test of Bendat & Piersol.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, finite, not constant, any unit.
+    segments : int
+        Number m of segments, ≥ 2, with n ≥ 2m.
+    alpha : float, optional
+        Significance level in (0, 1), default 0.05.
+
+    Returns
+    -------
+    test : InversionTest
+        Counts, statistics and both decisions.
+
+    Raises
+    ------
+    ValueError
+        For a series too short for ``segments``, a constant series or an invalid ``alpha``.
     """
     y = _series(y)
     m = integer(segments, "segments", 2)
@@ -165,7 +252,23 @@ def stationarity_report(y, segments: int, *, alpha: float = 0.05, regression: st
 
     ADF: null = unit root (stationary when rejected).  KPSS: null = level stationarity
     (stationary when *not* rejected; statsmodels' p-value is truncated to [0.01, 0.1]).
-    Returns one row per test: ``test``, ``statistic``, ``threshold``, ``stationary``.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series (n ≥ 20), finite.
+    segments : int
+        Number of segments of the inversion test.
+    alpha : float, optional
+        Significance level, default 0.05.
+    regression : {"c", "ct"}, optional
+        Deterministic terms of ADF and KPSS: constant, or constant and trend; default ``"c"``.
+
+    Returns
+    -------
+    report : pandas.DataFrame
+        One row per test (printed and two-sided inversion, ADF, KPSS): ``test``, ``statistic``,
+        ``threshold``, ``stationary``.
     """
     from statsmodels.tsa.stattools import adfuller, kpss
 
@@ -189,7 +292,20 @@ def stationarity_report(y, segments: int, *, alpha: float = 0.05, regression: st
 
 
 def difference(y, d: int = 1) -> np.ndarray:
-    """The d-th difference (1 - B)^d y_t (chen2019 Fig. 3-4, 差分平稳处理)."""
+    """The d-th difference (1 - B)^d y_t (chen2019 Fig. 3-4, 差分平稳处理).
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, finite, n > d + 2.
+    d : int, optional
+        Differencing order ≥ 0, default 1 (0 returns a copy).
+
+    Returns
+    -------
+    yd : ndarray, shape (n - d,)
+        The differenced series, in the unit of ``y``.
+    """
     y = _series(y)
     integer(d, "d", 0, "the differencing order {name} must be a non-negative integer, got {value!r}")
     if y.size <= d + 2:
@@ -200,8 +316,30 @@ def difference(y, d: int = 1) -> np.ndarray:
 def make_stationary(y, segments: int, *, max_d: int = 2, alpha: float = 0.05) -> tuple[np.ndarray, int, InversionTest]:
     """Difference until the (two-sided) inversion test accepts stationarity (chen2019 Fig. 3-4).
 
-    Returns ``(series, d, test)``.  Raises :class:`NonStationaryError` when ``max_d`` differences
-    do not suffice.
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, finite.
+    segments : int
+        Number of segments of the inversion test.
+    max_d : int, optional
+        Largest differencing order tried, default 2.
+    alpha : float, optional
+        Significance level, default 0.05.
+
+    Returns
+    -------
+    series : ndarray, shape (n - d,)
+        The first differenced series the test accepts.
+    d : int
+        Its differencing order.
+    test : InversionTest
+        The accepting test.
+
+    Raises
+    ------
+    NonStationaryError
+        When ``max_d`` differences do not suffice.
     """
     y = _series(y)
     integer(max_d, "max_d", 0)
@@ -225,6 +363,18 @@ def acf_printed(y, nlags: int) -> np.ndarray:
 
     No mean is removed (the printed formula assumes a zero-mean series); equal to statsmodels
     ``acf(y, adjusted=False, demean=False)``.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, finite, not identically zero.
+    nlags : int
+        Largest lag, 1 ≤ nlags < n.
+
+    Returns
+    -------
+    rho : ndarray, shape (nlags + 1,)
+        rho_0 (= 1) .. rho_nlags.
     """
     y = _series(y)
     integer(nlags, "nlags")
@@ -241,8 +391,20 @@ def pacf_printed(y, nlags: int) -> np.ndarray:
     """Sample PACF by solving the Yule-Walker system of chen2019 eq. (3-10) for k = 1..nlags.
 
     phi_kk is the last element of the solution of R_k phi_k = rho_(1..k) with the Toeplitz
-    matrix R_k of the (3-9) autocorrelations.  Returns [1, phi_11, ..., phi_KK] (lag 0 = 1, as
-    statsmodels); equal to statsmodels ``pacf(y, method='ywm')`` on a zero-mean series.
+    matrix R_k of the (3-9) autocorrelations; equal to statsmodels ``pacf(y, method='ywm')`` on a
+    zero-mean series.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, finite.
+    nlags : int
+        Largest lag, 1 ≤ nlags < n.
+
+    Returns
+    -------
+    pacf : ndarray, shape (nlags + 1,)
+        [1, phi_11, ..., phi_KK] (lag 0 = 1, as statsmodels).
     """
     rho = acf_printed(y, nlags)
     out = [1.0]
@@ -256,7 +418,21 @@ def correlogram(y, nlags: int, *, alpha: float = 0.05) -> pd.DataFrame:
 
     The series is demeaned.  ``acf_band``: Bartlett's half-width z sqrt((1 + 2 sum_{j<k} r_j²)/n)
     (the band under the hypothesis that the ACF is zero beyond lag k-1, i.e. MA(k-1));
-    ``pacf_band``: z/sqrt(n) (the band under AR(k-1)).  Index: lag 1..nlags.
+    ``pacf_band``: z/sqrt(n) (the band under AR(k-1)).
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series (n ≥ 10), finite.
+    nlags : int
+        Largest lag, 1 ≤ nlags < n/2.
+    alpha : float, optional
+        Significance level of the bands, default 0.05.
+
+    Returns
+    -------
+    correlogram : pandas.DataFrame
+        Index ``lag`` 1..nlags; columns ``acf``, ``acf_band``, ``pacf``, ``pacf_band``.
     """
     from statsmodels.tsa.stattools import acf, pacf
 
@@ -288,6 +464,22 @@ def cutoff_lag(values, band, *, max_lag: int, alpha: float = 0.05) -> int | None
           quantile z_B = z_{1 - alpha/(2(K - q))}.
 
     The smallest such q is returned; if there is none up to ``max_lag`` the function tails off.
+
+    Parameters
+    ----------
+    values : array_like, shape (K,)
+        The correlation function at lags 1..K (K ≥ 2).
+    band : float or array_like, shape (K,)
+        Positive band half-widths at level ``alpha``, one or one per lag.
+    max_lag : int
+        Largest cut-off lag considered, 0 ≤ max_lag < K.
+    alpha : float, optional
+        Level of the band, default 0.05.
+
+    Returns
+    -------
+    q : int or None
+        The cut-off lag, or None when the function tails off.
     """
     c = finite_array(values, "values")
     if c.ndim != 1 or c.size < 2:
@@ -316,16 +508,31 @@ def cutoff_lag(values, band, *, max_lag: int, alpha: float = 0.05) -> int | None
 
 @dataclass(frozen=True)
 class Identification:
-    """Model class chosen by the Table 3-1 rules (:func:`identify_model`)."""
+    """Model class chosen by the Table 3-1 rules (:func:`identify_model`).
+
+    Attributes
+    ----------
+    model : str
+        'AR', 'MA', 'ARMA' or 'white noise'.
+    order : int or None
+        p for AR, q for MA, 0 for white noise, None for ARMA (orders then come from AIC).
+    acf_cutoff : int or None
+        Cut-off lag of the ACF (:func:`cutoff_lag`), None when it tails off.
+    pacf_cutoff : int or None
+        Cut-off lag of the PACF, None when it tails off.
+    acf_behaviour : str
+        'cuts off' or 'tails off' (拖尾/截尾 of Table 3-1) for the ACF.
+    pacf_behaviour : str
+        The same for the PACF.
+    note : str
+        How the decision was reached (cut-offs, AIC values).
+    """
 
     model: str
-    """'AR', 'MA', 'ARMA' or 'white noise'."""
     order: int | None
-    """p for AR, q for MA, None for ARMA (orders then come from AIC)."""
     acf_cutoff: int | None
     pacf_cutoff: int | None
     acf_behaviour: str
-    """'cuts off' or 'tails off' (拖尾/截尾 of Table 3-1) for the ACF."""
     pacf_behaviour: str
     note: str
 
@@ -341,7 +548,20 @@ def cutoff_aic(y, ar_order: int, ma_order: int) -> dict:
     w = 0; ``scipy.optimize.least_squares`` from theta = 0 within |theta_k| <= C(q, k), the bound
     of an invertible polynomial).  Then
     AIC_k = N ln(RSS_k/N) + 2 (k + 1) (eq. (3-13) with the noise variance counted).
-    Returns ``{"white noise": aic, "AR": aic, "MA": aic, "nobs": N}``.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series (n ≥ 20), finite.
+    ar_order : int
+        AR order p ≥ 0 (0: the AR candidate is white noise).
+    ma_order : int
+        MA order q ≥ 0 (0: the MA candidate is white noise).
+
+    Returns
+    -------
+    aic : dict
+        ``{"white noise": aic, "AR": aic, "MA": aic, "nobs": N}`` (AIC values float, N int).
     """
     from scipy.optimize import least_squares
 
@@ -399,8 +619,27 @@ def identify_model(y, *, nlags: int | None = None, max_order: int = 10, alpha: f
     support" for the other model, Burnham & Anderson 2002, §2.6); within the margin the lag
     reading stands.  The chosen model's function cuts off, the other tails off.
     ``rule="earliest"`` is the lag reading alone: right on long series, it identifies an
-    oscillatory AR(2) of 100 samples as MA(1) most of the time.  ``nlags`` defaults to
-    min(4 max_order, n/4).
+    oscillatory AR(2) of 100 samples as MA(1) most of the time.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, n ≥ 4 max_order + 10, finite.
+    nlags : int or None, optional
+        Lags of the correlogram; default min(4 max_order, n/4).
+    max_order : int, optional
+        Largest cut-off lag considered, default 10.
+    alpha : float, optional
+        Significance level of the bands, default 0.05.
+    rule : {"aic", "earliest"}, optional
+        How a double cut-off is resolved, default ``"aic"``.
+    margin : float, optional
+        AIC difference (≥ 0) by which the best candidate overrules the lag reading, default 4.
+
+    Returns
+    -------
+    identification : Identification
+        Model class, order, cut-offs and a note.
     """
     integer(max_order, "max_order")
     if nlags is not None:
@@ -445,6 +684,33 @@ def simulate_arma(phi, theta, n: int, n_series: int, rng: np.random.Generator, *
 
     Unit-variance Gaussian w; ``phi`` or ``theta`` may be empty (MA or AR); ``burn`` samples
     discarded.  Filtered with ``scipy.signal.lfilter([1, theta], [1, -phi])``.
+
+    Parameters
+    ----------
+    phi : array_like, shape (p,)
+        AR coefficients (stationary), possibly empty.
+    theta : array_like, shape (q,)
+        MA coefficients, possibly empty.
+    n : int
+        Length of each series, ≥ 2.
+    n_series : int
+        Number of series, ≥ 1.
+    rng : numpy.random.Generator
+        Seeded generator.
+    burn : int, optional
+        Burn-in samples discarded, default 200.
+
+    Returns
+    -------
+    Y : ndarray, shape (n_series, n)
+        The series (in units of the noise standard deviation).
+
+    Raises
+    ------
+    NonStationaryError
+        When the AR part is not stationary.
+    TypeError
+        When ``rng`` is not a numpy Generator.
     """
     ph = np.atleast_1d(numeric(phi, "phi"))
     th = np.atleast_1d(numeric(theta, "theta"))
@@ -467,8 +733,30 @@ def identification_rate(phi, theta, n: int, *, n_series: int, seed: int, rules=(
 
     ``n_series`` series of length ``n`` from :func:`simulate_arma` (seeded; the same series for
     every rule).  Correct: AR(p) for a pure AR(p), MA(q) for a pure MA(q), the class ARMA for a
-    mixed model.  Returns one row per rule: ``rate``, its 95 % Wilson interval ``low``/``high``,
-    ``hits``, ``n_series``.
+    mixed model.
+
+    Parameters
+    ----------
+    phi : array_like, shape (p,)
+        AR coefficients, possibly empty.
+    theta : array_like, shape (q,)
+        MA coefficients, possibly empty (not both).
+    n : int
+        Length of each series.
+    n_series : int
+        Number of series.
+    seed : int
+        Non-negative generator seed.
+    rules : sequence of str, optional
+        Rules of :func:`identify_model` to score, default ``("aic", "earliest")``.
+    max_order : int, optional
+        ``max_order`` of :func:`identify_model`, default 10.
+
+    Returns
+    -------
+    rates : pandas.DataFrame
+        One row per rule: ``rate``, its 95 % Wilson interval ``low``/``high``, ``hits``,
+        ``n_series``.
     """
     from statsmodels.stats.proportion import proportion_confint
 
@@ -500,6 +788,20 @@ def ar_design(y, p: int) -> tuple[np.ndarray, np.ndarray]:
     """The matrices C ((n-p) x p) and D (n-p) of chen2019 eq. (3-12).
 
     Row t of C is [y_{t-1}, ..., y_{t-p}] for t = p+1..n (1-based), D = [y_{p+1}, ..., y_n].
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, n > 2p, finite.
+    p : int
+        AR order ≥ 1.
+
+    Returns
+    -------
+    C : ndarray, shape (n - p, p)
+        Lagged values.
+    D : ndarray, shape (n - p,)
+        Targets.
     """
     y = _series(y)
     integer(p, "p", 1, "the AR order {name} must be a positive integer, got {value!r}")
@@ -513,9 +815,23 @@ def ar_design(y, p: int) -> tuple[np.ndarray, np.ndarray]:
 def ar_least_squares(y, p: int) -> tuple[np.ndarray, float]:
     """AR(p) least squares phi = (C^T C)^{-1} C^T D, chen2019 eqs. (3-11)-(3-12).
 
-    Returns ``(phi, sigma2)`` with sigma2 = RSS/(n-p), the maximum-likelihood residual variance
-    of the conditional fit (statsmodels' ``AutoReg(...).fit().sigma2``).  No intercept, as (3-11):
-    demean the series first if its mean is not zero.
+    sigma2 = RSS/(n-p) is the maximum-likelihood residual variance of the conditional fit
+    (statsmodels' ``AutoReg(...).fit().sigma2``).  No intercept, as (3-11): demean the series
+    first if its mean is not zero.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, n > 2p.
+    p : int
+        AR order ≥ 1.
+
+    Returns
+    -------
+    phi : ndarray, shape (p,)
+        AR coefficients.
+    sigma2 : float
+        Residual variance, in the unit of ``y`` squared.
     """
     C, D = ar_design(y, p)
     phi, *_ = np.linalg.lstsq(C, D, rcond=None)
@@ -537,6 +853,27 @@ def require_stationary_series(y, segments: int = 20, *, alpha: float = 0.05, max
        KPSS p >= 0.1) — a :class:`StationarityWarning` is issued and the series accepted.
 
     The error message says which test failed and what to do.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, finite.
+    segments : int, optional
+        Segments of the inversion test, default 20.
+    alpha : float, optional
+        Significance level of all three tests, default 0.05.
+    max_lag : int, optional
+        Largest ADF augmentation lag, default 12.
+
+    Raises
+    ------
+    NonStationaryError
+        When the inversion test fails or ADF and KPSS both point to a unit root.
+
+    Warns
+    -----
+    StationarityWarning
+        When only ADF cannot reject a unit root.
     """
     from statsmodels.tsa.stattools import adfuller, kpss
 
@@ -570,13 +907,37 @@ def require_stationary_series(y, segments: int = 20, *, alpha: float = 0.05, max
 def fit_ar(y, p: int, *, segments: int = 20, alpha: float = 0.05, check: bool = True, demean: bool = True):
     """Fit AR(p) by conditional least squares with statsmodels ``AutoReg`` (chen2019 eq. 3-11/3-12).
 
-    Returns the statsmodels ``AutoRegResults`` (``.params`` = phi, ``.sigma2``, ``.aic`` ...).
     With ``check`` (the default) the premise of chen2019 step 2 is enforced
     (:func:`require_stationary_series`: the two-sided inversion test with ``segments``, and no
     unit root by ADF (at most max(12, 2p) augmentation lags) paired with KPSS — refused only when
     both point to a unit root, a :class:`StationarityWarning` when only ADF does), and
     the fitted poles must lie inside the unit circle; otherwise :class:`NonStationaryError` says
     which check failed and what to do.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series, n ≥ max(2 segments, 2p + 2), finite.
+    p : int
+        AR order ≥ 1.
+    segments : int, optional
+        Segments of the inversion test, default 20.
+    alpha : float, optional
+        Significance level of the checks, default 0.05.
+    check : bool, optional
+        Enforce stationarity of the series and of the fit, default True.
+    demean : bool, optional
+        Remove the mean before fitting (the fit has no intercept), default True.
+
+    Returns
+    -------
+    result : statsmodels.tsa.ar_model.AutoRegResults
+        ``.params`` = phi, ``.sigma2``, ``.aic`` ...
+
+    Raises
+    ------
+    NonStationaryError
+        When a check fails.
     """
     from statsmodels.tsa.ar_model import AutoReg
 
@@ -600,25 +961,53 @@ def fit_ar(y, p: int, *, segments: int = 20, alpha: float = 0.05, check: bool = 
 # --------------------------------------------------------------------------- order by AIC
 
 def order_cap(n: int) -> int:
-    """The order cap floor(sqrt(n)) of chen2019 §3 step 2 (模型阶数的上限为 sqrt(n))."""
+    """The order cap floor(sqrt(n)) of chen2019 §3 step 2 (模型阶数的上限为 sqrt(n)).
+
+    Parameters
+    ----------
+    n : int
+        Series length ≥ 1.
+
+    Returns
+    -------
+    cap : int
+        floor(sqrt(n)).
+    """
     return int(math.isqrt(integer(n, "n")))
 
 
 def aic_by_order(y, max_order: int | None = None, *, demean: bool = True) -> pd.DataFrame:
     """AIC of AR(0..max_order) fitted on a common sample, in the normalizations in use (chen2019 eq. 3-13).
 
-    ``max_order`` defaults to (and may not exceed) the cap floor(sqrt(n)).  Every order is fitted
-    by statsmodels ``AutoReg(y, p, trend='n', hold_back=max_order)`` so that all fits use the same
-    N = n - max_order observations (as ``ar_select_order``).  Columns:
+    Every order is fitted by statsmodels ``AutoReg(y, p, trend='n', hold_back=max_order)`` so that
+    all fits use the same N = n - max_order observations (as ``ar_select_order``).  All three
+    normalizations select the same order.  A per-observation AIC can rise from one order to the
+    next by at most 2/N (a nested fit cannot lower the likelihood).
 
-    * ``aic`` — statsmodels' raw AIC, -2 ln L + 2(p + 1) (the +1 counts the noise variance);
-    * ``aic_printed_form`` — -2 ln L + 2p, the form of (3-13) with natural logarithms;
-    * ``aic_per_obs`` — aic / N = ln(2 pi sigma²) + 1 + 2(p + 1)/N;
-    * ``aic_log_sigma2`` — ln sigma² + 2p/N (Lütkepohl's / MATLAB's normalized AIC);
-    * ``sigma2`` (ML residual variance), ``llf``, ``nobs``.
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series (n ≥ 8), finite.
+    max_order : int or None, optional
+        Largest order; defaults to (and may not exceed) the cap floor(sqrt(n)).
+    demean : bool, optional
+        Remove the mean first, default True.
 
-    All three normalizations select the same order.  A per-observation AIC can rise from one
-    order to the next by at most 2/N (a nested fit cannot lower the likelihood).
+    Returns
+    -------
+    aic : pandas.DataFrame
+        Index ``order`` 0..max_order; columns:
+
+        * ``aic`` — statsmodels' raw AIC, -2 ln L + 2(p + 1) (the +1 counts the noise variance);
+        * ``aic_printed_form`` — -2 ln L + 2p, the form of (3-13) with natural logarithms;
+        * ``aic_per_obs`` — aic / N = ln(2 pi sigma²) + 1 + 2(p + 1)/N;
+        * ``aic_log_sigma2`` — ln sigma² + 2p/N (Lütkepohl's / MATLAB's normalized AIC);
+        * ``sigma2`` (ML residual variance, unit of ``y`` squared), ``llf``, ``nobs``.
+
+    Raises
+    ------
+    ValueError
+        When ``max_order`` exceeds the cap.
     """
     from statsmodels.tsa.ar_model import AutoReg
 
@@ -649,6 +1038,29 @@ def select_order(y, max_order: int | None = None, *, demean: bool = True, check:
     (:func:`require_stationary_series`: refused when the inversion test fails or when ADF and
     KPSS both point to a unit root, a :class:`StationarityWarning` when only ADF does): an order
     selected on a random walk means nothing.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series (n ≥ 8), finite.
+    max_order : int or None, optional
+        Largest order, capped at floor(sqrt(n)) (the default).
+    demean : bool, optional
+        Remove the mean first, default True.
+    check : bool, optional
+        Require a stationary series, default True.
+    segments : int, optional
+        Segments of the inversion test, default 20.
+
+    Returns
+    -------
+    order : int
+        The selected order (0 when no lag is selected).
+
+    Raises
+    ------
+    NonStationaryError
+        When ``check`` and the series is not stationary.
     """
     from statsmodels.tsa.ar_model import ar_select_order
 
@@ -673,7 +1085,23 @@ def select_order_checked(y, max_order: int | None = None, *, demean: bool = True
     increment is at most the penalty per order, 2 (chen2019 eq. (3-13)).  A larger increment
     means the normal equations have lost their digits (a series sampled far faster than its
     bandwidth): the AIC values, and so the selected order, are round-off and change with the
-    code path.  Returns ``(order, sound)``; report the order only when ``sound`` is true.
+    code path.  No stationarity check is made.
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The series (n ≥ 8), finite.
+    max_order : int or None, optional
+        Largest order, capped at floor(sqrt(n)) (the default).
+    demean : bool, optional
+        Remove the mean first, default True.
+
+    Returns
+    -------
+    order : int
+        The selected order.
+    sound : bool
+        True when every AIC increment is at most 2 (plus round-off); report the order only then.
     """
     from statsmodels.tsa.ar_model import ar_select_order
 
@@ -699,9 +1127,22 @@ def aic_increment_bound(aic_values, *, penalty_per_order: float = 2.0) -> dict:
 
     For nested fits on one sample the likelihood never decreases with the order, so
     AIC(p+1) - AIC(p) <= ``penalty_per_order`` x s, where s is the scale of the normalization
-    (s = 1 for raw AIC, 1/N for a per-observation AIC).  Returns the largest increment, the
-    smallest scale it requires (s >= increment/penalty) and, for a per-observation
-    normalization, the largest series length N <= penalty/increment compatible with it.
+    (s = 1 for raw AIC, 1/N for a per-observation AIC).
+
+    Parameters
+    ----------
+    aic_values : array_like, shape (k,)
+        AIC values for consecutive orders (k ≥ 2), finite.
+    penalty_per_order : float, optional
+        Penalty per order in raw units, positive, default 2.
+
+    Returns
+    -------
+    bound : dict
+        ``max_increment`` (the largest increment), ``at_order`` (the order p + 1 where it occurs),
+        ``min_scale`` (the smallest scale s ≥ increment/penalty it requires) and
+        ``max_length_per_obs`` (for a per-observation normalization, the largest series length
+        N ≤ penalty/increment compatible with it; inf when no increment is positive).
     """
     a = numeric(aic_values, "aic_values")
     penalty_per_order = positive(penalty_per_order, "penalty_per_order")
@@ -717,13 +1158,35 @@ def aic_increment_bound(aic_values, *, penalty_per_order: float = 2.0) -> dict:
 # --------------------------------------------------------------------------- AR model checks
 
 def ar_poles(phi) -> np.ndarray:
-    """Poles of y_t = sum phi_i y_{t-i} + w_t: roots of z^p - phi_1 z^{p-1} - ... - phi_p."""
+    """Poles of y_t = sum phi_i y_{t-i} + w_t: roots of z^p - phi_1 z^{p-1} - ... - phi_p.
+
+    Parameters
+    ----------
+    phi : float or array_like, shape (p,)
+        AR coefficients.
+
+    Returns
+    -------
+    poles : ndarray of complex, shape (p,)
+        The poles.
+    """
     phi = ar_coefficients(phi)
     return np.roots(np.r_[1.0, -phi])
 
 
 def is_stationary(phi) -> bool:
-    """True when every pole lies strictly inside the unit circle (statsmodels ``ArmaProcess.isstationary``)."""
+    """True when every pole lies strictly inside the unit circle (statsmodels ``ArmaProcess.isstationary``).
+
+    Parameters
+    ----------
+    phi : float or array_like, shape (p,)
+        AR coefficients.
+
+    Returns
+    -------
+    stationary : bool
+        Whether every pole has modulus < 1.
+    """
     return bool(np.all(np.abs(ar_poles(phi)) < 1.0))
 
 
@@ -738,7 +1201,25 @@ def _require_stationary(phi, what: str = "the AR model") -> np.ndarray:
 
 
 def ar_autocorrelation(phi, nlags: int) -> np.ndarray:
-    """Theoretical ACF rho_0..rho_nlags of a stationary AR model (statsmodels ``ArmaProcess.acf``)."""
+    """Theoretical ACF rho_0..rho_nlags of a stationary AR model (statsmodels ``ArmaProcess.acf``).
+
+    Parameters
+    ----------
+    phi : float or array_like, shape (p,)
+        AR coefficients of a stationary model.
+    nlags : int
+        Largest lag ≥ 0.
+
+    Returns
+    -------
+    rho : ndarray, shape (nlags + 1,)
+        rho_0 (= 1) .. rho_nlags.
+
+    Raises
+    ------
+    NonStationaryError
+        When the model is not stationary.
+    """
     from statsmodels.tsa.arima_process import ArmaProcess
 
     phi = _require_stationary(phi)
@@ -747,7 +1228,25 @@ def ar_autocorrelation(phi, nlags: int) -> np.ndarray:
 
 
 def ar_variance(phi, sigma2: float) -> float:
-    """Stationary variance gamma_0 = sigma2 / (1 - sum phi_i rho_i) of an AR model."""
+    """Stationary variance gamma_0 = sigma2 / (1 - sum phi_i rho_i) of an AR model.
+
+    Parameters
+    ----------
+    phi : float or array_like, shape (p,)
+        AR coefficients of a stationary model.
+    sigma2 : float
+        Driving-noise variance, positive, in the unit of the series squared.
+
+    Returns
+    -------
+    gamma_0 : float
+        Stationary variance, unit of ``sigma2``.
+
+    Raises
+    ------
+    NonStationaryError
+        When the model is not stationary.
+    """
     phi = _require_stationary(phi)
     positive(sigma2, "sigma2", "the noise variance {name} must be positive and finite, got {value!r}")
     rho = ar_autocorrelation(phi, phi.size)
@@ -757,13 +1256,29 @@ def ar_variance(phi, sigma2: float) -> float:
 def check_ar_model(phi, sigma2: float, *, dt: float | None = None, speed: float | None = None) -> dict:
     """The checks a careful analyst makes before using an AR model as a shaping filter.
 
-    Applied to chen2019 eq. (4-13).  Returns a dict with: ``max_pole_modulus`` and
-    ``stationary``; ``dominant_pole`` (largest modulus); ``negative_real_pole`` (a pole on the
-    negative real axis: the series alternates in sign and no real continuous-time process
-    sampled at dt has this model); and, for a stationary model, ``rho1``, ``variance``, ``std``,
-    ``variance_ratio`` (gamma_0/sigma2), ``peak_frequency`` (fraction of the Nyquist frequency
-    where the AR spectrum peaks), ``correlation_samples`` (-1/ln|dominant pole|), and with ``dt``
-    the correlation time (s), with ``speed`` the correlation distance (m).
+    Applied to chen2019 eq. (4-13).
+
+    Parameters
+    ----------
+    phi : float or array_like, shape (p,)
+        AR coefficients.
+    sigma2 : float
+        Driving-noise variance, positive, in the unit of the series squared.
+    dt : float, optional
+        Sample interval [s]; adds the correlation time.
+    speed : float, optional
+        Platform speed [m/s]; with ``dt`` adds the correlation distance.
+
+    Returns
+    -------
+    checks : dict
+        ``order``, ``max_pole_modulus`` and ``stationary``; ``dominant_pole`` (largest modulus,
+        complex); ``negative_real_pole`` (a pole on the negative real axis: the series alternates
+        in sign and no real continuous-time process sampled at dt has this model); and, for a
+        stationary model, ``rho1``, ``variance``, ``std`` (unit of the series), ``variance_ratio``
+        (gamma_0/sigma2), ``peak_frequency`` (fraction of the Nyquist frequency where the AR
+        spectrum peaks), ``correlation_samples`` (-1/ln|dominant pole|), and with ``dt`` the
+        ``correlation_time`` [s], with ``speed`` the ``correlation_distance`` [m].
     """
     phi = ar_coefficients(phi)
     positive(sigma2, "sigma2", "the noise variance {name} must be positive and finite, got {value!r}")
@@ -801,6 +1316,26 @@ def simulate_ar(phi, sigma2: float, n: int, n_series: int, rng: np.random.Genera
     """``n_series`` independent AR(p) series of length ``n`` (rows), vectorized with ``scipy.signal.lfilter``.
 
     A burn-in of ``burn`` samples (default: 10 correlation lengths, at least 100) is discarded.
+
+    Parameters
+    ----------
+    phi : float or array_like, shape (p,)
+        AR coefficients of a stationary model.
+    sigma2 : float
+        Driving-noise variance, non-negative.
+    n : int
+        Length of each series, ≥ 2.
+    n_series : int
+        Number of series.
+    rng : numpy.random.Generator
+        Seeded generator.
+    burn : int or None, optional
+        Burn-in samples discarded.
+
+    Returns
+    -------
+    Y : ndarray, shape (n_series, n)
+        The series, in the unit of sqrt(sigma2).
     """
     phi = _require_stationary(phi, "the model to simulate")
     nonnegative(sigma2, "sigma2", "the noise variance {name} must be non-negative and finite, got {value!r}")
@@ -829,7 +1364,7 @@ def gauss_markov(n: int, dt: float, std: float, tau: float, rng: np.random.Gener
     dt : float
         Sample interval (> 0), in the unit of ``tau``.
     std : float
-        Stationary standard deviation (>= 0).
+        Stationary standard deviation (>= 0), in the unit of the sequence.
     tau : float
         Correlation time (> 0).
     rng : numpy.random.Generator
@@ -839,8 +1374,8 @@ def gauss_markov(n: int, dt: float, std: float, tau: float, rng: np.random.Gener
 
     Returns
     -------
-    numpy.ndarray
-        Shape (n, size).
+    x : ndarray, shape (n, size)
+        The sequences, in the unit of ``std``.
     """
     integer(n, "n"), integer(size, "size")
     positive(dt, "dt", "need {name} > 0 and finite (sample interval), got {value!r}")
@@ -858,7 +1393,21 @@ def aic_batch(Y, max_order: int, *, chunk: int = 16) -> np.ndarray:
     Same common-sample conditional least squares as :func:`aic_by_order` (hold-back
     ``max_order``, no intercept, rows demeaned): N = n - max_order, sigma²_p = RSS_p/N,
     AIC_p = N (ln 2 pi sigma²_p + 1) + 2 (p + 1).  Solved from the normal equations of all
-    orders at once, ``chunk`` series at a time.  Returns shape (n_series, max_order + 1).
+    orders at once, ``chunk`` series at a time.
+
+    Parameters
+    ----------
+    Y : array_like, shape (n_series, n)
+        The series, one per row, finite, n > 3 max_order.
+    max_order : int
+        Largest order ≥ 1.
+    chunk : int, optional
+        Series per vectorized block, default 16.
+
+    Returns
+    -------
+    aic : ndarray, shape (n_series, max_order + 1)
+        AIC of orders 0..max_order per series.
     """
     Y = finite_array(Y, "Y")
     if Y.ndim != 2:
@@ -892,8 +1441,28 @@ def order_recovery(phi, sigma2: float, n: int, *, n_series: int, max_order: int,
     """How often AIC selects each order for series of length ``n`` from a known AR model.
 
     Simulated with :func:`simulate_ar` (seeded), scored with :func:`aic_batch` (orders
-    0..max_order, capped at sqrt(n)).  Returns the selection frequency indexed by order; the
-    frequency at ``len(phi)`` is the recovery rate.
+    0..max_order, capped at sqrt(n)).
+
+    Parameters
+    ----------
+    phi : float or array_like, shape (p,)
+        AR coefficients of a stationary model.
+    sigma2 : float
+        Driving-noise variance, positive.
+    n : int
+        Length of each series.
+    n_series : int
+        Number of series.
+    max_order : int
+        Largest order scored, at most floor(sqrt(n)).
+    seed : int
+        Non-negative generator seed.
+
+    Returns
+    -------
+    frequency : pandas.Series
+        Selection frequency indexed by ``order`` 0..max_order; the frequency at ``len(phi)`` is
+        the recovery rate.
     """
     phi = ar_coefficients(phi)
     integer(max_order, "max_order"), integer(n_series, "n_series")

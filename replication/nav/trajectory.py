@@ -45,19 +45,60 @@ __all__ = [
 
 @dataclass
 class Segment:
-    """Base class: a piece of motion lasting ``duration`` seconds."""
+    """Base class: a piece of motion lasting ``duration`` seconds.
+
+    Attributes
+    ----------
+    duration : float
+        Length of the segment [s]; a positive multiple of the sampling interval of
+        :func:`generate`.
+    """
 
     duration: float
 
     def pieces(self):
-        """Elementary segments this one expands into (composites override)."""
+        """Elementary segments this one expands into (composites override).
+
+        Returns
+        -------
+        pieces : list of Segment
+            ``[self]`` for an elementary segment.
+        """
         return [self]
 
     # profile(tau, start) -> hpr, hpr_rate, v, a   (each (n, 3))
     def profile(self, tau, start):  # pragma: no cover - abstract
+        """Attitude, attitude rates, velocity and acceleration of the segment in closed form.
+
+        Parameters
+        ----------
+        tau : ndarray, shape (n,)
+            Times since the segment start [s], within [0, duration].
+        start : tuple of ndarray
+            (hpr0, v0): heading, pitch, roll [rad], shape (3,), and ENU velocity [m/s], shape (3,), at
+            the segment start.
+
+        Returns
+        -------
+        hpr : ndarray, shape (n, 3)
+            Heading, pitch, roll [rad].
+        hpr_rate : ndarray, shape (n, 3)
+            Their time derivatives [rad/s].
+        v : ndarray, shape (n, 3)
+            Velocity (East, North, Up) [m/s].
+        a : ndarray, shape (n, 3)
+            Acceleration dv/dt (East, North, Up) [m/s²].
+        """
         raise NotImplementedError
 
     def label(self):
+        """Name of the segment in ``Trajectory.segments``.
+
+        Returns
+        -------
+        label : str
+            The class name.
+        """
         return type(self).__name__
 
 
@@ -123,7 +164,13 @@ class _Flight(Segment):
 
 @dataclass
 class Straight(_Flight):
-    """Straight (constant heading, speed and vertical speed) flight."""
+    """Straight (constant heading, speed and vertical speed) flight.
+
+    Attributes
+    ----------
+    duration : float
+        Length [s].
+    """
 
 
 @dataclass
@@ -131,28 +178,90 @@ class Turn(_Flight):
     """Coordinated turn by ``angle`` rad (positive = clockwise, to the right) with bank.
 
     Turn rate ψ̇ = angle (1 - cos 2πτ/T)/T: zero at both ends, so bank is continuous.
+
+    Attributes
+    ----------
+    duration : float
+        Length T of the turn [s].
+    angle : float
+        Heading change [rad], positive clockwise; default 0.
     """
 
     angle: float = 0.0
 
     def heading(self, tau):
+        """Heading change, turn rate and its derivative over the turn.
+
+        Parameters
+        ----------
+        tau : ndarray, shape (n,)
+            Times since the segment start [s].
+
+        Returns
+        -------
+        dpsi : ndarray, shape (n,)
+            Heading change since the start [rad].
+        rate : ndarray, shape (n,)
+            ψ̇ [rad/s].
+        rate_dot : ndarray, shape (n,)
+            ψ̈ [rad/s²].
+        """
         R, r, rd = _raised_cos(tau, self.duration)
         return self.angle * R, self.angle * r, self.angle * rd
 
 
 def UTurn(duration: float, clockwise: bool = True) -> Turn:
-    """A 180° coordinated U-turn (chen2019 Table 4-42: "顺时针/逆时针 U 型转弯 180°")."""
+    """A 180° coordinated U-turn (chen2019 Table 4-42: "顺时针/逆时针 U 型转弯 180°").
+
+    Parameters
+    ----------
+    duration : float
+        Length of the turn [s].
+    clockwise : bool, optional
+        Turn to the right (default) or to the left.
+
+    Returns
+    -------
+    turn : Turn
+        A turn by ±π rad.
+    """
     return Turn(duration, np.pi if clockwise else -np.pi)
 
 
 @dataclass
 class STurn(_Flight):
-    """S-turn(s): ψ = ψ0 + swing (1 - cos 2πcτ/T)/2 — right by ``swing`` then back, ``cycles`` times."""
+    """S-turn(s): ψ = ψ0 + swing (1 - cos 2πcτ/T)/2 — right by ``swing`` then back, ``cycles`` times.
+
+    Attributes
+    ----------
+    duration : float
+        Length T [s].
+    swing : float
+        Largest heading excursion [rad], default 0.
+    cycles : int
+        Number c of right-and-back cycles, default 1.
+    """
 
     swing: float = 0.0
     cycles: int = 1
 
     def heading(self, tau):
+        """Heading change, turn rate and its derivative over the S-turn.
+
+        Parameters
+        ----------
+        tau : ndarray, shape (n,)
+            Times since the segment start [s].
+
+        Returns
+        -------
+        dpsi : ndarray, shape (n,)
+            Heading change since the start [rad].
+        rate : ndarray, shape (n,)
+            ψ̇ [rad/s].
+        rate_dot : ndarray, shape (n,)
+            ψ̈ [rad/s²].
+        """
         T, c = self.duration, self.cycles
         w = 2 * np.pi * c / T
         return (self.swing * 0.5 * (1 - np.cos(w * tau)), self.swing * 0.5 * w * np.sin(w * tau),
@@ -161,42 +270,108 @@ class STurn(_Flight):
 
 @dataclass
 class FigureEight(Segment):
-    """Figure-8: a full clockwise turn followed by a full counter-clockwise one."""
+    """Figure-8: a full clockwise turn followed by a full counter-clockwise one.
+
+    Attributes
+    ----------
+    duration : float
+        Length of both turns together [s].
+    """
 
     def pieces(self):
+        """The two turns, each lasting half the duration.
+
+        Returns
+        -------
+        pieces : list of Turn
+            Turns by +2π and -2π rad.
+        """
         return [Turn(self.duration / 2, 2 * np.pi), Turn(self.duration / 2, -2 * np.pi)]
 
 
 @dataclass
 class Climb(_Flight):
-    """Climb (or descent, negative) by ``height_change`` m with a raised-cosine vertical speed."""
+    """Climb (or descent, negative) by ``height_change`` m with a raised-cosine vertical speed.
+
+    Attributes
+    ----------
+    duration : float
+        Length [s].
+    height_change : float
+        Height gained [m] (negative: descent), default 0.
+    """
 
     height_change: float = 0.0
 
     def vertical(self, tau):
+        """Change of the vertical speed and its derivative over the climb.
+
+        Parameters
+        ----------
+        tau : ndarray, shape (n,)
+            Times since the segment start [s].
+
+        Returns
+        -------
+        dw : ndarray, shape (n,)
+            Vertical-speed change since the start [m/s].
+        w_dot : ndarray, shape (n,)
+            Vertical acceleration [m/s²].
+        """
         _, r, rd = _raised_cos(tau, self.duration)
         return self.height_change * r, self.height_change * rd
 
 
 @dataclass
 class Accelerate(_Flight):
-    """Change the horizontal speed by ``speed_change`` m/s (raised-cosine acceleration)."""
+    """Change the horizontal speed by ``speed_change`` m/s (raised-cosine acceleration).
+
+    Attributes
+    ----------
+    duration : float
+        Length [s].
+    speed_change : float
+        Horizontal speed change [m/s], default 0.
+    """
 
     speed_change: float = 0.0
 
     def speed(self, tau):
+        """Change of the horizontal speed and its derivative over the segment.
+
+        Parameters
+        ----------
+        tau : ndarray, shape (n,)
+            Times since the segment start [s].
+
+        Returns
+        -------
+        dV : ndarray, shape (n,)
+            Speed change since the start [m/s].
+        V_dot : ndarray, shape (n,)
+            Horizontal acceleration along the track [m/s²].
+        """
         R, r, _ = _raised_cos(tau, self.duration)
         return self.speed_change * R, self.speed_change * r
 
 
 @dataclass
 class Rotate(Segment):
-    """Turntable move: heading/pitch/roll rates (rad/s), ENU velocity held constant.
+    """Turntable move: heading/pitch/roll rates, ENU velocity held constant.
 
     With ``ramp`` = 0 the rates are constant over the segment (a rate step at each end).  With
     ``ramp`` > 0 they rise from zero over ``ramp`` seconds, cruise at ``rates`` and fall back to
     zero, with s(τ) = (1 - cos πτ/ramp)/2 on the ramps (continuous angular rate, as a real table's
     servo gives), so the angles change by ``rates`` × (duration - ramp).
+
+    Attributes
+    ----------
+    duration : float
+        Length [s].
+    rates : tuple of float
+        Cruise heading, pitch and roll rates [rad/s], default zero.
+    ramp : float
+        Length of each ramp [s], at most half the duration; default 0.
     """
 
     rates: tuple = (0.0, 0.0, 0.0)
@@ -220,6 +395,31 @@ class Rotate(Segment):
         return S, s
 
     def profile(self, tau, start):
+        """Attitude, attitude rates, velocity and acceleration of the move.
+
+        Parameters
+        ----------
+        tau : ndarray, shape (n,)
+            Times since the segment start [s].
+        start : tuple of ndarray
+            (hpr0 [rad], v0 [m/s]) at the segment start, each shape (3,).
+
+        Returns
+        -------
+        hpr : ndarray, shape (n, 3)
+            Heading, pitch, roll [rad].
+        hpr_rate : ndarray, shape (n, 3)
+            Their rates [rad/s].
+        v : ndarray, shape (n, 3)
+            ENU velocity [m/s], constant.
+        a : ndarray, shape (n, 3)
+            Acceleration [m/s²], zero.
+
+        Raises
+        ------
+        ValueError
+            When the ramp is longer than half the move.
+        """
         hpr0, v0 = start
         r = np.asarray(self.rates, float)
         S, s = self._shape(np.asarray(tau, float))
@@ -230,9 +430,30 @@ class Rotate(Segment):
 
 
 def move(angles, rates, ramp: float = 1.0) -> Rotate:
-    """A turntable move by ``angles`` (heading, pitch, roll increments, rad) at cruise ``rates``
-    (rad/s; magnitudes, signs taken from ``angles``) with smooth ramps; all axes share the duration
-    max |angle|/|rate| + ramp, and the slower axes' cruise rates are scaled to arrive together."""
+    """A turntable move with smooth ramps.
+
+    All axes share the duration max |angle|/|rate| + ramp, and the slower axes' cruise rates are
+    scaled to arrive together.
+
+    Parameters
+    ----------
+    angles : array_like, shape (3,)
+        Heading, pitch, roll increments [rad].
+    rates : float or array_like, shape (3,)
+        Cruise rates [rad/s]; magnitudes, signs taken from ``angles``.
+    ramp : float, optional
+        Length of each ramp [s], default 1.
+
+    Returns
+    -------
+    rotate : Rotate
+        The move.
+
+    Raises
+    ------
+    ValueError
+        When a non-zero angle has a zero rate or every angle is zero.
+    """
     ang = np.asarray(angles, float)
     rt = np.abs(np.broadcast_to(np.asarray(rates, float), (3,)))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -246,14 +467,46 @@ def move(angles, rates, ramp: float = 1.0) -> Rotate:
 
 
 def Dwell(duration: float) -> Rotate:
-    """Rest (turntable position / steady motion at constant velocity and attitude)."""
+    """Rest (turntable position / steady motion at constant velocity and attitude).
+
+    Parameters
+    ----------
+    duration : float
+        Length of the rest [s].
+
+    Returns
+    -------
+    rotate : Rotate
+        A move with zero rates.
+    """
     return Rotate(duration, (0.0, 0.0, 0.0))
 
 
 @dataclass
 class ShipRocking(Segment):
-    """Ship rocking, fang2020 eq. (28): pitch = P_m sin(2πt/T_p + φ_p), roll = R_m sin(...),
-    heading = heading0 + Y_m sin(...); constant ENU velocity ``speed`` along ``course``."""
+    """Ship rocking, fang2020 eq. (28).
+
+    pitch = P_m sin(2πt/T_p + φ_p), roll = R_m sin(...), heading = heading0 + Y_m sin(...);
+    constant ENU velocity ``speed`` along ``course``.  As a first segment it sets the initial
+    attitude and velocity of :func:`generate`.
+
+    Attributes
+    ----------
+    duration : float
+        Length [s].
+    amplitudes : tuple of float
+        (P_m, R_m, Y_m): pitch, roll and yaw amplitudes [rad], default (3°, 5°, 4°).
+    periods : tuple of float
+        (T_p, T_r, T_y) [s], default (7, 9, 12).
+    phases : tuple of float
+        (φ_p, φ_r, φ_y) [rad], default zero.
+    heading0 : float
+        Mean heading [rad], default 90° (east).
+    speed : float
+        Speed over ground [m/s], default 10.
+    course : float or None
+        Course of the velocity [rad], clockwise from north; None (default): ``heading0``.
+    """
 
     amplitudes: tuple = (3 * DEG, 5 * DEG, 4 * DEG)    # pitch, roll, yaw
     periods: tuple = (7.0, 9.0, 12.0)
@@ -266,10 +519,39 @@ class ShipRocking(Segment):
         return self.heading0 if self.course is None else self.course
 
     def start_state(self):
+        """Attitude and velocity at τ = 0.
+
+        Returns
+        -------
+        hpr : ndarray, shape (3,)
+            Heading, pitch, roll [rad].
+        v : ndarray, shape (3,)
+            Velocity (East, North, Up) [m/s].
+        """
         hpr, _, v, _ = self.profile(np.zeros(1), None)
         return hpr[0], v[0]
 
     def profile(self, tau, start):
+        """Attitude, attitude rates, velocity and acceleration of the rocking ship.
+
+        Parameters
+        ----------
+        tau : ndarray, shape (n,)
+            Times since the segment start [s] (the phases refer to τ = 0).
+        start : tuple of ndarray or None
+            Ignored: the rocking sets its own attitude and velocity.
+
+        Returns
+        -------
+        hpr : ndarray, shape (n, 3)
+            Heading, pitch, roll [rad].
+        hpr_rate : ndarray, shape (n, 3)
+            Their rates [rad/s].
+        v : ndarray, shape (n, 3)
+            ENU velocity [m/s], constant.
+        a : ndarray, shape (n, 3)
+            Acceleration [m/s²], zero.
+        """
         (Pm, Rm, Ym), (Tp, Tr, Ty), (pp, pr, py) = self.amplitudes, self.periods, self.phases
         wp, wr, wy = 2 * np.pi / Tp, 2 * np.pi / Tr, 2 * np.pi / Ty
         pitch = Pm * np.sin(wp * tau + pp)
@@ -289,9 +571,30 @@ class ShipRocking(Segment):
 class Trajectory:
     """True motion sampled every ``dt`` with the ideal increments between samples.
 
-    Arrays with N+1 rows (sample instants): ``t``, ``lat``, ``lon``, ``h``, ``v_enu``, ``hpr``
-    (heading, pitch, roll), ``w_ib_b`` (ω_ib^b), ``f_b`` (f^b).  Arrays with N rows (intervals
-    t_{k-1}..t_k): ``dtheta`` (Δθ), ``dv`` (Δv).  ``segments`` lists (label, t_start, t_end).
+    Attributes
+    ----------
+    t : ndarray, shape (N + 1,)
+        Sample instants [s], from 0.
+    lat : ndarray, shape (N + 1,)
+        Geodetic latitude [rad].
+    lon : ndarray, shape (N + 1,)
+        Longitude [rad].
+    h : ndarray, shape (N + 1,)
+        Ellipsoidal height [m].
+    v_enu : ndarray, shape (N + 1, 3)
+        Velocity (East, North, Up) [m/s].
+    hpr : ndarray, shape (N + 1, 3)
+        Heading (in [0, 2π)), pitch, roll [rad].
+    w_ib_b : ndarray, shape (N + 1, 3)
+        Angular rate ω_ib^b [rad/s], body axes.
+    f_b : ndarray, shape (N + 1, 3)
+        Specific force f^b [m/s²], body axes.
+    dtheta : ndarray, shape (N, 3)
+        Angle increments Δθ = ∫ ω_ib^b dt over the intervals t_{k-1}..t_k [rad].
+    dv : ndarray, shape (N, 3)
+        Velocity increments Δv = ∫ f^b dt [m/s].
+    segments : list of tuple
+        (label, t_start [s], t_end [s]) of each elementary segment.
     """
 
     t: np.ndarray
@@ -313,33 +616,67 @@ class Trajectory:
 
     @property
     def dt(self) -> np.ndarray:
+        """Sampling intervals [s], shape (N,)."""
         return np.diff(self.t)
 
     @property
     def C_bn(self) -> np.ndarray:
+        """Attitude DCMs C_b^n, shape (N + 1, 3, 3)."""
         return euler_to_dcm(self.hpr[:, 0], self.hpr[:, 1], self.hpr[:, 2])
 
     @property
     def q_bn(self) -> np.ndarray:
+        """Attitude quaternions q_b^n (scalar first), shape (N + 1, 4)."""
         return dcm_to_quat(self.C_bn)
 
     @property
     def f_n(self) -> np.ndarray:
+        """Specific force in the navigation frame C_b^n f^b [m/s²], shape (N + 1, 3)."""
         return np.einsum("kij,kj->ki", self.C_bn, self.f_b)
 
     @property
     def position(self) -> np.ndarray:
-        """(N+1, 3) array of [lat, lon, h]."""
+        """(N+1, 3) array of [lat, lon, h] (rad, rad, m)."""
         return np.stack([self.lat, self.lon, self.h], -1)
 
     def initial_state(self, index: int = 0):
-        """The true navigation state at sample ``index`` (a :class:`replication.nav.strapdown.NavState`)."""
+        """The true navigation state at sample ``index``.
+
+        Parameters
+        ----------
+        index : int, optional
+            Sample index, default 0.
+
+        Returns
+        -------
+        state : NavState
+            A :class:`replication.nav.strapdown.NavState`.
+        """
 
         return NavState(lat=float(self.lat[index]), lon=float(self.lon[index]), h=float(self.h[index]),
                         v_enu=self.v_enu[index].copy(), C_bn=euler_to_dcm(*self.hpr[index]))
 
     def slice(self, k0: int, k1: int) -> "Trajectory":
-        """Samples k0..k1 (inclusive) with the increments between them."""
+        """Samples k0..k1 (inclusive) with the increments between them.
+
+        Parameters
+        ----------
+        k0 : int
+            First sample, 0 ≤ k0 < k1.
+        k1 : int
+            Last sample, k1 ≤ N.
+
+        Returns
+        -------
+        part : Trajectory
+            The k1 - k0 intervals, times unchanged (not restarted at 0), with the segments that
+            overlap them.
+
+        Raises
+        ------
+        ValueError
+            For bounds outside 0 ≤ k0 < k1 ≤ N.
+        """
         if not (0 <= k0 < k1 <= self.n):
             raise ValueError(f"slice bounds must satisfy 0 <= k0 < k1 <= {self.n}, got {k0}, {k1}")
         s = slice(k0, k1 + 1)
@@ -377,13 +714,56 @@ def generate(segments, lat0: float, lon0: float, h0: float, *, dt: float = 0.01,
              speed: float = 0.0, v_enu=None, pitch: float | None = None, roll: float = 0.0,
              quadrature_nodes: int = 3, polar_limit_deg: float = earth.POLAR_LIMIT_DEG,
              chunk: int = 50_000) -> Trajectory:
-    """Generate a trajectory from ``segments`` starting at (lat0, lon0, h0) (radians, m).
+    """Generate a trajectory from ``segments`` starting at (lat0, lon0, h0).
 
     The initial motion is ``speed`` m/s along ``heading`` (or an explicit ``v_enu``), with pitch
     equal to the flight-path angle unless given and ``roll``.  A :class:`ShipRocking` first
     segment sets its own initial attitude and velocity.  Every segment duration must be a
     multiple of ``dt``.  Increments: Gauss-Legendre quadrature with ``quadrature_nodes`` nodes per
     interval of the closed-form sensor outputs (see module docstring).
+
+    Parameters
+    ----------
+    segments : sequence of Segment
+        The motion, in order; composite segments are expanded (:meth:`Segment.pieces`).
+    lat0 : float
+        Initial geodetic latitude [rad].
+    lon0 : float
+        Initial longitude [rad].
+    h0 : float
+        Initial ellipsoidal height [m].
+    dt : float, optional
+        Sampling interval [s], default 0.01.
+    heading : float, optional
+        Initial heading [rad], default 0.
+    speed : float, optional
+        Initial horizontal speed along ``heading`` [m/s], default 0.
+    v_enu : array_like, shape (3,), optional
+        Initial velocity (East, North, Up) [m/s], in place of ``speed``.
+    pitch : float or None, optional
+        Initial pitch [rad]; default the flight-path angle.
+    roll : float, optional
+        Initial roll [rad], default 0.
+    quadrature_nodes : int, optional
+        Gauss-Legendre nodes per interval, default 3.
+    polar_limit_deg : float, optional
+        Latitude [deg] the trajectory must not reach, default
+        :data:`~replication.nav.earth.POLAR_LIMIT_DEG`.
+    chunk : int, optional
+        Samples evaluated at a time (memory bound), default 50 000.
+
+    Returns
+    -------
+    trajectory : Trajectory
+        Samples, sensor outputs and increments.
+
+    Raises
+    ------
+    ValueError
+        For no segment, a duration that is not a multiple of ``dt``, a flight segment that does
+        not start in steady flight, or a latitude within the polar limit.
+    TypeError
+        For an element of ``segments`` that is not a :class:`Segment`.
     """
     pieces = [p for s in segments for p in (s.pieces() if isinstance(s, Segment) else [s])]
     if not pieces:
@@ -479,7 +859,21 @@ def chen2019_flight(*, s_swing: float = np.pi, s_cycles: int = 2):
     Table 4-41's text: 47°N, 115°E, 6000 m, heading 45° (north-east), 100 m/s.
     The S-maneuver's amplitude is not printed: ``s_swing`` (default 180°) and ``s_cycles``
     (default 2) are this package's choice.
-    Returns ``(segments, initial)`` with ``initial`` the keyword arguments of :func:`generate`.
+
+    Parameters
+    ----------
+    s_swing : float, optional
+        Heading excursion of the S-maneuver [rad], default π.
+    s_cycles : int, optional
+        Its number of cycles, default 2.
+
+    Returns
+    -------
+    segments : list of Segment
+        The flight.
+    initial : dict
+        The keyword arguments of :func:`generate` (``lat0``, ``lon0`` [rad], ``h0`` [m],
+        ``heading`` [rad], ``speed`` [m/s]).
     """
     segs = [Straight(100.0), STurn(1200.0, swing=s_swing, cycles=s_cycles), Straight(1000.0),
             UTurn(400.0, clockwise=True), Straight(1000.0), UTurn(400.0, clockwise=False), Straight(1000.0)]
@@ -498,7 +892,33 @@ def turntable_chen2019(experiment: int = 2, *, dwell: float = 300.0, repeats: in
     counter-clockwise yaw, i.e. heading -90°).  Steps repeated ``repeats`` times.
     The outer angle α maps to heading ψ = -α, the middle (roll) axis to roll γ.  Each move
     accelerates and decelerates smoothly over ``ramp`` seconds (:func:`move`).
-    Returns ``(segments, initial_heading)``.
+
+    Parameters
+    ----------
+    experiment : {1, 2, 3}, optional
+        Which experiment, default 2.
+    dwell : float, optional
+        Rest between moves [s], default 300.
+    repeats : int, optional
+        Repetitions of the steps, default 3.
+    outer_rate : float, optional
+        Outer-axis (heading) rate [rad/s], default 9°/s.
+    middle_rate : float, optional
+        Middle-axis (roll) rate [rad/s], default 1°/s.
+    ramp : float, optional
+        Ramp of each move [s], default 1.
+
+    Returns
+    -------
+    segments : list of Segment
+        An initial dwell, then the moves and dwells.
+    initial_heading : float
+        Initial heading [rad]: 0, or -π/2 for experiment 3.
+
+    Raises
+    ------
+    ValueError
+        For another experiment number.
     """
     if experiment not in (1, 2, 3):
         raise ValueError("experiment must be 1, 2 or 3 (chen2019 §4.1.3)")
@@ -515,13 +935,29 @@ def turntable_chen2019(experiment: int = 2, *, dwell: float = 300.0, repeats: in
 
 
 def rotation_rich_turntable(duration: float = 3600.0, *, dwell: float = 20.0, tumble: bool = False):
-    """A rotation-rich turntable hour built from chen2019 §4.1.3 moves with short dwells:
-    outer axis ±90° steps at 9°/s, simultaneous outer 9°/s + roll 10° at 1°/s (experiments 2 and
-    3), and the same with pitch instead of roll, repeated to fill ``duration`` seconds.
+    """A rotation-rich turntable hour built from chen2019 §4.1.3 moves with short dwells.
 
-    ``tumble`` adds simultaneous three-axis moves (heading, pitch, roll together at 10°/s) — a
-    harsher motion than the report's table performs, used to show the two-sample coning
-    algorithm's O(dt³) error.  Returns ``(segments, initial_heading)``.
+    Outer axis ±90° steps at 9°/s, simultaneous outer 9°/s + roll 10° at 1°/s (experiments 2 and
+    3), and the same with pitch instead of roll, repeated to fill ``duration`` seconds (a final
+    dwell fills the remainder).
+
+    Parameters
+    ----------
+    duration : float, optional
+        Total length [s], default 3600.
+    dwell : float, optional
+        Rest after each group of moves [s], default 20.
+    tumble : bool, optional
+        Add simultaneous three-axis moves (heading, pitch, roll together at 10°/s) — a harsher
+        motion than the report's table performs, used to show the two-sample coning algorithm's
+        O(dt³) error.  Default False.
+
+    Returns
+    -------
+    segments : list of Segment
+        The moves and dwells.
+    initial_heading : float
+        Initial heading [rad], 0.
     """
     a, m = 9 * DEG, 1 * DEG
     block = [move((np.pi / 2, 0, 0), a), move((np.pi / 2, 0, 0), a), Dwell(dwell),
@@ -543,9 +979,25 @@ def rotation_rich_turntable(duration: float = 3600.0, *, dwell: float = 20.0, tu
 
 
 def fang2020_ship(duration: float, rng=None, *, northward: bool = False):
-    """fang2020 §3 ship motion: eq. (28) rocking (3°, 5°, 4°; 7, 9, 12 s; random phases), 10 m/s
-    east along the parallel (heading 90°) or, with ``northward``, north along the meridian
-    (heading 0°).  ``rng`` draws the phases (uniform on [0, 2π)).  Returns a segment list."""
+    """fang2020 §3 ship motion: eq. (28) rocking (3°, 5°, 4°; 7, 9, 12 s; random phases).
+
+    10 m/s east along the parallel (heading 90°) or, with ``northward``, north along the meridian
+    (heading 0°).
+
+    Parameters
+    ----------
+    duration : float
+        Length [s].
+    rng : numpy.random.Generator or int or None, optional
+        Draws the three phases (uniform on [0, 2π)).
+    northward : bool, optional
+        Sail north instead of east, default False.
+
+    Returns
+    -------
+    segments : list of ShipRocking
+        One rocking segment.
+    """
     rng = np.random.default_rng(rng)
     ph = tuple(rng.uniform(0, 2 * np.pi, 3))
     head = 0.0 if northward else 90 * DEG

@@ -44,7 +44,23 @@ KNOT = 1852.0 / 3600.0
 
 
 def deg_per_h2(variance_deg2_per_h2: float) -> float:
-    """A variance printed as (°/h)^2, converted to (rad/s)^2."""
+    """A variance printed as (°/h)^2, converted to (rad/s)^2.
+
+    Parameters
+    ----------
+    variance_deg2_per_h2 : float
+        Variance in (°/h)^2; must be non-negative.
+
+    Returns
+    -------
+    variance : float
+        The same variance in (rad/s)^2.
+
+    Raises
+    ------
+    ValueError
+        If the variance is negative.
+    """
     if variance_deg2_per_h2 < 0:
         raise ValueError("a variance cannot be negative")
     return variance_deg2_per_h2 * DEG_PER_H**2
