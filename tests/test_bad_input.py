@@ -266,6 +266,8 @@ PROBES += [
     ("closed_loop(initial = tuple)", "initial", lambda: _closed_loop(initial=(LAT, LON, H))),
     ("closed_loop(gnss sigma_pos = 0)", "sigma_pos",
      lambda: _closed_loop(gnss=sensors.gnss_measurements(_T1, rate_hz=10.0, sigma_pos=0.0, rng=0))),
+    ("monte_carlo(model with a scale-factor block)", "accel_scale",
+     lambda: kalman.monte_carlo(_T1, _M15.extend(errors.accel_scale(100e-6)), n_runs=2)),
     ("monte_carlo(n_runs = 0)", "n_runs", lambda: kalman.monte_carlo(_T1, _M15, n_runs=0)),
     ("monte_carlo(n_runs = 2.5)", "n_runs", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2.5)),
     ("monte_carlo(n_runs = '20')", "n_runs", lambda: kalman.monte_carlo(_T1, _M15, n_runs="20")),

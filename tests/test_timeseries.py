@@ -396,3 +396,13 @@ def test_stationarity_gate_pairs_adf_with_kpss(sunspots):
     assert ts.inversion_test(walk, 10).stationary       # so the unit-root pair decides
     with pytest.raises(ts.NonStationaryError, match="KPSS test rejects stationarity"):
         ts.require_stationary_series(walk, 10)
+
+
+def test_stationarity_report_thresholds_follow_alpha():
+    """The ADF and KPSS thresholds are the critical values at the requested level, never a silent 5 %."""
+    y = np.random.default_rng(1).standard_normal(300)
+    at = {a: ts.stationarity_report(y, 10, alpha=a).set_index("test")["threshold"] for a in (0.01, 0.05, 0.10, 0.07)}
+    adf, kp = "ADF (null: unit root)", "KPSS (null: stationary)"
+    assert at[0.01][adf] < at[0.05][adf] < at[0.10][adf] < 0          # more negative at a smaller level
+    assert at[0.01][kp] > at[0.05][kp] > at[0.10][kp] > 0
+    assert np.isnan(at[0.07][adf]) and np.isnan(at[0.07][kp])        # not tabulated: no threshold shown

@@ -811,7 +811,8 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
                 sigma_pos=(0.03, 0.03, 0.1), sigma_vel=0.03, vertical: str = "free", workers: int = 2,
                 h_ref=None, vu_ref=None, executor=None, chunk_runs=None, progress=None) -> MonteCarloResult:
     """Monte Carlo of the closed-loop filter along ``traj``: per run, random-constant sensor errors
-    drawn from the blocks' ``sd`` (accel_bias, gyro_bias required), white noise from the model's
+    drawn from the blocks' ``sd`` (accel_bias and gyro_bias, random constants, and no other block: a
+    block the simulated data would not carry is refused), white noise from the model's
     ``accel_psd``/``gyro_psd``, GNSS noise, initial navigation errors from ``nav_sd``.
 
     One batch of :mod:`replication.nav.closedloop` (run 0 leads, the others follow on ``workers``
@@ -887,7 +888,15 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     positive(gnss_rate_hz, "gnss_rate_hz", "{name} must be a positive finite rate (Hz), got {value!r}")
     _gnss_noise(sigma_pos, "sigma_pos"), _gnss_noise(sigma_vel, "sigma_vel")
     for need in ("accel_bias", "gyro_bias"):
-        model.block(need)
+        b = model.block(need)
+        if b.dynamics is not None and np.any(b.dynamics):
+            raise ValueError(f"monte_carlo draws {need} as a random constant, but the model gives it dynamics: "
+                             "the filter would be judged against a truth the data do not carry")
+    others = [b.name for b in model.blocks if b.name not in ("accel_bias", "gyro_bias")]
+    if others:
+        raise ValueError(f"monte_carlo puts only the constant accel_bias and gyro_bias into the simulated data; the "
+                         f"model's other blocks {others} would be estimated against truths the data do not carry "
+                         "(use a model_15 model here; chen2019.simulation.run_batch simulates the extended models)")
     n = traj.n
     _reference(h_ref, "h_ref", n + 1), _reference(vu_ref, "vu_ref", n + 1)
     if vertical != "free" and h_ref is None:

@@ -268,7 +268,9 @@ def stationarity_report(y, segments: int, *, alpha: float = 0.05, regression: st
     -------
     report : pandas.DataFrame
         One row per test (printed and two-sided inversion, ADF, KPSS): ``test``, ``statistic``,
-        ``threshold``, ``stationary``.
+        ``threshold``, ``stationary``.  The ADF and KPSS thresholds are statsmodels' critical values
+        at ``alpha`` where it tabulates one (ADF: 1, 5, 10 %; KPSS: 1, 2.5, 5, 10 %), NaN otherwise;
+        their ``stationary`` decisions come from the p-values at ``alpha`` either way.
     """
     from statsmodels.tsa.stattools import adfuller, kpss
 
@@ -276,6 +278,7 @@ def stationarity_report(y, segments: int, *, alpha: float = 0.05, regression: st
     _choice(regression, ("c", "ct"), "regression", "{name} must be one of {allowed} (constant, constant and trend: "
            "the trends both ADF and KPSS accept), got {value!r}")
     inv = inversion_test(y, segments, alpha=alpha)
+    level = f"{alpha * 100:g}%"           # the key of statsmodels' critical-value tables
     adf = adfuller(y, regression=regression, autolag="AIC", result_object=False)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # InterpolationWarning when the p-value is off the table
@@ -285,9 +288,10 @@ def stationarity_report(y, segments: int, *, alpha: float = 0.05, regression: st
              stationary=inv.stationary_printed),
         dict(test=f"inversion, two-sided (m={segments})", statistic=inv.statistic_two_sided,
              threshold=inv.critical, stationary=inv.stationary),
-        dict(test="ADF (null: unit root)", statistic=adf[0], threshold=adf[4][f"{int(alpha * 100)}%"]
-             if f"{int(alpha * 100)}%" in adf[4] else adf[4]["5%"], stationary=bool(adf[1] < alpha)),
-        dict(test="KPSS (null: stationary)", statistic=kp[0], threshold=kp[3]["5%"], stationary=bool(kp[1] > alpha)),
+        dict(test="ADF (null: unit root)", statistic=adf[0], threshold=adf[4].get(level, np.nan),
+             stationary=bool(adf[1] < alpha)),
+        dict(test="KPSS (null: stationary)", statistic=kp[0], threshold=kp[3].get(level, np.nan),
+             stationary=bool(kp[1] > alpha)),
     ])
 
 
