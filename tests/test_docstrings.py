@@ -33,7 +33,6 @@ PENDING: set[str] = {
     "replication.nav.parallel",
     "replication.nav.rotations",
     "replication.nav.sensors",
-    "replication.nav.strapdown",
     "replication.nav.timeseries",
     "replication.nav.trajectory",
     "replication.nav.units",
