@@ -30,7 +30,6 @@ PENDING: set[str] = {
     "replication.nav.earth",
     "replication.nav.errors",
     "replication.nav.kalman",
-    "replication.nav.parallel",
     "replication.nav.rotations",
     "replication.nav.sensors",
     "replication.nav.timeseries",
