@@ -773,13 +773,21 @@ def compensation_runs(traj, fields, seeds, *, workers: int = 2, executor=None, c
         :func:`replication.nav.parallel.default_chunk_runs`.
     progress : bool or None, optional
         Progress bar of the finished runs (``None``: on unless ``REPLICATION_PROGRESS=0``).
-    **kw
-        Passed to :func:`compensation_run` (not ``first_pass``).
+    **kw : dict, optional
+        Keyword arguments of :func:`compensation_run` (not ``first_pass``).
 
     Returns
     -------
-    list of dict
-        :func:`compensation_run`'s result for each pair, in the order of ``seeds``.
+    runs : list of dict
+        The results of :func:`compensation_run`, in the order of the pairs.
+
+    Raises
+    ------
+    ValueError
+        When fields and seeds do not pair up, ``workers`` or ``chunk_runs`` is not a positive
+        integer, or ``first_pass`` is given.
+    TypeError
+        When ``executor`` is not a ``concurrent.futures.Executor``.
     """
     fields, seeds = list(fields), [int(s) for s in seeds]
     if len(fields) != len(seeds):
