@@ -24,8 +24,6 @@ import replication
 # modules whose docstrings have not yet been brought to the numpydoc form; the list only shrinks
 PENDING: set[str] = {
     "replication.nav.closedloop",
-    "replication.nav.parallel",
-    "replication.nav.strapdown",
     "replication.papers.duan2023.airdata",
     "replication.registry.book",
     "replication.registry.reproduction",

@@ -1,8 +1,11 @@
 """Monte Carlo batches on executors (replication.nav.parallel): a Dask LocalCluster of two worker
 processes, a ProcessPoolExecutor and in-process chunks each give the one-batch result bit for bit,
 also when a worker process dies in the middle of the batch (kalman.monte_carlo and chen2019's
-simulation.run_batch with its smoother), and the per-setting sweeps of fang2020 and duan2023."""
+simulation.run_batch with its smoother), the per-setting sweeps of fang2020 and duan2023 and the
+gravity-compensation runs of chen2019 §4.3; the progress bar follows REPLICATION_PROGRESS."""
 
+import dataclasses
+import math
 import os
 import signal
 import threading
@@ -18,7 +21,8 @@ from replication.nav import errors as er
 from replication.nav import kalman as kf
 from replication.nav import parallel as par
 from replication.nav import trajectory as tr
-from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
+from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, DEG_PER_SQRT_H, MGAL, MICRO_G
+from replication.papers.chen2019 import gravity as gr
 from replication.papers.chen2019 import simulation as sim
 from replication.papers.duan2023 import airdata as ad
 from replication.papers.fang2020 import polar
@@ -178,17 +182,139 @@ def test_duan2023_sweep_on_process_pool_equals_in_process():
     pd.testing.assert_frame_equal(got, ref, check_exact=True)
 
 
-def _squares(r0, r1):
-    return np.arange(r0, r1) ** 2
+def _same_tree(a, b, where="result"):
+    """Equal bit for bit: arrays by numpy.array_equal (NaN where NaN), containers element by element."""
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and a.keys() == b.keys(), where
+        for k in a:
+            _same_tree(a[k], b[k], f"{where}[{k!r}]")
+    elif isinstance(a, (list, tuple)):
+        assert type(a) is type(b) and len(a) == len(b), where
+        for i, (x, y) in enumerate(zip(a, b)):
+            _same_tree(x, y, f"{where}[{i}]")
+    elif dataclasses.is_dataclass(a):
+        assert type(a) is type(b), where
+        for f in dataclasses.fields(a):
+            _same_tree(getattr(a, f.name), getattr(b, f.name), f"{where}.{f.name}")
+    elif isinstance(a, (np.ndarray, float, np.floating)):
+        assert np.array_equal(a, b, equal_nan=True), f"{where} differs"
+    else:
+        assert a == b, f"{where} differs"
 
 
-def test_progress_bar_on_request_and_off_by_environment(capsys, monkeypatch):
-    """A bar on stderr with progress=True; none with REPLICATION_PROGRESS=0 (set for the tests) or progress=False."""
-    parts = par.run_chunks(_squares, 5, chunk_runs=2, progress=True, desc="squares")
-    assert np.array_equal(np.concatenate(parts), np.arange(5) ** 2)
-    assert "squares" in capsys.readouterr().err
-    assert not par.progress_enabled() and not par.progress_enabled(False)
-    par.run_chunks(_squares, 5, chunk_runs=2)
-    assert capsys.readouterr().err == ""
+@pytest.fixture(scope="module")
+def gravity_case():
+    """Three runs of the §4.3 compensation on a 20-min, 50-Hz two-line survey (each its own field)."""
+    origin = (math.radians(30.0), math.radians(110.0), 500.0)
+    traj = gr.survey_flight(n_lines=2, duration=1200.0, turn_duration=60.0, speed=30.0, lat0=origin[0],
+                            lon0=origin[1], h0=origin[2], dt=0.02)
+    kw = dict(origin=origin, offset=(20e3, 20e3), photos=gr.photo_epochs(traj, 10),
+              imu=dict(accel_bias_sd=50 * MICRO_G, gyro_bias_sd=0.01 * DEG_PER_H, accel_psd=(10 * MICRO_G) ** 2,
+                       gyro_psd=(0.003 * DEG / 60) ** 2),
+              gnss_kw=dict(rate_hz=10, sigma_pos=0.1, sigma_vel=0.03),
+              model_kw=dict(position_sd=0.1, velocity_sd=0.03, attitude_sd=(1e-4, 1e-4, 5e-4)), cutoff_period=60.0)
+    seeds = [11, 12, 13]
+    fields = [gr.synthetic_field(60e3, 40e3, 250.0, sigma=30 * MGAL, correlation_length=10e3, altitude=500.0, seed=s)
+              for s in seeds]
+    ref = [gr.compensation_run(traj, f, seed=s, **kw) for f, s in zip(fields, seeds)]
+    return traj, fields, seeds, kw, ref
+
+
+def test_chen2019_compensation_runs_on_any_executor_equal_the_sequential_runs(gravity_case, cluster):
+    """compensation_runs on this process's threads, in chunks, on a ProcessPoolExecutor and on a
+    Dask cluster: every array of every run equals the sequential compensation_run calls bit for bit."""
+    traj, fields, seeds, kw, ref = gravity_case
+    assert not np.array_equal(ref[0]["state"]["pitch"], ref[1]["state"]["pitch"])   # three different runs
+    _same_tree(gr.compensation_runs(traj, fields, seeds, workers=1, **kw), ref)
+    _same_tree(gr.compensation_runs(traj, fields, seeds, workers=2, chunk_runs=2, **kw), ref)
+    with ProcessPoolExecutor(2) as ex:
+        _same_tree(gr.compensation_runs(traj, fields, seeds, executor=ex, chunk_runs=2, **kw), ref)
+    _, client = cluster
+    _same_tree(gr.compensation_runs(traj, fields, seeds, executor=client.get_executor(), chunk_runs=1, **kw), ref)
+    with pytest.raises(TypeError, match="executor must be a concurrent.futures.Executor"):
+        gr.compensation_runs(traj, fields, seeds, executor="dask", **kw)
+    with pytest.raises(ValueError, match="chunk_runs"):
+        gr.compensation_runs(traj, fields, seeds, chunk_runs=0, **kw)
+
+
+def _squares(r0, r1, offset=0):
+    return np.arange(r0, r1) ** 2 + offset
+
+
+def test_chunk_args_carry_each_chunk_its_share():
+    items = [10 * i for i in range(7)]
+    seen = []
+
+    def task(r0, r1, share):
+        seen.append(share)
+        return np.array(share) + r0 - r0
+
+    parts = par.run_chunks(task, 7, chunk_runs=3, chunk_args=lambda r0, r1: (items[r0:r1],))
+    assert np.array_equal(np.concatenate(parts), items) and seen == [items[0:3], items[3:6], items[6:7]]
+    with ProcessPoolExecutor(2) as ex:
+        parts = par.run_chunks(_squares, 7, executor=ex, chunk_runs=2, chunk_args=lambda r0, r1: (r0,))
+    assert [list(p) for p in parts] == [list(np.arange(r0, r1) ** 2 + r0) for r0, r1 in par.chunk_bounds(7, 2)]
+    with pytest.raises(TypeError, match="chunk_args"):
+        par.run_chunks(_squares, 7, chunk_args=(1,))
+
+
+@pytest.mark.parametrize("where", ["in process", "thread pool", "process pool"])
+def test_progress_bar_follows_the_environment(capfd, monkeypatch, where):
+    """With progress=None the bar (tqdm on stderr, counting runs) shows unless REPLICATION_PROGRESS
+    is 0 — set by the Makefile and tests/conftest.py for tests, stored notebook outputs and
+    benchmarks — in process as on an executor; progress=True/False overrides the variable."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    def run(**kw):
+        if where == "in process":
+            return par.run_chunks(_squares, 5, chunk_runs=2, desc="squares", **kw)
+        with (ThreadPoolExecutor(2) if where == "thread pool" else ProcessPoolExecutor(2)) as ex:
+            return par.run_chunks(_squares, 5, executor=ex, chunk_runs=2, desc="squares", **kw)
+
+    capfd.readouterr()
+    for off in ("0", "false", "Off"):
+        monkeypatch.setenv("REPLICATION_PROGRESS", off)
+        assert not par.progress_enabled()
+        assert np.array_equal(np.concatenate(run()), np.arange(5) ** 2)
+        assert capfd.readouterr().err == ""
+    assert par.progress_enabled(True)
+    run(progress=True)
+    assert "squares" in capfd.readouterr().err
+    for on in ("1", "yes"):
+        monkeypatch.setenv("REPLICATION_PROGRESS", on)
+        assert par.progress_enabled()
+        assert np.array_equal(np.concatenate(run()), np.arange(5) ** 2)
+        err = capfd.readouterr().err
+        assert "squares" in err and "/5" in err and "run" in err
+    run(progress=False)
+    assert capfd.readouterr().err == ""
+    monkeypatch.delenv("REPLICATION_PROGRESS")
+    assert par.progress_enabled()                                   # on by default
+    run()
+    assert "squares" in capfd.readouterr().err
+
+
+def test_progress_bar_of_an_in_process_loop(capfd, monkeypatch):
+    """progress_bar serves a loop of this process: a tqdm bar, or a silent stand-in when off."""
+    monkeypatch.setenv("REPLICATION_PROGRESS", "0")
+    with par.progress_bar(3, "settings") as bar:
+        for _ in range(3):
+            bar.update(1)
+    assert capfd.readouterr().err == ""
     monkeypatch.setenv("REPLICATION_PROGRESS", "1")
-    assert par.progress_enabled()
+    with par.progress_bar(3, "settings", unit="setting") as bar:
+        for _ in range(3):
+            bar.update(1)
+    err = capfd.readouterr().err
+    assert "settings" in err and "/3" in err and "setting" in err
+
+
+def test_compensation_runs_show_their_progress(gravity_case, capfd, monkeypatch):
+    traj, fields, seeds, kw, ref = gravity_case
+    monkeypatch.setenv("REPLICATION_PROGRESS", "1")
+    capfd.readouterr()
+    _same_tree(gr.compensation_runs(traj, fields[:1], seeds[:1], workers=1, **kw), ref[:1])
+    assert "chen2019 compensation runs" in capfd.readouterr().err
+    monkeypatch.setenv("REPLICATION_PROGRESS", "0")
+    gr.compensation_runs(traj, fields[:1], seeds[:1], workers=1, **kw)
+    assert capfd.readouterr().err == ""

@@ -36,7 +36,24 @@ VERTICAL_MODES = {"free": 0, "hold": 1, "damped": 2}
 
 @dataclass
 class NavState:
-    """Navigation state: geodetic position (rad, rad, m), ENU velocity (m/s), attitude C_b^n."""
+    """Navigation state at one instant (the initial condition of :func:`mechanize`).
+
+    The fields are checked on construction (:meth:`validate`); a field changed afterwards is
+    checked again by :func:`mechanize` and by :meth:`validate`.
+
+    Parameters
+    ----------
+    lat : float
+        Geodetic latitude L (rad), inside ±``earth.POLAR_LIMIT_DEG``.
+    lon : float
+        Longitude λ (rad).
+    h : float
+        Ellipsoidal height (m), within :data:`replication.nav.earth.HEIGHT_RANGE`.
+    v_enu : array_like, shape (3,)
+        Velocity (m/s), East, North, Up.
+    C_bn : array_like, shape (3, 3)
+        Attitude, the direction cosine matrix C_b^n (body Right-Front-Up to ENU).
+    """
 
     lat: float
     lon: float
@@ -53,11 +70,30 @@ class NavState:
         self.validate()
 
     def validate(self, *, name: str = "NavState", polar_limit_deg: float = earth.POLAR_LIMIT_DEG):
-        """Check every field (also after a field was changed): latitude within ±90° and outside the polar
-        singularity, finite longitude, height within :data:`replication.nav.earth.HEIGHT_RANGE`, finite
-        velocity below :data:`replication.nav.earth.SPEED_LIMIT`, C_bn a rotation matrix
-        (``_validate.ORTHONORMAL_TOL``).  Raises ``TypeError``/``ValueError`` naming the
-        field; the compiled mechanization checks nothing."""
+        """Check every field (also after a field was changed).
+
+        Latitude within ±90° and outside the polar singularity, finite longitude, height within
+        :data:`replication.nav.earth.HEIGHT_RANGE`, finite velocity below
+        :data:`replication.nav.earth.SPEED_LIMIT`, C_bn a rotation matrix
+        (``_validate.ORTHONORMAL_TOL``); the compiled mechanization checks nothing.
+
+        Parameters
+        ----------
+        name : str, optional
+            How the state is named in the messages (e.g. ``"initial"``).
+        polar_limit_deg : float, optional
+            Largest accepted |latitude| (degrees).
+
+        Returns
+        -------
+        NavState
+            The state itself.
+
+        Raises
+        ------
+        TypeError, ValueError
+            Naming the field at fault.
+        """
         earth.check_latitude(self.lat, polar_limit_deg=polar_limit_deg, name=f"{name}.lat")
         earth.check_longitude(self.lon, name=f"{name}.lon")
         earth.check_height(self.h, name=f"{name}.h")
@@ -70,15 +106,53 @@ class NavState:
 
     @classmethod
     def from_euler(cls, lat, lon, h, v_enu, heading, pitch, roll):
+        """The state with its attitude given as Euler angles (:func:`replication.nav.rotations.euler_to_dcm`).
+
+        Parameters
+        ----------
+        lat, lon : float
+            Latitude and longitude (rad).
+        h : float
+            Ellipsoidal height (m).
+        v_enu : array_like, shape (3,)
+            Velocity (m/s), East, North, Up.
+        heading, pitch, roll : float
+            Heading ψ (clockwise from north), pitch θ, roll γ (rad).
+
+        Returns
+        -------
+        NavState
+        """
         return cls(lat, lon, h, v_enu, euler_to_dcm(heading, pitch, roll))
 
     def vector(self):
+        """The position and velocity as one vector.
+
+        Returns
+        -------
+        numpy.ndarray, shape (6,)
+            [L (rad), λ (rad), h (m), v_E, v_N, v_U (m/s)].
+        """
         return np.array([self.lat, self.lon, self.h, *self.v_enu])
 
 
 @dataclass
 class NavSolution:
-    """Strapdown output at the N+1 sample instants."""
+    """Strapdown output at the N+1 sample instants (:func:`mechanize`).
+
+    Parameters
+    ----------
+    t : numpy.ndarray, shape (N+1,)
+        Sample times (s).
+    lat, lon : numpy.ndarray, shape (N+1,)
+        Latitude and longitude (rad).
+    h : numpy.ndarray, shape (N+1,)
+        Ellipsoidal height (m).
+    v_enu : numpy.ndarray, shape (N+1, 3)
+        Velocity (m/s), East, North, Up.
+    q_bn : numpy.ndarray, shape (N+1, 4)
+        Attitude quaternion q_b^n (scalar first); :attr:`C_bn` and :attr:`hpr` derive from it.
+    """
 
     t: np.ndarray
     lat: np.ndarray
@@ -89,22 +163,33 @@ class NavSolution:
 
     @property
     def C_bn(self):
+        """numpy.ndarray, shape (N+1, 3, 3): the attitude C_b^n."""
         return quat_to_dcm(self.q_bn)
 
     @property
     def hpr(self):
+        """numpy.ndarray, shape (N+1, 3): heading, pitch, roll (rad)."""
         return np.stack(dcm_to_euler(self.C_bn), -1)
 
     @property
     def position(self):
+        """numpy.ndarray, shape (N+1, 3): latitude (rad), longitude (rad), height (m)."""
         return np.stack([self.lat, self.lon, self.h], -1)
 
     def errors_against(self, truth):
-        """Errors against a :class:`~replication.nav.trajectory.Trajectory` with the same samples.
+        """Errors against a reference with the same samples.
 
-        Returns a dict: ``east``, ``north``, ``up`` (m), ``v`` (m/s, ENU), ``phi`` (rad, n-frame
-        misalignment with Ĉ = exp(-φ×) C)."""
+        Parameters
+        ----------
+        truth : replication.nav.trajectory.Trajectory
+            The true trajectory at the same N+1 samples.
 
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            ``east``, ``north``, ``up`` (m, shape (N+1,)), ``v`` (m/s, ENU, shape (N+1, 3)) and
+            ``phi`` (rad, shape (N+1, 3): the n-frame misalignment with Ĉ = exp(-φ×) C).
+        """
         if len(truth.t) != len(self.t):
             raise ValueError(f"truth has {len(truth.t)} samples, the solution {len(self.t)}")
         rm, rn = earth.radii(truth.lat)
@@ -117,25 +202,73 @@ class NavSolution:
         )
 
 
-def validate_time(t, n_increments: int | None = None, name: str = "t"):
-    """Check a time vector: 1-D, finite, strictly increasing, matching the increments."""
+def _all_finite(a) -> bool:
+    """Whether every element of ``a`` is finite.  A NaN or an infinity makes the sum non-finite, so a
+    finite sum settles it with one reduction; only a non-finite sum (also an overflow of large
+    finite values) is looked at element by element."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = a.sum()
+    return bool(np.isfinite(total)) or bool(np.isfinite(a).all())
+
+
+def _time_steps(t, n_increments, name):
+    """:func:`validate_time` returning the checked times and their differences."""
     t = numeric(t, name)
     if t.ndim != 1 or len(t) < 2:
         raise ValueError(f"{name} must be a 1-D array of at least two sample times")
-    if not np.all(np.isfinite(t)):
+    if not _all_finite(t):
         raise ValueError(f"{name} contains NaN or infinite values")
     d = np.diff(t)
-    if np.any(d <= 0):
+    if not d.min() > 0:
         k = int(np.argmax(d <= 0))
         raise ValueError(f"{name} must be strictly increasing: {name}[{k + 1}] = {t[k + 1]!r} follows "
                          f"{name}[{k}] = {t[k]!r}; sort the record or drop duplicated samples")
     if n_increments is not None and len(t) != n_increments + 1:
         raise ValueError(f"{name} has {len(t)} samples but there are {n_increments} increments: "
                          f"increments k = 1..N lie between samples, so len({name}) must be N + 1 = {n_increments + 1}")
-    return t
+    return t, d
+
+
+def validate_time(t, n_increments: int | None = None, name: str = "t"):
+    """Check a time vector: 1-D, finite, strictly increasing, matching the increments.
+
+    Parameters
+    ----------
+    t : array_like, shape (N+1,)
+        Sample times (s).
+    n_increments : int or None, optional
+        N, the number of increments between the samples (not checked when ``None``).
+    name : str, optional
+        The argument's name in the messages.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N+1,)
+        ``t`` as a float array.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Saying what is wrong and where (the first non-increasing sample).
+    """
+    return _time_steps(t, n_increments, name)[0]
 
 
 def validate_increments(dtheta, dv):
+    """Check IMU increments: two finite (N, 3) arrays of the same shape.
+
+    Parameters
+    ----------
+    dtheta : array_like, shape (N, 3)
+        Gyro increments Δθ (rad), body frame.
+    dv : array_like, shape (N, 3)
+        Accelerometer increments Δv (m/s), body frame.
+
+    Returns
+    -------
+    dtheta, dv : numpy.ndarray, shape (N, 3)
+        C-contiguous float arrays (the inputs themselves when they already are).
+    """
     dtheta = np.ascontiguousarray(numeric(dtheta, "dtheta"))
     dv = np.ascontiguousarray(numeric(dv, "dv"))
     if dtheta.ndim != 2 or dtheta.shape[1] != 3:
@@ -143,7 +276,7 @@ def validate_increments(dtheta, dv):
     if dv.shape != dtheta.shape:
         raise ValueError(f"dtheta and dv must have the same shape (one gyro and one accelerometer increment "
                          f"per interval), got {dtheta.shape} and {dv.shape}")
-    if not (np.all(np.isfinite(dtheta)) and np.all(np.isfinite(dv))):
+    if not (_all_finite(dtheta) and _all_finite(dv)):
         raise ValueError("increments contain NaN or infinite values")
     return dtheta, dv
 
@@ -153,6 +286,20 @@ def vertical_damping_gains(tau: float = 100.0, lat: float = 0.0, h: float = 0.0)
 
     With δḣ = δv_U - k1 δh, δv̇_U = (2γ/R) δh - k2 δh - k3 ∫δh, the characteristic polynomial is
     s³ + k1 s² + (k2 - 2γ/R) s + k3 = (s + 1/τ)³.
+
+    Parameters
+    ----------
+    tau : float, optional
+        Time constant τ of the loop (s).
+    lat : float, optional
+        Latitude (rad) where γ and R are evaluated.
+    h : float, optional
+        Height (m) where γ and R are evaluated.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        [k1 (1/s), k2 (1/s²), k3 (1/s³)].
     """
     tau = positive(tau, "tau", "the damping time constant {name} must be positive (seconds), got {value!r}")
     g = float(earth.normal_gravity(lat, h))
@@ -163,21 +310,20 @@ def vertical_damping_gains(tau: float = 100.0, lat: float = 0.0, h: float = 0.0)
 
 def _ref(arr, n, name):
     a = np.ascontiguousarray(np.broadcast_to(numeric(arr, name), (n,)), dtype=float)
-    if not np.all(np.isfinite(a)):
+    if not _all_finite(a):
         raise ValueError(f"{name} contains NaN or infinite values")
     return a
+
+
+_UNUSED = np.zeros(1)   # the reference arrays of a mode that does not read them
 
 
 def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref=None, vu_ref=None,
               damping_tau: float = 100.0, polar_limit_deg: float = earth.POLAR_LIMIT_DEG) -> NavSolution:
     """Integrate IMU increments with the ENU strapdown algorithm (chen2019 eq. (3-2)).
 
-    ``t`` holds the N+1 sample times (s, strictly increasing); ``dtheta`` and ``dv`` the (N, 3)
-    gyro and accelerometer increments Δθ (rad), Δv (m/s) in the body frame (Right-Front-Up),
-    increment k covering t[k]..t[k+1]; ``initial`` the navigation state at t[0].
-    ``vertical`` is "free", "hold" (needs ``h_ref`` and optionally ``vu_ref``, N+1 values each:
-    the papers' height channel held to the true height) or "damped" (third-order loop on
-    ``h_ref``, e.g. a barometric height, with poles at -1/``damping_tau``).
+    The update of the module docstring, one step per increment, compiled
+    (``replication.nav._kernels.strapdown_kernel``); the inputs are checked here, once.
 
     Comparing the free vertical channel with another package: gravity here is the WGS-84
     normal gravity of :func:`replication.nav.earth.normal_gravity` (NIMA TR8350.2, Somigliana with
@@ -186,10 +332,46 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
     free channel, unstable with rate sqrt(2g/R) ≈ 1.75e-3 s⁻¹, amplifies any such difference
     by about cosh(sqrt(2g/R) t) ≈ 280 in an hour: height differences against a peer's free
     channel of that origin are a choice of gravity model, not an error of either.
+
+    Parameters
+    ----------
+    t : array_like, shape (N+1,)
+        Sample times (s), strictly increasing.
+    dtheta : array_like, shape (N, 3)
+        Gyro increments Δθ (rad) in the body frame (Right-Front-Up); increment k covers
+        t[k]..t[k+1].
+    dv : array_like, shape (N, 3)
+        Accelerometer increments Δv (m/s) in the body frame, over the same intervals.
+    initial : NavState
+        The navigation state at t[0].
+    vertical : {"free", "hold", "damped"}, optional
+        The vertical channel: free; held (height and vertical speed set to ``h_ref`` and
+        ``vu_ref`` after every step, the papers' height channel held to the true height); or
+        damped (third-order loop on ``h_ref``, e.g. a barometric height, with all poles at
+        -1/``damping_tau``, :func:`vertical_damping_gains`).
+    h_ref : float or array_like, shape (N+1,), optional
+        Reference height (m) at the samples; required by "hold" and "damped".
+    vu_ref : float or array_like, shape (N+1,), optional
+        Reference vertical speed (m/s) at the samples for "hold" (default 0).
+    damping_tau : float, optional
+        Time constant (s) of the damped loop.
+    polar_limit_deg : float, optional
+        Largest |latitude| (degrees) accepted for the initial state and reached by the solution.
+
+    Returns
+    -------
+    NavSolution
+        Position, velocity and attitude at the N+1 samples.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For inputs of the wrong kind, shape or range, and when the solution reaches the polar
+        singularity (with the time it happens).
     """
     dtheta, dv = validate_increments(dtheta, dv)
     n = len(dtheta)
-    t = validate_time(t, n)
+    t, dt = _time_steps(t, n, "t")
     if not isinstance(initial, NavState):
         raise TypeError("initial must be a NavState (e.g. Trajectory.initial_state())")
     choice(vertical, sorted(VERTICAL_MODES), "vertical")
@@ -202,31 +384,54 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
         href = _ref(h_ref, n + 1, "h_ref")
         earth.check_height(href, name="h_ref")
     else:
-        href = np.zeros(n + 1)
-    if vu_ref is not None and np.ndim(vu_ref) and len(vu_ref) != n + 1:
-        raise ValueError(f"vu_ref has {len(vu_ref)} values; it needs one per sample ({n + 1})")
-    vuref = _ref(0.0 if vu_ref is None else vu_ref, n + 1, "vu_ref")
+        href = _UNUSED
+    if vu_ref is not None:
+        if np.ndim(vu_ref) and len(vu_ref) != n + 1:
+            raise ValueError(f"vu_ref has {len(vu_ref)} values; it needs one per sample ({n + 1})")
+        vuref = _ref(vu_ref, n + 1, "vu_ref")
+    else:
+        vuref = np.zeros(n + 1) if vertical == "hold" else _UNUSED
     gains = vertical_damping_gains(damping_tau, initial.lat, initial.h) if vertical == "damped" else np.zeros(3)
-    st0 = initial.vector()
     q0 = dcm_to_quat(initial.C_bn)
     out_st = np.empty((n + 1, 6))
     out_q = np.empty((n + 1, 4))
-    K.strapdown_kernel(np.diff(t), dtheta, dv, st0, q0, VERTICAL_MODES[vertical], href, vuref, gains, out_st, out_q)
-    lat = out_st[:, 0]
-    if np.any(np.abs(lat) >= np.radians(polar_limit_deg)) or not np.all(np.isfinite(lat)):
-        bad = int(np.argmax(~np.isfinite(lat) | (np.abs(lat) >= np.radians(polar_limit_deg))))
-        raise ValueError(f"the solution reaches latitude {np.degrees(lat[bad]):.4f}° at t = {t[bad]:.3f} s, "
+    bad = K.strapdown_kernel(dt, dtheta, dv, initial.vector(), q0, VERTICAL_MODES[vertical], href, vuref, gains,
+                             out_st, out_q, np.radians(polar_limit_deg))
+    if bad >= 0:
+        raise ValueError(f"the solution reaches latitude {np.degrees(out_st[bad, 0]):.4f}° at t = {t[bad]:.3f} s, "
                          f"within the n-frame polar singularity (limit ±{polar_limit_deg}°); "
                          "use a grid-frame mechanization near the pole")
-    return NavSolution(t, lat, out_st[:, 1], out_st[:, 2], out_st[:, 3:6], out_q)
+    return NavSolution(t, out_st[:, 0], out_st[:, 1], out_st[:, 2], out_st[:, 3:6], out_q)
 
 
 def navigation_rates(lat, lon, h, v_enu, C_bn, w_ib_b, f_b, g_extra=None):
-    """Continuous-time mechanization: (L̇, λ̇, ḣ, v̇^n, Ċ_b^n) — chen2019 eq. (3-2) and the
-    attitude equation Ċ_b^n = C_b^n (ω_ib^b ×) - (ω_in^n ×) C_b^n.
+    """Continuous-time mechanization: (L̇, λ̇, ḣ, v̇^n, Ċ_b^n), chen2019 eq. (3-2).
 
-    Used as the reference for the numerical Jacobian of the error model.  ``g_extra`` adds an
-    n-frame gravity disturbance to the normal gravity.
+    With the attitude equation Ċ_b^n = C_b^n (ω_ib^b ×) - (ω_in^n ×) C_b^n; the reference for the
+    numerical Jacobian of the error model.  Arrays with leading batch dimensions are evaluated
+    element by element.
+
+    Parameters
+    ----------
+    lat, lon : float or array_like
+        Latitude and longitude (rad).
+    h : float or array_like
+        Ellipsoidal height (m).
+    v_enu : array_like, shape (..., 3)
+        Velocity (m/s), East, North, Up.
+    C_bn : array_like, shape (..., 3, 3)
+        Attitude C_b^n.
+    w_ib_b : array_like, shape (..., 3)
+        Body angular rate ω_ib^b (rad/s).
+    f_b : array_like, shape (..., 3)
+        Specific force f^b (m/s²).
+    g_extra : array_like, shape (..., 3), optional
+        n-frame gravity disturbance (m/s²) added to the normal gravity.
+
+    Returns
+    -------
+    tuple
+        L̇ (rad/s), λ̇ (rad/s), ḣ (m/s), v̇^n (m/s², shape (..., 3)), Ċ_b^n (1/s, shape (..., 3, 3)).
     """
     lat = earth.check_latitude(lat, polar_limit_deg=earth.POLAR_LIMIT_DEG)
     earth.check_longitude(lon, name="lon")

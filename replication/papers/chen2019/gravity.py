@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 import scipy.linalg
@@ -35,6 +36,7 @@ from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import errors as er
 from replication.nav import kalman as kf
+from replication.nav import parallel as PAR
 from replication.nav import sensors as se
 from replication.nav import trajectory as tj
 from replication.nav.rotations import dcm_to_quat
@@ -1382,26 +1384,39 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
     return out
 
 
-def compensation_runs(traj, fields, seeds, *, workers: int = 2, **kw) -> list:
-    """:func:`compensation_run` for each (field, seed) pair, ``workers`` runs at a time on threads.
+def compensation_runs(traj, fields, seeds, *, workers: int = 2, executor=None, chunk_runs=None, progress=None,
+                      **kw) -> list:
+    """:func:`compensation_run` for each (field, seed) pair: the Monte Carlo of the Table 4-50
+    analog (chen2019 §4.3).
 
-    The Monte Carlo of the Table 4-50 analog (chen2019 §4.3): every run is independent (its own
-    truth, sensor errors and filters; the compiled filter releases the GIL), so the result is the
-    list of the sequential calls whatever ``workers``.
+    Every run is independent (its own truth, sensor errors and filters, drawn from its seed) and
+    deterministic, so the result is the list of the sequential calls whatever runs them: threads
+    of this process (the compiled filter releases the GIL), any ``concurrent.futures.Executor``
+    (a ``ProcessPoolExecutor``, ``dask.distributed.Client(...).get_executor()``), and any chunking
+    (:func:`replication.nav.parallel.run_chunks`).  Each run makes its own first pass and drops
+    it, which keeps the memory to the runs in flight.
 
     Parameters
     ----------
     traj : replication.nav.trajectory.Trajectory
-        The survey flight.
-    fields : iterable of PlanarGravityField
-        One field per run.
-    seeds : iterable of int
-        One seed per run, paired with ``fields``.
-    workers : int
-        Runs at a time (threads).
+        The survey flight (:func:`survey_flight`).
+    fields : sequence of PlanarGravityField
+        The disturbance field of each run.
+    seeds : sequence of int
+        The seed of each run, paired with ``fields``.
+    workers : int, optional
+        Threads running runs at once in this process when no ``executor`` is given (1: one run
+        after the other).
+    executor : concurrent.futures.Executor or None, optional
+        Where the runs go instead (in chunks of ``chunk_runs``, each a picklable task carrying
+        ``traj``, ``kw`` and its own runs' fields and seeds).
+    chunk_runs : int or None, optional
+        Runs per task; ``None``: one on this process's threads, else
+        :func:`replication.nav.parallel.default_chunk_runs`.
+    progress : bool or None, optional
+        Progress bar of the finished runs (``None``: on unless ``REPLICATION_PROGRESS=0``).
     **kw : dict, optional
-        Keyword arguments of :func:`compensation_run` (not ``first_pass``: each run makes its own
-        and drops it, which keeps the memory to ``workers`` runs).
+        Keyword arguments of :func:`compensation_run` (not ``first_pass``).
 
     Returns
     -------
@@ -1411,8 +1426,10 @@ def compensation_runs(traj, fields, seeds, *, workers: int = 2, **kw) -> list:
     Raises
     ------
     ValueError
-        When fields and seeds do not pair up, ``workers`` is not a positive integer, or
-        ``first_pass`` is given.
+        When fields and seeds do not pair up, ``workers`` or ``chunk_runs`` is not a positive
+        integer, or ``first_pass`` is given.
+    TypeError
+        When ``executor`` is not a ``concurrent.futures.Executor``.
     """
     fields, seeds = list(fields), [int(s) for s in seeds]
     if len(fields) != len(seeds):
@@ -1421,8 +1438,24 @@ def compensation_runs(traj, fields, seeds, *, workers: int = 2, **kw) -> list:
         raise ValueError("workers must be a positive integer (threads running runs at once)")
     if "first_pass" in kw:
         raise ValueError("compensation_runs makes each run's first pass itself; drop first_pass")
-    with ThreadPoolExecutor(max_workers=int(workers)) as ex:
-        return list(ex.map(lambda fs: compensation_run(traj, fs[0], seed=fs[1], **kw), zip(fields, seeds)))
+    task = partial(_compensation_chunk, traj, kw)
+    opts = dict(progress=progress, desc="chen2019 compensation runs",
+                chunk_args=lambda r0, r1: (fields[r0:r1], seeds[r0:r1]))   # each task carries its own fields
+    if executor is None:
+        chunk_runs = 1 if chunk_runs is None else chunk_runs
+        if int(workers) > 1:
+            with ThreadPoolExecutor(max_workers=int(workers)) as ex:
+                parts = PAR.run_chunks(task, len(seeds), executor=ex, chunk_runs=chunk_runs, **opts)
+        else:
+            parts = PAR.run_chunks(task, len(seeds), chunk_runs=chunk_runs, **opts)
+    else:
+        parts = PAR.run_chunks(task, len(seeds), executor=executor, chunk_runs=chunk_runs, **opts)
+    return [run for part in parts for run in part]
+
+
+def _compensation_chunk(traj, kw, r0, r1, fields, seeds) -> list:
+    """Runs ``r0 … r1−1`` of :func:`compensation_runs` (a picklable task) with their ``fields`` and ``seeds``."""
+    return [compensation_run(traj, f, seed=s, **kw) for f, s in zip(fields, seeds)]
 
 
 def consistent_kinematics(n: int, rng: np.random.Generator, *, lat=math.radians(40.0), h=500.0, speed=30.0,
