@@ -36,7 +36,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from replication.nav import earth
+from replication.nav import earth, sensors
 from replication.nav._validate import finite, finite_array, nonnegative, positive, vector3
 from replication.nav.timeseries import gauss_markov
 from replication.nav.units import ARCSEC, DEG_PER_H, G0
@@ -139,9 +139,8 @@ def misalignment_matrix(theta: Mapping[str, float]) -> np.ndarray:
     if any(abs(v) > 0.1 for v in t.values()):
         raise ValueError("misalignment angles are small-angle quantities in radians (|θ| ≤ 0.1 rad); "
                          "convert arc-seconds with replication.nav.units.ARCSEC")
-    return np.array([[0.0, -t["yz"], t["zy"]],
-                     [t["xz"], 0.0, -t["zx"]],
-                     [-t["xy"], t["yx"], 0.0]])
+    # the layout of eq. (2-8) is written once, in the toolkit
+    return sensors.misalignment_matrix([t["xy"], t["yx"], t["xz"], t["zx"], t["yz"], t["zy"]])
 
 
 def nonorthogonal_transform(theta: Mapping[str, float]) -> np.ndarray:
