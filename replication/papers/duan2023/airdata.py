@@ -2311,7 +2311,7 @@ def sweep(traj, setup: AirdataSetup, changes, *, n_runs: int = 3, seed: int = 7,
     """
     changes = list(changes)
     if executor is None and chunk_runs is None:
-        return pd.DataFrame(_sweep_rows(traj, setup, changes, n_runs, seed, 0, len(changes)))
+        chunk_runs = 1                  # one setting at a time in this process (the progress bar counts them)
     parts = PAR.run_chunks(partial(_sweep_rows, traj, setup, changes, n_runs, seed), len(changes),
                            executor=executor, chunk_runs=chunk_runs, progress=progress, desc="duan2023 settings")
     return pd.DataFrame([row for part in parts for row in part])

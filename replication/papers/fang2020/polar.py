@@ -1681,7 +1681,7 @@ def sensitivity(case, variants, *, n_runs=4, seed=None, executor=None, chunk_run
     """
     items = list(variants.items())
     if executor is None and chunk_runs is None:
-        return pd.DataFrame(_sensitivity_rows(case, items, n_runs, seed, 0, len(items)))
+        chunk_runs = 1                  # one variant at a time in this process (the progress bar counts them)
     parts = PAR.run_chunks(partial(_sensitivity_rows, case, items, n_runs, seed), len(items), executor=executor,
                            chunk_runs=chunk_runs, progress=progress, desc="fang2020 variants")
     return pd.DataFrame([row for part in parts for row in part])
