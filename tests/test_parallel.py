@@ -1,16 +1,19 @@
 """Monte Carlo batches on executors (replication.nav.parallel): a Dask LocalCluster of two worker
 processes, a ProcessPoolExecutor and in-process chunks each give the one-batch result bit for bit,
 also when a worker process dies in the middle of the batch (kalman.monte_carlo and chen2019's
-simulation.run_batch with its smoother), the per-setting sweeps of fang2020 and duan2023 and the
-gravity-compensation runs of chen2019 §4.3; the progress bar follows REPLICATION_PROGRESS."""
+simulation.run_batch with its smoother), the per-setting sweeps of fang2020 and duan2023, the
+gravity-compensation runs of chen2019 §4.3, chen2019's turntable runs, observability readings and
+error-effect computations, and fang2020's polar Monte Carlo; the progress bar follows
+REPLICATION_PROGRESS."""
 
 import dataclasses
 import math
+import multiprocessing
 import os
 import signal
 import threading
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import numpy as np
 import pandas as pd
@@ -22,10 +25,15 @@ from replication.nav import kalman as kf
 from replication.nav import parallel as par
 from replication.nav import trajectory as tr
 from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, DEG_PER_SQRT_H, MGAL, MICRO_G
+from replication.papers.chen2019 import error_effects as ee
 from replication.papers.chen2019 import gravity as gr
+from replication.papers.chen2019 import models as M
+from replication.papers.chen2019 import observability as O
 from replication.papers.chen2019 import simulation as sim
+from replication.papers.chen2019 import turntable as tt
 from replication.papers.duan2023 import airdata as ad
 from replication.papers.fang2020 import polar
+from replication.registry import reproduction as rp
 
 FIELDS = ("t_epoch", "nees", "nis", "final_estimates", "true_params", "final_sigma", "P_diag_run0")
 N_RUNS, SEED = 7, 20260
@@ -263,8 +271,6 @@ def test_progress_bar_follows_the_environment(capfd, monkeypatch, where):
     """With progress=None the bar (tqdm on stderr, counting runs) shows unless REPLICATION_PROGRESS
     is 0 — set by the Makefile and tests/conftest.py for tests, stored notebook outputs and
     benchmarks — in process as on an executor; progress=True/False overrides the variable."""
-    from concurrent.futures import ThreadPoolExecutor
-
     def run(**kw):
         if where == "in process":
             return par.run_chunks(_squares, 5, chunk_runs=2, desc="squares", **kw)
@@ -318,3 +324,102 @@ def test_compensation_runs_show_their_progress(gravity_case, capfd, monkeypatch)
     monkeypatch.setenv("REPLICATION_PROGRESS", "0")
     gr.compensation_runs(traj, fields[:1], seeds[:1], workers=1, **kw)
     assert capfd.readouterr().err == ""
+
+
+def test_chen2019_turntable_runs_on_threads_in_chunks_and_on_processes():
+    """run_scenario passes executor, chunk_runs and progress to simulation.run_batch: the smoothed
+    turntable runs equal the one batch bit for bit."""
+    setup = tt.tested_imu_setup(*(rp.load_paper(f"chen2019-table-4-{n}") for n in (33, 34, 41)))
+    traj = tt.scenario(2, dwell=10.0, repeats=1)
+    ref = tt.run_scenario(traj, setup, n_runs=3, seed=3)
+    with ThreadPoolExecutor(2) as ex:
+        _same_tree(tt.run_scenario(traj, setup, n_runs=3, seed=3, executor=ex, chunk_runs=1), ref)
+    _same_tree(tt.run_scenario(traj, setup, n_runs=3, seed=3, chunk_runs=1), ref)
+    with ProcessPoolExecutor(2) as ex:
+        _same_tree(tt.run_scenario(traj, setup, n_runs=3, seed=3, executor=ex), ref)
+    with pytest.raises(ValueError, match="chunk_runs"):
+        tt.run_scenario(traj, setup, n_runs=3, chunk_runs=0)
+
+
+def _same_frame_and_attrs(got, ref):
+    """Equal frames, and equal degrees tables (with their attributes) in attrs["tables"]."""
+    pd.testing.assert_frame_equal(got, ref, check_exact=True)
+    assert got.attrs.keys() == ref.attrs.keys() == {"tables"}
+    assert list(got.attrs["tables"]) == list(ref.attrs["tables"])
+    for name, table in ref.attrs["tables"].items():
+        pd.testing.assert_frame_equal(got.attrs["tables"][name], table, check_exact=True)
+        _same_tree(got.attrs["tables"][name].attrs, table.attrs, f"attrs of {name!r}")
+
+
+def test_chen2019_observability_readings_on_threads_in_chunks_and_on_processes():
+    """sweep computes one reading per chunk: the rows and every reading's degrees table (with its
+    rank tolerances and ambiguities) equal the in-process sweep bit for bit."""
+    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
+    m = M.model_45()
+    st = m.labels[:9] + M.table_2_3_states()[3:]
+    reference = O.degrees_table(m, mv, states=st, n_segments=4)
+    variants = {"r = 4": dict(n_segments=4), "r = 2": dict(n_segments=2), "max-normalized": dict(normalize="max"),
+                "assignment by singular vector": dict(assignment="singular", n_segments=4)}
+    ref = O.sweep(m, mv, reference, variants, states=st)
+    assert list(ref.index) == list(variants) and list(ref.attrs["tables"]) == list(variants)
+    with ThreadPoolExecutor(2) as ex:
+        _same_frame_and_attrs(O.sweep(m, mv, reference, variants, states=st, executor=ex, chunk_runs=1), ref)
+    _same_frame_and_attrs(O.sweep(m, mv, reference, variants, states=st, chunk_runs=3), ref)
+    with ProcessPoolExecutor(2) as ex:
+        _same_frame_and_attrs(O.sweep(m, mv, reference, variants, states=st, executor=ex), ref)
+    with pytest.raises(TypeError, match="executor must be a concurrent.futures.Executor"):
+        O.sweep(m, mv, reference, variants, states=st, executor="dask")
+
+
+def test_chen2019_error_effects_on_threads_in_chunks_and_on_processes():
+    """error_effects computes each (error, realisation) with its own seed: the table, noise
+    averages included, equals the in-process one bit for bit."""
+    traj = tr.generate([tr.Straight(60.0), tr.Turn(30.0, np.pi / 2), tr.Straight(60.0)], 47 * DEG, 115 * DEG,
+                       6000.0, dt=0.05, heading=0.0, speed=100.0)
+    ref = ee.error_effects(traj, noise_runs=2)
+    with ThreadPoolExecutor(2) as ex:
+        pd.testing.assert_frame_equal(ee.error_effects(traj, noise_runs=2, executor=ex, chunk_runs=1), ref,
+                                      check_exact=True)
+    pd.testing.assert_frame_equal(ee.error_effects(traj, noise_runs=2, chunk_runs=3), ref, check_exact=True)
+    with ProcessPoolExecutor(2) as ex:
+        pd.testing.assert_frame_equal(ee.error_effects(traj, noise_runs=2, executor=ex), ref, check_exact=True)
+    with pytest.raises(ValueError, match="chunk_runs"):
+        ee.error_effects(traj, noise_runs=2, chunk_runs=0)
+
+
+def _spawned_pool():
+    """Two worker processes started afresh: the polar kernel runs on numba's threads, and a process
+    that has run it cannot fork under the GNU OpenMP threading layer."""
+    return ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn"))
+
+
+@pytest.mark.parametrize("reading", ["shared phases, reset-only runs", "random phases, Euler heading, some runs"])
+def test_fang2020_runs_on_threads_in_chunks_and_on_processes(reading):
+    """simulate draws the rocking phases and the runs' noise seeds once and gives each chunk its
+    runs' share: every run integrates the same stream, and the records, estimates, observations
+    and phases equal the one batch bit for bit (a chunk of one run of a shared-phase reading
+    computes its own truth, a chunk of several the shared table)."""
+    if reading.startswith("shared"):
+        sc = polar.fang2020_scenario(1, duration=900.0, fix_times=(300.0, 600.0), **polar.FANG2020_READING)
+        kw = dict(reset_only_runs=2)
+    else:
+        sc = polar.fang2020_scenario(1, duration=900.0, fix_times=(300.0, 600.0))
+        kw = dict(reset_only_runs=3, continued_runs=3, heading_observation="euler", estimator="mean-attitude")
+    ref = polar.simulate(sc, 5, 7, **kw)
+    with ThreadPoolExecutor(2) as ex:
+        _same_tree(polar.simulate(sc, 5, 7, executor=ex, chunk_runs=1, **kw), ref)
+    for chunk_runs in (2, 3):
+        _same_tree(polar.simulate(sc, 5, 7, chunk_runs=chunk_runs, **kw), ref)
+    with _spawned_pool() as ex:
+        _same_tree(polar.simulate(sc, 5, 7, executor=ex, **kw), ref)
+    with pytest.raises(ValueError, match="chunk_runs"):
+        polar.simulate(sc, 5, 7, chunk_runs=0, **kw)
+
+
+def test_run_fang2020_passes_the_chunking_on():
+    kw = dict(duration=900.0, fix_times=(300.0, 600.0), continued_runs=2)
+    ref = polar.run_fang2020(2, 3, **kw)
+    with ThreadPoolExecutor(2) as ex:
+        _same_tree(polar.run_fang2020(2, 3, executor=ex, chunk_runs=1, **kw), ref)
+    with _spawned_pool() as ex:
+        _same_tree(polar.run_fang2020(2, 3, executor=ex, **kw), ref)

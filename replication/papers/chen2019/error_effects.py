@@ -24,9 +24,12 @@ numbers.
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import pandas as pd
 
+from replication.nav import parallel as PAR
 from replication.nav import trajectory as tr
 from replication.nav.sensors import ImuErrors, TriadErrors, apply_imu_errors
 from replication.nav.strapdown import mechanize
@@ -170,10 +173,15 @@ def error_features(traj, errors: ImuErrors, *, seed=0) -> dict:
             "tilt_rms_end": float(np.sqrt(np.mean(phi[half:, :2] ** 2)))}
 
 
-def error_effects(traj=None, errors: dict | None = None, *, noise_runs: int = 4, seed: int = 2019):
+def error_effects(traj=None, errors: dict | None = None, *, noise_runs: int = 4, seed: int = 2019, executor=None,
+                  chunk_runs=None, progress=None):
     """:func:`error_features` for every entry of ``errors``.
 
-    Random-noise entries are averaged over ``noise_runs`` realisations.
+    Random-noise entries are averaged over ``noise_runs`` realisations.  Every (entry,
+    realisation) is one computation with its own seed, so they are computed in chunks of
+    ``chunk_runs`` computations (:func:`replication.nav.parallel.run_chunks`; one at a time in
+    this process by default), on ``executor`` when one is given, and the table equals the
+    in-process one bit for bit whatever the executor and the chunking.
 
     Parameters
     ----------
@@ -186,6 +194,14 @@ def error_effects(traj=None, errors: dict | None = None, *, noise_runs: int = 4,
         Number of realisations averaged for an entry with white noise (≥ 1).
     seed : int
         Seed of the first realisation (realisation k uses ``seed + k``).
+    executor : concurrent.futures.Executor or None
+        Where the chunks run, e.g. a ``ProcessPoolExecutor`` or
+        ``dask.distributed.Client(...).get_executor()`` (``None``: this process).
+    chunk_runs : int or None
+        Computations (entry, realisation) per chunk (``None``: one per chunk in this process,
+        :func:`replication.nav.parallel.default_chunk_runs` on an executor).
+    progress : bool or None
+        Progress bar of the finished computations (``None``: on unless ``REPLICATION_PROGRESS=0``).
 
     Returns
     -------
@@ -196,21 +212,37 @@ def error_effects(traj=None, errors: dict | None = None, *, noise_runs: int = 4,
     Raises
     ------
     ValueError
-        When ``noise_runs`` is not a positive integer.
+        When ``noise_runs`` or ``chunk_runs`` is not a positive integer.
+    TypeError
+        When ``executor`` is not a ``concurrent.futures.Executor``.
     """
 
     traj = consequence_flight() if traj is None else traj
     errors = single_errors() if errors is None else errors
     if not isinstance(noise_runs, (int, np.integer)) or noise_runs < 1:
         raise ValueError("noise_runs must be a positive integer")
-    rows = {}
+    jobs = []                                     # (entry, realisation), in the entries' order
     for key, err in errors.items():
         noisy = np.any(err.gyro.white_psd > 0) or np.any(err.accel.white_psd > 0)
-        feats = [error_features(traj, err, seed=seed + k) for k in range(noise_runs if noisy else 1)]
-        rows[key] = {k: float(np.mean([f[k] for f in feats])) for k in feats[0]}
+        jobs += [(key, k) for k in range(noise_runs if noisy else 1)]
+    if executor is None and chunk_runs is None:
+        chunk_runs = 1                            # one computation at a time here (the progress bar counts them)
+    parts = PAR.run_chunks(partial(_features_chunk, traj, seed), len(jobs), executor=executor, chunk_runs=chunk_runs,
+                           progress=progress, desc="chen2019 error effects",
+                           chunk_args=lambda r0, r1: ([(k, errors[key]) for key, k in jobs[r0:r1]],))
+    feats = {}
+    for (key, _), f in zip(jobs, [f for part in parts for f in part]):
+        feats.setdefault(key, []).append(f)
+    rows = {key: {k: float(np.mean([f[k] for f in fs])) for k in fs[0]} for key, fs in feats.items()}
     df = pd.DataFrame(rows).T
     df.index.names = ["error", "triad"]
     return df
+
+
+def _features_chunk(traj, seed, r0, r1, share) -> list:
+    """:func:`error_features` of the computations ``r0 … r1−1`` of :func:`error_effects` (a picklable
+    task): ``share`` holds their (realisation k, errors), realisation k seeded ``seed + k``."""
+    return [error_features(traj, err, seed=seed + k) for k, err in share]
 
 
 CONSEQUENCE_RULES = {

@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 import pandas as pd
@@ -58,6 +59,7 @@ from scipy import stats
 
 from replication.nav import earth
 from replication.nav import errors as E
+from replication.nav import parallel as PAR
 from replication.nav import trajectory as tr
 from replication.nav._validate import choice, covariance, finite, finite_array, integer, nonnegative, numeric, positive
 from replication.nav.kalman import discretize_series, update
@@ -1171,8 +1173,14 @@ def best_scenario_counts(table, exclude=("before maneuver",)):
     return winners.value_counts().reindex(t.columns, fill_value=0)
 
 
-def sweep(model, maneuvers: dict, reference, variants: dict, *, states, reference_threshold: float = 1e-5):
+def sweep(model, maneuvers: dict, reference, variants: dict, *, states, reference_threshold: float = 1e-5,
+          executor=None, chunk_runs=None, progress=None):
     """Sensitivity of the comparison with ``reference`` to the unspecified choices.
+
+    Each variant is one computation independent of the others, so the variants are computed in
+    chunks of ``chunk_runs`` variants (:func:`replication.nav.parallel.run_chunks`; one at a time
+    in this process by default), on ``executor`` when one is given; the rows come back in the
+    variants' order, equal to the in-process ones bit for bit.
 
     Parameters
     ----------
@@ -1189,6 +1197,15 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
         Labels of the states computed.
     reference_threshold : float
         A reference degree above it is observable.
+    executor : concurrent.futures.Executor or None
+        Where the chunks run, e.g. a ``ProcessPoolExecutor`` or
+        ``dask.distributed.Client(...).get_executor()`` (``None``: this process); the models and
+        maneuvers must then be picklable.
+    chunk_runs : int or None
+        Variants per chunk (``None``: one per chunk in this process,
+        :func:`replication.nav.parallel.default_chunk_runs` on an executor).
+    progress : bool or None
+        Progress bar of the finished variants (``None``: on unless ``REPLICATION_PROGRESS=0``).
 
     Returns
     -------
@@ -1203,7 +1220,10 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
     Raises
     ------
     TypeError
-        When ``maneuvers``, ``reference`` or ``variants`` has the wrong type.
+        When ``maneuvers``, ``reference`` or ``variants`` has the wrong type, or ``executor`` is not
+        a ``concurrent.futures.Executor``.
+    ValueError
+        When ``chunk_runs`` is not a positive integer.
     """
 
     _maneuvers(maneuvers)
@@ -1215,8 +1235,23 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
     bad = [k for k, v in variants.items() if not isinstance(v, dict)]
     if bad:
         raise TypeError(f"variants[{bad[0]!r}] must be a dict of keyword arguments of degrees_table")
-    rows, tables = [], {}
-    for name, spec in variants.items():
+    items = list(variants.items())
+    if executor is None and chunk_runs is None:
+        chunk_runs = 1                  # one variant at a time in this process (the progress bar counts them)
+    parts = PAR.run_chunks(partial(_sweep_rows, model, maneuvers, reference, states, reference_threshold), len(items),
+                           executor=executor, chunk_runs=chunk_runs, progress=progress, desc="chen2019 readings",
+                           chunk_args=lambda r0, r1: (items[r0:r1],))
+    rows = [row for part in parts for row, _ in part]
+    out = pd.DataFrame(rows).set_index("variant")
+    out.attrs["tables"] = {row["variant"]: table for part in parts for row, table in part}
+    return out
+
+
+def _sweep_rows(model, maneuvers, reference, states, reference_threshold, r0, r1, share) -> list:
+    """(row, degrees table) of :func:`sweep` for the variants ``r0 … r1−1``, whose (name, spec) are
+    ``share`` (a picklable task)."""
+    out = []
+    for name, spec in share:
         spec = dict(spec)
         mdl, mvs, sts = spec.pop("model", model), spec.pop("maneuvers", maneuvers), spec.pop("states", states)
         table = degrees_table(mdl, mvs, states=sts, **spec)
@@ -1228,10 +1263,7 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
         row["verdicts agree"] = int(met["verdicts_agree"].sum())
         row["best maneuver"] = best_scenario_counts(table).idxmax()
         row.update({f"observable {c}": int((table[c] > tol[c]).sum()) for c in reference.columns})
-        rows.append(row)
-        tables[name] = table
-    out = pd.DataFrame(rows).set_index("variant")
-    out.attrs["tables"] = tables
+        out.append((row, table))
     return out
 
 

@@ -186,10 +186,14 @@ def scenario(experiment: int, *, imu_rate_hz: float = 100.0, dwell: float = 300.
     return _scenario_cached(int(experiment), 1.0 / float(imu_rate_hz), float(dwell), int(repeats))
 
 
-def run_scenario(traj, setup: S.SimulationSetup, *, n_runs: int = 12, seed: int = 0, model: str = "15"):
+def run_scenario(traj, setup: S.SimulationSetup, *, n_runs: int = 12, seed: int = 0, model: str = "15",
+                 executor=None, chunk_runs=None, progress=None):
     """Forward closed-loop filter plus RTS smoother over ``n_runs`` Monte Carlo runs on ``traj``.
 
-    Runs :func:`replication.papers.chen2019.simulation.run_batch`, recording every aiding epoch.
+    Runs :func:`replication.papers.chen2019.simulation.run_batch`, recording every aiding epoch;
+    ``executor``, ``chunk_runs`` and ``progress`` go to it unchanged: with either of the first two
+    the runs are computed in chunks (:func:`replication.nav.parallel.run_chunks`) and the
+    reassembled result equals the one batch bit for bit.
 
     Parameters
     ----------
@@ -205,6 +209,15 @@ def run_scenario(traj, setup: S.SimulationSetup, *, n_runs: int = 12, seed: int 
         The filter model kind of :func:`replication.papers.chen2019.simulation.filter_model`:
         ``"15"`` (default, the 15-state model of chen2019 eqs. (3-14)-(3-16); the report does not
         say which model the turntable test used), ``"36"`` or ``"45"``.
+    executor : concurrent.futures.Executor or None
+        Where the chunks of runs run, e.g. a ``ProcessPoolExecutor`` or
+        ``dask.distributed.Client(...).get_executor()`` (``None``: this process).
+    chunk_runs : int or None
+        Runs per chunk (``None``: :func:`replication.nav.parallel.default_chunk_runs` when an
+        executor is given, else one batch, as without these keywords).
+    progress : bool or None
+        Progress bar of the finished runs of a chunked batch (``None``: on unless
+        ``REPLICATION_PROGRESS=0``).
 
     Returns
     -------
@@ -214,13 +227,17 @@ def run_scenario(traj, setup: S.SimulationSetup, *, n_runs: int = 12, seed: int 
     Raises
     ------
     TypeError
-        When ``setup`` is not a ``SimulationSetup``.
+        When ``setup`` is not a ``SimulationSetup``, or ``executor`` not a
+        ``concurrent.futures.Executor``.
+    ValueError
+        When ``chunk_runs`` is not a positive integer.
     """
     if not isinstance(setup, S.SimulationSetup):
         raise TypeError("setup must be a SimulationSetup (see tested_imu_setup)")
     m = S.filter_model(model, setup, float(traj.lat[0]), float(traj.h[0]))
     return S.run_batch(traj, setup, m, n_runs=n_runs, seed=seed, record_every=1, smoother=True,
-                       smoother_covariance=False, chunk_epochs=500)
+                       smoother_covariance=False, chunk_epochs=500, executor=executor, chunk_runs=chunk_runs,
+                       progress=progress)
 
 
 def error_std(result, traj, smoothed: bool = True) -> np.ndarray:

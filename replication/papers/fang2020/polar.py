@@ -1364,7 +1364,7 @@ def initial_state(sc, n_runs, seed):
 
 
 def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimator="printed",
-             heading_observation="misalignment", continued_runs=None):
+             heading_observation="misalignment", continued_runs=None, executor=None, chunk_runs=None, progress=None):
     """Run fang2020 §3: damped grid INS, fixes at ``sc.fix_times``, two-point calibration.
 
     ``n_runs`` Monte Carlo runs (random rocking phases, white noise, ``seed``); the first fix resets
@@ -1374,6 +1374,12 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     the ``estimator`` estimate subtracted from the gyro outputs.  The first ``reset_only_runs``
     runs are continued a second time without compensation (the paper's dashed curves).  Every run
     has its own random stream, so the continued runs are the same whatever ``continued_runs``.
+
+    With ``executor`` or ``chunk_runs`` the runs are computed in chunks of ``chunk_runs`` runs
+    (:func:`replication.nav.parallel.run_chunks`), each one picklable task.  The rocking phases and
+    the runs' noise seeds are drawn here, once, for all ``n_runs`` runs (:func:`initial_state`),
+    and each chunk receives its runs' share, so that every run integrates the same stream as in
+    the one batch; the reassembled result equals the one-batch result bit for bit.
 
     Parameters
     ----------
@@ -1395,6 +1401,15 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     continued_runs : int, optional
         How many runs (the first ones) are integrated past the second fix, in [0, n_runs]
         (default: all); the records of the others are NaN from it on.
+    executor : concurrent.futures.Executor, optional
+        Where the chunks of runs run, e.g. a ``ProcessPoolExecutor`` or
+        ``dask.distributed.Client(...).get_executor()`` (``None``: this process).
+    chunk_runs : int, optional
+        Runs per chunk (``None``: :func:`replication.nav.parallel.default_chunk_runs` when an
+        executor is given, else one batch).
+    progress : bool, optional
+        Progress bar of the finished runs of a chunked batch (``None``: on unless
+        ``REPLICATION_PROGRESS=0``).
 
     Returns
     -------
@@ -1406,7 +1421,10 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     ------
     ValueError
         If an argument is out of range, ``record_every`` or a fix time is not a multiple of the
-        step, or a fix time is not a multiple of ``record_every``.
+        step, a fix time is not a multiple of ``record_every``, or ``chunk_runs`` is not a
+        positive integer.
+    TypeError
+        If ``executor`` is not a ``concurrent.futures.Executor``.
     """
     if heading_observation not in HEADING_OBSERVATIONS:
         raise ValueError(f"heading_observation must be one of {HEADING_OBSERVATIONS}")
@@ -1419,13 +1437,38 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     n_cont = n_runs if continued_runs is None else continued_runs
     if not isinstance(n_cont, (int, np.integer)) or not 0 <= n_cont <= n_runs:
         raise ValueError("continued_runs must be an integer in [0, n_runs] (or None: every run)")
-    dt = sc.dt
     rec_every_k = sc.steps(positive(record_every, "record_every (s)"))
     k_end = sc.steps(sc.duration)
     k1, k2 = sc.steps(sc.fix_times[0]), sc.steps(sc.fix_times[1])
     if k1 % rec_every_k or k2 % rec_every_k:
         raise ValueError("fix times must be multiples of record_every")
     phases, traj, sens, st = initial_state(sc, n_runs, seed)
+    opts = dict(rec_every_k=rec_every_k, k_end=k_end, reset_only_runs=int(reset_only_runs), continued_runs=int(n_cont),
+                estimator=estimator, heading_observation=heading_observation)
+    if executor is None and chunk_runs is None:
+        return _simulate_runs(sc, opts, 0, n_runs, phases, traj, sens, st)
+
+    def share(r0, r1):                  # the chunk's runs of the draws made above, as their own arrays
+        return (phases[r0:r1].copy(), traj[r0:r1].copy(), sens[r0:r1].copy(),
+                {k: v[r0:r1].copy() for k, v in st.items()})
+
+    parts = PAR.run_chunks(partial(_simulate_runs, sc, opts), n_runs, executor=executor, chunk_runs=chunk_runs,
+                           progress=progress, desc="fang2020 runs", chunk_args=share)
+    out = PAR.concat_runs(parts, ("errors", "errors_reset_only", "p2", "phases"))
+    out.estimates = {k: np.concatenate([p.estimates[k] for p in parts]) for k in parts[0].estimates}
+    return out
+
+
+def _simulate_runs(sc, opts, r0, r1, phases, traj, sens, st) -> SimulationResult:
+    """Runs ``r0 … r1−1`` of :func:`simulate` (arguments validated; a picklable task), from their share
+    of :func:`initial_state` (``phases``, ``traj``, ``sens`` and the arrays of ``st``, runs on the
+    first axis); ``opts["reset_only_runs"]`` and ``opts["continued_runs"]`` count the batch's first runs."""
+    n_runs = r1 - r0
+    rec_every_k, estimator, heading_observation = opts["rec_every_k"], opts["estimator"], opts["heading_observation"]
+    m = min(max(opts["reset_only_runs"] - r0, 0), n_runs)      # this chunk's runs among the reset-only ones
+    n_cont = min(max(opts["continued_runs"] - r0, 0), n_runs)  # ... and among the continued ones
+    dt, k_end = sc.dt, opts["k_end"]
+    k1, k2 = sc.steps(sc.fix_times[0]), sc.steps(sc.fix_times[1])
     cbp, vg, r, damp, comp, seeds = st["cbp"], st["vg"], st["r"], st["damp"], st["comp"], st["rng"]
     coef = discretize_damping(dt)
     n_rec = k_end // rec_every_k + 1
@@ -1452,7 +1495,6 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
     tau = sc.fix_times[1] - sc.fix_times[0]
     est = {"printed": two_point_drift(p2, r_ref2, cbg2, tau),
            "mean-attitude": two_point_drift(p2, r_ref2, None, tau, mean_c_b_e=acc_e / tau)}
-    m = reset_only_runs
     st = [x[:m].copy() for x in (cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens)]
     rec_reset = rec[:m].copy()
     comp[:] = est[estimator]
@@ -1548,7 +1590,8 @@ damped velocity, one rocking-phase set shared by all runs that leaves the ship l
 fixes; eq. (27) with the attitude at the second fix (``estimator="printed"``)."""
 
 
-def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, continued_runs=None, **changes):
+def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, continued_runs=None, executor=None, chunk_runs=None,
+                 progress=None, **changes):
     """The 20-run Monte Carlo of fang2020 §3 for case 1 (Table 1) or case 2 (Table 2).
 
     Full fidelity: 10 h at 100 Hz, fixes at 2 h and 3.5 h, under :data:`FANG2020_READING`.
@@ -1565,6 +1608,13 @@ def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, continued_run
         Runs continued also without compensation (:func:`simulate`).
     continued_runs : int, optional
         Runs integrated past the second fix (default: every run; see :func:`simulate`).
+    executor : concurrent.futures.Executor, optional
+        Where the chunks of runs run (:func:`simulate`; ``None``: this process).
+    chunk_runs : int, optional
+        Runs per chunk (:func:`simulate`; ``None`` without an executor: one batch).
+    progress : bool, optional
+        Progress bar of the finished runs of a chunked batch (``None``: on unless
+        ``REPLICATION_PROGRESS=0``).
     changes : float, tuple, bool or str
         Keyword arguments: :class:`Scenario` fields to override (for sensitivity checks).
 
@@ -1575,7 +1625,8 @@ def run_fang2020(case, n_runs=20, *, seed=None, reset_only_runs=1, continued_run
     """
     sc = fang2020_scenario(case, **{**FANG2020_READING, **changes})
     return simulate(sc, n_runs, FANG2020_SEEDS[case] if seed is None else seed,
-                    reset_only_runs=reset_only_runs, continued_runs=continued_runs)
+                    reset_only_runs=reset_only_runs, continued_runs=continued_runs, executor=executor,
+                    chunk_runs=chunk_runs, progress=progress)
 
 
 def drift_summary(result, estimator="printed"):
