@@ -1,8 +1,10 @@
 """Batches of independent runs split into chunks on any ``concurrent.futures.Executor``.
 
 One place for the chunking, submission and reassembly that the batch entry points share
-(:func:`replication.nav.kalman.monte_carlo`, ``chen2019.simulation.run_batch``,
-``chen2019.gravity.compensation_runs``, ``fang2020.polar.sensitivity``, ``duan2023.airdata.sweep``).
+(:func:`replication.nav.kalman.monte_carlo`, ``chen2019.simulation.run_batch`` and
+``chen2019.turntable.run_scenario``, ``chen2019.gravity.compensation_runs``, ``chen2019.observability.sweep``,
+``chen2019.error_effects.error_effects``, ``fang2020.polar.simulate`` and ``sensitivity``,
+``duan2023.airdata.sweep``).
 An entry point describes one chunk as a picklable callable ``task(r0, r1)`` (a module-level
 function bound with ``functools.partial``) that computes the runs ``r0 … r1−1`` and returns their
 results with the runs on the first axis; :func:`run_chunks` submits the chunks, waits for them in

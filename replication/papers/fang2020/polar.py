@@ -1403,7 +1403,10 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
         (default: all); the records of the others are NaN from it on.
     executor : concurrent.futures.Executor, optional
         Where the chunks of runs run, e.g. a ``ProcessPoolExecutor`` or
-        ``dask.distributed.Client(...).get_executor()`` (``None``: this process).
+        ``dask.distributed.Client(...).get_executor()`` (``None``: this process).  The compiled
+        kernel runs on numba's threads; under numba's GNU OpenMP threading layer a process that
+        has run it cannot fork, so give a ``ProcessPoolExecutor`` freshly started workers,
+        ``mp_context=multiprocessing.get_context("spawn")`` (Dask's workers are spawned).
     chunk_runs : int, optional
         Runs per chunk (``None``: :func:`replication.nav.parallel.default_chunk_runs` when an
         executor is given, else one batch).
