@@ -387,14 +387,16 @@ def test_chen2019_error_effects_on_threads_in_chunks_and_on_processes():
         ee.error_effects(traj, noise_runs=2, chunk_runs=0)
 
 
-def _spawned_pool():
+@pytest.fixture(scope="module")
+def spawned_pool():
     """Two worker processes started afresh: the polar kernel runs on numba's threads, and a process
     that has run it cannot fork under the GNU OpenMP threading layer."""
-    return ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn"))
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as ex:
+        yield ex
 
 
 @pytest.mark.parametrize("reading", ["shared phases, reset-only runs", "random phases, Euler heading, some runs"])
-def test_fang2020_runs_on_threads_in_chunks_and_on_processes(reading):
+def test_fang2020_runs_on_threads_in_chunks_and_on_processes(reading, spawned_pool):
     """simulate draws the rocking phases and the runs' noise seeds once and gives each chunk its
     runs' share: every run integrates the same stream, and the records, estimates, observations
     and phases equal the one batch bit for bit (a chunk of one run of a shared-phase reading
@@ -410,16 +412,14 @@ def test_fang2020_runs_on_threads_in_chunks_and_on_processes(reading):
         _same_tree(polar.simulate(sc, 5, 7, executor=ex, chunk_runs=1, **kw), ref)
     for chunk_runs in (2, 3):
         _same_tree(polar.simulate(sc, 5, 7, chunk_runs=chunk_runs, **kw), ref)
-    with _spawned_pool() as ex:
-        _same_tree(polar.simulate(sc, 5, 7, executor=ex, **kw), ref)
+    _same_tree(polar.simulate(sc, 5, 7, executor=spawned_pool, **kw), ref)
     with pytest.raises(ValueError, match="chunk_runs"):
         polar.simulate(sc, 5, 7, chunk_runs=0, **kw)
 
 
-def test_run_fang2020_passes_the_chunking_on():
+def test_run_fang2020_passes_the_chunking_on(spawned_pool):
     kw = dict(duration=900.0, fix_times=(300.0, 600.0), continued_runs=2)
     ref = polar.run_fang2020(2, 3, **kw)
     with ThreadPoolExecutor(2) as ex:
         _same_tree(polar.run_fang2020(2, 3, executor=ex, chunk_runs=1, **kw), ref)
-    with _spawned_pool() as ex:
-        _same_tree(polar.run_fang2020(2, 3, executor=ex, **kw), ref)
+    _same_tree(polar.run_fang2020(2, 3, executor=spawned_pool, **kw), ref)
