@@ -334,10 +334,15 @@ def _store(v: Any, grid: float, digits: int | None) -> float:
     return round_sig(f, DEFAULT_DIGITS)
 
 
+TRANSCRIBED_DIGITS = 10
+"""A paper value with at most this many significant digits is a transcription of the print, kept
+(and shown) as printed; a longer one was computed from a printed formula."""
+
+
 def _store_paper(v: Any, grid: float, digits: int | None) -> float:
     """A paper value: as transcribed when it is a short literal, else rounded like a computed one."""
     f = _as_float_or_nan(v)
-    if not math.isfinite(f) or _significant(repr(f)) <= 10:
+    if not math.isfinite(f) or _significant(repr(f)) <= TRANSCRIBED_DIGITS:
         return f
     return _store(f, grid, digits)
 
@@ -480,25 +485,117 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
     return pd.DataFrame(out, columns=list(TABLE_COLUMNS))
 
 
+DISPLAY_DIGITS = 6
+"""At most this many significant digits of a number are shown to a reader (book tables, the
+``.md`` and ``.tex`` exports, ``python -m replication show``); the CSV keeps the stored digits."""
+
+
+def display_number(v: Any, grid: float = 0.0) -> str:
+    """The reader's text of a stored number: whole numbers whole, the rest to the storage grid.
+
+    Parameters
+    ----------
+    v : str, float or int
+        The stored cell (text of a number as in the CSV, or a number); text that is not a number
+        is returned unchanged.
+    grid : float, optional
+        The decimal grid the row's tolerance supports (:func:`tolerance_grid`, one decade below the
+        absolute tolerance); 0 when the row has no tolerance.
+
+    Returns
+    -------
+    str
+        A whole number without a decimal point (a count ``44``, not ``44.0``); any other number
+        rounded to ``grid`` and to at most :data:`DISPLAY_DIGITS` significant digits, in the
+        shortest form that reads back as that rounded value; empty for an empty or NaN cell.
+    """
+    if isinstance(v, str) and not v.strip():
+        return ""
+    f = _as_float_or_nan(v)
+    if math.isnan(f):
+        return "" if not isinstance(v, str) or _is_nan_text(v) else v
+    return _display_float(f, _display_digits(f, grid))
+
+
+def _display_digits(f: float, grid: float, cap: int = DISPLAY_DIGITS) -> int:
+    """Significant digits of ``f`` down to the decade of ``grid``, between 1 and ``cap``."""
+    if not (math.isfinite(f) and f != 0 and grid > 0 and math.isfinite(grid)):
+        return cap
+    need = math.floor(math.log10(abs(f))) - math.floor(math.log10(grid) + 1e-9) + 1
+    return max(1, min(cap, need))
+
+
+def _display_float(f: float, digits: int) -> str:
+    if math.isfinite(f) and f == int(f) and abs(f) < 1e15:
+        return str(int(f))
+    r = round_sig(f, digits) if math.isfinite(f) else f
+    if math.isfinite(r) and r == int(r) and abs(r) < 1e15:
+        return str(int(r))
+    return format_number(r)
+
+
+def _row_grid(row: Mapping[str, Any]) -> float:
+    """The storage grid of a comparison row (:func:`tolerance_grid` of its absolute tolerance)."""
+    tol = _as_float_or_nan(row.get("tolerance", ""))
+    if not (math.isfinite(tol) and tol > 0):
+        return 0.0
+    if str(row.get("tolerance_kind", "")) == "rel":
+        p = _as_float_or_nan(row.get("paper", ""))
+        if not (math.isfinite(p) and p != 0):
+            return 0.0
+        tol = tol * abs(p)
+    return tolerance_grid(tol)
+
+
 def display_cell(row: Mapping[str, Any], column: str) -> str:
     """The reader's text of one cell of a comparison table.
 
     ``paper`` shows the printed form (``paper_text``) when the paper printed one, ``reproduced``
-    a non-numeric result, ``tolerance`` its kind when relative.
+    a non-numeric result, ``tolerance`` its kind when relative.  Numbers are shown by
+    :func:`display_number`: whole numbers whole, the others with the digits the row's tolerance
+    supports (at most :data:`DISPLAY_DIGITS` significant, or as many as the printed value beside
+    it has); a transcribed paper value as printed.
+
+    Parameters
+    ----------
+    row : mapping
+        One row of a comparison table (:data:`TABLE_COLUMNS`), as text (a row of
+        :func:`read_table`) or typed (a row of :func:`load_table`).
+    column : str
+        The column to show, one of :data:`TABLE_COLUMNS`.
+
+    Returns
+    -------
+    str
+        The cell as a reader sees it.
     """
     def get(c: str) -> str:
         v = row.get(c, "")
-        if isinstance(v, (float, np.floating, int, np.integer, bool, np.bool_)) or v is None:
-            return format_number(v, DEFAULT_DIGITS if isinstance(v, (float, np.floating)) else None)
+        if v is None or (isinstance(v, (float, np.floating)) and math.isnan(v)):
+            return ""
+        if isinstance(v, (float, np.floating, int, np.integer, bool, np.bool_)):
+            return format_number(v)
         return str(v)
 
-    if column == "paper":
-        return get("paper_text") or get("paper")
-    if column == "reproduced":
-        return get("reproduced_text") or get("reproduced")
-    if column == "tolerance":
-        t = get("tolerance")
-        return f"{t} (rel)" if t and get("tolerance_kind") == "rel" else t
+    if column == "paper" and get("paper_text"):
+        return get("paper_text")
+    if column == "reproduced" and get("reproduced_text"):
+        return get("reproduced_text")
+    if column in ("paper", "reproduced"):
+        p, r = _as_float_or_nan(get("paper")), _as_float_or_nan(get("reproduced"))
+        f = p if column == "paper" else r
+        if math.isnan(f):
+            return get(column)
+        # a transcribed paper value (at most TRANSCRIBED_DIGITS significant) is shown as printed, and
+        # the reproduced value beside it to as many digits as the print has where the grid supports them
+        printed = _significant(get("paper")) if math.isfinite(p) else 0
+        printed = printed if printed <= TRANSCRIBED_DIGITS else 0
+        cap = max(DISPLAY_DIGITS, printed)
+        digits = printed if column == "paper" and printed else min(cap, _display_digits(f, _row_grid(row), cap))
+        return _display_float(f, digits)
+    if column in ("abs_error", "tolerance", "rel_error"):
+        t = display_number(get(column), _row_grid(row) if column == "abs_error" else 0.0)
+        return f"{t} (rel)" if column == "tolerance" and t and get("tolerance_kind") == "rel" else t
     return get(column)
 
 
@@ -592,7 +689,7 @@ def _markdown(df: pd.DataFrame, title: str) -> str:
     return "\n".join([f"**{title}**", "", *_md_comparison(df, cols)]) + "\n"
 
 
-_TEX_SPECIAL = {"&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}",
+_TEX_SPECIAL = {"\x01": r"\allowbreak{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}",
                 "~": r"\textasciitilde{}", "^": r"\textasciicircum{}", "\\": r"\textbackslash{}"}
 
 
@@ -651,16 +748,80 @@ def _tex_escape(s: str) -> str:
     return "".join(out)
 
 
+TEX_PACKAGES = ("array", "longtable")
+r"""The LaTeX packages a document needs to ``\input`` an export ``tables/<id>.tex`` (both in
+LaTeX's tools bundle: Debian's ``texlive-latex-base``)."""
+
+TEX_COLUMNS = (("quantity", 0.16), ("unit", 0.11), ("paper", 0.16), ("reproduced", 0.16),
+               ("abs_error", 0.135), ("tolerance", 0.115), ("status", 0.16))
+r"""The columns of a ``.tex`` export and their shares of ``\linewidth``; the reason (the ``note``)
+follows each row on a line of the full width."""
+
+_BREAK = "\x01"          # a place where TeX may break a long token (``\allowbreak``)
+_LONG_TOKEN = 9
+
+
+def _tex_breakable(text: str, long: int = _LONG_TOKEN) -> str:
+    """``text`` with break points in tokens longer than ``long`` characters: after ``/ _ . , ; : =
+    +`` and closing brackets, and before the exponent of a number."""
+    out = []
+    for tok in re.split(r"(\s+)", text):
+        if len(tok) > long and not tok.isspace():
+            if re.fullmatch(r"[-+]?\d[\d.]*[eE][-+]?\d+", tok):
+                tok = re.sub(r"([eE])", _BREAK + r"\1", tok)
+            elif re.fullmatch(r"[-+]?\d+\.\d+", tok):        # a long decimal: breaks every four decimals
+                head, tail = tok.split(".")
+                tok = head + "." + _BREAK.join(tail[i:i + 4] for i in range(0, len(tail), 4))
+            else:
+                tok = re.sub(r"([/_.,;:=+)\]}])(?=[^\s])", r"\1" + _BREAK, tok)
+        out.append(tok)
+    return "".join(out)
+
+
+def _tex_cell(text: str, long: int = _LONG_TOKEN) -> str:
+    """A cell of a ``.tex`` export: escaped (:func:`_tex_escape`), with break points in tokens
+    longer than ``long`` characters."""
+    return _tex_escape(_tex_breakable(text, long)).replace(_CJK_NOTE, r"\allowbreak{}" + _CJK_NOTE + r"\allowbreak{}")
+
+
 def _latex(df: pd.DataFrame, title: str, table_id: str) -> str:
-    cols = ["quantity", "unit", "paper", "reproduced", "abs_error", "tolerance", "status"]
+    r"""The ``.tex`` export of a comparison table: a ``longtable`` that fits the text width of a
+    plain ``article`` (``p`` columns, long cells wrapped) and breaks across pages, its header
+    repeated; each row's reason (the ``note``) on a line of the full width below it.  Needs
+    ``\usepackage{array,longtable}`` (:data:`TEX_PACKAGES`)."""
+    n = len(TEX_COLUMNS)
+    # ragged right, and hyphenable from the first word of a cell on (``\hspace{0pt}``)
+    left = r">{\raggedright\arraybackslash\hspace{0pt}}"
+    spec = "".join(rf"{left}p{{\dimexpr {w}\linewidth-2\tabcolsep\relax}}" for _, w in TEX_COLUMNS)
+    full = left + r"p{\dimexpr\linewidth-2\tabcolsep\relax}"
+    header = " & ".join(_tex_escape(_HEADINGS.get(c, c)) for c, _ in TEX_COLUMNS) + r" \\"
     lines = [
-        r"\begin{table}[htbp]", r"\centering", rf"\caption{{{_tex_escape(title)}}}", rf"\label{{tab:{table_id}}}",
-        r"\begin{tabular}{" + "l" * len(cols) + "}", r"\hline",
-        " & ".join(_tex_escape(c) for c in cols) + r" \\", r"\hline",
+        f"% tables/{table_id}.tex: {_tex_escape(title)}",
+        "% Written by replication.registry.reproduction from tables/" + table_id + ".csv (which keeps every stored",
+        "% digit and the Chinese text); regenerate with `python -m replication index`.",
+        "% Include with \\input{" + table_id + "} in a document whose preamble has",
+        "%   \\usepackage{" + ",".join(TEX_PACKAGES) + "}",
+        "% (both in LaTeX's tools bundle, Debian's texlive-latex-base); the table fits the text width of a",
+        "% plain article, breaks across pages and repeats its header.",
+        r"\begingroup",
+        r"\footnotesize",
+        r"\setlength{\tabcolsep}{2pt}",
+        r"\begin{longtable}{" + spec + "}",
+        rf"\caption{{{_tex_escape(title)}}}\label{{tab:{table_id}}}\\",
+        r"\hline", header, r"\hline", r"\endfirsthead",
+        rf"\multicolumn{{{n}}}{{l}}{{\emph{{Table \thetable{{}} (continued)}}}}\\",
+        r"\hline", header, r"\hline", r"\endhead",
+        r"\hline", r"\endfoot",
     ]
     for _, r in df.iterrows():
-        lines.append(" & ".join(_tex_escape(display_cell(r, c)) for c in cols) + r" \\")
-    lines += [r"\hline", r"\end{tabular}", r"\end{table}"]
+        cells = " & ".join(_tex_cell(display_cell(r, c), 4 if c == "unit" else _LONG_TOKEN) for c, _ in TEX_COLUMNS)
+        note = str(r.get("note", "") or "").strip()
+        if note:
+            lines.append(cells + r" \\*")
+            lines.append(rf"\multicolumn{{{n}}}{{{full}}}{{\hspace*{{1em}}\emph{{reason:}} {_tex_cell(note)}}} \\[2pt]")
+        else:
+            lines.append(cells + r" \\")
+    lines += [r"\end{longtable}", r"\endgroup"]
     return "\n".join(lines) + "\n"
 
 
@@ -1518,10 +1679,13 @@ def _register_markdown(register: pd.DataFrame) -> str:
             sub = part[part["kind"] == kind]
             if sub.empty:
                 continue
-            rows = ([f"`{r['table']}`: {r['quantity']}", r["printed"],
-                     _formula(r["corrected"] or r["reproduced"]) if kind == "erratum" else r["reproduced"],
+            # numbers as display_cell shows them (a count whole, at most DISPLAY_DIGITS beyond the print)
+            shown = [{"paper": r["printed"], "reproduced": r["reproduced"]} for _, r in sub.iterrows()]
+            rows = ([f"`{r['table']}`: {r['quantity']}", display_cell(sh, "paper"),
+                     _formula(r["corrected"] or display_cell(sh, "reproduced")) if kind == "erratum"
+                     else display_cell(sh, "reproduced"),
                      re.sub(r"book/([\w/.-]+?)\.ipynb", r"{doc}`/\1`", str(r["note"]))]
-                    for _, r in sub.iterrows())
+                    for sh, (_, r) in zip(shown, sub.iterrows()))
             lines += [f"### {title} of {source}", "", *_md_table(["where", "printed", third, "why"], rows), ""]
     return "\n".join(lines)
 
