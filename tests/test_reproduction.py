@@ -496,7 +496,9 @@ def test_cite_gives_year_version_and_the_sidecar_commit():
 
 def test_datapackage_describes_every_exported_csv():
     """tables/datapackage.json (Frictionless tabular data package) lists every CSV with its exact
-    header; every cell of a ``number`` field parses as a number or is empty (missing)."""
+    header; every field has a description, every numeric column its unit (a count ``1``, a
+    comparison's number the row's ``unit`` column); every cell of a ``number`` field parses as a
+    number or is empty (missing)."""
     import json as _json
 
     path = rp.tables_dir() / rp.DATAPACKAGE
@@ -508,6 +510,11 @@ def test_datapackage_describes_every_exported_csv():
         df = pd.read_csv(rp.tables_dir() / res["path"], dtype=str, keep_default_na=False)
         assert [f["name"] for f in res["schema"]["fields"]] == list(df.columns), res["path"]
         for f in res["schema"]["fields"]:
+            assert f.get("description", "").strip(), (res["path"], f["name"], "no description")
+            if f["name"] in rp.FIELD_UNITS and "git_commit" in res:      # a comparison's numeric column
+                assert f.get("unitField") == "unit" or f.get("unit") == "1", (res["path"], f["name"], "no unit")
+            if f["type"] == "integer" and res["name"] == "status":          # the counts
+                assert f.get("unit") == "1", (res["path"], f["name"])
             if f["type"] in ("number", "integer"):
                 cells = df[f["name"]][df[f["name"]] != ""]
                 assert pd.to_numeric(cells, errors="coerce").notna().all(), (res["path"], f["name"])

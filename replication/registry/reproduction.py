@@ -1125,25 +1125,59 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
 
 FIELD_DESCRIPTIONS = {
     "quantity": "what is compared; in a readings ledger '<reading> | <quantity of the main table>'",
-    "unit": "unit of paper, reproduced, abs_error and tolerance (an absolute tolerance)",
-    "paper": "the printed value as a number (empty when the print is a formula, a range or text: see paper_text)",
+    "unit": "unit of paper, reproduced, abs_error and an absolute tolerance of this row ('1' or empty: "
+            "dimensionless; 'text' where the row compares words)",
+    "paper": "the printed value as a number, in the row's unit (empty when the print is a formula, a range or "
+             "text: see paper_text)",
     "paper_text": "the printed form where it is not a single number",
-    "reproduced": "the value computed by the package, stored with the digits every machine computes",
+    "reproduced": "the value computed by the package, in the row's unit, stored with the digits every machine "
+                  "computes",
     "reproduced_text": "the computed result where it is not a single number",
-    "abs_error": "|reproduced - paper|, shown only for rows compared against a tolerance",
-    "rel_error": "abs_error / |paper|",
-    "tolerance": "the tolerance stated before the comparison (absolute in the row's unit, or relative)",
+    "abs_error": "|reproduced - paper| in the row's unit, shown only for rows compared against a tolerance",
+    "rel_error": "abs_error / |paper| (dimensionless)",
+    "tolerance": "the tolerance stated before the comparison: in the row's unit when tolerance_kind is abs, "
+                 "dimensionless (a fraction of |paper|) when rel",
     "tolerance_kind": "abs or rel",
     "status": "reproduced, erratum, inconsistent, qualitative, analog, unverifiable, not-reproduced or pending "
               "(CONTRIBUTING.md, Statuses)",
     "note": "why the row has its status",
     "evidence": "the notebook and test that prove an erratum (or support a finding)",
     "corrected": "the corrected expression or value of an erratum",
-    "kind": "erratum (a printed value proven wrong) or inconsistent (two printed parts that disagree)",
-    "table": "the exported table holding the row",
-    "printed": "what the source prints, as printed",
 }
-"""Descriptions of the columns of the exported CSVs (``tables/datapackage.json``)."""
+"""Descriptions of the columns of the exported comparison tables (``tables/datapackage.json``)."""
+
+FIELD_UNITS = {"paper": "unit", "reproduced": "unit", "abs_error": "unit", "tolerance": "unit", "rel_error": "1"}
+"""The unit of each numeric column of a comparison table: ``"unit"`` where it is the row's own
+``unit`` column (a per-row unit), ``"1"`` where dimensionless; a ``rel`` tolerance is a fraction."""
+
+_COUNT = "number of rows of the artifact's tables with status {}"
+STATUS_FIELD_DESCRIPTIONS = {
+    "id": "the artifact (or supplementary table) id, as printed by python -m replication status",
+    "source": "the source document (chen2019, an2021, fang2020, duan2023) or toolkit",
+    "kind": "paper (an artifact of data/artifacts.csv) or supplementary (a check table beyond them)",
+    "artifact": "where the artifact is printed (e.g. 'Table 2-3', 'eq. (4)') or 'supplementary'",
+    "description": "what the artifact is",
+    "status": "the artifact's status from its rows (CONTRIBUTING.md, Statuses; mixed where they differ)",
+    "rows": "number of rows of the artifact's tables",
+    **{s.replace("-", "_"): _COUNT.format(s) for s in STATUSES},
+    "tables": "the exported tables covering the artifact (space-separated ids)",
+    "notebook": "the notebooks that wrote them (space-separated paths)",
+}
+"""Descriptions of the columns of ``tables/status.csv``."""
+
+REGISTER_FIELD_DESCRIPTIONS = {
+    "kind": "erratum (a printed value proven wrong) or inconsistent (two printed parts that disagree)",
+    "source": "the source document holding the finding",
+    "table": "the exported table holding the row",
+    "quantity": "the quantity of that row",
+    "printed": "what the source prints, as printed (paper_text, else the printed number in the row's unit: see "
+               "the table's unit column)",
+    "reproduced": "what the package computes (reproduced_text, else the number in the row's unit)",
+    "corrected": "the corrected expression or value of an erratum",
+    "note": "why: the finding in words",
+    "evidence": "the notebook and test that prove it",
+}
+"""Descriptions of the columns of ``tables/register.csv``."""
 
 
 DATAPACKAGE = "datapackage.json"
@@ -1164,6 +1198,24 @@ def _field_type(name: str, values: pd.Series, comparison: bool = True) -> str:
     return "string"
 
 
+def _field(name: str, values: pd.Series, resource: str, comparison: bool) -> dict:
+    """The Frictionless field of column ``name`` of the CSV ``resource``: name, type, description and,
+    for a count or a numeric column of a comparison, its unit (``unit``: ``"1"`` for a count or a
+    dimensionless number; the name of the column holding a per-row unit otherwise, ``unitField``)."""
+    descriptions = (FIELD_DESCRIPTIONS if comparison else STATUS_FIELD_DESCRIPTIONS if resource == "status"
+                    else REGISTER_FIELD_DESCRIPTIONS if resource == "register" else {})
+    f = {"name": name, "type": _field_type(name, values, comparison=comparison)}
+    if name in descriptions:
+        f["description"] = descriptions[name]
+    if comparison and name in FIELD_UNITS:
+        f.update({"unitField": "unit"} if FIELD_UNITS[name] == "unit" else {"unit": FIELD_UNITS[name]})
+        if name == "tolerance":
+            f["unitNote"] = "the row's unit when tolerance_kind is abs; 1 (a fraction of |paper|) when rel"
+    elif not comparison and resource == "status" and f["type"] == "integer":
+        f["unit"] = "1"
+    return f
+
+
 def datapackage() -> dict:
     """A Frictionless *tabular data package* describing every CSV of ``tables/``: one resource per
     file, with its title, the notebook that wrote it, its commit and a schema (field names in file
@@ -1179,9 +1231,7 @@ def datapackage() -> dict:
                "title": meta.get("title", {"status": "Reproduction status of every artifact",
                                            "register": "Register of errata and inconsistencies"}.get(path.stem,
                                                                                                        path.stem)),
-               "schema": {"fields": [dict({"name": c, "type": _field_type(c, df[c], comparison=bool(meta))},
-                                          **({"description": FIELD_DESCRIPTIONS[c]} if c in FIELD_DESCRIPTIONS else {}))
-                                     for c in df.columns],
+               "schema": {"fields": [_field(c, df[c], path.stem, bool(meta)) for c in df.columns],
                           "missingValues": [""]}}
         if meta:
             res["sources"] = [{"title": meta.get("notebook", ""), "path": meta.get("notebook", "")}]
