@@ -48,8 +48,6 @@ PENDING: set[str] = {
     "replication.papers.duan2023.airdata",
     "replication.papers.fang2020.polar",
     "replication.papers.plots",
-    "replication.registry.book",
-    "replication.registry.reproduction",
 }
 
 
