@@ -2149,9 +2149,16 @@ def _status_markdown(status: pd.DataFrame) -> str:
 
 
 def _formula(text: str) -> str:
-    """A corrected expression written in LaTeX is shown as inline maths; plain text stays text."""
+    """A corrected expression written in LaTeX is shown as inline maths; plain text stays text.
+
+    A long expression is set as several inline formulas, cut after each ``;`` and after each comma
+    followed by a TeX space (``,\\ ``), so that the browser can wrap it in its table cell (MathJax
+    does not break an inline formula)."""
     t = str(text)
-    return f"${t}$" if "\\" in t and "$" not in t else t
+    if "\\" not in t or "$" in t:
+        return t
+    pieces = [p for p in re.split(r"(?<=;)\s+|(?<=,)(?=\\ )", t) if p.strip()]
+    return " ".join(f"${p.strip()}$" for p in pieces)
 
 
 def _register_markdown(register: pd.DataFrame) -> str:
