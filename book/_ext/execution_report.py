@@ -79,8 +79,9 @@ class ExecutionReport(Directive):
             return [nodes.paragraph(text=NO_RECORD)]
         machines, rows = report_rows(data)
         total = sum(float(r.get("seconds") or 0) for r in data["notebooks"].values())
-        out = [nodes.paragraph(text=f"{len(rows)} notebooks recorded, {total:.0f} s of run time in all "
-                                    "(several run at once: see the last columns).")]
+        n = len(rows)
+        out = [nodes.paragraph(text=f"{n} notebook{'' if n == 1 else 's'} recorded, {total:.0f} s of run time "
+                                    "in all (several may run at once: see the last columns).")]
         lst = nodes.bullet_list()
         for i, m in enumerate(machines):
             lst += nodes.list_item("", nodes.paragraph(text=f"Machine {chr(ord('A') + i)}: {m}"))
