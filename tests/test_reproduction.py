@@ -599,3 +599,11 @@ def test_numbers_are_shown_with_the_digits_their_tolerance_supports():
     md = rp._markdown(df, "t")
     assert "| 44 | 45 |" in md and "3.7367302193658" not in md
     assert "3.7367302193658" not in rp._latex(df, "t", "chen2019-table-9")
+
+
+def test_a_long_corrected_expression_is_set_as_formulas_that_wrap():
+    f = rp._formula(r"F22(1,1) = (V_N \tan L - V_U)/(R_N+h); third row [2\omega_{ie}\cos L + 2V_E/(R_N+h),\ 0]")
+    assert f == r"$F22(1,1) = (V_N \tan L - V_U)/(R_N+h);$ third row $[2\omega_{ie}\cos L$ $+ 2V_E/(R_N+h),$ $\ 0]$"
+    assert rp._formula(r"\sin^2 2L") == r"$\sin^2 2L$"
+    assert rp._formula("sin^2 2L, as printed") == "sin^2 2L, as printed"        # no TeX: text
+    assert all(not p.endswith("\\") for p in f.split("$"))          # no piece ends in an escaped dollar

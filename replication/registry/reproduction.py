@@ -2151,14 +2151,23 @@ def _status_markdown(status: pd.DataFrame) -> str:
 def _formula(text: str) -> str:
     """A corrected expression written in LaTeX is shown as inline maths; plain text stays text.
 
-    A long expression is set as several inline formulas, cut after each ``;`` and after each comma
-    followed by a TeX space (``,\\ ``), so that the browser can wrap it in its table cell (MathJax
-    does not break an inline formula)."""
+    A long expression is set as several inline formulas, cut after each ``;``, after each comma
+    followed by a TeX space (``,\\ ``) and before each `` + ``, with words that open a piece
+    ("third row") set as text, so that the browser can wrap it in its table cell (MathJax does not
+    break an inline formula)."""
     t = str(text)
     if "\\" not in t or "$" in t:
         return t
-    pieces = [p for p in re.split(r"(?<=;)\s+|(?<=,)(?=\\ )", t) if p.strip()]
-    return " ".join(f"${p.strip()}$" for p in pieces)
+    out = []
+    for piece in (p.strip() for p in re.split(r"(?<=;)\s+|(?<=,)(?=\\ )|\s+(?=\+ )", t)):
+        if not piece:
+            continue
+        words = re.match(r"([A-Za-z]{2,}(?: [A-Za-z]{2,})*:?) (?=[\[(\\])", piece)
+        if words:
+            out.append(words.group(1))
+            piece = piece[words.end():]
+        out.append(f"${piece}$")
+    return " ".join(out)
 
 
 def _register_markdown(register: pd.DataFrame) -> str:
