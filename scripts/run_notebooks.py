@@ -11,14 +11,22 @@ the new rendering differs from it by less than ``--image-rms`` (root-mean-square
 the 0-255 scale, as matplotlib's own image comparison): anti-aliasing and font hinting move a
 few pixels between machines while the figure does not change. A failing cell is reported and
 the run fails.
+
+Each notebook's run (its time, when it finished and on what machine: CPU model, cores, Python and
+numpy versions) is recorded in ``.cache/execution-report.json`` (:data:`REPORT`), outside the
+tracked files, so that running the book leaves ``git status`` clean; the book's execution report
+page renders it at build time (``book/_ext/execution_report.py``).
 """
 
 from __future__ import annotations
 
 import argparse
 import base64
+import datetime
 import io
+import json
 import os
+import platform
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -31,6 +39,54 @@ from nbclient.exceptions import CellExecutionError
 ROOT = Path(__file__).resolve().parent.parent
 KEEP_NB_METADATA = ("kernelspec", "language_info")
 SKIP_PARTS = {"_build", ".ipynb_checkpoints", "jupyter_execute", ".venv"}
+
+
+REPORT = ROOT / ".cache" / "execution-report.json"
+"""The execution record of this checkout (git-ignored): ``{"notebooks": {path: run}}``, one entry per
+notebook, replaced by its latest run (``make notebooks`` / ``make notebook``)."""
+
+
+def cpu_model() -> str:
+    """The processor's model name (``/proc/cpuinfo`` on Linux, else :func:`platform.processor`)."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text(encoding="utf-8", errors="replace").splitlines():
+            if line.lower().startswith("model name"):
+                return " ".join(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    return platform.processor() or platform.machine() or "unknown"
+
+
+def machine() -> dict:
+    """What a run depends on beside the code: CPU model, cores, operating system, Python, numpy."""
+    from importlib import metadata
+
+    def version(name: str) -> str:
+        try:
+            return metadata.version(name)
+        except metadata.PackageNotFoundError:
+            return "absent"
+
+    return {"cpu": cpu_model(), "cores": os.cpu_count() or 1, "system": f"{platform.system()} {platform.release()}",
+            "python": platform.python_version(), "numpy": version("numpy"), "numba": version("numba")}
+
+
+def record_runs(runs: dict[str, dict], report: Path = REPORT) -> Path:
+    """Merge ``{notebook: run}`` into the execution record ``report`` (written whole, atomically);
+    returns its path.  A run is ``{"seconds", "finished", "outcome", "jobs", "machine"}``."""
+    try:
+        data = json.loads(report.read_text(encoding="utf-8"))
+        if not isinstance(data.get("notebooks"), dict):
+            raise ValueError
+    except (OSError, ValueError):
+        data = {"notebooks": {}}
+    data["notebooks"].update(runs)
+    data["notebooks"] = dict(sorted(data["notebooks"].items()))
+    report.parent.mkdir(parents=True, exist_ok=True)
+    tmp = report.with_name(report.name + f".{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+    os.replace(tmp, report)
+    return report
 
 
 def book_notebooks() -> list[Path]:
@@ -183,7 +239,9 @@ def main(argv: list[str] | None = None) -> int:
             return 2
     t0 = time.perf_counter()
     failed = []
-    with ProcessPoolExecutor(max_workers=min(args.jobs, len(paths))) as pool:
+    host = machine()
+    jobs = min(args.jobs, len(paths))
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
         futures = [pool.submit(_run_one, p, args.timeout, args.image_rms) for p in _order(paths)]
         for fut in as_completed(futures):
             p, dt, err = fut.result()
@@ -193,6 +251,11 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"FAILED {rel}:\n{err}", file=sys.stderr)
             else:
                 print(f"executed {rel} in {dt:.1f} s", flush=True)
+            if p.is_relative_to(ROOT):
+                record_runs({rel.as_posix(): {
+                    "seconds": None if dt is None else round(dt, 1), "outcome": "failed" if dt is None else "ok",
+                    "finished": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+                    "jobs": jobs, "machine": host}})
     print(f"{len(paths) - len(failed)} of {len(paths)} notebooks in {time.perf_counter() - t0:.1f} s wall")
     return 1 if failed else 0
 

@@ -6,6 +6,10 @@ leaves no raw ``$``/LaTeX outside rendered maths, shows no figure twice, and eve
 no table wider than the content column at 1280 px (the status and reason columns visible), the
 status bars and the findings boxes present (a table with a status column must fit: data frames
 printed by a notebook may scroll).  Math renders with the local MathJax; figures decode.
+What a reader sees first: the landing page states the verdicts (the "In short" sentences of
+``book/intro.md``) and links the repository; on the register, the status page, the execution
+report and a few chapters with tables, no table or register is wider than the content column and
+the column itself does not scroll sideways (scrollWidth against clientWidth, measured).
 
 Run after the book is built (``make html-strict``); ``make test`` does both. Every request the
 pages make is recorded: any request that leaves the local server, or fails, is an error. A
@@ -159,11 +163,55 @@ MATHJAX_SRC_JS = "Array.from(document.scripts).map(s => s.src).filter(s => s.inc
 FINDINGS = ".admonition:has(.admonition-title:text('Findings of this chapter'))"
 OVERVIEW = ["status.html"] + [f"{p}/index.html" for p in ("chen2019", "fang2020", "duan2023", "an2021")]
 
+WIDTH_PAGES = ["register.html", "status.html", "appendix/execution.html", "appendix/exports.html",
+               "foundations/01_earth_normal_gravity.html", "chen2019/02_imu_error_model_and_calibration.html",
+               "fang2020/01_polar_grid_calibration.html", "an2021/01_gravity_to_attitude.html"]
+"""Pages whose every table (registers, comparisons, the execution report) must fit at 1280 px."""
+
+WIDTH_JS = """() => {
+  const art = document.querySelector('.bd-article');
+  const box = art.getBoundingClientRect();
+  const tables = Array.from(art.querySelectorAll('table')).filter(t => t.offsetParent !== null
+      && !t.closest('.cell_output .dataframe, .output .dataframe') && !t.classList.contains('dataframe'));
+  return {column: {client: art.clientWidth, scroll: art.scrollWidth, width: Math.round(box.width)},
+          tables: tables.map(t => {
+            const wrap = t.parentElement;
+            return {width: Math.round(t.getBoundingClientRect().width), right: t.getBoundingClientRect().right,
+                    wrapScroll: wrap.scrollWidth - wrap.clientWidth,
+                    head: (t.tHead ? t.tHead.innerText : t.innerText).replace(/\\s+/g, ' ').slice(0, 50)};
+          }), right: box.right};
+}"""
+"""The content column's width and overflow, and each table's width and its container's overflow.
+A data frame printed by a notebook (``.dataframe``) may scroll; a table of the book may not."""
+
+LANDING = "intro.html"
+
+
+def _in_short() -> list[str]:
+    """The opening words (up to the first parenthesis, colon or semicolon) of each "In short" verdict of book/intro.md."""
+    text = (ROOT / "book" / "intro.md").read_text(encoding="utf-8")
+    section = text.split("## In short", 1)[1].split("\n## ", 1)[0]
+    section = section.split("\n\n")[1] if section.startswith("\n\n") else section
+    out = []
+    for item in re.split(r"^\* ", section, flags=re.M)[1:]:
+        plain = re.sub(r"\{\w+\}`([^`<]*)(<[^>]*>)?`", r"\1", item)
+        plain = " ".join(plain.replace("**", "").replace("`", "").split())
+        out.append(re.split(r"[(:;]", plain, maxsplit=1)[0].strip())
+    return out
+
+
+def _normal(text: str) -> str:
+    """Whitespace collapsed, typographic quotes and dashes as typed."""
+    for a, b in (("\u2019", "'"), ("\u2018", "'"), ("\u201c", '"'), ("\u201d", '"'), ("\u2013", "--")):
+        text = text.replace(a, b)
+    return " ".join(text.split())
+
 
 @pytest.fixture(scope="module")
 def seen(server, browser):
     """Every page visited once at 1280 px, with what each test below checks recorded."""
     wide = set(OVERVIEW + _chapter_of_each_paper())
+    measured = set(WIDTH_PAGES)
     out = {}
     shot = False
     tab = _Visitor(browser)
@@ -191,9 +239,49 @@ def seen(server, browser):
                      findings=page.locator(FINDINGS).count())
             if rel == "status.html":
                 page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot-status.png"), full_page=False)
+        if rel in measured:
+            r["widths_measured"] = page.evaluate(WIDTH_JS)
+        if rel == LANDING:
+            r["text"] = _normal(page.evaluate("() => document.querySelector('.bd-article').innerText"))
+            r["repo_links"] = page.evaluate("""url => Array.from(document.querySelectorAll('a'))
+                .filter(a => a.href.replace(/\\/$/, '') === url && a.getClientRects().length > 0).length""",
+                                            _repository_url())
         out[rel] = r
     tab.page.close()
     return out
+
+
+def _repository_url() -> str:
+    import replication
+
+    return replication.repository_url().rstrip("/")
+
+
+def test_the_landing_page_states_the_verdicts_and_links_the_repository(seen):
+    """The "In short" verdicts of book/intro.md, one per source document, are on the landing page as
+    a reader sees it, and a visible link leads to the repository."""
+    r = seen[LANDING]
+    verdicts = _in_short()
+    assert len(verdicts) == 4 and all(len(v.split()) >= 5 for v in verdicts), verdicts
+    missing = [v for v in verdicts if _normal(v) not in r["text"]]
+    assert not missing, f"verdicts not shown on {LANDING}: {missing}"
+    assert r["repo_links"] >= 1, f"no visible link to {_repository_url()} on {LANDING}"
+
+
+def test_no_table_or_register_is_wider_than_its_column(seen):
+    """At 1280 px: the content column does not scroll sideways, and no table of the register, the
+    status page, the execution report or a chapter is wider than it or scrolls inside it."""
+    problems = []
+    for rel in WIDTH_PAGES:
+        m = seen[rel]["widths_measured"]
+        if m["column"]["scroll"] > m["column"]["client"] + 1:
+            problems.append(f"{rel}: the content column scrolls ({m['column']['scroll']} > {m['column']['client']} px)")
+        for t in m["tables"]:
+            if t["right"] > m["right"] + 2 or t["wrapScroll"] > 2:
+                problems.append(f"{rel}: table {t['head']!r} {t['width']} px in a {m['column']['width']} px column "
+                                f"(scrolls by {t['wrapScroll']} px)")
+    assert any(seen[rel]["widths_measured"]["tables"] for rel in WIDTH_PAGES), "no table measured"
+    assert not problems, "\n".join(problems)
 
 
 def test_every_page_loads_offline(seen):

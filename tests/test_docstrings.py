@@ -25,8 +25,6 @@ import replication
 PENDING: set[str] = {
     "replication.nav.closedloop",
     "replication.papers.duan2023.airdata",
-    "replication.registry.book",
-    "replication.registry.reproduction",
 }
 
 

@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -290,7 +291,7 @@ def test_cli_show_cite_and_unknown_id(sandbox, capsys):
     assert cli(["show", "chen2019-table-9-9", "--format", "csv"]) == 0
     assert "alpha,m,1.5,,1.5,,0,0,0,abs,reproduced" in capsys.readouterr().out
     assert cli(["show", "chen2019-table-9-9", "--format", "tex"]) == 0
-    assert r"\begin{tabular}" in capsys.readouterr().out
+    assert r"\begin{longtable}" in capsys.readouterr().out
     assert cli(["cite", "chen2019-table-9-9"]) == 0
     out = capsys.readouterr().out
     assert "@misc{repro-chen2019-table-9-9," in out and "@techreport{chen2019," in out
@@ -451,7 +452,8 @@ def test_every_id_the_status_command_prints_works_in_show_and_cite(sandbox, caps
         for fmt in ("md", "csv", "tex"):
             assert cli(["show", ident, "--format", fmt]) == 0, (ident, fmt)
             out = capsys.readouterr().out
-            assert out.count("Title of ") == len(tables) if fmt != "csv" else "q,,1.0,,1.0," in out
+            heading = {"md": "**Title of ", "tex": "\\caption{Title of "}.get(fmt)
+            assert out.count(heading) == len(tables) if fmt != "csv" else "q,,1.0,,1.0," in out
             headings = re.findall(r"^(?:## |# |% )(chen2019-check-[ab]) \((\d) of 2 tables covering chen2019-eq-4-8\)$",
                                   out, flags=re.M)
             assert headings == ([("chen2019-check-a", "1"), ("chen2019-check-b", "2")] if len(tables) > 1 else [])
@@ -494,7 +496,9 @@ def test_cite_gives_year_version_and_the_sidecar_commit():
 
 def test_datapackage_describes_every_exported_csv():
     """tables/datapackage.json (Frictionless tabular data package) lists every CSV with its exact
-    header; every cell of a ``number`` field parses as a number or is empty (missing)."""
+    header; every field has a description, every numeric column its unit (a count ``1``, a
+    comparison's number the row's ``unit`` column); every cell of a ``number`` field parses as a
+    number or is empty (missing)."""
     import json as _json
 
     path = rp.tables_dir() / rp.DATAPACKAGE
@@ -506,6 +510,11 @@ def test_datapackage_describes_every_exported_csv():
         df = pd.read_csv(rp.tables_dir() / res["path"], dtype=str, keep_default_na=False)
         assert [f["name"] for f in res["schema"]["fields"]] == list(df.columns), res["path"]
         for f in res["schema"]["fields"]:
+            assert f.get("description", "").strip(), (res["path"], f["name"], "no description")
+            if f["name"] in rp.FIELD_UNITS and "git_commit" in res:      # a comparison's numeric column
+                assert f.get("unitField") == "unit" or f.get("unit") == "1", (res["path"], f["name"], "no unit")
+            if f["type"] == "integer" and res["name"] == "status":          # the counts
+                assert f.get("unit") == "1", (res["path"], f["name"])
             if f["type"] in ("number", "integer"):
                 cells = df[f["name"]][df[f["name"]] != ""]
                 assert pd.to_numeric(cells, errors="coerce").notna().all(), (res["path"], f["name"])
@@ -559,3 +568,42 @@ def test_part_summary_links_every_artifact_of_its_paper():
     for i in ids:
         assert f"{{doc}}`{i} " in md
     assert "../../tables/fang2020-table-1.csv" in md and "chen2019" not in md
+
+
+def test_numbers_are_shown_with_the_digits_their_tolerance_supports():
+    df = rp.comparison_frame([
+        # a count: whole, never 44.0
+        dict(quantity="states", unit="", paper=44.0, reproduced=45.0, status="inconsistent", note="two parts"),
+        # a closed form at a relative 1e-12: the CSV keeps 14 digits, a reader sees DISPLAY_DIGITS
+        dict(quantity="A", unit="1/s", paper=3.7367302193658e-5, reproduced=3.7367302193658e-5, tolerance=1e-12,
+             tolerance_kind="rel"),
+        # a tolerance of 0.01: the value to the grid one decade below it
+        dict(quantity="x", unit="m", paper=12.3, reproduced=12.3456789, tolerance=0.01),
+        # a transcribed paper value is shown as printed, the reproduced value to as many digits
+        dict(quantity="g", unit="m/s^2", paper=9.7803253, reproduced=9.78032534, tolerance=1e-6),
+    ])
+    assert df.loc[0, "paper"] == "44.0" and df.loc[1, "paper"] == "3.7367302193658e-5"   # CSV digits kept
+    shown = [[rp.display_cell(r, c) for c in ("paper", "reproduced", "abs_error")] for _, r in df.iterrows()]
+    assert shown[0] == ["44", "45", ""]
+    assert shown[1] == ["3.73673e-5", "3.73673e-5", "0"]
+    assert shown[2] == ["12.3", "12.346", "0.046"]
+    assert shown[3] == ["9.7803253", "9.7803253", "0"]
+    assert rp.display_number("44.0") == "44" and rp.display_number("") == "" and rp.display_number("n/a") == "n/a"
+    assert rp.display_number("0.123456789", 0.001) == "0.123"
+    # the exports and a typed table (load_table's floats) show the same
+    typed = df.copy()
+    for c in rp.NUMERIC_COLUMNS:
+        typed[c] = pd.to_numeric(typed[c].replace("", np.nan))
+    assert [[rp.display_cell(r, c) for c in ("paper", "reproduced")] for _, r in typed.iterrows()] == \
+        [s[:2] for s in shown]
+    md = rp._markdown(df, "t")
+    assert "| 44 | 45 |" in md and "3.7367302193658" not in md
+    assert "3.7367302193658" not in rp._latex(df, "t", "chen2019-table-9")
+
+
+def test_a_long_corrected_expression_is_set_as_formulas_that_wrap():
+    f = rp._formula(r"F22(1,1) = (V_N \tan L - V_U)/(R_N+h); third row [2\omega_{ie}\cos L + 2V_E/(R_N+h),\ 0]")
+    assert f == r"$F22(1,1) = (V_N \tan L - V_U)/(R_N+h);$ third row $[2\omega_{ie}\cos L$ $+ 2V_E/(R_N+h),$ $\ 0]$"
+    assert rp._formula(r"\sin^2 2L") == r"$\sin^2 2L$"
+    assert rp._formula("sin^2 2L, as printed") == "sin^2 2L, as printed"        # no TeX: text
+    assert all(not p.endswith("\\") for p in f.split("$"))          # no piece ends in an escaped dollar

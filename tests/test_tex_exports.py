@@ -1,7 +1,9 @@
 """The ``.tex`` exports of ``tables/`` compile with pdflatex in a plain article (Debian's
-``texlive-latex-base``), and the escaping of a cell is right."""
+``texlive-latex-base``) whose preamble loads only the packages each export's header names, fit its
+text width and page height (no overfull box), and the escaping of a cell is right."""
 
 import os
+import re
 import shutil
 import subprocess
 
@@ -9,7 +11,12 @@ import pytest
 
 from replication.registry import reproduction as rp
 
-PREAMBLE = "\\documentclass{article}\n\\begin{document}\n"
+PREAMBLE = "\\documentclass{article}\n\\usepackage{" + ",".join(rp.TEX_PACKAGES) + "}\n\\begin{document}\n"
+
+OVERFULL_BOUND_PT = 0.0
+"""No box of any export may be overfull, by any amount: the column widths are shares of
+``\\linewidth`` that sum to one, every long token has break points, and longtable breaks a tall
+table across pages.  (TeX reports an overfull box only beyond ``\\hfuzz`` = 0.1 pt.)"""
 
 
 def test_escaping_of_specials_and_unicode():
@@ -38,6 +45,12 @@ def _compile(exe, tmp_path, names):
     return r.returncode == 0, r.stdout[-1500:]
 
 
+def overfull_boxes(log: str) -> list[tuple[str, float, str]]:
+    """``(kind, excess in pt, where)`` of every overfull box reported in a TeX log."""
+    return [(m.group(1), float(m.group(2)), m.group(3).strip())
+            for m in re.finditer(r"^Overfull \\([hv]box) \(([0-9.]+)pt too (?:wide|high)\) ([^\n]*)", log, re.M)]
+
+
 def test_every_tex_export_compiles_in_a_plain_article(tmp_path):
     exe = _pdflatex()
     files = sorted(rp.tables_dir().glob("*.tex"))
@@ -51,3 +64,23 @@ def test_every_tex_export_compiles_in_a_plain_article(tmp_path):
         failing = [f.name for f in files if not _compile(exe, tmp_path, [f.stem])[0]]
         pytest.fail(f"pdflatex fails on {failing[:10]}:\n{log}")
     assert (tmp_path / "all.pdf").stat().st_size > 10_000
+    log = (tmp_path / "all.log").read_text(encoding="latin-1")
+    over = [b for b in overfull_boxes(log) if b[1] > OVERFULL_BOUND_PT]
+    assert not over, f"{len(over)} overfull boxes beyond {OVERFULL_BOUND_PT} pt, e.g. {over[:5]}"
+    assert "Float too large" not in log
+
+
+def test_export_header_names_the_packages_and_keeps_the_reason():
+    df = rp.comparison_frame([
+        dict(quantity="q", unit="m", paper=1.0, reproduced=1.5, tolerance=0.1, status="erratum",
+             note="a reason/with/a/very_long_unbreakable_path/in.it", evidence="nb"),
+    ])
+    tex = rp._latex(df, "t", "chen2019-table-9")
+    assert "\\usepackage{array,longtable}" in tex and "\\begin{longtable}" in tex
+    assert "\\emph{reason:}" in tex and "very\\_\\allowbreak{}long" in tex.replace("very\\_long", "very\\_\\allowbreak{}long")
+    assert "1.5" in tex and "1.0" not in tex
+
+
+def test_overfull_boxes_are_read_from_the_log():
+    log = "x\nOverfull \\hbox (12.5pt too wide) in alignment at lines 10--12\nOverfull \\vbox (3.0pt too high) has occurred\n"
+    assert overfull_boxes(log) == [("hbox", 12.5, "in alignment at lines 10--12"), ("vbox", 3.0, "has occurred")]

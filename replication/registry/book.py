@@ -17,7 +17,19 @@ import pandas as pd
 
 
 def plain(value):
-    """``value`` with numpy scalars (and 0-d arrays) converted to Python ``int``/``float``/``bool``."""
+    """``value`` with numpy scalars (and 0-d arrays) converted to Python ``int``/``float``/``bool``.
+
+    Parameters
+    ----------
+    value : object
+        A numpy scalar, a 0-d array or anything else.
+
+    Returns
+    -------
+    object
+        The Python ``bool``, ``int`` or ``float`` of a numpy scalar or 0-d array; any other value
+        unchanged.
+    """
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if isinstance(value, np.bool_):
@@ -39,6 +51,27 @@ def glue(name: str, value, display: bool = True, digits: int = GLUE_DIGITS):
     A float is rounded to ``digits`` significant digits before it is stored.  A matplotlib
     figure is closed once glued, so that the inline backend does not show it a second time at the
     end of the cell (the book shows it where ``{glue:figure}`` places it).
+
+    Parameters
+    ----------
+    name : str
+        The glue key the book refers to (``{glue:text}`name```); not empty.
+    value : object
+        A number (finite), text, DataFrame, figure or anything ``myst_nb.glue`` takes.
+    display : bool, optional
+        Also show the value where the cell is (``myst_nb.glue``'s ``display``).
+    digits : int, optional
+        Significant digits a float keeps (positive; :data:`GLUE_DIGITS` by default).
+
+    Returns
+    -------
+    object
+        What ``myst_nb.glue`` returns (None).
+
+    Raises
+    ------
+    ValueError
+        An empty name, a number that is not finite or ``digits`` not a positive integer.
     """
     from myst_nb import glue as _glue
 
@@ -64,6 +97,18 @@ def sig(value, digits: int = 3):
 
     For printed output of results whose last digits depend on the code path (long nonlinear
     runs, Monte-Carlo statistics): see the precision policy of CONTRIBUTING.md.
+
+    Parameters
+    ----------
+    value : float, numpy.ndarray, pandas.Series or pandas.DataFrame
+        The number(s) to round; non-float cells (text, integers, NaN, 0) are left as they are.
+    digits : int, optional
+        Significant digits (positive).
+
+    Returns
+    -------
+    float, numpy.ndarray, pandas.Series or pandas.DataFrame
+        ``value`` rounded, of the same kind (an array of floats for an array).
     """
 
     if not isinstance(digits, int) or isinstance(digits, bool) or digits < 1:
@@ -89,6 +134,16 @@ def order_bound(value) -> float:
 
     An ideal-sensor error of 1.46e-4 m, or a relative difference of 1.3e-14 between two exact
     implementations, is round-off: its digits change with the code path, its order does not.
+
+    Parameters
+    ----------
+    value : float
+        A finite number, in any unit.
+
+    Returns
+    -------
+    float
+        ``10**ceil(log10(|value|))`` in the unit of ``value``; 0 for 0.
     """
     v = abs(float(plain(value)))
     if not np.isfinite(v):
@@ -104,6 +159,21 @@ def below(value, bound: float, digits: int = 2):
     For a residual that is only known to lie under a stated accuracy (a numerical derivative, a
     round-off difference): its digits below the bound are noise; whether it exceeds the bound is
     the finding.  ``bound`` must be positive.
+
+    Parameters
+    ----------
+    value : float
+        The residual (finite), in the unit of ``bound``.
+    bound : float
+        The stated accuracy (positive, finite).
+    digits : int, optional
+        Significant digits of ``value`` when it is not below ``bound``.
+
+    Returns
+    -------
+    str or float
+        ``"< 1e-08"`` (the bound in exponent form) when ``|value| < bound``, else ``value`` rounded
+        (:func:`sig`).
     """
     b = float(plain(bound))
     if not np.isfinite(b) or b <= 0:

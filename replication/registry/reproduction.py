@@ -86,7 +86,13 @@ class RegistryError(ValueError):
 # --------------------------------------------------------------------------- locations
 
 def project_root() -> Path:
-    """The repository root: ``$REPLICATION_ROOT`` or the folder holding ``pyproject.toml``."""
+    """The repository root: ``$REPLICATION_ROOT`` or the folder holding ``pyproject.toml``.
+
+    Returns
+    -------
+    pathlib.Path
+        The absolute path of the repository root.
+    """
     env = os.environ.get("REPLICATION_ROOT")
     if env:
         return Path(env).resolve()
@@ -101,15 +107,45 @@ def project_root() -> Path:
 
 
 def paper_dir() -> Path:
+    """The folder of the paper values, ``data/paper/`` under :func:`project_root`.
+
+    Returns
+    -------
+    pathlib.Path
+        ``<root>/data/paper``.
+    """
     return project_root() / "data" / "paper"
 
 
 def tables_dir() -> Path:
+    """The folder of the exported tables, ``tables/`` under :func:`project_root`.
+
+    Returns
+    -------
+    pathlib.Path
+        ``<root>/tables``.
+    """
     return project_root() / "tables"
 
 
 def validate_id(table_id: str) -> str:
-    """Check a table id against ``<key>-(table|figure|eq|claim|check)-<n>``."""
+    """Check a table id against ``<key>-(table|figure|eq|claim|check)-<n>``.
+
+    Parameters
+    ----------
+    table_id : str
+        A table id such as ``'chen2019-table-2-3'``.
+
+    Returns
+    -------
+    str
+        ``table_id`` unchanged.
+
+    Raises
+    ------
+    RegistryError
+        A malformed id, with the accepted forms.
+    """
     if not isinstance(table_id, str) or not _ID_RE.match(table_id):
         raise RegistryError(
             f"malformed table id {table_id!r}: expected '<key>-table-<n>', '<key>-figure-<n>', "
@@ -123,7 +159,19 @@ def validate_id(table_id: str) -> str:
 
 @dataclass
 class PaperTable:
-    """Paper values of one printed table / equation set, with provenance."""
+    """Paper values of one printed table / equation set, with provenance.
+
+    Attributes
+    ----------
+    table_id : str
+        The id of the printed artifact (the file's stem).
+    path : pathlib.Path
+        The paper-value file, ``data/paper/<key>/<table_id>.csv``.
+    provenance : dict of str to str
+        The ``#`` header fields (``document``, ``location``, ``section``, ``notes`` ...).
+    data : pandas.DataFrame
+        The CSV body as text: ``quantity``, ``unit``, ``value`` and any further columns.
+    """
 
     table_id: str
     path: Path
@@ -131,7 +179,23 @@ class PaperTable:
     data: pd.DataFrame = field(repr=False)
 
     def value(self, quantity: str) -> Any:
-        """The printed value of ``quantity`` (float when numeric, else the printed text)."""
+        """The printed value of ``quantity`` (float when numeric, else the printed text).
+
+        Parameters
+        ----------
+        quantity : str
+            A quantity of the file.
+
+        Returns
+        -------
+        float or str
+            The printed value, in the row's unit.
+
+        Raises
+        ------
+        RegistryError
+            An unknown or duplicated quantity.
+        """
         rows = self.data[self.data["quantity"] == quantity]
         if rows.empty:
             raise RegistryError(
@@ -142,6 +206,23 @@ class PaperTable:
         return _as_number(rows.iloc[0]["value"])
 
     def unit(self, quantity: str) -> str:
+        """The printed unit of ``quantity``.
+
+        Parameters
+        ----------
+        quantity : str
+            A quantity of the file.
+
+        Returns
+        -------
+        str
+            Its ``unit`` cell.
+
+        Raises
+        ------
+        RegistryError
+            An unknown quantity.
+        """
         rows = self.data[self.data["quantity"] == quantity]
         if rows.empty:
             raise RegistryError(f"{self.path.name}: no quantity {quantity!r}")
@@ -152,7 +233,13 @@ class PaperTable:
         return list(self.data["quantity"])
 
     def numeric(self) -> pd.Series:
-        """The numeric values indexed by quantity (non-numeric entries become NaN)."""
+        """The numeric values indexed by quantity (non-numeric entries become NaN).
+
+        Returns
+        -------
+        pandas.Series
+            Float values (each in its row's unit) indexed by quantity, named ``paper``.
+        """
         return pd.Series(
             [_as_float_or_nan(v) for v in self.data["value"]], index=self.data["quantity"], name="paper"
         )
@@ -183,6 +270,16 @@ def parse_paper_file(path: str | os.PathLike) -> PaperTable:
 
     Raises :class:`RegistryError` with the file name and what to fix when the header lacks a
     provenance field, the body lacks a required column, a quantity is duplicated or empty.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A paper-value CSV (UTF-8).
+
+    Returns
+    -------
+    PaperTable
+        The values with their provenance; the table id is the file's stem.
     """
     path = Path(path)
     if not path.exists():
@@ -231,7 +328,23 @@ def parse_paper_file(path: str | os.PathLike) -> PaperTable:
 
 
 def load_paper(table_id: str) -> PaperTable:
-    """Paper values of ``table_id`` from ``data/paper/<key>/<table_id>.csv``."""
+    """Paper values of ``table_id`` from ``data/paper/<key>/<table_id>.csv``.
+
+    Parameters
+    ----------
+    table_id : str
+        A table id (:func:`validate_id`).
+
+    Returns
+    -------
+    PaperTable
+        The paper values of that artifact.
+
+    Raises
+    ------
+    RegistryError
+        No file for the id (the message lists the known ones of that source).
+    """
     validate_id(table_id)
     key = table_id.split("-", 1)[0]
     path = paper_dir() / key / f"{table_id}.csv"
@@ -264,7 +377,20 @@ ERROR_DIGITS = 2
 
 
 def round_sig(x: float, digits: int) -> float:
-    """``x`` rounded to ``digits`` significant digits (0, NaN and inf unchanged)."""
+    """``x`` rounded to ``digits`` significant digits (0, NaN and inf unchanged).
+
+    Parameters
+    ----------
+    x : float
+        Any number.
+    digits : int
+        Significant digits, positive.
+
+    Returns
+    -------
+    float
+        ``x`` rounded half-to-even in decimal (through its text ``.{digits-1}e``).
+    """
     if not isinstance(digits, (int, np.integer)) or isinstance(digits, bool) or digits < 1:
         raise RegistryError(f"significant digits must be a positive integer, not {digits!r}")
     x = float(x)
@@ -274,7 +400,20 @@ def round_sig(x: float, digits: int) -> float:
 
 
 def round_to_grid(x: float, step: float) -> float:
-    """``x`` rounded to a multiple of the power of ten ``step`` (the text of that grid)."""
+    """``x`` rounded to a multiple of the power of ten ``step`` (the text of that grid).
+
+    Parameters
+    ----------
+    x : float
+        Any number.
+    step : float
+        A power of ten (the grid); ``x`` is returned unchanged for ``step <= 0``.
+
+    Returns
+    -------
+    float
+        The nearest multiple of ``step``, written with no more decimals than ``step`` has.
+    """
     x = float(x)
     if not math.isfinite(x) or step <= 0:
         return x
@@ -283,14 +422,40 @@ def round_to_grid(x: float, step: float) -> float:
 
 
 def tolerance_grid(tol_abs: float) -> float:
-    """The storage grid of a row with absolute tolerance ``tol_abs``: one decade below it."""
+    """The storage grid of a row with absolute tolerance ``tol_abs``: one decade below it.
+
+    Parameters
+    ----------
+    tol_abs : float
+        An absolute tolerance, in the row's unit.
+
+    Returns
+    -------
+    float
+        ``10**(floor(log10(tol_abs)) - 1)`` in the same unit; 0 for a tolerance that is not positive
+        and finite.
+    """
     if not (tol_abs > 0 and math.isfinite(tol_abs)):
         return 0.0
     return 10.0 ** (math.floor(math.log10(tol_abs)) - 1)
 
 
 def format_number(v: Any, digits: int | None = None) -> str:
-    """Deterministic text of a number: shortest round-trip form, optionally ``digits`` significant."""
+    """Deterministic text of a number: shortest round-trip form, optionally ``digits`` significant.
+
+    Parameters
+    ----------
+    v : object
+        A number (Python or numpy), None, or anything else.
+    digits : int, optional
+        Significant digits to round a float to first.
+
+    Returns
+    -------
+    str
+        ``repr`` of a float with the exponent's leading zero dropped (``1e-5``), an integer as
+        such, empty for None and NaN, ``str(v)`` otherwise.
+    """
     if v is None:
         return ""
     if isinstance(v, (bool, np.bool_)):
@@ -334,10 +499,15 @@ def _store(v: Any, grid: float, digits: int | None) -> float:
     return round_sig(f, DEFAULT_DIGITS)
 
 
+TRANSCRIBED_DIGITS = 10
+"""A paper value with at most this many significant digits is a transcription of the print, kept
+(and shown) as printed; a longer one was computed from a printed formula."""
+
+
 def _store_paper(v: Any, grid: float, digits: int | None) -> float:
     """A paper value: as transcribed when it is a short literal, else rounded like a computed one."""
     f = _as_float_or_nan(v)
-    if not math.isfinite(f) or _significant(repr(f)) <= 10:
+    if not math.isfinite(f) or _significant(repr(f)) <= TRANSCRIBED_DIGITS:
         return f
     return _store(f, grid, digits)
 
@@ -414,6 +584,22 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
     otherwise.  Numbers are stored by the precision policy of this module (see
     :data:`DEFAULT_DIGITS`); the status is decided on the stored values, so the CSV is
     self-consistent.  Errors are shown only for rows compared against a tolerance.
+
+    Parameters
+    ----------
+    rows : iterable of mappings
+        One mapping per compared quantity, with the keys of :data:`ROW_KEYS`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The long-format table, columns :data:`TABLE_COLUMNS`, every cell text (numbers as stored).
+
+    Raises
+    ------
+    RegistryError
+        A row without a quantity, a duplicate, an unknown key, a missing tolerance and status, an
+        explicit status that its numbers contradict, an erratum without evidence.
     """
     out = []
     seen = set()
@@ -480,25 +666,117 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
     return pd.DataFrame(out, columns=list(TABLE_COLUMNS))
 
 
+DISPLAY_DIGITS = 6
+"""At most this many significant digits of a number are shown to a reader (book tables, the
+``.md`` and ``.tex`` exports, ``python -m replication show``); the CSV keeps the stored digits."""
+
+
+def display_number(v: Any, grid: float = 0.0) -> str:
+    """The reader's text of a stored number: whole numbers whole, the rest to the storage grid.
+
+    Parameters
+    ----------
+    v : str, float or int
+        The stored cell (text of a number as in the CSV, or a number); text that is not a number
+        is returned unchanged.
+    grid : float, optional
+        The decimal grid the row's tolerance supports (:func:`tolerance_grid`, one decade below the
+        absolute tolerance); 0 when the row has no tolerance.
+
+    Returns
+    -------
+    str
+        A whole number without a decimal point (a count ``44``, not ``44.0``); any other number
+        rounded to ``grid`` and to at most :data:`DISPLAY_DIGITS` significant digits, in the
+        shortest form that reads back as that rounded value; empty for an empty or NaN cell.
+    """
+    if isinstance(v, str) and not v.strip():
+        return ""
+    f = _as_float_or_nan(v)
+    if math.isnan(f):
+        return "" if not isinstance(v, str) or _is_nan_text(v) else v
+    return _display_float(f, _display_digits(f, grid))
+
+
+def _display_digits(f: float, grid: float, cap: int = DISPLAY_DIGITS) -> int:
+    """Significant digits of ``f`` down to the decade of ``grid``, between 1 and ``cap``."""
+    if not (math.isfinite(f) and f != 0 and grid > 0 and math.isfinite(grid)):
+        return cap
+    need = math.floor(math.log10(abs(f))) - math.floor(math.log10(grid) + 1e-9) + 1
+    return max(1, min(cap, need))
+
+
+def _display_float(f: float, digits: int) -> str:
+    if math.isfinite(f) and f == int(f) and abs(f) < 1e15:
+        return str(int(f))
+    r = round_sig(f, digits) if math.isfinite(f) else f
+    if math.isfinite(r) and r == int(r) and abs(r) < 1e15:
+        return str(int(r))
+    return format_number(r)
+
+
+def _row_grid(row: Mapping[str, Any]) -> float:
+    """The storage grid of a comparison row (:func:`tolerance_grid` of its absolute tolerance)."""
+    tol = _as_float_or_nan(row.get("tolerance", ""))
+    if not (math.isfinite(tol) and tol > 0):
+        return 0.0
+    if str(row.get("tolerance_kind", "")) == "rel":
+        p = _as_float_or_nan(row.get("paper", ""))
+        if not (math.isfinite(p) and p != 0):
+            return 0.0
+        tol = tol * abs(p)
+    return tolerance_grid(tol)
+
+
 def display_cell(row: Mapping[str, Any], column: str) -> str:
     """The reader's text of one cell of a comparison table.
 
     ``paper`` shows the printed form (``paper_text``) when the paper printed one, ``reproduced``
-    a non-numeric result, ``tolerance`` its kind when relative.
+    a non-numeric result, ``tolerance`` its kind when relative.  Numbers are shown by
+    :func:`display_number`: whole numbers whole, the others with the digits the row's tolerance
+    supports (at most :data:`DISPLAY_DIGITS` significant, or as many as the printed value beside
+    it has); a transcribed paper value as printed.
+
+    Parameters
+    ----------
+    row : mapping
+        One row of a comparison table (:data:`TABLE_COLUMNS`), as text (a row of
+        :func:`read_table`) or typed (a row of :func:`load_table`).
+    column : str
+        The column to show, one of :data:`TABLE_COLUMNS`.
+
+    Returns
+    -------
+    str
+        The cell as a reader sees it.
     """
     def get(c: str) -> str:
         v = row.get(c, "")
-        if isinstance(v, (float, np.floating, int, np.integer, bool, np.bool_)) or v is None:
-            return format_number(v, DEFAULT_DIGITS if isinstance(v, (float, np.floating)) else None)
+        if v is None or (isinstance(v, (float, np.floating)) and math.isnan(v)):
+            return ""
+        if isinstance(v, (float, np.floating, int, np.integer, bool, np.bool_)):
+            return format_number(v)
         return str(v)
 
-    if column == "paper":
-        return get("paper_text") or get("paper")
-    if column == "reproduced":
-        return get("reproduced_text") or get("reproduced")
-    if column == "tolerance":
-        t = get("tolerance")
-        return f"{t} (rel)" if t and get("tolerance_kind") == "rel" else t
+    if column == "paper" and get("paper_text"):
+        return get("paper_text")
+    if column == "reproduced" and get("reproduced_text"):
+        return get("reproduced_text")
+    if column in ("paper", "reproduced"):
+        p, r = _as_float_or_nan(get("paper")), _as_float_or_nan(get("reproduced"))
+        f = p if column == "paper" else r
+        if math.isnan(f):
+            return get(column)
+        # a transcribed paper value (at most TRANSCRIBED_DIGITS significant) is shown as printed, and
+        # the reproduced value beside it to as many digits as the print has where the grid supports them
+        printed = _significant(get("paper")) if math.isfinite(p) else 0
+        printed = printed if printed <= TRANSCRIBED_DIGITS else 0
+        cap = max(DISPLAY_DIGITS, printed)
+        digits = printed if column == "paper" and printed else min(cap, _display_digits(f, _row_grid(row), cap))
+        return _display_float(f, digits)
+    if column in ("abs_error", "tolerance", "rel_error"):
+        t = display_number(get(column), _row_grid(row) if column == "abs_error" else 0.0)
+        return f"{t} (rel)" if column == "tolerance" and t and get("tolerance_kind") == "rel" else t
     return get(column)
 
 
@@ -592,7 +870,7 @@ def _markdown(df: pd.DataFrame, title: str) -> str:
     return "\n".join([f"**{title}**", "", *_md_comparison(df, cols)]) + "\n"
 
 
-_TEX_SPECIAL = {"&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}",
+_TEX_SPECIAL = {"\x01": r"\allowbreak{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}",
                 "~": r"\textasciitilde{}", "^": r"\textasciicircum{}", "\\": r"\textbackslash{}"}
 
 
@@ -651,16 +929,80 @@ def _tex_escape(s: str) -> str:
     return "".join(out)
 
 
+TEX_PACKAGES = ("array", "longtable")
+r"""The LaTeX packages a document needs to ``\input`` an export ``tables/<id>.tex`` (both in
+LaTeX's tools bundle: Debian's ``texlive-latex-base``)."""
+
+TEX_COLUMNS = (("quantity", 0.16), ("unit", 0.11), ("paper", 0.16), ("reproduced", 0.16),
+               ("abs_error", 0.135), ("tolerance", 0.115), ("status", 0.16))
+r"""The columns of a ``.tex`` export and their shares of ``\linewidth``; the reason (the ``note``)
+follows each row on a line of the full width."""
+
+_BREAK = "\x01"          # a place where TeX may break a long token (``\allowbreak``)
+_LONG_TOKEN = 9
+
+
+def _tex_breakable(text: str, long: int = _LONG_TOKEN) -> str:
+    """``text`` with break points in tokens longer than ``long`` characters: after ``/ _ . , ; : =
+    +`` and closing brackets, and before the exponent of a number."""
+    out = []
+    for tok in re.split(r"(\s+)", text):
+        if len(tok) > long and not tok.isspace():
+            if re.fullmatch(r"[-+]?\d[\d.]*[eE][-+]?\d+", tok):
+                tok = re.sub(r"([eE])", _BREAK + r"\1", tok)
+            elif re.fullmatch(r"[-+]?\d+\.\d+", tok):        # a long decimal: breaks every four decimals
+                head, tail = tok.split(".")
+                tok = head + "." + _BREAK.join(tail[i:i + 4] for i in range(0, len(tail), 4))
+            else:
+                tok = re.sub(r"([/_.,;:=+)\]}])(?=[^\s])", r"\1" + _BREAK, tok)
+        out.append(tok)
+    return "".join(out)
+
+
+def _tex_cell(text: str, long: int = _LONG_TOKEN) -> str:
+    """A cell of a ``.tex`` export: escaped (:func:`_tex_escape`), with break points in tokens
+    longer than ``long`` characters."""
+    return _tex_escape(_tex_breakable(text, long)).replace(_CJK_NOTE, r"\allowbreak{}" + _CJK_NOTE + r"\allowbreak{}")
+
+
 def _latex(df: pd.DataFrame, title: str, table_id: str) -> str:
-    cols = ["quantity", "unit", "paper", "reproduced", "abs_error", "tolerance", "status"]
+    r"""The ``.tex`` export of a comparison table: a ``longtable`` that fits the text width of a
+    plain ``article`` (``p`` columns, long cells wrapped) and breaks across pages, its header
+    repeated; each row's reason (the ``note``) on a line of the full width below it.  Needs
+    ``\usepackage{array,longtable}`` (:data:`TEX_PACKAGES`)."""
+    n = len(TEX_COLUMNS)
+    # ragged right, and hyphenable from the first word of a cell on (``\hspace{0pt}``)
+    left = r">{\raggedright\arraybackslash\hspace{0pt}}"
+    spec = "".join(rf"{left}p{{\dimexpr {w}\linewidth-2\tabcolsep\relax}}" for _, w in TEX_COLUMNS)
+    full = left + r"p{\dimexpr\linewidth-2\tabcolsep\relax}"
+    header = " & ".join(_tex_escape(_HEADINGS.get(c, c)) for c, _ in TEX_COLUMNS) + r" \\"
     lines = [
-        r"\begin{table}[htbp]", r"\centering", rf"\caption{{{_tex_escape(title)}}}", rf"\label{{tab:{table_id}}}",
-        r"\begin{tabular}{" + "l" * len(cols) + "}", r"\hline",
-        " & ".join(_tex_escape(c) for c in cols) + r" \\", r"\hline",
+        f"% tables/{table_id}.tex: {_tex_escape(title)}",
+        "% Written by replication.registry.reproduction from tables/" + table_id + ".csv (which keeps every stored",
+        "% digit and the Chinese text); regenerate with `python -m replication index`.",
+        "% Include with \\input{" + table_id + "} in a document whose preamble has",
+        "%   \\usepackage{" + ",".join(TEX_PACKAGES) + "}",
+        "% (both in LaTeX's tools bundle, Debian's texlive-latex-base); the table fits the text width of a",
+        "% plain article, breaks across pages and repeats its header.",
+        r"\begingroup",
+        r"\footnotesize",
+        r"\setlength{\tabcolsep}{2pt}",
+        r"\begin{longtable}{" + spec + "}",
+        rf"\caption{{{_tex_escape(title)}}}\label{{tab:{table_id}}}\\",
+        r"\hline", header, r"\hline", r"\endfirsthead",
+        rf"\multicolumn{{{n}}}{{l}}{{\emph{{Table \thetable{{}} (continued)}}}}\\",
+        r"\hline", header, r"\hline", r"\endhead",
+        r"\hline", r"\endfoot",
     ]
     for _, r in df.iterrows():
-        lines.append(" & ".join(_tex_escape(display_cell(r, c)) for c in cols) + r" \\")
-    lines += [r"\hline", r"\end{tabular}", r"\end{table}"]
+        cells = " & ".join(_tex_cell(display_cell(r, c), 4 if c == "unit" else _LONG_TOKEN) for c, _ in TEX_COLUMNS)
+        note = str(r.get("note", "") or "").strip()
+        if note:
+            lines.append(cells + r" \\*")
+            lines.append(rf"\multicolumn{{{n}}}{{{full}}}{{\hspace*{{1em}}\emph{{reason:}} {_tex_cell(note)}}} \\[2pt]")
+        else:
+            lines.append(cells + r" \\")
+    lines += [r"\end{longtable}", r"\endgroup"]
     return "\n".join(lines) + "\n"
 
 
@@ -700,6 +1042,39 @@ def compare(
     Writing is idempotent: when the table and its inputs are unchanged the files are not
     touched, so re-running a chapter leaves ``git status`` clean.  The sidecar's ``git_commit`` is
     the commit on top of which the values were last (re)computed.
+
+    Parameters
+    ----------
+    table_id : str
+        The id of the exported table (:func:`validate_id`).
+    rows : iterable of mappings or pandas.DataFrame
+        The compared quantities (:func:`comparison_frame`).
+    title : str
+        The table's title (caption of the exports, title of the citation).
+    notebook : str
+        The chapter that computes it, relative to the repository root.
+    seeds : mapping of str to int, optional
+        The random seeds used.
+    paper_source : str, optional
+        The ``data/paper`` file, relative to the root.
+    description : str, optional
+        A longer description for the sidecar.
+    main_reading : str, optional
+        The reading the table follows (with ``reading_evidence``).
+    reading_evidence : str, optional
+        The printed numbers that support the main reading, in one sentence.
+    readings : str or sequence of str, optional
+        The readings ledgers' table ids.
+    ruled_out : mapping of str to str, optional
+        Reading (or prefix) to the printed evidence that excludes it.
+    summary : str, optional
+        The table's verdict in one line.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The comparison table (:func:`comparison_frame`), with ``attrs`` ``table_id`` and
+        ``notebook`` (so that :func:`display_table` links it).
     """
     validate_id(table_id)
     if bool(main_reading) != bool(reading_evidence):
@@ -785,7 +1160,18 @@ def compare(
 def refresh_exports(table_ids: Iterable[str] | None = None) -> list[str]:
     """Rewrite the ``.md`` and ``.tex`` exports of tables from their stored CSV and sidecar title,
     without recomputing anything (after a change of the export format).  Returns the ids whose
-    files changed; the CSV and the sidecar are left as they are."""
+    files changed; the CSV and the sidecar are left as they are.
+
+    Parameters
+    ----------
+    table_ids : iterable of str, optional
+        The tables to refresh; every exported table by default.
+
+    Returns
+    -------
+    list of str
+        The ids whose ``.md`` or ``.tex`` changed.
+    """
     changed = []
     for tid in list_tables() if table_ids is None else list(table_ids):
         df = read_table(tid)
@@ -802,7 +1188,23 @@ def refresh_exports(table_ids: Iterable[str] | None = None) -> list[str]:
 
 
 def read_table(table_id: str) -> pd.DataFrame:
-    """An exported comparison table (``tables/<id>.csv``) as text columns."""
+    """An exported comparison table (``tables/<id>.csv``) as text columns.
+
+    Parameters
+    ----------
+    table_id : str
+        An exported table id.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``tables/<id>.csv`` with every column as text (empty cells as ``""``).
+
+    Raises
+    ------
+    RegistryError
+        No such exported table (the message lists those of the same source).
+    """
     validate_id(table_id)
     path = tables_dir() / f"{table_id}.csv"
     if not path.exists():
@@ -813,6 +1215,13 @@ def read_table(table_id: str) -> pd.DataFrame:
 
 
 def list_tables() -> list[str]:
+    """The ids of the exported tables (those with a sidecar in ``tables/``).
+
+    Returns
+    -------
+    list of str
+        Sorted table ids; empty when ``tables/`` does not exist.
+    """
     d = tables_dir()
     return sorted(p.stem for p in d.glob("*.json") if _ID_RE.match(p.stem)) if d.exists() else []
 
@@ -833,6 +1242,22 @@ def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterabl
     IPython ``Markdown`` object whose text is a ``{table}`` directive; the book renders it as a
     numbered table labelled ``name`` (reference it with ``{numref}``); a table returned by
     :func:`compare` is also a target named by its id (``{ref}`` with the table id).
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        A comparison table (:func:`compare`, :func:`comparison_frame` or :func:`read_table`).
+    caption : str
+        The table's caption.
+    name : str
+        Its label (lower-case letters, digits and ``-``).
+    columns : iterable of str, optional
+        The columns to show (of :data:`TABLE_COLUMNS`).
+
+    Returns
+    -------
+    IPython.display.Markdown
+        The MyST text of the table (and of its download link and full-column dropdown).
     """
     from IPython.display import Markdown
 
@@ -860,7 +1285,18 @@ def display_table(df: pd.DataFrame, *, caption: str, name: str, columns: Iterabl
 # --------------------------------------------------------------------------- index
 
 def load_artifacts() -> pd.DataFrame:
-    """The list of reproducible artifacts of every seed (``data/artifacts.csv``)."""
+    """The list of reproducible artifacts of every seed (``data/artifacts.csv``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``id``, ``source``, ``artifact``, ``description`` (and ``tables`` where given), as text.
+
+    Raises
+    ------
+    RegistryError
+        A missing column, a malformed or duplicated id.
+    """
     path = project_root() / "data" / "artifacts.csv"
     df = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
     need = {"id", "source", "artifact", "description"}
@@ -888,6 +1324,16 @@ def summarize_status(statuses: Iterable[str]) -> str:
     (``analog``, ``unverifiable``, ``not-reproduced``) → that kind; any other combination →
     ``mixed``, whose split the row counts show.  An artifact with only errata (or only
     inconsistencies) rows is ``erratum`` (``inconsistent``); with no rows, ``pending``.
+
+    Parameters
+    ----------
+    statuses : iterable of str
+        The row statuses (each of :data:`STATUSES`).
+
+    Returns
+    -------
+    str
+        One of :data:`ARTIFACT_STATUSES`.
     """
     present = list(statuses)
     for s in present:
@@ -908,7 +1354,18 @@ def summarize_status(statuses: Iterable[str]) -> str:
 def status_label(row: Mapping[str, Any]) -> str:
     """``status`` of a ``tables/status.csv`` row with its findings about the print, e.g.
     ``reproduced, 52 errata`` — so that an artifact's status never hides its errata; ``mixed``
-    always carries its split, failures first: ``mixed (3 not-reproduced, 20 reproduced)``."""
+    always carries its split, failures first: ``mixed (3 not-reproduced, 20 reproduced)``.
+
+    Parameters
+    ----------
+    row : mapping
+        A row of ``tables/status.csv`` (``status`` and the row counts per status).
+
+    Returns
+    -------
+    str
+        The label shown on the status page.
+    """
     n_e, n_i = int(row.get("erratum", 0) or 0), int(row.get("inconsistent", 0) or 0)
     extra = ([f"{n_e} {'erratum' if n_e == 1 else 'errata'}"] if n_e else []) + \
             ([f"{n_i} {'inconsistency' if n_i == 1 else 'inconsistencies'}"] if n_i else [])
@@ -929,6 +1386,17 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
     exported table, with its ``kind``.  Refuses (:class:`RegistryError`) when an exported table
     breaks the verdict rule (:func:`verdict_violations`), after writing the files, so that the pages
     show the state that the message describes.  Returns ``(status, register)``.
+
+    Parameters
+    ----------
+    write : bool, optional
+        Write the files (``status.csv``, ``register.csv``, their pages, the findings boxes and
+        ``datapackage.json``); with False only compute.
+
+    Returns
+    -------
+    tuple of pandas.DataFrame
+        ``(status, register)``.
     """
     arts = load_artifacts()
     exported = {tid: json.loads((tables_dir() / f"{tid}.json").read_text(encoding="utf-8")) for tid in list_tables()}
@@ -964,25 +1432,59 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
 
 FIELD_DESCRIPTIONS = {
     "quantity": "what is compared; in a readings ledger '<reading> | <quantity of the main table>'",
-    "unit": "unit of paper, reproduced, abs_error and tolerance (an absolute tolerance)",
-    "paper": "the printed value as a number (empty when the print is a formula, a range or text: see paper_text)",
+    "unit": "unit of paper, reproduced, abs_error and an absolute tolerance of this row ('1' or empty: "
+            "dimensionless; 'text' where the row compares words)",
+    "paper": "the printed value as a number, in the row's unit (empty when the print is a formula, a range or "
+             "text: see paper_text)",
     "paper_text": "the printed form where it is not a single number",
-    "reproduced": "the value computed by the package, stored with the digits every machine computes",
+    "reproduced": "the value computed by the package, in the row's unit, stored with the digits every machine "
+                  "computes",
     "reproduced_text": "the computed result where it is not a single number",
-    "abs_error": "|reproduced - paper|, shown only for rows compared against a tolerance",
-    "rel_error": "abs_error / |paper|",
-    "tolerance": "the tolerance stated before the comparison (absolute in the row's unit, or relative)",
+    "abs_error": "|reproduced - paper| in the row's unit, shown only for rows compared against a tolerance",
+    "rel_error": "abs_error / |paper| (dimensionless)",
+    "tolerance": "the tolerance stated before the comparison: in the row's unit when tolerance_kind is abs, "
+                 "dimensionless (a fraction of |paper|) when rel",
     "tolerance_kind": "abs or rel",
     "status": "reproduced, erratum, inconsistent, qualitative, analog, unverifiable, not-reproduced or pending "
               "(CONTRIBUTING.md, Statuses)",
     "note": "why the row has its status",
     "evidence": "the notebook and test that prove an erratum (or support a finding)",
     "corrected": "the corrected expression or value of an erratum",
-    "kind": "erratum (a printed value proven wrong) or inconsistent (two printed parts that disagree)",
-    "table": "the exported table holding the row",
-    "printed": "what the source prints, as printed",
 }
-"""Descriptions of the columns of the exported CSVs (``tables/datapackage.json``)."""
+"""Descriptions of the columns of the exported comparison tables (``tables/datapackage.json``)."""
+
+FIELD_UNITS = {"paper": "unit", "reproduced": "unit", "abs_error": "unit", "tolerance": "unit", "rel_error": "1"}
+"""The unit of each numeric column of a comparison table: ``"unit"`` where it is the row's own
+``unit`` column (a per-row unit), ``"1"`` where dimensionless; a ``rel`` tolerance is a fraction."""
+
+_COUNT = "number of rows of the artifact's tables with status {}"
+STATUS_FIELD_DESCRIPTIONS = {
+    "id": "the artifact (or supplementary table) id, as printed by python -m replication status",
+    "source": "the source document (chen2019, an2021, fang2020, duan2023) or toolkit",
+    "kind": "paper (an artifact of data/artifacts.csv) or supplementary (a check table beyond them)",
+    "artifact": "where the artifact is printed (e.g. 'Table 2-3', 'eq. (4)') or 'supplementary'",
+    "description": "what the artifact is",
+    "status": "the artifact's status from its rows (CONTRIBUTING.md, Statuses; mixed where they differ)",
+    "rows": "number of rows of the artifact's tables",
+    **{s.replace("-", "_"): _COUNT.format(s) for s in STATUSES},
+    "tables": "the exported tables covering the artifact (space-separated ids)",
+    "notebook": "the notebooks that wrote them (space-separated paths)",
+}
+"""Descriptions of the columns of ``tables/status.csv``."""
+
+REGISTER_FIELD_DESCRIPTIONS = {
+    "kind": "erratum (a printed value proven wrong) or inconsistent (two printed parts that disagree)",
+    "source": "the source document holding the finding",
+    "table": "the exported table holding the row",
+    "quantity": "the quantity of that row",
+    "printed": "what the source prints, as printed (paper_text, else the printed number in the row's unit: see "
+               "the table's unit column)",
+    "reproduced": "what the package computes (reproduced_text, else the number in the row's unit)",
+    "corrected": "the corrected expression or value of an erratum",
+    "note": "why: the finding in words",
+    "evidence": "the notebook and test that prove it",
+}
+"""Descriptions of the columns of ``tables/register.csv``."""
 
 
 DATAPACKAGE = "datapackage.json"
@@ -1003,10 +1505,35 @@ def _field_type(name: str, values: pd.Series, comparison: bool = True) -> str:
     return "string"
 
 
+def _field(name: str, values: pd.Series, resource: str, comparison: bool) -> dict:
+    """The Frictionless field of column ``name`` of the CSV ``resource``: name, type, description and,
+    for a count or a numeric column of a comparison, its unit (``unit``: ``"1"`` for a count or a
+    dimensionless number; the name of the column holding a per-row unit otherwise, ``unitField``)."""
+    descriptions = (FIELD_DESCRIPTIONS if comparison else STATUS_FIELD_DESCRIPTIONS if resource == "status"
+                    else REGISTER_FIELD_DESCRIPTIONS if resource == "register" else {})
+    f = {"name": name, "type": _field_type(name, values, comparison=comparison)}
+    if name in descriptions:
+        f["description"] = descriptions[name]
+    if comparison and name in FIELD_UNITS:
+        f.update({"unitField": "unit"} if FIELD_UNITS[name] == "unit" else {"unit": FIELD_UNITS[name]})
+        if name == "tolerance":
+            f["unitNote"] = "the row's unit when tolerance_kind is abs; 1 (a fraction of |paper|) when rel"
+    elif not comparison and resource == "status" and f["type"] == "integer":
+        f["unit"] = "1"
+    return f
+
+
 def datapackage() -> dict:
     """A Frictionless *tabular data package* describing every CSV of ``tables/``: one resource per
     file, with its title, the notebook that wrote it, its commit and a schema (field names in file
-    order; ``number`` for the numeric columns of a comparison, empty cells missing values)."""
+    order; ``number`` for the numeric columns of a comparison, empty cells missing values).
+
+    Returns
+    -------
+    dict
+        The descriptor: ``profile``, ``name``, ``title``, ``version``, ``licenses`` and one resource
+        per CSV, each field with its type, description and unit (:data:`FIELD_UNITS`).
+    """
     d = tables_dir()
     resources = []
     for path in sorted(d.glob("*.csv")):
@@ -1018,9 +1545,7 @@ def datapackage() -> dict:
                "title": meta.get("title", {"status": "Reproduction status of every artifact",
                                            "register": "Register of errata and inconsistencies"}.get(path.stem,
                                                                                                        path.stem)),
-               "schema": {"fields": [dict({"name": c, "type": _field_type(c, df[c], comparison=bool(meta))},
-                                          **({"description": FIELD_DESCRIPTIONS[c]} if c in FIELD_DESCRIPTIONS else {}))
-                                     for c in df.columns],
+               "schema": {"fields": [_field(c, df[c], path.stem, bool(meta)) for c in df.columns],
                           "missingValues": [""]}}
         if meta:
             res["sources"] = [{"title": meta.get("notebook", ""), "path": meta.get("notebook", "")}]
@@ -1033,7 +1558,13 @@ def datapackage() -> dict:
 
 
 def write_datapackage() -> Path:
-    """Write :func:`datapackage` to ``tables/datapackage.json`` (only when it changed)."""
+    """Write :func:`datapackage` to ``tables/datapackage.json`` (only when it changed).
+
+    Returns
+    -------
+    pathlib.Path
+        ``tables/datapackage.json``.
+    """
     path = tables_dir() / DATAPACKAGE
     _write_if_changed(path, json.dumps(datapackage(), indent=1, sort_keys=True, ensure_ascii=False) + "\n")
     return path
@@ -1049,6 +1580,17 @@ def load_table(table_id: str) -> pd.DataFrame:
     artifact id covered by one table.  An artifact covered by several tables raises
     :class:`RegistryError` listing all of them (one call always returns one table);
     :func:`load_tables` returns them all.
+
+    Parameters
+    ----------
+    table_id : str
+        A table id, or an artifact id covered by one table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The table, numeric columns as floats (each in its row's ``unit``; ``rel_error`` and a
+        relative tolerance dimensionless), ``attrs`` the sidecar.
     """
     table_id = resolve_table_id(table_id)
     df = read_table(table_id)
@@ -1064,7 +1606,18 @@ def load_table(table_id: str) -> pd.DataFrame:
 def load_tables(ident: str) -> dict[str, pd.DataFrame]:
     """Every exported table behind an id printed by ``python -m replication status``, as
     ``{table_id: DataFrame}`` typed as by :func:`load_table` (one entry for a table id or an
-    artifact covered by one table, one per table for an artifact covered by several)."""
+    artifact covered by one table, one per table for an artifact covered by several).
+
+    Parameters
+    ----------
+    ident : str
+        A table id or an artifact id.
+
+    Returns
+    -------
+    dict of str to pandas.DataFrame
+        The tables in the order of ``tables/status.csv``.
+    """
     return {tid: load_table(tid) for tid in resolve_table_ids(ident)}
 
 
@@ -1073,6 +1626,16 @@ def artifact_tables(artifact: Mapping[str, Any]) -> list[str]:
 
     By default the table with the artifact's own id; the optional ``tables`` column lists
     other ids (space-separated) when a chapter covers the artifact with check tables.
+
+    Parameters
+    ----------
+    artifact : mapping
+        A row of :func:`load_artifacts` (``id`` and optional ``tables``).
+
+    Returns
+    -------
+    list of str
+        The table ids.
     """
     extra = str(artifact.get("tables", "") or "").split()
     for tid in extra:
@@ -1102,7 +1665,20 @@ def _sidecar(table_id: str) -> dict:
 
 def readings_ledgers(table_id: str, meta: Mapping[str, Any] | None = None) -> list[str]:
     """The readings ledgers of an exported table: those its sidecar names (``readings``), else
-    ``<key>-check-<rest>-readings`` for ``<key>-<rest>`` when that table is exported."""
+    ``<key>-check-<rest>-readings`` for ``<key>-<rest>`` when that table is exported.
+
+    Parameters
+    ----------
+    table_id : str
+        An exported table id.
+    meta : mapping, optional
+        Its sidecar, when already read.
+
+    Returns
+    -------
+    list of str
+        The ledgers' table ids (empty when it has none).
+    """
     meta = _sidecar(table_id) if meta is None else meta
     if meta.get("readings"):
         return list(meta["readings"])
@@ -1145,6 +1721,16 @@ def verdict_violations(table_ids: Iterable[str] | None = None) -> list[str]:
        reading (otherwise the ledger says nothing about that verdict).
     4. A table with a readings ledger records its main reading and the printed evidence for it.
     5. A ``ruled_out`` entry names a reading of the ledger.
+
+    Parameters
+    ----------
+    table_ids : iterable of str, optional
+        The tables to check; every exported table by default.
+
+    Returns
+    -------
+    list of str
+        One message per violation (empty when the rule holds).
     """
     out = []
     ids = list_tables() if table_ids is None else list(table_ids)
@@ -1205,7 +1791,18 @@ def verdict_violations(table_ids: Iterable[str] | None = None) -> list[str]:
 
 def check_verdicts(table_ids: Iterable[str] | None = None) -> None:
     """Raise :class:`RegistryError` listing every break of the verdict rule (see
-    :func:`verdict_violations`)."""
+    :func:`verdict_violations`).
+
+    Parameters
+    ----------
+    table_ids : iterable of str, optional
+        The tables to check; every exported table by default.
+
+    Raises
+    ------
+    RegistryError
+        Listing every violation.
+    """
     bad = verdict_violations(table_ids)
     if bad:
         raise RegistryError("the verdict rule is broken (CONTRIBUTING.md, \"Readings and the main reading\"):\n  - "
@@ -1221,7 +1818,18 @@ def build_register(exported: Mapping[str, dict] | None = None) -> pd.DataFrame:
     """The register of findings about the print: every row with status ``erratum`` (a printed
     value proven wrong) or ``inconsistent`` (two printed parts that disagree), with its ``kind``,
     the printed text as printed (``paper_text`` where the print is a formula or a range), the
-    reproduced value, the correction (errata), the reason and the evidence."""
+    reproduced value, the correction (errata), the reason and the evidence.
+
+    Parameters
+    ----------
+    exported : mapping of str to dict, optional
+        The sidecars of the exported tables by id; read from ``tables/`` by default.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`REGISTER_COLUMNS`, by source, kind and table.
+    """
     exported = {t: _sidecar(t) for t in list_tables()} if exported is None else exported
     rows = []
     for tid in sorted(exported):
@@ -1255,7 +1863,18 @@ def failing_artifacts(status: pd.DataFrame) -> pd.DataFrame:
     """The paper artifacts holding ``not-reproduced`` rows, most such rows first, each with its
     one-line reason: the ``summary`` of its table's sidecar, else the first clause of the first
     not-reproduced row's note.  Columns ``id``, ``source``, ``artifact``, ``label``,
-    ``not_reproduced``, ``tables``, ``notebook``, ``reason``."""
+    ``not_reproduced``, ``tables``, ``notebook``, ``reason``.
+
+    Parameters
+    ----------
+    status : pandas.DataFrame
+        ``tables/status.csv`` as text (:func:`build_index`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per failing artifact, most not-reproduced rows first.
+    """
     sub = status[(status["kind"] == "paper") & (status["not_reproduced"].astype(int) > 0)]
     rows = []
     for _, r in sub.iterrows():
@@ -1306,7 +1925,18 @@ def _write_if_changed(path: Path, content: str) -> None:
 def status_tally(status: pd.DataFrame) -> dict[str, str]:
     """One line per kind of artifact (``paper``, ``supplementary``): how many have each status
     and how many errata they carry — paper artifacts are never counted with the package's own
-    checks."""
+    checks.
+
+    Parameters
+    ----------
+    status : pandas.DataFrame
+        ``tables/status.csv`` as text.
+
+    Returns
+    -------
+    dict of str to str
+        ``{kind: line}``.
+    """
     out = {}
     for kind in ("paper", "supplementary"):
         part = status[status["kind"] == kind]
@@ -1333,7 +1963,18 @@ green shades for reproduced, amber for mixed, grey for analog, red for not repro
 
 def status_bar_html(counts: Mapping[str, int]) -> str:
     """A horizontal bar of artifact statuses (inline HTML, one segment per status, width ∝ count,
-    the count written in it and the status in its tooltip) followed by its legend."""
+    the count written in it and the status in its tooltip) followed by its legend.
+
+    Parameters
+    ----------
+    counts : mapping of str to int
+        Artifacts per status.
+
+    Returns
+    -------
+    str
+        The inline HTML of the bar.
+    """
     total = sum(int(v) for v in counts.values())
     if total <= 0:
         raise RegistryError("status_bar_html: no artifact to draw")
@@ -1464,7 +2105,18 @@ def _findings_markdown(status: pd.DataFrame, notebook: str) -> str:
 
 
 def findings_file(notebook: str) -> str:
-    """File name of a chapter's findings box in ``tables/`` (``findings-<part>-<stem>.md``)."""
+    """File name of a chapter's findings box in ``tables/`` (``findings-<part>-<stem>.md``).
+
+    Parameters
+    ----------
+    notebook : str
+        A chapter's path (``book/<part>/<stem>.ipynb``).
+
+    Returns
+    -------
+    str
+        The file name in ``tables/``.
+    """
     p = Path(notebook)
     return f"findings-{p.parent.name}-{p.stem}.md"
 
@@ -1497,9 +2149,25 @@ def _status_markdown(status: pd.DataFrame) -> str:
 
 
 def _formula(text: str) -> str:
-    """A corrected expression written in LaTeX is shown as inline maths; plain text stays text."""
+    """A corrected expression written in LaTeX is shown as inline maths; plain text stays text.
+
+    A long expression is set as several inline formulas, cut after each ``;``, after each comma
+    followed by a TeX space (``,\\ ``) and before each `` + ``, with words that open a piece
+    ("third row") set as text, so that the browser can wrap it in its table cell (MathJax does not
+    break an inline formula)."""
     t = str(text)
-    return f"${t}$" if "\\" in t and "$" not in t else t
+    if "\\" not in t or "$" in t:
+        return t
+    out = []
+    for piece in (p.strip() for p in re.split(r"(?<=;)\s+|(?<=,)(?=\\ )|\s+(?=\+ )", t)):
+        if not piece:
+            continue
+        words = re.match(r"([A-Za-z]{2,}(?: [A-Za-z]{2,})*:?) (?=[\[(\\])", piece)
+        if words:
+            out.append(words.group(1))
+            piece = piece[words.end():]
+        out.append(f"${piece}$")
+    return " ".join(out)
 
 
 def _register_markdown(register: pd.DataFrame) -> str:
@@ -1518,10 +2186,13 @@ def _register_markdown(register: pd.DataFrame) -> str:
             sub = part[part["kind"] == kind]
             if sub.empty:
                 continue
-            rows = ([f"`{r['table']}`: {r['quantity']}", r["printed"],
-                     _formula(r["corrected"] or r["reproduced"]) if kind == "erratum" else r["reproduced"],
+            # numbers as display_cell shows them (a count whole, at most DISPLAY_DIGITS beyond the print)
+            shown = [{"paper": r["printed"], "reproduced": r["reproduced"]} for _, r in sub.iterrows()]
+            rows = ([f"`{r['table']}`: {r['quantity']}", display_cell(sh, "paper"),
+                     _formula(r["corrected"] or display_cell(sh, "reproduced")) if kind == "erratum"
+                     else display_cell(sh, "reproduced"),
                      re.sub(r"book/([\w/.-]+?)\.ipynb", r"{doc}`/\1`", str(r["note"]))]
-                    for _, r in sub.iterrows())
+                    for sh, (_, r) in zip(shown, sub.iterrows()))
             lines += [f"### {title} of {source}", "", *_md_table(["where", "printed", third, "why"], rows), ""]
     return "\n".join(lines)
 
@@ -1534,7 +2205,18 @@ def resolve_table_ids(ident: str) -> list[str]:
     """The exported tables behind ``ident``: ``[ident]`` for a table id, the tables of
     ``tables/status.csv`` that cover an artifact id otherwise (one or several).  Raises
     :class:`RegistryError` for an artifact no table covers yet, and for an unknown id (naming
-    every exported table of that source)."""
+    every exported table of that source).
+
+    Parameters
+    ----------
+    ident : str
+        A table id or an artifact id, as ``python -m replication status`` prints them.
+
+    Returns
+    -------
+    list of str
+        The exported table ids.
+    """
     validate_id(ident)
     if (tables_dir() / f"{ident}.csv").exists():
         return [ident]
@@ -1553,7 +2235,18 @@ def resolve_table_ids(ident: str) -> list[str]:
 
 def resolve_table_id(ident: str) -> str:
     """The one exported table behind ``ident`` (:func:`resolve_table_ids`); an artifact covered
-    by several tables raises :class:`RegistryError` listing every one of them."""
+    by several tables raises :class:`RegistryError` listing every one of them.
+
+    Parameters
+    ----------
+    ident : str
+        A table id, or an artifact id covered by one table.
+
+    Returns
+    -------
+    str
+        The table id.
+    """
     tables = resolve_table_ids(ident)
     if len(tables) > 1:
         raise RegistryError(f"{ident!r} is covered by {len(tables)} tables: {', '.join(tables)}; name one of "
@@ -1569,6 +2262,16 @@ def bibtex_for(ident: str) -> str:
     computed, not the checkout's), its status with the row split; a table reproducing a paper
     relates to that paper's entry, which follows once; a supplementary check of the package's
     own cites the package only.
+
+    Parameters
+    ----------
+    ident : str
+        A table id or an artifact id.
+
+    Returns
+    -------
+    str
+        The entries, one per table, then each reproduced source's entry once.
     """
     entries, sources = [], []
     for table_id in resolve_table_ids(ident):
@@ -1608,7 +2311,18 @@ def _table_bibtex(table_id: str) -> tuple[str, str]:
 
 
 def source_bibtex(key: str) -> str:
-    """The BibTeX entry of one of the four source documents (from ``data/sources.bib``)."""
+    """The BibTeX entry of one of the four source documents (from ``data/sources.bib``).
+
+    Parameters
+    ----------
+    key : str
+        A source key (:data:`SOURCE_KEYS`).
+
+    Returns
+    -------
+    str
+        The entry with a trailing newline; empty when ``data/sources.bib`` lacks it.
+    """
     path = project_root() / "data" / "sources.bib"
     if not path.exists():
         return ""
