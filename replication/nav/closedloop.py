@@ -53,7 +53,6 @@ __all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gain
            "ROW_KINDS"]
 
 _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
-_MMAX = 9   # at most 9 measurement rows: position, velocity, specific force
 
 #: Configuration of the filter (numba-compatible bundle).  ``fconst``/``qc`` are the model's
 #: constant F and process-noise parts, ``tg/kd/bs/bz`` its block encoding
@@ -61,10 +60,10 @@ _MMAX = 9   # at most 9 measurement rows: position, velocity, specific force
 #: dynamics, ``rows`` the codes of the measurement row kinds in use (:data:`ROW_KINDS`, in the order
 #: of their rows) with, per kind, the variances of its rows ``row_R``, the error-state column it
 #: reads (``row_col``, −1: none) and the column of ``ChunkInputs.aux`` holding its measured value
-#: (``row_aux``), ``ar_T``/``ar_Q`` the discrete AR transition applied at ``ar_tick`` epochs,
-#: ``sf_H`` the gravity columns of the specific-force rows.
+#: (``row_aux``), ``m_max`` the most rows of an epoch, ``ar_T``/``ar_Q`` the discrete AR transition
+#: applied at ``ar_tick`` epochs, ``sf_H`` the gravity columns of the specific-force rows.
 Spec = namedtuple("Spec", ["fconst", "qc", "q_accel", "q_gyro", "tg", "kd", "bs", "bz", "order", "dyn_rows",
-                           "rows", "row_R", "row_col", "row_aux", "lever0", "vmode", "gains",
+                           "rows", "row_R", "row_col", "row_aux", "m_max", "lever0", "vmode", "gains",
                            "ar_T", "ar_Q", "sf_H", "use_pbar", "nees"])
 
 #: Inputs of one chunk of IMU steps (``R`` runs): increments (R × K × 3), step lengths, vertical
@@ -275,15 +274,16 @@ _Scratch = namedtuple("_Scratch", ["F", "Phi", "Qd", "Qc", "w1", "w2", "w3", "nz
 
 
 @njit(inline="always", **_NJ)
-def _new_scratch(n, n_dyn, ar_T):
-    """The :data:`_Scratch` of a filter with ``n`` states, ``n_dyn`` sensor states with dynamics."""
+def _new_scratch(n, n_dyn, m_max, ar_T):
+    """The :data:`_Scratch` of a filter with ``n`` states, ``n_dyn`` sensor states with dynamics,
+    at most ``m_max`` measurement rows per epoch."""
     c = np.empty((3, 3))
     steps = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, np.empty(4),
              np.empty(3), np.empty(3), np.empty(3), np.empty(3))
     return _Scratch(np.zeros((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)),
                     np.empty((n, n)), np.empty((n, n)), np.empty((n, n), np.int64), np.empty((n, n)),
                     np.empty(n, np.int64), np.zeros((3, 3)), np.zeros((6, n)), np.zeros(3), np.zeros(5), np.zeros(2),
-                    np.zeros((_MMAX, n)), np.zeros(_MMAX), np.empty(_MMAX), np.empty(n), np.empty(n),
+                    np.zeros((m_max, n)), np.zeros(m_max), np.empty(m_max), np.empty(n), np.empty(n),
                     np.empty(max(n_dyn, n)), np.empty(n, np.int64), np.ascontiguousarray(ar_T[9:, 9:]), steps)
 
 
@@ -466,7 +466,7 @@ def _lead_measurement(spec, inp, j, sf, bs_, lead, gains, T, sc):
     H, Rd, c = sc.H, sc.Rd, sc.steps[6]
     w_ie, w_en = sc.steps[8], sc.steps[9]
     K.q2c(bs_.q[0], c)
-    for i in range(_MMAX):
+    for i in range(H.shape[0]):
         for jj in range(n):
             H[i, jj] = 0.0
     wx, wy, wz = _body_rate(bs_.dth_cp[0], T, c, bs_.st[0], w_ie, w_en)
@@ -594,7 +594,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     n_steps = inp.dt.shape[0]
     n = spec.fconst.shape[0]
     n_ep = inp.ep_step.shape[0]
-    sc = _new_scratch(n, spec.dyn_rows.shape[0], spec.ar_T)
+    sc = _new_scratch(n, spec.dyn_rows.shape[0], spec.m_max, spec.ar_T)
     store_nav = out.nav_st.shape[1] > 0
     record = out.rec_Phi.shape[0] > 0
     if store_nav:
@@ -787,12 +787,13 @@ def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov,
     L = np.ascontiguousarray(lam.T)
     L2 = np.empty((n, R))
     X = np.zeros((n, R))
-    Nu = np.empty((_MMAX, R))
+    m_max = H.shape[1]
+    Nu = np.empty((m_max, R))
     acc = np.empty(R)
     u = np.empty(n)
     row = np.empty(n)
-    hz = np.empty((_MMAX, n), np.int64)
-    nh = np.empty(_MMAX, np.int64)
+    hz = np.empty((m_max, n), np.int64)
+    nh = np.empty(m_max, np.int64)
     used = np.empty(n, np.int64)
     W = np.empty((n, n))
     nzc = np.empty((n, n), np.int64)
@@ -998,8 +999,7 @@ def build_spec(model: ErrorModel, *, R_pos=None, R_vel=None, lever_arm_b=(0.0, 0
     if not (use_position or use_velocity or len(rows)):
         raise ValueError("use at least one measurement: GNSS position, GNSS velocity or a kind of rows")
     size = {code: m for code, m in ROW_KINDS.values()}
-    if sum(size[k] for k in kinds) > _MMAX:
-        raise ValueError(f"at most {_MMAX} measurement rows per epoch")
+    m_max = sum(size[k] for k in kinds)
     series_order = integer(series_order, "series_order")
     lever = finite_array(lever_arm_b, "lever_arm_b", (3,))
     finite_array(gains, "gains", (3,))
@@ -1017,7 +1017,7 @@ def build_spec(model: ErrorModel, *, R_pos=None, R_vel=None, lever_arm_b=(0.0, 0
         raise ValueError(f"sf_H must be 3×{n - 9}")
     return Spec(fconst, qc, np.asarray(model.accel_psd, float), np.asarray(model.gyro_psd, float), tg, kd, bs, bz,
                 int(series_order), dyn, np.array(kinds, np.int64), np.array(row_R, float), np.array(row_col, np.int64),
-                np.array(row_aux, np.int64), lever.copy(), int(vmode), np.asarray(gains, float), arT, arQ, sfH,
+                np.array(row_aux, np.int64), int(m_max), lever.copy(), int(vmode), np.asarray(gains, float), arT, arQ, sfH,
                 bool(prior_covariance), bool(nees))
 
 
@@ -1073,10 +1073,10 @@ class Records:
     P_s: np.ndarray | None = None
 
 
-def _empty_gains(E_, n, n_dyn, n_aug, with_nees):
+def _empty_gains(E_, n, n_dyn, n_aug, with_nees, m_max):
     E_n = E_ if with_nees else 0
-    return Gains(np.zeros(E_, np.int64), np.zeros((E_, _MMAX, n)), np.zeros((E_, _MMAX, n)),
-                 np.ones((E_, _MMAX)), np.zeros((E_, max(n_dyn, 0), n_aug)), np.empty((E_n, n)),
+    return Gains(np.zeros(E_, np.int64), np.zeros((E_, m_max, n)), np.zeros((E_, m_max, n)),
+                 np.ones((E_, m_max)), np.zeros((E_, max(n_dyn, 0), n_aug)), np.empty((E_n, n)),
                  np.empty((E_n, n, n)))
 
 
@@ -1116,7 +1116,7 @@ def _new_records(spec: Spec, rec_ep, R: int, n: int, n_ep: int, n_steps: int, st
     n_aug = n - 9
     m_rec = len(rec_ep)
     return Records(epochs=rec_ep, st=np.empty((R, m_rec, 6)), q=np.empty((R, m_rec, 4)),
-                   p_hat=np.empty((R, m_rec, n_aug)), nis=np.empty((R, m_rec)), innov=np.zeros((R, m_rec, _MMAX)),
+                   p_hat=np.empty((R, m_rec, n_aug)), nis=np.empty((R, m_rec)), innov=np.zeros((R, m_rec, spec.m_max)),
                    nees=np.full((R, m_rec), np.nan) if spec.nees else None,
                    P=np.empty((m_rec, n, n)) if store_P else None,
                    P_bar=np.empty((m_rec, n, n)) if spec.use_pbar else None, pdiag_all=np.empty((n_ep, n)),
@@ -1179,7 +1179,7 @@ class _ChunkPlan:
         # the smoother's replay (``record``) keeps Φ per epoch and P⁺ at the recorded epochs; the RTS
         # form also P⁺, P⁻ and the estimates x̂ per epoch
         return ChunkOut(np.empty((R, E_, 6)), np.empty((R, E_, 4)), np.empty((R, E_, self.n_aug)), np.empty((R, E_)),
-                        np.zeros((R, E_, _MMAX)), np.full((R, E_), np.nan) if spec.nees else np.empty((R, 0)),
+                        np.zeros((R, E_, spec.m_max)), np.full((R, E_), np.nan) if spec.nees else np.empty((R, 0)),
                         np.empty((R, nav, 6)), np.empty((R, nav, 4)), np.empty((E_, n)), flag,
                         np.empty((n_f, n, n)) if self.store_P or record else e3,
                         np.empty((n_f, n, n)) if spec.use_pbar and self.store_P else e3,
@@ -1191,7 +1191,7 @@ class _ChunkPlan:
         """Epochs, inputs, output arrays and empty gains of chunk ``ci`` for every run."""
         j0, j1, k0, k1 = self.bounds(ci)
         return (j0, j1, self.inputs(ci, k0, k1, self.ep[j0:j1]), self.chunk_out(j0, j1, k0, k1, record),
-                _empty_gains(j1 - j0, self.n, self.n_dyn, self.n_aug, self.spec.nees))
+                _empty_gains(j1 - j0, self.n, self.n_dyn, self.n_aug, self.spec.nees, self.spec.m_max))
 
     def lead_pass(self, st_, lead_, x, g, o):
         """Run 0 over one chunk, leaving the gains ``g`` for the followers."""
@@ -1221,7 +1221,7 @@ class _ChunkPlan:
         x = (self.lead_inputs(ci, k0, k1, self.ep[j0:j1]) if self.lead_inputs is not None
              else _inputs_view(self.inputs(ci, k0, k1, self.ep[j0:j1]), slice(0, 1)))
         o = self.chunk_out(j0, j1, k0, k1, True, R=1, store_nav=False)
-        g = _empty_gains(j1 - j0, self.n, self.n_dyn, self.n_aug, False)
+        g = _empty_gains(j1 - j0, self.n, self.n_dyn, self.n_aug, False, self.spec.m_max)
         filter_chunk(self.spec_replay, x, st0, lead_, g, o, True)
         return j0, j1, o, g
 
