@@ -26,7 +26,6 @@ PENDING: set[str] = {
     "replication.crosschecks.chen2019_gravity_compensation",
     "replication.crosschecks.chen2019_model_comparison",
     "replication.crosschecks.fang2020",
-    "replication.nav.closedloop",
     "replication.nav.earth",
     "replication.nav.errors",
     "replication.nav.kalman",

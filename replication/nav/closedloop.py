@@ -6,9 +6,13 @@ increments (chen2019 eq. (2-10)) and the strapdown of ``replication.nav._kernels
 (chen2019 eq. (3-2)) advances the run.  One GNSS epoch: the error-state F of
 ``replication.nav._kernels.build_F_core`` plus the sensor-block couplings C_b^n B(u) — both
 averaged over the interval's IMU steps (F is affine in them, so this is the interval mean of F)
-— gives (Φ, Q_d) by the Van Loan series; P⁻ = Φ P Φᵀ + Q_d; the measurement rows are written
-once, in ``replication.nav._kernels.gnss_rows`` (antenna position and velocity with the lever arm,
-chen2019 eq. (2-13)) and ``_specific_force_rows`` (chen2019 eq. (3-18)); the update is the
+— gives (Φ, Q_d) by the Van Loan series; P⁻ = Φ P Φᵀ + Q_d; the measurement rows come from the
+*row kinds* in use (:data:`ROW_KINDS`): each kind writes its rows of H and their variances, and
+its residuals, in one place (``_kind_rows``, ``_kind_residuals``), chosen by a kind code the
+compiled loop dispatches on — GNSS antenna position and velocity with the lever arm (chen2019
+eq. (2-13), ``replication.nav._kernels.gnss_position_rows`` and ``gnss_velocity_rows``), the
+specific force of chen2019 eq. (3-18), the air-data height and airspeed (duan2023 refs. [15-17]
+as read by :func:`replication.papers.duan2023.airdata.literature_filter`); the update is the
 Joseph form one (independent) measurement at a time; then the navigation errors are fed back and
 the sensor-error estimates accumulated.  Optional: a vertical channel held or damped
 (:mod:`replication.nav.strapdown`), discrete AR transitions of a gravity block at chosen epochs, the
@@ -26,10 +30,12 @@ follow on other threads, chunk by chunk, while the lead goes on: the result does
 the number of threads.
 
 :func:`run` is the driver (chunks, threads, records, smoother); :func:`build_spec` bundles the
-configuration of an :class:`replication.nav.errors.ErrorModel`.  The public entry points are
+configuration of an :class:`replication.nav.errors.ErrorModel` and the row kinds;
+:func:`chunk_inputs` and :func:`array_inputs` build its inputs.  The public entry points are
 :func:`replication.nav.kalman.closed_loop` (one run), :func:`replication.nav.kalman.monte_carlo`,
-:func:`replication.papers.chen2019.simulation.run_batch` (chen2019 §4.2) and
-:func:`replication.papers.chen2019.gravity.augmented_filter` (chen2019 eq. (3-18)).
+:func:`replication.papers.chen2019.simulation.run_batch` (chen2019 §4.2),
+:func:`replication.papers.chen2019.gravity.augmented_filter` (chen2019 eq. (3-18)) and
+:func:`replication.papers.duan2023.airdata.literature_filter`.
 """
 
 from __future__ import annotations
@@ -54,42 +60,166 @@ __all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gain
 
 _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
-#: Configuration of the filter (numba-compatible bundle).  ``fconst``/``qc`` are the model's
-#: constant F and process-noise parts, ``tg/kd/bs/bz`` its block encoding
-#: (``ErrorModel.kernel_encoding``), ``dyn_rows`` the augmented states with
-#: dynamics, ``rows`` the codes of the measurement row kinds in use (:data:`ROW_KINDS`, in the order
-#: of their rows) with, per kind, the variances of its rows ``row_R``, the error-state column it
-#: reads (``row_col``, −1: none) and the column of ``ChunkInputs.aux`` holding its measured value
-#: (``row_aux``), ``m_max`` the most rows of an epoch, ``ar_T``/``ar_Q`` the discrete AR transition
-#: applied at ``ar_tick`` epochs, ``sf_H`` the gravity columns of the specific-force rows.
 Spec = namedtuple("Spec", ["fconst", "qc", "q_accel", "q_gyro", "tg", "kd", "bs", "bz", "order", "dyn_rows",
                            "rows", "row_R", "row_col", "row_aux", "m_max", "lever0", "vmode", "gains",
                            "ar_T", "ar_Q", "sf_H", "use_pbar", "nees"])
+Spec.__doc__ = """Configuration of the filter (a numba-compatible bundle), built by :func:`build_spec`.
 
-#: Inputs of one chunk of IMU steps (``R`` runs): increments (R × K × 3), step lengths, vertical
-#: references (K + 1), the step after which each GNSS epoch falls, the GNSS fixes (R × E × 3), the
-#: specific-force windows (per step: weight and window id, per epoch: id of the window ending
-#: there, per window: GNSS acceleration and variance), AR ticks per epoch, truth for the NEES, the
-#: measured values of the other row kinds (``aux``, R × E × columns).  Built by :func:`chunk_inputs`.
+Attributes
+----------
+fconst, qc : (n, n) ndarray
+    The model's constant part of F and of the process-noise PSD matrix Q_c.
+q_accel, q_gyro : (3,) ndarray
+    Accelerometer and gyro white-noise PSDs ((m/s²)²/Hz, (rad/s)²/Hz).
+tg, kd, bs, bz : (blocks,) ndarray of int
+    The block encoding of ``ErrorModel.kernel_encoding``: target, coupling kind, first state, size.
+order : int
+    Order of the Van Loan series.
+dyn_rows : (k,) ndarray of int
+    The augmented states (index − 9) with dynamics.
+rows : (kinds,) ndarray of int
+    Codes of the measurement row kinds in use (:data:`ROW_KINDS`), in the order of their rows.
+row_R : (kinds, 3) ndarray
+    Per kind, the variances of its rows (unused entries zero).
+row_col : (kinds,) ndarray of int
+    Per kind, the error state modelling its measurement error (−1: none).
+row_aux : (kinds,) ndarray of int
+    Per kind, its column of ``ChunkInputs.aux`` (−1: none).
+m_max : int
+    The most measurement rows of an epoch.
+lever0 : (3,) ndarray
+    Lever arm in use at the start, body frame, m.
+vmode : int
+    Vertical channel: 0 free, 1 held, 2 damped.
+gains : (3,) ndarray
+    Gains of the damped vertical channel.
+ar_T, ar_Q : (n, n) ndarray
+    Discrete AR transition and its noise, applied at the ``ChunkInputs.ar_tick`` epochs.
+sf_H : (3, n − 9) ndarray
+    Gravity columns of the specific-force rows (chen2019 eq. (3-18)).
+use_pbar : bool
+    Also propagate the covariance without measurements.
+nees : bool
+    Compute the NEES against the truth of the inputs.
+"""
+
 ChunkInputs = namedtuple("ChunkInputs", ["dt", "dth", "dvv", "h_ref", "vu_ref", "ep_step", "gpos", "gvel",
                                          "sf_w", "sf_win", "sf_end", "sf_a", "sf_R", "ar_tick",
                                          "truth_st", "truth_q", "truth_p", "aux"])
+ChunkInputs.__doc__ = """Inputs of one chunk of K IMU steps and E epochs for R runs, built by :func:`chunk_inputs`.
 
-#: Per-run state carried from chunk to chunk.
+Attributes
+----------
+dt : (K,) ndarray
+    Step lengths, s.
+dth, dvv : (R, K, 3) ndarray
+    Gyro and accelerometer increments, rad and m/s.
+h_ref, vu_ref : (K + 1,) ndarray
+    Vertical references of a held or damped vertical channel, m and m/s.
+ep_step : (E,) ndarray of int
+    The step after which each epoch falls.
+gpos, gvel : (R, E, 3) ndarray
+    GNSS fixes [L, λ, h] (rad, m) and ENU velocities (m/s).
+sf_w, sf_win : (K,) ndarray
+    Per step, its weight in its specific-force window and the window's id (−1: none).
+sf_end : (E,) ndarray of int
+    Per epoch, the id of the window ending there (−1: none).
+sf_a, sf_R : (windows, 3) ndarray
+    Per window, the GNSS acceleration (m/s²) and the variances of its rows ((m/s²)²).
+ar_tick : (E,) ndarray of int
+    1 at the epochs of a discrete AR step.
+truth_st, truth_q : (E, 6), (E, 4) ndarray
+    True navigation state and attitude quaternion at the epochs (for the NEES).
+truth_p : (R, E, n − 9) ndarray
+    True augmented states.
+aux : (R, E, k) ndarray
+    Measured values of the kinds of ``build_spec(rows=...)`` (m, m/s).
+"""
+
 BatchState = namedtuple("BatchState", ["st", "st_prev", "q", "p_hat", "lever", "g_extra", "dth_cp", "dv_cp",
                                        "trig", "damp", "vacc", "first"])
+BatchState.__doc__ = """Per-run state carried from chunk to chunk (R runs), built by :func:`initial_batch_state`.
 
-#: The lead's state carried from chunk to chunk: covariance (and the covariance propagated
-#: without measurements), window sums of f^n and of the accelerometer couplings.
+Attributes
+----------
+st, st_prev : (R, 6) ndarray
+    Navigation state [L, λ, h, v_E, v_N, v_U] (rad, m, m/s) now and at the previous step.
+q : (R, 4) ndarray
+    Attitude quaternion q_b^n.
+p_hat : (R, n − 9) ndarray
+    Accumulated estimates of the augmented states.
+lever : (R, 3) ndarray
+    Lever arm in use, body frame, m.
+g_extra : (R, 3) ndarray
+    Estimated gravity disturbance compensated in the mechanization, m/s².
+dth_cp, dv_cp : (R, 3) ndarray
+    Corrected increments of the last step (coning and sculling).
+trig : (R, 3) ndarray
+    L, sin L, cos L of the last step.
+damp : (R,) ndarray
+    Integrator of the damped vertical channel.
+vacc : (R, 3) ndarray
+    Window sum of the INS acceleration (specific-force rows).
+first : (1,) ndarray of int
+    1 before the first step.
+"""
+
 LeadState = namedtuple("LeadState", ["P", "Pbar", "facc", "Cw"])
+LeadState.__doc__ = """The lead's state carried from chunk to chunk.
 
-#: What the lead leaves, per epoch, for the runs that follow it (with the NEES: the standard
-#: deviations of P⁺ and the Cholesky factor of P⁺ scaled to a correlation matrix).
+Attributes
+----------
+P, Pbar : (n, n) ndarray
+    Covariance, and the covariance propagated without measurements.
+facc : (3,) ndarray
+    Window sum of f^n (specific-force rows), m/s².
+Cw : (6, n) ndarray
+    Window sums of the couplings C_b^n B(u) of the sensor blocks.
+"""
+
 Gains = namedtuple("Gains", ["m", "H", "Kg", "s", "Phid", "nees_sd", "nees_L"])
+Gains.__doc__ = """What the lead leaves, per epoch of a chunk (E), for the runs that follow it.
 
-#: Outputs of one chunk (per run and epoch unless noted).
+Attributes
+----------
+m : (E,) ndarray of int
+    Number of measurement rows.
+H, Kg : (E, m_max, n) ndarray
+    Rows and gains of the sequential update.
+s : (E, m_max) ndarray
+    Innovation variances.
+Phid : (E, k, n − 9) ndarray
+    Rows of Φ of the augmented states with dynamics.
+nees_sd, nees_L : (E, n), (E, n, n) ndarray
+    Standard deviations of P⁺ and the Cholesky factor of P⁺ scaled to a correlation matrix
+    (empty without the NEES).
+"""
+
 ChunkOut = namedtuple("ChunkOut", ["st", "q", "phat", "nis", "innov", "nees", "nav_st", "nav_q", "pdiag",
                                    "flag", "P", "Pbar", "rec_Pf", "rec_Pp", "rec_Phi", "rec_x"])
+ChunkOut.__doc__ = """Outputs of one chunk (R runs, E epochs; empty arrays where not kept).
+
+Attributes
+----------
+st, q, phat : (R, E, ·) ndarray
+    Navigation state, quaternion and accumulated estimates after the feedback.
+nis, nees : (R, E) ndarray
+    Normalized innovation and estimation error squared.
+innov : (R, E, m_max) ndarray
+    Residuals of the rows in use.
+nav_st, nav_q : (R, K + 1, ·) ndarray
+    The IMU-rate solution.
+pdiag : (E, n) ndarray
+    diag P⁺ of the lead.
+flag : (E,) ndarray of int
+    Index of the epoch among the chunk's recorded ones (−1: not recorded).
+P, Pbar : (recorded, n, n) ndarray
+    P⁺ and the covariance without measurements at the recorded epochs.
+rec_Pf, rec_Pp, rec_Phi : (E, n, n) ndarray
+    For the smoother: P⁺, P⁻ and the transition per epoch.
+rec_x : (R, E, n) ndarray
+    For the RTS smoother: every run's estimate before the feedback.
+"""
 
 
 # ----------------------------------------------------------------------------- measurement row kinds
@@ -639,10 +769,34 @@ def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, o
 
     The filter feeds its estimate back, so its error state after each update is zero and the
     smoothed error is d_k = C_k (d_{k+1} + x̂_{k+1}) with C_k = P_k⁺ Φ_kᵀ (P_{k+1}⁻)⁻¹ (x̂ the
-    update's estimate before feedback), P^s_k = P_k⁺ + C_k (P^s_{k+1} − P_{k+1}⁻) C_kᵀ.  ``ds``
-    (runs × n) and ``Ps`` hold the smoothed error and covariance at the epoch after the chunk on
-    entry (when ``has_next``) and at the chunk's first epoch on return.  Without ``with_cov`` only
-    the state recursion runs (C_k needs P_k⁺, P_{k+1}⁻ and Φ_k, not P^s)."""
+    update's estimate before feedback), P^s_k = P_k⁺ + C_k (P^s_{k+1} − P_{k+1}⁻) C_kᵀ.  Without
+    ``with_cov`` only the state recursion runs (C_k needs P_k⁺, P_{k+1}⁻ and Φ_k, not P^s).
+
+    Parameters
+    ----------
+    Pf, Pp, Phi : (E, n, n) ndarray
+        P⁺, P⁻ and the transition into each epoch of the chunk (the lead's replay).
+    xrec : (R, E, n) ndarray
+        Every run's estimate x̂ before the feedback, per epoch.
+    has_next : bool
+        A chunk follows: ``Pp_n``, ``Phi_n``, ``x_n`` are its first epoch's P⁻, Φ and x̂.
+    Pp_n, Phi_n : (n, n) ndarray
+        P⁻ and Φ of the epoch after the chunk.
+    x_n : (R, n) ndarray
+        x̂ of the epoch after the chunk.
+    ds : (R, n) ndarray
+        Smoothed error at the epoch after the chunk on entry, at its first epoch on return.
+    Ps : (n, n) ndarray
+        The same for P^s.
+    out_flag : (E,) ndarray of int
+        Index of each epoch among the recorded ones (−1: not recorded).
+    out_ds, out_Ps : (R, recorded, n), (recorded, n, n) ndarray
+        Smoothed errors and covariances at the recorded epochs (written).
+    out_psdiag : (E, n) ndarray
+        diag P^s per epoch (written).
+    with_cov : bool
+        Also run the covariance recursion.
+    """
     E_ = Pf.shape[0]
     R = ds.shape[0]
     n = Pf.shape[1]
@@ -775,12 +929,36 @@ def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov,
 
     then λ_{k−1} = Φ_kᵀ λ, Λ_{k−1} = Φ_kᵀ Λ Φ_k; λ = 0, Λ = 0 after the last epoch.  The innovations
     are recomputed from the raw ones ``z`` (runs × epochs × rows, INS − GNSS) as the filter formed
-    them (the same numbers).  ``Phi``, ``m``, ``H``, ``Kg``, ``s`` per epoch of the chunk (the
-    lead's pass), ``Pf`` the P⁺ of the flagged epochs (``flag`` ≥ 0, their index in
-    ``out_ds``/``out_Ps``).  ``lam`` (runs × n) and ``Lam`` hold λ, Λ of the last epoch of the
-    chunk on entry and of the epoch before the chunk on return (the transition of the chunk's first
-    epoch is applied only when ``transition_first``).  Without ``with_cov`` only λ is propagated.
-    The runs are processed side by side (λ as n × runs)."""
+    them (the same numbers).  Without ``with_cov`` only λ is propagated.  The runs are processed
+    side by side (λ as n × runs).
+
+    Parameters
+    ----------
+    Phi : (E, n, n) ndarray
+        Transition into each epoch of the chunk (the lead's pass).
+    m : (E,) ndarray of int
+        Number of rows per epoch.
+    H, Kg : (E, m_max, n) ndarray
+        Rows and gains of the sequential update.
+    s : (E, m_max) ndarray
+        Innovation variances.
+    z : (R, E, m_max) ndarray
+        Every run's residuals (INS − aid).
+    Pf : (recorded, n, n) ndarray
+        P⁺ at the recorded epochs.
+    flag : (E,) ndarray of int
+        Index of each epoch among the recorded ones (−1: not recorded).
+    lam : (R, n) ndarray
+        λ of the last epoch of the chunk on entry, of the epoch before the chunk on return.
+    Lam : (n, n) ndarray
+        The same for Λ.
+    out_ds, out_Ps : (R, recorded, n), (recorded, n, n) ndarray
+        Smoothed errors and covariances at the recorded epochs (written).
+    with_cov : bool
+        Also propagate Λ and form P^s.
+    transition_first : bool
+        Apply the transition of the chunk's first epoch (False for the first chunk).
+    """
     E_ = Phi.shape[0]
     R = lam.shape[0]
     n = Phi.shape[1]
@@ -1022,8 +1200,21 @@ def build_spec(model: ErrorModel, *, R_pos=None, R_vel=None, lever_arm_b=(0.0, 0
 
 
 def initial_batch_state(st, q, lever0) -> BatchState:
-    """Per-run state at the start: navigation states ``st`` (R × 6: L, λ, h, vE, vN, vU),
-    quaternions ``q`` (R × 4), the lever arm in use ``lever0``."""
+    """Per-run state at the start of :func:`run`.
+
+    Parameters
+    ----------
+    st : (R, 6) array_like
+        Navigation states [L, λ, h, v_E, v_N, v_U] (rad, m, m/s).
+    q : (R, 4) array_like
+        Attitude quaternions q_b^n.
+    lever0 : (3,) array_like
+        Lever arm in use, body frame, m.
+
+    Returns
+    -------
+    BatchState
+    """
     st = np.ascontiguousarray(numeric(st, "st"))
     q = np.ascontiguousarray(numeric(q, "q"))
     if st.ndim != 2 or st.shape[1] != 6 or q.shape != (st.shape[0], 4):
@@ -1050,12 +1241,31 @@ def _split(bs: BatchState, sl) -> BatchState:
 
 @dataclass
 class Records:
-    """Outputs of :func:`run` at the recorded epochs (runs × epochs unless noted).
+    """Outputs of :func:`run` at the recorded epochs (R runs × recorded epochs unless noted).
 
-    ``st``/``q`` the navigation state after feedback, ``p_hat`` the accumulated sensor-error
-    estimates, ``nis``, ``innov`` (rows as used), ``nees`` (or None), ``P`` (recorded epochs × n ×
-    n), ``P_bar`` (or None), ``pdiag_all`` (every epoch × n), ``nav_st``/``nav_q`` the IMU-rate
-    solution (or None), ``ds``/``P_s`` the smoothed error and covariance (or None)."""
+    Attributes
+    ----------
+    epochs : (recorded,) ndarray of int
+        Indices of the recorded epochs.
+    st, q : (R, recorded, 6), (R, recorded, 4) ndarray
+        Navigation state [L, λ, h, v_E, v_N, v_U] and quaternion after the feedback.
+    p_hat : (R, recorded, n − 9) ndarray
+        Accumulated estimates of the augmented states.
+    nis : (R, recorded) ndarray
+        Normalized innovation squared.
+    innov : (R, recorded, m_max) ndarray
+        Residuals of the rows in use, in the order of ``Spec.rows``.
+    nees : (R, recorded) ndarray or None
+        NEES against the truth.
+    P, P_bar : (recorded, n, n) ndarray or None
+        P⁺ of the lead, and its covariance without measurements.
+    pdiag_all : (E, n) ndarray
+        diag P⁺ at every epoch.
+    nav_st, nav_q : (R, N + 1, 6), (R, N + 1, 4) ndarray or None
+        The IMU-rate solution.
+    ds, P_s : (R, recorded, n), (recorded, n, n) ndarray or None
+        Smoothed error and covariance.
+    """
 
     epochs: np.ndarray
     st: np.ndarray
