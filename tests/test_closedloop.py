@@ -161,6 +161,10 @@ def test_bad_configuration_is_refused():
         cl.build_spec("15", R_pos=np.eye(3), R_vel=np.eye(3))
     with pytest.raises(ValueError, match="R×6"):
         cl.initial_batch_state(np.zeros(6), np.zeros(4), np.zeros(3))
+    with pytest.raises(ValueError, match="ep_step"):
+        cl.chunk_inputs(np.ones(4), np.zeros((1, 4, 3)), np.zeros((1, 4, 3)), [4])
+    with pytest.raises(ValueError, match="gpos"):
+        cl.array_inputs(np.arange(5.0), np.zeros((2, 4, 3)), np.zeros((2, 4, 3)), [2, 4], gpos=np.zeros((1, 2, 3)))
 
 
 # ----------------------------------------------------------------------------- smoother

@@ -1662,8 +1662,14 @@ def chunk_inputs(dt, dth, dvv, ep_step, *, gpos=None, gvel=None, h_ref=None, vu_
     """
     c = np.ascontiguousarray
     dth, dvv = c(dth, dtype=float), c(dvv, dtype=float)
+    if dth.ndim != 3 or dth.shape[2] != 3 or dvv.shape != dth.shape:
+        raise ValueError(f"dth and dvv must both be (runs, steps, 3) arrays, got {dth.shape} and {dvv.shape}")
     R, K_ = dth.shape[0], dth.shape[1]
+    if np.shape(dt) != (K_,):
+        raise ValueError(f"dt must hold one step length per step ({K_}), got shape {np.shape(dt)}")
     ep_step = np.asarray(ep_step, np.int64)
+    if ep_step.ndim != 1 or np.any(ep_step < 0) or np.any(ep_step >= K_):
+        raise ValueError(f"ep_step must be a 1-D array of steps in 0..{K_ - 1}")
     E_ = len(ep_step)
     zero3 = np.zeros((R, E_, 3))
     sf_w, sf_win, sf_end, sf_a, sf_R = (windows if windows is not None else
@@ -1715,6 +1721,11 @@ def array_inputs(t, dth, dvv, ep_samples, *, gpos=None, gvel=None, h_ref=None, v
     """
     idx = np.asarray(ep_samples, np.int64)
     dt = np.diff(np.asarray(t, float))
+    if np.ndim(dth) != 3 or np.shape(dth)[1:] != (len(dt), 3) or np.shape(dvv) != np.shape(dth):
+        raise ValueError(f"dth and dvv must be (runs, {len(dt)}, 3): one increment per interval of t")
+    for name, a in (("gpos", gpos), ("gvel", gvel), ("aux", aux)):
+        if a is not None and (np.ndim(a) != 3 or np.shape(a)[:2] != (np.shape(dth)[0], len(idx))):
+            raise ValueError(f"{name} must be (runs, epochs, ·) = ({np.shape(dth)[0]}, {len(idx)}, ·), got {np.shape(a)}")
 
     def inputs(ci, k0, k1, eps):
         j0 = int(np.searchsorted(idx, eps[0])) if len(eps) else 0
