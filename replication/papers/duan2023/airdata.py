@@ -33,7 +33,7 @@ The module has four parts.
 4. **The simulation of the three systems** (pure SINS, a SINS/ADS Kalman filter of the kind of
    duan2023 refs. [15-17], the error-correction method) built on the navigation core
    (:mod:`replication.nav.trajectory`, :mod:`replication.nav.sensors`, :mod:`replication.nav.strapdown`,
-   :mod:`replication.nav.errors`, :mod:`replication.nav.kalman`).
+   :mod:`replication.nav.errors`, :mod:`replication.nav.closedloop`).
 
 Units: SI and radians; displacements in metres, velocities in m/s.
 """
