@@ -51,16 +51,23 @@ def _setting():
     return m, spec, inp, lead, (c, lever, *w, st)
 
 
-def _rows(spec, inp, lead, nav, i):
+def _rows(spec, inp, lead, nav, i, sf=0):
+    """The rows of the ``i``-th kind of ``spec`` alone."""
+    c, lever, wx, wy, wz, st = nav
     H = np.zeros((9, spec.fconst.shape[0]))
     Rd = np.zeros(9)
-    m = cl._kind_rows(i, spec, inp, 0, lead, nav, H, Rd, 0)
+    m = cl._kind_rows(spec.rows[i:i + 1], spec.row_R[i:i + 1], spec.row_col[i:i + 1], sf, inp.sf_R, lead.facc,
+                      lead.Cw, spec.sf_H, spec.tg, spec.bs, spec.bz, c, lever, wx, wy, wz, st, H, Rd)
     return m, H[:m], Rd[:m]
 
 
 def _residuals(spec, inp, nav, i, p_hat):
+    """The residuals of the ``i``-th kind of ``spec`` alone (run 0, epoch 0)."""
+    c, lever, wx, wy, wz, st = nav
     z = np.zeros(9)
-    m = cl._kind_residuals(i, spec, inp, 0, 0, 0, nav, np.array([0.1, -0.2, 0.3]), p_hat, z, 0)
+    m = cl._kind_residuals(spec.rows[i:i + 1], spec.row_col[i:i + 1], spec.row_aux[i:i + 1], 0, inp.sf_a,
+                           np.array([0.1, -0.2, 0.3]), inp.gpos[0, 0], inp.gvel[0, 0], inp.aux[0, 0], p_hat, c, lever,
+                           wx, wy, wz, st, z)
     return m, z[:m]
 
 
@@ -79,8 +86,7 @@ def test_every_registered_kind_writes_its_rows_and_residuals():
         else:
             assert np.array_equal(Rd, inp.sf_R[0])
     # no measurement of the specific force where no window ends
-    assert cl._kind_rows(list(spec.rows).index(cl.ROW_SPECIFIC_FORCE), spec, inp, -1, lead, nav,
-                         np.zeros((9, m.n)), np.zeros(9), 0) == 0
+    assert _rows(spec, inp, lead, nav, list(spec.rows).index(cl.ROW_SPECIFIC_FORCE), sf=-1)[0] == 0
 
 
 def test_row_kinds_live_in_one_module():

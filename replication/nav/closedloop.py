@@ -262,93 +262,105 @@ def _specific_force_rows(H, r, facc, Cw, sf_H, tg, bs, bz):
 
 
 @njit(inline="always", **_NJ)
-def _kind_rows(i, spec, inp, sf, lead, nav, H, Rd, r):
-    """Rows r.. of H (zero on entry) and their variances ``Rd`` of the ``i``-th kind of
-    ``spec.rows`` at the lead's ``nav`` = (C_b^n, lever arm in use, ω_eb^b (three floats),
-    navigation state [L, λ, h, v_E, v_N, v_U]); ``sf`` the specific-force window ending at the
-    epoch (−1: none), ``lead`` its window sums.  Returns the number of rows written (0 when the
-    kind has no measurement at this epoch).
+def _kind_rows(rows, row_R, row_col, sf, sf_R, facc, Cw, sf_H, tg, bs, bz, c, lever, wx, wy, wz, st, H, Rd):
+    """The lead's measurement rows of one epoch: for each kind of ``rows`` (codes of
+    :data:`ROW_KINDS`, in order) its rows of H (zero on entry) and their variances ``Rd``; returns
+    the number of rows written.
+
+    The arguments are the arrays the kinds read, passed one by one rather than as the
+    configuration bundles (a compiled helper that receives a bundle takes a reference to each of
+    its arrays, which costs more per epoch than the rows themselves): per kind its variances
+    ``row_R`` and error-state column ``row_col`` (−1: none); the specific-force window ending at
+    the epoch ``sf`` (−1: none), its variances ``sf_R`` and the lead's window sums ``facc``,
+    ``Cw``, the gravity columns ``sf_H``; the block encoding ``tg``, ``bs``, ``bz``; the lead's
+    C_b^n ``c``, lever arm in use, ω_eb^b (``wx``, ``wy``, ``wz``) and navigation state ``st``
+    [L, λ, h, v_E, v_N, v_U].
 
     GNSS position and velocity at the antenna: chen2019 eqs. (3-17), (2-13)
     (``replication.nav._kernels.gnss_position_rows``, ``gnss_velocity_rows``); specific force:
     chen2019 eq. (3-18); air-data height ĥ − h_ADS = δh − b_h; airspeed |v̂| − V_TAS =
-    (v̂/|v̂|)·δv − b_V (b the air-data error state in column ``spec.row_col[i]``, if any)."""
-    kind = spec.rows[i]
-    c, lever, wx, wy, wz, st = nav
-    if kind == ROW_GNSS_POSITION:
-        K.gnss_position_rows(H, r, c, lever, st[0], st[2], spec.tg, spec.bs)
-        for a in range(3):
-            Rd[r + a] = spec.row_R[i, a]
-        return 3
-    elif kind == ROW_GNSS_VELOCITY:
-        K.gnss_velocity_rows(H, r, c, lever, wx, wy, wz, spec.tg, spec.bs)
-        for a in range(3):
-            Rd[r + a] = spec.row_R[i, a]
-        return 3
-    elif kind == ROW_SPECIFIC_FORCE:
-        if sf < 0:
-            return 0
-        _specific_force_rows(H, r, lead.facc, lead.Cw, spec.sf_H, spec.tg, spec.bs, spec.bz)
-        for a in range(3):
-            Rd[r + a] = inp.sf_R[sf, a]
-        return 3
-    elif kind == ROW_AIR_HEIGHT:
-        H[r, 2] = 1.0
-    elif kind == ROW_AIRSPEED:
-        vn = math.sqrt(st[3] * st[3] + st[4] * st[4] + st[5] * st[5])
-        for a in range(3):
-            H[r, 3 + a] = st[3 + a] / vn
-    else:
-        return 0
-    if spec.row_col[i] >= 0:
-        H[r, spec.row_col[i]] = -1.0
-    Rd[r] = spec.row_R[i, 0]
-    return 1
+    (v̂/|v̂|)·δv − b_V (b the kind's error state, if any)."""
+    r = 0
+    for i in range(rows.shape[0]):
+        kind = rows[i]
+        if kind == ROW_GNSS_POSITION:
+            K.gnss_position_rows(H, r, c, lever, st[0], st[2], tg, bs)
+            for a in range(3):
+                Rd[r + a] = row_R[i, a]
+            r += 3
+        elif kind == ROW_GNSS_VELOCITY:
+            K.gnss_velocity_rows(H, r, c, lever, wx, wy, wz, tg, bs)
+            for a in range(3):
+                Rd[r + a] = row_R[i, a]
+            r += 3
+        elif kind == ROW_SPECIFIC_FORCE:
+            if sf >= 0:
+                _specific_force_rows(H, r, facc, Cw, sf_H, tg, bs, bz)
+                for a in range(3):
+                    Rd[r + a] = sf_R[sf, a]
+                r += 3
+        elif kind == ROW_AIR_HEIGHT or kind == ROW_AIRSPEED:
+            if kind == ROW_AIR_HEIGHT:
+                H[r, 2] = 1.0
+            else:
+                vn = math.sqrt(st[3] * st[3] + st[4] * st[4] + st[5] * st[5])
+                for a in range(3):
+                    H[r, 3 + a] = st[3 + a] / vn
+            if row_col[i] >= 0:
+                H[r, row_col[i]] = -1.0
+            Rd[r] = row_R[i, 0]
+            r += 1
+    return r
 
 
 @njit(inline="always", **_NJ)
-def _kind_residuals(i, spec, inp, r, j, sf, nav, vacc, p_hat, z, row):
-    """Residuals z[row..] (measured by the INS minus measured by the aid, with the accumulated
-    estimates applied) of the ``i``-th kind of ``spec.rows`` for run ``r`` at epoch ``j``, the
-    rows of :func:`_kind_rows` in the same order; ``nav`` as there for this run, ``vacc`` its
-    window sum of the INS acceleration (reset here), ``p_hat`` its accumulated estimates.  Returns
-    the number of rows written."""
-    kind = spec.rows[i]
-    c, lever, wx, wy, wz, st = nav
-    if kind == ROW_GNSS_POSITION:
-        rm, rn = K.radii_s(st[0])
-        h = st[2]
-        la0 = c[0, 0] * lever[0] + c[0, 1] * lever[1] + c[0, 2] * lever[2]
-        la1 = c[1, 0] * lever[0] + c[1, 1] * lever[1] + c[1, 2] * lever[2]
-        la2 = c[2, 0] * lever[0] + c[2, 1] * lever[1] + c[2, 2] * lever[2]
-        z[row + 0] = (st[1] - inp.gpos[r, j, 1]) * (rn + h) * math.cos(st[0]) + la0
-        z[row + 1] = (st[0] - inp.gpos[r, j, 0]) * (rm + h) + la1
-        z[row + 2] = (st[2] - inp.gpos[r, j, 2]) + la2
-        return 3
-    elif kind == ROW_GNSS_VELOCITY:
-        cx = wy * lever[2] - wz * lever[1]
-        cy = wz * lever[0] - wx * lever[2]
-        cz = wx * lever[1] - wy * lever[0]
-        for a in range(3):
-            z[row + a] = st[3 + a] + c[a, 0] * cx + c[a, 1] * cy + c[a, 2] * cz - inp.gvel[r, j, a]
-        return 3
-    elif kind == ROW_SPECIFIC_FORCE:
-        if sf < 0:
-            return 0
-        for a in range(3):
-            z[row + a] = vacc[a] - inp.sf_a[sf, a]
-            vacc[a] = 0.0
-        return 3
-    elif kind == ROW_AIR_HEIGHT:
-        v = st[2] - inp.aux[r, j, spec.row_aux[i]]
-    elif kind == ROW_AIRSPEED:
-        v = math.sqrt(st[3] * st[3] + st[4] * st[4] + st[5] * st[5]) - inp.aux[r, j, spec.row_aux[i]]
-    else:
-        return 0
-    if spec.row_col[i] >= 0:
-        v += p_hat[spec.row_col[i] - 9]
-    z[row] = v
-    return 1
+def _kind_residuals(rows, row_col, row_aux, sf, sf_a, vacc, gpos, gvel, aux, p_hat, c, lever, wx, wy, wz, st, z):
+    """One run's residuals of one epoch (measured by the INS minus measured by the aid, with the
+    accumulated estimates applied), the rows of :func:`_kind_rows` in the same order; returns the
+    number of rows written.
+
+    The arguments are the arrays the kinds read (see :func:`_kind_rows` for why one by one): the
+    kinds ``rows``, per kind its error-state column ``row_col`` and its column of the measured
+    values ``aux`` (``row_aux``); the specific-force window ``sf`` (−1: none), the GNSS
+    accelerations ``sf_a`` and the run's window sum of the INS acceleration ``vacc`` (reset here);
+    the run's GNSS fix ``gpos`` [L, λ, h] and velocity ``gvel``, its accumulated estimates
+    ``p_hat``, its C_b^n ``c``, lever arm in use, ω_eb^b and navigation state ``st``."""
+    m = 0
+    for i in range(rows.shape[0]):
+        kind = rows[i]
+        if kind == ROW_GNSS_POSITION:
+            rm, rn = K.radii_s(st[0])
+            h = st[2]
+            la0 = c[0, 0] * lever[0] + c[0, 1] * lever[1] + c[0, 2] * lever[2]
+            la1 = c[1, 0] * lever[0] + c[1, 1] * lever[1] + c[1, 2] * lever[2]
+            la2 = c[2, 0] * lever[0] + c[2, 1] * lever[1] + c[2, 2] * lever[2]
+            z[m + 0] = (st[1] - gpos[1]) * (rn + h) * math.cos(st[0]) + la0
+            z[m + 1] = (st[0] - gpos[0]) * (rm + h) + la1
+            z[m + 2] = (st[2] - gpos[2]) + la2
+            m += 3
+        elif kind == ROW_GNSS_VELOCITY:
+            cx = wy * lever[2] - wz * lever[1]
+            cy = wz * lever[0] - wx * lever[2]
+            cz = wx * lever[1] - wy * lever[0]
+            for a in range(3):
+                z[m + a] = st[3 + a] + c[a, 0] * cx + c[a, 1] * cy + c[a, 2] * cz - gvel[a]
+            m += 3
+        elif kind == ROW_SPECIFIC_FORCE:
+            if sf >= 0:
+                for a in range(3):
+                    z[m + a] = vacc[a] - sf_a[sf, a]
+                    vacc[a] = 0.0
+                m += 3
+        elif kind == ROW_AIR_HEIGHT or kind == ROW_AIRSPEED:
+            if kind == ROW_AIR_HEIGHT:
+                v = st[2] - aux[row_aux[i]]
+            else:
+                v = math.sqrt(st[3] * st[3] + st[4] * st[4] + st[5] * st[5]) - aux[row_aux[i]]
+            if row_col[i] >= 0:
+                v += p_hat[row_col[i] - 9]
+            z[m] = v
+            m += 1
+    return m
 
 
 # ----------------------------------------------------------------------------- compiled pieces
@@ -394,39 +406,16 @@ def _attitude_error(q, tq, e):
     e[8] = -2.0 * sg * r[3]
 
 
-#: Work arrays of one call of :func:`filter_chunk` (allocated once per chunk): the interval's F, Φ,
-#: Q_d and the series' scratch, the interval sums of F's inputs (``Csum``, ``Cpl``, ``fsum``,
-#: ``navsum``, ``sums`` = [steps, seconds]), the epoch's rows (``H``, ``Rd``), residuals ``z`` and
-#: estimate ``xk``, the NEES error ``e``, the AR transition of the sensor states ``Ta`` and the
-#: per-step scratch of :func:`_run_steps` (``steps``; its C_b^n, quaternion and rates are shared).
-_Scratch = namedtuple("_Scratch", ["F", "Phi", "Qd", "Qc", "w1", "w2", "w3", "nzc", "nzv", "cnt", "Csum", "Cpl", "fsum",
-                                   "navsum", "sums", "H", "Rd", "z", "xk", "e", "tmp", "hz", "Ta", "steps"])
-
-
 @njit(inline="always", **_NJ)
-def _new_scratch(n, n_dyn, m_max, ar_T):
-    """The :data:`_Scratch` of a filter with ``n`` states, ``n_dyn`` sensor states with dynamics,
-    at most ``m_max`` measurement rows per epoch."""
-    c = np.empty((3, 3))
-    steps = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, np.empty(4),
-             np.empty(3), np.empty(3), np.empty(3), np.empty(3))
-    return _Scratch(np.zeros((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)),
-                    np.empty((n, n)), np.empty((n, n)), np.empty((n, n), np.int64), np.empty((n, n)),
-                    np.empty(n, np.int64), np.zeros((3, 3)), np.zeros((6, n)), np.zeros(3), np.zeros(5), np.zeros(2),
-                    np.zeros((m_max, n)), np.zeros(m_max), np.empty(m_max), np.empty(n), np.empty(n),
-                    np.empty(max(n_dyn, n)), np.empty(n, np.int64), np.ascontiguousarray(ar_T[9:, 9:]), steps)
-
-
-@njit(inline="always", **_NJ)
-def _lead_time_update(spec, lead, sc):
+def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd, w1,
+                      w2, w3, nzc, nzv, cnt, P, Pbar, use_pbar):
     """F as the interval mean (``build_F_core`` at the mean inputs plus the mean couplings ``Cpl``),
     (Φ, Q_d) by the Van Loan series with the navigation white noise at the mean C_b^n, then
     P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements)."""
-    F, navsum, fsum, Csum, Cpl = sc.F, sc.navsum, sc.fsum, sc.Csum, sc.Cpl
     n = F.shape[0]
-    inv = 1.0 / int(sc.sums[0])
+    inv = 1.0 / nsum
     K.build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
-                   fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, spec.fconst, F)
+                   fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, fconst, F)
     for i in range(3):
         for jj in range(9, n):
             F[3 + i, jj] += Cpl[i, jj] * inv
@@ -434,12 +423,11 @@ def _lead_time_update(spec, lead, sc):
     for i in range(3):
         for jj in range(3):
             Csum[i, jj] *= inv
-    K.interval_discretize(F, spec.qc, Csum, spec.q_accel, spec.q_gyro, sc.sums[1], spec.order, sc.Qc, sc.Phi, sc.Qd,
-                          sc.w1, sc.w2, sc.nzc, sc.nzv, sc.cnt)
-    K.row_nonzeros(sc.Phi, sc.nzc, sc.nzv, sc.cnt)
-    _propagate_sparse(sc.Phi, lead.P, sc.Qd, sc.w1, sc.w2, sc.w3, sc.nzc, sc.nzv, sc.cnt)
-    if spec.use_pbar:
-        _propagate_sparse(sc.Phi, lead.Pbar, sc.Qd, sc.w1, sc.w2, sc.w3, sc.nzc, sc.nzv, sc.cnt)
+    K.interval_discretize(F, qc, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt)
+    K.row_nonzeros(Phi, nzc, nzv, cnt)
+    _propagate_sparse(Phi, P, Qd, w1, w2, w3, nzc, nzv, cnt)
+    if use_pbar:
+        _propagate_sparse(Phi, Pbar, Qd, w1, w2, w3, nzc, nzv, cnt)
 
 
 @njit(**_NJ)
@@ -487,17 +475,12 @@ def _lead_gains(P, H, m, Rd, gK, gs, bvec, hz):
 
 
 @njit(inline="always", **_NJ)
-def _run_steps(spec, inp, bs_, r, k0, k1, first, lead_acc, lead, out, nav_last, sc):
-    """IMU steps k0..k1-1 of run ``r`` of ``bs_`` (views of its state taken once per interval):
-    corrections, strapdown, window sums; the lead's interval sums of the inputs of F when
-    ``lead_acc``; the IMU-rate solution for steps before ``nav_last``.  Returns the damping-loop
-    integrator."""
-    st, st_prev, q, p_hat = bs_.st[r], bs_.st_prev[r], bs_.q[r], bs_.p_hat[r]
-    g_extra, dth_cp, dv_cp, trig, vacc = bs_.g_extra[r], bs_.dth_cp[r], bs_.dv_cp[r], bs_.trig[r], bs_.vacc[r]
-    damp = bs_.damp[r]
-    nav_st, nav_q = out.nav_st[r], out.nav_q[r]
-    sums, fsum, Csum, navsum, Cpl = sc.sums, sc.fsum, sc.Csum, sc.navsum, sc.Cpl
-    u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en, ta, tb = sc.steps
+def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_cp, trig, vacc, damp, first,
+               lead_acc, lead, sums, fsum, Csum, navsum, Cpl, nav_st, nav_q, nav_last, w):
+    """IMU steps k0..k1-1 of run ``r`` (views of its state taken once per interval): corrections,
+    strapdown, window sums; the lead's interval sums of the inputs of F when ``lead_acc``; the
+    IMU-rate solution for steps before ``nav_last``.  Returns the damping-loop integrator."""
+    u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en, ta, tb = w
     store_nav = nav_st.shape[0] > 0
     for k in range(k0, k1):
         T = inp.dt[k]
@@ -546,155 +529,19 @@ def _run_steps(spec, inp, bs_, r, k0, k1, first, lead_acc, lead, out, nav_last, 
     return damp
 
 
-@njit(inline="always", **_NJ)
-def _time_update(spec, inp, j, bs_, lead, gains, out, is_lead, record, sc):
-    """Epoch ``j``'s time update: the lead's P⁻ (and the Φ rows of the sensor states with
-    dynamics, left in ``gains``), every run's sensor-error estimates carried by those rows, the
-    discrete AR step at an AR epoch, and the smoother's records of the transition."""
-    R = bs_.st.shape[0]
-    n_dyn = spec.dyn_rows.shape[0]
-    n_aug = spec.fconst.shape[0] - 9
-    Phi, tmp = sc.Phi, sc.tmp
-    if is_lead:
-        _lead_time_update(spec, lead, sc)
-        for t in range(n_dyn):
-            for jj in range(n_aug):
-                gains.Phid[j, t, jj] = Phi[9 + spec.dyn_rows[t], 9 + jj]
-    # sensor-error estimates with dynamics (Markov, gravity) follow Φ
-    for r in range(R):
-        for t in range(n_dyn):
-            s_ = 0.0
-            for jj in range(n_aug):
-                s_ += gains.Phid[j, t, jj] * bs_.p_hat[r, jj]
-            tmp[t] = s_
-        for t in range(n_dyn):
-            bs_.p_hat[r, spec.dyn_rows[t]] = tmp[t]
-    if inp.ar_tick[j]:
-        # discrete AR step of the gravity states (held between steps): x ← T x, P ← T P Tᵀ + Q
-        if is_lead:
-            lead.P[:, :] = spec.ar_T @ lead.P @ spec.ar_T.T + spec.ar_Q
-            if spec.use_pbar:
-                lead.Pbar[:, :] = spec.ar_T @ lead.Pbar @ spec.ar_T.T + spec.ar_Q
-        for r in range(R):
-            bs_.p_hat[r, :] = sc.Ta @ bs_.p_hat[r]
-    if is_lead and record:
-        # the transition from the last epoch's P⁺ to this epoch's P⁻ (T Φ at an AR epoch)
-        if inp.ar_tick[j]:
-            out.rec_Phi[j] = spec.ar_T @ Phi
-        else:
-            out.rec_Phi[j] = Phi
-        if out.rec_Pp.shape[0] > 0:
-            out.rec_Pp[j] = lead.P
-
-
-@njit(inline="always", **_NJ)
-def _lead_measurement(spec, inp, j, sf, bs_, lead, gains, T, sc):
-    """The lead's measurement at epoch ``j``: the rows of every kind of ``spec.rows`` at run 0's
-    state, the sequential Joseph update of P⁺ and the gains and rows left in ``gains`` for every
-    run (with the NEES factor), then the specific-force window sums cleared."""
-    n = spec.fconst.shape[0]
-    H, Rd, c = sc.H, sc.Rd, sc.steps[6]
-    w_ie, w_en = sc.steps[8], sc.steps[9]
-    K.q2c(bs_.q[0], c)
-    for i in range(H.shape[0]):
-        for jj in range(n):
-            H[i, jj] = 0.0
-    wx, wy, wz = _body_rate(bs_.dth_cp[0], T, c, bs_.st[0], w_ie, w_en)
-    nav = (c, bs_.lever[0], wx, wy, wz, bs_.st[0])
-    m = 0
-    for i in range(spec.rows.shape[0]):
-        m += _kind_rows(i, spec, inp, sf, lead, nav, H, Rd, m)
-    gains.m[j] = m
-    _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j], sc.tmp, sc.hz)
-    for a in range(m):
-        gains.H[j, a, :] = H[a]
-    if gains.nees_L.shape[0] > 0:
-        K.chol_scaled(lead.P, gains.nees_sd[j], gains.nees_L[j])
-    if sf >= 0:
-        lead.facc[:] = 0.0
-        lead.Cw[:, :] = 0.0
-
-
-@njit(inline="always", **_NJ)
-def _correct_runs(spec, inp, j, sf, bs_, gains, out, T, sc):
-    """Every run at epoch ``j``: its residuals by kind, the sequential correction with the lead's
-    rows and gains, the feedback of the estimate, and its records (state, estimates, NIS,
-    residuals, NEES against the truth)."""
-    R = bs_.st.shape[0]
-    n = spec.fconst.shape[0]
-    n_aug = n - 9
-    m = gains.m[j]
-    gH, gK, gS = gains.H[j], gains.Kg[j], gains.s[j]
-    z, xk, e, c = sc.z, sc.xk, sc.e, sc.steps[6]
-    qtmp, w_ie, w_en = sc.steps[7], sc.steps[8], sc.steps[9]
-    record_x = out.rec_x.shape[1] > 0
-    for r in range(R):
-        st_r = bs_.st[r]
-        q_r = bs_.q[r]
-        ph_r = bs_.p_hat[r]
-        lev_r = bs_.lever[r]
-        K.q2c(q_r, c)
-        wx, wy, wz = _body_rate(bs_.dth_cp[r], T, c, st_r, w_ie, w_en)
-        nav = (c, lev_r, wx, wy, wz, st_r)
-        mr = 0
-        for i in range(spec.rows.shape[0]):
-            mr += _kind_residuals(i, spec, inp, r, j, sf, nav, bs_.vacc[r], ph_r, z, mr)
-        for i in range(n):
-            xk[i] = 0.0
-        nis = 0.0
-        for a in range(m):
-            nu = z[a]
-            for kk in range(n):
-                nu -= gH[a, kk] * xk[kk]
-            for i in range(n):
-                xk[i] += gK[a, i] * nu
-            nis += nu * nu / gS[a]
-        out.nis[r, j] = nis
-        for a in range(m):
-            out.innov[r, j, a] = z[a]
-        if record_x:
-            out.rec_x[r, j, :] = xk
-        K.feedback_nav(xk, st_r, bs_.st_prev[r], q_r, ph_r, qtmp, e)
-        K.feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, bs_.g_extra[r])
-        for i in range(6):
-            out.st[r, j, i] = st_r[i]
-        for i in range(4):
-            out.q[r, j, i] = q_r[i]
-        for i in range(n_aug):
-            out.phat[r, j, i] = ph_r[i]
-        if spec.nees:
-            for i in range(6):
-                e[i] = st_r[i] - inp.truth_st[j, i]
-            _attitude_error(q_r, inp.truth_q[j], e)
-            for i in range(n_aug):
-                e[9 + i] = inp.truth_p[r, j, i] - ph_r[i]
-            out.nees[r, j] = K.solve_scaled(gains.nees_L[j], gains.nees_sd[j], e)
-
-
-@njit(inline="always", **_NJ)
-def _lead_records(spec, j, lead, out, record):
-    """The lead's covariance records of epoch ``j``: diag P⁺, and P⁺ (P̄) where recorded."""
-    n = lead.P.shape[0]
-    for i in range(n):
-        out.pdiag[j, i] = lead.P[i, i]
-    if record and out.rec_Pf.shape[0] > 0:
-        out.rec_Pf[j] = lead.P
-    f = out.flag[j]
-    if f >= 0 and out.P.shape[0] > 0:
-        out.P[f] = lead.P
-        if spec.use_pbar and out.Pbar.shape[0] > 0:
-            out.Pbar[f] = lead.Pbar
-
-
 @njit(**_NJ)
 def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     """One chunk of the closed-loop filter for the runs of a batch (see the module docstring).
 
-    The runs advance one GNSS interval at a time (:func:`_run_steps`); at each epoch the time
-    update (:func:`_time_update`), the lead's measurement rows and gains (:func:`_lead_measurement`),
-    every run's correction and feedback (:func:`_correct_runs`) and the lead's records
-    (:func:`_lead_records`).  The pieces are compiled inline: a compiled call carrying the
-    configuration bundles cost about 4 µs per epoch, a fifth of a 15-state single run.
+    The runs advance one GNSS interval at a time (``_run_steps``); at each epoch the lead's time
+    update (``_lead_time_update``), the sensor-error estimates carried by Φ, the lead's
+    measurement rows by kind (``_kind_rows``) and its sequential Joseph update (``_lead_gains``),
+    then every run's residuals by kind (``_kind_residuals``), correction, feedback and records.
+
+    The epoch is written inline and its helpers take arrays, not the bundles: a compiled helper
+    that receives a bundle takes a reference to each of its arrays, and splitting the epoch into
+    helpers that carry ``spec``, ``inp``, ``bs_``, ``gains``, ``out`` and a scratch bundle made the
+    15-state hour about a quarter slower (0.61 s against 0.41 s of CPU).
 
     Parameters
     ----------
@@ -724,9 +571,40 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     n_steps = inp.dt.shape[0]
     n = spec.fconst.shape[0]
     n_ep = inp.ep_step.shape[0]
-    sc = _new_scratch(n, spec.dyn_rows.shape[0], spec.m_max, spec.ar_T)
+    n_dyn = spec.dyn_rows.shape[0]
+    n_aug = n - 9
+    c = np.empty((3, 3))
+    qtmp = np.empty(4)
+    w_ie = np.empty(3)
+    w_en = np.empty(3)
+    w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en,
+         np.empty(3), np.empty(3))
+    F = np.zeros((n, n))
+    Phi = np.empty((n, n))
+    Qd = np.empty((n, n))
+    Qc = np.empty((n, n))
+    w1 = np.empty((n, n))
+    w2 = np.empty((n, n))
+    w3 = np.empty((n, n))
+    nzc = np.empty((n, n), np.int64)
+    nzv = np.empty((n, n))
+    cnt = np.empty(n, np.int64)
+    Csum = np.zeros((3, 3))
+    Cpl = np.zeros((6, n))
+    fsum = np.zeros(3)
+    navsum = np.zeros(5)
+    sums = np.zeros(2)
+    H = np.zeros((spec.m_max, n))
+    Rd = np.zeros(spec.m_max)
+    z = np.empty(spec.m_max)
+    xk = np.empty(n)
+    e = np.empty(n)
+    tmp = np.empty(max(n_dyn, n))
+    hz = np.empty(n, np.int64)
+    Ta = np.ascontiguousarray(spec.ar_T[9:, 9:])
     store_nav = out.nav_st.shape[1] > 0
     record = out.rec_Phi.shape[0] > 0
+    record_x = out.rec_x.shape[1] > 0
     if store_nav:
         for r in range(R):
             out.nav_st[r, 0, :] = bs_.st[r]
@@ -738,22 +616,127 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
         has_ep = j < n_ep
         k_end = inp.ep_step[j] + 1 if has_ep else n_steps
         for r in range(R):
-            bs_.damp[r] = _run_steps(spec, inp, bs_, r, k, k_end, first, is_lead and r == 0, lead, out,
-                                     k_end - 1 if has_ep else k_end, sc)
+            bs_.damp[r] = _run_steps(spec, inp, r, k, k_end, bs_.st[r], bs_.st_prev[r], bs_.q[r], bs_.p_hat[r],
+                                     bs_.g_extra[r], bs_.dth_cp[r], bs_.dv_cp[r], bs_.trig[r], bs_.vacc[r],
+                                     bs_.damp[r], first, is_lead and r == 0, lead, sums, fsum, Csum, navsum, Cpl,
+                                     out.nav_st[r], out.nav_q[r], k_end - 1 if has_ep else k_end, w)
         first = False
         bs_.first[0] = 0
         if has_ep:
+            # ---------------- one GNSS epoch: time update and gains (lead), then every run's
+            # innovation, correction, feedback and records
             T = inp.dt[k_end - 1]
+            nsum = int(sums[0])
+            tsum = sums[1]
             sf = inp.sf_end[j]
-            _time_update(spec, inp, j, bs_, lead, gains, out, is_lead, record, sc)
+            # ---------------- time update (lead)
             if is_lead:
-                _lead_measurement(spec, inp, j, sf, bs_, lead, gains, T, sc)
-            _correct_runs(spec, inp, j, sf, bs_, gains, out, T, sc)
+                _lead_time_update(spec.fconst, spec.qc, spec.q_accel, spec.q_gyro, spec.order, navsum, fsum, Csum, Cpl,
+                                  nsum, tsum, F, Qc, Phi, Qd, w1, w2, w3, nzc, nzv, cnt, lead.P, lead.Pbar,
+                                  spec.use_pbar)
+                for t in range(n_dyn):
+                    for jj in range(n_aug):
+                        gains.Phid[j, t, jj] = Phi[9 + spec.dyn_rows[t], 9 + jj]
+            # sensor-error estimates with dynamics (Markov, gravity) follow Φ
+            for r in range(R):
+                for t in range(n_dyn):
+                    s_ = 0.0
+                    for jj in range(n_aug):
+                        s_ += gains.Phid[j, t, jj] * bs_.p_hat[r, jj]
+                    tmp[t] = s_
+                for t in range(n_dyn):
+                    bs_.p_hat[r, spec.dyn_rows[t]] = tmp[t]
+            if inp.ar_tick[j]:
+                # discrete AR step of the gravity states (held between steps): x ← T x, P ← T P Tᵀ + Q
+                if is_lead:
+                    lead.P[:, :] = spec.ar_T @ lead.P @ spec.ar_T.T + spec.ar_Q
+                    if spec.use_pbar:
+                        lead.Pbar[:, :] = spec.ar_T @ lead.Pbar @ spec.ar_T.T + spec.ar_Q
+                for r in range(R):
+                    bs_.p_hat[r, :] = Ta @ bs_.p_hat[r]
+            if is_lead and record:
+                # the transition from the last epoch's P⁺ to this epoch's P⁻ (T Φ at an AR epoch)
+                if inp.ar_tick[j]:
+                    out.rec_Phi[j] = spec.ar_T @ Phi
+                else:
+                    out.rec_Phi[j] = Phi
+                if out.rec_Pp.shape[0] > 0:
+                    out.rec_Pp[j] = lead.P
+            # ---------------- measurement rows and gains (lead)
             if is_lead:
-                _lead_records(spec, j, lead, out, record)
-            K.reset_interval(sc.Cpl, sc.fsum, sc.Csum, sc.navsum)
-            sc.sums[0] = 0.0
-            sc.sums[1] = 0.0
+                K.q2c(bs_.q[0], c)
+                for i in range(spec.m_max):
+                    for jj in range(n):
+                        H[i, jj] = 0.0
+                wx, wy, wz = _body_rate(bs_.dth_cp[0], T, c, bs_.st[0], w_ie, w_en)
+                m = _kind_rows(spec.rows, spec.row_R, spec.row_col, sf, inp.sf_R, lead.facc, lead.Cw, spec.sf_H,
+                               spec.tg, spec.bs, spec.bz, c, bs_.lever[0], wx, wy, wz, bs_.st[0], H, Rd)
+                gains.m[j] = m
+                _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j], tmp, hz)
+                for a in range(m):
+                    gains.H[j, a, :] = H[a]
+                if gains.nees_L.shape[0] > 0:
+                    K.chol_scaled(lead.P, gains.nees_sd[j], gains.nees_L[j])
+                if sf >= 0:
+                    lead.facc[:] = 0.0
+                    lead.Cw[:, :] = 0.0
+            m = gains.m[j]
+            # ---------------- per run: innovation, correction, feedback, records
+            gH = gains.H[j]
+            gK = gains.Kg[j]
+            gS = gains.s[j]
+            for r in range(R):
+                st_r = bs_.st[r]
+                q_r = bs_.q[r]
+                ph_r = bs_.p_hat[r]
+                lev_r = bs_.lever[r]
+                K.q2c(q_r, c)
+                wx, wy, wz = _body_rate(bs_.dth_cp[r], T, c, st_r, w_ie, w_en)
+                _kind_residuals(spec.rows, spec.row_col, spec.row_aux, sf, inp.sf_a, bs_.vacc[r], inp.gpos[r, j],
+                                inp.gvel[r, j], inp.aux[r, j], ph_r, c, lev_r, wx, wy, wz, st_r, z)
+                for i in range(n):
+                    xk[i] = 0.0
+                nis = 0.0
+                for a in range(m):
+                    nu = z[a]
+                    for kk in range(n):
+                        nu -= gH[a, kk] * xk[kk]
+                    for i in range(n):
+                        xk[i] += gK[a, i] * nu
+                    nis += nu * nu / gS[a]
+                out.nis[r, j] = nis
+                for a in range(m):
+                    out.innov[r, j, a] = z[a]
+                if record_x:
+                    out.rec_x[r, j, :] = xk
+                K.feedback_nav(xk, st_r, bs_.st_prev[r], q_r, ph_r, qtmp, e)
+                K.feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, bs_.g_extra[r])
+                for i in range(6):
+                    out.st[r, j, i] = st_r[i]
+                for i in range(4):
+                    out.q[r, j, i] = q_r[i]
+                for i in range(n_aug):
+                    out.phat[r, j, i] = ph_r[i]
+                if spec.nees:
+                    for i in range(6):
+                        e[i] = st_r[i] - inp.truth_st[j, i]
+                    _attitude_error(q_r, inp.truth_q[j], e)
+                    for i in range(n_aug):
+                        e[9 + i] = inp.truth_p[r, j, i] - ph_r[i]
+                    out.nees[r, j] = K.solve_scaled(gains.nees_L[j], gains.nees_sd[j], e)
+            if is_lead:
+                for i in range(n):
+                    out.pdiag[j, i] = lead.P[i, i]
+                if record and out.rec_Pf.shape[0] > 0:
+                    out.rec_Pf[j] = lead.P
+                f = out.flag[j]
+                if f >= 0 and out.P.shape[0] > 0:
+                    out.P[f] = lead.P
+                    if spec.use_pbar and out.Pbar.shape[0] > 0:
+                        out.Pbar[f] = lead.Pbar
+            K.reset_interval(Cpl, fsum, Csum, navsum)
+            sums[0] = 0.0
+            sums[1] = 0.0
             j += 1
             if store_nav:
                 for r in range(R):
