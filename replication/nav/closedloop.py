@@ -12,7 +12,7 @@ its residuals, in one place (``_kind_rows``, ``_kind_residuals``), chosen by a k
 compiled loop dispatches on — GNSS antenna position and velocity with the lever arm (chen2019
 eq. (2-13), ``replication.nav._kernels.gnss_position_rows`` and ``gnss_velocity_rows``), the
 specific force of chen2019 eq. (3-18), the air-data height and airspeed (duan2023 refs. [15-17]
-as read by :func:`replication.papers.duan2023.airdata.literature_filter`); the update is the
+as read by ``replication.papers.duan2023.airdata.literature_filter``); the update is the
 Joseph form one (independent) measurement at a time; then the navigation errors are fed back and
 the sensor-error estimates accumulated.  Optional: a vertical channel held or damped
 (:mod:`replication.nav.strapdown`), discrete AR transitions of a gravity block at chosen epochs, the
@@ -35,7 +35,7 @@ configuration of an :class:`replication.nav.errors.ErrorModel` and the row kinds
 :func:`replication.nav.kalman.closed_loop` (one run), :func:`replication.nav.kalman.monte_carlo`,
 :func:`replication.papers.chen2019.simulation.run_batch` (chen2019 §4.2),
 :func:`replication.papers.chen2019.gravity.augmented_filter` (chen2019 eq. (3-18)) and
-:func:`replication.papers.duan2023.airdata.literature_filter`.
+``replication.papers.duan2023.airdata.literature_filter``.
 """
 
 from __future__ import annotations
@@ -225,8 +225,8 @@ rec_x : (R, E, n) ndarray
 # ----------------------------------------------------------------------------- measurement row kinds
 
 #: The measurement row kinds of the filter: name → (code, number of rows).  Each kind writes, in
-#: one place, its rows of H and their variances for the lead (:func:`_kind_rows`) and its residuals
-#: for every run (:func:`_kind_residuals`); :func:`build_spec` lists the kinds a filter uses, in
+#: one place, its rows of H and their variances for the lead (``_kind_rows``) and its residuals
+#: for every run (``_kind_residuals``); :func:`build_spec` lists the kinds a filter uses, in
 #: the order of their rows, and the compiled loop dispatches on the code.  A new kind is an entry
 #: here and one branch in each of the two functions (and its test).
 ROW_KINDS = {"gnss_position": (0, 3), "gnss_velocity": (1, 3), "specific_force": (2, 3), "air_height": (3, 1),
@@ -411,7 +411,12 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cp
                       w2, w3, nzc, nzv, cnt, P, Pbar, use_pbar):
     """F as the interval mean (``build_F_core`` at the mean inputs plus the mean couplings ``Cpl``),
     (Φ, Q_d) by the Van Loan series with the navigation white noise at the mean C_b^n, then
-    P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements)."""
+    P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements).
+
+    The arguments are arrays, one by one (the configuration's ``fconst``, ``qc``, PSDs and series
+    order; the interval sums ``navsum``, ``fsum``, ``Csum``, ``Cpl`` over ``nsum`` steps and
+    ``tsum`` seconds; the work arrays of the series; the lead's ``P`` and ``Pbar``): a compiled
+    helper that receives a bundle takes a reference to each of its arrays once per epoch."""
     n = F.shape[0]
     inv = 1.0 / nsum
     K.build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
@@ -479,7 +484,12 @@ def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_
                lead_acc, lead, sums, fsum, Csum, navsum, Cpl, nav_st, nav_q, nav_last, w):
     """IMU steps k0..k1-1 of run ``r`` (views of its state taken once per interval): corrections,
     strapdown, window sums; the lead's interval sums of the inputs of F when ``lead_acc``; the
-    IMU-rate solution for steps before ``nav_last``.  Returns the damping-loop integrator."""
+    IMU-rate solution for steps before ``nav_last``.  Returns the damping-loop integrator.
+
+    Called once per run and GNSS interval: the run's state arrays (``st`` … ``damp``), the lead's
+    interval sums (``sums``, ``fsum``, ``Csum``, ``navsum``, ``Cpl``), the run's IMU-rate records
+    and the per-step work arrays ``w`` are passed one by one, as views taken once per interval
+    (a bundle would cost a reference per array at every call)."""
     u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en, ta, tb = w
     store_nav = nav_st.shape[0] > 0
     for k in range(k0, k1):
@@ -530,7 +540,7 @@ def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_
 
 
 @njit(**_NJ)
-def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
+def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
     """One chunk of the closed-loop filter for the runs of a batch (see the module docstring).
 
     The runs advance one GNSS interval at a time (``_run_steps``); at each epoch the lead's time
@@ -540,7 +550,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
 
     The epoch is written inline and its helpers take arrays, not the bundles: a compiled helper
     that receives a bundle takes a reference to each of its arrays, and splitting the epoch into
-    helpers that carry ``spec``, ``inp``, ``bs_``, ``gains``, ``out`` and a scratch bundle made the
+    helpers that carry ``spec``, ``inp``, ``batch``, ``gains``, ``out`` and a scratch bundle made the
     15-state hour about a quarter slower (0.61 s against 0.41 s of CPU).
 
     Parameters
@@ -548,17 +558,17 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     spec : Spec
         The configuration (:func:`build_spec`).
     inp : ChunkInputs
-        The chunk's inputs for the runs of ``bs_``.
-    bs_ : BatchState
+        The chunk's inputs for the runs of ``batch``.
+    batch : BatchState
         The runs' state (views), advanced in place.
     lead : LeadState
         The lead's covariance and window sums, advanced in place when ``is_lead``.
     gains : Gains
         Per epoch of the chunk: written by the lead's pass, read by the followers.
     out : ChunkOut
-        The chunk's outputs for the runs of ``bs_``, written in place.
+        The chunk's outputs for the runs of ``batch``, written in place.
     is_lead : bool
-        Run 0 of ``bs_`` is the lead: the covariance is propagated and updated from it and the
+        Run 0 of ``batch`` is the lead: the covariance is propagated and updated from it and the
         gains are written for every epoch; otherwise the runs follow ``gains`` written by the
         lead's pass over the same chunk.
 
@@ -607,21 +617,21 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
     record_x = out.rec_x.shape[1] > 0
     if store_nav:
         for r in range(R):
-            out.nav_st[r, 0, :] = bs_.st[r]
-            out.nav_q[r, 0, :] = bs_.q[r]
-    first = bs_.first[0] == 1
+            out.nav_st[r, 0, :] = batch.st[r]
+            out.nav_q[r, 0, :] = batch.q[r]
+    first = batch.first[0] == 1
     j = 0
     k = 0
     while k < n_steps:
         has_ep = j < n_ep
         k_end = inp.ep_step[j] + 1 if has_ep else n_steps
         for r in range(R):
-            bs_.damp[r] = _run_steps(spec, inp, r, k, k_end, bs_.st[r], bs_.st_prev[r], bs_.q[r], bs_.p_hat[r],
-                                     bs_.g_extra[r], bs_.dth_cp[r], bs_.dv_cp[r], bs_.trig[r], bs_.vacc[r],
-                                     bs_.damp[r], first, is_lead and r == 0, lead, sums, fsum, Csum, navsum, Cpl,
+            batch.damp[r] = _run_steps(spec, inp, r, k, k_end, batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r],
+                                     batch.g_extra[r], batch.dth_cp[r], batch.dv_cp[r], batch.trig[r], batch.vacc[r],
+                                     batch.damp[r], first, is_lead and r == 0, lead, sums, fsum, Csum, navsum, Cpl,
                                      out.nav_st[r], out.nav_q[r], k_end - 1 if has_ep else k_end, w)
         first = False
-        bs_.first[0] = 0
+        batch.first[0] = 0
         if has_ep:
             # ---------------- one GNSS epoch: time update and gains (lead), then every run's
             # innovation, correction, feedback and records
@@ -642,10 +652,10 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                 for t in range(n_dyn):
                     s_ = 0.0
                     for jj in range(n_aug):
-                        s_ += gains.Phid[j, t, jj] * bs_.p_hat[r, jj]
+                        s_ += gains.Phid[j, t, jj] * batch.p_hat[r, jj]
                     tmp[t] = s_
                 for t in range(n_dyn):
-                    bs_.p_hat[r, spec.dyn_rows[t]] = tmp[t]
+                    batch.p_hat[r, spec.dyn_rows[t]] = tmp[t]
             if inp.ar_tick[j]:
                 # discrete AR step of the gravity states (held between steps): x ← T x, P ← T P Tᵀ + Q
                 if is_lead:
@@ -653,7 +663,7 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                     if spec.use_pbar:
                         lead.Pbar[:, :] = spec.ar_T @ lead.Pbar @ spec.ar_T.T + spec.ar_Q
                 for r in range(R):
-                    bs_.p_hat[r, :] = Ta @ bs_.p_hat[r]
+                    batch.p_hat[r, :] = Ta @ batch.p_hat[r]
             if is_lead and record:
                 # the transition from the last epoch's P⁺ to this epoch's P⁻ (T Φ at an AR epoch)
                 if inp.ar_tick[j]:
@@ -664,13 +674,13 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                     out.rec_Pp[j] = lead.P
             # ---------------- measurement rows and gains (lead)
             if is_lead:
-                K.q2c(bs_.q[0], c)
+                K.q2c(batch.q[0], c)
                 for i in range(spec.m_max):
                     for jj in range(n):
                         H[i, jj] = 0.0
-                wx, wy, wz = _body_rate(bs_.dth_cp[0], T, c, bs_.st[0], w_ie, w_en)
+                wx, wy, wz = _body_rate(batch.dth_cp[0], T, c, batch.st[0], w_ie, w_en)
                 m = _kind_rows(spec.rows, spec.row_R, spec.row_col, sf, inp.sf_R, lead.facc, lead.Cw, spec.sf_H,
-                               spec.tg, spec.bs, spec.bz, c, bs_.lever[0], wx, wy, wz, bs_.st[0], H, Rd)
+                               spec.tg, spec.bs, spec.bz, c, batch.lever[0], wx, wy, wz, batch.st[0], H, Rd)
                 gains.m[j] = m
                 _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j], tmp, hz)
                 for a in range(m):
@@ -686,13 +696,13 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
             gK = gains.Kg[j]
             gS = gains.s[j]
             for r in range(R):
-                st_r = bs_.st[r]
-                q_r = bs_.q[r]
-                ph_r = bs_.p_hat[r]
-                lev_r = bs_.lever[r]
+                st_r = batch.st[r]
+                q_r = batch.q[r]
+                ph_r = batch.p_hat[r]
+                lev_r = batch.lever[r]
                 K.q2c(q_r, c)
-                wx, wy, wz = _body_rate(bs_.dth_cp[r], T, c, st_r, w_ie, w_en)
-                _kind_residuals(spec.rows, spec.row_col, spec.row_aux, sf, inp.sf_a, bs_.vacc[r], inp.gpos[r, j],
+                wx, wy, wz = _body_rate(batch.dth_cp[r], T, c, st_r, w_ie, w_en)
+                _kind_residuals(spec.rows, spec.row_col, spec.row_aux, sf, inp.sf_a, batch.vacc[r], inp.gpos[r, j],
                                 inp.gvel[r, j], inp.aux[r, j], ph_r, c, lev_r, wx, wy, wz, st_r, z)
                 for i in range(n):
                     xk[i] = 0.0
@@ -709,8 +719,8 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
                     out.innov[r, j, a] = z[a]
                 if record_x:
                     out.rec_x[r, j, :] = xk
-                K.feedback_nav(xk, st_r, bs_.st_prev[r], q_r, ph_r, qtmp, e)
-                K.feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, bs_.g_extra[r])
+                K.feedback_nav(xk, st_r, batch.st_prev[r], q_r, ph_r, qtmp, e)
+                K.feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, batch.g_extra[r])
                 for i in range(6):
                     out.st[r, j, i] = st_r[i]
                 for i in range(4):
@@ -740,8 +750,8 @@ def filter_chunk(spec, inp, bs_, lead, gains, out, is_lead):
             j += 1
             if store_nav:
                 for r in range(R):
-                    out.nav_st[r, k_end, :] = bs_.st[r]
-                    out.nav_q[r, k_end, :] = bs_.q[r]
+                    out.nav_st[r, k_end, :] = batch.st[r]
+                    out.nav_q[r, k_end, :] = batch.q[r]
         k = k_end
     return j
 
