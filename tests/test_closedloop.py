@@ -57,7 +57,8 @@ def _measurement(x, st_hat, C_hat, lever_used, w_eb):
 
 @pytest.mark.parametrize("lever", [(0.0, 0.0, 0.0), (0.4, -1.2, 2.5)])
 def test_gnss_rows_are_the_jacobian_of_the_antenna_measurement(lever):
-    """chen2019 eq. (2-13): H of :func:`replication.nav._kernels.gnss_rows` (position and velocity at the
+    """chen2019 eq. (2-13): H of the GNSS row kinds (:func:`replication.nav._kernels.gnss_position_rows`,
+    :func:`replication.nav._kernels.gnss_velocity_rows`: position and velocity at the
     antenna, lever-arm state columns) equals the central-difference Jacobian of the nonlinear
     measurement, column-relative difference < 1e-6 (steps 1e-7 of each state's scale: the
     truncation error is O(step²), the rounding O(1e-16/step))."""
@@ -68,8 +69,8 @@ def test_gnss_rows_are_the_jacobian_of_the_antenna_measurement(lever):
     n = 12
     H = np.zeros((6, n))
     tg = np.array([K.TARGET_LEVER], np.int64)
-    rows = K.gnss_rows(H, C, lever, *w_eb, st[0], st[2], True, True, tg, np.array([9], np.int64))
-    assert rows == 6
+    K.gnss_position_rows(H, 0, C, lever, st[0], st[2], tg, np.array([9], np.int64))
+    K.gnss_velocity_rows(H, 3, C, lever, *w_eb, tg, np.array([9], np.int64))
     scale = np.r_[1e-6, 1e-6, 1.0, 0.1, 0.1, 0.1, 1e-3, 1e-3, 1e-3, 0.1, 0.1, 0.1]
     J = np.empty((6, n))
     for i in range(n):
@@ -152,10 +153,18 @@ def test_bad_configuration_is_refused():
         cl.build_spec(m, R_pos=np.ones((3, 3)), R_vel=np.eye(3))
     with pytest.raises(ValueError, match="at least one"):
         cl.build_spec(m, R_pos=np.eye(3), R_vel=np.eye(3), use_position=False, use_velocity=False)
+    with pytest.raises(ValueError, match="R_vel is needed"):
+        cl.build_spec(m, R_pos=np.eye(3))
+    with pytest.raises(ValueError, match="kind"):
+        cl.build_spec(m, R_pos=np.eye(3), R_vel=np.eye(3), rows=[("gnss_position", None, 1.0)])
     with pytest.raises(TypeError, match="ErrorModel"):
         cl.build_spec("15", R_pos=np.eye(3), R_vel=np.eye(3))
     with pytest.raises(ValueError, match="R×6"):
         cl.initial_batch_state(np.zeros(6), np.zeros(4), np.zeros(3))
+    with pytest.raises(ValueError, match="ep_step"):
+        cl.chunk_inputs(np.ones(4), np.zeros((1, 4, 3)), np.zeros((1, 4, 3)), [4])
+    with pytest.raises(ValueError, match="gpos"):
+        cl.array_inputs(np.arange(5.0), np.zeros((2, 4, 3)), np.zeros((2, 4, 3)), [2, 4], gpos=np.zeros((1, 2, 3)))
 
 
 # ----------------------------------------------------------------------------- smoother

@@ -22,10 +22,7 @@ from numpydoc.docscrape import ClassDoc, FunctionDoc
 import replication
 
 # modules whose docstrings have not yet been brought to the numpydoc form; the list only shrinks
-PENDING: set[str] = {
-    "replication.nav.closedloop",
-    "replication.papers.duan2023.airdata",
-}
+PENDING: set[str] = set()
 
 
 def _public_modules():

@@ -824,52 +824,47 @@ def _skew_rows(H, r, u0, u1, u2):
 
 
 @njit(inline="always", **_NJ)
-def gnss_rows(H, c, lever, wx, wy, wz, L, h, use_pos, use_vel, blk_target, blk_start):
-    """GNSS measurement rows of the error state, chen2019 eqs. (3-17) and (2-13); returns the
-    number of rows written (H must be zero on entry).
-
-    Position rows (0-2 when ``use_pos``): antenna position p + C_b^n l (E, N, U in metres):
-    δp columns (R_N+h)cos L, R_M+h, 1; attitude columns (C l)×; lever-arm state columns -C.
-    Velocity rows (next three when ``use_vel``): antenna velocity v + C (ω_eb^b × l): δv columns
-    I; attitude columns (C(ω×l))×; lever-arm state columns -C (ω_eb^b ×).  Lever-arm states are
-    true minus used (δl = l - l̂).  ``(wx, wy, wz)`` is ω_eb^b, ``lever`` the lever arm in use.
-    """
+def gnss_position_rows(H, r, c, lever, L, h, blk_target, blk_start):
+    """Rows r..r+2 of H (zero on entry) for the GNSS antenna position, chen2019 eqs. (3-17) and
+    (2-13): antenna position p + C_b^n l (E, N, U in metres): δp columns (R_N+h)cos L, R_M+h, 1;
+    attitude columns (C l)×; lever-arm state columns -C (δl = l - l̂, ``lever`` the arm in use)."""
     rm, rn = radii_s(L)
-    r = 0
-    if use_pos:
-        la0 = c[0, 0] * lever[0] + c[0, 1] * lever[1] + c[0, 2] * lever[2]
-        la1 = c[1, 0] * lever[0] + c[1, 1] * lever[1] + c[1, 2] * lever[2]
-        la2 = c[2, 0] * lever[0] + c[2, 1] * lever[1] + c[2, 2] * lever[2]
-        H[0, 1] = (rn + h) * math.cos(L)
-        H[1, 0] = rm + h
-        H[2, 2] = 1.0
-        _skew_rows(H, 0, la0, la1, la2)
-        for b in range(blk_target.shape[0]):
-            if blk_target[b] == TARGET_LEVER:
-                for i in range(3):
-                    for jj in range(3):
-                        H[i, blk_start[b] + jj] = -c[i, jj]
-        r = 3
-    if use_vel:
-        cx = wy * lever[2] - wz * lever[1]
-        cy = wz * lever[0] - wx * lever[2]
-        cz = wx * lever[1] - wy * lever[0]
-        u0 = c[0, 0] * cx + c[0, 1] * cy + c[0, 2] * cz
-        u1 = c[1, 0] * cx + c[1, 1] * cy + c[1, 2] * cz
-        u2 = c[2, 0] * cx + c[2, 1] * cy + c[2, 2] * cz
-        H[r + 0, 3] = 1.0
-        H[r + 1, 4] = 1.0
-        H[r + 2, 5] = 1.0
-        _skew_rows(H, r, u0, u1, u2)
-        for b in range(blk_target.shape[0]):
-            if blk_target[b] == TARGET_LEVER:
-                k0 = blk_start[b]
-                for i in range(3):
-                    H[r + i, k0] = -(c[i, 1] * wz - c[i, 2] * wy)          # -(C [ω×])[i, :]
-                    H[r + i, k0 + 1] = -(-c[i, 0] * wz + c[i, 2] * wx)
-                    H[r + i, k0 + 2] = -(c[i, 0] * wy - c[i, 1] * wx)
-        r += 3
-    return r
+    la0 = c[0, 0] * lever[0] + c[0, 1] * lever[1] + c[0, 2] * lever[2]
+    la1 = c[1, 0] * lever[0] + c[1, 1] * lever[1] + c[1, 2] * lever[2]
+    la2 = c[2, 0] * lever[0] + c[2, 1] * lever[1] + c[2, 2] * lever[2]
+    H[r + 0, 1] = (rn + h) * math.cos(L)
+    H[r + 1, 0] = rm + h
+    H[r + 2, 2] = 1.0
+    _skew_rows(H, r, la0, la1, la2)
+    for b in range(blk_target.shape[0]):
+        if blk_target[b] == TARGET_LEVER:
+            for i in range(3):
+                for jj in range(3):
+                    H[r + i, blk_start[b] + jj] = -c[i, jj]
+
+
+@njit(inline="always", **_NJ)
+def gnss_velocity_rows(H, r, c, lever, wx, wy, wz, blk_target, blk_start):
+    """Rows r..r+2 of H (zero on entry) for the GNSS antenna velocity, chen2019 eqs. (3-17) and
+    (2-13): antenna velocity v + C (ω_eb^b × l): δv columns I; attitude columns (C(ω×l))×;
+    lever-arm state columns -C (ω_eb^b ×).  ``(wx, wy, wz)`` is ω_eb^b."""
+    cx = wy * lever[2] - wz * lever[1]
+    cy = wz * lever[0] - wx * lever[2]
+    cz = wx * lever[1] - wy * lever[0]
+    u0 = c[0, 0] * cx + c[0, 1] * cy + c[0, 2] * cz
+    u1 = c[1, 0] * cx + c[1, 1] * cy + c[1, 2] * cz
+    u2 = c[2, 0] * cx + c[2, 1] * cy + c[2, 2] * cz
+    H[r + 0, 3] = 1.0
+    H[r + 1, 4] = 1.0
+    H[r + 2, 5] = 1.0
+    _skew_rows(H, r, u0, u1, u2)
+    for b in range(blk_target.shape[0]):
+        if blk_target[b] == TARGET_LEVER:
+            k0 = blk_start[b]
+            for i in range(3):
+                H[r + i, k0] = -(c[i, 1] * wz - c[i, 2] * wy)          # -(C [ω×])[i, :]
+                H[r + i, k0 + 1] = -(-c[i, 0] * wz + c[i, 2] * wx)
+                H[r + i, k0 + 2] = -(c[i, 0] * wy - c[i, 1] * wx)
 
 
 @njit(inline="always", **_NJ)

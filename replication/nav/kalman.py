@@ -631,23 +631,10 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
 
 def _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp):
     """The :class:`replication.nav.closedloop.ChunkInputs` of one recorded run, chunk by chunk."""
-    gpos = np.ascontiguousarray(gnss.position, dtype=float)[None]
-    gvel = np.ascontiguousarray(gnss.v_enu, dtype=float)[None]
-    dt = np.diff(t)
-    tp = np.ascontiguousarray(tp)[None]
-
-    def inputs(ci, k0, k1, eps):
-        j0 = int(np.searchsorted(idx, eps[0])) if len(eps) else 0
-        j1 = j0 + len(eps)
-        extra = CL.no_windows(k1 - k0, j1 - j0, 1, tp.shape[2])
-        extra.update(truth_st=np.ascontiguousarray(tst[j0:j1]), truth_q=np.ascontiguousarray(tq[j0:j1]),
-                     truth_p=np.ascontiguousarray(tp[:, j0:j1]))
-        return CL.ChunkInputs(dt=np.ascontiguousarray(dt[k0:k1]), dth=np.ascontiguousarray(dtheta[None, k0:k1]),
-                              dvv=np.ascontiguousarray(dv[None, k0:k1]), h_ref=np.ascontiguousarray(href[k0:k1 + 1]),
-                              vu_ref=np.ascontiguousarray(vuref[k0:k1 + 1]),
-                              ep_step=(np.asarray(eps, np.int64) - 1 - k0), gpos=np.ascontiguousarray(gpos[:, j0:j1]),
-                              gvel=np.ascontiguousarray(gvel[:, j0:j1]), **extra)
-    return inputs
+    return CL.array_inputs(t, np.asarray(dtheta)[None], np.asarray(dv)[None], idx,
+                           gpos=np.asarray(gnss.position, dtype=float)[None],
+                           gvel=np.asarray(gnss.v_enu, dtype=float)[None], h_ref=href, vu_ref=vuref,
+                           truth=(tst, tq, np.asarray(tp)[None]), n_aug=np.shape(tp)[1])
 
 
 def perturb_state(state: NavState, model: ErrorModel, rng=None) -> NavState:
@@ -784,27 +771,12 @@ def _draw_runs(traj, model: ErrorModel, seeds, gnss_rate_hz, sigma_pos, sigma_ve
 def _batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref):
     """The :class:`replication.nav.closedloop.ChunkInputs` of a batch of runs, chunk by chunk, with the NEES truth."""
     n_runs, n_aug = p_true.shape
-    m_ep = len(idx)
-    gpos = np.stack([g.position for g in gn])
-    gvel = np.stack([np.asarray(g.v_enu, float) for g in gn])
     tst = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
     tq = dcm_to_quat(euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2]))
-    tp = np.ascontiguousarray(np.broadcast_to(p_true[:, None, :], (n_runs, m_ep, n_aug)))
-    dt = np.diff(traj.t)
-
-    def inputs(ci, k0, k1, eps):
-        j0 = int(np.searchsorted(idx, eps[0]))
-        j1 = j0 + len(eps)
-        extra = CL.no_windows(k1 - k0, j1 - j0, n_runs, n_aug)
-        extra.update(truth_st=np.ascontiguousarray(tst[j0:j1]), truth_q=np.ascontiguousarray(tq[j0:j1]),
-                     truth_p=np.ascontiguousarray(tp[:, j0:j1]))
-        return CL.ChunkInputs(dt=np.ascontiguousarray(dt[k0:k1]), dth=np.ascontiguousarray(dth[:, k0:k1]),
-                              dvv=np.ascontiguousarray(dvv[:, k0:k1]), h_ref=np.ascontiguousarray(href[k0:k1 + 1]),
-                              vu_ref=np.ascontiguousarray(vuref[k0:k1 + 1]),
-                              ep_step=(np.asarray(eps, np.int64) - 1 - k0),
-                              gpos=np.ascontiguousarray(gpos[:, j0:j1]), gvel=np.ascontiguousarray(gvel[:, j0:j1]),
-                              **extra)
-    return inputs
+    tp = np.broadcast_to(p_true[:, None, :], (n_runs, len(idx), n_aug))
+    return CL.array_inputs(traj.t, dth, dvv, idx, gpos=np.stack([g.position for g in gn]),
+                           gvel=np.stack([np.asarray(g.v_enu, float) for g in gn]), h_ref=href, vu_ref=vuref,
+                           truth=(tst, tq, tp), n_aug=n_aug)
 
 
 def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gnss_rate_hz: float = 10.0,

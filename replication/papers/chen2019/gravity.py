@@ -1760,24 +1760,10 @@ def _discrete_gravity_steps(model, gblk, gs, discrete, sf_interval, m, n_epochs:
 
 def _augmented_filter_inputs(t, dtheta, dv, idx, gnss, n_aug: int, windows, ar_tick):
     """The :class:`replication.nav.closedloop.ChunkInputs` of :func:`augmented_filter`, chunk by chunk."""
-    wgt, win, win_end, a_g, R_sf = windows
-    gpos = np.ascontiguousarray(gnss.position, dtype=float)[None]
-    gvel = np.ascontiguousarray(gnss.v_enu, dtype=float)[None]
-    dtv = np.diff(t)
-
-    def inputs(ci, k0, k1, eps):
-        j0 = int(np.searchsorted(idx, eps[0]))
-        j1 = j0 + len(eps)
-        none = CL.no_windows(k1 - k0, j1 - j0, 1, n_aug)
-        return CL.ChunkInputs(dt=np.ascontiguousarray(dtv[k0:k1]), dth=np.ascontiguousarray(dtheta[None, k0:k1]),
-                              dvv=np.ascontiguousarray(dv[None, k0:k1]), h_ref=np.zeros(k1 - k0 + 1),
-                              vu_ref=np.zeros(k1 - k0 + 1), ep_step=(np.asarray(eps, np.int64) - 1 - k0),
-                              gpos=np.ascontiguousarray(gpos[:, j0:j1]), gvel=np.ascontiguousarray(gvel[:, j0:j1]),
-                              sf_w=np.ascontiguousarray(wgt[k0:k1]), sf_win=np.ascontiguousarray(win[k0:k1]),
-                              sf_end=np.ascontiguousarray(win_end[j0:j1]), sf_a=np.ascontiguousarray(a_g),
-                              sf_R=np.ascontiguousarray(R_sf), ar_tick=np.ascontiguousarray(ar_tick[j0:j1]),
-                              truth_st=none["truth_st"], truth_q=none["truth_q"], truth_p=none["truth_p"])
-    return inputs
+    return CL.array_inputs(t, np.asarray(dtheta)[None], np.asarray(dv)[None], idx,
+                           gpos=np.asarray(gnss.position, dtype=float)[None],
+                           gvel=np.asarray(gnss.v_enu, dtype=float)[None], windows=windows, ar_tick=ar_tick,
+                           n_aug=n_aug)
 
 
 def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float | None = None, P0=None,

@@ -924,10 +924,7 @@ def _run_rows(traj, setup, model, run_ids, *, seed, chunk_epochs, record_every, 
             pos = rec_pos[j0:j0 + len(eps)]
             for k in procs_rec:
                 procs_rec[k][:, pos[pos >= 0]] = procs[k][:, pos >= 0]
-        extra = CL.no_windows(k1 - k0, len(eps), n_runs if runs is None else runs, n_aug)
-        return CL.ChunkInputs(dt=np.ascontiguousarray(dtv[k0:k1]), dth=dth, dvv=dvv, h_ref=np.zeros(k1 - k0 + 1),
-                              vu_ref=np.zeros(k1 - k0 + 1), ep_step=(np.asarray(eps) - 1 - k0).astype(np.int64),
-                              gpos=gpos, gvel=gvel, **extra)
+        return CL.chunk_inputs(dtv[k0:k1], dth, dvv, np.asarray(eps) - 1 - k0, gpos=gpos, gvel=gvel, n_aug=n_aug)
 
     rec = CL.run(spec, CL.initial_batch_state(st, q, lever0), model.P0(), ep_samples, N, inputs,
                  lead_inputs=lambda ci, k0, k1, eps: inputs(ci, k0, k1, eps, runs=1),

@@ -33,7 +33,7 @@ The module has four parts.
 4. **The simulation of the three systems** (pure SINS, a SINS/ADS Kalman filter of the kind of
    duan2023 refs. [15-17], the error-correction method) built on the navigation core
    (:mod:`replication.nav.trajectory`, :mod:`replication.nav.sensors`, :mod:`replication.nav.strapdown`,
-   :mod:`replication.nav.errors`, :mod:`replication.nav.kalman`).
+   :mod:`replication.nav.errors`, :mod:`replication.nav.closedloop`).
 
 Units: SI and radians; displacements in metres, velocities in m/s.
 """
@@ -48,13 +48,13 @@ import pandas as pd
 from scipy import stats
 from scipy.integrate import solve_ivp
 
+from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import parallel as PAR
 from replication.nav import trajectory as tr
 from replication.nav._validate import choice
 from replication.nav.errors import NavPoint, StateBlock, model_15
-from replication.nav.kalman import van_loan
-from replication.nav.rotations import attitude_error, euler_to_dcm, orthonormalize, quat_to_dcm, rotvec_to_dcm
+from replication.nav.rotations import attitude_error, dcm_to_quat, euler_to_dcm, orthonormalize, quat_to_dcm, rotvec_to_dcm
 from replication.nav.strapdown import NavState, mechanize
 from replication.nav.units import DEG, DEG_PER_H, MICRO_G
 
@@ -1782,8 +1782,20 @@ def literature_filter_model(setup):
     15 states (core :func:`replication.nav.errors.model_15`: δp, δv, φ, ∇_b, ε_b) plus two
     first-order Markov states for the air data (height error and airspeed error, σ =
     ``sigma_height`` / ``sigma_airspeed``, τ = ``markov_tau``) — "建立一阶马尔可夫过程".
-    """
 
+    Parameters
+    ----------
+    setup : AirdataSetup
+        The simulation parameters: the initial errors, the sensor biases (their filter σ is
+        twice the simulated value) and white noise, the air-data σ [m, m/s] and the Markov
+        correlation time ``markov_tau`` [s].
+
+    Returns
+    -------
+    model : replication.nav.errors.ErrorModel
+        The 17-state model (15 core states, then ``ads_markov``: the height [m] and airspeed
+        [m/s] errors).
+    """
     rm, rn = earth.radii(np.radians(45.0))
     m = model_15(position_sd=setup.initial_position_error, velocity_sd=setup.initial_velocity_error,
                  attitude_sd=(1e-4, 1e-4, 1e-3), accel_bias_sd=2 * setup.accel_bias,
@@ -1796,83 +1808,70 @@ def literature_filter_model(setup):
     return m.extend(ads)
 
 
-def literature_gains(traj, setup):
-    """Kalman gains of the literature SINS/ADS along the true trajectory (shared by all runs).
+def literature_filter(traj, dth, dv, ads, setup, *, every: int = 50, workers: int = 2):
+    """The literature SINS/ADS (refs. [15-17] as read by this package) for a batch of runs.
 
-    Measurements every ``setup.filter_interval`` s: z = [ĥ - h_ADS, |v̂| - V_TAS] =
-    H x + n, H = [[e_h, -1 (height Markov)], [v/|v| on δv, -1 (airspeed Markov)]], white noise
-    R = diag(σ_h², σ_V²) on top of the Markov states (a filter of the kind of refs. [15-17]).
-    The covariance is propagated along the truth (F from :class:`replication.nav.errors.ErrorModel`,
-    Φ and Q_d by Van Loan) and does not depend on the measured values, so the gains are computed
-    once.  Returns (epoch indices, gains (m × n × 2), H (m × 2 × n), Φ_ads (2×2), model).
+    The closed-loop error-state Kalman filter of :func:`replication.nav.closedloop.run` on
+    :func:`literature_filter_model` (15 core states and two first-order Markov states of the
+    air-data errors), updated every ``setup.filter_interval`` s by the row kinds ``air_height``
+    (z = ĥ − h_ADS = δh − b_h) and ``airspeed`` (z = |v̂| − V_TAS = (v̂/|v̂|)·δv − b_V), white noise
+    R = diag(σ_h², σ_V²) on top of the Markov states; δp, δv, φ fed back, ∇̂, ε̂ accumulated and
+    removed from the increments.  Run 0 of the batch leads the covariance and the gains, the other
+    runs follow them (the gains do not depend on the measured values, only on the state they are
+    linearized at).
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N IMU steps).
+    dth, dv : (R, N, 3) array_like
+        Every run's corrupted gyro and accelerometer increments (rad, m/s).
+    ads : sequence of AirData
+        Every run's air-data measurements (:func:`ads_measurements`).
+    setup : AirdataSetup
+        Initial errors, sensor noise, ``filter_interval``, ``markov_tau``.
+    every : int
+        Record the solution every ``every`` samples.
+    workers : int
+        Threads for the runs that follow run 0 (the result does not depend on it).
+
+    Returns
+    -------
+    list of _Recorder
+        Per run, the solution on the grid of every ``every``-th sample (after the feedback at an
+        update epoch).
     """
-
+    dth = np.ascontiguousarray(dth, dtype=float)
+    dv = np.ascontiguousarray(dv, dtype=float)
+    R = len(ads)
+    if dth.shape != (R, traj.n, 3) or dv.shape != dth.shape:
+        raise ValueError(f"dth and dv must be (runs, samples, 3) = ({R}, {traj.n}, 3), one run per air-data record")
     model = literature_filter_model(setup)
-    n = model.n
-    ep = _epochs(traj, setup.filter_interval)
-    sl = model.slices["ads_markov"]
-    P = model.P0()
-    R = np.diag([setup.sigma_height**2, setup.sigma_airspeed**2])
-    gains = np.empty((len(ep) - 1, n, 2))
-    Hs = np.empty((len(ep) - 1, 2, n))
-    Phi = Qd = None
-    for j, (k0, k1) in enumerate(zip(ep[:-1], ep[1:])):
-        km = (k0 + k1) // 2
-        pt = NavPoint.from_trajectory(traj, km)
-        if Phi is None or j % 10 == 0:          # F changes slowly: re-discretise every 10 epochs
-            Phi, Qd = van_loan(model.F(pt), model.G_Qc(pt.C_bn), traj.t[k1] - traj.t[k0])
-        P = Phi @ P @ Phi.T + Qd
-        v = traj.v_enu[k1]
-        H = np.zeros((2, n))
-        H[0, 2] = 1.0
-        H[0, sl.start] = -1.0
-        H[1, 3:6] = v / np.linalg.norm(v)
-        H[1, sl.start + 1] = -1.0
-        S = H @ P @ H.T + R
-        K = np.linalg.solve(S, H @ P).T
-        A = np.eye(n) - K @ H
-        P = A @ P @ A.T + K @ R @ K.T
-        P = 0.5 * (P + P.T)
-        gains[j], Hs[j] = K, H
-    phi_ads = np.exp(-setup.filter_interval / setup.markov_tau) * np.eye(2)
-    return ep, gains, Hs, phi_ads, model
-
-
-def run_literature(traj, dth, dv, ads, setup, gains_pack, *, every: int = 50):
-    """The literature SINS/ADS (refs. [15-17] as read by this package): closed-loop error-state
-    Kalman filter with ADS height and airspeed, feedback of δp, δv, φ, accumulated ∇̂, ε̂."""
-
-    ep, gains, Hs, phi_ads, model = gains_pack
-    sl = model.slices
-    sa, sg, sm = sl["accel_bias"], sl["gyro_bias"], sl["ads_markov"]
-    rec = _Recorder(traj, every)
-    state = _initial_state(traj, setup)
-    ba, bg = np.zeros(3), np.zeros(3)
-    xads = np.zeros(2)
-    T = np.diff(traj.t)[:, None]
-    xm = np.zeros(model.n)
-    for j, (k0, k1) in enumerate(zip(ep[:-1], ep[1:])):
-        sol = mechanize(traj.t[k0:k1 + 1], dth[k0:k1] - bg * T[k0:k1], dv[k0:k1] - ba * T[k0:k1], state)
-        v_end = sol.v_enu[-1]
-        xads = phi_ads @ xads
-        z = np.array([sol.h[-1] - ads.height[k1], np.sqrt(v_end @ v_end) - ads.airspeed[k1]])
-        xm[sm] = xads
-        x = xm + gains[j] @ (z - Hs[j] @ xm)
-        C = rotvec_to_dcm(x[6:9]) @ quat_to_dcm(sol.q_bn[-1])
-        state = NavState(sol.lat[-1] - x[0], sol.lon[-1] - x[1], sol.h[-1] - x[2], v_end - x[3:6], C)
-        ba = ba + x[sa]
-        bg = bg + x[sg]
-        xads = x[sm]
-        ks = np.arange(k0, k1 + 1)
-        sel = np.flatnonzero((ks % every) == 0)
-        if sel.size:
-            st = np.column_stack([sol.lat[sel], sol.lon[sel], sol.h[sel], sol.v_enu[sel]])
-            Cs = quat_to_dcm(sol.q_bn[sel])
-            if ks[sel[-1]] == k1:
-                st[-1] = [state.lat, state.lon, state.h, *state.v_enu]
-                Cs[-1] = state.C_bn
-            rec.put(ks[sel], st, Cs)
-    return rec
+    col = model.slices["ads_markov"].start
+    ep = _epochs(traj, setup.filter_interval)[1:]
+    spec = CL.build_spec(model, use_position=False, use_velocity=False,
+                         rows=(("air_height", col, setup.sigma_height ** 2),
+                               ("airspeed", col + 1, setup.sigma_airspeed ** 2)))
+    init = _initial_state(traj, setup)
+    state = CL.initial_batch_state(np.tile(init.vector(), (R, 1)), np.tile(dcm_to_quat(init.C_bn), (R, 1)),
+                                   np.zeros(3))
+    aux = np.stack([np.column_stack([a.height[ep], a.airspeed[ep]]) for a in ads])
+    grid = np.arange(0, traj.n + 1, every)
+    on_epochs = bool(np.all(np.isin(grid[1:], ep)))
+    rec = CL.run(spec, state, model.P0(), ep, traj.n, CL.array_inputs(traj.t, dth, dv, ep, aux=aux, n_aug=model.n - 9),
+                 store_nav=not on_epochs, store_P=False, workers=workers)
+    out = []
+    for r in range(R):
+        if on_epochs:
+            at = np.searchsorted(ep, grid[1:])
+            st = np.vstack([init.vector(), rec.st[r, at]])
+            q = np.vstack([dcm_to_quat(init.C_bn), rec.q[r, at]])
+        else:
+            st, q = rec.nav_st[r, grid], rec.nav_q[r, grid]
+        rr = _Recorder(traj, every)
+        rr.put(grid, st, quat_to_dcm(q))
+        out.append(rr)
+    return out
 
 
 def navigation_errors(traj, rec):
@@ -1975,12 +1974,13 @@ class MonteCarlo:
 
 
 def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, every: int = 50,
-             systems=SYSTEMS, gains_pack=None) -> MonteCarlo:
+             systems=SYSTEMS) -> MonteCarlo:
     """Monte Carlo of the three systems of duan2023 §3 on one trajectory.
 
     Each run draws IMU white noise, ADS height and airspeed noise from its own generator
     (``SeedSequence(seed).spawn(n_runs)``); the three systems of a run share the same draws
-    (common random numbers).  The literature filter's gains are computed once along the truth.
+    (common random numbers).  The literature filter runs the batch of runs at once
+    (:func:`literature_filter`: run 0 leads its gains).
 
     Parameters
     ----------
@@ -1996,9 +1996,6 @@ def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, e
         Record every ``every``-th sample.
     systems : sequence of str, default SYSTEMS
         The systems simulated (a subset of ``SYSTEMS``).
-    gains_pack : tuple, optional
-        Precomputed gains of the literature filter (output of ``literature_gains``); computed when
-        that system is simulated and none is given.
 
     Returns
     -------
@@ -2015,23 +2012,31 @@ def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, e
     unknown = set(systems) - set(SYSTEMS)
     if unknown:
         raise ValueError(f"unknown systems {sorted(unknown)}; choose from {SYSTEMS}")
-    if "literature SINS/ADS" in systems and gains_pack is None:
-        gains_pack = literature_gains(traj, setup)
-    out = {s: {"enu": [], "v": [], "phi": []} for s in systems}
+    lit = "literature SINS/ADS" in systems
+    recs = {s: [] for s in systems}
+    drawn = ([], [], [])
     infos = []
-    t = None
     for ss in np.random.SeedSequence(seed).spawn(n_runs):
         rng = np.random.default_rng(ss)
         dth, dv = _corrupt(traj, setup, rng)
         ads = ads_measurements(traj, sigma_height=setup.sigma_height, sigma_airspeed=setup.sigma_airspeed, rng=rng)
+        if lit:
+            for lst, x in zip(drawn, (dth, dv, ads)):
+                lst.append(x)
         for s in systems:
             if s == "SINS":
-                rec = run_pure_sins(traj, dth, dv, setup, every=every)
-            elif s == "literature SINS/ADS":
-                rec = run_literature(traj, dth, dv, ads, setup, gains_pack, every=every)
-            else:
+                recs[s].append(run_pure_sins(traj, dth, dv, setup, every=every))
+            elif s == "proposed SINS/ADS":
                 rec = run_error_correction(traj, dth, dv, ads, setup, every=every)
                 infos.append(rec.infos)
+                recs[s].append(rec)
+    if lit:
+        recs["literature SINS/ADS"] = literature_filter(traj, np.stack(drawn[0]), np.stack(drawn[1]), drawn[2], setup,
+                                                        every=every)
+    out = {s: {"enu": [], "v": [], "phi": []} for s in systems}
+    t = None
+    for s in systems:
+        for rec in recs[s]:
             e = navigation_errors(traj, rec)
             t = e["t"]
             for q in ("enu", "v", "phi"):
