@@ -6,6 +6,7 @@ import pytest
 
 from replication.nav.rotations import dcm_to_rotvec, rotvec_to_dcm
 from replication.papers.duan2023 import airdata as ad
+from replication.papers.duan2023 import findings
 from replication.registry import reproduction as rp
 
 # A 30-s interval at ~180 m/s climbing at ~3°: S ≈ 5.4 km, h ≈ 280 m.
@@ -425,15 +426,15 @@ def test_bias_experiment_tilt_grows_linearly(sign):
 
 def test_readings_ledger_rows_reach_the_print_only_within_the_stated_tolerance():
     t1 = rp.load_paper("duan2023-table-1")
-    p = {q: t1.value(f"proposed SINS/ADS / {q}") for q in ad.LEDGER_QUANTITIES}
+    p = {q: t1.value(f"proposed SINS/ADS / {q}") for q in findings.LEDGER_QUANTITIES}
     readings = {"at the print": {q: 1.2 * v for q, v in p.items()},
-                "far": pd.Series({col: 10.0 * p[q] for q, col in ad.LEDGER_QUANTITIES.items()})}
-    rows = ad.readings_ledger_rows(readings, t1, runs=2)
+                "far": pd.Series({col: 10.0 * p[q] for q, col in findings.LEDGER_QUANTITIES.items()})}
+    rows = findings.readings_ledger_rows(readings, t1, runs=2)
     assert len(rows) == 6 and rows[0]["quantity"] == "at the print | proposed SINS/ADS / misalignment"
     st = list(rp.comparison_frame(rows)["status"])
     assert st[:3] == ["reproduced"] * 3 and st[3:] == ["not-reproduced"] * 3
     with pytest.raises(ValueError, match="no finite"):
-        ad.readings_ledger_rows({"x": {"misalignment": 1.0}}, t1)
+        findings.readings_ledger_rows({"x": {"misalignment": 1.0}}, t1)
 
 
 def test_mean_interval_is_the_student_t_interval_of_the_mean():
@@ -468,7 +469,7 @@ def test_diagnostic_rows_state_runs_and_interval_without_a_printed_value(short_f
     setup = ad.AirdataSetup(correction_interval=30.0, threshold=1.0)
     diags = ad.diagnostic_runs(short_flight, setup, n_runs=3, seed=1)
     assert list(diags) == list(ad.BIAS_DIAGNOSTICS)
-    rows = ad.diagnostic_ledger_rows(diags, t1)
+    rows = findings.diagnostic_ledger_rows(diags, t1)
     assert len(rows) == 6 and all(r["paper"] == "" and "3-run mean" in r["note"] and "95 % CI" in r["note"]
                                   for r in rows)
     df = rp.comparison_frame(rows)
