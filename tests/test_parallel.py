@@ -315,6 +315,38 @@ def test_progress_bar_of_an_in_process_loop(capfd, monkeypatch):
     assert "settings" in err and "/3" in err and "setting" in err
 
 
+def test_in_process_monte_carlo_shows_the_steps_filtered(case, reference, capfd, monkeypatch):
+    """The one batch in this process shows a bar of the IMU steps filtered, and its result is the
+    same with the bar as without."""
+    traj, model = case
+    monkeypatch.setenv("REPLICATION_PROGRESS", "1")
+    capfd.readouterr()
+    assert_same(kf.monte_carlo(traj, model, n_runs=N_RUNS, seed=SEED, workers=2), reference)
+    err = capfd.readouterr().err
+    assert f"Monte Carlo, {N_RUNS} runs" in err and f"/{traj.n}" in err and "step" in err
+    monkeypatch.setenv("REPLICATION_PROGRESS", "0")
+    kf.monte_carlo(traj, model, n_runs=N_RUNS, seed=SEED, workers=2)
+    assert capfd.readouterr().err == ""
+
+
+def test_counting_inputs_counts_each_chunk_once():
+    """A chunk prepared again (the smoother's replay) does not advance the bar a second time."""
+    from replication.nav import closedloop as CL
+
+    class Bar:
+        n = 0
+
+        def update(self, k):
+            self.n += k
+
+    bar = Bar()
+    counted = CL.counting_inputs(lambda ci, k0, k1, eps, **kw: (ci, kw), bar)
+    for ci, (k0, k1) in enumerate([(0, 100), (100, 250), (250, 300)]):
+        assert counted(ci, k0, k1, None) == (ci, {})
+    assert counted(1, 100, 250, None, runs=1) == (1, {"runs": 1})
+    assert bar.n == 300
+
+
 def test_compensation_runs_show_their_progress(gravity_case, capfd, monkeypatch):
     traj, fields, seeds, kw, ref = gravity_case
     monkeypatch.setenv("REPLICATION_PROGRESS", "1")

@@ -56,7 +56,7 @@ from replication.nav.errors import ErrorModel
 
 __all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state",
            "Records", "run", "filter_chunk", "rts_chunk", "mbf_chunk", "chunk_inputs", "array_inputs",
-           "ROW_KINDS"]
+           "counting_inputs", "ROW_KINDS"]
 
 _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
@@ -1679,6 +1679,35 @@ def chunk_inputs(dt, dth, dvv, ep_step, *, gpos=None, gvel=None, h_ref=None, vu_
                        ar_tick=np.zeros(E_, np.int64) if ar_tick is None else c(ar_tick),
                        truth_st=c(truth_st), truth_q=c(truth_q), truth_p=c(truth_p),
                        aux=np.zeros((R, E_, 0)) if aux is None else c(aux, dtype=float))
+
+
+def counting_inputs(inputs, bar):
+    """``inputs`` of :func:`run` that advances a progress bar by the IMU steps of each chunk.
+
+    A chunk counts the first time it is prepared (a replay for the smoother does not count it
+    again), so the bar ends at ``n_steps``.
+
+    Parameters
+    ----------
+    inputs : callable
+        ``inputs(ci, k0, k1, eps, **kw)`` as :func:`run` takes it.
+    bar : object
+        A bar with ``update(k)`` (:func:`replication.nav.parallel.progress_bar`).
+
+    Returns
+    -------
+    counted : callable
+        The same inputs, advancing ``bar``.
+    """
+    seen = set()
+
+    def counted(ci, k0, k1, eps, **kw):
+        if ci not in seen:
+            seen.add(ci)
+            bar.update(int(k1) - int(k0))
+        return inputs(ci, k0, k1, eps, **kw)
+
+    return counted
 
 
 def array_inputs(t, dth, dvv, ep_samples, *, gpos=None, gvel=None, h_ref=None, vu_ref=None, windows=None,

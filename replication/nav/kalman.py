@@ -831,8 +831,9 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
         Runs per chunk (with ``executor=None``: chunks one after the other in this process, memory
         bounded by one chunk); ``None`` with an executor: two chunks per worker, or four.
     progress : bool or None
-        Progress bar of the finished runs of a chunked batch (``None``: on unless the environment
-        variable ``REPLICATION_PROGRESS`` is 0).
+        Progress bar (``None``: on unless the environment variable ``REPLICATION_PROGRESS`` is 0):
+        of the finished runs of a chunked batch, of the IMU steps filtered of the one batch in this
+        process.
 
     Returns
     -------
@@ -876,7 +877,8 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     opts = dict(gnss_rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, vertical=vertical,
                 h_ref=h_ref, vu_ref=vu_ref)
     if executor is None and chunk_runs is None:
-        return _monte_carlo_batch(traj, model, np.random.SeedSequence(seed).spawn(n_runs), workers=workers, **opts)
+        return _monte_carlo_batch(traj, model, np.random.SeedSequence(seed).spawn(n_runs), workers=workers,
+                                  progress=progress, **opts)
     entropy = PAR.seed_entropy(seed)
     task = partial(_monte_carlo_chunk, traj, model, entropy, workers if executor is None else 1, opts)
     parts = PAR.run_chunks(task, n_runs, executor=executor, chunk_runs=chunk_runs, progress=progress,
@@ -899,8 +901,9 @@ def _monte_carlo_chunk(traj, model, entropy, workers, opts, r0, r1) -> MonteCarl
 
 
 def _monte_carlo_batch(traj, model, seeds, *, gnss_rate_hz, sigma_pos, sigma_vel, vertical, workers,
-                       h_ref, vu_ref) -> MonteCarloResult:
-    """One batch of :func:`monte_carlo` over the runs of ``seeds`` (arguments validated), the first leading."""
+                       h_ref, vu_ref, progress=False) -> MonteCarloResult:
+    """One batch of :func:`monte_carlo` over the runs of ``seeds`` (arguments validated), the first leading;
+    ``progress``: a bar of the IMU steps filtered (in this process; a chunk on an executor shows none)."""
     n_runs = len(seeds)
     R_pos, R_vel = _gnss_noise(sigma_pos, "sigma_pos"), _gnss_noise(sigma_vel, "sigma_vel")
     n = traj.n
@@ -911,8 +914,10 @@ def _monte_carlo_batch(traj, model, seeds, *, gnss_rate_hz, sigma_pos, sigma_vel
     gains = vertical_damping_gains(100.0, traj.lat[0], traj.h[0]) if vertical == "damped" else np.zeros(3)
     spec = CL.build_spec(model, R_pos=R_pos, R_vel=R_vel,
                          lever_arm_b=g0.lever_arm_b, vmode=VERTICAL_MODES[vertical], gains=gains, nees=True)
-    rec = CL.run(spec, CL.initial_batch_state(st0, q0, g0.lever_arm_b), model.P0(), idx, n,
-                 _batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref), store_P=False, workers=workers)
+    with PAR.progress_bar(n, f"Monte Carlo, {n_runs} runs", progress, unit="step") as bar:
+        rec = CL.run(spec, CL.initial_batch_state(st0, q0, g0.lever_arm_b), model.P0(), idx, n,
+                     CL.counting_inputs(_batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref), bar),
+                     store_P=False, workers=workers)
     return MonteCarloResult(
         t_epoch=traj.t[idx],
         nees=rec.nees,

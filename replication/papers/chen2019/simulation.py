@@ -827,8 +827,8 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
         Runs per chunk (``None``: :func:`replication.nav.parallel.default_chunk_runs` when an
         executor is given, else one batch).
     progress : bool or None
-        Progress bar of the finished runs of a chunked batch (``None``: on unless
-        ``REPLICATION_PROGRESS=0``).
+        Progress bar (``None``: on unless ``REPLICATION_PROGRESS=0``): of the finished runs of a
+        chunked batch, of the IMU steps filtered of the one batch in this process.
 
     Returns
     -------
@@ -864,7 +864,7 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
                 fixed_constants=fixed_constants, series_order=series_order, smoother_form=smoother_form)
     if executor is None and chunk_runs is None:
         return _run_rows(traj, setup, model, np.arange(int(first_run), int(first_run) + n_runs), workers=workers,
-                         **opts)
+                         progress=progress, **opts)
     task = partial(_run_batch_chunk, traj, setup, model, int(first_run), workers if executor is None else 1, opts)
     parts = PAR.run_chunks(task, n_runs, executor=executor, chunk_runs=chunk_runs, progress=progress,
                            desc="chen2019 runs")
@@ -889,8 +889,9 @@ def _run_batch_chunk(traj, setup, model, first_run, workers, opts, r0, r1) -> Ba
 
 
 def _run_rows(traj, setup, model, run_ids, *, seed, chunk_epochs, record_every, smoother, smoother_covariance,
-              prior_covariance, fixed_constants, series_order, workers, smoother_form) -> BatchResult:
-    """One batch of :func:`run_batch` over the runs numbered ``run_ids`` (arguments validated), the first leading."""
+              prior_covariance, fixed_constants, series_order, workers, smoother_form, progress=False) -> BatchResult:
+    """One batch of :func:`run_batch` over the runs numbered ``run_ids`` (arguments validated), the first leading;
+    ``progress``: a bar of the IMU steps filtered (in this process; a chunk on an executor shows none)."""
     n_runs = len(run_ids)
     step = setup.gnss_step
     N = traj.n
@@ -926,10 +927,11 @@ def _run_rows(traj, setup, model, run_ids, *, seed, chunk_epochs, record_every, 
                 procs_rec[k][:, pos[pos >= 0]] = procs[k][:, pos >= 0]
         return CL.chunk_inputs(dtv[k0:k1], dth, dvv, np.asarray(eps) - 1 - k0, gpos=gpos, gvel=gvel, n_aug=n_aug)
 
-    rec = CL.run(spec, CL.initial_batch_state(st, q, lever0), model.P0(), ep_samples, N, inputs,
-                 lead_inputs=lambda ci, k0, k1, eps: inputs(ci, k0, k1, eps, runs=1),
-                 record_every=record_every, chunk_epochs=chunk_epochs, smoother=smoother,
-                 smoother_covariance=smoother_covariance, smoother_form=smoother_form, workers=workers)
+    with PAR.progress_bar(N, f"chen2019, {len(run_ids)} runs", progress, unit="step") as bar:
+        rec = CL.run(spec, CL.initial_batch_state(st, q, lever0), model.P0(), ep_samples, N,
+                     CL.counting_inputs(inputs, bar), lead_inputs=lambda ci, k0, k1, eps: inputs(ci, k0, k1, eps, runs=1),
+                     record_every=record_every, chunk_epochs=chunk_epochs, smoother=smoother,
+                     smoother_covariance=smoother_covariance, smoother_form=smoother_form, workers=workers)
     nav_err = navigation_errors(rec.st, rec.q, truth_st[rec_ep], truth_q[rec_ep])
     p_true = truth_parameters(model, truth.const, procs_rec)
     return BatchResult(model=model, setup=setup, t=traj.t[ep_samples[rec_ep]], epoch_index=ep_samples[rec_ep],
