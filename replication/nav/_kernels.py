@@ -176,7 +176,7 @@ def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vmode, href, vuref, gai
         0 free, 1 hold (h, v_U set to ``href``, ``vuref`` after the step), 2 damped
         (third-order loop on h - ``href``).
     href, vuref : float
-        Reference height (m) and vertical speed (m/s) (read by modes 1 and 2, and 1).
+        Reference height (m; modes 1 and 2) and vertical speed (m/s; mode 1).
     gains : tuple of 3 float
         Damping-loop gains k1, k2, k3 (mode 2).
     dampint : float
