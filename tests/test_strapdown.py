@@ -141,11 +141,14 @@ def _sd_step_loop(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains):
 
 @pytest.mark.parametrize("vertical", ["free", "hold", "damped"])
 def test_public_kernel_is_the_closed_loop_step_bit_for_bit(vertical):
-    """``strapdown_kernel`` (the step on scalars behind ``mechanize``) and ``sd_step`` (the closed
-    loop's step on arrays) are one algorithm: the same bits in every vertical mode, on a record
-    that takes every branch — rotation vectors above the series' range (|φ| > 0.02 rad: 30°/s at
-    1 s steps), latitude jumps beyond the carried sin/cos (a 0.2-s gap after 200 km/s² of north
-    acceleration), and the reference arrays of hold and damped."""
+    """``strapdown_kernel`` (behind ``mechanize``) and ``sd_step`` (the closed loop's step) run the
+    one scalar step ``_sd_step_s``: the kernel carries the state at k-1 and k-2, the attitude and
+    the sin/cos of the latitude in locals, ``sd_step`` loads them from its arrays and stores them
+    back.  Both carry the same quantities when they give the same bits in every vertical mode
+    (the reference heights and speeds read at the same samples, the gains in the damped mode
+    only), on a record that takes every branch — rotation vectors above the series' range
+    (|φ| > 0.02 rad: 30°/s at 1 s steps), latitude jumps beyond the carried sin/cos (a 0.2-s gap
+    after 200 km/s² of north acceleration), and the reference arrays of hold and damped."""
     rng = np.random.default_rng(3)
     n = 1500
     dt = np.full(n, 0.01)
@@ -166,6 +169,25 @@ def test_public_kernel_is_the_closed_loop_step_bit_for_bit(vertical):
     assert K.strapdown_kernel(dt, dth, dv, st0, q0, mode, h_ref, vu_ref, gains, out_st, out_q) == -1
     assert np.abs(np.diff(out_st[:, 0])).max() > 1e-5         # the exact sin/cos branch was taken
     assert np.array_equal(out_st, want_st) and np.array_equal(out_q, want_q)
+
+
+def test_closed_loop_step_adds_the_gravity_disturbance():
+    """``g_extra`` of ``sd_step`` (the compensated gravity disturbance of the augmented filters) is
+    added to g^n: over one 0.01-s step it moves the velocity by g_extra T (1e-6 m/s here) to the
+    rounding of the two velocities compared (four units in the last place of |v| < 64 m/s,
+    6e-14 m/s), and leaves the attitude untouched."""
+    st0 = np.array([0.7, 2.0, 500.0, 50.0, 10.0, 1.0])
+    q0 = np.array([0.9, 0.1, -0.2, 0.3]) / np.linalg.norm([0.9, 0.1, -0.2, 0.3])
+    dth, dv, T = np.array([1e-4, -2e-4, 3e-4]), np.array([1e-3, 2e-3, 0.0981]), 0.01
+    g = np.array([1e-4, -2e-4, 3e-4])
+    out = []
+    for g_extra in (np.zeros(3), g):
+        st, st_prev, q, trig = st0.copy(), st0.copy(), q0.copy(), np.array([st0[0], np.sin(st0[0]), np.cos(st0[0])])
+        w = [np.empty(4), np.empty((3, 3))] + [np.empty(3) for _ in range(4)]
+        K.sd_step(T, dth, dv, dth, dv, st, st_prev, q, *w, 0, 0.0, 0.0, np.zeros(3), 0.0, g_extra, trig)
+        out.append((st, q))
+    assert np.allclose(out[1][0][3:] - out[0][0][3:], g * T, rtol=0, atol=4 * np.spacing(64.0))
+    assert np.array_equal(out[1][1], out[0][1])
 
 
 def test_mechanize_refuses_non_finite_inputs_with_their_name():
