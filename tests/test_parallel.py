@@ -1,7 +1,8 @@
 """Monte Carlo batches on executors (replication.nav.parallel): a Dask LocalCluster of two worker
 processes, a ProcessPoolExecutor and in-process chunks each give the one-batch result bit for bit,
 also when a worker process dies in the middle of the batch (kalman.monte_carlo and chen2019's
-simulation.run_batch with its smoother), the per-setting sweeps of fang2020 and duan2023, the
+simulation.run_batch with its smoother), the per-setting sweeps of fang2020 and duan2023, duan2023's
+Monte Carlo of its three systems and its diagnostic runs, the
 gravity-compensation runs of chen2019 §4.3, chen2019's turntable runs, observability readings and
 error-effect computations, and fang2020's polar Monte Carlo; the progress bar follows
 REPLICATION_PROGRESS."""
@@ -188,6 +189,53 @@ def test_duan2023_sweep_on_process_pool_equals_in_process():
     with ProcessPoolExecutor(2) as ex:
         got = ad.sweep(traj, setup, changes, n_runs=1, seed=3, executor=ex, chunk_runs=2)
     pd.testing.assert_frame_equal(got, ref, check_exact=True)
+
+
+@pytest.fixture(scope="module")
+def duan_case():
+    """3 min of duan2023's kind of flight (straight, climb, straight at 10 Hz), three runs of the three systems."""
+    traj = tr.generate([tr.Straight(60.0), tr.Climb(60.0, height_change=300.0), tr.Straight(60.0)], 45 * DEG,
+                       110 * DEG, 1000.0, dt=0.1, heading=0.3, speed=180.0)
+    setup = ad.AirdataSetup(correction_interval=30.0, threshold=1.0)
+    kw = dict(n_runs=3, seed=11, every=10)
+    return traj, setup, kw, ad.simulate(traj, setup, **kw)
+
+
+def test_duan2023_simulate_on_threads_in_chunks_and_on_processes(duan_case):
+    """simulate draws run r from SeedSequence(seed, spawn_key=(r,)) in every chunk, and a chunk
+    without run 0 redraws it to lead its literature filter: every array of the three systems and
+    every correction record equal the one batch bit for bit."""
+    traj, setup, kw, ref = duan_case
+    lit = ref.errors["literature SINS/ADS"]["enu"]
+    assert not np.array_equal(lit[1], lit[2])                     # three different runs
+    with ThreadPoolExecutor(2) as ex:
+        _same_tree(ad.simulate(traj, setup, executor=ex, chunk_runs=1, **kw), ref)
+    _same_tree(ad.simulate(traj, setup, chunk_runs=2, **kw), ref)
+    with ProcessPoolExecutor(2) as ex:
+        _same_tree(ad.simulate(traj, setup, executor=ex, **kw), ref)
+    with pytest.raises(ValueError, match="chunk_runs"):
+        ad.simulate(traj, setup, chunk_runs=0, **kw)
+    with pytest.raises(TypeError, match="executor must be a concurrent.futures.Executor"):
+        ad.simulate(traj, setup, executor="dask", **kw)
+
+
+def test_duan2023_diagnostic_runs_on_threads_in_chunks_and_on_processes(duan_case):
+    """diagnostic_runs passes the chunking on to simulate: each diagnostic's Monte Carlo equals the
+    in-process one bit for bit, and with the main run's seed its runs share the main run's noise."""
+    traj, setup, kw, ref = duan_case
+    kw = dict(n_runs=3, seed=11)
+    one = ad.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}}, **kw)
+    for s in ("enu", "v", "phi"):
+        assert np.array_equal(one["as is"].errors["proposed SINS/ADS"][s],
+                              ref.errors["proposed SINS/ADS"][s][:, ::5])  # every=50 against every=10
+    with ThreadPoolExecutor(2) as ex:
+        _same_tree(ad.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}},
+                                      executor=ex, chunk_runs=1, **kw), one)
+    _same_tree(ad.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}},
+                                  chunk_runs=2, **kw), one)
+    with ProcessPoolExecutor(2) as ex:
+        _same_tree(ad.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}},
+                                      executor=ex, **kw), one)
 
 
 def _same_tree(a, b, where="result"):

@@ -52,7 +52,7 @@ from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import parallel as PAR
 from replication.nav import trajectory as tr
-from replication.nav._validate import choice
+from replication.nav._validate import choice, integer
 from replication.nav.errors import NavPoint, StateBlock, model_15
 from replication.nav.rotations import attitude_error, dcm_to_quat, euler_to_dcm, orthonormalize, quat_to_dcm, rotvec_to_dcm
 from replication.nav.strapdown import NavState, mechanize
@@ -1978,13 +1978,25 @@ class MonteCarlo:
 
 
 def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, every: int = 50,
-             systems=SYSTEMS) -> MonteCarlo:
+             systems=SYSTEMS, executor=None, chunk_runs=None, progress=None) -> MonteCarlo:
     """Monte Carlo of the three systems of duan2023 §3 on one trajectory.
 
     Each run draws IMU white noise, ADS height and airspeed noise from its own generator
-    (``SeedSequence(seed).spawn(n_runs)``); the three systems of a run share the same draws
-    (common random numbers).  The literature filter runs the batch of runs at once
+    (``SeedSequence(seed).spawn(n_runs)``), in this order: the gyro increments' noise, the
+    accelerometer increments' noise (``_corrupt``), the ADS height noise, the ADS airspeed
+    noise (:func:`ads_measurements`); the three systems of a run share the same draws (common
+    random numbers).  The literature filter runs the batch of runs at once
     (:func:`literature_filter`: run 0 leads its gains).
+
+    With ``executor`` (any ``concurrent.futures.Executor``: a ``ProcessPoolExecutor``,
+    ``dask.distributed.Client(...).get_executor()``, …) or ``chunk_runs``, the runs are split into
+    chunks of ``chunk_runs`` (:func:`replication.nav.parallel.run_chunks`), each chunk one picklable
+    task.  Run r draws from ``SeedSequence(seed, spawn_key=(r,))``, the r-th child of the in-process
+    ``spawn``, so its pure SINS and proposed SINS/ADS runs are the in-process ones.  Run 0 leads the
+    literature filter (its covariance and gains serve every run), so every chunk that lacks it
+    redraws run 0 from its stream, runs it as the lead of the chunk's literature batch and drops it
+    (its pure SINS and proposed runs are not recomputed).  The reassembled result equals the
+    in-process one bit for bit, whatever the executor and chunking.
 
     Parameters
     ----------
@@ -2000,6 +2012,14 @@ def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, e
         Record every ``every``-th sample.
     systems : sequence of str, default SYSTEMS
         The systems simulated (a subset of ``SYSTEMS``).
+    executor : concurrent.futures.Executor or None, default None
+        Where the chunks run; ``None`` with ``chunk_runs=None``: the one in-process batch.
+    chunk_runs : int or None, default None
+        Runs per chunk (with ``executor=None``: chunks one after the other in this process, memory
+        bounded by one chunk); ``None`` with an executor: two chunks per worker, or four.
+    progress : bool or None, default None
+        Progress bar of the finished runs of a chunked batch (``None``: on unless the environment
+        variable ``REPLICATION_PROGRESS`` is 0).
 
     Returns
     -------
@@ -2009,24 +2029,53 @@ def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, e
     Raises
     ------
     ValueError
-        If ``n_runs`` is below 1 or a system is unknown.
+        If ``n_runs`` is below 1 or a system is unknown, or ``chunk_runs`` is not a positive
+        integer.
+    TypeError
+        If ``executor`` is not a ``concurrent.futures.Executor``.
     """
-    if n_runs < 1:
-        raise ValueError("n_runs must be at least 1")
+    n_runs = integer(n_runs, "n_runs", 1, "{name} must be at least 1 (a whole number of runs), got {value!r}")
+    systems = tuple(systems)
     unknown = set(systems) - set(SYSTEMS)
     if unknown:
         raise ValueError(f"unknown systems {sorted(unknown)}; choose from {SYSTEMS}")
+    if executor is None and chunk_runs is None:
+        return _simulate_batch(traj, setup, np.random.SeedSequence(seed).spawn(n_runs), every, systems, seed)
+    entropy = PAR.seed_entropy(seed)
+    task = partial(_simulate_chunk, traj, setup, entropy, every, systems, seed, 2 if executor is None else 1)
+    parts = PAR.run_chunks(task, n_runs, executor=executor, chunk_runs=chunk_runs, progress=progress,
+                           desc="duan2023 runs")
+    first = parts[0]
+    errors = {s: {q: np.concatenate([p.errors[s][q] for p in parts], axis=0) for q in d}
+              for s, d in first.errors.items()}
+    return replace(first, errors=errors, infos=[i for p in parts for i in p.infos])
+
+
+def _simulate_chunk(traj, setup, entropy, every, systems, seed, workers, r0, r1) -> MonteCarlo:
+    """Runs ``r0 … r1−1`` of :func:`simulate` (a picklable task); with the literature filter and ``r0 > 0``,
+    run 0 is redrawn as the lead of the chunk's filter batch and dropped."""
+    lead = "literature SINS/ADS" in systems and r0 > 0
+    runs = ([0] if lead else []) + list(range(r0, r1))
+    return _simulate_batch(traj, setup, PAR.run_seeds(entropy, runs), every, systems, seed, lead_only=lead,
+                           workers=workers)
+
+
+def _simulate_batch(traj, setup, seeds, every, systems, seed, *, lead_only=False, workers=2) -> MonteCarlo:
+    """The runs of :func:`simulate` over the streams ``seeds`` (arguments validated); with ``lead_only``,
+    the first stream only leads the literature filter and is left out of the result."""
     lit = "literature SINS/ADS" in systems
     recs = {s: [] for s in systems}
     drawn = ([], [], [])
     infos = []
-    for ss in np.random.SeedSequence(seed).spawn(n_runs):
+    for i, ss in enumerate(seeds):
         rng = np.random.default_rng(ss)
         dth, dv = _corrupt(traj, setup, rng)
         ads = ads_measurements(traj, sigma_height=setup.sigma_height, sigma_airspeed=setup.sigma_airspeed, rng=rng)
         if lit:
             for lst, x in zip(drawn, (dth, dv, ads)):
                 lst.append(x)
+        if lead_only and i == 0:
+            continue
         for s in systems:
             if s == "SINS":
                 recs[s].append(run_pure_sins(traj, dth, dv, setup, every=every))
@@ -2035,8 +2084,9 @@ def simulate(traj, setup: AirdataSetup, *, n_runs: int = 10, seed: int = 2023, e
                 infos.append(rec.infos)
                 recs[s].append(rec)
     if lit:
-        recs["literature SINS/ADS"] = literature_filter(traj, np.stack(drawn[0]), np.stack(drawn[1]), drawn[2], setup,
-                                                        every=every)
+        led = literature_filter(traj, np.stack(drawn[0]), np.stack(drawn[1]), drawn[2], setup, every=every,
+                                workers=workers)
+        recs["literature SINS/ADS"] = led[1:] if lead_only else led
     out = {s: {"enu": [], "v": [], "phi": []} for s in systems}
     t = None
     for s in systems:
@@ -2278,11 +2328,13 @@ and the constant bias of all three axes."""
 
 
 def diagnostic_runs(traj, setup: AirdataSetup, diagnostics=None, *, n_runs: int = 20,
-                    seed: int = 2023) -> dict:
+                    seed: int = 2023, executor=None, chunk_runs=None, progress=None) -> dict:
     """Monte Carlo of the proposed SINS/ADS under each diagnostic change of ``setup``.
 
     The runs draw from ``SeedSequence(seed)`` as ``simulate`` does, so with the main run's
-    seed they share its noise (common random numbers).
+    seed they share its noise (common random numbers).  ``executor``, ``chunk_runs`` and
+    ``progress`` are passed on to :func:`simulate`, one diagnostic after the other: its runs are
+    cut into chunks, and the result equals the in-process one bit for bit.
 
     Parameters
     ----------
@@ -2297,6 +2349,15 @@ def diagnostic_runs(traj, setup: AirdataSetup, diagnostics=None, *, n_runs: int 
         Runs per diagnostic, at least 2.
     seed : int, default 2023
         Seed of the ``SeedSequence``.
+    executor : concurrent.futures.Executor or None, default None
+        Where the chunks of runs run (:func:`simulate`); ``None`` with ``chunk_runs=None``: each
+        diagnostic's one in-process batch.
+    chunk_runs : int or None, default None
+        Runs per chunk (with ``executor=None``: chunks one after the other in this process);
+        ``None`` with an executor: two chunks per worker, or four.
+    progress : bool or None, default None
+        Progress bar of the finished runs of each chunked diagnostic (``None``: on unless the
+        environment variable ``REPLICATION_PROGRESS`` is 0).
 
     Returns
     -------
@@ -2313,7 +2374,8 @@ def diagnostic_runs(traj, setup: AirdataSetup, diagnostics=None, *, n_runs: int 
         raise ValueError("diagnostics must be a non-empty dict: label -> dict of AirdataSetup fields")
     if n_runs < 2:
         raise ValueError("n_runs must be at least 2 (a 95 % interval of the mean needs a spread)")
-    return {lab: simulate(traj, replace(setup, **ch), n_runs=n_runs, seed=seed, systems=("proposed SINS/ADS",))
+    return {lab: simulate(traj, replace(setup, **ch), n_runs=n_runs, seed=seed, systems=("proposed SINS/ADS",),
+                          executor=executor, chunk_runs=chunk_runs, progress=progress)
             for lab, ch in diagnostics.items()}
 
 
