@@ -1,6 +1,6 @@
 """chen2019's findings: the rows its chapters hand to the registry.
 
-The method modules of :mod:`replication.papers.chen2019` compute; this module decides — it turns
+The method modules of ``replication.papers.chen2019`` compute; this module decides — it turns
 their results into comparison rows with a status, a note, evidence and corrected text
 (CONTRIBUTING.md, "Statuses" and "Readings and the main reading"), and holds the printed passages
 the chapters record as errata or inconsistencies.  No method module imports it; the notebooks and
@@ -28,7 +28,7 @@ __all__ = ["compare_verdicts", "figure_4_14_ledger", "ordering_rows", "PRINTED_C
 
 
 def _stored_degree(table, state, scenario) -> float:
-    """A degree to 6 significant digits, or 0 when it is round-off (see :func:`verdict_under`)."""
+    """A degree to 6 significant digits, or 0 when it is round-off (see :func:`replication.papers.chen2019.observability.verdict_under`)."""
     d = float(table.loc[state, scenario])
     return 0.0 if d <= ROUND_OFF_MARGIN * table.attrs["rank_tol"][scenario] else float(f"{d:.6g}")
 
@@ -50,7 +50,7 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
         The printed degrees (rows: states, columns: scenarios), dimensionless.
     readings : dict
         Reading name → degrees table of the same shape with ``attrs["rank_tol"]`` and
-        ``attrs["ambiguity"]`` (:func:`degrees_table`, or ``sweep(...).attrs["tables"]``).
+        ``attrs["ambiguity"]`` (:func:`replication.papers.chen2019.observability.degrees_table`, or ``sweep(...).attrs["tables"]``).
     main : str
         The main reading, a key of ``readings``.
     exact : dict
@@ -178,7 +178,7 @@ def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1
     Parameters
     ----------
     readings : dict
-        Label -> ``(result, smoothed, misalignment_unit)``: a 45-state :class:`BatchResult`, bool,
+        Label -> ``(result, smoothed, misalignment_unit)``: a 45-state :class:`replication.papers.chen2019.simulation.BatchResult`, bool,
         display unit of the misalignments [rad].
     claim : pandas.DataFrame
         The printed ranges (``chen2019-claim-figure-4-14-ranges``), indexed by quantity, columns
@@ -230,17 +230,17 @@ def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indic
     Parameters
     ----------
     paper_exp : array_like, shape (9,)
-        The nine printed values of the experiment, in :data:`QUANTITIES` order and :data:`UNITS`.
+        The nine printed values of the experiment, in :data:`replication.papers.chen2019.turntable.QUANTITIES` order and :data:`replication.papers.chen2019.turntable.UNITS`.
     paper_ref : array_like, shape (9,)
         The nine printed values of the reference experiment (positive).
     runs_exp : array_like, shape (runs, 9)
-        The simulated per-run values of the experiment (:func:`error_std`), at least two runs.
+        The simulated per-run values of the experiment (:func:`replication.papers.chen2019.turntable.error_std`), at least two runs.
     runs_ref : array_like, shape (runs, 9)
         The simulated per-run values of the reference experiment (independent runs, positive).
     label : str
         Names the reference experiment in the quantity, e.g. ``"experiment 1"``.
     indices : sequence of int
-        Positions in :data:`QUANTITIES` (0 ... 8) to compare.
+        Positions in :data:`replication.papers.chen2019.turntable.QUANTITIES` (0 ... 8) to compare.
 
     Returns
     -------
@@ -329,7 +329,7 @@ TABLE_2_2_CORRECTED_TEXT = {
     "F53": r"columns G_zx, G_yz, G_zy: [-C_{\cdot 2}\omega_z,\ -C_{\cdot 1}\omega_y,\ C_{\cdot 1}\omega_z]",
 }
 """Corrected expressions of the Table 2-2 blocks whose printed form differs (see
-:func:`table_2_2_corrected`), in LaTeX; the chapter renders them.
+:func:`replication.papers.chen2019.models.table_2_2_corrected`), in LaTeX; the chapter renders them.
 
 :meta hide-value:
 """

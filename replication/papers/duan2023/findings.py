@@ -156,12 +156,12 @@ def readings_ledger_rows(readings, table1, system="proposed SINS/ADS", *, runs=N
 
 
 def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> list[dict]:
-    """Rows of the Table 1 readings ledger for the diagnostics of :func:`diagnostic_runs`.
+    """Rows of the Table 1 readings ledger for the diagnostics of :func:`replication.papers.duan2023.airdata.diagnostic_runs`.
 
     A diagnostic is not a reading of the method and is compared with no printed value: the paper
     column stays empty; ``reproduced`` is the run mean of the flight maximum, stored with ``digits``
     significant digits, and the note gives the run count and the 95 % Student-t interval of the
-    mean (:func:`mean_interval`).  The statement checked: the diagnostic does not bring the
+    mean (:func:`replication.papers.duan2023.airdata.mean_interval`).  The statement checked: the diagnostic does not bring the
     proposed method to the print by the ledger's rule (:data:`LEDGER_TOLERANCE`) — the lower end
     of its interval lies above (1 + tolerance) × the printed proposed-method value.  ``qualitative``
     where it holds; ``not-reproduced`` (the statement fails: the removed bias is what separates the
@@ -170,7 +170,7 @@ def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> lis
     Parameters
     ----------
     diagnostics : dict of str to MonteCarlo
-        Output of :func:`diagnostic_runs` (at least two runs each).
+        Output of :func:`replication.papers.duan2023.airdata.diagnostic_runs` (at least two runs each).
     table1 : PaperTable
         ``rp.load_paper("duan2023-table-1")``.
     digits : int, default 2
@@ -251,7 +251,7 @@ _INCONSISTENT = {
 
 #: Printed elements that match the re-derivation but disagree with another printed part at the
 #: paper's approximation level (status ``inconsistent``), as functions of the reference state
-#: (:func:`reference_state`).
+#: (:func:`replication.papers.duan2023.airdata.reference_state`).
 _REMARKS = {
     "eq. (4) phi^c per dh^c": lambda st: (
         "reproduced as printed (the first-order expansion of tan(theta_1 - theta_2) with S^c = S), but assumption 1 and "
@@ -275,9 +275,9 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
     paper : PaperTable
         ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
     reading : {"A", "B"}, default "B"
-        Reading of β and of the position-state order (:func:`derived_coefficients`).
+        Reading of β and of the position-state order (:func:`replication.papers.duan2023.airdata.derived_coefficients`).
     state : {"climb", "level", "steep"}, default "climb"
-        Reference state (:func:`reference_state`).
+        Reference state (:func:`replication.papers.duan2023.airdata.reference_state`).
 
     Returns
     -------
@@ -328,7 +328,7 @@ def eq22_readings_rows(paper, state: str = "climb"):
     paper : PaperTable
         ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
     state : {"climb", "level", "steep"}, default "climb"
-        Reference state (:func:`reference_state`).
+        Reference state (:func:`replication.papers.duan2023.airdata.reference_state`).
 
     Returns
     -------
