@@ -557,6 +557,7 @@ def test_findings_box_states_the_reason_of_every_unreproduced_artifact():
         name = r["artifact"] if r["kind"] == "paper" else r["id"]
         line = next(l for l in box.splitlines() if f"**{rp.status_label(r)}**" in l and name in l)
         assert " — " in line and not line.endswith("— -")  # a reason is quoted
+    assert "more: see the table" not in box and "…" not in box  # every reason in full, none cut
     # the paper artifacts and the package's own checks are counted apart
     assert "**Paper artifacts**" in box and "**Supplementary checks**" in box
 

@@ -2052,11 +2052,6 @@ FINDING_REASON_STATUSES = ("not-reproduced", "analog", "unverifiable")
 """Row statuses whose notes a findings box quotes as the reason an artifact is not reproduced."""
 
 
-def _short(text: str, n: int = 220) -> str:
-    t = " ".join(str(text).split()).replace("|", "/")
-    return t if len(t) <= n else t[: n - 1].rsplit(" ", 1)[0] + " …"
-
-
 def _findings_markdown(status: pd.DataFrame, notebook: str) -> str:
     """The findings box at the top of a chapter: which of its artifacts reproduced, which did not
     and why (the notes of their not-reproduced, analog and unverifiable rows), the errata and
@@ -2081,17 +2076,26 @@ def _findings_markdown(status: pd.DataFrame, notebook: str) -> str:
         if len(ok):
             lines.append("- reproduced or checked: " + ", ".join(link(r) for _, r in ok.iterrows()))
         for _, r in sub[~sub["status"].isin(["reproduced", "qualitative"])].iterrows():
-            notes, seen = [], set()
-            tables = [read_table(tid) for tid in str(r["tables"]).split()]
+            notes, seen, summary = [], set(), ""
+            tids = str(r["tables"]).split()
+            tables = [read_table(tid) for tid in tids]
+            for tid in tids:
+                summary = summary or str(_sidecar(tid).get("summary") or "").strip()
             for st in FINDING_REASON_STATUSES:  # the strongest reason first
                 for df in tables:
                     for nt in df.loc[df["status"] == st, "note"]:
                         key = re.sub(r"-?\d[\d.,e+-]*", "#", str(nt))  # the same reason with other numbers
                         if nt and key not in seen:
                             seen.add(key)
-                            notes.append(_short(nt))
-            why = ("; ".join(notes[:2]) + (f" (and {len(notes) - 2} more: see the table)" if len(notes) > 2 else "")) or "-"
-            lines.append(f"- {link(r)}: **{status_label(r)}** ({_row_split(r)}) — {why}")
+                            notes.append(" ".join(str(nt).split()).replace("|", "/"))
+            # the table's one-line verdict (a sentence its chapter wrote) leads; every distinct reason
+            # follows in full, none cut
+            lead = summary or (notes[0] if notes else "differs from the print beyond the tolerance stated before "
+                               "comparing")
+            rest = notes if summary else notes[1:]
+            lines.append(f"- {link(r)}: **{status_label(r)}** ({_row_split(r)}) — {lead}")
+            if rest:
+                lines += [f"  - {n}" for n in rest]
         n_e, n_i = int(sub["erratum"].sum()), int(sub["inconsistent"].sum())
         if n_e or n_i:
             lines.append(f"- {n_e} {'erratum' if n_e == 1 else 'errata'} and {n_i} "
