@@ -282,6 +282,8 @@ PROBES += [
      lambda: closedloop.build_spec(_M15, R_pos=np.diag([np.nan, 1.0, 1.0]), R_vel=I3)),
     ("closedloop.build_spec(lever_arm_b = [nan, 0, 0])", "lever_arm_b",
      lambda: closedloop.build_spec(_M15, R_pos=I3, R_vel=I3, lever_arm_b=[np.nan, 0.0, 0.0])),
+    ("closedloop.counting_inputs(inputs = None)", "inputs", lambda: closedloop.counting_inputs(None, object())),
+    ("closedloop.counting_inputs(bar without update)", "bar", lambda: closedloop.counting_inputs(print, object())),
     ("closedloop.run(P0 = -I)", "P0", lambda: _cl_run(P0=-np.eye(15))),
     ("closedloop.run(record_every = 0)", "record_every", lambda: _cl_run(record_every=0)),
     ("closedloop.run(smoother_form = 'ukf')", "smoother_form", lambda: _cl_run(smoother_form="ukf")),

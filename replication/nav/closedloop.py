@@ -1699,6 +1699,10 @@ def counting_inputs(inputs, bar):
     counted : callable
         The same inputs, advancing ``bar``.
     """
+    if not callable(inputs):
+        raise TypeError(f"inputs must be callable as inputs(ci, k0, k1, eps), got {type(inputs).__name__}")
+    if not callable(getattr(bar, "update", None)):
+        raise TypeError(f"bar must have an update(k) method (parallel.progress_bar), got {type(bar).__name__}")
     seen = set()
 
     def counted(ci, k0, k1, eps, **kw):
