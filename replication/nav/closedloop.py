@@ -267,8 +267,8 @@ def _kind_rows(rows, row_R, row_col, sf, sf_R, facc, Cw, sf_H, tg, bs, bz, c, le
     :data:`ROW_KINDS`, in order) its rows of H (zero on entry) and their variances ``Rd``; returns
     the number of rows written.
 
-    The arguments are the arrays the kinds read, passed one by one rather than as the
-    configuration bundles (a compiled helper that receives a bundle takes a reference to each of
+    The arguments are the arrays the kinds read, passed one by one (arrays, not a bundle) rather
+    than as the configuration bundles (a compiled helper that receives a bundle takes a reference to each of
     its arrays, which costs more per epoch than the rows themselves): per kind its variances
     ``row_R`` and error-state column ``row_col`` (−1: none); the specific-force window ending at
     the epoch ``sf`` (−1: none), its variances ``sf_R`` and the lead's window sums ``facc``,
@@ -319,7 +319,8 @@ def _kind_residuals(rows, row_col, row_aux, sf, sf_a, vacc, gpos, gvel, aux, p_h
     accumulated estimates applied), the rows of :func:`_kind_rows` in the same order; returns the
     number of rows written.
 
-    The arguments are the arrays the kinds read (see :func:`_kind_rows` for why one by one): the
+    The arguments are the arrays the kinds read (arrays, not a bundle: see :func:`_kind_rows` for
+    why one by one): the
     kinds ``rows``, per kind its error-state column ``row_col`` and its column of the measured
     values ``aux`` (``row_aux``); the specific-force window ``sf`` (−1: none), the GNSS
     accelerations ``sf_a`` and the run's window sum of the INS acceleration ``vacc`` (reset here);
@@ -413,7 +414,7 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cp
     (Φ, Q_d) by the Van Loan series with the navigation white noise at the mean C_b^n, then
     P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements).
 
-    The arguments are arrays, one by one (the configuration's ``fconst``, ``qc``, PSDs and series
+    The arguments are arrays, one by one, not a bundle (the configuration's ``fconst``, ``qc``, PSDs and series
     order; the interval sums ``navsum``, ``fsum``, ``Csum``, ``Cpl`` over ``nsum`` steps and
     ``tsum`` seconds; the work arrays of the series; the lead's ``P`` and ``Pbar``): a compiled
     helper that receives a bundle takes a reference to each of its arrays once per epoch."""
@@ -488,8 +489,8 @@ def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_
 
     Called once per run and GNSS interval: the run's state arrays (``st`` … ``damp``), the lead's
     interval sums (``sums``, ``fsum``, ``Csum``, ``navsum``, ``Cpl``), the run's IMU-rate records
-    and the per-step work arrays ``w`` are passed one by one, as views taken once per interval
-    (a bundle would cost a reference per array at every call)."""
+    and the per-step work arrays ``w`` are passed one by one (arrays, not a bundle), as views taken
+    once per interval (a bundle would cost a reference per array at every call)."""
     u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en, ta, tb = w
     store_nav = nav_st.shape[0] > 0
     for k in range(k0, k1):
@@ -765,6 +766,9 @@ def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, o
     update's estimate before feedback), P^s_k = P_k⁺ + C_k (P^s_{k+1} − P_{k+1}⁻) C_kᵀ.  Without
     ``with_cov`` only the state recursion runs (C_k needs P_k⁺, P_{k+1}⁻ and Φ_k, not P^s).
 
+    A compiled kernel: it takes the chunk's arrays one by one, not a bundle (numba takes a
+    reference to each array of a bundle it receives; see CONTRIBUTING, "Library").
+
     Parameters
     ----------
     Pf, Pp, Phi : (E, n, n) ndarray
@@ -924,6 +928,9 @@ def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov,
     are recomputed from the raw ones ``z`` (runs × epochs × rows, INS − GNSS) as the filter formed
     them (the same numbers).  Without ``with_cov`` only λ is propagated.  The runs are processed
     side by side (λ as n × runs).
+
+    A compiled kernel: it takes the chunk's arrays one by one, not a bundle (numba takes a
+    reference to each array of a bundle it receives; see CONTRIBUTING, "Library").
 
     Parameters
     ----------
