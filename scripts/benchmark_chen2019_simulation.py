@@ -31,6 +31,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from replication.nav import closedloop as CL  # noqa: E402
 from replication.papers.chen2019 import simulation as sim  # noqa: E402
 from replication.registry import reproduction as rp
 
@@ -60,13 +61,13 @@ def main(argv=None):
     model = sim.filter_model("45", setup, traj.lat[0], traj.h[0])
     # warm-up: compile on a short slice
     short = traj.slice(0, 20_000)
-    sim.run_batch(short, setup, model, n_runs=2, seed=SEED, chunk_epochs=500, smoother=True, prior_covariance=True)
+    sim.run_batch(short, setup, model, n_runs=2, seed=SEED, options=CL.Options(chunk_epochs=500, smoother=True, prior_covariance=True))
     res = {
         "forward_one_run": best_of(lambda: sim.run_batch(traj, setup, model, n_runs=1, seed=SEED), args.repeats),
         "forward_and_smoother_one_run": best_of(
-            lambda: sim.run_batch(traj, setup, model, n_runs=1, seed=SEED, smoother=True), args.repeats),
+            lambda: sim.run_batch(traj, setup, model, n_runs=1, seed=SEED, options=CL.Options(smoother=True)), args.repeats),
         "monte_carlo_20_runs_forward_with_prior": best_of(
-            lambda: sim.run_batch(traj, setup, model, n_runs=20, seed=SEED, prior_covariance=True), 1),
+            lambda: sim.run_batch(traj, setup, model, n_runs=20, seed=SEED, options=CL.Options(prior_covariance=True)), 1),
     }
     out = {
         "workload": {"duration_s": float(traj.t[-1]), "imu_samples": int(traj.n), "imu_rate_hz": setup.imu_rate_hz,

@@ -115,8 +115,12 @@ def _workload(name):
     if name == "chen2019_45_one_run":
         return (lambda: sim.run_batch(warm_traj, setup, model, n_runs=1, seed=7),
                 lambda: sim.run_batch(traj, setup, model, n_runs=1, seed=7))
-    return (lambda: sim.run_batch(warm_traj, setup, model, n_runs=3, seed=7, smoother=True),
-            lambda: sim.run_batch(traj, setup, model, n_runs=20, seed=7, smoother=True))
+    from replication.nav import closedloop as CL
+
+    # the smoother as the tree under test takes it: an option bundle, or (earlier trees) a keyword
+    smoothed = dict(options=CL.Options(smoother=True)) if hasattr(CL, "Options") else dict(smoother=True)
+    return (lambda: sim.run_batch(warm_traj, setup, model, n_runs=3, seed=7, **smoothed),
+            lambda: sim.run_batch(traj, setup, model, n_runs=20, seed=7, **smoothed))
 
 
 def _head(gnss, n_imu):

@@ -378,7 +378,7 @@ def test_schuler_response_matches_core():
     allow ~10 % (stated before the comparison)."""
     from replication.nav import trajectory as tr
     from replication.nav.rotations import rotvec_to_dcm
-    from replication.nav.strapdown import NavState, mechanize
+    from replication.nav.strapdown import NavState, VerticalChannel, mechanize
     from replication.nav.units import DEG
 
     traj = tr.generate([tr.Straight(5100.0)], 45 * DEG, 110 * DEG, 3000.0, dt=0.2, heading=0.5, speed=200.0)
@@ -386,7 +386,7 @@ def test_schuler_response_matches_core():
     u = np.cross(np.array([np.sin(0.5), np.cos(0.5), 0.0]), [0.0, 0.0, 1.0])
     tilt = 1e-4
     st = NavState(s0.lat, s0.lon, s0.h, s0.v_enu, rotvec_to_dcm(-tilt * u) @ s0.C_bn)
-    sol = mechanize(traj.t, traj.dtheta, traj.dv, st, vertical="hold", h_ref=traj.h)
+    sol = mechanize(traj.t, traj.dtheta, traj.dv, st, vertical=VerticalChannel("hold", h_ref=traj.h))
     dv = np.linalg.norm((sol.v_enu - traj.v_enu)[:, :2], axis=1)
     pred = ad.schuler_response(tilt, np.radians(45.0), 3000.0)
     assert pred["period"] == pytest.approx(5067, rel=0.01)

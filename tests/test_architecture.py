@@ -147,12 +147,8 @@ MAX_ARGUMENTS = 12
 ARGUED = "not a bundle"
 SIGNATURES_PENDING: set[str] = {
     "replication.papers.chen2019.models.model_45", "replication.papers.chen2019.models.model_36",
-    "replication.nav.kalman.closed_loop", "replication.nav.kalman.monte_carlo",
-    "replication.papers.chen2019.simulation.run_batch", "replication.papers.chen2019.simulation._run_rows",
     "replication.papers.chen2019.gravity.compensation_run",
     "replication.papers.chen2019.gravity.analog_direct_difference",
-    "replication.nav.closedloop.run", "replication.nav.closedloop.build_spec",
-    "replication.nav.closedloop.chunk_inputs", "replication.nav.closedloop.array_inputs",
     "replication.nav.trajectory.generate", "replication.papers.fang2020.polar._run_grid",
     "replication.papers.fang2020.polar._simulate_runs.seg",
     "replication.crosschecks.duan2023.proposed_linear_propagation",

@@ -144,15 +144,21 @@ def _cl_run(**kw):
     """closedloop.run of one recorded run along _T1 (the inputs of kalman.closed_loop)."""
     n = _T1.n
     idx = np.asarray(_G1.index, np.int64)
-    spec = closedloop.build_spec(_M15, R_pos=0.01 * I3, R_vel=1e-4 * I3)
+    spec = closedloop.build_spec(_M15, gnss=closedloop.GnssRows(R_pos=0.01 * I3, R_vel=1e-4 * I3))
     state = closedloop.initial_batch_state(_T1.initial_state().vector()[None, :],
                                            rotations.dcm_to_quat(_T1.initial_state().C_bn)[None, :], np.zeros(3))
     m = len(idx)
-    inputs = kalman._single_run_inputs(_T1.t, _T1.dtheta, _T1.dv, np.zeros(n + 1), np.zeros(n + 1), idx, _G1,
-                                       np.zeros((m, 6)), np.zeros((m, 4)), np.zeros((m, _M15.n - 9)))
-    args = dict(spec=spec, state=state, P0=_M15.P0(), ep_samples=idx, n_steps=n, inputs=inputs, workers=1)
+    inputs = kalman._single_run_inputs(_T1.t, _T1.dtheta, _T1.dv, (np.zeros(n + 1), np.zeros(n + 1)), idx, _G1,
+                                       (np.zeros((m, 6)), np.zeros((m, 4)), np.zeros((m, _M15.n - 9))))
+    args = dict(spec=spec, state=state, P0=_M15.P0(), ep_samples=idx, n_steps=n, inputs=inputs,
+                options=closedloop.Options(workers=1))
     args.update(kw)
     return closedloop.run(**args)
+
+
+def _build_spec(R_pos=I3, R_vel=I3, lever_arm_b=(0.0, 0.0, 0.0), **kw):
+    """closedloop.build_spec with GNSS rows of these noises and lever arm."""
+    return closedloop.build_spec(gnss=closedloop.GnssRows(R_pos, R_vel, lever_arm_b), **kw)
 
 
 _Y0 = np.random.default_rng(1).standard_normal(200)         # white noise: a stationary series
@@ -260,9 +266,17 @@ PROBES += [
     ("closed_loop(P0 = -I)", "P0", lambda: _closed_loop(P0=-np.eye(15))),
     ("closed_loop(P0 with NaN)", "P0", lambda: _closed_loop(P0=np.diag([np.nan] + [1.0] * 14))),
     ("closed_loop(vertical = 'up')", "vertical", lambda: _closed_loop(vertical="up")),
-    ("closed_loop(h_ref = [nan])", "h_ref", lambda: _closed_loop(vertical="hold", h_ref=[np.nan])),
-    ("closed_loop(damping_tau = -100)", "damping_tau", lambda: _closed_loop(damping_tau=-100.0)),
-    ("closed_loop(series_order = 2.5)", "series_order", lambda: _closed_loop(series_order=2.5)),
+    ("closed_loop(h_ref = [nan])", "h_ref",
+     lambda: _closed_loop(vertical=strapdown.VerticalChannel("hold", h_ref=[np.nan]))),
+    ("VerticalChannel(damping_tau = -100)", "damping_tau", lambda: strapdown.VerticalChannel(damping_tau=-100.0)),
+    ("VerticalChannel('hold') without h_ref", "h_ref", lambda: strapdown.VerticalChannel("hold")),
+    ("closed_loop(vertical = 3)", "vertical", lambda: _closed_loop(vertical=3)),
+    ("Options(series_order = 2.5)", "series_order", lambda: _closed_loop(options=closedloop.Options(series_order=2.5))),
+    ("closed_loop(use = ())", "use", lambda: _closed_loop(use=())),
+    ("closed_loop(use = ['pos'])", "use", lambda: _closed_loop(use=["pos"])),
+    ("closed_loop(options with a smoother)", "smoother",
+     lambda: _closed_loop(options=closedloop.Options(smoother=True))),
+    ("closed_loop(options = dict)", "options", lambda: _closed_loop(options={"store_P": True})),
     ("closed_loop(initial = tuple)", "initial", lambda: _closed_loop(initial=(LAT, LON, H))),
     ("closed_loop(gnss sigma_pos = 0)", "sigma_pos",
      lambda: _closed_loop(gnss=sensors.gnss_measurements(_T1, rate_hz=10.0, sigma_pos=0.0, rng=0))),
@@ -279,14 +293,17 @@ PROBES += [
     ("monte_carlo(workers = 0)", "workers", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, workers=0)),
     ("monte_carlo(model = '15-state')", "model", lambda: kalman.monte_carlo(_T1, "15-state", n_runs=2)),
     ("closedloop.build_spec(R_pos with NaN)", "R_pos",
-     lambda: closedloop.build_spec(_M15, R_pos=np.diag([np.nan, 1.0, 1.0]), R_vel=I3)),
+     lambda: _build_spec(model=_M15, R_pos=np.diag([np.nan, 1.0, 1.0]))),
     ("closedloop.build_spec(lever_arm_b = [nan, 0, 0])", "lever_arm_b",
-     lambda: closedloop.build_spec(_M15, R_pos=I3, R_vel=I3, lever_arm_b=[np.nan, 0.0, 0.0])),
+     lambda: _build_spec(model=_M15, lever_arm_b=[np.nan, 0.0, 0.0])),
+    ("closedloop.build_spec(gnss = dict)", "gnss", lambda: closedloop.build_spec(_M15, gnss={"R_pos": I3})),
     ("closedloop.counting_inputs(inputs = None)", "inputs", lambda: closedloop.counting_inputs(None, object())),
     ("closedloop.counting_inputs(bar without update)", "bar", lambda: closedloop.counting_inputs(print, object())),
     ("closedloop.run(P0 = -I)", "P0", lambda: _cl_run(P0=-np.eye(15))),
-    ("closedloop.run(record_every = 0)", "record_every", lambda: _cl_run(record_every=0)),
-    ("closedloop.run(smoother_form = 'ukf')", "smoother_form", lambda: _cl_run(smoother_form="ukf")),
+    ("closedloop.Options(record_every = 0)", "record_every", lambda: _cl_run(options=closedloop.Options(record_every=0))),
+    ("closedloop.Smoother(form = 'ukf')", "form", lambda: closedloop.Smoother("ukf")),
+    ("closedloop.Options(smoother = 'rts')", "smoother", lambda: closedloop.Options(smoother="rts")),
+    ("closedloop.run(options = 1)", "options", lambda: _cl_run(options=1)),
     ("closedloop.run(ep_samples = [2.5])", "ep_samples", lambda: _cl_run(ep_samples=[2.5])),
     ("inversion_test(segments = 2.5)", "segments", lambda: timeseries.inversion_test(_Y0, 2.5)),
     ("inversion_test(alpha = 1.5)", "alpha", lambda: timeseries.inversion_test(_Y0, 10, alpha=1.5)),
@@ -591,22 +608,27 @@ _CALLS = {
                                         "printed_threshold": "sd"}),
     "kalman.closed_loop": (_closed_loop, dict(),
                            {"initial": "object", "gnss": "object", "model": "object", "P0": "cov15",
-                            "vertical": "option", "h_ref": "series", "vu_ref": "series", "damping_tau": "rate",
-                            "series_order": "count", "truth": "object"}),
+                            "vertical": "option", "use": "option", "truth": "object", "options": "object"}),
+    "strapdown.VerticalChannel": (lambda **kw: _closed_loop(vertical=strapdown.VerticalChannel(**kw)),
+                                  dict(mode="hold", h_ref=H),
+                                  {"mode": "option", "h_ref": "series", "vu_ref": "series", "damping_tau": "rate"}),
+    "closedloop.Options": (lambda **kw: _cl_run(options=closedloop.Options(**kw)), dict(workers=1),
+                           {"record_every": "count", "chunk_epochs": "count", "workers": "count",
+                            "series_order": "count", "store_nav": "option", "store_P": "option"}),
+    "closedloop.Smoother": (closedloop.Smoother, dict(), {"form": "option", "covariance": "option"}),
     "kalman.monte_carlo": (kalman.monte_carlo, dict(traj=_T1, model=_M15, n_runs=2, workers=1),
                            {"traj": "object", "model": "object", "n_runs": "count", "seed": "seed",
                             "gnss_rate_hz": "rate", "sigma_pos": "gnss_sd", "sigma_vel": "gnss_sd",
-                            "vertical": "option", "workers": "count", "h_ref": "series", "vu_ref": "series"}),
-    "closedloop.build_spec": (closedloop.build_spec, dict(model=_M15, R_pos=I3, R_vel=I3),
+                            "vertical": "option", "workers": "count"}),
+    "closedloop.build_spec": (_build_spec, dict(model=_M15),
                               {"model": "object", "R_pos": "mat3", "R_vel": "mat3", "lever_arm_b": "vec3",
-                               "vmode": "option", "gains": "vec3", "series_order": "count"}),
+                               "vmode": "option", "gains": "vec3", "options": "object"}),
     "closedloop.initial_batch_state": (closedloop.initial_batch_state,
                                        dict(st=np.zeros((1, 6)), q=np.array([[1.0, 0, 0, 0]]), lever0=np.zeros(3)),
                                        {"st": "mat", "q": "mat", "lever0": "vec3"}),
     "closedloop.run": (_cl_run, dict(),
                        {"spec": "object", "state": "object", "P0": "cov15", "ep_samples": "epochs", "n_steps": "count",
-                        "inputs": "object", "record_every": "count", "chunk_epochs": "count", "workers": "count",
-                        "smoother_form": "option"}),
+                        "inputs": "object", "options": "object"}),
     "timeseries.inversion_count": (timeseries.inversion_count, dict(values=[1.0, 3.0, 2.0]), {"values": "series"}),
     "timeseries.inversion_moments": (timeseries.inversion_moments, dict(m=5), {"m": "count"}),
     "timeseries.inversion_distribution": (timeseries.inversion_distribution, dict(m=5), {"m": "count"}),

@@ -2,6 +2,8 @@
 form, its GNSS rows against numerical Jacobians of the antenna measurement, its couplings against
 the error model, batches independent of the thread count, and every entry point on one kernel."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -132,8 +134,8 @@ def test_batch_results_do_not_depend_on_the_thread_count_or_the_chunking(short_f
     0 either beyond rounding."""
     s = _setup()
     m = sim.filter_model(model, s, short_flight.lat[0], short_flight.h[0])
-    a = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, record_every=5, chunk_epochs=300, workers=1)
-    b = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, record_every=5, chunk_epochs=300, workers=3)
+    a = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, options=cl.Options(record_every=5, chunk_epochs=300, workers=1))
+    b = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, options=cl.Options(record_every=5, chunk_epochs=300, workers=3))
     assert np.array_equal(a.errors(), b.errors()) and np.array_equal(a.p_hat, b.p_hat)
     assert np.array_equal(a.nis, b.nis) and np.array_equal(a.P, b.P)
 
@@ -150,21 +152,27 @@ def test_monte_carlo_does_not_depend_on_the_thread_count(short_flight):
 def test_bad_configuration_is_refused():
     m = er.model_15(lat=0.8, h=0.0)
     with pytest.raises(ValueError, match="diagonal"):
-        cl.build_spec(m, R_pos=np.ones((3, 3)), R_vel=np.eye(3))
+        cl.build_spec(m, gnss=cl.GnssRows(R_pos=np.ones((3, 3)), R_vel=np.eye(3)))
     with pytest.raises(ValueError, match="at least one"):
-        cl.build_spec(m, R_pos=np.eye(3), R_vel=np.eye(3), use_position=False, use_velocity=False)
-    with pytest.raises(ValueError, match="R_vel is needed"):
-        cl.build_spec(m, R_pos=np.eye(3))
+        cl.build_spec(m, gnss=cl.GnssRows())
+    with pytest.raises(TypeError, match="GnssRows"):
+        cl.build_spec(m, gnss=(np.eye(3), np.eye(3)))
     with pytest.raises(ValueError, match="kind"):
-        cl.build_spec(m, R_pos=np.eye(3), R_vel=np.eye(3), rows=[("gnss_position", None, 1.0)])
+        cl.build_spec(m, gnss=cl.GnssRows(np.eye(3), np.eye(3)), rows=[("gnss_position", None, 1.0)])
     with pytest.raises(TypeError, match="ErrorModel"):
-        cl.build_spec("15", R_pos=np.eye(3), R_vel=np.eye(3))
+        cl.build_spec("15", gnss=cl.GnssRows(np.eye(3), np.eye(3)))
     with pytest.raises(ValueError, match="R×6"):
         cl.initial_batch_state(np.zeros(6), np.zeros(4), np.zeros(3))
     with pytest.raises(ValueError, match="ep_step"):
         cl.chunk_inputs(np.ones(4), np.zeros((1, 4, 3)), np.zeros((1, 4, 3)), [4])
     with pytest.raises(ValueError, match="gpos"):
-        cl.array_inputs(np.arange(5.0), np.zeros((2, 4, 3)), np.zeros((2, 4, 3)), [2, 4], gpos=np.zeros((1, 2, 3)))
+        cl.array_inputs(np.arange(5.0), np.zeros((2, 4, 3)), np.zeros((2, 4, 3)), [2, 4], gnss=(np.zeros((1, 2, 3)), None))
+    with pytest.raises(ValueError, match="pair"):
+        cl.chunk_inputs(np.ones(4), np.zeros((1, 4, 3)), np.zeros((1, 4, 3)), [3], gnss=np.zeros((1, 1, 3)))
+    with pytest.raises(TypeError, match="Smoother"):
+        cl.Options(smoother="rts")
+    with pytest.raises(TypeError, match="unknown"):
+        cl.Options().resolved(record_evry=3)
 
 
 # ----------------------------------------------------------------------------- smoother
@@ -180,9 +188,9 @@ def test_mbf_smoother_equals_the_rts_smoother(short_flight, model):
     leaves three decades for other machines' arithmetic."""
     s = _setup()
     m = sim.filter_model(model, s, short_flight.lat[0], short_flight.h[0])
-    kw = dict(n_runs=4, seed=4, record_every=3, chunk_epochs=150, smoother=True)
-    a = sim.run_batch(short_flight, s, m, **kw)
-    b = sim.run_batch(short_flight, s, m, smoother_form="rts", **kw)
+    opt = cl.Options(record_every=3, chunk_epochs=150, smoother=True)
+    a = sim.run_batch(short_flight, s, m, n_runs=4, seed=4, options=opt)
+    b = sim.run_batch(short_flight, s, m, n_runs=4, seed=4, options=replace(opt, smoother=cl.Smoother("rts")))
     assert np.array_equal(a.errors(), b.errors()) and np.array_equal(a.P, b.P)
     sd_f = np.sqrt(np.einsum("kii->ki", b.P))
     sd_s = np.sqrt(np.einsum("kii->ki", b.P_s))
@@ -194,8 +202,6 @@ def test_mbf_smoother_equals_the_rts_smoother(short_flight, model):
 def test_smoother_does_not_depend_on_the_thread_count(short_flight):
     s = _setup()
     m = sim.filter_model("45", s, short_flight.lat[0], short_flight.h[0])
-    a = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, record_every=5, chunk_epochs=300, smoother=True,
-                      workers=1)
-    b = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, record_every=5, chunk_epochs=300, smoother=True,
-                      workers=3)
+    a = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, options=cl.Options(record_every=5, chunk_epochs=300, smoother=True, workers=1))
+    b = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, options=cl.Options(record_every=5, chunk_epochs=300, smoother=True, workers=3))
     assert np.array_equal(a.ds, b.ds) and np.array_equal(a.P_s, b.P_s)

@@ -21,6 +21,7 @@ import pandas as pd
 import pytest
 from dask.distributed import Client, LocalCluster
 
+from replication.nav import closedloop as CL
 from replication.nav import errors as er
 from replication.nav import kalman as kf
 from replication.nav import parallel as par
@@ -147,7 +148,7 @@ def chen_case():
         position_sd=(0.05, 0.05, 0.1), velocity_sd=0.02, attitude_sd=(30 * ARCSEC, 30 * ARCSEC, 10 * ARCMIN),
         gravity_sigma=0.0, lever_arm_b=(0.2, 0.5, 1.0), lever_arm_sd=0.05, flight_duration=40.0)
     model = sim.filter_model("36", setup, traj.lat[0], traj.h[0])
-    kw = dict(n_runs=5, seed=9, first_run=2, record_every=10, chunk_epochs=150, smoother=True)
+    kw = dict(n_runs=5, seed=9, first_run=2, options=CL.Options(record_every=10, chunk_epochs=150, smoother=True))
     return traj, setup, model, kw, sim.run_batch(traj, setup, model, **kw)
 
 

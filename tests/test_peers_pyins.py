@@ -114,7 +114,7 @@ def test_stationary_hour_height_held_within_pyins_thresholds(stationary):
     # source: pyins test_strapdown.py::test_integrate_stationary (with_altitude=False ↔ vertical="hold");
     # tolerance: pyins' own thresholds (its integrator meets them on the same IMU)
     s = stationary
-    sol = sd.mechanize(s.t, s.dtheta, s.dv, s.initial_state(), vertical="hold", h_ref=s.h)
+    sol = sd.mechanize(s.t, s.dtheta, s.dv, s.initial_state(), vertical=sd.VerticalChannel("hold", h_ref=s.h))
     err = s.errors(sol)
     assert (err < STATIONARY_THRESHOLDS).all(), err[err >= STATIONARY_THRESHOLDS]
 

@@ -7,6 +7,7 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
+from replication.nav import closedloop as cl  # noqa: E402
 from replication.nav import trajectory as tr  # noqa: E402
 from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MICRO_G  # noqa: E402
 from replication.papers import plots
@@ -24,7 +25,7 @@ def test_state_estimates_has_one_panel_per_state():
                             velocity_sd=0.02, attitude_sd=(30 * ARCSEC, 30 * ARCSEC, 10 * ARCMIN), gravity_sigma=0.0,
                             lever_arm_b=(0.0, 0.0, 0.0), lever_arm_sd=0.0, flight_duration=40.0)
     m = sim.filter_model("15", s, traj.lat[0], traj.h[0])
-    res = sim.run_batch(traj, s, m, n_runs=1, seed=1, record_every=5, smoother=True)
+    res = sim.run_batch(traj, s, m, n_runs=1, seed=1, options=cl.Options(record_every=5, smoother=True))
     fig = plots.state_estimates(res, every=1)
     drawn = [ax for ax in fig.axes if ax.axison]
     assert len(drawn) == m.n

@@ -31,7 +31,7 @@ def _setting():
                         sd=np.array([1.0, 0.5]))
     m = er.model_15(lat=0.8, h=3000.0).extend(er.lever_arm(0.1), air)
     col = m.slices["air"].start
-    spec = cl.build_spec(m, R_pos=np.diag([0.01, 0.02, 0.03]), R_vel=np.diag([1e-4, 2e-4, 3e-4]),
+    spec = cl.build_spec(m, gnss=cl.GnssRows(np.diag([0.01, 0.02, 0.03]), np.diag([1e-4, 2e-4, 3e-4])),
                          rows=(("air_height", col, 1.0), ("airspeed", col + 1, 0.25)))
     st = np.array([0.8, 2.0, 3000.0, 80.0, -40.0, 2.0])
     c = rotvec_to_dcm(np.array([0.05, -0.03, 1.1]))
@@ -43,8 +43,8 @@ def _setting():
     gpos = np.array([st[0] + la[1] / (rm + st[2]), st[1] + la[0] / ((rn + st[2]) * np.cos(st[0])), st[2] + la[2]])
     gvel = st[3:6] + c @ np.cross(w, lever)
     aux = np.array([[[st[2], np.linalg.norm(st[3:6])]]])
-    inp = cl.chunk_inputs(np.full(1, 0.01), np.zeros((1, 1, 3)), np.zeros((1, 1, 3)), [0], gpos=gpos[None, None],
-                          gvel=gvel[None, None], windows=(np.ones(1), np.zeros(1, np.int64), np.zeros(1, np.int64),
+    inp = cl.chunk_inputs(np.full(1, 0.01), np.zeros((1, 1, 3)), np.zeros((1, 1, 3)), [0],
+                          gnss=(gpos[None, None], gvel[None, None]), windows=(np.ones(1), np.zeros(1, np.int64), np.zeros(1, np.int64),
                                                           np.array([[0.1, -0.2, 0.3]]), np.array([[1e-4, 1e-4, 1e-4]])),
                           aux=aux, n_aug=m.n - 9)
     lead = cl.LeadState(np.eye(m.n), np.eye(m.n), np.array([0.1, 0.2, 9.8]), np.zeros((6, m.n)))

@@ -84,13 +84,13 @@ def test_nees_consistent_on_small_system(short_flight):
     with an unmodelled 2-mg accelerometer Markov bias (τ = 100 s) must fail the same test."""
     s = _small_setup()
     m = sim.filter_model("15", s, short_flight.lat[0], short_flight.h[0])
-    res = sim.run_batch(short_flight, s, m, n_runs=30, seed=5, record_every=10, chunk_epochs=300)
+    res = sim.run_batch(short_flight, s, m, n_runs=30, seed=5, options=cl.Options(record_every=10, chunk_epochs=300))
     nees = kf.nees(res.errors(), res.P[None])
     frac, mean, lo, hi = sim.fraction_in_band(nees, m.n)
     assert frac >= 0.85
     assert 0.8 * m.n < np.median(mean) < 1.2 * m.n
     bad = _small_setup(accel_markov_sigma=2000 * MICRO_G, accel_markov_tau=100.0)
-    res_b = sim.run_batch(short_flight, bad, m, n_runs=30, seed=5, record_every=10, chunk_epochs=300)
+    res_b = sim.run_batch(short_flight, bad, m, n_runs=30, seed=5, options=cl.Options(record_every=10, chunk_epochs=300))
     frac_b, *_ = sim.fraction_in_band(kf.nees(res_b.errors(), res_b.P[None]), m.n)
     assert frac_b < 0.5
 
@@ -98,15 +98,14 @@ def test_nees_consistent_on_small_system(short_flight):
 def test_batched_runs_replay_exactly_and_share_gains_to_first_order(short_flight):
     s = _small_setup(gyro_markov_sigma=0.02 * DEG_PER_H, scale_sd=2e-5, lever_arm_sd=0.05)
     m = sim.filter_model("36", s, short_flight.lat[0], short_flight.h[0])
-    a = sim.run_batch(short_flight, s, m, n_runs=2, seed=9, record_every=10, chunk_epochs=400)
-    b = sim.run_batch(short_flight, s, m, n_runs=2, seed=9, record_every=10, chunk_epochs=400, smoother=True,
-                      smoother_covariance=False)
+    a = sim.run_batch(short_flight, s, m, n_runs=2, seed=9, options=cl.Options(record_every=10, chunk_epochs=400))
+    b = sim.run_batch(short_flight, s, m, n_runs=2, seed=9, options=cl.Options(record_every=10, chunk_epochs=400, smoother=cl.Smoother(covariance=False)))
     assert np.array_equal(a.errors(), b.errors())          # the smoother's replay leaves the forward pass as is
-    c = sim.run_batch(short_flight, s, m, n_runs=1, seed=9, record_every=10, chunk_epochs=400)
+    c = sim.run_batch(short_flight, s, m, n_runs=1, seed=9, options=cl.Options(record_every=10, chunk_epochs=400))
     assert np.array_equal(c.errors()[0], a.errors()[0])    # run 0 does not depend on the batch size
     # run 1 with run 0's gains vs run 1 as its own extended filter: same truth, differences far
     # below the filter σ (second order in the navigation errors)
-    own = sim.run_batch(short_flight, s, m, n_runs=1, seed=9, record_every=10, first_run=1, chunk_epochs=400)
+    own = sim.run_batch(short_flight, s, m, n_runs=1, seed=9, first_run=1, options=cl.Options(record_every=10, chunk_epochs=400))
     sig = a.sigma()
     live = sig[-1] > 0                                      # the accelerometer Markov σ is zero here
     d = np.abs(own.errors()[0] - a.errors()[1])[:, live] / sig[:, live]
@@ -127,7 +126,7 @@ def test_batched_filter_agrees_with_the_core_closed_loop(short_flight, model, le
         kw.update(gyro_markov_sigma=0.02 * DEG_PER_H, scale_sd=2e-5)
     s = _small_setup(**kw)
     m = sim.filter_model(model, s, short_flight.lat[0], short_flight.h[0])
-    res = sim.run_batch(short_flight, s, m, n_runs=1, seed=2, record_every=1, chunk_epochs=5000)
+    res = sim.run_batch(short_flight, s, m, n_runs=1, seed=2, options=cl.Options(record_every=1, chunk_epochs=5000))
     truth = sim._Truth(s, short_flight, 1, 2, m.nav_sd)
     st, q = truth.initial_states()
     ep = np.arange(s.gnss_step, short_flight.n + 1, s.gnss_step)
@@ -138,7 +137,7 @@ def test_batched_filter_agrees_with_the_core_closed_loop(short_flight, model, le
     from replication.nav.rotations import quat_to_dcm
     from replication.nav.strapdown import NavState
     init = NavState(st[0, 0], st[0, 1], st[0, 2], st[0, 3:6], quat_to_dcm(q[0]))
-    core = kf.closed_loop(short_flight.t, dth[0], dvv[0], init, gn, m, store_nav=False)
+    core = kf.closed_loop(short_flight.t, dth[0], dvv[0], init, gn, m, options=cl.Options(store_nav=False))
     sig = res.sigma()
     live = sig[-1, 9:] > 0                                  # states with zero σ (e.g. no Markov) carry nothing
     d_sensor = np.abs(core.estimates - res.p_hat[0])[:, live] / sig[:, 9:][:, live]
@@ -191,7 +190,7 @@ def test_closed_loop_rts_equals_textbook_rts_with_feedback_inputs():
 def test_smoother_reduces_error_and_stays_consistent(short_flight):
     s = _small_setup()
     m = sim.filter_model("15", s, short_flight.lat[0], short_flight.h[0])
-    res = sim.run_batch(short_flight, s, m, n_runs=20, seed=3, record_every=10, chunk_epochs=250, smoother=True)
+    res = sim.run_batch(short_flight, s, m, n_runs=20, seed=3, options=cl.Options(record_every=10, chunk_epochs=250, smoother=True))
     ef, es = res.errors(), res.errors(smoothed=True)
     # heading error: smoothed RMS below filtered RMS (the smoother sees the turns before they happen)
     assert np.sqrt(np.mean(es[:, :, 8] ** 2)) < 0.8 * np.sqrt(np.mean(ef[:, :, 8] ** 2))

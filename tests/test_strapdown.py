@@ -41,8 +41,7 @@ def test_ideal_sensors_chen2019_flight_height_held(chen_flight):
     """Requirement: along the 5100-s Table 4-42 flight, height held to truth, ideal
     increments: horizontal error ≤ 0.05 m and attitude error ≤ 1e-6 rad throughout."""
     traj = chen_flight
-    sol = sd.mechanize(traj.t, traj.dtheta, traj.dv, traj.initial_state(), vertical="hold",
-                       h_ref=traj.h, vu_ref=traj.v_enu[:, 2])
+    sol = sd.mechanize(traj.t, traj.dtheta, traj.dv, traj.initial_state(), vertical=sd.VerticalChannel("hold", h_ref=traj.h, vu_ref=traj.v_enu[:, 2]))
     e = sol.errors_against(traj)
     horizontal = np.hypot(e["east"], e["north"])
     assert horizontal.max() <= 0.05
@@ -56,7 +55,7 @@ def test_ideal_sensors_turntable_hour():
     traj = tr.generate(segs, 40 * DEG, 116 * DEG, 50.0, heading=h0, speed=0.0)
     assert np.abs(traj.w_ib_b).max() > 8.9 * DEG              # 9°/s moves
     assert np.linalg.norm(traj.dtheta, axis=1).sum() > 100.0   # > 100 rad turned in the hour
-    sol = sd.mechanize(traj.t, traj.dtheta, traj.dv, traj.initial_state(), vertical="hold", h_ref=traj.h)
+    sol = sd.mechanize(traj.t, traj.dtheta, traj.dv, traj.initial_state(), vertical=sd.VerticalChannel("hold", h_ref=traj.h))
     e = sol.errors_against(traj)
     assert np.abs(e["phi"]).max() <= 1e-7
 
@@ -73,7 +72,7 @@ def test_free_vertical_channel_diverges_as_predicted():
     expect = np.cosh(wv * traj.t)
     assert expect[-1] > 1.8                                   # a visible divergence in 20 min
     assert np.allclose(sol.h - h, expect, rtol=2e-3)
-    damped = sd.mechanize(traj.t, traj.dtheta, traj.dv, init, vertical="damped", h_ref=traj.h, damping_tau=60.0)
+    damped = sd.mechanize(traj.t, traj.dtheta, traj.dv, init, vertical=sd.VerticalChannel("damped", h_ref=traj.h, damping_tau=60.0))
     assert np.abs(damped.h[-100:] - h).max() < 1e-3
 
 
@@ -87,7 +86,7 @@ def test_attitude_algorithm_error_is_third_order_in_dt():
     err = []
     for dt in (0.02, 0.01):
         traj = tr.generate(segs, 40 * DEG, 116 * DEG, 50.0, speed=0.0, dt=dt)
-        sol = sd.mechanize(traj.t, traj.dtheta, traj.dv, traj.initial_state(), vertical="hold", h_ref=traj.h)
+        sol = sd.mechanize(traj.t, traj.dtheta, traj.dv, traj.initial_state(), vertical=sd.VerticalChannel("hold", h_ref=traj.h))
         err.append(np.linalg.norm(sol.errors_against(traj)["phi"][-1]))
     assert 6.0 < err[0] / err[1] < 10.0
     assert err[1] < 1e-8
@@ -112,7 +111,7 @@ def test_bad_inputs():
         sd.NavState(0.5, 0.0, 0.0, [0, 0, 0], 2 * np.eye(3))
     with pytest.raises(ValueError, match="needs h_ref"):
         sd.mechanize(traj.t, traj.dtheta, traj.dv, init, vertical="hold")
-    with pytest.raises(ValueError, match="vertical must be"):
+    with pytest.raises(ValueError, match="vertical mode must be"):
         sd.mechanize(traj.t, traj.dtheta, traj.dv, init, vertical="up")
     # a solution running into the polar cap is refused with the time it happens
     polar = tr.generate([tr.Straight(10.0)], np.radians(89.89), 0.0, 0.0, speed=10.0)
@@ -205,7 +204,7 @@ def test_mechanize_refuses_non_finite_inputs_with_their_name():
         h = traj.h.copy()
         h[3] = bad
         with pytest.raises(ValueError, match="h_ref contains NaN"):
-            sd.mechanize(traj.t, traj.dtheta, traj.dv, init, vertical="hold", h_ref=h)
+            sd.mechanize(traj.t, traj.dtheta, traj.dv, init, vertical=sd.VerticalChannel("hold", h_ref=h))
     # large finite increments are finite, even where their sum overflows
     big = np.full_like(traj.dv, 1e308)
     assert sd.validate_increments(traj.dtheta, big)[1] is not None

@@ -44,7 +44,7 @@ import math
 import threading
 from collections import namedtuple
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from typing import Callable
 
 import numpy as np
@@ -54,11 +54,168 @@ from replication.nav import _kernels as K
 from replication.nav._validate import choice, covariance, finite_array, integer, numeric
 from replication.nav.errors import ErrorModel
 
-__all__ = ["Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state",
+__all__ = ["Options", "Smoother", "GnssRows", "resolve_options", "Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state",
            "Records", "run", "filter_chunk", "rts_chunk", "mbf_chunk", "chunk_inputs", "array_inputs",
            "counting_inputs", "ROW_KINDS"]
 
 _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
+
+@dataclass(frozen=True)
+class Smoother:
+    """The fixed-interval smoother pass of :func:`run` (replaying the forward pass chunk by chunk).
+
+    Attributes
+    ----------
+    form : {"mbf", "rts"}
+        The backward recursion: the modified Bryson-Frazier form (:func:`mbf_chunk`, the default)
+        or the Rauch-Tung-Striebel covariance form (:func:`rts_chunk`); the two give the same
+        smoothed error and covariance (to rounding).  The MBF form inverts nothing and forms the
+        O(n³) products only at the recorded epochs; it needs per epoch the lead's Φ, rows and
+        gains and every run's innovations, so the forward pass keeps the innovations (runs ×
+        epochs × rows) and the replay re-runs the lead alone.  The RTS form needs every run's
+        estimates and replays the whole batch.
+    covariance : bool
+        Also compute the smoothed covariance P^s (default True).
+    """
+
+    form: str = "mbf"
+    covariance: bool = True
+
+    def __post_init__(self):
+        choice(self.form, ("mbf", "rts"), "smoother form")
+        if not isinstance(self.covariance, (bool, np.bool_)):
+            raise TypeError(f"Smoother.covariance must be True or False, got {self.covariance!r}")
+
+
+@dataclass(frozen=True)
+class Options:
+    """How the closed-loop filter runs: its numerics, what it records, its smoother, its threads.
+
+    One bundle for :func:`build_spec` (which reads ``series_order`` and ``prior_covariance``),
+    :func:`run` (which reads the rest) and the public entry points
+    (:func:`replication.nav.kalman.closed_loop`,
+    :func:`replication.papers.chen2019.simulation.run_batch`).  A field left ``None`` takes the
+    default of the function it is given to (:meth:`resolved`): ``run_batch`` records every 20th
+    epoch, :func:`run` every epoch.
+
+    Attributes
+    ----------
+    record_every : int or None
+        Record every ``record_every``-th epoch (the P's and the per-run records); run's default 1.
+    chunk_epochs : int or None
+        Epochs per chunk (memory of the gains and of the smoother's records), at least 2; run's
+        default 2000.
+    smoother : Smoother, bool or None
+        The smoother pass (``True``: ``Smoother()``; ``None`` or ``False``: none).
+    store_nav : bool or None
+        Keep the IMU-rate solution; run's default False.
+    store_P : bool or None
+        Keep the covariance at the recorded epochs (``Records.P``; its diagonal is always kept);
+        run's default True.
+    workers : int or None
+        Threads for the runs that follow the lead (≥ 1; results do not depend on it); run's
+        default 2.
+    series_order : int or None
+        Order of the Van Loan series for (Φ, Q_d); default 4.
+    prior_covariance : bool or None
+        Also propagate the covariance without measurements; default False.
+    """
+
+    record_every: int | None = None
+    chunk_epochs: int | None = None
+    smoother: Smoother | bool | None = None
+    store_nav: bool | None = None
+    store_P: bool | None = None
+    workers: int | None = None
+    series_order: int | None = None
+    prior_covariance: bool | None = None
+
+    def __post_init__(self):
+        sm = self.smoother
+        if sm is True:
+            object.__setattr__(self, "smoother", Smoother())
+        elif sm is False:
+            object.__setattr__(self, "smoother", None)
+        elif sm is not None and not isinstance(sm, Smoother):
+            raise TypeError(f"Options.smoother must be a closedloop.Smoother, True, False or None, got {sm!r}")
+        for name, low in (("record_every", 1), ("chunk_epochs", 2), ("workers", 1), ("series_order", 1)):
+            v = getattr(self, name)
+            if v is not None:
+                integer(v, f"Options.{name}", low)
+        for name in ("store_nav", "store_P", "prior_covariance"):
+            v = getattr(self, name)
+            if v is not None and not isinstance(v, (bool, np.bool_)):
+                raise TypeError(f"Options.{name} must be True or False, got {v!r}")
+
+    def resolved(self, **defaults) -> "Options":
+        """These options with every field left ``None`` set from ``defaults``, then from :func:`run`'s.
+
+        Parameters
+        ----------
+        **defaults : int or bool
+            The caller's defaults, by field name.
+
+        Returns
+        -------
+        Options
+            Every field set.
+        """
+        unknown = set(defaults) - {f.name for f in fields(Options)}
+        if unknown:
+            raise TypeError(f"unknown Options fields {sorted(unknown)}")
+        base = dict(_RUN_DEFAULTS, **defaults)
+        return replace(self, **{f.name: base[f.name] for f in fields(Options)
+                                if getattr(self, f.name) is None and f.name != "smoother"})
+
+
+_RUN_DEFAULTS = dict(record_every=1, chunk_epochs=2000, store_nav=False, store_P=True, workers=2, series_order=4,
+                     prior_covariance=False)
+
+
+def resolve_options(value, defaults: dict | None = None, name: str = "options") -> Options:
+    """``value`` (an :class:`Options` or ``None``) with its unset fields from ``defaults``, then :func:`run`'s.
+
+    Parameters
+    ----------
+    value : Options or None
+        The caller's options.
+    defaults : dict, optional
+        The entry point's defaults, by field name.
+    name : str, optional
+        The argument's name in the error message.
+
+    Returns
+    -------
+    Options
+        Every field set.
+    """
+    if value is None:
+        value = Options()
+    if not isinstance(value, Options):
+        raise TypeError(f"{name} must be a closedloop.Options, got {type(value).__name__}")
+    return value.resolved(**(defaults or {}))
+
+
+@dataclass(frozen=True, eq=False)
+class GnssRows:
+    """The GNSS measurement rows of :func:`build_spec`: antenna position and velocity with the lever arm
+    (chen2019 eqs. (3-17), (2-13)).
+
+    Attributes
+    ----------
+    R_pos : (3, 3) array_like or None
+        Diagonal position noise covariance (ENU, m²); ``None``: no position rows.
+    R_vel : (3, 3) array_like or None
+        Diagonal velocity noise covariance ((m/s)²); ``None``: no velocity rows.
+    lever_arm_b : (3,) array_like
+        Antenna lever arm in the body frame used by the filter, m.
+    """
+
+    R_pos: object = None
+    R_vel: object = None
+    lever_arm_b: object = (0.0, 0.0, 0.0)
+
+
 
 Spec = namedtuple("Spec", ["fconst", "qc", "q_accel", "q_gyro", "tg", "kd", "bs", "bz", "order", "dyn_rows",
                            "rows", "row_R", "row_col", "row_aux", "m_max", "lever0", "vmode", "gains",
@@ -1093,9 +1250,8 @@ def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov,
 
 # ----------------------------------------------------------------------------- configuration
 
-def build_spec(model: ErrorModel, *, R_pos=None, R_vel=None, lever_arm_b=(0.0, 0.0, 0.0), use_position: bool = True,
-               use_velocity: bool = True, vmode: int = 0, gains=(0.0, 0.0, 0.0), series_order: int = 4,
-               ar=None, sf_H=None, rows=(), prior_covariance: bool = False, nees: bool = False) -> Spec:
+def build_spec(model: ErrorModel, *, gnss: GnssRows | None = None, rows=(), vmode: int = 0, gains=(0.0, 0.0, 0.0),
+               ar=None, sf_H=None, nees: bool = False, options: Options | None = None) -> Spec:
     """The filter's configuration for ``model``.
 
     The measurement rows, in this order: GNSS antenna position and velocity (chen2019 eqs. (3-17),
@@ -1106,19 +1262,12 @@ def build_spec(model: ErrorModel, *, R_pos=None, R_vel=None, lever_arm_b=(0.0, 0
     ----------
     model : ErrorModel
         The error-state model (15 states or any extension, :mod:`replication.nav.errors`).
-    R_pos, R_vel : (3, 3) array_like, optional
-        Diagonal GNSS position (ENU, m²) and velocity ((m/s)²) noise covariances; needed when the
-        rows are used.
-    lever_arm_b : (3,) array_like
-        Antenna lever arm in the body frame used by the filter, m (chen2019 eq. (2-13)).
-    use_position, use_velocity : bool
-        Which GNSS rows to use.
+    gnss : GnssRows, optional
+        The GNSS position and velocity rows and the lever arm (none by default).
     vmode : int
         Vertical channel: 0 free, 1 held, 2 damped with ``gains`` (:mod:`replication.nav.strapdown`).
     gains : (3,) array_like
         Gains of the damped vertical channel.
-    series_order : int
-        Order of the Van Loan series for (Φ, Q_d).
     ar : tuple (T, Q) of (n, n) arrays, optional
         Discrete transition applied at the epochs flagged in ``ChunkInputs.ar_tick``.
     sf_H : (3, n - 9) array_like, optional
@@ -1128,10 +1277,11 @@ def build_spec(model: ErrorModel, *, R_pos=None, R_vel=None, lever_arm_b=(0.0, 0
         the error state its measurement error is modelled by (column of ``model``, or None) and
         the variance of its white noise (m², (m/s)²).  The k-th entry reads its measured values
         from column k of ``ChunkInputs.aux``.
-    prior_covariance : bool
-        Also propagate the covariance without measurements.
     nees : bool
         Compute the NEES against the truth of the inputs.
+    options : Options, optional
+        Its ``series_order`` (order of the Van Loan series for (Φ, Q_d)) and ``prior_covariance``
+        (also propagate the covariance without measurements).
 
     Returns
     -------
@@ -1140,13 +1290,15 @@ def build_spec(model: ErrorModel, *, R_pos=None, R_vel=None, lever_arm_b=(0.0, 0
     """
     if not isinstance(model, ErrorModel):
         raise TypeError("model must be a replication.nav.errors.ErrorModel")
+    gnss = GnssRows() if gnss is None else gnss
+    if not isinstance(gnss, GnssRows):
+        raise TypeError(f"gnss must be a closedloop.GnssRows, got {type(gnss).__name__}")
+    opt = resolve_options(options)
     n = model.n
     kinds, row_R, row_col, row_aux = [], [], [], []
-    for use, name, M in ((use_position, "R_pos", R_pos), (use_velocity, "R_vel", R_vel)):
-        if not use:
-            continue
+    for name, M in (("R_pos", gnss.R_pos), ("R_vel", gnss.R_vel)):
         if M is None:
-            raise ValueError(f"{name} is needed for the GNSS {name[2:]} rows (a 3×3 diagonal covariance)")
+            continue
         M = numeric(M, name)
         if M.shape != (3, 3) or np.any(M != np.diag(np.diag(M))) or not np.all(np.diag(M) > 0):
             raise ValueError(f"{name} must be a 3×3 diagonal matrix with positive variances (independent axes)")
@@ -1174,12 +1326,13 @@ def build_spec(model: ErrorModel, *, R_pos=None, R_vel=None, lever_arm_b=(0.0, 0
         row_R.append(np.array([var, 0.0, 0.0]))
         row_col.append(col)
         row_aux.append(k)
-    if not (use_position or use_velocity or len(rows)):
-        raise ValueError("use at least one measurement: GNSS position, GNSS velocity or a kind of rows")
+    if not (gnss.R_pos is not None or gnss.R_vel is not None or len(rows)):
+        raise ValueError("use at least one measurement: GNSS position (GnssRows.R_pos), velocity (R_vel) or a kind of "
+                         "rows")
     size = {code: m for code, m in ROW_KINDS.values()}
     m_max = sum(size[k] for k in kinds)
-    series_order = integer(series_order, "series_order")
-    lever = finite_array(lever_arm_b, "lever_arm_b", (3,))
+    series_order = opt.series_order
+    lever = finite_array(gnss.lever_arm_b, "lever_arm_b", (3,))
     finite_array(gains, "gains", (3,))
     choice(vmode, (0, 1, 2), "vmode", "{name} must be one of {allowed} (free, held, damped), got {value!r}")
     fconst, qc, tg, kd, bs, bz = model.kernel_encoding()
@@ -1196,7 +1349,7 @@ def build_spec(model: ErrorModel, *, R_pos=None, R_vel=None, lever_arm_b=(0.0, 0
     return Spec(fconst, qc, np.asarray(model.accel_psd, float), np.asarray(model.gyro_psd, float), tg, kd, bs, bz,
                 int(series_order), dyn, np.array(kinds, np.int64), np.array(row_R, float), np.array(row_col, np.int64),
                 np.array(row_aux, np.int64), int(m_max), lever.copy(), int(vmode), np.asarray(gains, float), arT, arQ, sfH,
-                bool(prior_covariance), bool(nees))
+                bool(opt.prior_covariance), bool(nees))
 
 
 def initial_batch_state(st, q, lever0) -> BatchState:
@@ -1290,7 +1443,7 @@ def _empty_gains(E_, n, n_dyn, n_aug, with_nees, m_max):
                  np.empty((E_n, n, n)))
 
 
-def _run_arguments(spec: Spec, P0, ep_samples, n_steps: int, record_every, chunk_epochs, workers, smoother_form):
+def _run_arguments(spec: Spec, P0, ep_samples, n_steps: int):
     """The checked epoch samples and initial covariance of :func:`run` (``ValueError`` otherwise)."""
     if not isinstance(spec, Spec):
         raise TypeError(f"spec must be a closedloop.Spec (closedloop.build_spec), got {type(spec).__name__}")
@@ -1302,8 +1455,6 @@ def _run_arguments(spec: Spec, P0, ep_samples, n_steps: int, record_every, chunk
     n = spec.fconst.shape[0]
     if np.any(np.diff(ep) <= 0) or ep[0] < 1 or ep[-1] > n_steps:
         raise ValueError(f"ep_samples must be strictly increasing sample indices in 1..{n_steps}")
-    integer(record_every, "record_every"), integer(chunk_epochs, "chunk_epochs", 2), integer(workers, "workers")
-    choice(smoother_form, ("mbf", "rts"), "smoother_form")
     P0 = np.array(numeric(P0, "P0"), dtype=float)
     if P0.shape != (n, n):
         raise ValueError(f"P0 must be {n}×{n}")
@@ -1355,12 +1506,14 @@ def _inputs_view(x: ChunkInputs, sl) -> ChunkInputs:
 class _ChunkPlan:
     """The chunks of one call of :func:`run` and the filter's work on one chunk (lead, followers, replay)."""
 
-    def __init__(self, spec: Spec, ep, n_steps: int, chunk_epochs: int, rec_pos, R: int, groups, inputs,
-                 lead_inputs, store_nav: bool, store_P: bool, rts: bool):
+    def __init__(self, spec: Spec, ep, n_steps: int, rec_pos, R: int, inputs, lead_inputs, opt: Options):
         n_ep = len(ep)
-        self.spec, self.ep, self.n_steps, self.rec_pos, self.R, self.groups = spec, ep, n_steps, rec_pos, R, groups
+        self.spec, self.ep, self.n_steps, self.rec_pos, self.R = spec, ep, n_steps, rec_pos, R
+        self.groups = _follower_groups(R, opt.workers)
         self.inputs, self.lead_inputs = inputs, lead_inputs
-        self.store_nav, self.store_P, self.rts = store_nav, store_P, rts
+        self.store_nav, self.store_P = opt.store_nav, opt.store_P
+        self.rts = opt.smoother is not None and opt.smoother.form == "rts"
+        chunk_epochs = opt.chunk_epochs
         self.chunks = [(j0, min(j0 + int(chunk_epochs), n_ep)) for j0 in range(0, n_ep, int(chunk_epochs))]
         self.n = spec.fconst.shape[0]
         self.n_aug = self.n - 9
@@ -1492,9 +1645,8 @@ def _forward_pass(plan: _ChunkPlan, state: BatchState, lead: LeadState, res: Rec
 
 def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *,
-        lead_inputs: Callable[[int, int, int, np.ndarray], ChunkInputs] | None = None, record_every: int = 1,
-        chunk_epochs: int = 2000, smoother: bool = False, smoother_covariance: bool = True,
-        smoother_form: str = "mbf", store_nav: bool = False, store_P: bool = True, workers: int = 2) -> Records:
+        lead_inputs: Callable[[int, int, int, np.ndarray], ChunkInputs] | None = None,
+        options: Options | None = None) -> Records:
     """Run the closed-loop filter of ``spec`` over ``n_steps`` IMU steps for the runs of ``state``.
 
     Parameters
@@ -1516,33 +1668,18 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     lead_inputs : callable, optional
         The same for run 0 alone (arrays of one run), for the smoother's replay of the lead (two
         chunks at once, from two threads); by default run 0's slice of ``inputs``.
-    record_every : int
-        Record every ``record_every``-th epoch (the P's and the per-run records).
-    chunk_epochs : int
-        Epochs per chunk (memory of the gains and of the smoother's records).
-    smoother, smoother_covariance : bool
-        Add the fixed-interval smoother pass (replaying the forward pass chunk by chunk), with or
-        without P^s.
-    smoother_form : {"mbf", "rts"}
-        The smoother's backward recursion: the modified Bryson-Frazier form (:func:`mbf_chunk`,
-        the default) or the Rauch-Tung-Striebel covariance form (:func:`rts_chunk`); the two give
-        the same smoothed error and covariance (to rounding).  The MBF form inverts nothing and
-        forms the O(n³) products only at the recorded epochs; it needs per epoch the lead's Φ,
-        rows and gains and every run's innovations, so the forward pass keeps the innovations
-        (runs × epochs × rows) and the replay re-runs the lead alone.  The RTS form needs every
-        run's estimates and replays the whole batch.
-    store_nav : bool
-        Keep the IMU-rate solution.
-    store_P : bool
-        Keep the covariance at the recorded epochs (``Records.P``; its diagonal is always kept).
-    workers : int
-        Threads for the runs that follow the lead (≥ 1; results do not depend on it).
+    options : Options, optional
+        Records (``record_every``, ``store_nav``, ``store_P``), chunking (``chunk_epochs``), the
+        smoother pass (``smoother``: a :class:`Smoother`, replaying the forward pass chunk by
+        chunk) and threads (``workers``); unset fields take run's defaults (every epoch recorded,
+        2000 epochs per chunk, no smoother, no IMU-rate solution, P kept, 2 threads).
 
     Returns
     -------
     Records
     """
-    ep, P0 = _run_arguments(spec, P0, ep_samples, n_steps, record_every, chunk_epochs, workers, smoother_form)
+    opt = resolve_options(options)
+    ep, P0 = _run_arguments(spec, P0, ep_samples, n_steps)
     if not isinstance(state, BatchState):
         raise TypeError(f"state must be a closedloop.BatchState (closedloop.initial_batch_state), got "
                         f"{type(state).__name__}")
@@ -1551,15 +1688,15 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     n = spec.fconst.shape[0]
     state = _with_phat(state, n - 9)
     R = state.st.shape[0]
-    rec_ep, rec_pos = _record_positions(len(ep), record_every)
-    res = _new_records(spec, rec_ep, R, n, len(ep), n_steps, store_P, store_nav)
+    rec_ep, rec_pos = _record_positions(len(ep), opt.record_every)
+    res = _new_records(spec, rec_ep, R, n, len(ep), n_steps, opt.store_P, opt.store_nav)
     lead = LeadState(P0.copy(), P0.copy(), np.zeros(3), np.zeros((6, n)))
-    plan = _ChunkPlan(spec, ep, n_steps, chunk_epochs, rec_pos, R, _follower_groups(R, workers), inputs, lead_inputs,
-                      store_nav, store_P, smoother_form == "rts")
+    plan = _ChunkPlan(spec, ep, n_steps, rec_pos, R, inputs, lead_inputs, opt)
+    smoother = opt.smoother is not None
     checkpoints, innov = _forward_pass(plan, state, lead, res, smoother)
     if smoother:
         _smooth(res, plan.chunks, lambda ci: plan.replay(checkpoints, ci), innov, rec_pos, R, n, len(rec_ep),
-                smoother_covariance, plan.rts)
+                opt.smoother.covariance, plan.rts)
     return res
 
 
@@ -1627,8 +1764,8 @@ def _smooth(res: Records, chunks, replay, innov, rec_pos, R, n, m_rec, with_cov,
                 res.P_s[pos] = o_Ps
 
 
-def chunk_inputs(dt, dth, dvv, ep_step, *, gpos=None, gvel=None, h_ref=None, vu_ref=None, windows=None,
-                 ar_tick=None, truth=None, aux=None, n_aug: int = 0) -> ChunkInputs:
+def chunk_inputs(dt, dth, dvv, ep_step, *, gnss=None, vertical=None, windows=None, ar_tick=None, truth=None,
+                 aux=None, n_aug: int = 0) -> ChunkInputs:
     """The :class:`ChunkInputs` of one chunk of ``K`` IMU steps and ``E`` epochs for ``R`` runs,
     with the unused fields filled.
 
@@ -1640,10 +1777,12 @@ def chunk_inputs(dt, dth, dvv, ep_step, *, gpos=None, gvel=None, h_ref=None, vu_
         Gyro and accelerometer increments, rad and m/s.
     ep_step : (E,) array_like of int
         The step (0..K−1) after which each epoch falls.
-    gpos, gvel : (R, E, 3) array_like, optional
-        GNSS fixes [L, λ, h] (rad, m) and ENU velocities (m/s); zero when their rows are unused.
-    h_ref, vu_ref : (K + 1,) array_like, optional
-        Vertical references of a held or damped vertical channel (m, m/s); zero by default.
+    gnss : tuple (gpos, gvel), optional
+        GNSS fixes [L, λ, h] (rad, m) and ENU velocities (m/s), each (R, E, 3) or None; zero when
+        their rows are unused.
+    vertical : tuple (h_ref, vu_ref), optional
+        Vertical references of a held or damped vertical channel (m, m/s), each (K + 1,) or None;
+        zero by default.
     windows : tuple, optional
         The specific-force windows (``sf_w`` (K,), ``sf_win`` (K,), ``sf_end`` (E,), ``sf_a``
         (windows × 3, m/s²), ``sf_R`` (windows × 3, (m/s²)²)); none by default.
@@ -1661,6 +1800,8 @@ def chunk_inputs(dt, dth, dvv, ep_step, *, gpos=None, gvel=None, h_ref=None, vu_
     ChunkInputs
     """
     c = np.ascontiguousarray
+    gpos, gvel = _pair(gnss, "gnss", "(gpos, gvel)")
+    h_ref, vu_ref = _pair(vertical, "vertical", "(h_ref, vu_ref)")
     dth, dvv = c(dth, dtype=float), c(dvv, dtype=float)
     if dth.ndim != 3 or dth.shape[2] != 3 or dvv.shape != dth.shape:
         raise ValueError(f"dth and dvv must both be (runs, steps, 3) arrays, got {dth.shape} and {dvv.shape}")
@@ -1686,6 +1827,15 @@ def chunk_inputs(dt, dth, dvv, ep_step, *, gpos=None, gvel=None, h_ref=None, vu_
                        ar_tick=np.zeros(E_, np.int64) if ar_tick is None else c(ar_tick),
                        truth_st=c(truth_st), truth_q=c(truth_q), truth_p=c(truth_p),
                        aux=np.zeros((R, E_, 0)) if aux is None else c(aux, dtype=float))
+
+
+def _pair(value, name, what):
+    """``value`` as a pair (``None``: two ``None``), or a ``ValueError`` naming ``what``."""
+    if value is None:
+        return None, None
+    if not isinstance(value, (tuple, list)) or len(value) != 2:
+        raise ValueError(f"{name} must be a pair {what} (either may be None), got {type(value).__name__}")
+    return value
 
 
 def counting_inputs(inputs, bar):
@@ -1721,8 +1871,8 @@ def counting_inputs(inputs, bar):
     return counted
 
 
-def array_inputs(t, dth, dvv, ep_samples, *, gpos=None, gvel=None, h_ref=None, vu_ref=None, windows=None,
-                 ar_tick=None, truth=None, aux=None, n_aug: int = 0):
+def array_inputs(t, dth, dvv, ep_samples, *, gnss=None, vertical=None, windows=None, ar_tick=None, truth=None,
+                 aux=None, n_aug: int = 0):
     """The ``inputs`` callable of :func:`run` for whole-flight arrays: each chunk's slices through
     :func:`chunk_inputs`.
 
@@ -1734,10 +1884,12 @@ def array_inputs(t, dth, dvv, ep_samples, *, gpos=None, gvel=None, h_ref=None, v
         Increments of the ``R`` runs (rad, m/s).
     ep_samples : (E,) array_like of int
         Sample index of each epoch (as for :func:`run`).
-    gpos, gvel, aux : (R, E, ·) array_like, optional
-        Per run and epoch (see :func:`chunk_inputs`).
-    h_ref, vu_ref : (N + 1,) array_like, optional
-        Vertical references.
+    gnss : tuple (gpos, gvel), optional
+        GNSS fixes and velocities, each (R, E, 3) or None (see :func:`chunk_inputs`).
+    vertical : tuple (h_ref, vu_ref), optional
+        Vertical references, each (N + 1,) or None.
+    aux : (R, E, k) array_like, optional
+        Measured values of the kinds of ``build_spec(rows=...)``, per run and epoch.
     windows : tuple, optional
         ``sf_w`` (N,), ``sf_win`` (N,), ``sf_end`` (E,), ``sf_a``, ``sf_R`` (per window, whole).
     ar_tick : (E,) array_like of int, optional
@@ -1753,6 +1905,8 @@ def array_inputs(t, dth, dvv, ep_samples, *, gpos=None, gvel=None, h_ref=None, v
         ``inputs(chunk, k0, k1, epochs)`` → :class:`ChunkInputs`.
     """
     idx = np.asarray(ep_samples, np.int64)
+    gpos, gvel = _pair(gnss, "gnss", "(gpos, gvel)")
+    h_ref, vu_ref = _pair(vertical, "vertical", "(h_ref, vu_ref)")
     dt = np.diff(np.asarray(t, float))
     if np.ndim(dth) != 3 or np.shape(dth)[1:] != (len(dt), 3) or np.shape(dvv) != np.shape(dth):
         raise ValueError(f"dth and dvv must be (runs, {len(dt)}, 3): one increment per interval of t")
@@ -1765,9 +1919,9 @@ def array_inputs(t, dth, dvv, ep_samples, *, gpos=None, gvel=None, h_ref=None, v
         j1 = j0 + len(eps)
         ep = slice(j0, j1)
         return chunk_inputs(dt[k0:k1], dth[:, k0:k1], dvv[:, k0:k1], np.asarray(eps, np.int64) - 1 - k0,
-                            gpos=None if gpos is None else gpos[:, ep], gvel=None if gvel is None else gvel[:, ep],
-                            h_ref=None if h_ref is None else h_ref[k0:k1 + 1],
-                            vu_ref=None if vu_ref is None else vu_ref[k0:k1 + 1],
+                            gnss=(None if gpos is None else gpos[:, ep], None if gvel is None else gvel[:, ep]),
+                            vertical=(None if h_ref is None else h_ref[k0:k1 + 1],
+                                      None if vu_ref is None else vu_ref[k0:k1 + 1]),
                             windows=None if windows is None else (windows[0][k0:k1], windows[1][k0:k1],
                                                                   windows[2][ep], windows[3], windows[4]),
                             ar_tick=None if ar_tick is None else ar_tick[ep],

@@ -33,17 +33,17 @@ from replication.nav.errors import ErrorModel
 from replication.nav.rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from replication.nav.sensors import GnssMeasurements, ImuErrors, gnss_measurements
 from replication.nav.strapdown import (
-    VERTICAL_MODES,
     NavSolution,
     NavState,
+    VerticalChannel,
     validate_increments,
     validate_time,
-    vertical_damping_gains,
+    vertical_channel,
 )
 from replication.nav.trajectory import Trajectory
 
 __all__ = ["van_loan", "discretize_series", "predict", "update", "rts_smoother", "nees", "nis", "chi2_band",
-           "ClosedLoopResult", "closed_loop", "perturb_state", "MonteCarloResult", "monte_carlo",
+           "ClosedLoopResult", "GNSS_ROWS", "closed_loop", "perturb_state", "MonteCarloResult", "monte_carlo",
            "true_parameter_vector"]
 
 
@@ -510,15 +510,18 @@ def _gnss_noise(value, name: str) -> np.ndarray:
     return np.diag(np.broadcast_to(np.asarray(value, float), (3,)) ** 2)
 
 
+#: The GNSS rows :func:`closed_loop` can use.
+GNSS_ROWS = ("position", "velocity")
+
+
 def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model: ErrorModel, *,
-                use_position: bool = True, use_velocity: bool = True, P0=None, vertical: str = "free",
-                h_ref=None, vu_ref=None, damping_tau: float = 100.0, truth=None, true_params=None,
-                store_nav: bool = True, store_P: bool = False, series_order: int = 4) -> ClosedLoopResult:
+                use=GNSS_ROWS, P0=None, vertical: VerticalChannel | str = "free", truth=None, true_params=None,
+                options: CL.Options | None = None) -> ClosedLoopResult:
     """Closed-loop INS/GNSS integration with the error-state Kalman filter of ``model``.
 
     Strapdown (chen2019 eq. (3-2)) at the IMU rate on increments corrected by the accumulated
     sensor-error estimates; at each GNSS epoch: F from the interval averages of its inputs, Van
-    Loan (Φ, Q_d) by series (order ``series_order``), Joseph-form update — one measurement at a
+    Loan (Φ, Q_d) by series (order ``options.series_order``), Joseph-form update — one measurement at a
     time, the GNSS noise being independent per axis (``gnss.sigma_pos``, ``gnss.sigma_vel``) —
     with antenna position (ENU metres, lever arm of chen2019 eq. (2-13)) and/or velocity, feedback
     of δp, δv, φ and accumulation p̂ += x̂ of the augmented states.
@@ -538,31 +541,23 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
         ``sigma_vel`` [m/s] (positive) set the filter's measurement noise.
     model : ErrorModel
         The error-state model.
-    use_position : bool, optional
-        Use the GNSS position, default True.
-    use_velocity : bool, optional
-        Use the GNSS velocity, default True (at least one of the two).
+    use : sequence of {"position", "velocity"}, optional
+        The GNSS rows used, default both (at least one).
     P0 : array_like, shape (n, n), optional
         Initial covariance, state units squared; default ``model.P0()``.
-    vertical : str, optional
-        Vertical-channel mode, a key of ``replication.nav.strapdown.VERTICAL_MODES``; default
-        ``"free"``; other modes need ``h_ref``.
-    h_ref : float or array_like, shape (N + 1,), optional
-        Reference height [m] per IMU sample for the vertical channel.
-    vu_ref : float or array_like, shape (N + 1,), optional
-        Reference vertical velocity [m/s] per IMU sample, default zero.
-    damping_tau : float, optional
-        Time constant [s] of the ``"damped"`` vertical channel, default 100.
+    vertical : VerticalChannel or str, optional
+        The vertical channel (:class:`replication.nav.strapdown.VerticalChannel`: mode, reference
+        height and vertical velocity per IMU sample, damping time constant), default free.
     truth : Trajectory, optional
         The true trajectory on the same samples; enables the NEES at every epoch.
     true_params : float or array_like, shape (n_aug,), optional
         Augmented-state truth for the NEES (see :func:`true_parameter_vector`), default zeros.
-    store_nav : bool, optional
-        Keep the corrected navigation at every IMU sample, default True.
-    store_P : bool, optional
-        Keep the full covariance at every epoch, default False.
-    series_order : int, optional
-        Terms of the series of (Φ, Q_d), default 4.
+    options : replication.nav.closedloop.Options, optional
+        ``store_nav`` (keep the corrected navigation at every IMU sample, default True),
+        ``store_P`` (keep the full covariance at every epoch, default False), ``series_order``
+        (terms of the series of (Φ, Q_d), default 4), ``chunk_epochs``; every epoch is recorded
+        and there is no smoother here (:func:`replication.papers.chen2019.simulation.run_batch`
+        has one).
 
     Returns
     -------
@@ -574,8 +569,8 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     TypeError
         For a ``model``, ``gnss``, ``initial`` or ``truth`` of the wrong type.
     ValueError
-        For inconsistent samples, GNSS epochs off the IMU samples, no measurement used, an
-        unknown ``vertical`` or a vertical mode without ``h_ref``.
+        For inconsistent samples, GNSS epochs off the IMU samples, no measurement used, or
+        options this function does not offer (a smoother, epochs left unrecorded).
     """
     dtheta, dv = validate_increments(dtheta, dv)
     n = len(dtheta)
@@ -583,14 +578,14 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     _prepare(t, dtheta, dv, gnss, model, n)
     if not isinstance(initial, NavState):
         raise TypeError(f"initial must be a strapdown.NavState, got {type(initial).__name__}")
-    if not (use_position or use_velocity):
-        raise ValueError("use at least one of GNSS position and velocity (use_position, use_velocity)")
-    choice(vertical, sorted(VERTICAL_MODES), "vertical")
-    href, vuref = _reference(h_ref, "h_ref", n + 1), _reference(vu_ref, "vu_ref", n + 1)
-    if vertical != "free" and h_ref is None:
-        raise ValueError(f"vertical={vertical!r} needs h_ref")
-    positive(damping_tau, "damping_tau", "{name} must be a positive finite time constant (s), got {value!r}")
-    gains = vertical_damping_gains(damping_tau, initial.lat, initial.h) if vertical == "damped" else np.zeros(3)
+    use = _gnss_rows_used(use)
+    vc = vertical_channel(vertical)
+    href, vuref = _reference(vc.h_ref, "h_ref", n + 1), _reference(vc.vu_ref, "vu_ref", n + 1)
+    gains = vc.gains(initial.lat, initial.h)
+    opt = CL.resolve_options(options, dict(store_nav=True, store_P=False, workers=1))
+    if opt.smoother is not None or opt.record_every != 1:
+        raise ValueError("closed_loop records every epoch and has no smoother (options.smoother, options.record_every): "
+                         "chen2019.simulation.run_batch has both")
     P0 = model.P0() if P0 is None else covariance(P0, "P0", model.n)
     R_pos = _gnss_noise(gnss.sigma_pos, "gnss.sigma_pos")
     R_vel = _gnss_noise(gnss.sigma_vel, "gnss.sigma_vel")
@@ -614,26 +609,42 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
             np.asarray(true_params, float), (m_ep, n_aug))
     else:
         tst, tq, tp = np.zeros((m_ep, 6)), np.zeros((m_ep, 4)), np.zeros((m_ep, n_aug))
-    spec = CL.build_spec(model, R_pos=R_pos, R_vel=R_vel,
-                         lever_arm_b=gnss.lever_arm_b, use_position=use_position, use_velocity=use_velocity,
-                         vmode=VERTICAL_MODES[vertical], gains=gains, series_order=series_order, nees=compute_nees)
+    rows = CL.GnssRows(R_pos=R_pos if "position" in use else None, R_vel=R_vel if "velocity" in use else None,
+                       lever_arm_b=gnss.lever_arm_b)
+    spec = CL.build_spec(model, gnss=rows, vmode=vc.code, gains=gains, nees=compute_nees, options=opt)
     state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], gnss.lever_arm_b)
-    rec = CL.run(spec, state, P0, idx, n, _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp),
-                 store_nav=store_nav, store_P=store_P, workers=1)
-    nm = 3 * (int(use_position) + int(use_velocity))
+    rec = CL.run(spec, state, P0, idx, n, _single_run_inputs(t, dtheta, dv, (href, vuref), idx, gnss, (tst, tq, tp)),
+                 options=opt)
+    nm = 3 * len(use)
     sol = None
-    if store_nav:
+    if opt.store_nav:
         sol = NavSolution(t, rec.nav_st[0, :, 0], rec.nav_st[0, :, 1], rec.nav_st[0, :, 2], rec.nav_st[0, :, 3:6],
                           rec.nav_q[0])
     return ClosedLoopResult(model, t[idx], rec.st[0], rec.q[0], rec.p_hat[0], rec.pdiag_all, rec.innov[0, :, :nm],
-                            rec.nis[0], rec.nees[0] if compute_nees else None, rec.P if store_P else None, sol)
+                            rec.nis[0], rec.nees[0] if compute_nees else None, rec.P if opt.store_P else None, sol)
 
 
-def _single_run_inputs(t, dtheta, dv, href, vuref, idx, gnss, tst, tq, tp):
+def _gnss_rows_used(use) -> tuple:
+    """``use`` of :func:`closed_loop` checked: a non-empty set of :data:`GNSS_ROWS`, in that order."""
+    if isinstance(use, str):
+        use = (use,)
+    try:
+        names = list(use)
+    except TypeError:
+        raise TypeError(f"use must be a sequence of {GNSS_ROWS}, got {use!r}") from None
+    for u in names:
+        choice(u, GNSS_ROWS, "use")
+    if not names:
+        raise ValueError(f"use at least one of the GNSS rows {GNSS_ROWS} (use)")
+    return tuple(u for u in GNSS_ROWS if u in names)
+
+
+def _single_run_inputs(t, dtheta, dv, vertical, idx, gnss, truth):
     """The :class:`replication.nav.closedloop.ChunkInputs` of one recorded run, chunk by chunk."""
+    tst, tq, tp = truth
     return CL.array_inputs(t, np.asarray(dtheta)[None], np.asarray(dv)[None], idx,
-                           gpos=np.asarray(gnss.position, dtype=float)[None],
-                           gvel=np.asarray(gnss.v_enu, dtype=float)[None], h_ref=href, vu_ref=vuref,
+                           gnss=(np.asarray(gnss.position, dtype=float)[None],
+                                 np.asarray(gnss.v_enu, dtype=float)[None]), vertical=vertical,
                            truth=(tst, tq, np.asarray(tp)[None]), n_aug=np.shape(tp)[1])
 
 
@@ -774,14 +785,14 @@ def _batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref):
     tst = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
     tq = dcm_to_quat(euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2]))
     tp = np.broadcast_to(p_true[:, None, :], (n_runs, len(idx), n_aug))
-    return CL.array_inputs(traj.t, dth, dvv, idx, gpos=np.stack([g.position for g in gn]),
-                           gvel=np.stack([np.asarray(g.v_enu, float) for g in gn]), h_ref=href, vu_ref=vuref,
-                           truth=(tst, tq, tp), n_aug=n_aug)
+    return CL.array_inputs(traj.t, dth, dvv, idx, gnss=(np.stack([g.position for g in gn]),
+                                                        np.stack([np.asarray(g.v_enu, float) for g in gn])),
+                           vertical=(href, vuref), truth=(tst, tq, tp), n_aug=n_aug)
 
 
 def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gnss_rate_hz: float = 10.0,
-                sigma_pos=(0.03, 0.03, 0.1), sigma_vel=0.03, vertical: str = "free", workers: int = 2,
-                h_ref=None, vu_ref=None, executor=None, chunk_runs=None, progress=None) -> MonteCarloResult:
+                sigma_pos=(0.03, 0.03, 0.1), sigma_vel=0.03, vertical: VerticalChannel | str = "free",
+                workers: int = 2, executor=None, chunk_runs=None, progress=None) -> MonteCarloResult:
     """Monte Carlo of the closed-loop filter along ``traj``: per run, random-constant sensor errors
     drawn from the blocks' ``sd`` (accel_bias and gyro_bias, random constants, and no other block: a
     block the simulated data would not carry is refused), white noise from the model's
@@ -816,15 +827,10 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
         and the filter's.
     sigma_vel : float or array_like, shape (3,), optional
         GNSS velocity noise standard deviation (E, N, U) [m/s], positive.
-    vertical : str, optional
-        Vertical-channel mode, as in :func:`closed_loop`, default ``"free"`` (``"damped"`` uses a
-        100 s time constant).
+    vertical : VerticalChannel or str, optional
+        The vertical channel, as in :func:`closed_loop`, default free.
     workers : int, optional
         Threads for the runs that follow run 0 (within each chunk when chunked), default 2.
-    h_ref : float or array_like, shape (N + 1,), optional
-        Reference height [m] per sample for the vertical channel, as in :func:`closed_loop`.
-    vu_ref : float or array_like, shape (N + 1,), optional
-        Reference vertical velocity [m/s] per sample, default zero.
     executor : concurrent.futures.Executor or None
         Where the chunks run; ``None`` with ``chunk_runs=None``: the one in-process batch.
     chunk_runs : int or None
@@ -845,7 +851,7 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     TypeError
         For a ``traj`` or ``model`` of the wrong type.
     ValueError
-        For invalid counts, rates or noises, or a vertical mode without ``h_ref``.
+        For invalid counts, rates or noises, or vertical references of the wrong length.
     KeyError
         For a model without an ``accel_bias`` or a ``gyro_bias`` block.
     """
@@ -857,7 +863,7 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     if seed is not None:
         integer(seed, "seed", 0, "{name} must be a non-negative integer (the SeedSequence entropy), got {value!r}")
     workers = integer(workers, "workers")
-    choice(vertical, sorted(VERTICAL_MODES), "vertical")
+    vertical = vertical_channel(vertical)
     positive(gnss_rate_hz, "gnss_rate_hz", "{name} must be a positive finite rate (Hz), got {value!r}")
     _gnss_noise(sigma_pos, "sigma_pos"), _gnss_noise(sigma_vel, "sigma_vel")
     for need in ("accel_bias", "gyro_bias"):
@@ -871,11 +877,8 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
                          f"model's other blocks {others} would be estimated against truths the data do not carry "
                          "(use a model_15 model here; chen2019.simulation.run_batch simulates the extended models)")
     n = traj.n
-    _reference(h_ref, "h_ref", n + 1), _reference(vu_ref, "vu_ref", n + 1)
-    if vertical != "free" and h_ref is None:
-        raise ValueError(f"vertical={vertical!r} needs h_ref")
-    opts = dict(gnss_rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, vertical=vertical,
-                h_ref=h_ref, vu_ref=vu_ref)
+    _reference(vertical.h_ref, "h_ref", n + 1), _reference(vertical.vu_ref, "vu_ref", n + 1)
+    opts = dict(gnss_rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, vertical=vertical)
     if executor is None and chunk_runs is None:
         return _monte_carlo_batch(traj, model, np.random.SeedSequence(seed).spawn(n_runs), workers=workers,
                                   progress=progress, **opts)
@@ -901,23 +904,23 @@ def _monte_carlo_chunk(traj, model, entropy, workers, opts, r0, r1) -> MonteCarl
 
 
 def _monte_carlo_batch(traj, model, seeds, *, gnss_rate_hz, sigma_pos, sigma_vel, vertical, workers,
-                       h_ref, vu_ref, progress=False) -> MonteCarloResult:
+                       progress=False) -> MonteCarloResult:
     """One batch of :func:`monte_carlo` over the runs of ``seeds`` (arguments validated), the first leading;
     ``progress``: a bar of the IMU steps filtered (in this process; a chunk on an executor shows none)."""
     n_runs = len(seeds)
     R_pos, R_vel = _gnss_noise(sigma_pos, "sigma_pos"), _gnss_noise(sigma_vel, "sigma_vel")
     n = traj.n
-    href, vuref = _reference(h_ref, "h_ref", n + 1), _reference(vu_ref, "vu_ref", n + 1)
+    href, vuref = _reference(vertical.h_ref, "h_ref", n + 1), _reference(vertical.vu_ref, "vu_ref", n + 1)
     p_true, dth, dvv, gn, st0, q0 = _draw_runs(traj, model, seeds, gnss_rate_hz, sigma_pos, sigma_vel, workers)
     g0 = gn[0]
     idx = np.asarray(g0.index, np.int64)
-    gains = vertical_damping_gains(100.0, traj.lat[0], traj.h[0]) if vertical == "damped" else np.zeros(3)
-    spec = CL.build_spec(model, R_pos=R_pos, R_vel=R_vel,
-                         lever_arm_b=g0.lever_arm_b, vmode=VERTICAL_MODES[vertical], gains=gains, nees=True)
+    gains = vertical.gains(traj.lat[0], traj.h[0])
+    spec = CL.build_spec(model, gnss=CL.GnssRows(R_pos, R_vel, g0.lever_arm_b), vmode=vertical.code, gains=gains,
+                         nees=True)
     with PAR.progress_bar(n, f"Monte Carlo, {n_runs} runs", progress, unit="step") as bar:
         rec = CL.run(spec, CL.initial_batch_state(st0, q0, g0.lever_arm_b), model.P0(), idx, n,
                      CL.counting_inputs(_batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref), bar),
-                     store_P=False, workers=workers)
+                     options=CL.Options(store_P=False, workers=workers))
     return MonteCarloResult(
         t_epoch=traj.t[idx],
         nees=rec.nees,

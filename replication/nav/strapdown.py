@@ -28,8 +28,8 @@ from replication.nav import earth
 from replication.nav._validate import choice, matrix3, numeric, positive, rotation, vector3
 from replication.nav.rotations import attitude_error, dcm_to_euler, dcm_to_quat, euler_to_dcm, quat_to_dcm, skew
 
-__all__ = ["NavState", "NavSolution", "mechanize", "navigation_rates", "vertical_damping_gains",
-           "validate_time", "validate_increments", "VERTICAL_MODES"]
+__all__ = ["NavState", "NavSolution", "VerticalChannel", "vertical_channel", "mechanize", "navigation_rates",
+           "vertical_damping_gains", "validate_time", "validate_increments", "VERTICAL_MODES"]
 
 VERTICAL_MODES = {"free": 0, "hold": 1, "damped": 2}
 
@@ -315,11 +315,96 @@ def _ref(arr, n, name):
     return a
 
 
+@dataclass(frozen=True, eq=False)
+class VerticalChannel:
+    """The vertical channel of a mechanization: free, held to a reference, or damped on it.
+
+    One description serves :func:`mechanize`, :func:`replication.nav.kalman.closed_loop` and
+    :func:`replication.nav.kalman.monte_carlo`.  The references are checked against the number of
+    samples where they are used.
+
+    Attributes
+    ----------
+    mode : {"free", "hold", "damped"}
+        Free; held (height and vertical speed set to ``h_ref`` and ``vu_ref`` after every step,
+        the papers' height channel held to the true height); or damped (third-order loop on
+        ``h_ref``, e.g. a barometric height, with all poles at -1/``damping_tau``,
+        :func:`vertical_damping_gains`).
+    h_ref : float or array_like, shape (N+1,), optional
+        Reference height (m) at the samples; required by "hold" and "damped".
+    vu_ref : float or array_like, shape (N+1,), optional
+        Reference vertical speed (m/s) at the samples (default 0).
+    damping_tau : float
+        Time constant (s) of the damped loop, default 100.
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``mode``, a mode other than "free" without ``h_ref``, or a damping time
+        constant that is not positive and finite.
+    """
+
+    mode: str = "free"
+    h_ref: object = None
+    vu_ref: object = None
+    damping_tau: float = 100.0
+
+    def __post_init__(self):
+        choice(self.mode, sorted(VERTICAL_MODES), "vertical mode")
+        positive(self.damping_tau, "damping_tau", "{name} must be a positive finite time constant (s), got {value!r}")
+        if self.mode != "free" and self.h_ref is None:
+            raise ValueError(f"the {self.mode!r} vertical channel needs h_ref (reference heights at the N+1 samples): "
+                             f"VerticalChannel({self.mode!r}, h_ref=...)")
+
+    @property
+    def code(self) -> int:
+        """The mode's code in the compiled loops (:data:`VERTICAL_MODES`)."""
+        return VERTICAL_MODES[self.mode]
+
+    def gains(self, lat: float, h: float) -> np.ndarray:
+        """The loop gains at (``lat``, ``h``): :func:`vertical_damping_gains` when damped, else zeros.
+
+        Parameters
+        ----------
+        lat : float
+            Latitude (rad).
+        h : float
+            Height (m).
+
+        Returns
+        -------
+        numpy.ndarray, shape (3,)
+            [k1 (1/s), k2 (1/s²), k3 (1/s³)].
+        """
+        return vertical_damping_gains(self.damping_tau, lat, h) if self.mode == "damped" else np.zeros(3)
+
+
+def vertical_channel(value, name: str = "vertical") -> VerticalChannel:
+    """``value`` as a :class:`VerticalChannel`: one already, or a mode name (``"free"``, ...).
+
+    Parameters
+    ----------
+    value : VerticalChannel or str
+        The channel, or the name of a mode that needs no reference.
+    name : str, optional
+        The argument's name in the error message.
+
+    Returns
+    -------
+    VerticalChannel
+    """
+    if isinstance(value, VerticalChannel):
+        return value
+    if isinstance(value, str):
+        return VerticalChannel(value)
+    raise TypeError(f"{name} must be a strapdown.VerticalChannel or a mode name ('free'), got {type(value).__name__}")
+
+
 _UNUSED = np.zeros(1)   # the reference arrays of a mode that does not read them
 
 
-def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref=None, vu_ref=None,
-              damping_tau: float = 100.0, polar_limit_deg: float = earth.POLAR_LIMIT_DEG) -> NavSolution:
+def mechanize(t, dtheta, dv, initial: NavState, *, vertical: VerticalChannel | str = "free",
+              polar_limit_deg: float = earth.POLAR_LIMIT_DEG) -> NavSolution:
     """Integrate IMU increments with the ENU strapdown algorithm (chen2019 eq. (3-2)).
 
     The update of the module docstring, one step per increment, compiled
@@ -344,17 +429,9 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
         Accelerometer increments Δv (m/s) in the body frame, over the same intervals.
     initial : NavState
         The navigation state at t[0].
-    vertical : {"free", "hold", "damped"}, optional
-        The vertical channel: free; held (height and vertical speed set to ``h_ref`` and
-        ``vu_ref`` after every step, the papers' height channel held to the true height); or
-        damped (third-order loop on ``h_ref``, e.g. a barometric height, with all poles at
-        -1/``damping_tau``, :func:`vertical_damping_gains`).
-    h_ref : float or array_like, shape (N+1,), optional
-        Reference height (m) at the samples; required by "hold" and "damped".
-    vu_ref : float or array_like, shape (N+1,), optional
-        Reference vertical speed (m/s) at the samples for "hold" (default 0).
-    damping_tau : float, optional
-        Time constant (s) of the damped loop.
+    vertical : VerticalChannel or str, optional
+        The vertical channel (:class:`VerticalChannel`), default free; e.g.
+        ``VerticalChannel("hold", h_ref=traj.h)``.
     polar_limit_deg : float, optional
         Largest |latitude| (degrees) accepted for the initial state and reached by the solution.
 
@@ -374,11 +451,10 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
     t, dt = _time_steps(t, n, "t")
     if not isinstance(initial, NavState):
         raise TypeError("initial must be a NavState (e.g. Trajectory.initial_state())")
-    choice(vertical, sorted(VERTICAL_MODES), "vertical")
+    vc = vertical_channel(vertical)
+    h_ref, vu_ref = vc.h_ref, vc.vu_ref
     initial.validate(name="initial", polar_limit_deg=polar_limit_deg)
-    if vertical in ("hold", "damped"):
-        if h_ref is None:
-            raise ValueError(f"vertical={vertical!r} needs h_ref (reference heights at the N+1 samples)")
+    if vc.mode in ("hold", "damped"):
         if np.ndim(h_ref) and len(h_ref) != n + 1:
             raise ValueError(f"h_ref has {len(h_ref)} values; it needs one per sample ({n + 1})")
         href = _ref(h_ref, n + 1, "h_ref")
@@ -390,12 +466,12 @@ def mechanize(t, dtheta, dv, initial: NavState, *, vertical: str = "free", h_ref
             raise ValueError(f"vu_ref has {len(vu_ref)} values; it needs one per sample ({n + 1})")
         vuref = _ref(vu_ref, n + 1, "vu_ref")
     else:
-        vuref = np.zeros(n + 1) if vertical == "hold" else _UNUSED
-    gains = vertical_damping_gains(damping_tau, initial.lat, initial.h) if vertical == "damped" else np.zeros(3)
+        vuref = np.zeros(n + 1) if vc.mode == "hold" else _UNUSED
+    gains = vc.gains(initial.lat, initial.h)
     q0 = dcm_to_quat(initial.C_bn)
     out_st = np.empty((n + 1, 6))
     out_q = np.empty((n + 1, 4))
-    bad = K.strapdown_kernel(dt, dtheta, dv, initial.vector(), q0, VERTICAL_MODES[vertical], href, vuref, gains,
+    bad = K.strapdown_kernel(dt, dtheta, dv, initial.vector(), q0, vc.code, href, vuref, gains,
                              out_st, out_q, np.radians(polar_limit_deg))
     if bad >= 0:
         raise ValueError(f"the solution reaches latitude {np.degrees(out_st[bad, 0]):.4f}° at t = {t[bad]:.3f} s, "

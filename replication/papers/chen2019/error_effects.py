@@ -32,7 +32,7 @@ import pandas as pd
 from replication.nav import parallel as PAR
 from replication.nav import trajectory as tr
 from replication.nav.sensors import ImuErrors, TriadErrors, apply_imu_errors
-from replication.nav.strapdown import mechanize
+from replication.nav.strapdown import VerticalChannel, mechanize
 from replication.nav.units import ARCSEC, DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G, PPM, UG_PER_SQRT_HZ
 
 __all__ = ["consequence_flight", "single_errors", "error_features", "error_effects", "classify", "CONSEQUENCE_RULES"]
@@ -150,7 +150,7 @@ def error_features(traj, errors: ImuErrors, *, seed=0) -> dict:
     if not isinstance(errors, ImuErrors):
         raise TypeError("errors must be a replication.nav.sensors.ImuErrors")
     dth, dv, _ = apply_imu_errors(traj.t, traj.dtheta, traj.dv, errors, rng=seed)
-    sol = mechanize(traj.t, dth, dv, traj.initial_state(), vertical="hold", h_ref=traj.h)
+    sol = mechanize(traj.t, dth, dv, traj.initial_state(), vertical=VerticalChannel("hold", h_ref=traj.h))
     e = sol.errors_against(traj)
     hor = np.hypot(e["east"], e["north"])
     half = len(hor) // 2

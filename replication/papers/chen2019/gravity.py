@@ -1095,7 +1095,8 @@ def direct_difference_from_filter(result, dv, t, gnss, *, cutoff_period: float) 
     """
     sol = result.solution
     if sol is None:
-        raise ValueError("the run must store the navigation solution (closed_loop(..., store_nav=True))")
+        raise ValueError("the run must store the navigation solution (closed_loop stores it unless options.store_nav "
+                         "is False)")
     idx = np.asarray(gnss.index)
     step = int(np.median(np.diff(idx)))
     dt_imu = np.diff(t)
@@ -1761,8 +1762,8 @@ def _discrete_gravity_steps(model, gblk, gs, discrete, sf_interval, m, n_epochs:
 def _augmented_filter_inputs(t, dtheta, dv, idx, gnss, n_aug: int, windows, ar_tick):
     """The :class:`replication.nav.closedloop.ChunkInputs` of :func:`augmented_filter`, chunk by chunk."""
     return CL.array_inputs(t, np.asarray(dtheta)[None], np.asarray(dv)[None], idx,
-                           gpos=np.asarray(gnss.position, dtype=float)[None],
-                           gvel=np.asarray(gnss.v_enu, dtype=float)[None], windows=windows, ar_tick=ar_tick,
+                           gnss=(np.asarray(gnss.position, dtype=float)[None],
+                                 np.asarray(gnss.v_enu, dtype=float)[None]), windows=windows, ar_tick=ar_tick,
                            n_aug=n_aug)
 
 
@@ -1853,10 +1854,11 @@ def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float 
         win_end[:] = -1
     R_pos = np.diag(np.broadcast_to(np.asarray(gnss.sigma_pos, float), (3,)) ** 2)
     R_vel = np.diag(np.broadcast_to(np.asarray(gnss.sigma_vel, float), (3,)) ** 2)
-    spec = CL.build_spec(model, R_pos=R_pos, R_vel=R_vel, series_order=series_order,
-                         ar=(Tg, Qg) if discrete is not None else None, sf_H=Hg)
+    opt = CL.Options(store_nav=True, store_P=False, workers=1, series_order=series_order)
+    spec = CL.build_spec(model, gnss=CL.GnssRows(R_pos, R_vel), ar=(Tg, Qg) if discrete is not None else None, sf_H=Hg,
+                         options=opt)
     inputs = _augmented_filter_inputs(t, dtheta, dv, idx, gnss, model.n - 9, (wgt, win, win_end, a_g, R_sf), ar_tick)
     state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], np.zeros(3))
-    rec = CL.run(spec, state, P0, idx, n, inputs, store_nav=True, store_P=False, workers=1)
+    rec = CL.run(spec, state, P0, idx, n, inputs, options=opt)
     return NavSolution(t, rec.nav_st[0, :, 0], rec.nav_st[0, :, 1], rec.nav_st[0, :, 2], rec.nav_st[0, :, 3:6],
                        rec.nav_q[0])

@@ -60,7 +60,7 @@ from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import errors as E
 from replication.nav import parallel as PAR
-from replication.nav._validate import choice, probability
+from replication.nav._validate import choice, integer, probability
 from replication.nav.rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from replication.nav.sensors import gauss_markov_coefficients, gauss_markov_recursion, lever_arm_offset, misalignment_matrix
 from replication.nav.trajectory import chen2019_flight, generate
@@ -689,7 +689,7 @@ class BatchResult:
         Parameters
         ----------
         smoothed : bool
-            Subtract the RTS estimate ê^s (needs ``run_batch(..., smoother=True)``).
+            Subtract the RTS estimate ê^s (needs ``run_batch(..., options=closedloop.Options(smoother=True))``).
 
         Returns
         -------
@@ -704,7 +704,7 @@ class BatchResult:
         e = np.concatenate([self.nav_err, self.p_true - self.p_hat], axis=-1)
         if smoothed:
             if self.ds is None:
-                raise ValueError("run_batch(..., smoother=True) to get smoothed errors")
+                raise ValueError("run_batch(..., options=closedloop.Options(smoother=True)) to get smoothed errors")
             e = e - self.ds
         return e
 
@@ -714,7 +714,7 @@ class BatchResult:
         Parameters
         ----------
         smoothed : bool
-            The RTS-smoothed estimates (needs ``run_batch(..., smoother=True)``).
+            The RTS-smoothed estimates (needs ``run_batch(..., options=closedloop.Options(smoother=True))``).
 
         Returns
         -------
@@ -729,7 +729,7 @@ class BatchResult:
         if not smoothed:
             return self.p_hat
         if self.ds is None:
-            raise ValueError("run_batch(..., smoother=True) to get smoothed estimates")
+            raise ValueError("run_batch(..., options=closedloop.Options(smoother=True)) to get smoothed estimates")
         return self.p_hat + self.ds[..., 9:]
 
     def sigma(self, smoothed: bool = False) -> np.ndarray:
@@ -752,7 +752,7 @@ class BatchResult:
         """
         P = self.P_s if smoothed else self.P
         if P is None:
-            raise ValueError("no smoothed covariance: run_batch(..., smoother=True)")
+            raise ValueError("no smoothed covariance: run_batch(..., options=closedloop.Options(smoother=True))")
         return np.sqrt(np.diagonal(P, axis1=1, axis2=2))
 
 
@@ -762,11 +762,13 @@ def _check_traj(traj, setup):
         raise ValueError(f"the trajectory must be sampled at the setup's IMU rate {setup.imu_rate_hz} Hz")
 
 
+#: :func:`run_batch`'s defaults of the fields of ``options`` left unset.
+BATCH_DEFAULTS = dict(record_every=20, chunk_epochs=1000)
+
+
 def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int = 20, seed: int = 0,
-              chunk_epochs: int = 1000, record_every: int = 20, smoother: bool = False,
-              smoother_covariance: bool = True, prior_covariance: bool = False, first_run: int = 0,
-              fixed_constants: bool = False, series_order: int = 4, workers: int = 2,
-              smoother_form: str = "mbf", executor=None, chunk_runs=None, progress=None) -> BatchResult:
+              first_run: int = 0, fixed_constants: bool = False, options: CL.Options | None = None, executor=None,
+              chunk_runs=None, progress=None) -> BatchResult:
     """Monte Carlo of the closed-loop INS/GNSS filter of ``model`` on ``traj`` with the truth of ``setup``.
 
     The truth: chen2019 eq. (2-10) sensor errors, eq. (2-12) gravity disturbance, eq. (2-13)
@@ -793,33 +795,22 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
         Number of Monte Carlo runs (≥ 1).
     seed : int
         Seed of the runs' random streams.
-    chunk_epochs : int
-        GNSS epochs per chunk of the forward pass (≥ 2); the smoother replays the lead's forward
-        pass chunk by chunk from checkpoints.
-    record_every : int
-        Record every ``record_every``-th GNSS epoch (20 → 1 Hz at 20-Hz GNSS).
-    smoother : bool
-        Add the fixed-interval smoother pass.
-    smoother_covariance : bool
-        Compute the smoothed covariance P^s; ``False`` keeps only the smoothed states.
-    prior_covariance : bool
-        Propagate the covariance without measurements as well (``P_bar``, for
-        :func:`observable_nees`).
     first_run : int
         Number of the first run (≥ 0).
     fixed_constants : bool
         Set every random constant (bias, drift, scale factors, misalignments) to its printed value
         (+σ on every axis) instead of drawing it — the reading of Table 4-41 under which the ranges
         stated for Fig. 4-14 make sense; the NEES Monte Carlo draws them.
-    series_order : int
-        Order of the series of the Van Loan discretization of Φ and Q_d
-        (:func:`replication.nav.closedloop.build_spec`).
-    workers : int
-        Threads of the compiled passes.
-    smoother_form : str
-        The backward recursion of :func:`replication.nav.closedloop.run`: ``"mbf"`` (modified
-        Bryson-Frazier) or ``"rts"`` (Rauch-Tung-Striebel covariance form), the same results to
-        rounding.
+    options : replication.nav.closedloop.Options, optional
+        How the filter runs (:class:`replication.nav.closedloop.Options`): ``record_every``
+        (default 20: 1 Hz at 20-Hz GNSS), ``chunk_epochs`` (GNSS epochs per chunk of the forward
+        pass, default 1000; the smoother replays the lead's forward pass chunk by chunk from
+        checkpoints), ``smoother`` (a :class:`replication.nav.closedloop.Smoother`: the
+        fixed-interval smoother pass in the modified Bryson-Frazier or the Rauch-Tung-Striebel
+        form, with or without P^s; default none), ``prior_covariance`` (propagate the covariance
+        without measurements as well, ``P_bar``, for :func:`observable_nees`; default False),
+        ``series_order`` (of the Van Loan series of Φ and Q_d, default 4) and ``workers`` (threads
+        of the compiled passes, default 2).
     executor : concurrent.futures.Executor or None
         Where the chunks of runs run, e.g. a ``ProcessPoolExecutor`` or
         ``dask.distributed.Client(...).get_executor()``.
@@ -847,10 +838,9 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
         raise TypeError("model must be a replication.nav.errors.ErrorModel (see filter_model)")
     if not isinstance(setup, SimulationSetup):
         raise TypeError("setup must be a SimulationSetup (see table_4_41_setup)")
-    if int(n_runs) < 1 or int(chunk_epochs) < 2 or int(record_every) < 1:
-        raise ValueError("n_runs ≥ 1, chunk_epochs ≥ 2 and record_every ≥ 1 are required")
+    n_runs = integer(n_runs, "n_runs")
+    opt = CL.resolve_options(options, BATCH_DEFAULTS)
     _check_traj(traj, setup)
-    n_runs, chunk_epochs, record_every = int(n_runs), int(chunk_epochs), int(record_every)
     step = setup.gnss_step
     N = traj.n
     ep_samples = np.arange(step, N + 1, step)
@@ -859,13 +849,12 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
         raise ValueError("the trajectory is shorter than two GNSS epochs")
     if int(first_run) < 0:
         raise ValueError("first_run must be non-negative")
-    opts = dict(seed=seed, chunk_epochs=chunk_epochs, record_every=record_every, smoother=smoother,
-                smoother_covariance=smoother_covariance, prior_covariance=prior_covariance,
-                fixed_constants=fixed_constants, series_order=series_order, smoother_form=smoother_form)
+    kw = dict(seed=seed, fixed_constants=fixed_constants)
     if executor is None and chunk_runs is None:
-        return _run_rows(traj, setup, model, np.arange(int(first_run), int(first_run) + n_runs), workers=workers,
-                         progress=progress, **opts)
-    task = partial(_run_batch_chunk, traj, setup, model, int(first_run), workers if executor is None else 1, opts)
+        return _run_rows(traj, setup, model, np.arange(int(first_run), int(first_run) + n_runs), opt,
+                         progress=progress, **kw)
+    task = partial(_run_batch_chunk, traj, setup, model, int(first_run),
+                   opt if executor is None else replace(opt, workers=1), kw)
     parts = PAR.run_chunks(task, n_runs, executor=executor, chunk_runs=chunk_runs, progress=progress,
                            desc="chen2019 runs")
     out = PAR.concat_runs(parts, [f for f in _BATCH_RUN_FIELDS if getattr(parts[0], f) is not None])
@@ -877,19 +866,18 @@ def run_batch(traj, setup: SimulationSetup, model: E.ErrorModel, *, n_runs: int 
 _BATCH_RUN_FIELDS = ("nav_err", "p_hat", "p_true", "nis", "ds")
 
 
-def _run_batch_chunk(traj, setup, model, first_run, workers, opts, r0, r1) -> BatchResult:
+def _run_batch_chunk(traj, setup, model, first_run, opt, kw, r0, r1) -> BatchResult:
     """Runs ``first_run + r0 … first_run + r1 − 1`` of :func:`run_batch` (a picklable task), led by run
     ``first_run``: recomputed and dropped when ``r0 > 0``."""
     ids = np.arange(first_run + r0, first_run + r1)
     if r0 == 0:
-        return _run_rows(traj, setup, model, ids, workers=workers, **opts)
-    res = _run_rows(traj, setup, model, np.concatenate([[first_run], ids]), workers=workers, **opts)
+        return _run_rows(traj, setup, model, ids, opt, **kw)
+    res = _run_rows(traj, setup, model, np.concatenate([[first_run], ids]), opt, **kw)
     drop = {f: getattr(res, f)[1:] for f in _BATCH_RUN_FIELDS if getattr(res, f) is not None}
     return replace(res, const={k: v[1:] for k, v in res.const.items()}, **drop)
 
 
-def _run_rows(traj, setup, model, run_ids, *, seed, chunk_epochs, record_every, smoother, smoother_covariance,
-              prior_covariance, fixed_constants, series_order, workers, smoother_form, progress=False) -> BatchResult:
+def _run_rows(traj, setup, model, run_ids, opt: CL.Options, *, seed, fixed_constants, progress=False) -> BatchResult:
     """One batch of :func:`run_batch` over the runs numbered ``run_ids`` (arguments validated), the first leading;
     ``progress``: a bar of the IMU steps filtered (in this process; a chunk on an executor shows none)."""
     n_runs = len(run_ids)
@@ -901,15 +889,15 @@ def _run_rows(traj, setup, model, run_ids, *, seed, chunk_epochs, record_every, 
     n = model.n
     n_aug = n - 9
     lever0 = np.asarray(setup.lever_arm_b, float)
-    spec = CL.build_spec(model, R_pos=np.diag(np.asarray(setup.sigma_pos, float) ** 2),
-                         R_vel=np.diag(np.full(3, setup.sigma_vel ** 2)), lever_arm_b=lever0,
-                         series_order=series_order, prior_covariance=prior_covariance)
+    gnss = CL.GnssRows(R_pos=np.diag(np.asarray(setup.sigma_pos, float) ** 2),
+                       R_vel=np.diag(np.full(3, setup.sigma_vel ** 2)), lever_arm_b=lever0)
+    spec = CL.build_spec(model, gnss=gnss, options=opt)
     st, q = truth.initial_states()
     idx = ep_samples
     truth_st = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
     truth_q = dcm_to_quat(euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2]))
     dtv = np.diff(traj.t)
-    rec_ep = np.nonzero((np.arange(n_ep) + 1) % record_every == 0)[0]
+    rec_ep = np.nonzero((np.arange(n_ep) + 1) % opt.record_every == 0)[0]
     rec_pos = np.full(n_ep, -1, np.int64)
     rec_pos[rec_ep] = np.arange(len(rec_ep))
     procs_rec = {k: np.empty((n_runs, len(rec_ep), 3)) for k in ("gyro_markov", "accel_markov", "gravity")}
@@ -925,13 +913,12 @@ def _run_rows(traj, setup, model, run_ids, *, seed, chunk_epochs, record_every, 
             pos = rec_pos[j0:j0 + len(eps)]
             for k in procs_rec:
                 procs_rec[k][:, pos[pos >= 0]] = procs[k][:, pos >= 0]
-        return CL.chunk_inputs(dtv[k0:k1], dth, dvv, np.asarray(eps) - 1 - k0, gpos=gpos, gvel=gvel, n_aug=n_aug)
+        return CL.chunk_inputs(dtv[k0:k1], dth, dvv, np.asarray(eps) - 1 - k0, gnss=(gpos, gvel), n_aug=n_aug)
 
     with PAR.progress_bar(N, f"chen2019, {len(run_ids)} runs", progress, unit="step") as bar:
         rec = CL.run(spec, CL.initial_batch_state(st, q, lever0), model.P0(), ep_samples, N,
                      CL.counting_inputs(inputs, bar), lead_inputs=lambda ci, k0, k1, eps: inputs(ci, k0, k1, eps, runs=1),
-                     record_every=record_every, chunk_epochs=chunk_epochs, smoother=smoother,
-                     smoother_covariance=smoother_covariance, smoother_form=smoother_form, workers=workers)
+                     options=opt)
     nav_err = navigation_errors(rec.st, rec.q, truth_st[rec_ep], truth_q[rec_ep])
     p_true = truth_parameters(model, truth.const, procs_rec)
     return BatchResult(model=model, setup=setup, t=traj.t[ep_samples[rec_ep]], epoch_index=ep_samples[rec_ep],
@@ -1536,7 +1523,7 @@ def figure_4_14_estimates(result: BatchResult, *, smoothed: bool = False, window
     Parameters
     ----------
     result : BatchResult
-        A 45-state run (:func:`run_batch`; ``smoothed`` needs ``smoother=True``).
+        A 45-state run (:func:`run_batch`; ``smoothed`` needs ``options=closedloop.Options(smoother=True)``).
     smoothed : bool
         RTS-smoothed instead of filtered estimates.
     window : float

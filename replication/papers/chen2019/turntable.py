@@ -34,6 +34,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav.trajectory import generate, turntable_chen2019
 from replication.nav.units import DEG, DEG_PER_H, G0
@@ -235,9 +236,9 @@ def run_scenario(traj, setup: S.SimulationSetup, *, n_runs: int = 12, seed: int 
     if not isinstance(setup, S.SimulationSetup):
         raise TypeError("setup must be a SimulationSetup (see tested_imu_setup)")
     m = S.filter_model(model, setup, float(traj.lat[0]), float(traj.h[0]))
-    return S.run_batch(traj, setup, m, n_runs=n_runs, seed=seed, record_every=1, smoother=True,
-                       smoother_covariance=False, chunk_epochs=500, executor=executor, chunk_runs=chunk_runs,
-                       progress=progress)
+    opt = CL.Options(record_every=1, chunk_epochs=500, smoother=CL.Smoother(covariance=False))
+    return S.run_batch(traj, setup, m, n_runs=n_runs, seed=seed, options=opt, executor=executor,
+                       chunk_runs=chunk_runs, progress=progress)
 
 
 def error_std(result, traj, smoothed: bool = True) -> np.ndarray:

@@ -1853,8 +1853,7 @@ def literature_filter(traj, dth, dv, ads, setup, *, every: int = 50, workers: in
     model = literature_filter_model(setup)
     col = model.slices["ads_markov"].start
     ep = _epochs(traj, setup.filter_interval)[1:]
-    spec = CL.build_spec(model, use_position=False, use_velocity=False,
-                         rows=(("air_height", col, setup.sigma_height ** 2),
+    spec = CL.build_spec(model, rows=(("air_height", col, setup.sigma_height ** 2),
                                ("airspeed", col + 1, setup.sigma_airspeed ** 2)))
     init = _initial_state(traj, setup)
     state = CL.initial_batch_state(np.tile(init.vector(), (R, 1)), np.tile(dcm_to_quat(init.C_bn), (R, 1)),
@@ -1863,7 +1862,7 @@ def literature_filter(traj, dth, dv, ads, setup, *, every: int = 50, workers: in
     grid = np.arange(0, traj.n + 1, every)
     on_epochs = bool(np.all(np.isin(grid[1:], ep)))
     rec = CL.run(spec, state, model.P0(), ep, traj.n, CL.array_inputs(traj.t, dth, dv, ep, aux=aux, n_aug=model.n - 9),
-                 store_nav=not on_epochs, store_P=False, workers=workers)
+                 options=CL.Options(store_nav=not on_epochs, store_P=False, workers=workers))
     out = []
     for r in range(R):
         if on_epochs:
