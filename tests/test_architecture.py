@@ -146,7 +146,6 @@ MAX_ARGUMENTS = 12
 # its docstring, with this phrase.
 ARGUED = "not a bundle"
 SIGNATURES_PENDING: set[str] = {
-    "replication.papers.chen2019.models.model_45", "replication.papers.chen2019.models.model_36",
     "replication.nav.kalman.closed_loop", "replication.nav.kalman.monte_carlo",
     "replication.papers.chen2019.simulation.run_batch", "replication.papers.chen2019.simulation._run_rows",
     "replication.papers.chen2019.gravity.compensation_run",
