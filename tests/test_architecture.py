@@ -146,7 +146,6 @@ MAX_ARGUMENTS = 12
 # its docstring, with this phrase.
 ARGUED = "not a bundle"
 SIGNATURES_PENDING: set[str] = {
-    "replication.papers.chen2019.models.model_45", "replication.papers.chen2019.models.model_36",
     "replication.papers.chen2019.gravity.compensation_run",
     "replication.papers.chen2019.gravity.analog_direct_difference",
     "replication.nav.trajectory.generate", "replication.papers.fang2020.polar._run_grid",

@@ -32,6 +32,12 @@ def _state(**kw):
     return strapdown.NavState(**args)
 
 
+def _imu_sd(accel=(), gyro=()):
+    """An ``imu_sd`` of the chen2019 models: the given fields per triad, Markov τ 3600 s unless given."""
+    return sensors.ImuErrors(accel=sensors.TriadErrors(**{"markov_tau": 3600.0, **dict(accel)}),
+                             gyro=sensors.TriadErrors(**{"markov_tau": 3600.0, **dict(gyro)}))
+
+
 def _point(**kw):
     args = dict(lat=LAT, lon=LON, h=H, v_enu=np.array([10.0, 0.0, 0.0]), C_bn=I3,
                 f_b=np.array([0.0, 0.0, 9.8]), w_ib_b=np.zeros(3))
@@ -75,6 +81,12 @@ PROBES = [
     ("model_15(position_sd=-10)", "position_sd", lambda: errors.model_15(position_sd=-10)),
     ("model_15(position_sd=nan)", "position_sd", lambda: errors.model_15(position_sd=np.nan)),
     ("model_45(position_sd=-10)", "position_sd", lambda: models.model_45(position_sd=-10)),
+    ("model_45(imu_sd='abc')", "imu_sd", lambda: models.model_45(imu_sd="abc")),
+    ("model_45(imu_sd with gyro bias σ -1)", "bias", lambda: models.model_45(imu_sd=_imu_sd(gyro=dict(bias=-1.0)))),
+    ("model_45(imu_sd with markov_tau = inf)", "markov_tau", lambda: models.model_45(imu_sd=sensors.ImuErrors())),
+    ("model_36(imu_sd with a misalignment σ)", "misalignment",
+     lambda: models.model_36(imu_sd=_imu_sd(accel=dict(misalignment=1e-5)))),
+    ("model_36(gyro_random_walk_psd=-1)", "gyro_random_walk_psd", lambda: models.model_36(gyro_random_walk_psd=-1.0)),
     ("accel_bias(sd=-1)", "sd", lambda: errors.accel_bias(-1.0)),
     ("ErrorModel(accel_psd=-1)", "accel_psd", lambda: errors.ErrorModel(accel_psd=-1.0)),
     ("kalman.update(R = -0.5 I)", "R", lambda: kalman.update(X2, P2, X2, H2, -0.5 * np.eye(2))),
@@ -507,8 +519,17 @@ _CALLS = {
     "errors.accel_markov": (errors.accel_markov, dict(sigma=1e-3, tau=100.0), {"sigma": "sd", "tau": "rate"}),
     "errors.gravity_shaping": (errors.gravity_shaping, dict(sigma=1e-4, beta=1e-3), {"sigma": "sd", "beta": "rate"}),
     "models.model_45": (models.model_45, dict(),
-                        {"position_sd": "sd", "accel_bias_sd": "sd", "gyro_markov_sigma": "sd",
-                         "gyro_markov_tau": "rate", "gravity_beta": "rate", "lever_arm_sd": "sd", "lat": "lat"}),
+                        {"imu_sd": "object", "position_sd": "sd", "gravity_sigma": "sd", "gravity_beta": "rate",
+                         "lever_arm_sd": "sd", "lat": "lat", "misalignment_coupling": "option"}),
+    "models.model_45, imu_sd.gyro": (lambda **kw: models.model_45(imu_sd=_imu_sd(gyro=kw)), dict(),
+                                     {"bias": "sd", "markov_sigma": "sd", "markov_tau": "rate", "white_psd": "sd",
+                                      "scale": "sd", "misalignment": "sd"}),
+    "models.model_36": (models.model_36, dict(),
+                        {"imu_sd": "object", "accel_random_walk_psd": "sd", "gyro_random_walk_psd": "sd",
+                         "velocity_sd": "sd", "lever_arm_sd": "sd", "h": "h"}),
+    "models.model_36, imu_sd.accel": (lambda **kw: models.model_36(imu_sd=_imu_sd(accel=kw)), dict(),
+                                      {"bias": "sd", "markov_sigma": "sd", "markov_tau": "rate", "white_psd": "sd",
+                                       "scale": "sd"}),
     "kalman.update": (kalman.update, dict(x=X2, P=P2, z=X2, H=H2, R=np.eye(2)),
                       {"x": "vec2", "P": "cov2", "z": "vec2", "H": "mat2", "R": "cov2"}),
     "kalman.predict": (kalman.predict, dict(x=X2, P=P2, Phi=np.eye(2), Qd=np.eye(2)),

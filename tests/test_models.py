@@ -6,6 +6,7 @@ import pytest
 
 from replication.nav import errors as E
 from replication.nav import trajectory as tr
+from replication.nav.sensors import ImuErrors, TriadErrors
 from replication.nav.units import DEG
 from replication.papers.chen2019 import models as M
 
@@ -18,9 +19,16 @@ def maneuvering():
     return tr.generate(segs, 47 * DEG, 115 * DEG, 6000.0, heading=45 * DEG, speed=100.0, dt=0.1)
 
 
+def _imu(accel=(), gyro=()):
+    """An ``imu_sd`` of the models: the given fields per triad, the Markov correlation times 3600 s
+    unless given (the models' default)."""
+    return ImuErrors(accel=TriadErrors(**{"markov_tau": 3600.0, **dict(accel)}),
+                     gyro=TriadErrors(**{"markov_tau": 3600.0, **dict(gyro)}))
+
+
 @pytest.fixture(scope="module")
 def m45():
-    return M.model_45(accel_markov_sigma=5e-4, gyro_markov_sigma=5e-8, gravity_sigma=1e-4, lever_arm_sd=0.1)
+    return M.model_45(imu_sd=_imu(dict(markov_sigma=5e-4), dict(markov_sigma=5e-8)), gravity_sigma=1e-4, lever_arm_sd=0.1)
 
 
 def test_45_state_order_matches_the_text(m45):
@@ -49,6 +57,72 @@ def test_36_state_model_layout():
     F = m.F(p)
     assert np.array_equal(F[:, m.slices["accel_bias"]], F[:, m.slices["accel_random_walk"]])
     assert np.array_equal(F[:, m.slices["gyro_bias"]], F[:, m.slices["gyro_random_walk"]])
+
+
+def _same_model(a, b):
+    """Equal labels, constant F, Q, block codes, P0 and white-noise intensities, bit for bit."""
+    return (a.labels == b.labels and all(np.array_equal(x, y) for x, y in zip(a.kernel_encoding(), b.kernel_encoding()))
+            and np.array_equal(a.P0(), b.P0()) and np.array_equal(a.accel_psd, b.accel_psd)
+            and np.array_equal(a.gyro_psd, b.gyro_psd))
+
+
+def test_imu_sd_fields_enter_their_blocks():
+    """Each field of ``imu_sd`` lands in its block: the 45- and 36-state models equal the ones
+    assembled block by block from the same values; without ``imu_sd`` both Gauss-Markov blocks
+    have τ = 3600 s (their -1/τ is in F whatever their σ, as chapter 04 prints F)."""
+    rng = np.random.default_rng(1)
+
+    def v(scale, n=3):                                   # distinct values per axis and field
+        return scale * rng.uniform(0.5, 2.0, n)
+
+    acc = dict(bias=v(1e-3), markov_sigma=v(1e-4), markov_tau=900.0, white_psd=v(1e-9), scale=v(1e-5))
+    gyr = dict(bias=v(1e-7), markov_sigma=v(1e-8), markov_tau=300.0, white_psd=v(1e-13), scale=v(2e-5))
+    a_mis, g_mis, grav, lever, arw, grw = v(1e-5, 6), v(2e-5, 6), v(1e-4), v(0.1), v(1e-12), v(1e-18)
+    nav = dict(position_sd=v(10.0), velocity_sd=v(0.1), attitude_sd=v(1e-4), lat=0.8, h=6000.0)
+    for coupling in ("eq-2-8", "table-2-2"):
+        sd = ImuErrors(accel=TriadErrors(**acc, misalignment=a_mis), gyro=TriadErrors(**gyr, misalignment=g_mis))
+        m = M.model_45(imu_sd=sd, gravity_sigma=grav, gravity_beta=2e-3, lever_arm_sd=lever,
+                       misalignment_coupling=coupling, **nav)
+        blocks = (E.accel_bias(acc["bias"]), E.accel_markov(acc["markov_sigma"], 900.0), E.accel_scale(acc["scale"]),
+                  E.accel_misalignment(a_mis, coupling=coupling), E.gyro_bias(gyr["bias"]),
+                  E.gyro_markov(gyr["markov_sigma"], 300.0), E.gyro_scale(gyr["scale"]),
+                  E.gyro_misalignment(g_mis, coupling=coupling), E.gravity_shaping(grav, 2e-3), E.lever_arm(lever))
+        ref = E.ErrorModel(blocks=blocks, accel_psd=acc["white_psd"], gyro_psd=gyr["white_psd"], nav_sd=m.nav_sd)
+        assert _same_model(m, ref), coupling
+    m = M.model_36(imu_sd=ImuErrors(accel=TriadErrors(**acc), gyro=TriadErrors(**gyr)), accel_random_walk_psd=arw,
+                   gyro_random_walk_psd=grw, lever_arm_sd=lever, **nav)
+    blocks = (E.accel_bias(acc["bias"]), E.accel_bias(0.0, name="accel_random_walk", random_walk_psd=arw),
+              E.accel_markov(acc["markov_sigma"], 900.0), E.accel_scale(acc["scale"]), E.gyro_bias(gyr["bias"]),
+              E.gyro_bias(0.0, name="gyro_random_walk", random_walk_psd=grw), E.gyro_markov(gyr["markov_sigma"], 300.0),
+              E.gyro_scale(gyr["scale"]), E.lever_arm(lever))
+    assert _same_model(m, E.ErrorModel(blocks=blocks, accel_psd=acc["white_psd"], gyro_psd=gyr["white_psd"],
+                                       nav_sd=m.nav_sd))
+    # the defaults: zero σ, τ = 3600 s for both Markov blocks, β = 1e-3 1/s
+    for model, sd in ((M.model_45(), _imu()), (M.model_36(), _imu())):
+        assert _same_model(model, (M.model_45 if model.n == 45 else M.model_36)(imu_sd=sd))
+        s = model.slices
+        F = model.kernel_encoding()[0]
+        assert np.array_equal(F[s["accel_markov"], s["accel_markov"]], -np.eye(3) / 3600.0)
+        assert np.array_equal(F[s["gyro_markov"], s["gyro_markov"]], -np.eye(3) / 3600.0)
+
+
+def test_one_imu_sd_draws_the_truth_and_builds_the_filter():
+    """``imu_sd`` is read as ``sensors.draw_imu_errors`` reads it: the model's prior σ of the
+    random constants are the σ the realisations are drawn with (the P0 diagonal holds their
+    squares), its Markov and white-noise parameters those copied into the realisation."""
+    from replication.nav.sensors import draw_imu_errors
+    sd = _imu(dict(bias=1e-3, scale=2e-5, misalignment=3e-5, markov_sigma=1e-4, white_psd=1e-9),
+              dict(bias=1e-7, scale=4e-5, misalignment=5e-5, markov_sigma=1e-8, markov_tau=300.0, white_psd=1e-13))
+    m = M.model_45(imu_sd=sd)
+    sig = np.sqrt(np.diag(m.P0()))
+    s = m.slices
+    for kind in ("accel", "gyro"):
+        t = getattr(sd, kind)
+        for field, block in (("bias", "bias"), ("scale", "scale"), ("misalignment", "misalignment"),
+                             ("markov_sigma", "markov")):
+            assert np.allclose(sig[s[f"{kind}_{block}"]], getattr(t, field), rtol=1e-15, atol=0), (kind, field)
+        drawn = getattr(draw_imu_errors(sd, rng=0), kind)
+        assert drawn.markov_tau == t.markov_tau and np.array_equal(drawn.white_psd, getattr(m, f"{kind}_psd"))
 
 
 def test_table_2_3_states_exist_in_the_45_state_model(m45):
@@ -91,7 +165,7 @@ def test_F_matches_numerical_jacobian_along_maneuvers(maneuvering, m45):
 
 def test_augmented_dynamics(m45):
     """Random constants: zero rows; Markov: -1/τ; gravity: -β (eq. (2-12)); lever arm: zero."""
-    m = M.model_45(accel_markov_tau=9000.0, gyro_markov_tau=300.0, gravity_beta=2e-3)
+    m = M.model_45(imu_sd=_imu(dict(markov_tau=9000.0), dict(markov_tau=300.0)), gravity_beta=2e-3)
     p = E.NavPoint(0.8, 2.0, 6000.0, np.array([70.0, 70.0, 0.0]), np.eye(3), np.array([0.0, 0.0, 9.8]), np.zeros(3))
     F = m.F(p)
     s = m.slices
@@ -105,8 +179,9 @@ def test_augmented_dynamics(m45):
 
 
 def test_noise_input_reproduces_G_Qc(maneuvering):
-    m = M.model_45(accel_markov_sigma=5e-4, accel_markov_tau=9000.0, gyro_markov_sigma=5e-8, gyro_markov_tau=300.0,
-                   gravity_sigma=1e-4, gravity_beta=1e-3, accel_psd=2.4e-7, gyro_psd=2.35e-11)
+    sd = _imu(dict(markov_sigma=5e-4, markov_tau=9000.0, white_psd=2.4e-7),
+              dict(markov_sigma=5e-8, markov_tau=300.0, white_psd=2.35e-11))
+    m = M.model_45(imu_sd=sd, gravity_sigma=1e-4, gravity_beta=1e-3)
     C = maneuvering.C_bn[300]
     G, q, lab = M.noise_input(m, C)
     assert G.shape == (45, 15) and len(q) == 15 and len(lab) == 15
@@ -172,14 +247,39 @@ def test_permutation_to_the_extend_order(maneuvering):
 
 
 def test_bad_inputs():
-    with pytest.raises(ValueError, match="non-negative"):
-        M.model_45(gyro_bias_sd=-1.0)
-    with pytest.raises(ValueError, match="tau"):
-        M.model_45(gyro_markov_tau=0.0)
+    with pytest.raises(ValueError, match=r"imu_sd\.gyro\.bias must be finite and non-negative"):
+        M.model_45(imu_sd=_imu(gyro=dict(bias=-1.0)))
+    with pytest.raises(ValueError, match="markov_tau"):
+        M.model_45(imu_sd=_imu(gyro=dict(markov_tau=0.0)))
+    changed = _imu()                                     # a field set after the triad checked its own
+    changed.gyro.markov_tau = 0.0
+    with pytest.raises(ValueError, match=r"imu_sd\.gyro\.markov_tau"):
+        M.model_45(imu_sd=changed)
     with pytest.raises(ValueError, match="6 components"):
-        M.model_45(accel_misalignment_sd=[1.0, 2.0])
+        M.model_45(imu_sd=_imu(dict(misalignment=[1.0, 2.0])))
+    changed = _imu()
+    changed.accel.misalignment = [1.0, 2.0]
+    with pytest.raises(ValueError, match=r"imu_sd\.accel\.misalignment must be a scalar or have 6 components"):
+        M.model_45(imu_sd=changed)
     with pytest.raises(ValueError, match="gravity_beta"):
         M.model_45(gravity_beta=-1.0)
+    # TriadErrors' "no Gauss-Markov process" (τ = inf) cannot give the models' Markov states a τ
+    for model in (M.model_45, M.model_36):
+        with pytest.raises(ValueError, match=r"imu_sd\.accel\.markov_tau is inf.*seconds"):
+            model(imu_sd=ImuErrors(gyro=TriadErrors(markov_tau=600.0)))
+        with pytest.raises(TypeError, match="imu_sd must be a replication.nav.sensors.ImuErrors"):
+            model(imu_sd=dict(accel=TriadErrors(markov_tau=3600.0)))
+        with pytest.raises(TypeError, match=r"imu_sd\.gyro must be a replication.nav.sensors.TriadErrors"):
+            model(imu_sd=ImuErrors(accel=TriadErrors(markov_tau=3600.0), gyro=1e-8))
+        changed = _imu()
+        changed.gyro.white_psd = -1e-14
+        with pytest.raises(ValueError, match=r"imu_sd\.gyro\.white_psd"):
+            model(imu_sd=changed)
+    # the 36-state model has no misalignment states: a misalignment σ is refused, not dropped
+    with pytest.raises(ValueError, match=r"imu_sd\.gyro\.misalignment must be zero for the 36-state model"):
+        M.model_36(imu_sd=_imu(gyro=dict(misalignment=1e-5)))
+    with pytest.raises(ValueError, match="gyro_random_walk_psd"):
+        M.model_36(gyro_random_walk_psd=-1.0)
     with pytest.raises(TypeError, match="ErrorModel"):
         M.state_symbols("45")
     with pytest.raises(ValueError, match="permutation"):
@@ -226,7 +326,7 @@ def test_table_2_2_corrected_blocks_match_the_verified_blocks(maneuvering):
     verified blocks (finite differences / Jacobian-checked F) element by element: within 3e-9 of
     the block scale (Richardson-extrapolated central differences leave ≲ 1e-9, mostly round-off of
     the attitude rows; measured natively and under the perturbed configurations)."""
-    m = M.model_45(accel_markov_tau=9000.0, gyro_markov_tau=300.0)
+    m = M.model_45(imu_sd=_imu(dict(markov_tau=9000.0), dict(markov_tau=300.0)))
     for p in _points(maneuvering):
         Cb = M.table_2_2_corrected(p, accel_markov_tau=9000.0, gyro_markov_tau=300.0)
         Vb = M.table_2_2_verified(m, p)
@@ -250,7 +350,7 @@ def test_printed_table_2_2_differs_exactly_at_the_listed_elements(maneuvering):
     at a generic point the printed blocks differ from the verified ones exactly at these
     elements; every other printed element (F11, F12, F21 but (3,3), F31, F41, F42, F51, F6, F7...)
     agrees within the finite-difference accuracy."""
-    m = M.model_45(accel_markov_tau=9000.0, gyro_markov_tau=300.0)
+    m = M.model_45(imu_sd=_imu(dict(markov_tau=9000.0), dict(markov_tau=300.0)))
     p = _points(maneuvering)[-1]
     diffs = M.table_2_2_differences(m, p)
     flagged = {(d["block"], d["row"], d["col"]) for d in diffs if d["differs"]}
@@ -272,7 +372,7 @@ def test_table_2_2_misalignment_blocks_follow_the_table_coupling():
     p = M.table_2_2_reference_point()
     printed = M.table_2_2_printed(p, accel_markov_tau=3600.0, gyro_markov_tau=600.0)
     for coupling, agree in (("table-2-2", True), ("eq-2-8", False)):
-        m = M.model_45(accel_markov_tau=3600.0, gyro_markov_tau=600.0, misalignment_coupling=coupling)
+        m = M.model_45(imu_sd=_imu(gyro=dict(markov_tau=600.0)), misalignment_coupling=coupling)
         v = M.table_2_2_verified(m, p)
         for b in ("F32", "F33", "F52", "F53"):
             rel = np.max(np.abs(v[b] - printed[b])) / np.max(np.abs(printed[b]))

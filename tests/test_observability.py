@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from replication.nav import trajectory as tr
+from replication.nav.sensors import ImuErrors, TriadErrors
 from replication.papers.chen2019 import findings
 from replication.papers.chen2019 import models as M
 from replication.papers.chen2019 import observability as O
@@ -149,8 +150,9 @@ def test_covariance_observability(flight):
     """√(P0/P): the unexcited accelerometer y scale factor (f_y = 0 at constant speed) keeps
     its prior to 1e-3; velocity errors, measured directly with σ = 0.03 m/s against a prior
     of 1 m/s, shrink by far more than 10."""
-    m = M.model_45(velocity_sd=1.0, accel_bias_sd=5e-4, gyro_bias_sd=5e-8, accel_scale_sd=1e-5,
-                   gyro_scale_sd=1e-5, accel_misalignment_sd=1e-5, gyro_misalignment_sd=1e-5)
+    sd = ImuErrors(accel=TriadErrors(bias=5e-4, scale=1e-5, misalignment=1e-5, markov_tau=3600.0),
+                   gyro=TriadErrors(bias=5e-8, scale=1e-5, misalignment=1e-5, markov_tau=3600.0))
+    m = M.model_45(imu_sd=sd, velocity_sd=1.0)
     keep = m.labels[:9] + M.table_2_3_states()[3:]
     Rm = np.diag([0.03**2, 0.03**2, 0.1**2, 0.03**2, 0.03**2, 0.03**2])
     r = O.covariance_observability(m, flight, 0.0, 180.0, update_interval=2.0, R=Rm, states=keep)
@@ -190,7 +192,9 @@ def test_series_discretization_matches_expm(flight):
     couplings: the truncated terms are below (ω_s T)^8 / 8!)."""
     from replication.nav import errors as E
     from replication.nav.kalman import discretize_series, van_loan
-    m = M.model_45(accel_markov_sigma=1e-4, gyro_markov_sigma=1e-8, gravity_sigma=1e-4, accel_psd=1e-8, gyro_psd=1e-14)
+    sd = ImuErrors(accel=TriadErrors(markov_sigma=1e-4, markov_tau=3600.0, white_psd=1e-8),
+                   gyro=TriadErrors(markov_sigma=1e-8, markov_tau=3600.0, white_psd=1e-14))
+    m = M.model_45(imu_sd=sd, gravity_sigma=1e-4)
     p = E.NavPoint.from_trajectory(flight, 200)
     F, Qc = m.F(p), m.G_Qc(p.C_bn)
     P1, Q1 = discretize_series(F, Qc, 2.0, 8)

@@ -104,9 +104,11 @@ class TriadErrors:
 
     Raises
     ------
+    TypeError
+        For a field that is not a number or an array of numbers (text, ``None``).
     ValueError
-        For a negative ``white_psd`` or ``markov_sigma``, a non-positive ``markov_tau`` or a wrong
-        number of components.
+        For a negative ``white_psd`` or ``markov_sigma``, a ``markov_tau`` that is not one
+        positive number (NaN, zero, an array) or a wrong number of components.
     """
 
     bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -124,8 +126,9 @@ class TriadErrors:
             raise ValueError("white_psd and markov_sigma cannot be negative")
         self.scale = components(self.scale, "scale")
         self.misalignment = components(self.misalignment, "misalignment", 6)
-        if not self.markov_tau > 0:
-            raise ValueError("markov_tau must be positive (seconds; np.inf for none)")
+        tau = numeric(self.markov_tau, "markov_tau")
+        if tau.ndim != 0 or not tau > 0:
+            raise ValueError(f"markov_tau must be one positive number of seconds (np.inf for none), got {self.markov_tau!r:.40}")
 
     @property
     def matrix(self):

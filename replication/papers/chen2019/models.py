@@ -47,9 +47,15 @@ model's order (accelerometer group before gyro group, lever arm last):
     position, velocity, attitude, accel_bias, accel_random_walk, accel_markov, accel_scale,
     gyro_bias, gyro_random_walk, gyro_markov, gyro_scale, lever_arm.
 
+The sensor errors enter both models as one :class:`replication.nav.sensors.ImuErrors` of
+standard deviations and intensities (``imu_sd``, eq. (2-10) per triad), the object
+:func:`replication.nav.sensors.draw_imu_errors` draws a truth from.
+
 Typical use::
 
-    m = models.model_45(accel_bias_sd=..., gyro_bias_sd=..., ...)     # an errors.ErrorModel
+    sd = ImuErrors(accel=TriadErrors(bias=..., markov_sigma=..., markov_tau=..., white_psd=...),
+                   gyro=TriadErrors(bias=..., scale=..., misalignment=..., markov_tau=...))
+    m = models.model_45(imu_sd=sd, position_sd=..., gravity_sigma=...)  # an errors.ErrorModel
     F = m.F(errors.NavPoint.from_trajectory(traj, k))                   # 45 × 45
     G, q, w = models.noise_input(m, C_bn)                               # G (45 × 15), PSDs, labels
     H = models.measurement_matrix(m, point, lever_arm_sins_b)           # 6 × 45, eq. (2-13)
@@ -70,8 +76,9 @@ import pandas as pd
 from replication.nav import earth
 from replication.nav import errors as E
 from replication.nav._kernels import KIND_MISALIGN, coupling_matrix
-from replication.nav._validate import components, numeric, positive
+from replication.nav._validate import choice, components, numeric, positive
 from replication.nav.rotations import euler_to_dcm, rotvec_to_dcm, skew
+from replication.nav.sensors import ImuErrors, TriadErrors
 
 __all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "EXTEND_ORDER_45", "NAV_SYMBOLS", "model_45", "model_36",
            "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
@@ -133,20 +140,43 @@ def _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h):
                            _nonneg(velocity_sd, "velocity_sd"), _nonneg(attitude_sd, "attitude_sd")])
 
 
-def _markov_block(kind, sigma, tau, name):
-    s = _nonneg(sigma, f"{name}_sigma")
-    tau = positive(tau, f"{name}_tau (correlation time)", _SECONDS)
-    return (E.accel_markov if kind == "accel" else E.gyro_markov)(s, tau, name=name)
+_MARKOV_TAU = 3600.0
+"""Correlation time [s] of both Gauss-Markov blocks when ``imu_sd`` is not given."""
+
+
+def _imu_triads(imu_sd):
+    """The (accel, gyro) triads of ``imu_sd``; ``None`` gives zero σ and τ = 3600 s."""
+    if imu_sd is None:
+        return TriadErrors(markov_tau=_MARKOV_TAU), TriadErrors(markov_tau=_MARKOV_TAU)
+    if not isinstance(imu_sd, ImuErrors):
+        raise TypeError("imu_sd must be a replication.nav.sensors.ImuErrors holding the standard deviations and "
+                        f"intensities of the sensor errors (SI units), got {type(imu_sd).__name__} {imu_sd!r:.40}")
+    for kind in ("accel", "gyro"):
+        if not isinstance(getattr(imu_sd, kind), TriadErrors):
+            raise TypeError(f"imu_sd.{kind} must be a replication.nav.sensors.TriadErrors, "
+                            f"got {type(getattr(imu_sd, kind)).__name__}")
+    return imu_sd.accel, imu_sd.gyro
+
+
+def _triad_sd(triad, kind, model):
+    """The fields of one triad of ``imu_sd`` checked as a model's σ and intensities (SI units)."""
+    p = f"imu_sd.{kind}."
+    tau = numeric(triad.markov_tau, p + "markov_tau")
+    if tau.ndim == 0 and np.isposinf(tau):
+        raise ValueError(f"{p}markov_tau is inf (TriadErrors' default: no Gauss-Markov process), but the {model} "
+                         "model carries the Gauss-Markov states, with -1/τ in F whatever their σ: give their "
+                         f"correlation time in seconds (without imu_sd the model uses {_MARKOV_TAU:g} s)")
+    return dict(bias=_nonneg(triad.bias, p + "bias"), markov_sigma=_nonneg(triad.markov_sigma, p + "markov_sigma"),
+                markov_tau=positive(triad.markov_tau, p + "markov_tau (correlation time)", _SECONDS),
+                white_psd=_nonneg(triad.white_psd, p + "white_psd"), scale=_nonneg(triad.scale, p + "scale"),
+                misalignment=_nonneg(triad.misalignment, p + "misalignment", 6))
 
 
 # ----------------------------------------------------------------------------- the models
 
-def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e-4, 1e-4, 1e-3),
-             accel_bias_sd=0.0, accel_markov_sigma=0.0, accel_markov_tau=3600.0, accel_scale_sd=0.0,
-             accel_misalignment_sd=0.0, gyro_bias_sd=0.0, gyro_markov_sigma=0.0, gyro_markov_tau=3600.0,
-             gyro_scale_sd=0.0, gyro_misalignment_sd=0.0, gravity_sigma=0.0, gravity_beta=1e-3,
-             lever_arm_sd=0.0, accel_psd=0.0, gyro_psd=0.0, lat=0.0, h=0.0,
-             misalignment_coupling: str = "eq-2-8") -> E.ErrorModel:
+def model_45(*, imu_sd: ImuErrors | None = None, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1,
+             attitude_sd=(1e-4, 1e-4, 1e-3), gravity_sigma=0.0, gravity_beta=1e-3, lever_arm_sd=0.0, lat=0.0,
+             h=0.0, misalignment_coupling: str = "eq-2-8") -> E.ErrorModel:
     """The 45-state SINS/GNSS error model of chen2019 eqs. (2-14), (2-15) and Table 2-2.
 
     The states are in the text's order (see the module docstring; ``model.labels`` /
@@ -154,54 +184,52 @@ def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
 
     Dynamics: eq. (2-15) with every first-order term (:meth:`replication.nav.errors.ErrorModel.F`);
     random constants (eq. (2-5), (2-6), (2-9)): ẋ = 0; first-order Gauss-Markov biases (eq. (2-5)):
-    ẋ = -x/τ + w with stationary σ (``*_markov_sigma``; driving intensity 2σ²/τ — convert the
-    report's "驱动白噪声方差强度" with :func:`replication.nav.sensors.markov_sigma_from_driving_psd`);
-    gravity disturbance (eqs. (2-11), (2-12)): δġ = -β δg + n per ENU axis with stationary σ
-    (``gravity_sigma``, ``gravity_beta`` = 1/correlation time); lever arm: constant, enters the
-    measurement only (eq. (2-13), :func:`measurement_matrix`).
+    ẋ = -x/τ + w with stationary σ (``markov_sigma`` of a triad; driving intensity 2σ²/τ —
+    convert the report's "驱动白噪声方差强度" with
+    :func:`replication.nav.sensors.markov_sigma_from_driving_psd`); gravity disturbance
+    (eqs. (2-11), (2-12)): δġ = -β δg + n per ENU axis with stationary σ (``gravity_sigma``,
+    ``gravity_beta`` = 1/correlation time); lever arm: constant, enters the measurement only
+    (eq. (2-13), :func:`measurement_matrix`).
 
-    All arguments are SI.  The defaults of the standard deviations are zero (no prior); set them
-    (e.g. from chen2019 Table 4-41 with :mod:`replication.nav.units`) before running a filter.  A
+    The sensor errors come as one :class:`replication.nav.sensors.ImuErrors` of eq. (2-10), read
+    as :func:`replication.nav.sensors.draw_imu_errors` reads it — the same object draws a truth
+    and builds the filter that estimates it.  Per triad (``imu_sd.accel`` in m/s²-based units,
+    ``imu_sd.gyro`` in rad/s-based units), field → block::
+
+        bias          σ of the random constant           → accel_bias / gyro_bias (P0)
+        markov_sigma  stationary σ of the Gauss-Markov   → accel_markov / gyro_markov (P0, Q)
+        markov_tau    its correlation time τ [s]         → -1/τ on the block's diagonal of F
+        white_psd     white-noise intensity              → ErrorModel.accel_psd / gyro_psd (Q)
+        scale         σ of the scale-factor errors       → accel_scale / gyro_scale (P0)
+        misalignment  σ of the six angles (xy, yx, xz, zx, yz, zy) → *_misalignment (P0)
+
+    The Gauss-Markov states are in the model whatever their σ, and their -1/τ in F with them:
+    ``markov_tau`` must be a finite time (``TriadErrors``' default ``inf``, "no process", is
+    refused).
+
+    All arguments are SI.  The standard deviations default to zero (no prior); set them (e.g.
+    from chen2019 Table 4-41 with :mod:`replication.nav.units`) before running a filter.  A
     scalar σ applies to every axis of its block.
 
     Parameters
     ----------
+    imu_sd : replication.nav.sensors.ImuErrors or None, optional
+        Standard deviations and intensities of the accelerometer and gyro errors (table above):
+        bias [m/s² | rad/s], markov_sigma [m/s² | rad/s], markov_tau [s], white_psd
+        [(m/s²)²·s | (rad/s)²·s], scale [1], misalignment [rad].  Default ``None``: every σ and
+        intensity zero, both correlation times 3600 s.
     position_sd : float or array_like, shape (3,)
         Initial position σ, east, north, up [m]; converted to (δL, δλ, δh) at (``lat``, ``h``).
     velocity_sd : float or array_like, shape (3,)
         Initial velocity σ, ENU [m/s].
     attitude_sd : float or array_like, shape (3,)
         Initial attitude σ, φ_E, φ_N, φ_U [rad].
-    accel_bias_sd : float or array_like, shape (3,)
-        Accelerometer random-constant bias σ [m/s²].
-    accel_markov_sigma : float or array_like, shape (3,)
-        Stationary σ of the accelerometer Gauss-Markov bias [m/s²].
-    accel_markov_tau : float
-        Correlation time of the accelerometer Gauss-Markov bias [s].
-    accel_scale_sd : float or array_like, shape (3,)
-        Accelerometer scale-factor error σ [1].
-    accel_misalignment_sd : float or array_like, shape (6,)
-        Accelerometer misalignment-angle σ, order xy, yx, xz, zx, yz, zy [rad].
-    gyro_bias_sd : float or array_like, shape (3,)
-        Gyro random-constant drift σ [rad/s].
-    gyro_markov_sigma : float or array_like, shape (3,)
-        Stationary σ of the gyro Gauss-Markov drift [rad/s].
-    gyro_markov_tau : float
-        Correlation time of the gyro Gauss-Markov drift [s].
-    gyro_scale_sd : float or array_like, shape (3,)
-        Gyro scale-factor error σ [1].
-    gyro_misalignment_sd : float or array_like, shape (6,)
-        Gyro misalignment-angle σ, order xy, yx, xz, zx, yz, zy [rad].
     gravity_sigma : float or array_like, shape (3,)
         Stationary σ of the gravity disturbance per ENU axis [m/s²].
     gravity_beta : float
         Inverse correlation time β of the gravity disturbance [1/s].
     lever_arm_sd : float or array_like, shape (3,)
         σ of the lever-arm error, body frame [m].
-    accel_psd : float or array_like, shape (3,)
-        Accelerometer white-noise intensity (velocity random walk squared) [(m/s²)²/Hz].
-    gyro_psd : float or array_like, shape (3,)
-        Gyro white-noise intensity (angle random walk squared) [(rad/s)²/Hz].
     lat : float
         Latitude at which ``position_sd`` is converted [rad].
     h : float
@@ -218,82 +246,77 @@ def model_45(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
 
     Raises
     ------
+    TypeError
+        When ``imu_sd`` is not an ``ImuErrors`` (or a triad of it not a ``TriadErrors``).
     ValueError
-        When a σ or intensity is negative or not finite, a correlation time or β is not positive,
-        or ``lat``/``h`` is out of range.
+        When a σ or intensity is negative or not finite, a correlation time is not a positive
+        finite number of seconds, β is not positive, ``lat``/``h`` is out of range, or
+        ``misalignment_coupling`` is not one of the two.
     """
     nav_sd = _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h)
+    acc, gyr = _imu_triads(imu_sd)
+    a, g = _triad_sd(acc, "accel", "45-state"), _triad_sd(gyr, "gyro", "45-state")
     beta = positive(gravity_beta, "gravity_beta", _SECONDS)
+    choice(misalignment_coupling, sorted(E.MISALIGNMENT_COUPLINGS), "misalignment_coupling")
     blocks = (
-        E.accel_bias(_nonneg(accel_bias_sd, "accel_bias_sd")),
-        _markov_block("accel", accel_markov_sigma, accel_markov_tau, "accel_markov"),
-        E.accel_scale(_nonneg(accel_scale_sd, "accel_scale_sd")),
-        E.accel_misalignment(_nonneg(accel_misalignment_sd, "accel_misalignment_sd", 6), coupling=misalignment_coupling),
-        E.gyro_bias(_nonneg(gyro_bias_sd, "gyro_bias_sd")),
-        _markov_block("gyro", gyro_markov_sigma, gyro_markov_tau, "gyro_markov"),
-        E.gyro_scale(_nonneg(gyro_scale_sd, "gyro_scale_sd")),
-        E.gyro_misalignment(_nonneg(gyro_misalignment_sd, "gyro_misalignment_sd", 6), coupling=misalignment_coupling),
+        E.accel_bias(a["bias"]),
+        E.accel_markov(a["markov_sigma"], a["markov_tau"]),
+        E.accel_scale(a["scale"]),
+        E.accel_misalignment(a["misalignment"], coupling=misalignment_coupling),
+        E.gyro_bias(g["bias"]),
+        E.gyro_markov(g["markov_sigma"], g["markov_tau"]),
+        E.gyro_scale(g["scale"]),
+        E.gyro_misalignment(g["misalignment"], coupling=misalignment_coupling),
         E.gravity_shaping(_nonneg(gravity_sigma, "gravity_sigma"), beta),
         E.lever_arm(_nonneg(lever_arm_sd, "lever_arm_sd")),
     )
-    m = E.ErrorModel(blocks=blocks, accel_psd=_nonneg(accel_psd, "accel_psd"),
-                     gyro_psd=_nonneg(gyro_psd, "gyro_psd"), nav_sd=nav_sd)
+    m = E.ErrorModel(blocks=blocks, accel_psd=a["white_psd"], gyro_psd=g["white_psd"], nav_sd=nav_sd)
     assert m.n == 45 and tuple(b.name for b in m.blocks) == CHEN2019_45_ORDER
     return m
 
 
-def model_36(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e-4, 1e-4, 1e-3),
-             accel_bias_sd=0.0, accel_random_walk_psd=0.0, accel_markov_sigma=0.0, accel_markov_tau=3600.0,
-             accel_scale_sd=0.0, gyro_bias_sd=0.0, gyro_random_walk_psd=0.0, gyro_markov_sigma=0.0,
-             gyro_markov_tau=3600.0, gyro_scale_sd=0.0, lever_arm_sd=0.0, accel_psd=0.0, gyro_psd=0.0,
+def model_36(*, imu_sd: ImuErrors | None = None, accel_random_walk_psd=0.0, gyro_random_walk_psd=0.0,
+             position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e-4, 1e-4, 1e-3), lever_arm_sd=0.0,
              lat=0.0, h=0.0) -> E.ErrorModel:
     """The 36-state model of chen2019's ref. [35] as the report describes it (ch. 1 §3).
 
     9 navigation + 24 IMU + 3 lever-arm states.  Interpretation (stated, the report prints no
-    equations for it): the gyro drift and the accelerometer bias are each the sum of a random
-    constant (``*_bias_sd``), a random walk (ẋ = w, intensity ``*_random_walk_psd``; initial value
-    zero) and a first-order Gauss-Markov process (``*_markov_sigma``, ``*_markov_tau``) — 18
-    states; random-constant scale-factor errors of gyros and accelerometers — 6 states; no
-    misalignment and no gravity states.  The random constant and the random walk of one axis enter
-    the dynamics through the same column (both are additive biases), so only their sum is
-    observable from navigation errors; their separation rests on the priors and the noise model.
+    equations for it): for each triad a random-constant bias (``bias`` of the triad), a
+    random-walk bias (state starts at zero, driven by ``*_random_walk_psd``) and a first-order
+    Gauss-Markov process (``markov_sigma``, ``markov_tau``) — 18 states; random-constant
+    scale-factor errors of gyros and accelerometers (``scale``) — 6 states; no misalignment and
+    no gravity states.  The random constant and the random walk of one axis enter the dynamics
+    through the same column (both are additive biases), so only their sum is observable from
+    navigation errors; their separation rests on the priors and the noise model.
+
+    The sensor errors come as in :func:`model_45` (one
+    :class:`replication.nav.sensors.ImuErrors` of standard deviations and intensities, finite
+    ``markov_tau``), with two differences: the model has no misalignment states, so a non-zero
+    ``misalignment`` σ is refused rather than dropped; and the random walk of the bias, which
+    eq. (2-10) and ``TriadErrors`` do not have (nor does the simulation of
+    :func:`replication.nav.sensors.apply_imu_errors`), has its own two keywords.
 
     Units and conventions as :func:`model_45` (SI; a scalar σ applies to every axis).
 
     Parameters
     ----------
+    imu_sd : replication.nav.sensors.ImuErrors or None, optional
+        Standard deviations and intensities of the accelerometer and gyro errors: bias
+        [m/s² | rad/s], markov_sigma [m/s² | rad/s], markov_tau [s], white_psd
+        [(m/s²)²·s | (rad/s)²·s], scale [1]; misalignment must be zero.  Default ``None``: every
+        σ and intensity zero, both correlation times 3600 s.
+    accel_random_walk_psd : float or array_like, shape (3,)
+        Intensity of the accelerometer bias random walk [(m/s²)²/s].
+    gyro_random_walk_psd : float or array_like, shape (3,)
+        Intensity of the gyro drift random walk [(rad/s)²/s].
     position_sd : float or array_like, shape (3,)
         Initial position σ, east, north, up [m]; converted to (δL, δλ, δh) at (``lat``, ``h``).
     velocity_sd : float or array_like, shape (3,)
         Initial velocity σ, ENU [m/s].
     attitude_sd : float or array_like, shape (3,)
         Initial attitude σ, φ_E, φ_N, φ_U [rad].
-    accel_bias_sd : float or array_like, shape (3,)
-        Accelerometer random-constant bias σ [m/s²].
-    accel_random_walk_psd : float or array_like, shape (3,)
-        Intensity of the accelerometer bias random walk [(m/s²)²/s].
-    accel_markov_sigma : float or array_like, shape (3,)
-        Stationary σ of the accelerometer Gauss-Markov bias [m/s²].
-    accel_markov_tau : float
-        Correlation time of the accelerometer Gauss-Markov bias [s].
-    accel_scale_sd : float or array_like, shape (3,)
-        Accelerometer scale-factor error σ [1].
-    gyro_bias_sd : float or array_like, shape (3,)
-        Gyro random-constant drift σ [rad/s].
-    gyro_random_walk_psd : float or array_like, shape (3,)
-        Intensity of the gyro drift random walk [(rad/s)²/s].
-    gyro_markov_sigma : float or array_like, shape (3,)
-        Stationary σ of the gyro Gauss-Markov drift [rad/s].
-    gyro_markov_tau : float
-        Correlation time of the gyro Gauss-Markov drift [s].
-    gyro_scale_sd : float or array_like, shape (3,)
-        Gyro scale-factor error σ [1].
     lever_arm_sd : float or array_like, shape (3,)
         σ of the lever-arm error, body frame [m].
-    accel_psd : float or array_like, shape (3,)
-        Accelerometer white-noise intensity [(m/s²)²/Hz].
-    gyro_psd : float or array_like, shape (3,)
-        Gyro white-noise intensity [(rad/s)²/Hz].
     lat : float
         Latitude at which ``position_sd`` is converted [rad].
     h : float
@@ -306,25 +329,33 @@ def model_36(*, position_sd=(10.0, 10.0, 10.0), velocity_sd=0.1, attitude_sd=(1e
 
     Raises
     ------
+    TypeError
+        When ``imu_sd`` is not an ``ImuErrors`` (or a triad of it not a ``TriadErrors``).
     ValueError
-        When a σ or intensity is negative or not finite, a correlation time is not positive, or
-        ``lat``/``h`` is out of range.
+        When a σ or intensity is negative or not finite, a misalignment σ is not zero, a
+        correlation time is not a positive finite number of seconds, or ``lat``/``h`` is out of
+        range.
     """
     nav_sd = _nav_sd(position_sd, velocity_sd, attitude_sd, lat, h)
+    acc, gyr = _imu_triads(imu_sd)
+    a, g = _triad_sd(acc, "accel", "36-state"), _triad_sd(gyr, "gyro", "36-state")
+    for kind, t in (("accel", a), ("gyro", g)):
+        if np.any(t["misalignment"] != 0):
+            raise ValueError(f"imu_sd.{kind}.misalignment must be zero for the 36-state model, which has no "
+                             f"misalignment states (model_45 has them), got {t['misalignment']}")
     blocks = (
-        E.accel_bias(_nonneg(accel_bias_sd, "accel_bias_sd")),
+        E.accel_bias(a["bias"]),
         E.accel_bias(0.0, name="accel_random_walk",
                      random_walk_psd=_nonneg(accel_random_walk_psd, "accel_random_walk_psd")),
-        _markov_block("accel", accel_markov_sigma, accel_markov_tau, "accel_markov"),
-        E.accel_scale(_nonneg(accel_scale_sd, "accel_scale_sd")),
-        E.gyro_bias(_nonneg(gyro_bias_sd, "gyro_bias_sd")),
+        E.accel_markov(a["markov_sigma"], a["markov_tau"]),
+        E.accel_scale(a["scale"]),
+        E.gyro_bias(g["bias"]),
         E.gyro_bias(0.0, name="gyro_random_walk", random_walk_psd=_nonneg(gyro_random_walk_psd, "gyro_random_walk_psd")),
-        _markov_block("gyro", gyro_markov_sigma, gyro_markov_tau, "gyro_markov"),
-        E.gyro_scale(_nonneg(gyro_scale_sd, "gyro_scale_sd")),
+        E.gyro_markov(g["markov_sigma"], g["markov_tau"]),
+        E.gyro_scale(g["scale"]),
         E.lever_arm(_nonneg(lever_arm_sd, "lever_arm_sd")),
     )
-    m = E.ErrorModel(blocks=blocks, accel_psd=_nonneg(accel_psd, "accel_psd"),
-                     gyro_psd=_nonneg(gyro_psd, "gyro_psd"), nav_sd=nav_sd)
+    m = E.ErrorModel(blocks=blocks, accel_psd=a["white_psd"], gyro_psd=g["white_psd"], nav_sd=nav_sd)
     assert m.n == 36 and tuple(b.name for b in m.blocks) == CHEN2019_36_ORDER
     return m
 

@@ -60,6 +60,7 @@ from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import errors as E
 from replication.nav import parallel as PAR
+from replication.nav import sensors as se
 from replication.nav._validate import choice, integer, probability
 from replication.nav.rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from replication.nav.sensors import gauss_markov_coefficients, gauss_markov_recursion, lever_arm_offset, misalignment_matrix
@@ -418,25 +419,24 @@ def filter_model(kind: str, setup: SimulationSetup, lat: float, h: float) -> E.E
     if kind not in ("15", "36", "45"):
         raise ValueError(f"kind must be '15', '36' or '45', got {kind!r}")
     s = setup
-    nav = dict(position_sd=s.position_sd, velocity_sd=s.velocity_sd, attitude_sd=s.attitude_sd, lat=lat, h=h,
-               accel_psd=s.accel_white_psd, gyro_psd=s.gyro_white_psd)
+    nav = dict(position_sd=s.position_sd, velocity_sd=s.velocity_sd, attitude_sd=s.attitude_sd, lat=lat, h=h)
     if kind == "15":
         return E.model_15(accel_bias_sd=math.hypot(s.accel_bias_sd, s.accel_markov_sigma),
-                          gyro_bias_sd=math.hypot(s.gyro_bias_sd, s.gyro_markov_sigma), **nav)
+                          gyro_bias_sd=math.hypot(s.gyro_bias_sd, s.gyro_markov_sigma),
+                          accel_psd=s.accel_white_psd, gyro_psd=s.gyro_white_psd, **nav)
+
+    def imu_sd(misalignment_sd):        # the truth's sensor errors as σ and intensities per triad
+        return se.ImuErrors(
+            gyro=se.TriadErrors(bias=s.gyro_bias_sd, markov_sigma=s.gyro_markov_sigma, markov_tau=s.gyro_markov_tau,
+                                white_psd=s.gyro_white_psd, scale=s.scale_sd, misalignment=misalignment_sd),
+            accel=se.TriadErrors(bias=s.accel_bias_sd, markov_sigma=s.accel_markov_sigma, markov_tau=s.accel_markov_tau,
+                                 white_psd=s.accel_white_psd, scale=s.scale_sd, misalignment=misalignment_sd))
+
     if kind == "36":
-        f2 = s.random_walk_fraction ** 2 / s.flight_duration
-        return M.model_36(accel_bias_sd=s.accel_bias_sd, accel_random_walk_psd=f2 * s.accel_bias_sd ** 2,
-                          accel_markov_sigma=s.accel_markov_sigma, accel_markov_tau=s.accel_markov_tau,
-                          accel_scale_sd=s.scale_sd, gyro_bias_sd=s.gyro_bias_sd,
-                          gyro_random_walk_psd=f2 * s.gyro_bias_sd ** 2, gyro_markov_sigma=s.gyro_markov_sigma,
-                          gyro_markov_tau=s.gyro_markov_tau, gyro_scale_sd=s.scale_sd,
-                          lever_arm_sd=s.lever_arm_sd, **nav)
-    return M.model_45(accel_bias_sd=s.accel_bias_sd, accel_markov_sigma=s.accel_markov_sigma,
-                      accel_markov_tau=s.accel_markov_tau, accel_scale_sd=s.scale_sd,
-                      accel_misalignment_sd=s.misalignment_sd, gyro_bias_sd=s.gyro_bias_sd,
-                      gyro_markov_sigma=s.gyro_markov_sigma, gyro_markov_tau=s.gyro_markov_tau,
-                      gyro_scale_sd=s.scale_sd, gyro_misalignment_sd=s.misalignment_sd,
-                      gravity_sigma=s.gravity_sigma, gravity_beta=1.0 / s.gravity_tau,
+        f2 = s.random_walk_fraction ** 2 / s.flight_duration       # imu_sd(0.0): it has no misalignment states
+        return M.model_36(imu_sd=imu_sd(0.0), accel_random_walk_psd=f2 * s.accel_bias_sd ** 2,
+                          gyro_random_walk_psd=f2 * s.gyro_bias_sd ** 2, lever_arm_sd=s.lever_arm_sd, **nav)
+    return M.model_45(imu_sd=imu_sd(s.misalignment_sd), gravity_sigma=s.gravity_sigma, gravity_beta=1.0 / s.gravity_tau,
                       lever_arm_sd=s.lever_arm_sd, **nav)
 
 
