@@ -358,7 +358,7 @@ class VerticalChannel:
 
     @property
     def code(self) -> int:
-        """The mode's code in the compiled loops (:data:`VERTICAL_MODES`)."""
+        """The mode's code in the compiled loops (``VERTICAL_MODES``)."""
         return VERTICAL_MODES[self.mode]
 
     def gains(self, lat: float, h: float) -> np.ndarray:
