@@ -316,6 +316,26 @@ def test_three_systems_short_run(short_flight):
         ad.simulate(short_flight, setup, systems=("INS",))
 
 
+def test_recording_grid_coarser_than_the_correction_interval(short_flight):
+    """Recording every 70 samples while correcting every 30 (3 s at 10 Hz): intervals without a
+    recorded sample are corrected all the same, and the states at the samples both grids share
+    are those of the finer grid (recording changes nothing computed; at sample 210, an interval's
+    end, both hold the corrected state)."""
+    setup = ad.AirdataSetup(correction_interval=3.0, threshold=1.0)
+    rng = np.random.default_rng(2)
+    ads = ad.ads_measurements(short_flight, sigma_height=setup.sigma_height, rng=rng)
+    dth, dv = ad._corrupt(short_flight, setup, rng)
+    coarse = ad.run_error_correction(short_flight, dth, dv, ads, setup, every=70)
+    fine = ad.run_error_correction(short_flight, dth, dv, ads, setup, every=10)
+    assert any(not np.any((coarse.idx >= k0) & (coarse.idx <= k0 + 30)) for k0 in range(0, short_flight.n, 30))
+    assert len(coarse.infos) == len(fine.infos) == short_flight.n // 30
+    common = np.isin(fine.idx, coarse.idx)
+    np.testing.assert_array_equal(coarse.st, fine.st[common])
+    np.testing.assert_array_equal(coarse.C, fine.C[common])
+    with pytest.raises(ValueError, match="every"):
+        ad.run_error_correction(short_flight, dth, dv, ads, setup, every=0)
+
+
 # --------------------------------------------------------------------------- controlled experiment
 
 @pytest.fixture(scope="module")

@@ -1415,7 +1415,7 @@ def run_pure_sins(traj, dth, dv, setup, *, every: int = 50):
         (m, 6) = latitude, longitude [rad], height [m], v_E, v_N, v_U [m/s], and ``rec.C``
         (m, 3, 3) C_b^n.
     """
-    rec = _Recorder(traj, every)
+    rec = _Recorder(traj, integer(every, "every"))
     sol, ks, st, C = _segment(traj.t, dth, dv, 0, traj.n, _initial_state(traj, setup), every)
     rec.put(ks, st, C)
     return rec
@@ -1507,7 +1507,7 @@ def run_error_correction(traj, dth, dv, ads, setup, *, every: int = 50):
         ``rec.infos`` lists the ``info`` dict of every correction (``error_correction_step``)
         with its time ``t`` [s].
     """
-    rec = _Recorder(traj, every)
+    rec = _Recorder(traj, integer(every, "every"))
     ep = _epochs(traj, setup.correction_interval)
     state = _initial_state(traj, setup)
     infos = []
@@ -1518,8 +1518,8 @@ def run_error_correction(traj, dth, dv, ads, setup, *, every: int = 50):
         state, info = error_correction_step(origin, end, ads.height[k1], setup)
         info["t"] = float(traj.t[k1])
         infos.append(info)
-        st[-1] = [state.lat, state.lon, state.h, *state.v_enu] if ks[-1] == k1 else st[-1]
-        if ks[-1] == k1:
+        if len(ks) and ks[-1] == k1:        # the corrected state where the interval's end is recorded
+            st[-1] = [state.lat, state.lon, state.h, *state.v_enu]
             C[-1] = state.C_bn
         rec.put(ks, st, C)
     rec.infos = infos
