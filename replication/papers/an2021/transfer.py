@@ -850,8 +850,8 @@ def is_identity(expr_a, expr_b):
     return sp.simplify(sp.expand(sp.numer(sp.together(diff)))) == 0
 
 
-def coefficient_location(name, motion):
-    """Where a printed coefficient lives (an2021 eqs. (4)-(7)).
+def coefficient_location(name):
+    """Where a printed coefficient lives (an2021 eqs. (4)-(7), the same for both motions).
 
     n_1k: numerator of ϕ_E/g_dN, n_2k: numerator of ϕ_N/g_dE, d_k: the shared denominator; k is
     the power of s.
@@ -860,8 +860,6 @@ def coefficient_location(name, motion):
     ----------
     name : str
         Coefficient name, ``"n_1k"``, ``"n_2k"`` or ``"d_k"`` (k a digit).
-    motion : {"north-south", "east-west"}
-        North-south motion (V_E = 0, eqs. (4)-(5)) or east-west motion (V_N = 0, eqs. (6)-(7)).
 
     Returns
     -------
@@ -875,10 +873,10 @@ def coefficient_location(name, motion):
     Raises
     ------
     ValueError
-        If ``motion`` is unknown or ``name`` does not follow the pattern.
+        If ``name`` does not follow the pattern.
     """
-    choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
-
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a coefficient name such as 'n_13' or 'd_4', got {type(name).__name__}")
     m = re.fullmatch(r"([nd])_(\d+)", name)
     if not m:
         raise ValueError(f"coefficient names look like 'n_13' or 'd_4', not {name!r}")
@@ -913,9 +911,10 @@ def derived_coefficient(name, motion):
     Raises
     ------
     ValueError
-        If ``name`` or ``motion`` is not valid (:func:`coefficient_location`).
+        If ``name`` (:func:`coefficient_location`) or ``motion`` is not valid.
     """
-    pair, part, power = coefficient_location(name, motion)
+    choice(motion, MOTIONS, "motion", _NOT_ONE_OF)
+    pair, part, power = coefficient_location(name)
     num, den, _ = symbolic_transfer_functions(motion)[pair]
     return coefficient(num if part == "num" else den, power)
 
@@ -1012,7 +1011,7 @@ def coefficient_checks(printed, motion, points, *, radius=None, gravity=None):
             tfs[(lat, v, pair)] = polynomial_coefficients(
                 transfer_function(lat, ve, vn, pair, radius=radius, gravity=gravity))
     for name in printed:
-        pair, part, power = coefficient_location(name, motion)
+        pair, part, power = coefficient_location(name)
         if motion == "east-west" and name == "d_4":
             pair, part, power = "phiE/gdN", "num", 2
         derived = derived_coefficient("n_12" if (motion == "east-west" and name == "d_4") else name, motion)
@@ -1283,7 +1282,7 @@ def integrated_model(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None)
     return a, b, c, output_matrix(12)
 
 
-def noise_matrices(lat, noise: NoiseSettings, *, radius=None, gravity=None):
+def noise_matrices(lat, noise: NoiseSettings, *, radius=None):
     """Continuous process-noise PSD Q and measurement-noise PSD R_c for eq. (8).
 
     Q = diag(ARW² ×3, VRW² ×2, 0, 0, bias-RW² ×5); the position fix of σ metres at f Hz becomes
@@ -1297,8 +1296,6 @@ def noise_matrices(lat, noise: NoiseSettings, *, radius=None, gravity=None):
         The noise levels.
     radius : float, optional
         Earth radius R [m] converting the fix σ to radians; default as :func:`earth_parameters`.
-    gravity : float, optional
-        Gravity g [m/s²], only validated (:func:`earth_parameters`); it does not enter Q or R_c.
 
     Returns
     -------
@@ -1318,7 +1315,7 @@ def noise_matrices(lat, noise: NoiseSettings, *, radius=None, gravity=None):
     if not isinstance(noise, NoiseSettings):
         raise TypeError("noise must be a NoiseSettings")
     lat, _, _ = _check_motion(lat, 0.0, 0.0)
-    r, _ = earth_parameters(lat, radius, gravity)
+    r, _ = earth_parameters(lat, radius, None)
     q = np.zeros(12)
     q[0:3] = noise.gyro_arw**2
     q[3:5] = noise.accel_vrw**2
@@ -1526,7 +1523,7 @@ def integrated_gravity_to_attitude(lat, v_east=0.0, v_north=0.0, noise: NoiseSet
     """
     a, b, c, h = integrated_model(lat, v_east, v_north, radius=radius, gravity=gravity)
     if gain is None:
-        q, rc = noise_matrices(lat, noise, radius=radius, gravity=gravity)
+        q, rc = noise_matrices(lat, noise, radius=radius)
         gain = steady_state_gain(a, c, q, rc, state_scale=_STATE_SCALE_12)
     gain = np.asarray(gain, float)
     if gain.shape != (12, 2):
