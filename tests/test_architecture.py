@@ -153,8 +153,6 @@ SIGNATURES_PENDING: set[str] = {
     "replication.papers.chen2019.gravity.analog_direct_difference",
     "replication.nav.closedloop.run", "replication.nav.closedloop.build_spec",
     "replication.nav.closedloop.chunk_inputs", "replication.nav.closedloop.array_inputs",
-    "replication.papers.fang2020.polar._run_grid",
-    "replication.papers.fang2020.polar._simulate_runs.seg",
     "replication.crosschecks.duan2023.proposed_linear_propagation",
     "replication.nav._kernels.sd_step", "replication.nav._kernels._sd_step_s",
     "replication.nav._kernels.interval_discretize", "replication.nav._kernels.build_F",
