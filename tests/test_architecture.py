@@ -153,7 +153,6 @@ SIGNATURES_PENDING: set[str] = {
     "replication.papers.chen2019.gravity.analog_direct_difference",
     "replication.nav.closedloop.run", "replication.nav.closedloop.build_spec",
     "replication.nav.closedloop.chunk_inputs", "replication.nav.closedloop.array_inputs",
-    "replication.crosschecks.duan2023.proposed_linear_propagation",
     "replication.nav._kernels.sd_step", "replication.nav._kernels._sd_step_s",
     "replication.nav._kernels.interval_discretize", "replication.nav._kernels.build_F",
     "replication.papers.fang2020._polar_kernels.run_grid", "replication.papers.fang2020._polar_kernels.truth_step",
