@@ -149,8 +149,6 @@ SIGNATURES_PENDING: set[str] = {
     "replication.papers.chen2019.models.model_45", "replication.papers.chen2019.models.model_36",
     "replication.nav.kalman.closed_loop", "replication.nav.kalman.monte_carlo",
     "replication.papers.chen2019.simulation.run_batch", "replication.papers.chen2019.simulation._run_rows",
-    "replication.papers.chen2019.gravity.compensation_run",
-    "replication.papers.chen2019.gravity.analog_direct_difference",
     "replication.nav.closedloop.run", "replication.nav.closedloop.build_spec",
     "replication.nav.closedloop.chunk_inputs", "replication.nav.closedloop.array_inputs",
     "replication.nav._kernels.sd_step", "replication.nav._kernels._sd_step_s",
