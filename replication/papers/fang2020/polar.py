@@ -1590,8 +1590,8 @@ def ecef_reference_comparison(sc, duration, *, seed=0, record_every=60.0):
     ve = np.ascontiguousarray(np.einsum("nji,nj->ni", ceg, vg))
     r_e = r.copy()
     n_rec = k_end // rec_k + 1
-    rp_, rv_, ra_ = np.zeros((1, n_rec, 3)), np.zeros((1, n_rec, 3)), np.zeros((1, n_rec, 9))
-    _k.run_ecef(0, k_end, dt, traj, sens, cbe_nav, ve, r_e, seeds.copy(), rp_, rv_, ra_, rec_k)
+    rec = np.zeros((1, n_rec, 15))                 # ECEF position, velocity, C_b^e (row-major)
+    _k.run_ecef(0, k_end, dt, traj, sens, cbe_nav, ve, r_e, seeds.copy(), rec, rec_k)
     # grid run in segments, reading its absolute state at every record time
     coef = discretize_damping(dt)
     pos_grid, vel_grid, cbe_grid = [r[0].copy()], [ceg[0].T @ vg[0]], [ceg[0].T @ cbp[0]]
@@ -1607,12 +1607,12 @@ def ecef_reference_comparison(sc, duration, *, seed=0, record_every=60.0):
         cbe_grid.append(c.T @ cbp[0])
     t = np.arange(n_rec) * rec_k * dt
     re_t = np.concatenate([true_state(sc, tt, phases)[1] for tt in t])
-    d = np.array(cbe_grid) @ np.swapaxes(ra_[0].reshape(-1, 3, 3), -1, -2)
+    d = np.array(cbe_grid) @ np.swapaxes(np.ascontiguousarray(rec[0, :, 6:]).reshape(-1, 3, 3), -1, -2)
     # small-angle rotation vector from the antisymmetric part (insensitive to 1e-12 scale drift)
     w = 0.5 * np.stack([d[:, 2, 1] - d[:, 1, 2], d[:, 0, 2] - d[:, 2, 0], d[:, 1, 0] - d[:, 0, 1]], -1)
     ang = np.arcsin(np.clip(np.linalg.norm(w, axis=-1), 0, 1))
-    return {"t": t, "pos_grid": np.array(pos_grid), "pos_ecef": rp_[0], "vel_grid": np.array(vel_grid),
-            "vel_ecef": rv_[0], "attitude_angle": ang, "pos_true": re_t}
+    return {"t": t, "pos_grid": np.array(pos_grid), "pos_ecef": rec[0, :, 0:3].copy(), "vel_grid": np.array(vel_grid),
+            "vel_ecef": rec[0, :, 3:6].copy(), "attitude_angle": ang, "pos_true": re_t}
 
 
 # =============================================================================== fang2020 §3 runs
