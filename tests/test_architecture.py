@@ -151,7 +151,7 @@ SIGNATURES_PENDING: set[str] = {
     "replication.papers.chen2019.simulation.run_batch", "replication.papers.chen2019.simulation._run_rows",
     "replication.nav.closedloop.run", "replication.nav.closedloop.build_spec",
     "replication.nav.closedloop.chunk_inputs", "replication.nav.closedloop.array_inputs",
-    "replication.nav._kernels._sd_step_s", "replication.papers.fang2020._polar_kernels.run_grid",
+    "replication.papers.fang2020._polar_kernels.run_grid",
 }
 
 

@@ -147,13 +147,16 @@ def q2c(q, c):
 # ----------------------------------------------------------------------------- strapdown step
 
 @njit(inline="always", **_NJ)
-def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vmode, href, vuref, gains, dampint, g_extra):
+def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vertical, dampint, g_extra):
     """One ENU strapdown update (chen2019 eq. (3-2)) on scalars: the one implementation of the step,
     inlined into :func:`strapdown_kernel` and :func:`sd_step`.
 
     Two-sample (previous + current) coning and sculling corrections, exact rotation-vector
     attitude update, Earth and transport rates and normal gravity at the mid-interval state
     extrapolated from the last two samples (one evaluation of the Earth model per step).
+
+    Everything arrives as scalars and tuples of scalars (values the compiler keeps in registers,
+    no array references), so the vertical channel's settings travel as one tuple.
 
     Parameters
     ----------
@@ -172,13 +175,10 @@ def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vmode, href, vuref, gai
     trig : tuple of 3 float
         [L, sin L, cos L] of the previous step's mid latitude: sin and cos are advanced by the
         angle-sum formulas when the latitude moved by less than 1e-5 rad, evaluated otherwise.
-    vmode : int
-        0 free, 1 hold (h, v_U set to ``href``, ``vuref`` after the step), 2 damped
-        (third-order loop on h - ``href``).
-    href, vuref : float
-        Reference height (m; modes 1 and 2) and vertical speed (m/s; mode 1).
-    gains : tuple of 3 float
-        Damping-loop gains k1, k2, k3 (mode 2).
+    vertical : tuple (int, float, float, tuple of 3 float)
+        The vertical channel (``vmode``, ``href``, ``vuref``, ``gains``): mode 0 free, 1 hold
+        (h, v_U set to ``href`` (m), ``vuref`` (m/s) after the step), 2 damped (third-order loop on
+        h - ``href`` with the gains k1, k2, k3).
     dampint : float
         Damping-loop integrator state (m/s²).
     g_extra : tuple of 3 float
@@ -202,6 +202,7 @@ def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vmode, href, vuref, gai
     L0, lam0, h0, ve0, vn0, vu0 = x
     pL, ph, pve, pvn, pvu = x_p
     tL, tS, tC = trig
+    vmode, href, vuref, gains = vertical
     k1, k2, k3 = gains
     gx, gy, gz = g_extra
     # extrapolated mid-interval state and its Earth model
@@ -340,7 +341,7 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
         T, (dth[0], dth[1], dth[2]), (dvv[0], dvv[1], dvv[2]), (dth_prev[0], dth_prev[1], dth_prev[2]),
         (dv_prev[0], dv_prev[1], dv_prev[2]), (st[0], st[1], st[2], st[3], st[4], st[5]),
         (st_prev[0], st_prev[2], st_prev[3], st_prev[4], st_prev[5]), (q[0], q[1], q[2], q[3]),
-        (trig[0], trig[1], trig[2]), vmode, h_ref, vu_ref, gk, dampint, (g_extra[0], g_extra[1], g_extra[2]))
+        (trig[0], trig[1], trig[2]), (vmode, h_ref, vu_ref, gk), dampint, (g_extra[0], g_extra[1], g_extra[2]))
     for i in range(6):
         st_prev[i] = st[i]
     st[0], st[1], st[2], st[3], st[4], st[5] = x
@@ -409,7 +410,7 @@ def strapdown_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains, out_s
         x_new, q, trig, dampint = _sd_step_s(
             dt[k], (dtheta[k, 0], dtheta[k, 1], dtheta[k, 2]), (dv[k, 0], dv[k, 1], dv[k, 2]),
             (dtheta[kp, 0], dtheta[kp, 1], dtheta[kp, 2]), (dv[kp, 0], dv[kp, 1], dv[kp, 2]), x, x_p, q, trig,
-            vmode, href, vuref, gk, dampint, (0.0, 0.0, 0.0))
+            (vmode, href, vuref, gk), dampint, (0.0, 0.0, 0.0))
         x_p = (x[0], x[2], x[3], x[4], x[5])
         x = x_new
         for i in range(6):
