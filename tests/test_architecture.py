@@ -146,15 +146,7 @@ MAX_ARGUMENTS = 12
 # its docstring, with this phrase.
 ARGUED = "not a bundle"
 SIGNATURES_PENDING: set[str] = {
-    "replication.papers.chen2019.gravity.compensation_run",
-    "replication.papers.chen2019.gravity.analog_direct_difference",
-    "replication.nav.trajectory.generate", "replication.papers.fang2020.polar._run_grid",
-    "replication.papers.fang2020.polar._simulate_runs.seg",
-    "replication.crosschecks.duan2023.proposed_linear_propagation",
-    "replication.nav._kernels.sd_step", "replication.nav._kernels._sd_step_s",
-    "replication.nav._kernels.interval_discretize", "replication.nav._kernels.build_F",
-    "replication.papers.fang2020._polar_kernels.run_grid", "replication.papers.fang2020._polar_kernels.truth_step",
-    "replication.papers.fang2020._polar_kernels.run_ecef", "replication.papers.fang2020._polar_kernels._record",
+    "replication.papers.fang2020._polar_kernels.run_grid",
 }
 
 

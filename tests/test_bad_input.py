@@ -20,7 +20,8 @@ from hypothesis import strategies as st
 from replication.nav import closedloop, earth, errors, kalman, rotations, sensors, strapdown, timeseries, trajectory
 from replication.nav.units import DEG
 from replication.papers.an2021 import transfer
-from replication.papers.chen2019 import calibration, findings, models, observability, simulation
+from replication.papers.chen2019 import calibration, findings, gravity, models, observability, simulation
+from replication.papers.fang2020 import polar
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
 I3 = np.eye(3)
@@ -355,6 +356,34 @@ PROBES += [
     ("aic_batch(Y with NaN)", "Y", lambda: timeseries.aic_batch(np.r_[np.nan, np.zeros(99)].reshape(2, 50), 3)),
     ("order_recovery(seed = -1)", "seed",
      lambda: timeseries.order_recovery([0.5], 1.0, 100, n_series=2, max_order=3, seed=-1)),
+]
+
+# option bundles: a wrong value refused where the bundle is built, a wrong type where it is passed
+_FIELD = gravity.synthetic_field(20e3, 20e3, 500.0, seed=0)
+_LAYOUT = gravity.SurveyLayout(n_lines=1, line_length=5e3, spacing=500.0, speed=30.0)
+_FANG = polar.fang2020_scenario(1)
+PROBES += [
+    ("SurveyLayout(n_lines = 0)", "n_lines", lambda: gravity.SurveyLayout(0, 5e3, 500.0, 30.0)),
+    ("SurveyLayout(speed = nan)", "speed", lambda: gravity.SurveyLayout(1, 5e3, 500.0, np.nan)),
+    ("SurveyLayout(start = (1, 2, 3))", "start", lambda: gravity.SurveyLayout(1, 5e3, 500.0, 30.0, start=(1, 2, 3))),
+    ("analog_direct_difference(layout = dict)", "layout",
+     lambda: gravity.analog_direct_difference(_FIELD, dict(n_lines=1, line_length=5e3, spacing=500.0, speed=30.0),
+                                              seed=0)),
+    ("analog_direct_difference(out_dt = 0.15)", "out_dt",
+     lambda: gravity.analog_direct_difference(_FIELD, _LAYOUT, seed=0, out_dt=0.15)),
+    ("CompensationSettings(cutoff_period = -1)", "cutoff_period",
+     lambda: gravity.CompensationSettings(cutoff_period=-1.0)),
+    ("CompensationSettings(ar_interval = nan)", "ar_interval", lambda: gravity.CompensationSettings(ar_interval=np.nan)),
+    ("CompensationSettings(methods = ['bogus'])", "methods", lambda: gravity.CompensationSettings(methods=["bogus"])),
+    ("CompensationSettings(methods = 'normal')", "methods", lambda: gravity.CompensationSettings(methods="normal")),
+    ("CompensationSettings(specific_force = 'yes')", "specific_force",
+     lambda: gravity.CompensationSettings(specific_force="yes")),
+    ("compensation_run(settings = dict)", "settings",
+     lambda: gravity.compensation_run(None, _FIELD, seed=0, origin=None, offset=None, photos=None, imu={}, gnss_kw={},
+                                      model_kw={}, settings=dict(cutoff_period=100.0))),
+    ("fang2020 run_segment(state = dict)", "state",
+     lambda: polar.run_segment(_FANG, 0, 10, *polar.initial_state(_FANG, 1, 0)[1:3],
+                               polar.initial_state(_FANG, 1, 0)[3]._asdict())),
 ]
 
 

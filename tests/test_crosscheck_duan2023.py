@@ -54,7 +54,8 @@ def sins():
 def proposed_scan():
     """Linear propagation, both readings of the attitude sign, eight straight headings."""
     return {
-        (sign, psi): xc.proposed_linear_propagation(heading_deg=psi, tilt_sign=sign, step_s=30.0)
+        (sign, psi): xc.proposed_linear_propagation(heading_deg=psi, reading=xc.CorrectionReading(tilt_sign=sign),
+                                                     step_s=30.0)
         for sign in (1, -1)
         for psi in HEADINGS
     }
@@ -129,7 +130,7 @@ def test_closed_form_matches_linear_propagation(proposed_scan):
 
 
 def test_proposed_errors_far_above_print(proposed_scan):
-    half = xc.proposed_linear_propagation(eq6_factor=0.5, step_s=30.0)
+    half = xc.proposed_linear_propagation(reading=xc.CorrectionReading(eq6_factor=0.5), step_s=30.0)
     for key, res in list(proposed_scan.items()) + [("eq6 as printed", half)]:
         assert res["final"]["position_km"] > 10 * PRINT["proposed SINS/ADS"]["position_km"], key
         assert res["max"]["velocity_mps"] > 10 * PRINT["proposed SINS/ADS"]["velocity_mps"], key
@@ -159,9 +160,9 @@ def test_horizontal_floor_without_tilt_exceeds_print():
     # (per axis |R eps (t - sin w_s t / w_s)| - |b/w_s^2 (1 - cos w_s t)| >= 0.76 km)
     for sg in itertools.product((1, -1), repeat=4):
         res = xc.proposed_linear_propagation(
-            apply_tilt=False,
-            gyro_drift_dph=[0.01 * sg[0], 0.01 * sg[1], 0.01],
-            accel_bias_ug=[100 * sg[2], 100 * sg[3], 100],
+            errors=xc.ErrorSources(gyro_drift_dph=[0.01 * sg[0], 0.01 * sg[1], 0.01],
+                                   accel_bias_ug=[100 * sg[2], 100 * sg[3], 100]),
+            reading=xc.CorrectionReading(apply_tilt=False),
             step_s=30.0,
         )
         assert res["final"]["position_km"] > 2 * PRINT["proposed SINS/ADS"]["position_km"], sg
@@ -176,7 +177,10 @@ def test_horizontal_floor_without_tilt_exceeds_print():
         (lambda: xc.proposed_closed_form(reading="other"), "reading must be one of"),
         (lambda: xc.proposed_closed_form(interval_s=4000), "must be shorter than duration_s"),
         (lambda: xc.proposed_linear_propagation(step_s=7), "must divide interval_s"),
-        (lambda: xc.proposed_linear_propagation(tilt_sign=0), "tilt_sign must be"),
+        (lambda: xc.CorrectionReading(tilt_sign=0), "tilt_sign must be"),
+        (lambda: xc.CorrectionReading(eq6_factor=0.0), "eq6_factor"),
+        (lambda: xc.ErrorSources(ads_sigma_m=-1.0), "ads_sigma_m"),
+        (lambda: xc.ErrorSources(accel_bias_ug=[1, 2]), "three finite numbers"),
         (lambda: xc.pure_sins_linear_propagation(lat0_deg=89.5), "too close to a pole"),
         (lambda: xc.pure_sins_linear_propagation(accel_bias_ug=[1, 2]), "three finite numbers"),
         (lambda: xc.vertical_reset_sequence(0), "positive integer"),
@@ -186,6 +190,15 @@ def test_horizontal_floor_without_tilt_exceeds_print():
 def test_inputs_are_validated(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_proposed_linear_propagation_refuses_a_wrong_bundle():
+    with pytest.raises(TypeError, match="errors must be an ErrorSources"):
+        xc.proposed_linear_propagation(errors={"dv0_mps": 0.1})
+    with pytest.raises(TypeError, match="reading must be a CorrectionReading"):
+        xc.proposed_linear_propagation(reading="literal")
+    with pytest.raises(TypeError, match="apply_tilt"):
+        xc.CorrectionReading(apply_tilt="no")
 
 
 def test_pure_sins_sources_rejects_unknown_argument():

@@ -218,10 +218,11 @@ def test_gauss_markov_statistics():
 
 def test_analog_direct_difference_without_errors_is_the_filtered_field():
     f = gr.synthetic_field(40e3, 20e3, 250.0, seed=4)
-    kw = dict(n_lines=2, line_length=20e3, spacing=500.0, speed=30.0, cutoff_period=10.0, start=(10e3, 5e3))
-    clean = gr.analog_direct_difference(f, seed=1, sigma_v=0.0, level_error_std=0.0, **kw)
+    layout = gr.SurveyLayout(n_lines=2, line_length=20e3, spacing=500.0, speed=30.0, start=(10e3, 5e3))
+    kw = dict(cutoff_period=10.0)
+    clean = gr.analog_direct_difference(f, layout, seed=1, sigma_v=0.0, level_error_std=0.0, **kw)
     np.testing.assert_allclose(clean["measured"], clean["true"], atol=1e-15)
-    noisy = gr.analog_direct_difference(f, seed=1, sigma_v=0.03, level_error_std=1e-4, **kw)
+    noisy = gr.analog_direct_difference(f, layout, seed=1, sigma_v=0.03, level_error_std=1e-4, **kw)
     err = (noisy["measured"] - noisy["true"]).std(axis=0)
     assert err[0] > 0.5 * 1e-4 * 9.8 and err[2] < err[0]  # the level error shows in the horizontals only
     assert clean["t"][1] - clean["t"][0] == pytest.approx(1.0)
@@ -441,7 +442,8 @@ def test_compensation_runs_equal_the_sequential_runs_whatever_the_threads():
               imu=dict(accel_bias_sd=50 * MICRO_G, gyro_bias_sd=0.01 * DEG_PER_H, accel_psd=(10 * MICRO_G) ** 2,
                        gyro_psd=(0.003 * DEG / 60) ** 2),
               gnss_kw=dict(rate_hz=10, sigma_pos=0.1, sigma_vel=0.03),
-              model_kw=dict(position_sd=0.1, velocity_sd=0.03, attitude_sd=(1e-4, 1e-4, 5e-4)), cutoff_period=100.0)
+              model_kw=dict(position_sd=0.1, velocity_sd=0.03, attitude_sd=(1e-4, 1e-4, 5e-4)),
+              settings=gr.CompensationSettings(cutoff_period=100.0))
     seeds = [11, 12]
     fields = [gr.synthetic_field(100e3, 60e3, 250.0, sigma=30 * MGAL, correlation_length=10e3, altitude=500.0, seed=s)
               for s in seeds]

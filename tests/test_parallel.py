@@ -269,7 +269,8 @@ def gravity_case():
               imu=dict(accel_bias_sd=50 * MICRO_G, gyro_bias_sd=0.01 * DEG_PER_H, accel_psd=(10 * MICRO_G) ** 2,
                        gyro_psd=(0.003 * DEG / 60) ** 2),
               gnss_kw=dict(rate_hz=10, sigma_pos=0.1, sigma_vel=0.03),
-              model_kw=dict(position_sd=0.1, velocity_sd=0.03, attitude_sd=(1e-4, 1e-4, 5e-4)), cutoff_period=60.0)
+              model_kw=dict(position_sd=0.1, velocity_sd=0.03, attitude_sd=(1e-4, 1e-4, 5e-4)),
+              settings=gr.CompensationSettings(cutoff_period=60.0))
     seeds = [11, 12, 13]
     fields = [gr.synthetic_field(60e3, 40e3, 250.0, sigma=30 * MGAL, correlation_length=10e3, altitude=500.0, seed=s)
               for s in seeds]

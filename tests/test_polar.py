@@ -160,13 +160,13 @@ def test_calibration_in_the_undamped_ins_with_exact_psi_recovers_drift():
     phases, traj, sens, st = polar.initial_state(sc, 1, 5)
     k1, k2 = sc.steps(sc.fix_times[0]), sc.steps(sc.fix_times[1])
     polar.run_segment(sc, 0, k1, traj, sens, st)
-    psi1, _ = polar.true_psi(sc, sc.fix_times[0], phases, st["cbp"], st["r"])
+    psi1, _ = polar.true_psi(sc, sc.fix_times[0], phases, st.cbp, st.r)
     polar.run_segment(sc, k1, k2, traj, sens, st)
-    psi2, re2 = polar.true_psi(sc, sc.fix_times[1], phases, st["cbp"], st["r"])
+    psi2, re2 = polar.true_psi(sc, sc.fix_times[1], phases, st.cbp, st.r)
     tau = sc.fix_times[1] - sc.fix_times[0]
     dpsi = psi2 - psi1 @ polar.transition_t(polar.OMEGA * tau).T
     lat, lon, _ = earth.ecef_to_geodetic(re2)
-    est = polar.drift_from_psi(dpsi, lat, lon, st["cbp"], tau)
+    est = polar.drift_from_psi(dpsi, lat, lon, st.cbp, tau)
     truth = np.array(sc.gyro_drift)
     assert np.max(np.abs(est - truth)) < 1e-3 * truth[0]
 
@@ -381,6 +381,10 @@ def test_bad_inputs_are_refused_with_messages():
         polar.simulate(polar.fang2020_scenario(1), 0, 1)
     with pytest.raises(ValueError, match="parallel"):
         polar.fang2020_scenario(1, lat0=np.radians(89.95))
+    sc = polar.fang2020_scenario(1)
+    _, traj, sens, st = polar.initial_state(sc, 1, 2)
+    with pytest.raises(TypeError, match="state must be a GridState"):
+        polar.run_segment(sc, 0, 10, traj, sens, st._asdict())
 
 
 def test_shared_truth_gives_the_same_bits_as_each_run_computing_its_own():
@@ -395,13 +399,13 @@ def test_shared_truth_gives_the_same_bits_as_each_run_computing_its_own():
     for shared in (False, True):
         _, traj, sens, st = polar.initial_state(sc, 3, 11)
         rec = np.zeros((3, k1 // every + 1, K.N_REC))
-        args = (0, k1, sc.dt, traj, sens, st["cbp"], st["vg"], st["r"], st["damp"], st["comp"], st["rng"],
-                st["acc_e"], st["acc_i"], polar.discretize_damping(sc.dt), 1, 1, rec, every, 10)
+        rest = (polar.discretize_damping(sc.dt), 1, 1, rec, every, 10)
         if shared:
-            polar._run_grid(*args)
+            polar._run_grid(0, k1, sc.dt, traj, sens, st, *rest)
         else:
-            K.run_grid(*args, 0, np.empty((0, K.TRUTH_STEP_FIELDS)), np.empty((0, K.TRUTH_RECORD_FIELDS)))
-        out.append((rec, st["cbp"], st["vg"], st["r"], st["acc_e"]))
+            K.run_grid(0, k1, sc.dt, traj, sens, *st, *rest, 0, np.empty((0, K.TRUTH_STEP_FIELDS)),
+                       np.empty((0, K.TRUTH_RECORD_FIELDS)))
+        out.append((rec, st.cbp, st.vg, st.r, st.acc_e))
     assert np.all(out[0][0][:, :, 3] != 0.0), "the runs recorded no velocity error"
     for a, b in zip(*out):
         assert np.array_equal(a, b)

@@ -51,6 +51,8 @@ against ~300 m for the bias).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.linalg import expm
 
@@ -65,6 +67,8 @@ __all__ = [
     "pure_sins_linear_propagation",
     "vertical_reset_sequence",
     "proposed_closed_form",
+    "ErrorSources",
+    "CorrectionReading",
     "proposed_linear_propagation",
     "table1_second_computation",
 ]
@@ -619,6 +623,81 @@ def proposed_closed_form(
     }
 
 
+@dataclass(frozen=True)
+class ErrorSources:
+    """The error sources of a proposed SINS/ADS run, §3's printed values by default.
+
+    Parameters
+    ----------
+    dv0_mps : float
+        Initial velocity error on each of E, N, U (m/s, §3: 0.1 m/s).
+    dp0_m : float
+        Initial position error on each of E, N, U (m, §3: 10 m).
+    gyro_drift_dph : float or array_like, shape (3,)
+        Constant gyro drift resolved in the navigation frame (°/h): a scalar (the same on E, N,
+        U; §3: 0.01 °/h) or three values (E, N, U).
+    accel_bias_ug : float or array_like, shape (3,)
+        Constant accelerometer bias resolved in the navigation frame (µg), likewise (§3: 100 µg).
+    ads_sigma_m : float
+        Standard deviation of the ADS height error (m, §3: 1 m); 0 for an exact ADS.
+
+    Raises
+    ------
+    ValueError
+        For a value that is not finite, a drift or bias that is neither one nor three numbers,
+        or a negative ``ads_sigma_m``.
+    """
+
+    dv0_mps: float = PAPER["dv0_mps"]
+    dp0_m: float = PAPER["dp0_m"]
+    gyro_drift_dph: float = PAPER["gyro_drift_dph"]
+    accel_bias_ug: float = PAPER["accel_bias_ug"]
+    ads_sigma_m: float = PAPER["ads_error_m"]
+
+    def __post_init__(self):
+        finite(self.dv0_mps, "dv0_mps")
+        finite(self.dp0_m, "dp0_m")
+        _axes("gyro_drift_dph", self.gyro_drift_dph)
+        _axes("accel_bias_ug", self.accel_bias_ug)
+        nonnegative(self.ads_sigma_m, "ads_sigma_m")
+
+
+@dataclass(frozen=True)
+class CorrectionReading:
+    """How the attitude correction of eqs. (4)-(6) and (22) is read (the printed text leaves it open).
+
+    Parameters
+    ----------
+    eq6_factor : float
+        ``c`` of ``φ^c = c S dh^c/(S²+h²)``: 1 (derived from eq. (5)) or 0.5 (eq. (6) as
+        printed); positive.
+    tilt_sign : {1, -1}
+        +1: eq. (22) read literally, ``φ ← φ + φ^c u`` (``reading="literal"`` of
+        ``proposed_closed_form``); -1: the attitude turned as the geometry of eqs. (2)-(4)
+        intends, computed pitch raised by ``dh^c/S`` (``reading="geometric"``).
+    apply_tilt : bool
+        False applies only the height, velocity and position corrections (control run).
+
+    Raises
+    ------
+    ValueError
+        For a non-positive ``eq6_factor`` or a ``tilt_sign`` other than ±1.
+    TypeError
+        For an ``apply_tilt`` that is not a bool.
+    """
+
+    eq6_factor: float = 1.0
+    tilt_sign: float = 1.0
+    apply_tilt: bool = True
+
+    def __post_init__(self):
+        positive(self.eq6_factor, "eq6_factor")
+        if self.tilt_sign not in (1, -1, 1.0, -1.0):
+            raise ValueError(f"tilt_sign must be +1 or -1, got {self.tilt_sign!r}")
+        if not isinstance(self.apply_tilt, (bool, np.bool_)):
+            raise TypeError(f"apply_tilt must be True or False, got {self.apply_tilt!r}")
+
+
 def _ads_correction(T, c, tilt_sign, apply_tilt, noise, h0):
     """The correction ``X ← X + X^C`` of eqs. (4)-(22) for ``_propagate``, with the ADS errors ``noise``."""
     state = {"h_prev": h0}
@@ -656,26 +735,20 @@ def proposed_linear_propagation(
     heading_deg=45.0,
     lat0_deg=PAPER["lat0_deg"],
     height_m=5000.0,
-    dv0_mps=PAPER["dv0_mps"],
-    dp0_m=PAPER["dp0_m"],
-    gyro_drift_dph=PAPER["gyro_drift_dph"],
-    accel_bias_ug=PAPER["accel_bias_ug"],
-    ads_sigma_m=PAPER["ads_error_m"],
+    errors=ErrorSources(),
+    reading=CorrectionReading(),
     seed=0,
-    eq6_factor=1.0,
-    tilt_sign=1.0,
-    apply_tilt=True,
     step_s=10.0,
 ):
     """Proposed SINS/ADS: eq. (1) propagated linearly, corrected by eqs. (4)-(22) every ``T``.
 
     At every correction instant, with ``S = (S_x, S_y)`` the horizontal SINS displacement over
     the interval (``V T`` along the track), ``h`` the SINS up displacement over the interval
-    and ``dh^c = h_ADS - h_SINS = -δh + n`` (``n ~ N(0, ads_sigma_m²)``), the correction
-    ``X ← X + X^C`` of eq. (22) is applied with
+    and ``dh^c = h_ADS - h_SINS = -δh + n`` (``n ~ N(0, σ²)``, ``σ = errors.ads_sigma_m``), the
+    correction ``X ← X + X^C`` of eq. (22) is applied with
 
-    * ``φ_E^c, φ_N^c = c (S_y, -S_x) dh^c/(S²+h²)`` (eqs. (4)-(6); ``c = eq6_factor``),
-      multiplied by ``tilt_sign``;
+    * ``φ_E^c, φ_N^c = c (S_y, -S_x) dh^c/(S²+h²)`` (eqs. (4)-(6); ``c = reading.eq6_factor``),
+      multiplied by ``reading.tilt_sign`` (none without ``reading.apply_tilt``);
     * ``δV_U^c = S² V dh^c/(S²+h²)^{3/2}`` (eq. (13)), ``δV_{E,N}^c = -(S_{x,y} h/S²) δV_U^c``
       (eq. (11));
     * ``δS^c = -(h/S) dh^c`` along the track (eqs. (18)-(19)), turned into ``δL^c, δλ^c`` with
@@ -687,22 +760,12 @@ def proposed_linear_propagation(
     ----------
     duration_s, interval_s, speed_mps, heading_deg, lat0_deg, height_m : float
         Flight and correction interval (see ``pure_sins_linear_propagation``).
-    dv0_mps, dp0_m : float
-        Initial velocity (m/s) and position (m) error on each of E, N, U (§3).
-    gyro_drift_dph, accel_bias_ug : float or array_like
-        Sensor errors as in ``pure_sins_linear_propagation`` (§3: 0.01 °/h, 100 µg).
-    ads_sigma_m : float
-        Standard deviation of the ADS height error (m, §3: 1 m); 0 for an exact ADS.
+    errors : ErrorSources
+        Initial, sensor and ADS errors (default: §3's printed values).
+    reading : CorrectionReading
+        The reading of the attitude correction (default: eq. (5)'s factor, eq. (22) literally).
     seed : int
         Seed of the ADS error draw.
-    eq6_factor : float
-        1 (from eq. (5)) or 0.5 (eq. (6) as printed).
-    tilt_sign : {1, -1}
-        +1: eq. (22) read literally, ``φ ← φ + φ^c u`` (``reading="literal"`` of
-        ``proposed_closed_form``); -1: the attitude turned as the geometry of eqs. (2)-(4)
-        intends, computed pitch raised by ``dh^c/S`` (``reading="geometric"``).
-    apply_tilt : bool
-        False applies only the height, velocity and position corrections (control run).
     step_s : float
         Propagation step (s); must divide ``interval_s``.
 
@@ -710,22 +773,35 @@ def proposed_linear_propagation(
     -------
     dict
         ``final`` and ``max`` dicts as in ``pure_sins_linear_propagation``.
+
+    Raises
+    ------
+    TypeError
+        For ``errors`` that is not an ``ErrorSources`` or ``reading`` that is not a
+        ``CorrectionReading``.
+    ValueError
+        For a flight value out of range or a ``step_s`` that does not divide ``interval_s``.
     """
+    if not isinstance(errors, ErrorSources):
+        raise TypeError(f"errors must be an ErrorSources (e.g. ErrorSources(accel_bias_ug=50.0)), "
+                        f"got {type(errors).__name__}")
+    if not isinstance(reading, CorrectionReading):
+        raise TypeError(f"reading must be a CorrectionReading (e.g. CorrectionReading(tilt_sign=-1)), "
+                        f"got {type(reading).__name__}")
     T = positive(interval_s, "interval_s")
     step = positive(step_s, "step_s")
     if abs(T / step - round(T / step)) > 1e-9:
         raise ValueError(f"step_s ({step}) must divide interval_s ({T}) into whole steps")
-    sigma = nonnegative(ads_sigma_m, "ads_sigma_m")
-    c = positive(eq6_factor, "eq6_factor")
-    if tilt_sign not in (1, -1, 1.0, -1.0):
-        raise ValueError(f"tilt_sign must be +1 or -1, got {tilt_sign!r}")
+    sigma = nonnegative(errors.ads_sigma_m, "ads_sigma_m")
     t_end = positive(duration_s, "duration_s")
     rng = np.random.default_rng(seed)
     noise = sigma * rng.standard_normal(int(t_end // T) + 2)
-    correct = _ads_correction(T, c, tilt_sign, apply_tilt, noise, float(finite(dp0_m, "dp0_m")))
-    x0 = _initial_state(_latitude(lat0_deg), _height(height_m), finite(dv0_mps, "dv0_mps"), finite(dp0_m, "dp0_m"))
-    g = _axes("gyro_drift_dph", gyro_drift_dph)
-    a = _axes("accel_bias_ug", accel_bias_ug)
+    dp0 = finite(errors.dp0_m, "dp0_m")
+    correct = _ads_correction(T, positive(reading.eq6_factor, "eq6_factor"), reading.tilt_sign, reading.apply_tilt,
+                              noise, float(dp0))
+    x0 = _initial_state(_latitude(lat0_deg), _height(height_m), finite(errors.dv0_mps, "dv0_mps"), dp0)
+    g = _axes("gyro_drift_dph", errors.gyro_drift_dph)
+    a = _axes("accel_bias_ug", errors.accel_bias_ug)
     _, hist, _ = _propagate(
         duration_s, speed_mps, heading_deg, lat0_deg, height_m, x0, g, a, step,
         correction=correct, interval_s=T,

@@ -147,13 +147,16 @@ def q2c(q, c):
 # ----------------------------------------------------------------------------- strapdown step
 
 @njit(inline="always", **_NJ)
-def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vmode, href, vuref, gains, dampint, g_extra):
+def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vertical, dampint, g_extra):
     """One ENU strapdown update (chen2019 eq. (3-2)) on scalars: the one implementation of the step,
     inlined into :func:`strapdown_kernel` and :func:`sd_step`.
 
     Two-sample (previous + current) coning and sculling corrections, exact rotation-vector
     attitude update, Earth and transport rates and normal gravity at the mid-interval state
     extrapolated from the last two samples (one evaluation of the Earth model per step).
+
+    Everything arrives as scalars and tuples of scalars (values the compiler keeps in registers,
+    no array references), so the vertical channel's settings travel as one tuple.
 
     Parameters
     ----------
@@ -172,13 +175,10 @@ def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vmode, href, vuref, gai
     trig : tuple of 3 float
         [L, sin L, cos L] of the previous step's mid latitude: sin and cos are advanced by the
         angle-sum formulas when the latitude moved by less than 1e-5 rad, evaluated otherwise.
-    vmode : int
-        0 free, 1 hold (h, v_U set to ``href``, ``vuref`` after the step), 2 damped
-        (third-order loop on h - ``href``).
-    href, vuref : float
-        Reference height (m; modes 1 and 2) and vertical speed (m/s; mode 1).
-    gains : tuple of 3 float
-        Damping-loop gains k1, k2, k3 (mode 2).
+    vertical : tuple (int, float, float, tuple of 3 float)
+        The vertical channel (``vmode``, ``href``, ``vuref``, ``gains``): mode 0 free, 1 hold
+        (h, v_U set to ``href`` (m), ``vuref`` (m/s) after the step), 2 damped (third-order loop on
+        h - ``href`` with the gains k1, k2, k3).
     dampint : float
         Damping-loop integrator state (m/s²).
     g_extra : tuple of 3 float
@@ -202,6 +202,7 @@ def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vmode, href, vuref, gai
     L0, lam0, h0, ve0, vn0, vu0 = x
     pL, ph, pve, pvn, pvu = x_p
     tL, tS, tC = trig
+    vmode, href, vuref, gains = vertical
     k1, k2, k3 = gains
     gx, gy, gz = g_extra
     # extrapolated mid-interval state and its Earth model
@@ -296,6 +297,10 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
     Loads the arrays into scalars, runs :func:`_sd_step_s` (the step of :func:`strapdown_kernel`,
     compiled into both) and stores the results back.
 
+    Called at every IMU step of every run of the closed-loop filter, it takes the state arrays one
+    by one, not a bundle: a compiled helper that receives a bundle takes a reference to each of its
+    arrays per call, which costs more than the step's arithmetic (see CONTRIBUTING, "Library").
+
     Parameters
     ----------
     T : float
@@ -336,7 +341,7 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
         T, (dth[0], dth[1], dth[2]), (dvv[0], dvv[1], dvv[2]), (dth_prev[0], dth_prev[1], dth_prev[2]),
         (dv_prev[0], dv_prev[1], dv_prev[2]), (st[0], st[1], st[2], st[3], st[4], st[5]),
         (st_prev[0], st_prev[2], st_prev[3], st_prev[4], st_prev[5]), (q[0], q[1], q[2], q[3]),
-        (trig[0], trig[1], trig[2]), vmode, h_ref, vu_ref, gk, dampint, (g_extra[0], g_extra[1], g_extra[2]))
+        (trig[0], trig[1], trig[2]), (vmode, h_ref, vu_ref, gk), dampint, (g_extra[0], g_extra[1], g_extra[2]))
     for i in range(6):
         st_prev[i] = st[i]
     st[0], st[1], st[2], st[3], st[4], st[5] = x
@@ -405,7 +410,7 @@ def strapdown_kernel(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains, out_s
         x_new, q, trig, dampint = _sd_step_s(
             dt[k], (dtheta[k, 0], dtheta[k, 1], dtheta[k, 2]), (dv[k, 0], dv[k, 1], dv[k, 2]),
             (dtheta[kp, 0], dtheta[kp, 1], dtheta[kp, 2]), (dv[kp, 0], dv[kp, 1], dv[kp, 2]), x, x_p, q, trig,
-            vmode, href, vuref, gk, dampint, (0.0, 0.0, 0.0))
+            (vmode, href, vuref, gk), dampint, (0.0, 0.0, 0.0))
         x_p = (x[0], x[2], x[3], x[4], x[5])
         x = x_new
         for i in range(6):
@@ -456,6 +461,11 @@ def build_F(lat, h, ve, vn, vu, c, f_b, w_b, fconst, blk_target, blk_kind, blk_s
 
     State order: [δL, δλ, δh, δvE, δvN, δvU, φE, φN, φU, augmented blocks...].
     ``fconst`` holds the constant part (block dynamics, gravity-state output couplings).
+
+    Called from Python once per F (``ErrorModel.F``, every interval of the error propagation), it
+    takes the arrays one by one, not a bundle: numba's dispatcher types a tuple of arrays member by
+    member on its slow path (a namedtuple of eight arrays: 1.7 µs per call against 0.6 µs for the
+    eight arrays), more than the whole call of this kernel costs (0.75 µs for the 15-state F).
     """
     fn0 = c[0, 0] * f_b[0] + c[0, 1] * f_b[1] + c[0, 2] * f_b[2]
     fn1 = c[1, 0] * f_b[0] + c[1, 1] * f_b[1] + c[1, 2] * f_b[2]
@@ -764,7 +774,11 @@ def interval_discretize(F, qc_const, Cm, q_accel, q_gyro, T, order, Qc, Phi, Qd,
     """(Φ, Q_d) of one GNSS interval of length ``T``: Qc = ``qc_const`` plus the navigation white
     noise G diag(q) Gᵀ with G = [0; C; -C] (``Cm`` the interval-mean C_b^n, accelerometer and gyro
     PSDs ``q_accel``, ``q_gyro``), then the Van Loan series of :func:`discretize_series_into`
-    (scratch ``nzc``, ``nzv``, ``cnt``)."""
+    (scratch ``nzc``, ``nzv``, ``cnt``).
+
+    Inlined into the filter's epoch (once per GNSS interval), it takes its arrays one by one,
+    not a bundle: even inlined, a helper that receives a bundle takes a reference to each of its
+    arrays per call (see CONTRIBUTING, "Library")."""
     n = Qc.shape[0]
     for i in range(n):
         for jj in range(n):

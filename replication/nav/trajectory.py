@@ -687,6 +687,10 @@ class Trajectory:
 
 _GL_CACHE: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
+#: Samples :func:`generate` evaluates at a time (a memory bound: the sensor outputs of a chunk
+#: and of its quadrature nodes are held at once); the result does not depend on it.
+_GENERATE_CHUNK = 50_000
+
 
 def _gauss(nq):
     if nq not in _GL_CACHE:
@@ -712,8 +716,7 @@ def _sensor_outputs(seg, tau, start, sol, polar_limit_deg):
 
 def generate(segments, lat0: float, lon0: float, h0: float, *, dt: float = 0.01, heading: float = 0.0,
              speed: float = 0.0, v_enu=None, pitch: float | None = None, roll: float = 0.0,
-             quadrature_nodes: int = 3, polar_limit_deg: float = earth.POLAR_LIMIT_DEG,
-             chunk: int = 50_000) -> Trajectory:
+             quadrature_nodes: int = 3, polar_limit_deg: float = earth.POLAR_LIMIT_DEG) -> Trajectory:
     """Generate a trajectory from ``segments`` starting at (lat0, lon0, h0).
 
     The initial motion is ``speed`` m/s along ``heading`` (or an explicit ``v_enu``), with pitch
@@ -749,8 +752,6 @@ def generate(segments, lat0: float, lon0: float, h0: float, *, dt: float = 0.01,
     polar_limit_deg : float, optional
         Latitude [deg] the trajectory must not reach, default
         :data:`~replication.nav.earth.POLAR_LIMIT_DEG`.
-    chunk : int, optional
-        Samples evaluated at a time (memory bound), default 50 000.
 
     Returns
     -------
@@ -822,15 +823,15 @@ def generate(segments, lat0: float, lon0: float, h0: float, *, dt: float = 0.01,
                         dense_output=True).sol
         # sample instants
         taus = np.arange(m + 1) * dt
-        for c0 in range(0, m + 1, chunk):
-            tt = taus[c0:c0 + chunk]
+        for c0 in range(0, m + 1, _GENERATE_CHUNK):
+            tt = taus[c0:c0 + _GENERATE_CHUNK]
             lat, lon, h, v, hpr, w, f = _sensor_outputs(p, tt, s_local, sol, polar_limit_deg)
             sl = slice(k0 + c0, k0 + c0 + len(tt))
             out["lat"][sl], out["lon"][sl], out["h"][sl] = lat, lon, h
             out["v"][sl], out["hpr"][sl], out["w"][sl], out["f"][sl] = v, hpr, w, f
         # increments by Gauss-Legendre quadrature
-        for c0 in range(0, m, chunk):
-            ii = np.arange(c0, min(m, c0 + chunk))
+        for c0 in range(0, m, _GENERATE_CHUNK):
+            ii = np.arange(c0, min(m, c0 + _GENERATE_CHUNK))
             nodes = ((ii[:, None] + 0.5) * dt + 0.5 * dt * xg[None, :]).ravel()
             _, _, _, _, _, w, f = _sensor_outputs(p, nodes, s_local, sol, polar_limit_deg)
             wts = 0.5 * dt * wg

@@ -57,9 +57,10 @@ __all__ = [
     "specific_force_nav", "direct_difference", "direct_difference_error", "attitude_error_equivalent",
     "gnss_acceleration", "lowpass", "differentiation_noise_std", "filtered_differentiation_noise_std",
     "ar_companion", "ar_state_space", "GravityAugmentation", "gravity_augmentation",
-    "augment_transition", "specific_force_measurement", "gauss_markov", "analog_direct_difference",
+    "augment_transition", "specific_force_measurement", "gauss_markov", "SurveyLayout", "analog_direct_difference",
     "survey_flight", "local_east_north", "disturbed_increments", "direct_difference_from_filter",
-    "compensated_increments", "attitude_position_errors", "photo_epochs", "compensation_run", "compensation_first_pass",
+    "compensated_increments", "attitude_position_errors", "photo_epochs", "COMPENSATION_METHODS", "CompensationSettings", "compensation_run",
+    "compensation_first_pass",
     "compensation_runs",
     "consistent_kinematics", "ar_continuous", "ar_gravity_block", "slope_weights", "augmented_filter",
 ]
@@ -876,13 +877,56 @@ def specific_force_measurement(f_n, v_gnss, a_gnss, lat, h) -> np.ndarray:
 
 # --------------------------------------------------------------------------- analog series
 
-def analog_direct_difference(field_: PlanarGravityField, *, n_lines: int, line_length: float, spacing: float,
-                             speed: float, seed: int, gnss_dt: float = 0.1, sigma_v: float = 0.03,
-                             cutoff_period: float = 100.0, level_error_std: float = 0.0,
-                             level_error_tau: float = 600.0, out_dt: float = 1.0, start=(0.0, 0.0)) -> dict:
+@dataclass(frozen=True)
+class SurveyLayout:
+    """The layout of an east-west line survey (chen2019 Table 4-47), as :func:`survey_lines` flies it.
+
+    Parameters
+    ----------
+    n_lines : int
+        Number of survey lines (positive).
+    line_length : float
+        Length of each line [m].
+    spacing : float
+        Distance between lines [m].
+    speed : float
+        Ground speed [m/s].
+    start : tuple of float
+        East, north offset of the pattern in the field [m].
+
+    Raises
+    ------
+    ValueError
+        When ``n_lines`` is not a positive integer, a length or the speed is not a positive number,
+        or ``start`` is not two finite numbers.
+    """
+
+    n_lines: int
+    line_length: float
+    spacing: float
+    speed: float
+    start: tuple = (0.0, 0.0)
+
+    def __post_init__(self):
+        if isinstance(self.n_lines, bool) or not isinstance(self.n_lines, (int, np.integer)) or self.n_lines < 1:
+            raise ValueError(f"n_lines must be a positive integer, got {self.n_lines!r}")
+        for name, unit in (("line_length", "m"), ("spacing", "m"), ("speed", "m/s")):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not (isinstance(v, (int, float, np.integer, np.floating)) and np.isfinite(v)
+                                           and v > 0):
+                raise ValueError(f"{name} must be a positive finite number ({unit}), got {v!r}")
+        start = self.start
+        if not (isinstance(start, (tuple, list, np.ndarray)) and len(start) == 2
+                and all(isinstance(x, (int, float, np.integer, np.floating)) and np.isfinite(x) for x in start)):
+            raise ValueError(f"start must be two finite numbers (east, north offset in m), got {start!r}")
+
+
+def analog_direct_difference(field_: PlanarGravityField, layout: SurveyLayout, *, seed: int, gnss_dt: float = 0.1,
+                             sigma_v: float = 0.03, cutoff_period: float = 100.0, level_error_std: float = 0.0,
+                             level_error_tau: float = 600.0, out_dt: float = 1.0) -> dict:
     """A simulated direct-difference disturbance series along survey lines (an analog, not flight data).
 
-    The true disturbance is sampled along :func:`survey_lines` every ``gnss_dt``; the direct
+    The true disturbance is sampled along the survey ``layout`` (:func:`survey_lines`) every ``gnss_dt``; the direct
     difference (3-7) adds the errors of (3-8) that dominate for a navigation-grade SINS: the
     acceleration noise of differentiated GNSS velocity (white, ``sigma_v`` per sample) and the
     level attitude error psi (first-order Gauss-Markov) acting on f^n ~ [0, 0, g]; the sum is
@@ -893,14 +937,8 @@ def analog_direct_difference(field_: PlanarGravityField, *, n_lines: int, line_l
     ----------
     field_ : PlanarGravityField
         The true disturbance field.
-    n_lines : int
-        Number of survey lines.
-    line_length : float
-        Length of each line [m].
-    spacing : float
-        Distance between lines [m].
-    speed : float
-        Ground speed [m/s].
+    layout : SurveyLayout
+        The survey lines, their speed and the pattern's offset in the field.
     seed : int
         Seed of the noise draws.
     gnss_dt : float
@@ -915,8 +953,6 @@ def analog_direct_difference(field_: PlanarGravityField, *, n_lines: int, line_l
         Correlation time of the level attitude error [s].
     out_dt : float
         Output interval [s], an integer multiple of ``gnss_dt``.
-    start : tuple of float
-        East, north offset of the pattern in the field [m].
 
     Returns
     -------
@@ -928,11 +964,16 @@ def analog_direct_difference(field_: PlanarGravityField, *, n_lines: int, line_l
     ------
     ValueError
         When ``out_dt`` is not a multiple of ``gnss_dt`` or the survey is too short for the filter.
+    TypeError
+        When ``layout`` is not a :class:`SurveyLayout`.
     """
+    if not isinstance(layout, SurveyLayout):
+        raise TypeError(f"layout must be a SurveyLayout (e.g. SurveyLayout(n_lines=4, line_length=20e3, "
+                        f"spacing=500.0, speed=30.0)), got {type(layout).__name__}")
     step = int(round(out_dt / gnss_dt))
     if step < 1 or abs(step * gnss_dt - out_dt) > 1e-9:
         raise ValueError("out_dt must be an integer multiple of gnss_dt")
-    tr = survey_lines(n_lines, line_length, spacing, speed, gnss_dt, start=start)
+    tr = survey_lines(layout.n_lines, layout.line_length, layout.spacing, layout.speed, gnss_dt, start=layout.start)
     rng = np.random.default_rng(seed)
     dg = field_.sample(tr["east"], tr["north"])
     n = dg.shape[0]
@@ -1251,15 +1292,80 @@ def compensation_first_pass(traj, field_: PlanarGravityField, *, seed: int, orig
     return dict(key=(seed, id(field_), tuple(offset)), dth=dth, dvm=dvm, gnss=gnss, m15=m15, init=init, r1=r1, dg=dg)
 
 
+COMPENSATION_METHODS = ("normal", "direct", "state")
+"""The methods of chen2019 §4.3 that the ``methods`` of a :class:`CompensationSettings` may name."""
+
+
+@dataclass(frozen=True)
+class CompensationSettings:
+    """The settings of the compensation methods of :func:`compensation_run` (chen2019 §4.3): what
+    the truth and the normal-gravity filter (:func:`compensation_first_pass`) do not depend on.
+
+    Parameters
+    ----------
+    cutoff_period : float
+        Cut-off period of the direct difference's low-pass [s], positive.
+    ar_interval : float or None
+        Sampling interval of the AR identification and of the specific-force windows [s], a
+        multiple of the GNSS interval (``None``: ``cutoff_period / 2``).
+    true_model : tuple (sigma, beta) or None
+        Per-axis stationary σ [m/s²] and inverse correlation time β [1/s] of the field's own
+        Gauss-Markov model, for the ``true-model`` method (``None``: not run).
+    specific_force : bool
+        Use the specific-force rows of (3-18).
+    gauss_markov_reference : bool
+        Also run ``state-gm``.
+    methods : tuple of str
+        Which of :data:`COMPENSATION_METHODS` are returned (``normal`` is always run: step 1
+        needs it; ``state`` always returned).
+
+    Raises
+    ------
+    ValueError
+        For a ``cutoff_period`` or ``ar_interval`` that is not a positive number, a ``true_model``
+        that is not a (sigma, beta) pair, or a method not in :data:`COMPENSATION_METHODS`.
+    TypeError
+        For ``specific_force`` or ``gauss_markov_reference`` not a bool, or ``methods`` not a
+        sequence of names.
+    """
+
+    cutoff_period: float = 100.0
+    ar_interval: float | None = None
+    true_model: tuple | None = None
+    specific_force: bool = True
+    gauss_markov_reference: bool = False
+    methods: tuple = COMPENSATION_METHODS
+
+    def __post_init__(self):
+        for name in ("cutoff_period", "ar_interval"):
+            v = getattr(self, name)
+            if name == "ar_interval" and v is None:
+                continue
+            if isinstance(v, bool) or not (isinstance(v, (int, float, np.integer, np.floating)) and np.isfinite(v)
+                                           and v > 0):
+                raise ValueError(f"{name} must be a positive number of seconds, got {v!r}")
+        if self.true_model is not None and len(self.true_model) != 2:
+            raise ValueError("true_model must be None or a (sigma [m/s²], beta [1/s]) pair of per-axis values")
+        for name in ("specific_force", "gauss_markov_reference"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise TypeError(f"{name} must be True or False, got {getattr(self, name)!r}")
+        if isinstance(self.methods, str) or not isinstance(self.methods, (tuple, list)):
+            raise TypeError(f"methods must be a tuple of method names from {COMPENSATION_METHODS}, "
+                            f"got {self.methods!r}")
+        unknown = [m for m in self.methods if m not in COMPENSATION_METHODS]
+        if unknown:
+            raise ValueError(f"methods {unknown} unknown; choose from {COMPENSATION_METHODS}")
+        object.__setattr__(self, "methods", tuple(self.methods))
+
+
 def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, offset, photos, imu: dict, gnss_kw: dict,
-                     model_kw: dict, cutoff_period: float = 100.0, ar_interval: float | None = None,
-                     true_model: tuple | None = None, specific_force: bool = True,
-                     gauss_markov_reference: bool = False, methods=("normal", "direct", "state"),
+                     model_kw: dict, settings: CompensationSettings = CompensationSettings(),
                      first_pass: dict | None = None) -> dict:
     """One Monte-Carlo run of the three compensation methods of chen2019 §4.3 (Table 4-50 analog).
 
     The truth flies through ``field_`` (sampled at the planar offsets of the track from
-    ``origin``, shifted by ``offset``); IMU errors and GNSS are drawn from ``seed``.  Methods:
+    ``origin``, shifted by ``offset``); IMU errors and GNSS are drawn from ``seed``.  Methods
+    (their settings in ``settings``, a :class:`CompensationSettings`):
 
     * ``normal`` — 15-state closed loop (:func:`replication.nav.kalman.closed_loop`), normal
       gravity;
@@ -1302,20 +1408,9 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
         Keyword arguments of :func:`replication.nav.sensors.gnss_measurements`.
     model_kw : dict
         Keyword arguments of :func:`replication.nav.errors.model_15` (initial σ).
-    cutoff_period : float
-        Cut-off period of the direct difference's low-pass [s].
-    ar_interval : float or None
-        Sampling interval of the AR identification and of the specific-force windows [s], a
-        multiple of the GNSS interval (``None``: ``cutoff_period / 2``).
-    true_model : tuple (sigma, beta) or None
-        Per-axis stationary σ [m/s²] and inverse correlation time β [1/s] of the field's own
-        Gauss-Markov model, for the ``true-model`` method.
-    specific_force : bool
-        Use the specific-force rows of (3-18).
-    gauss_markov_reference : bool
-        Also run ``state-gm``.
-    methods : sequence of str
-        Which of ``normal``/``direct`` are returned (``normal`` is always run: step 1 needs it).
+    settings : CompensationSettings
+        Cut-off period, AR interval, the optional reference methods and which methods are
+        returned (default: ``CompensationSettings()``).
     first_pass : dict or None
         From :func:`compensation_first_pass` with the same seed, field and offset: reuses the truth
         and the normal-gravity filter of an earlier call — they do not depend on the cut-off, the AR
@@ -1335,8 +1430,14 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
     ValueError
         When ``first_pass`` belongs to another seed, field or offset, or an AR(3) fit is not
         stationary.
+    TypeError
+        When ``settings`` is not a :class:`CompensationSettings`.
     """
-
+    if not isinstance(settings, CompensationSettings):
+        raise TypeError(f"settings must be a CompensationSettings (e.g. CompensationSettings(cutoff_period=100.0)), "
+                        f"got {type(settings).__name__}")
+    cutoff_period, ar_interval, true_model = settings.cutoff_period, settings.ar_interval, settings.true_model
+    specific_force, methods = settings.specific_force, settings.methods
     fp = compensation_first_pass(traj, field_, seed=seed, origin=origin, offset=offset, imu=imu, gnss_kw=gnss_kw,
                                  model_kw=model_kw) if first_pass is None else first_pass
     if fp.get("key") != (seed, id(field_), tuple(offset)):
@@ -1371,7 +1472,7 @@ def compensation_run(traj, field_: PlanarGravityField, *, seed: int, origin, off
     kw = dict(P0=P0, sf_interval=ar_dt, discrete=(aug.A, aug.Q))
     sol3 = augmented_filter(traj.t, dth, dvm, init, gnss, m3, use_specific_force=specific_force, **kw)
     out["state"] = attitude_position_errors(sol3, traj, photos)
-    if gauss_markov_reference:
+    if settings.gauss_markov_reference:
         sig = np.array([a[2]["std"] for a in ar])
         beta = np.array([1.0 / a[2]["correlation_time"] for a in ar])
         r3 = kf.closed_loop(traj.t, dth, dvm, init, gnss, m15.extend(er.gravity_shaping(sig, beta)))
@@ -1417,7 +1518,9 @@ def compensation_runs(traj, fields, seeds, *, workers: int = 2, executor=None, c
     progress : bool or None, optional
         Progress bar of the finished runs (``None``: on unless ``REPLICATION_PROGRESS=0``).
     **kw : dict, optional
-        Keyword arguments of :func:`compensation_run` (not ``first_pass``).
+        Keyword arguments of :func:`compensation_run`: the survey's ``origin``, ``offset``,
+        ``photos``, ``imu``, ``gnss_kw``, ``model_kw`` and the methods' ``settings`` (not
+        ``first_pass``).
 
     Returns
     -------

@@ -311,7 +311,11 @@ def truth_step(t, p, cbi0, cbi1, vi0, vi1, gi0, gi1, dt, cbe, re, rde, dth, dvl,
     """One step of the truth: the true state at ``t`` (C_b^e, r^e, ṙ^e into ``cbe``, ``re``,
     ``rde``), the ideal increments of the interval ending at ``t`` from the previous state
     (``cbi0``, ``vi0``, ``gi0``) into ``dth``, ``dvl``, which then becomes the state at ``t``;
-    returns the true grid-east and grid-north velocity (the damping reference)."""
+    returns the true grid-east and grid-north velocity (the damping reference).
+
+    Called at every step of every run, it takes the truth's arrays one by one, not a bundle: the
+    same step with its fourteen arrays in a namedtuple ran a third slower (570 against 430 ns per
+    step), a compiled helper taking a reference to each array of a bundle it receives."""
     truth_inertial(t, p, cbi1, vi1, gi1, cbe, re, rde)
     ideal_increments(cbi0, cbi1, vi0, vi1, gi0, gi1, dt, dth, dvl)
     for a in range(3):
@@ -530,11 +534,18 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
                                 cbe[a, b] = trec[j, 3 * a + b]
                             re[a] = trec[j, 9 + a]
                             rde[a] = trec[j, 12 + a]
-                    _record(rec, i, j, c, v, pos, cbe, re, rde, tge, tgn, tu, tmp)
+                    _record(rec, i, j, c, v, pos, cbe, re, rde)
 
 
 @njit(cache=True)
-def _record(rec, i, j, c, v, pos, cbe, re, rde, tge, tgn, tu, tmp):
+def _record(rec, i, j, c, v, pos, cbe, re, rde):
+    """Record ``j`` of run ``i``: REC_FIELDS of the navigator (``c`` = C_b^p, grid velocity ``v``,
+    ECEF position ``pos``) against the truth (``cbe``, ``re``, ``rde``).  Its workspace is its own
+    (a record comes every ``rec_every`` steps, so the four small arrays cost nothing per step)."""
+    tge = np.empty(3)
+    tgn = np.empty(3)
+    tu = np.empty(3)
+    tmp = np.empty((3, 3))
     grid_axes(re, tge, tgn, tu)
     # true C_b^G = C_e^G C_b^e
     for col in range(3):
@@ -561,13 +572,14 @@ def _record(rec, i, j, c, v, pos, cbe, re, rde, tge, tgn, tu, tmp):
 # ----------------------------------------------------------------------------- ECEF reference INS
 
 @njit(cache=True, parallel=True)
-def run_ecef(k0, k1, dt, traj, sens, cbe_nav, ve, r, rng, rec_pos, rec_vel, rec_att, rec_every):
+def run_ecef(k0, k1, dt, traj, sens, cbe_nav, ve, r, rng, rec, rec_every):
     """Reference strapdown INS mechanized in ECEF (no damping), same IMU model as run_grid.
 
     Ċ_b^e = C_b^e[ω_ib×] - [ω_ie×]C_b^e;  v̇^e = C_b^e f - 2ω_ie × v^e + g^e (normal gravity,
     -γu); ṙ^e = v^e.  The vertical channel is held at sea level as in run_grid (the component
-    of v^e along the normal is removed and r projected on the ellipsoid).  Records ECEF position,
-    ECEF velocity and C_b^e (flattened) every ``rec_every`` steps.
+    of v^e along the normal is removed and r projected on the ellipsoid).  Records into ``rec``
+    (runs × records × 15) the ECEF position (columns 0-2), ECEF velocity (3-5) and C_b^e
+    (6-14, row-major) every ``rec_every`` steps.
     """
     nrun = traj.shape[0]
     for i in prange(nrun):
@@ -642,11 +654,11 @@ def run_ecef(k0, k1, dt, traj, sens, cbe_nav, ve, r, rng, rec_pos, rec_vel, rec_
                     cbi0[a, 0], cbi0[a, 1], cbi0[a, 2] = cbi1[a, 0], cbi1[a, 1], cbi1[a, 2]
                     vi0[a] = vi1[a]
                     gi0[a] = gi1[a]
-            if rec_pos.shape[1] > 0 and k % rec_every == 0:
+            if rec.shape[1] > 0 and k % rec_every == 0:
                 j = (k - k0) // rec_every
-                if j < rec_pos.shape[1]:
+                if j < rec.shape[1]:
                     for a in range(3):
-                        rec_pos[i, j, a] = pos[a]
-                        rec_vel[i, j, a] = v[a]
+                        rec[i, j, a] = pos[a]
+                        rec[i, j, 3 + a] = v[a]
                         for b in range(3):
-                            rec_att[i, j, 3 * a + b] = c[a, b]
+                            rec[i, j, 6 + 3 * a + b] = c[a, b]

@@ -26,6 +26,7 @@ the true rate (strapdown convention); fang2020's ψ equation (18)-(24) is writte
 
 from __future__ import annotations
 
+from collections import namedtuple
 from dataclasses import dataclass, field, replace
 from functools import partial
 
@@ -1274,10 +1275,42 @@ def true_psi(sc, t, phases, cbp, r):
     return np.einsum("nij,nj->ni", c_g_oepq, phi - theta), re
 
 
-def _run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i, coef, damping, pos_damped,
-              rec, rec_every, acc_every):
-    """:func:`_polar_kernels.run_grid` over steps k0..k1; runs that share one trajectory (every row
-    of ``traj`` equal: a rocking-phase set shared by all runs) get its truth computed once by
+GridState = namedtuple("GridState", ["cbp", "vg", "r", "damp", "comp", "rng", "acc_e", "acc_i"])
+GridState.__doc__ = """The grid INS's state of n runs (runs on the first axis), built by :func:`initial_state`
+and advanced in place by :func:`run_segment`.
+
+Attributes
+----------
+cbp : numpy.ndarray, shape (n, 3, 3)
+    C_b^p, the attitude of the body in the platform (computed grid) frame.
+vg : numpy.ndarray, shape (n, 3)
+    Grid velocity [m/s].
+r : numpy.ndarray, shape (n, 3)
+    ECEF position [m].
+damp : numpy.ndarray, shape (n, 2, 2)
+    Memory of the discrete damping filter H_y (fang2020 eq. (1)).
+comp : numpy.ndarray, shape (n, 3)
+    Drift compensation subtracted from the gyro outputs [rad/s].
+rng : numpy.ndarray of uint64, shape (n,)
+    State of each run's noise stream.
+acc_e, acc_i : numpy.ndarray, shape (n, 3, 3)
+    Σ C_b^e Δt and Σ C_b^i Δt of the navigator's attitude [s] (for the interval-mean attitude of
+    :func:`two_point_drift`).
+"""
+
+
+def _grid_state(state):
+    """``state`` checked to be a :class:`GridState` (what :func:`initial_state` returns)."""
+    if not isinstance(state, GridState):
+        raise TypeError(f"state must be a GridState (the fourth value initial_state returns), "
+                        f"got {type(state).__name__}")
+    return state
+
+
+def _run_grid(k0, k1, dt, traj, sens, state, coef, damping, pos_damped, rec, rec_every, acc_every):
+    """:func:`_polar_kernels.run_grid` over steps k0..k1 of the runs' :class:`GridState` ``state``
+    (advanced in place); runs that share one trajectory (every row of ``traj`` equal: a
+    rocking-phase set shared by all runs) get its truth computed once by
     :func:`_polar_kernels.truth_table` (bit-identical to each run computing it)."""
     shared = traj.shape[0] > 1 and bool(np.all(traj == traj[0]))
     if shared:
@@ -1286,7 +1319,7 @@ def _run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
         _k.truth_table(k0, k1, dt, np.ascontiguousarray(traj[0]), rec_every, tin, trec)
     else:
         tin, trec = np.empty((0, _k.TRUTH_STEP_FIELDS)), np.empty((0, _k.TRUTH_RECORD_FIELDS))
-    _k.run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i, coef, damping, pos_damped,
+    _k.run_grid(k0, k1, dt, traj, sens, *state, coef, damping, pos_damped,
                 rec, rec_every, acc_every, 1 if shared else 0, tin, trec)
 
 
@@ -1305,18 +1338,23 @@ def run_segment(sc, k0, k1, traj, sens, state):
         Trajectory parameters of the n runs (:func:`initial_state`).
     sens : numpy.ndarray, shape (n, N_SENS)
         Sensor parameters of the n runs (:func:`initial_state`).
-    state : dict
+    state : GridState
         Navigator state of :func:`initial_state`, updated in place.
 
     Returns
     -------
-    state : dict
+    state : GridState
         The same ``state`` object, advanced to step k1.
+
+    Raises
+    ------
+    TypeError
+        If ``state`` is not a :class:`GridState`.
     """
+    _grid_state(state)
     rec = np.zeros((traj.shape[0], 0, _k.N_REC))
-    _run_grid(k0, k1, sc.dt, traj, sens, state["cbp"], state["vg"], state["r"], state["damp"],
-              state["comp"], state["rng"], state["acc_e"], state["acc_i"], discretize_damping(sc.dt),
-              1 if sc.damping else 0, _pos_flag(sc), rec, max(k1 - k0, 1), 10)
+    _run_grid(k0, k1, sc.dt, traj, sens, state, discretize_damping(sc.dt), 1 if sc.damping else 0,
+              _pos_flag(sc), rec, max(k1 - k0, 1), 10)
     return state
 
 
@@ -1342,11 +1380,10 @@ def initial_state(sc, n_runs, seed):
     sens : numpy.ndarray, shape (n, N_SENS)
         Sensor parameters (``_polar_kernels.SENS_FIELDS``): gyro drift [rad/s], accelerometer bias
         [m/s²], white-noise levels.
-    state : dict
-        ``cbp`` (n, 3, 3) C_b^p with the initial attitude errors, ``vg`` (n, 3) grid velocity
-        [m/s], ``r`` (n, 3) ECEF position [m], ``damp`` (n, 2, 2) damping-filter memory, ``comp``
-        (n, 3) drift compensation [rad/s], ``rng`` (n,) uint64 noise seeds, ``acc_e``, ``acc_i``
-        (n, 3, 3) attitude accumulators.
+    state : GridState
+        ``cbp`` with the initial attitude errors, ``vg`` the true grid velocity [m/s], ``r`` the
+        true ECEF position [m], ``rng`` one noise seed per run, the damping memory, compensation
+        and accumulators zero.
     """
     rng = np.random.default_rng(seed)
     phases = rng.uniform(0, 2 * np.pi, (n_runs, 3))
@@ -1358,8 +1395,8 @@ def initial_state(sc, n_runs, seed):
     sens[:, 0:3], sens[:, 3:6] = sc.gyro_drift, sc.accel_bias
     sens[:, 6], sens[:, 7] = sc.gyro_white, sc.accel_white
     cbp, vg, r = _initial_state(sc, phases)
-    state = {"cbp": cbp, "vg": vg, "r": r, "damp": np.zeros((n_runs, 2, 2)), "comp": np.zeros((n_runs, 3)),
-             "rng": seeds, "acc_e": np.zeros((n_runs, 3, 3)), "acc_i": np.zeros((n_runs, 3, 3))}
+    state = GridState(cbp=cbp, vg=vg, r=r, damp=np.zeros((n_runs, 2, 2)), comp=np.zeros((n_runs, 3)), rng=seeds,
+                      acc_e=np.zeros((n_runs, 3, 3)), acc_i=np.zeros((n_runs, 3, 3)))
     return phases, traj, sens, state
 
 
@@ -1453,7 +1490,7 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
 
     def share(r0, r1):                  # the chunk's runs of the draws made above, as their own arrays
         return (phases[r0:r1].copy(), traj[r0:r1].copy(), sens[r0:r1].copy(),
-                {k: v[r0:r1].copy() for k, v in st.items()})
+                GridState(*(v[r0:r1].copy() for v in st)))
 
     parts = PAR.run_chunks(partial(_simulate_runs, sc, opts), n_runs, executor=executor, chunk_runs=chunk_runs,
                            progress=progress, desc="fang2020 runs", chunk_args=share)
@@ -1464,49 +1501,46 @@ def simulate(sc, n_runs, seed, *, record_every=10.0, reset_only_runs=1, estimato
 
 def _simulate_runs(sc, opts, r0, r1, phases, traj, sens, st) -> SimulationResult:
     """Runs ``r0 … r1−1`` of :func:`simulate` (arguments validated; a picklable task), from their share
-    of :func:`initial_state` (``phases``, ``traj``, ``sens`` and the arrays of ``st``, runs on the
-    first axis); ``opts["reset_only_runs"]`` and ``opts["continued_runs"]`` count the batch's first runs."""
+    of :func:`initial_state` (``phases``, ``traj``, ``sens`` and the :class:`GridState` ``st``, runs on
+    the first axis); ``opts["reset_only_runs"]`` and ``opts["continued_runs"]`` count the batch's first runs."""
     n_runs = r1 - r0
     rec_every_k, estimator, heading_observation = opts["rec_every_k"], opts["estimator"], opts["heading_observation"]
     m = min(max(opts["reset_only_runs"] - r0, 0), n_runs)      # this chunk's runs among the reset-only ones
     n_cont = min(max(opts["continued_runs"] - r0, 0), n_runs)  # ... and among the continued ones
     dt, k_end = sc.dt, opts["k_end"]
     k1, k2 = sc.steps(sc.fix_times[0]), sc.steps(sc.fix_times[1])
-    cbp, vg, r, damp, comp, seeds = st["cbp"], st["vg"], st["r"], st["damp"], st["comp"], st["rng"]
     coef = discretize_damping(dt)
     n_rec = k_end // rec_every_k + 1
     rec = np.full((n_runs, n_rec, _k.N_REC), np.nan)
-    acc_e = np.zeros((n_runs, 3, 3))
-    acc_i = np.zeros((n_runs, 3, 3))
     flag = 1 if sc.damping else 0
     acc_every = 10
 
-    def seg(ka, kb, cbp_, vg_, r_, damp_, comp_, rng_, acc_e_, acc_i_, traj_, sens_, rec_):
+    def seg(ka, kb, st_, traj_, sens_, rec_):
         j0 = ka // rec_every_k
         sub = np.zeros((traj_.shape[0], (kb - ka) // rec_every_k + 1, _k.N_REC))
-        _run_grid(ka, kb, dt, traj_, sens_, cbp_, vg_, r_, damp_, comp_, rng_, acc_e_, acc_i_,
-                  coef, flag, _pos_flag(sc), sub, rec_every_k, acc_every)
+        _run_grid(ka, kb, dt, traj_, sens_, st_, coef, flag, _pos_flag(sc), sub, rec_every_k, acc_every)
         rec_[:, j0:j0 + sub.shape[1]] = sub
 
-    seg(0, k1, cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens, rec)
+    seg(0, k1, st, traj, sens, rec)
     e1 = np.array(sc.fix_position_error, float)
-    _fix(sc, sc.fix_times[0], phases, cbp, r, e1, sc.fix_heading_error, heading_observation)
-    acc_e[:] = 0.0
-    acc_i[:] = 0.0
-    seg(k1, k2, cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens, rec)
-    p2, r_ref2, cbg2 = _fix(sc, sc.fix_times[1], phases, cbp, r, e1, sc.fix_heading_error, heading_observation)
+    _fix(sc, sc.fix_times[0], phases, st.cbp, st.r, e1, sc.fix_heading_error, heading_observation)
+    st.acc_e[:] = 0.0
+    st.acc_i[:] = 0.0
+    seg(k1, k2, st, traj, sens, rec)
+    p2, r_ref2, cbg2 = _fix(sc, sc.fix_times[1], phases, st.cbp, st.r, e1, sc.fix_heading_error, heading_observation)
     tau = sc.fix_times[1] - sc.fix_times[0]
     est = {"printed": two_point_drift(p2, r_ref2, cbg2, tau),
-           "mean-attitude": two_point_drift(p2, r_ref2, None, tau, mean_c_b_e=acc_e / tau)}
-    st = [x[:m].copy() for x in (cbp, vg, r, damp, comp, seeds, acc_e, acc_i, traj, sens)]
+           "mean-attitude": two_point_drift(p2, r_ref2, None, tau, mean_c_b_e=st.acc_e / tau)}
+    st_reset = GridState(*(x[:m].copy() for x in st))
+    traj_reset, sens_reset = traj[:m].copy(), sens[:m].copy()
     rec_reset = rec[:m].copy()
-    comp[:] = est[estimator]
+    st.comp[:] = est[estimator]
     rec[n_cont:, k2 // rec_every_k:] = np.nan
     if n_cont:
         c = slice(0, n_cont)
-        seg(k2, k_end, cbp[c], vg[c], r[c], damp[c], comp[c], seeds[c], acc_e[c], acc_i[c], traj[c], sens[c], rec[c])
+        seg(k2, k_end, GridState(*(x[c] for x in st)), traj[c], sens[c], rec[c])
     if m:
-        seg(k2, k_end, *st, rec_reset)
+        seg(k2, k_end, st_reset, traj_reset, sens_reset, rec_reset)
     t = np.arange(n_rec) * rec_every_k * dt
     return SimulationResult(sc, t, rec, rec_reset, est, p2, phases)
 
@@ -1556,28 +1590,29 @@ def ecef_reference_comparison(sc, duration, *, seed=0, record_every=60.0):
     ve = np.ascontiguousarray(np.einsum("nji,nj->ni", ceg, vg))
     r_e = r.copy()
     n_rec = k_end // rec_k + 1
-    rp_, rv_, ra_ = np.zeros((1, n_rec, 3)), np.zeros((1, n_rec, 3)), np.zeros((1, n_rec, 9))
-    _k.run_ecef(0, k_end, dt, traj, sens, cbe_nav, ve, r_e, seeds.copy(), rp_, rv_, ra_, rec_k)
+    rec = np.zeros((1, n_rec, 15))                 # ECEF position, velocity, C_b^e (row-major)
+    _k.run_ecef(0, k_end, dt, traj, sens, cbe_nav, ve, r_e, seeds.copy(), rec, rec_k)
     # grid run in segments, reading its absolute state at every record time
     coef = discretize_damping(dt)
     pos_grid, vel_grid, cbe_grid = [r[0].copy()], [ceg[0].T @ vg[0]], [ceg[0].T @ cbp[0]]
     rng_g = seeds.copy()
     empty = np.zeros((1, 0, _k.N_REC))
     for j in range(1, n_rec):
-        _run_grid((j - 1) * rec_k, j * rec_k, dt, traj, sens, cbp, vg, r, np.zeros((1, 2, 2)),
-                  np.zeros((1, 3)), rng_g, np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), coef, 0, 0, empty, rec_k, 10)
+        state = GridState(cbp, vg, r, np.zeros((1, 2, 2)), np.zeros((1, 3)), rng_g, np.zeros((1, 3, 3)),
+                          np.zeros((1, 3, 3)))
+        _run_grid((j - 1) * rec_k, j * rec_k, dt, traj, sens, state, coef, 0, 0, empty, rec_k, 10)
         c = grid_frame(r[0])
         pos_grid.append(r[0].copy())
         vel_grid.append(c.T @ vg[0])
         cbe_grid.append(c.T @ cbp[0])
     t = np.arange(n_rec) * rec_k * dt
     re_t = np.concatenate([true_state(sc, tt, phases)[1] for tt in t])
-    d = np.array(cbe_grid) @ np.swapaxes(ra_[0].reshape(-1, 3, 3), -1, -2)
+    d = np.array(cbe_grid) @ np.swapaxes(np.ascontiguousarray(rec[0, :, 6:]).reshape(-1, 3, 3), -1, -2)
     # small-angle rotation vector from the antisymmetric part (insensitive to 1e-12 scale drift)
     w = 0.5 * np.stack([d[:, 2, 1] - d[:, 1, 2], d[:, 0, 2] - d[:, 2, 0], d[:, 1, 0] - d[:, 0, 1]], -1)
     ang = np.arcsin(np.clip(np.linalg.norm(w, axis=-1), 0, 1))
-    return {"t": t, "pos_grid": np.array(pos_grid), "pos_ecef": rp_[0], "vel_grid": np.array(vel_grid),
-            "vel_ecef": rv_[0], "attitude_angle": ang, "pos_true": re_t}
+    return {"t": t, "pos_grid": np.array(pos_grid), "pos_ecef": rec[0, :, 0:3].copy(), "vel_grid": np.array(vel_grid),
+            "vel_ecef": rec[0, :, 3:6].copy(), "attitude_angle": ang, "pos_true": re_t}
 
 
 # =============================================================================== fang2020 §3 runs
