@@ -225,7 +225,7 @@ def main(argv=None):
     res = {k: {} for k in trees}
     for name in names:
         rts = name == "chen2019_45_20_runs_rts"
-        for _ in range(1 if rts else args.processes):
+        for _ in range(args.processes):
             for k, (tree, _) in trees.items():
                 r = _run(tree, name, 1 if rts else args.repeats)
                 print(f"{name:28s} {k:8s} {r}", flush=True)
@@ -239,7 +239,7 @@ def main(argv=None):
            "implementations": {k: v[1] for k, v in trees.items()}, "targets": TARGETS, "met": met,
            "notes": f"best wall time over {args.processes} processes per implementation (alternating) of the best of "
                     f"{args.repeats} calls after a warm-up (compilation excluded), CPU time of that call beside it; "
-                    "the 20-run batch with the smoother: one process, one call",
+                    "the 20-run batch with the smoother: one call per process",
            "timings": res}
     Path(args.out).write_text(json.dumps(doc, indent=2, sort_keys=True) + "\n")
     if tmp is not None:

@@ -145,9 +145,7 @@ MAX_ARGUMENTS = 12
 # closed-loop filter's hour 0.61 s of CPU against 0.41 s with arrays).  Such a kernel says so in
 # its docstring, with this phrase.
 ARGUED = "not a bundle"
-SIGNATURES_PENDING: set[str] = {
-    "replication.papers.fang2020._polar_kernels.run_grid",
-}
+SIGNATURES_PENDING: set[str] = set()
 
 
 def _functions(tree, prefix):

@@ -403,7 +403,7 @@ def test_shared_truth_gives_the_same_bits_as_each_run_computing_its_own():
         if shared:
             polar._run_grid(0, k1, sc.dt, traj, sens, st, *rest)
         else:
-            K.run_grid(0, k1, sc.dt, traj, sens, *st, *rest, 0, np.empty((0, K.TRUTH_STEP_FIELDS)),
+            K.run_grid(0, k1, sc.dt, traj, sens, tuple(st), rest[:3], *rest[3:], np.empty((0, K.TRUTH_STEP_FIELDS)),
                        np.empty((0, K.TRUTH_RECORD_FIELDS)))
         out.append((rec, st.cbp, st.vg, st.r, st.acc_e))
     assert np.all(out[0][0][:, :, 3] != 0.0), "the runs recorded no velocity error"

@@ -125,15 +125,13 @@ def _sd_step_loop(dt, dtheta, dv, st0, q0, vmode, h_ref, vu_ref, gains):
     """The strapdown as the closed-loop filter runs it: ``_kernels.sd_step`` once per increment."""
     n = len(dtheta)
     st, st_prev, q = st0.copy(), st0.copy(), q0.copy()
-    qtmp, c, w_ie, w_en, ta, tb = np.empty(4), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     trig = np.array([st0[0], np.sin(st0[0]), np.cos(st0[0])])
     out_st, out_q = np.empty((n + 1, 6)), np.empty((n + 1, 4))
     out_st[0], out_q[0] = st0, q0
     damp = 0.0
     for k in range(n):
         kp = max(k - 1, 0)
-        damp = K.sd_step(dt[k], dtheta[k], dv[k], dtheta[kp], dv[kp], st, st_prev, q, qtmp, c, w_ie, w_en, ta, tb,
-                         vmode, h_ref[k + 1] if vmode == 1 else h_ref[k], vu_ref[k + 1], gains, damp, np.zeros(3), trig)
+        damp = K.sd_step(dt[k], dtheta[k], dv[k], dtheta[kp], dv[kp], st, st_prev, q, vmode, h_ref[k + 1] if vmode == 1 else h_ref[k], vu_ref[k + 1], gains, damp, np.zeros(3), trig)
         out_st[k + 1], out_q[k + 1] = st, q
     return out_st, out_q
 
@@ -182,8 +180,7 @@ def test_closed_loop_step_adds_the_gravity_disturbance():
     out = []
     for g_extra in (np.zeros(3), g):
         st, st_prev, q, trig = st0.copy(), st0.copy(), q0.copy(), np.array([st0[0], np.sin(st0[0]), np.cos(st0[0])])
-        w = [np.empty(4), np.empty((3, 3))] + [np.empty(3) for _ in range(4)]
-        K.sd_step(T, dth, dv, dth, dv, st, st_prev, q, *w, 0, 0.0, 0.0, np.zeros(3), 0.0, g_extra, trig)
+        K.sd_step(T, dth, dv, dth, dv, st, st_prev, q, 0, 0.0, 0.0, np.zeros(3), 0.0, g_extra, trig)
         out.append((st, q))
     assert np.allclose(out[1][0][3:] - out[0][0][3:], g * T, rtol=0, atol=4 * np.spacing(64.0))
     assert np.array_equal(out[1][1], out[0][1])

@@ -289,8 +289,7 @@ def _sd_step_s(T, dth, dv, dth_p, dv_p, x, x_p, q, trig, vertical, dampint, g_ex
 
 
 @njit(**_NJ)
-def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en, tmp3a, tmp3b,
-            vmode, h_ref, vu_ref, gains, dampint, g_extra, trig):
+def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, vmode, h_ref, vu_ref, gains, dampint, g_extra, trig):
     """One ENU strapdown update (chen2019 eq. (3-2)) on arrays, in place: the step of the
     closed-loop filter.
 
@@ -315,8 +314,6 @@ def sd_step(T, dth, dvv, dth_prev, dv_prev, st, st_prev, q, qtmp, c, w_ie, w_en,
         The state at k-2 (extrapolation), updated to k-1.
     q : ndarray, shape (4,)
         q_b^n at k-1 (scalar first), updated to k.
-    qtmp, c, w_ie, w_en, tmp3a, tmp3b : ndarray
-        Workspace of the callers (shapes (4,), (3, 3), (3,) ×4); neither read nor written.
     vmode : int
         0 free, 1 hold (h, v_U set to ``h_ref``, ``vu_ref`` after the step), 2 damped
         (third-order loop).

@@ -648,7 +648,7 @@ def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_
     interval sums (``sums``, ``fsum``, ``Csum``, ``navsum``, ``Cpl``), the run's IMU-rate records
     and the per-step work arrays ``w`` are passed one by one (arrays, not a bundle), as views taken
     once per interval (a bundle would cost a reference per array at every call)."""
-    u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en, ta, tb = w
+    u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en = w
     store_nav = nav_st.shape[0] > 0
     for k in range(k0, k1):
         T = inp.dt[k]
@@ -680,7 +680,7 @@ def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_
             sums[1] += T
         v0, v1, v2 = st[3], st[4], st[5]
         href = inp.h_ref[k + 1] if spec.vmode == 1 else inp.h_ref[k]
-        damp = K.sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, qtmp, c, w_ie, w_en, ta, tb, spec.vmode,
+        damp = K.sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, spec.vmode,
                          href, inp.vu_ref[k + 1], spec.gains, damp, g_extra, trig)
         if in_win:
             vacc[0] += w_sf * (st[3] - v0) / T
@@ -745,8 +745,7 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
     qtmp = np.empty(4)
     w_ie = np.empty(3)
     w_en = np.empty(3)
-    w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en,
-         np.empty(3), np.empty(3))
+    w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en)
     F = np.zeros((n, n))
     Phi = np.empty((n, n))
     Qd = np.empty((n, n))

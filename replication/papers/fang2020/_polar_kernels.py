@@ -375,14 +375,16 @@ def truth_table(k0, k1, dt, p, rec_every, tin, trec):
 
 
 @njit(cache=True, parallel=True)
-def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
-             coef, damping, pos_damped, rec, rec_every, acc_every, shared, tin, trec):
+def run_grid(k0, k1, dt, traj, sens, state, network, rec, rec_every, acc_every, tin, trec):
     """Integrate the damped grid-frame strapdown INS of every run from step k0 to k1.
 
-    State per run (updated in place): platform attitude ``cbp`` = C_b^p (3×3), grid velocity
-    ``vg`` (E, N, U; the vertical channel is held at sea level, U = 0), ECEF position ``r`` (on the
-    ellipsoid), damping-network states ``damp`` (2 channels × 2), gyro compensation ``comp``
-    (rad/s, subtracted from the gyro output), random state ``rng``.
+    ``state`` is the runs' batch state, the fields of ``polar.GridState`` in its order (updated in
+    place): platform attitude ``cbp`` = C_b^p (3×3), grid velocity ``vg`` (E, N, U; the vertical
+    channel is held at sea level, U = 0), ECEF position ``r`` (on the ellipsoid), damping-network
+    states ``damp`` (2 channels × 2), gyro compensation ``comp`` (rad/s, subtracted from the gyro
+    output), random state ``rng``, attitude sums ``acc_e``, ``acc_i``; ``network`` is
+    (``coef``, ``damping``, ``pos_damped``).  The bundles are unpacked once per call, outside the
+    loop over runs and steps (a call per segment: bundles cost nothing measurable here).
 
     Per step: ω_iG^G = ω_ie^G + ω_eG^G(V_c) commands the platform, where the external horizontal
     damping (fang2020 Fig. 1, eq. (1)) feeds the transport rate with
@@ -396,10 +398,13 @@ def run_grid(k0, k1, dt, traj, sens, cbp, vg, r, damp, comp, rng, acc_e, acc_i,
     ``acc_every`` steps (for the interval-mean attitude of the calibration).
     ``rec`` (runs × records × 8) receives REC_FIELDS every ``rec_every`` steps (k % rec_every == 0,
     record index (k - k0) // rec_every, k0 included).
-    ``shared`` = 1: every run follows the same trajectory, whose truth :func:`truth_table` has
+    ``tin`` with rows: every run follows the same trajectory, whose truth :func:`truth_table` has
     put in ``tin``/``trec`` once (computing it once instead of per run; the same numbers);
-    ``shared`` = 0: each run computes its own (``tin``, ``trec`` unused).
+    ``tin`` without rows: each run computes its own (``trec`` unused).
     """
+    cbp, vg, r, damp, comp, rng, acc_e, acc_i = state
+    coef, damping, pos_damped = network
+    shared = 1 if tin.shape[0] > 0 else 0
     nrun = traj.shape[0]
     b0, b1, b2, a1, a2 = coef[0], coef[1], coef[2], coef[3], coef[4]
     for i in prange(nrun):

@@ -1319,8 +1319,8 @@ def _run_grid(k0, k1, dt, traj, sens, state, coef, damping, pos_damped, rec, rec
         _k.truth_table(k0, k1, dt, np.ascontiguousarray(traj[0]), rec_every, tin, trec)
     else:
         tin, trec = np.empty((0, _k.TRUTH_STEP_FIELDS)), np.empty((0, _k.TRUTH_RECORD_FIELDS))
-    _k.run_grid(k0, k1, dt, traj, sens, *state, coef, damping, pos_damped,
-                rec, rec_every, acc_every, 1 if shared else 0, tin, trec)
+    _k.run_grid(k0, k1, dt, traj, sens, tuple(state), (coef, damping, pos_damped), rec, rec_every, acc_every, tin,
+                trec)
 
 
 def run_segment(sc, k0, k1, traj, sens, state):
