@@ -160,8 +160,9 @@ def _child(name, repeats):
 # ----------------------------------------------------------------------------- driver
 
 def _run(tree: Path, name: str, repeats: int) -> dict:
+    # no progress bars: an earlier tree may have none, and a bar's updates are not the filter's time
     env = dict(os.environ, PYTHONPATH=str(tree), REPLICATION_ROOT=str(tree), OPENBLAS_NUM_THREADS="1",
-               PYTHONDONTWRITEBYTECODE="0")
+               PYTHONDONTWRITEBYTECODE="0", REPLICATION_PROGRESS="0")
     out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--child", name, "--repeats", str(repeats)],
                          cwd=tree, env=env, capture_output=True, text=True)
     if out.returncode != 0:
