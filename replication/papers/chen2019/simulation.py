@@ -1567,7 +1567,8 @@ def figure_4_14_retained_sigma(result: BatchResult, *, misalignment_unit: float 
 
     Per quantity of :data:`FIGURE_4_14_QUANTITIES`: the smallest and largest over axes of the
     standard deviation at the last epoch (RTS-smoothed if the run has the smoothed covariance,
-    else filtered) and at the first recorded epoch, in the text's units, and their ratio.  For the
+    else filtered) and the prior's (``model.P0()``, the filter's initial covariance), in the text's
+    units, and their ratio.  For the
     totals the variance is that of the sum, var(b) + var(m) + 2 cov(b, m).  A ratio near 1 means
     the flight leaves the quantity unobserved: its estimate stays near the prior mean whatever the
     truth.
@@ -1595,7 +1596,7 @@ def figure_4_14_retained_sigma(result: BatchResult, *, misalignment_unit: float 
         raise ValueError("result must be the BatchResult of simulation.run_batch")
     m = result.model
     P_end = result.P_s[-1] if result.P_s is not None else result.P[-1]
-    P_0 = result.P[0]
+    P_0 = m.P0()
     scales = _figure_4_14_scales(misalignment_unit)
     rows = {}
     for q, groups in FIGURE_4_14_QUANTITIES.items():
