@@ -284,6 +284,8 @@ PROBES += [
     ("VerticalChannel(damping_tau = -100)", "damping_tau", lambda: strapdown.VerticalChannel(damping_tau=-100.0)),
     ("VerticalChannel('hold') without h_ref", "h_ref", lambda: strapdown.VerticalChannel("hold")),
     ("closed_loop(vertical = 3)", "vertical", lambda: _closed_loop(vertical=3)),
+    ("rotation_rich_turntable(duration = -10)", "duration", lambda: trajectory.rotation_rich_turntable(-10.0)),
+    ("rotation_rich_turntable(dwell = nan)", "dwell", lambda: trajectory.rotation_rich_turntable(dwell=np.nan)),
     ("Options(series_order = 2.5)", "series_order", lambda: _closed_loop(options=closedloop.Options(series_order=2.5))),
     ("closed_loop(use = ())", "use", lambda: _closed_loop(use=())),
     ("closed_loop(use = ['pos'])", "use", lambda: _closed_loop(use=["pos"])),

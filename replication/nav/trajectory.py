@@ -30,6 +30,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from replication.nav import earth
+from replication.nav._validate import positive
 from replication.nav.rotations import body_rate_from_euler_rates, dcm_to_quat, euler_to_dcm
 from replication.nav.strapdown import NavState
 from replication.nav.units import DEG, G0
@@ -959,7 +960,14 @@ def rotation_rich_turntable(duration: float = 3600.0, *, dwell: float = 20.0, tu
         The moves and dwells.
     initial_heading : float
         Initial heading [rad], 0.
+
+    Raises
+    ------
+    ValueError
+        For a ``duration`` or ``dwell`` that is not a positive number of seconds.
     """
+    duration = positive(duration, "duration", "{name} must be a positive number of seconds, got {value!r}")
+    dwell = positive(dwell, "dwell", "{name} must be a positive number of seconds, got {value!r}")
     a, m = 9 * DEG, 1 * DEG
     block = [move((np.pi / 2, 0, 0), a), move((np.pi / 2, 0, 0), a), Dwell(dwell),
              move((-np.pi / 2, 0, 10 * DEG), (a, 0, m)), move((-np.pi / 2, 0, -10 * DEG), (a, 0, m)), Dwell(dwell),
