@@ -50,7 +50,11 @@ def test_field_sampling_and_bounds():
 
 
 def test_survey_lines_space_to_time():
-    tr = gr.survey_lines(4, 20e3, 500.0, 30.0, 1.0)
+    tr = gr.survey_lines(gr.SurveyLayout(4, 20e3, 500.0, 30.0), 1.0)
+    with pytest.raises(TypeError, match="SurveyLayout"):
+        gr.survey_lines((4, 20e3, 500.0, 30.0), 1.0)
+    with pytest.raises(ValueError, match="dt"):
+        gr.survey_lines(gr.SurveyLayout(4, 20e3, 500.0, 30.0), 0.0)
     step = np.hypot(np.diff(tr["east"]), np.diff(tr["north"]))
     # chord vs arc on the 250 m turns: 1 - theta^2/24 with theta = 30/250 rad -> < 1e-3 relative
     np.testing.assert_allclose(step, 30.0, rtol=1e-3)

@@ -39,6 +39,7 @@ from replication.nav import kalman as kf
 from replication.nav import parallel as PAR
 from replication.nav import sensors as se
 from replication.nav import trajectory as tj
+from replication.nav._validate import positive
 from replication.nav.rotations import dcm_to_quat
 from replication.nav.strapdown import NavSolution, validate_increments, validate_time
 from replication.nav.timeseries import (
@@ -274,28 +275,20 @@ def synthetic_field(
                               altitude, seed)
 
 
-def survey_lines(n_lines: int, line_length: float, spacing: float, speed: float, dt: float, *,
-                 start=(0.0, 0.0)) -> dict:
+def survey_lines(layout: SurveyLayout, dt: float) -> dict:
     """Planar east-west survey pattern (chen2019 Table 4-47: east-west strips) sampled in time.
 
-    Lines of ``line_length``, ``spacing`` apart northwards, flown alternately eastwards and
-    westwards and joined by semicircular turns of radius spacing/2, at constant ground ``speed``.
-    Space becomes time through t = s/speed (arc length s).
+    The :class:`SurveyLayout`'s lines of ``line_length``, ``spacing`` apart northwards, flown
+    alternately eastwards and westwards and joined by semicircular turns of radius spacing/2, at
+    constant ground ``speed``, from ``start``.  Space becomes time through t = s/speed (arc length
+    s).
 
     Parameters
     ----------
-    n_lines : int
-        Number of lines (positive).
-    line_length : float
-        Length of each line [m].
-    spacing : float
-        Distance between lines [m].
-    speed : float
-        Ground speed [m/s].
+    layout : SurveyLayout
+        Lines, their length and spacing, the speed and the offset of the pattern.
     dt : float
         Sampling interval [s].
-    start : tuple of float
-        East, north offset of the pattern [m].
 
     Returns
     -------
@@ -306,13 +299,16 @@ def survey_lines(n_lines: int, line_length: float, spacing: float, speed: float,
 
     Raises
     ------
+    TypeError
+        When ``layout`` is not a :class:`SurveyLayout`.
     ValueError
-        When ``n_lines`` is not a positive integer or a length, speed or interval is not positive.
+        When ``dt`` is not a positive number of seconds.
     """
-    if int(n_lines) != n_lines or n_lines < 1:
-        raise ValueError("n_lines must be a positive integer")
-    if not (line_length > 0 and spacing > 0 and speed > 0 and dt > 0):
-        raise ValueError("line_length, spacing, speed and dt must be positive (m, m, m/s, s)")
+    if not isinstance(layout, SurveyLayout):
+        raise TypeError(f"layout must be a SurveyLayout, got {type(layout).__name__}")
+    dt = positive(dt, "dt", "{name} must be a positive number of seconds, got {value!r}")
+    n_lines, line_length, spacing, speed, start = (layout.n_lines, layout.line_length, layout.spacing, layout.speed,
+                                                   layout.start)
     r = spacing / 2
     turn = np.pi * r
     seg_len = line_length + turn
@@ -973,7 +969,7 @@ def analog_direct_difference(field_: PlanarGravityField, layout: SurveyLayout, *
     step = int(round(out_dt / gnss_dt))
     if step < 1 or abs(step * gnss_dt - out_dt) > 1e-9:
         raise ValueError("out_dt must be an integer multiple of gnss_dt")
-    tr = survey_lines(layout.n_lines, layout.line_length, layout.spacing, layout.speed, gnss_dt, start=layout.start)
+    tr = survey_lines(layout, gnss_dt)
     rng = np.random.default_rng(seed)
     dg = field_.sample(tr["east"], tr["north"])
     n = dg.shape[0]
