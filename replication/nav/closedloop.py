@@ -209,11 +209,29 @@ class GnssRows:
         Diagonal velocity noise covariance ((m/s)²); ``None``: no velocity rows.
     lever_arm_b : (3,) array_like
         Antenna lever arm in the body frame used by the filter, m.
+
+    Raises
+    ------
+    ValueError
+        For a covariance that is not 3×3, diagonal, positive and finite, or a lever arm that is
+        not three finite numbers.
     """
 
     R_pos: object = None
     R_vel: object = None
     lever_arm_b: object = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        for name in ("R_pos", "R_vel"):
+            M = getattr(self, name)
+            if M is None:
+                continue
+            M = numeric(M, name)
+            if M.shape != (3, 3) or np.any(M != np.diag(np.diag(M))) or not np.all(np.diag(M) > 0):
+                raise ValueError(f"{name} must be a 3×3 diagonal matrix with positive variances (independent axes)")
+            finite_array(M, name)
+            object.__setattr__(self, name, M)
+        object.__setattr__(self, "lever_arm_b", finite_array(self.lever_arm_b, "lever_arm_b", (3,)))
 
 
 
@@ -1295,13 +1313,9 @@ def build_spec(model: ErrorModel, *, gnss: GnssRows | None = None, rows=(), vmod
     opt = resolve_options(options)
     n = model.n
     kinds, row_R, row_col, row_aux = [], [], [], []
-    for name, M in (("R_pos", gnss.R_pos), ("R_vel", gnss.R_vel)):
+    for name, M in (("R_pos", gnss.R_pos), ("R_vel", gnss.R_vel)):      # checked by GnssRows
         if M is None:
             continue
-        M = numeric(M, name)
-        if M.shape != (3, 3) or np.any(M != np.diag(np.diag(M))) or not np.all(np.diag(M) > 0):
-            raise ValueError(f"{name} must be a 3×3 diagonal matrix with positive variances (independent axes)")
-        finite_array(M, name)
         kinds.append(ROW_GNSS_POSITION if name == "R_pos" else ROW_GNSS_VELOCITY)
         row_R.append(np.diag(M).astype(float))
         row_col.append(-1)
@@ -1331,7 +1345,7 @@ def build_spec(model: ErrorModel, *, gnss: GnssRows | None = None, rows=(), vmod
     size = {code: m for code, m in ROW_KINDS.values()}
     m_max = sum(size[k] for k in kinds)
     series_order = opt.series_order
-    lever = finite_array(gnss.lever_arm_b, "lever_arm_b", (3,))
+    lever = gnss.lever_arm_b
     finite_array(gains, "gains", (3,))
     choice(vmode, (0, 1, 2), "vmode", "{name} must be one of {allowed} (free, held, damped), got {value!r}")
     fconst, qc, tg, kd, bs, bz = model.kernel_encoding()
