@@ -43,6 +43,12 @@ def sandbox(tmp_path, monkeypatch):
         encoding="utf-8",
     )
     (tmp_path / "data" / "paper" / "chen2019" / "chen2019-table-9-9.csv").write_text(GOOD, encoding="utf-8")
+    # the notebook and the tests that the sandbox tables name as evidence (the audit checks they exist)
+    (tmp_path / "book").mkdir()
+    (tmp_path / "book" / "x.ipynb").write_text("{}", encoding="utf-8")
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "test_x.py").write_text("def test_beta():\n    pass\n", encoding="utf-8")
+    (tmp_path / "tests" / "t.py").write_text("def t():\n    pass\n", encoding="utf-8")
     monkeypatch.setenv("REPLICATION_ROOT", str(tmp_path))
     return tmp_path
 

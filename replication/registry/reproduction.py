@@ -43,6 +43,7 @@ import numpy as np
 import pandas as pd
 
 from replication._meta import __version__, repository_url
+from replication.registry import verdicts as _verdicts
 
 STATUSES = (
     "reproduced", "erratum", "inconsistent", "qualitative", "analog", "unverifiable", "not-reproduced", "pending",
@@ -57,7 +58,7 @@ REQUIRED_PROVENANCE = ("document", "location", "section", "notes")
 
 TABLE_COLUMNS = (
     "quantity", "unit", "paper", "paper_text", "reproduced", "reproduced_text", "abs_error", "rel_error",
-    "tolerance", "tolerance_kind", "status", "note", "evidence", "corrected",
+    "tolerance", "tolerance_kind", "status", "note", "evidence", "corrected", "basis", "agrees", "rests_on",
 )
 """Columns of every exported comparison table, in order.  ``paper``, ``reproduced``,
 ``abs_error``, ``rel_error`` and ``tolerance`` hold numbers only (or nothing); the printed form
@@ -68,7 +69,7 @@ NUMERIC_COLUMNS = ("paper", "reproduced", "abs_error", "rel_error", "tolerance")
 
 ROW_KEYS = (
     "quantity", "unit", "paper", "paper_text", "reproduced", "tolerance", "tolerance_kind", "status",
-    "note", "evidence", "corrected", "digits",
+    "note", "evidence", "corrected", "digits", "basis", "agrees", "rests_on",
 )
 """Keys a comparison row may carry (see :func:`comparison_frame`)."""
 
@@ -559,6 +560,44 @@ def _decide(row: Mapping[str, Any], ae: float, re_: float) -> str:
     return "reproduced" if err <= float(tol) else "not-reproduced"
 
 
+def _derive(row: Mapping[str, Any], q: Any, basis: str, p_num: float, r_num: float, ae: float, re_: float,
+            tol: Any, kind: str) -> str:
+    """The status of a row that declares its basis (:func:`replication.registry.verdicts.derive_status`),
+    before its table's readings ledger is consulted (:func:`compare` does that)."""
+    if basis not in _verdicts.BASES:
+        raise RegistryError(f"row {q!r}: unknown basis {basis!r}; one of {', '.join(_verdicts.BASES)}")
+    if row.get("status") not in (None, ""):
+        raise RegistryError(f"row {q!r}: a row that declares its basis takes its status from its evidence; "
+                            f"drop status={row.get('status')!r}")
+    s_note = str(row.get("note", "")).strip()
+    within = None
+    if tol is not None and not math.isnan(ae):
+        within = (ae if kind == "abs" else re_) <= float(tol)
+    try:
+        agrees = _verdicts.parse_agrees(row.get("agrees"))
+    except ValueError as exc:
+        raise RegistryError(f"row {q!r}: {exc}") from None
+    refs = row.get("rests_on") or []
+    refs = _verdicts.split_refs(refs) if isinstance(refs, str) else [str(r) for r in refs]
+    rests = []
+    for ref in refs:
+        tid, _, quantity = ref.partition("#")
+        df = read_table(tid)
+        sub = df[df["quantity"] == quantity] if quantity else df
+        if sub.empty:
+            raise RegistryError(f"row {q!r}: rests_on {ref!r} names no row of {tid}")
+        rests += list(sub["status"])
+    ev = _verdicts.Evidence(basis=basis, agrees=agrees, within=within, rests_on=tuple(rests),
+                            has_test=bool(str(row.get("evidence", "")).strip()))
+    try:
+        status = _verdicts.derive_status(ev)
+    except ValueError as exc:
+        raise RegistryError(f"row {q!r}: {exc}") from None
+    if basis != "value" and status != "reproduced" and not s_note:
+        raise RegistryError(f"row {q!r}: status {status!r} (from its {basis} evidence) needs a note saying why")
+    return status
+
+
 def _text_or_number(v: Any) -> tuple[float, str]:
     """Split a cell into its numeric value (NaN if none) and its text (empty if numeric)."""
     if v is None or (isinstance(v, str) and not v.strip()):
@@ -636,7 +675,11 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
             ae = _store(ae, grid, None if grid > 0 else (digits or DEFAULT_DIGITS))
             if math.isfinite(p_num) and p_num == 0:
                 re_dec = 0.0 if ae == 0 else float("inf")
-        status = _decide(row, ae, re_dec)
+        basis = row.get("basis") or ("value" if tol is not None and row.get("status") in (None, "") else "")
+        if basis:
+            status = _derive(row, q, basis, p_num, r_num, ae, re_dec, tol, kind)
+        else:
+            status = _decide(row, ae, re_dec)
         if tol is None:
             # no comparison was made (an explicit status without a tolerance): no error is shown
             ae = float("nan")
@@ -660,6 +703,10 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
             "note": _fmt(row.get("note", "")),
             "evidence": _fmt(row.get("evidence", "")),
             "corrected": _fmt(corrected if corrected is not None else ""),
+            "basis": basis,
+            "agrees": _verdicts.format_agrees(row.get("agrees")),
+            "rests_on": "; ".join(_verdicts.split_refs(row.get("rests_on") if isinstance(row.get("rests_on"), str)
+                                                       else "; ".join(row.get("rests_on") or []))),
         })
     if not out:
         raise RegistryError("a comparison needs at least one row")
@@ -783,7 +830,7 @@ def display_cell(row: Mapping[str, Any], column: str) -> str:
 SIDECAR_IDENTITY = (
     "id", "title", "description", "source", "notebook", "notebook_digest", "paper_source", "paper_digest",
     "table_digest", "seeds", "status_counts", "generated_by", "main_reading", "main_reading_evidence",
-    "readings", "ruled_out", "summary",
+    "readings", "ruled_out", "summary", "groups",
 )
 """Sidecar fields that identify a table and its inputs; when all are unchanged on a rerun the
 stored sidecar (commit, versions) is kept."""
@@ -1020,6 +1067,7 @@ def compare(
     readings: Sequence[str] | None = None,
     ruled_out: Mapping[str, str] | None = None,
     summary: str = "",
+    groups: Mapping[str, Sequence[str]] | None = None,
 ) -> pd.DataFrame:
     """Compare reproduced with paper values and export ``tables/<table_id>.*``.
 
@@ -1069,6 +1117,11 @@ def compare(
         Reading (or prefix) to the printed evidence that excludes it.
     summary : str, optional
         The table's verdict in one line.
+    groups : mapping of str to sequence of str, optional
+        Rows that one reading must reach together (e.g. a column of a printed table): a failing
+        row that a reading reaches only by losing another printed value of its group is
+        ``inconsistent`` (the group contradicts itself), not ``unverifiable``
+        (:func:`replication.registry.verdicts.derive_status`).
 
     Returns
     -------
@@ -1093,6 +1146,24 @@ def compare(
     if isinstance(rows, pd.DataFrame):
         rows = rows.to_dict("records")
     df = comparison_frame(rows)
+    grouped = {}
+    for g, qs in dict(groups or {}).items():
+        qs = [str(x) for x in qs]
+        unknown = sorted(set(qs) - set(df["quantity"]))
+        if unknown:
+            raise RegistryError(f"{table_id}: group {g!r} names rows that are not in the table: {unknown[:5]}")
+        grouped[str(g)] = qs
+    if (df["basis"] != "").any() and (ledgers or readings_ledgers(table_id, {})):
+        from replication.registry import audit as _audit  # reads the exported ledgers
+
+        meta = {"main_reading": main_reading, "ruled_out": ruled, "groups": grouped}
+        readings_rows = _audit._ledger_rows(ledgers or readings_ledgers(table_id, {}))
+        for i, r in df.iterrows():
+            if r["basis"] in ("value", "verdict", "derivation") and r["status"] in ("not-reproduced", "erratum"):
+                led = _audit.ledger_evidence(r["quantity"], df, meta, readings_rows)
+                if led.reaching:
+                    df.loc[i, "status"] = _verdicts.after_ledger(
+                        led, "not-reproduced" if r["status"] == "not-reproduced" else "erratum")
     root = project_root()
     out_dir = tables_dir()
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -1125,7 +1196,7 @@ def compare(
         "generated_by": "replication.registry.reproduction.compare",
     }
     for key, value in (("main_reading", main_reading), ("main_reading_evidence", reading_evidence),
-                       ("readings", ledgers), ("ruled_out", ruled), ("summary", summary)):
+                       ("readings", ledgers), ("ruled_out", ruled), ("summary", summary), ("groups", grouped)):
         if value:
             sidecar[key] = value
     json_path = out_dir / f"{table_id}.json"
@@ -1648,15 +1719,6 @@ def artifact_tables(artifact: Mapping[str, Any]) -> list[str]:
 READING_SEPARATOR = " | "
 """A readings ledger names each row ``<reading> | <quantity of the main table>``."""
 
-DIAGNOSTIC = "diagnostic"
-"""A ledger row whose reading starts with this word is a counterfactual of the package's own (an
-error source removed, a setting the print excludes), shown for understanding: not a reading of
-the print, so it neither supports nor threatens a verdict."""
-
-REPRODUCING = ("reproduced", "qualitative", "analog")
-"""Statuses with which a ledger row *reaches* the print under its reading (CONTRIBUTING.md,
-"Statuses": within tolerance, found to hold, or not contradicting it)."""
-
 
 def _sidecar(table_id: str) -> dict:
     path = tables_dir() / f"{table_id}.json"
@@ -1687,111 +1749,28 @@ def readings_ledgers(table_id: str, meta: Mapping[str, Any] | None = None) -> li
     return [cand] if (tables_dir() / f"{cand}.csv").exists() else []
 
 
-def _split_reading(quantity: str) -> tuple[str, str] | None:
-    if READING_SEPARATOR not in quantity:
-        return None
-    reading, rest = quantity.split(READING_SEPARATOR, 1)
-    return reading, rest
-
-
-def _reaches(ledger_row: Mapping[str, Any], main_row: Mapping[str, Any]) -> bool:
-    """Whether a ledger row reaches the printed value of the main row: by its own status, or — for
-    a numeric row with a tolerance — by lying within the main row's tolerance of the print."""
-    if ledger_row["status"] in REPRODUCING:
-        return True
-    p, r, tol = (_as_float_or_nan(main_row["paper"]), _as_float_or_nan(ledger_row["reproduced"]),
-                 _as_float_or_nan(main_row["tolerance"]))
-    if any(math.isnan(x) for x in (p, r, tol)):
-        return False
-    err = abs(r - p) if main_row["tolerance_kind"] != "rel" else (abs(r - p) / abs(p) if p else float("inf"))
-    return err <= tol
-
-
 def verdict_violations(table_ids: Iterable[str] | None = None) -> list[str]:
-    """Where exported tables break the verdict rule (CONTRIBUTING.md, "Readings and the main
-    reading"); an empty list when none does.
-
-    1. A ``not-reproduced`` row is refused while a reading of its table's readings ledger reaches
-       the print (a ledger row ``<reading> | <quantity>`` with a status in :data:`REPRODUCING`, or
-       within the row's tolerance), unless the table's ``ruled_out`` names that reading (or a prefix
-       of it) with the printed evidence that excludes it.
-    2. The same for an ``erratum`` row: a printed value that a faithful reading reproduces is
-       another convention or a second printed part, recorded as ``inconsistent``, not a misprint.
-    3. Each ``not-reproduced`` row of a table with a ledger appears in it under at least one
-       reading (otherwise the ledger says nothing about that verdict).
-    4. A table with a readings ledger records its main reading and the printed evidence for it.
-    5. A ``ruled_out`` entry names a reading of the ledger.
+    """Every problem of the stored tables, as messages naming table, row and reason
+    (:func:`replication.registry.audit.audit`: the status criteria, the verdict rule of
+    CONTRIBUTING.md, "Readings and the main reading", and the digests); empty when none.
 
     Parameters
     ----------
     table_ids : iterable of str, optional
-        The tables to check; every exported table by default.
+        The tables to check; every exported table (and every stray CSV) by default.
 
     Returns
     -------
     list of str
-        One message per violation (empty when the rule holds).
+        One message per problem.
     """
-    out = []
-    ids = list_tables() if table_ids is None else list(table_ids)
-    for tid in ids:
-        if "-check-" in tid and tid.endswith("-readings"):
-            continue
-        meta = _sidecar(tid)
-        ledgers = readings_ledgers(tid, meta)
-        if not ledgers:
-            continue
-        if not meta.get("main_reading") or not meta.get("main_reading_evidence"):
-            out.append(f"{tid}: has the readings ledger {', '.join(ledgers)} but records no main_reading with "
-                       "its printed evidence (compare(..., main_reading=, reading_evidence=))")
-        df = read_table(tid)
-        ruled = dict(meta.get("ruled_out") or {})
-        flagged = df[df["status"].isin(["not-reproduced", "erratum"])]
-        by_q = {r["quantity"]: r for _, r in flagged.iterrows()}
-        all_readings: set[str] = set()
-        covered: set[str] = set()
-        for lid in ledgers:
-            if not (tables_dir() / f"{lid}.csv").exists():
-                out.append(f"{tid}: its readings ledger {lid} is not exported")
-                continue
-            ledger = read_table(lid)
-            rows: dict[str, dict[str, Any]] = {}
-            for _, lr in ledger.iterrows():
-                split = _split_reading(lr["quantity"])
-                if split is None:
-                    continue
-                reading, q = split
-                if reading.lower().startswith(DIAGNOSTIC):
-                    continue
-                all_readings.add(reading)
-                rows.setdefault(reading, {})[q] = lr
-            for reading, per_q in rows.items():
-                covered.update(q for q in per_q if q in by_q)
-                excluded = any(reading == k or reading.startswith(k) for k in ruled)
-                if excluded:
-                    continue
-                for q, mr in by_q.items():
-                    lr = per_q.get(q)
-                    if lr is not None and _reaches(lr, mr):
-                        what = ("a misprint that a faithful reading reproduces is an inconsistency or another "
-                                "convention" if mr["status"] == "erratum" else "not-reproduced needs every faithful "
-                                "reading to miss the print")
-                        out.append(f"{tid}: row {q!r} is {mr['status']} but reading {reading!r} of {lid} reaches the "
-                                   f"print ({lr['status']}): {what}; give the printed evidence ruling the reading out "
-                                   "(ruled_out=) or change the status")
-        for q, mr in by_q.items():
-            if mr["status"] == "not-reproduced" and q not in covered:
-                out.append(f"{tid}: row {q!r} is not-reproduced but no reading of {', '.join(ledgers)} shows it "
-                           f"(a ledger row '<reading>{READING_SEPARATOR}{q}')")
-        for k in ruled:
-            if not any(r == k or r.startswith(k) for r in all_readings):
-                out.append(f"{tid}: ruled_out names {k!r}, which is no reading of {', '.join(ledgers)}")
-    return out
+    from replication.registry import audit as _audit
+
+    return [str(p) for p in _audit.audit(table_ids)]
 
 
 def check_verdicts(table_ids: Iterable[str] | None = None) -> None:
-    """Raise :class:`RegistryError` listing every break of the verdict rule (see
-    :func:`verdict_violations`).
+    """Raise :class:`RegistryError` listing every problem of the stored tables (:func:`verdict_violations`).
 
     Parameters
     ----------
@@ -1801,12 +1780,11 @@ def check_verdicts(table_ids: Iterable[str] | None = None) -> None:
     Raises
     ------
     RegistryError
-        Listing every violation.
+        Listing every problem.
     """
-    bad = verdict_violations(table_ids)
-    if bad:
-        raise RegistryError("the verdict rule is broken (CONTRIBUTING.md, \"Readings and the main reading\"):\n  - "
-                            + "\n  - ".join(bad))
+    from replication.registry import audit as _audit
+
+    _audit.check(table_ids)
 
 
 REGISTER_COLUMNS = ("kind", "source", "table", "quantity", "printed", "reproduced", "corrected", "note",
