@@ -204,21 +204,41 @@ def test_index_lists_every_artifact_and_collects_the_register(sandbox):
 
 
 def _main_and_ledger(ledger_status="qualitative", ledger_value=2.0, **kw):
-    """A main table with one not-reproduced row and a readings ledger with one other reading."""
-    rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1)],
-               title="T", notebook="book/x.ipynb", **kw)
+    """A main table with one row that misses the print under its main reading, and a readings
+    ledger with the main reading and one other; the ledger is exported first, as a chapter must."""
     rp.compare("chen2019-check-table-9-9-readings",
-               [dict(quantity="main | alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1),
+               [dict(quantity="main | alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1, note="misses"),
                 dict(quantity="other convention | alpha", unit="m", paper=1.5, reproduced=ledger_value,
                      **({"tolerance": 0.1} if ledger_status is None else {"status": ledger_status, "note": "n"}))],
                title="ledger", notebook="book/x.ipynb")
+    return rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0,
+                                                  tolerance=0.1, note="misses the print")],
+                      title="T", notebook="book/x.ipynb", **kw)
 
 
-def test_verdict_rule_refuses_a_not_reproduced_row_that_a_reading_reproduces(sandbox):
-    """A planted bad status: the row is not-reproduced while 'other convention' reproduces it."""
-    _main_and_ledger(main_reading="main", reading_evidence="the printed numbers of column 2")
+def test_a_reading_that_reaches_the_print_makes_a_miss_unverifiable(sandbox):
+    """The status follows from the ledger: a reading the print leaves open reaches the printed value,
+    so the row is not 'not-reproduced' (every faithful reading would have to miss)."""
+    df = _main_and_ledger(main_reading="main", reading_evidence="the printed numbers of column 2 (1.5)")
+    assert df.set_index("quantity").loc["alpha", "status"] == "unverifiable"
+    assert rp.verdict_violations() == []
+    df = _main_and_ledger(ledger_value=2.0, ledger_status="not-reproduced", main_reading="main",
+                          reading_evidence="the printed numbers of column 2 (1.5)")
+    assert df.set_index("quantity").loc["alpha", "status"] == "not-reproduced"
+
+
+def test_a_stored_status_that_its_ledger_contradicts_is_refused(sandbox):
+    """A main table stored before its ledger changed (or edited by hand with its digest forged):
+    index re-derives the status and refuses the stored one, naming table, row and reason."""
+    rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1,
+                                           note="misses")], title="T", notebook="book/x.ipynb",
+               main_reading="main", reading_evidence="the printed numbers of column 2 (1.5)")
+    rp.compare("chen2019-check-table-9-9-readings",
+               [dict(quantity="main | alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1, note="misses"),
+                dict(quantity="other convention | alpha", unit="m", paper=1.5, reproduced=1.55, tolerance=0.1)],
+               title="ledger", notebook="book/x.ipynb")
     bad = rp.verdict_violations()
-    assert len(bad) == 1 and "other convention" in bad[0] and "'alpha'" in bad[0]
+    assert len(bad) == 1 and "'alpha'" in bad[0] and "gives unverifiable" in bad[0], bad
     with pytest.raises(rp.RegistryError, match="verdict rule"):
         rp.build_index()
     assert cli(["index"]) == 2
@@ -226,26 +246,33 @@ def test_verdict_rule_refuses_a_not_reproduced_row_that_a_reading_reproduces(san
 
 def test_verdict_rule_reads_the_tolerance_of_the_main_row(sandbox):
     """A ledger row whose own status says nothing still reaches the print within the row's tolerance."""
-    _main_and_ledger(ledger_status=None, ledger_value=1.55, main_reading="main", reading_evidence="e")
-    assert any("other convention" in v for v in rp.verdict_violations())
-    _main_and_ledger(ledger_status=None, ledger_value=1.7, main_reading="main", reading_evidence="e")
-    assert rp.verdict_violations() == []                                   # 0.2 > 0.1: it misses too
+    df = _main_and_ledger(ledger_status=None, ledger_value=1.55, main_reading="main", reading_evidence="e (1.5)")
+    assert df["status"].tolist() == ["unverifiable"]
+    df = _main_and_ledger(ledger_status=None, ledger_value=1.7, main_reading="main", reading_evidence="e (1.5)")
+    assert df["status"].tolist() == ["not-reproduced"]                   # 0.2 > 0.1: it misses too
+    assert rp.verdict_violations() == []
 
 
 def test_verdict_rule_accepts_a_reading_ruled_out_by_printed_evidence(sandbox):
-    _main_and_ledger(main_reading="main", reading_evidence="column 2 identifies the main convention",
-                     ruled_out={"other": "the printed column 2 (3.0, 1e-18) contradicts the other convention"})
+    """A reading that printed numbers exclude does not threaten the verdict; the sentence must quote
+    a printed value (alpha = 1.5 of the paper file)."""
+    df = _main_and_ledger(main_reading="main", reading_evidence="column 2 identifies the main convention (1.5)",
+                          ruled_out={"other": "the printed alpha = 1.5 m contradicts the other convention"})
+    assert df["status"].tolist() == ["not-reproduced"]
     assert rp.verdict_violations() == []
     status, _ = rp.build_index()
     fail = rp.failing_artifacts(status)
     assert list(fail["id"]) == ["chen2019-table-9-9"] and fail.iloc[0]["reason"]
+    _main_and_ledger(main_reading="main", reading_evidence="column 2 (1.5)",
+                     ruled_out={"other": "we think it unlikely"})
+    assert any("quotes no printed value" in v for v in rp.verdict_violations())
 
 
 def test_verdict_rule_needs_a_main_reading_and_a_named_reading(sandbox):
     _main_and_ledger(ledger_status="not-reproduced")
     assert any("no main_reading" in v for v in rp.verdict_violations())
     _main_and_ledger(ledger_status="not-reproduced", main_reading="main", reading_evidence="e",
-                     ruled_out={"a reading nobody tried": "x"})
+                     ruled_out={"a reading nobody tried": "alpha = 1.5 m"})
     assert any("is no reading" in v for v in rp.verdict_violations())
     with pytest.raises(rp.RegistryError, match="together"):
         rp.compare("chen2019-table-9-9", [dict(quantity="a", unit="", paper=1, reproduced=1, tolerance=0)],
@@ -253,15 +280,20 @@ def test_verdict_rule_needs_a_main_reading_and_a_named_reading(sandbox):
 
 
 def test_verdict_rule_refuses_an_erratum_that_a_reading_reproduces(sandbox):
-    """A 'misprint' that another printed part (a reading) reproduces is an inconsistency."""
-    rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1,
-                                           status="erratum", note="n", evidence="tests/t.py::t")],
-               title="T", notebook="book/x.ipynb", main_reading="main", reading_evidence="e")
+    """A 'misprint' that another printed part (a reading) reproduces is an inconsistency: typed as
+    erratum it is refused; declared as a derivation it is derived inconsistent."""
     rp.compare("chen2019-check-table-9-9-readings",
                [dict(quantity="the table's convention | alpha", unit="m", paper=1.5, reproduced=1.5, tolerance=0.1)],
                title="ledger", notebook="book/x.ipynb")
+    rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1,
+                                           status="erratum", note="n", evidence="tests/t.py::t")],
+               title="T", notebook="book/x.ipynb", main_reading="main", reading_evidence="e")
     bad = rp.verdict_violations()
     assert len(bad) == 1 and "is erratum" in bad[0] and "inconsistency" in bad[0]
+    df = rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1,
+                                                basis="derivation", note="n", evidence="tests/t.py::t")],
+                    title="T", notebook="book/x.ipynb", main_reading="main", reading_evidence="e")
+    assert df["status"].tolist() == ["inconsistent"]
 
 
 def test_the_stored_tables_obey_the_verdict_rule():
