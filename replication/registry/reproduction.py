@@ -1490,6 +1490,7 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
         _write_if_changed(d / "status.csv", status.to_csv(index=False, lineterminator="\n"))
         _write_if_changed(d / "register.csv", register.to_csv(index=False, lineterminator="\n"))
         _write_if_changed(d / "status.md", _status_markdown(status))
+        _write_if_changed(d / "status-criteria.md", _criteria_markdown())
         _write_if_changed(d / "register.md", _register_markdown(register))
         for src in SOURCE_KEYS:
             _write_if_changed(d / f"status-{src}.md", _paper_summary_markdown(status, src))
@@ -1521,6 +1522,12 @@ FIELD_DESCRIPTIONS = {
     "note": "why the row has its status",
     "evidence": "the notebook and test that prove an erratum (or support a finding)",
     "corrected": "the corrected expression or value of an erratum",
+    "basis": "how the row is judged: value, verdict, parts, derivation, claim, stand-in or unstated (CONTRIBUTING.md, "
+             "How a row is judged); the status follows from it and its evidence (empty: an older row with a typed "
+             "status, audited by the criteria of its status)",
+    "agrees": "yes or no: whether the row's own comparison agrees with the print, computed by the chapter's code "
+              "(empty for value rows, whose numbers decide)",
+    "rests_on": "for a claim: the rows it rests on, '<table id>#<quantity>' or a table id, '; '-separated",
 }
 """Descriptions of the columns of the exported comparison tables (``tables/datapackage.json``)."""
 
@@ -2101,6 +2108,18 @@ def findings_file(notebook: str) -> str:
     """
     p = Path(notebook)
     return f"findings-{p.parent.name}-{p.stem}.md"
+
+
+def _criteria_markdown() -> str:
+    """The bases a row may declare and the criteria the audit checks for each status, from the code
+    that applies them (:data:`replication.registry.verdicts.BASES`, :data:`replication.registry.audit.CRITERIA`)."""
+    from replication.registry import audit as _audit
+
+    lines = ["How a row is judged (its `basis` column) — the status follows from the basis and its evidence:", ""]
+    lines += _md_table(["basis", "compares"], [[f"`{k}`", v] for k, v in _verdicts.BASES.items()])
+    lines += ["", "What each status needs, checked for every stored row by `python -m replication index`:", ""]
+    lines += _md_table(["status", "needs (and what forbids it)"], [[f"`{k}`", v] for k, v in _audit.CRITERIA.items()])
+    return "\n".join(lines) + "\n"
 
 
 def _status_markdown(status: pd.DataFrame) -> str:
