@@ -85,47 +85,105 @@ class RegistryError(ValueError):
 
 # --------------------------------------------------------------------------- locations
 
+PACKAGED_DATA = Path(__file__).resolve().parents[1] / "_data"
+"""Where an installed (non-editable) wheel keeps the files the read side needs, laid out as in a
+clone: ``tables/``, ``data/artifacts.csv``, ``data/sources.bib`` and ``data/paper/`` (copied there
+when the wheel is built: ``setup.py``).  Absent in a clone and in an editable install."""
+
+
+def _is_clone(path: Path) -> bool:
+    """Whether ``path`` is the root of a clone of the repository (its ``pyproject.toml``, the
+    package's sources and ``data/artifacts.csv``)."""
+    return ((path / "pyproject.toml").is_file() and (path / "replication" / "__init__.py").is_file()
+            and (path / "data" / "artifacts.csv").is_file())
+
+
+def _clone_root() -> Path | None:
+    """The clone the registry works in, by the first rule that applies: ``$REPLICATION_ROOT``; the
+    clone the package is imported from (an editable install, or ``PYTHONPATH`` at a clone); a
+    clone containing the current directory.  ``None`` outside any clone."""
+    env = os.environ.get("REPLICATION_ROOT")
+    if env:
+        return Path(env).resolve()
+    here = Path(__file__).resolve().parents[2]
+    if _is_clone(here):
+        return here
+    cwd = Path.cwd().resolve()
+    return next((p for p in (cwd, *cwd.parents) if _is_clone(p)), None)
+
+
 def project_root() -> Path:
-    """The repository root: ``$REPLICATION_ROOT`` or the folder holding ``pyproject.toml``.
+    """The root of the clone, where chapters write their tables: ``$REPLICATION_ROOT``, else the
+    clone the package is imported from, else a clone containing the current directory.
+
+    Only a clone is written to (:func:`compare`, ``python -m replication index``); reading works
+    from an installed package too (:func:`data_root`).
 
     Returns
     -------
     pathlib.Path
         The absolute path of the repository root.
+
+    Raises
+    ------
+    RegistryError
+        Outside a clone: the message says what reads still work.
     """
-    env = os.environ.get("REPLICATION_ROOT")
-    if env:
-        return Path(env).resolve()
-    here = Path(__file__).resolve().parent.parent
-    if (here / "pyproject.toml").exists():
-        return here
-    cwd = Path.cwd().resolve()
-    for p in (cwd, *cwd.parents):
-        if (p / "pyproject.toml").exists() and (p / "replication").is_dir():
-            return p
-    raise RegistryError("cannot find the project root; set REPLICATION_ROOT")
+    root = _clone_root()
+    if root is None:
+        where = f" (this installed package reads the tables it ships, {PACKAGED_DATA})" if PACKAGED_DATA.is_dir() else ""
+        raise RegistryError("not in a clone of the repository: tables are written only in a clone; run inside it "
+                            f"or set REPLICATION_ROOT to it{where}")
+    return root
+
+
+def data_root() -> Path:
+    """Where the tables, the register and the artifact list are read from, by the first rule that
+    applies: ``$REPLICATION_ROOT``; the clone the package is imported from (an editable install
+    reads the clone's live tables); a clone containing the current directory; the data shipped
+    inside the installed package (:data:`PACKAGED_DATA`).
+
+    Returns
+    -------
+    pathlib.Path
+        A folder holding ``tables/`` and ``data/``.
+
+    Raises
+    ------
+    RegistryError
+        Neither a clone nor an installed package with its data.
+    """
+    root = _clone_root()
+    if root is not None:
+        return root
+    if PACKAGED_DATA.is_dir():
+        return PACKAGED_DATA
+    raise RegistryError("cannot find the tables: not in a clone of the repository, and this installation of "
+                        "replication carries no data; run inside the clone, set REPLICATION_ROOT to it, or "
+                        "install the package from a clone (pip install <clone>)")
 
 
 def paper_dir() -> Path:
-    """The folder of the paper values, ``data/paper/`` under :func:`project_root`.
+    """The folder of the paper values, ``data/paper/`` under :func:`data_root`.
 
     Returns
     -------
     pathlib.Path
         ``<root>/data/paper``.
     """
-    return project_root() / "data" / "paper"
+    return data_root() / "data" / "paper"
 
 
 def tables_dir() -> Path:
-    """The folder of the exported tables, ``tables/`` under :func:`project_root`.
+    """The folder of the exported tables, ``tables/`` under :func:`data_root` (a clone's, or
+    the copy an installed package ships).
 
     Returns
     -------
     pathlib.Path
         ``<root>/tables``.
     """
-    return project_root() / "tables"
+    return data_root() / "tables"
 
 
 def validate_id(table_id: str) -> str:
@@ -1262,6 +1320,7 @@ def refresh_exports(table_ids: Iterable[str] | None = None) -> list[str]:
     list of str
         The ids whose ``.md`` or ``.tex`` changed.
     """
+    project_root()                      # only a clone is written to: refuses outside one
     changed = []
     for tid in list_tables() if table_ids is None else list(table_ids):
         df = read_table(tid)
@@ -1387,7 +1446,7 @@ def load_artifacts() -> pd.DataFrame:
     RegistryError
         A missing column, a malformed or duplicated id.
     """
-    path = project_root() / "data" / "artifacts.csv"
+    path = data_root() / "data" / "artifacts.csv"
     df = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
     need = {"id", "source", "artifact", "description"}
     if not need <= set(df.columns):
@@ -2008,6 +2067,7 @@ def _status_row(tid: str, source: str, artifact: str, description: str, present:
 
 
 def _write_if_changed(path: Path, content: str) -> None:
+    project_root()                      # only a clone is written to: refuses outside one
     if not path.exists() or path.read_text(encoding="utf-8") != content:
         path.write_text(content, encoding="utf-8")
 
@@ -2417,7 +2477,7 @@ def source_bibtex(key: str) -> str:
     str
         The entry with a trailing newline; empty when ``data/sources.bib`` lacks it.
     """
-    path = project_root() / "data" / "sources.bib"
+    path = data_root() / "data" / "sources.bib"
     if not path.exists():
         return ""
     text = path.read_text(encoding="utf-8")
