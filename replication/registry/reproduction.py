@@ -86,47 +86,105 @@ class RegistryError(ValueError):
 
 # --------------------------------------------------------------------------- locations
 
+PACKAGED_DATA = Path(__file__).resolve().parents[1] / "_data"
+"""Where an installed (non-editable) wheel keeps the files the read side needs, laid out as in a
+clone: ``tables/``, ``data/artifacts.csv``, ``data/sources.bib`` and ``data/paper/`` (copied there
+when the wheel is built: ``setup.py``).  Absent in a clone and in an editable install."""
+
+
+def _is_clone(path: Path) -> bool:
+    """Whether ``path`` is the root of a clone of the repository (its ``pyproject.toml``, the
+    package's sources and ``data/artifacts.csv``)."""
+    return ((path / "pyproject.toml").is_file() and (path / "replication" / "__init__.py").is_file()
+            and (path / "data" / "artifacts.csv").is_file())
+
+
+def _clone_root() -> Path | None:
+    """The clone the registry works in, by the first rule that applies: ``$REPLICATION_ROOT``; the
+    clone the package is imported from (an editable install, or ``PYTHONPATH`` at a clone); a
+    clone containing the current directory.  ``None`` outside any clone."""
+    env = os.environ.get("REPLICATION_ROOT")
+    if env:
+        return Path(env).resolve()
+    here = Path(__file__).resolve().parents[2]
+    if _is_clone(here):
+        return here
+    cwd = Path.cwd().resolve()
+    return next((p for p in (cwd, *cwd.parents) if _is_clone(p)), None)
+
+
 def project_root() -> Path:
-    """The repository root: ``$REPLICATION_ROOT`` or the folder holding ``pyproject.toml``.
+    """The root of the clone, where chapters write their tables: ``$REPLICATION_ROOT``, else the
+    clone the package is imported from, else a clone containing the current directory.
+
+    Only a clone is written to (:func:`compare`, ``python -m replication index``); reading works
+    from an installed package too (:func:`data_root`).
 
     Returns
     -------
     pathlib.Path
         The absolute path of the repository root.
+
+    Raises
+    ------
+    RegistryError
+        Outside a clone: the message says what reads still work.
     """
-    env = os.environ.get("REPLICATION_ROOT")
-    if env:
-        return Path(env).resolve()
-    here = Path(__file__).resolve().parent.parent
-    if (here / "pyproject.toml").exists():
-        return here
-    cwd = Path.cwd().resolve()
-    for p in (cwd, *cwd.parents):
-        if (p / "pyproject.toml").exists() and (p / "replication").is_dir():
-            return p
-    raise RegistryError("cannot find the project root; set REPLICATION_ROOT")
+    root = _clone_root()
+    if root is None:
+        where = f" (this installed package reads the tables it ships, {PACKAGED_DATA})" if PACKAGED_DATA.is_dir() else ""
+        raise RegistryError("not in a clone of the repository: tables are written only in a clone; run inside it "
+                            f"or set REPLICATION_ROOT to it{where}")
+    return root
+
+
+def data_root() -> Path:
+    """Where the tables, the register and the artifact list are read from, by the first rule that
+    applies: ``$REPLICATION_ROOT``; the clone the package is imported from (an editable install
+    reads the clone's live tables); a clone containing the current directory; the data shipped
+    inside the installed package (:data:`PACKAGED_DATA`).
+
+    Returns
+    -------
+    pathlib.Path
+        A folder holding ``tables/`` and ``data/``.
+
+    Raises
+    ------
+    RegistryError
+        Neither a clone nor an installed package with its data.
+    """
+    root = _clone_root()
+    if root is not None:
+        return root
+    if PACKAGED_DATA.is_dir():
+        return PACKAGED_DATA
+    raise RegistryError("cannot find the tables: not in a clone of the repository, and this installation of "
+                        "replication carries no data; run inside the clone, set REPLICATION_ROOT to it, or "
+                        "install the package from a clone (pip install <clone>)")
 
 
 def paper_dir() -> Path:
-    """The folder of the paper values, ``data/paper/`` under :func:`project_root`.
+    """The folder of the paper values, ``data/paper/`` under :func:`data_root`.
 
     Returns
     -------
     pathlib.Path
         ``<root>/data/paper``.
     """
-    return project_root() / "data" / "paper"
+    return data_root() / "data" / "paper"
 
 
 def tables_dir() -> Path:
-    """The folder of the exported tables, ``tables/`` under :func:`project_root`.
+    """The folder of the exported tables, ``tables/`` under :func:`data_root` (a clone's, or
+    the copy an installed package ships).
 
     Returns
     -------
     pathlib.Path
         ``<root>/tables``.
     """
-    return project_root() / "tables"
+    return data_root() / "tables"
 
 
 def validate_id(table_id: str) -> str:
@@ -917,29 +975,65 @@ def _markdown(df: pd.DataFrame, title: str) -> str:
     return "\n".join([f"**{title}**", "", *_md_comparison(df, cols)]) + "\n"
 
 
-_TEX_SPECIAL = {"\x01": r"\allowbreak{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}",
-                "~": r"\textasciitilde{}", "^": r"\textasciicircum{}", "\\": r"\textbackslash{}"}
+_TEX_SPECIAL = {"\x01": r"\allowbreak{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\texttt{\char95}", "{": r"\{", "}": r"\}",
+                "\\": r"\textbackslash{}", "<": r"\textless{}", ">": r"\textgreater{}", "|": r"\textbar{}",
+                "~": r"\texttt{\char126}", "^": r"\texttt{\char94}", '"': r"\texttt{\char34}", "`": r"\textasciigrave{}"}
+r"""ASCII that TeX does not print as itself in the default (OT1) encoding of a plain article: the
+specials escaped; ``< > |`` as the symbols (OT1's slots hold ``¡ ¿ —``); ``~ ^ "``, which OT1 has only
+as accents and a closing quote, from the typewriter font, where they are the ASCII glyphs."""
 
+_TEX_LIGATURES = ("--", "''", ",,", "``")
+"""Pairs of ASCII characters that TeX fonts join into one glyph (an en dash, a closing or opening
+double quote, a low quote): kept apart by ``{}``, so a cell prints ``--`` as two hyphens."""
+
+_GREEK = dict(zip("αβγδεζηθικλμνξπρσςτυφχψωϵϕϑΓΔΘΛΞΠΣΥΦΨΩ",
+                  ("alpha", "beta", "gamma", "delta", "varepsilon", "zeta", "eta", "theta", "iota", "kappa", "lambda",
+                   "mu", "nu", "xi", "pi", "rho", "sigma", "varsigma", "tau", "upsilon", "varphi", "chi", "psi", "omega",
+                   "epsilon", "phi", "vartheta", "Gamma", "Delta", "Theta", "Lambda", "Xi", "Pi", "Sigma", "Upsilon",
+                   "Phi", "Psi", "Omega")))
+
+_MATH_SIGNS = {
+    "±": "pm", "∓": "mp", "×": "times", "÷": "div", "·": "cdot", "√": "surd", "∇": "nabla", "∂": "partial",
+    "∞": "infty", "∝": "propto", "∼": "sim", "≃": "simeq", "≅": "cong", "≡": "equiv", "≈": "approx", "≠": "neq",
+    "≥": "geq", "≤": "leq", "≪": "ll", "≫": "gg", "≲": "lesssim", "≳": "gtrsim", "∈": "in", "∉": "notin",
+    "⊂": "subset", "⊆": "subseteq", "∩": "cap", "∪": "cup", "∧": "wedge", "∨": "vee", "¬": "neg", "∀": "forall",
+    "∃": "exists", "⊥": "perp", "∥": "parallel", "⊕": "oplus", "⊗": "otimes", "∘": "circ", "•": "bullet",
+    "⋆": "star", "→": "rightarrow", "←": "leftarrow", "↔": "leftrightarrow", "⇒": "Rightarrow", "⇐": "Leftarrow",
+    "⇔": "Leftrightarrow", "↑": "uparrow", "↓": "downarrow", "↦": "mapsto", "ℓ": "ell", "′": "prime",
+    "µ": "mu", "∅": "emptyset", "⟨": "langle", "⟩": "rangle", "⌊": "lfloor", "⌋": "rfloor", "⌈": "lceil",
+    "⌉": "rceil", **_GREEK,
+}
+"""Characters set in mathematics mode (``\\ensuremath{\\<name>}``): Greek, operators, relations,
+arrows.  ``≲ ≳`` need ``amssymb`` (:data:`TEX_EXTRA_PACKAGES`)."""
 
 _TEX_UNICODE = {
-    "°": r"\textdegree{}", "±": r"\ensuremath{\pm}", "×": r"\ensuremath{\times}", "²": r"\ensuremath{^2}",
-    "³": r"\ensuremath{^3}", "√": r"\ensuremath{\surd}", "″": r"\ensuremath{''}", "′": r"\ensuremath{'}",
-    "∇": r"\ensuremath{\nabla}", "∂": r"\ensuremath{\partial}", "→": r"\ensuremath{\rightarrow}",
-    "≥": r"\ensuremath{\geq}", "≤": r"\ensuremath{\leq}", "≠": r"\ensuremath{\neq}", "≈": r"\ensuremath{\approx}",
-    "∈": r"\ensuremath{\in}", "−": "-", "–": "--", "—": "---", "…": r"\ldots{}", "·": r"\ensuremath{\cdot}",
-    "Ā": r"\=A", "ā": r"\=a", "μ": r"\ensuremath{\mu}", "µ": r"\ensuremath{\mu}", "φ": r"\ensuremath{\varphi}",
-    "ε": r"\ensuremath{\varepsilon}", "Δ": r"\ensuremath{\Delta}", "Ω": r"\ensuremath{\Omega}",
-    "Φ": r"\ensuremath{\Phi}", "Σ": r"\ensuremath{\Sigma}",
-    **{g: rf"\ensuremath{{\{n}}}" for g, n in zip("αβγδζηθικλνξπρστυχψω",
-                                                  ("alpha", "beta", "gamma", "delta", "zeta", "eta", "theta", "iota",
-                                                   "kappa", "lambda", "nu", "xi", "pi", "rho", "sigma", "tau",
-                                                   "upsilon", "chi", "psi", "omega"))},
+    **{ch: rf"\ensuremath{{\{name}}}" for ch, name in _MATH_SIGNS.items()},
+    "°": r"\textdegree{}", "§": r"\S{}", "¶": r"\P{}", "†": r"\dag{}", "‡": r"\ddag{}", "©": r"\copyright{}",
+    "¹": r"\ensuremath{^1}", "²": r"\ensuremath{^2}", "³": r"\ensuremath{^3}", "⁻": r"\ensuremath{^-}",
+    "″": r"\ensuremath{''}", "‴": r"\ensuremath{'''}", "−": r"\ensuremath{-}", "–": "--", "—": "---",
+    "…": r"\ldots{}", "‘": "`", "’": "'", "“": "``", "”": "''", "\u00a0": "~", "\u2009": r"\,",
+    "ß": r"\ss{}", "æ": r"\ae{}", "Æ": r"\AE{}", "œ": r"\oe{}", "Œ": r"\OE{}", "ø": r"\o{}", "Ø": r"\O{}",
+    "ı": r"\i{}", "\n": " ", "\t": " ", "¡": r"\textexclamdown{}", "¿": r"\textquestiondown{}",
 }
-r"""Unicode of the tables in LaTeX that pdflatex compiles without extra packages (Greek and the
-mathematical signs in ``\ensuremath``)."""
+r"""Unicode of the tables in LaTeX that pdflatex sets with the fonts of ``texlive-latex-base``:
+Greek and mathematical signs in ``\ensuremath`` (:data:`_MATH_SIGNS`), the others as text
+macros.  Accented Latin letters are composed (:data:`_TEX_TEXT_ACCENTS`), Chinese is set by
+``CJKutf8``, and any other character is refused (:func:`_tex_escape`)."""
 
-_TEX_ACCENTS = {"\u0304": "bar", "\u0302": "hat", "\u0307": "dot"}
-_CJK_NOTE = "[Chinese text: see the CSV]"
+_TEX_TEXT_ACCENTS = {"\u0300": "`", "\u0301": "'", "\u0302": "^", "\u0303": "~", "\u0304": "=", "\u0306": "u",
+                     "\u0307": ".", "\u0308": '"', "\u030a": "r", "\u030b": "H", "\u030c": "v", "\u0327": "c",
+                     "\u0328": "k"}
+"""Combining accents of a precomposed Latin letter (``ā``, ``é``), as LaTeX's text accents."""
+
+_TEX_ACCENTS = {"\u0304": "bar", "\u0302": "hat", "\u0307": "dot", "\u0308": "ddot", "\u0303": "tilde",
+                "\u0301": "acute", "\u0300": "grave", "\u030c": "check", "\u0306": "breve", "\u20d7": "vec"}
+"""A combining accent written after a symbol (``x̄``, ``φ̂``): the mathematical accent over it."""
+
+TEX_CJK_FONT = "gbsn"
+"""The font of Chinese text in a ``.tex`` export (AR PL SungtiL GB, through ``CJKutf8``)."""
+
+TEX_EXTRA_PACKAGES = {"≲": "amssymb", "≳": "amssymb"}
+"""Characters whose macro needs a package beyond :data:`TEX_PACKAGES` (Chinese needs ``CJKutf8``)."""
 
 
 def _is_cjk(ch: str) -> bool:
@@ -947,38 +1041,89 @@ def _is_cjk(ch: str) -> bool:
     return 0x3000 <= o <= 0x303F or 0x3400 <= o <= 0x9FFF or 0xFF00 <= o <= 0xFFEF
 
 
+def _tex_char(ch: str) -> str:
+    """One non-CJK character of a cell in LaTeX (:func:`_tex_escape`)."""
+    if ch in _TEX_SPECIAL:
+        return _TEX_SPECIAL[ch]
+    if " " <= ch <= "~":
+        return ch
+    if ch in _TEX_UNICODE:
+        return _TEX_UNICODE[ch]
+    base, *marks = unicodedata.normalize("NFD", ch)
+    if marks and all(m in _TEX_TEXT_ACCENTS for m in marks) and ("a" <= base.lower() <= "z"):
+        out = "\\i" if base == "i" else base
+        for m in marks:
+            out = f"\\{_TEX_TEXT_ACCENTS[m]}{{{out}}}"
+        return out
+    raise RegistryError(f"no LaTeX for the character {ch!r} (U+{ord(ch):04X} {unicodedata.name(ch, '?')}) of a "
+                        "table: add it to replication.registry.reproduction._TEX_UNICODE")
+
+
 def _tex_escape(s: str) -> str:
-    """Text of a cell in LaTeX that compiles with pdflatex in a plain article: TeX specials
-    escaped, Greek letters and mathematical signs as macros (:data:`_TEX_UNICODE`), a combining
-    accent over the preceding letter, a run of Chinese characters replaced by a pointer to the CSV
-    (which keeps them), any other non-ASCII character by its Unicode name."""
+    r"""Text of a cell in LaTeX that prints it with pdflatex in a plain article: TeX specials and
+    the ASCII that OT1 fonts do not hold escaped (:data:`_TEX_SPECIAL`), ligatures of ASCII pairs
+    kept apart (:data:`_TEX_LIGATURES`), Greek letters and mathematical signs as macros
+    (:data:`_TEX_UNICODE`), accented letters composed, a combining accent over the preceding
+    symbol, and each run of Chinese in a ``CJK`` environment of ``CJKutf8`` (font
+    :data:`TEX_CJK_FONT`), left as UTF-8.
+
+    Raises
+    ------
+    RegistryError
+        A character that has no LaTeX here (never printed as a placeholder).
+    """
     out: list[str] = []
-    cjk = False
-    for ch in s:
+    i = 0
+    while i < len(s):
+        ch = s[i]
         if _is_cjk(ch):
-            if not cjk:
-                out.append(_CJK_NOTE)
-            cjk = True
+            j = i
+            while j < len(s) and _is_cjk(s[j]):
+                j += 1
+            out.append(rf"\begin{{CJK}}{{UTF8}}{{{TEX_CJK_FONT}}}{s[i:j]}\end{{CJK}}")
+            i = j
             continue
-        cjk = False
         if ch in _TEX_ACCENTS and out:
             prev = out.pop()
             inner = prev[len(r"\ensuremath{"):-1] if prev.startswith(r"\ensuremath{") else prev
             out.append(rf"\ensuremath{{\{_TEX_ACCENTS[ch]}{{{inner}}}}}")
-        elif ch in _TEX_SPECIAL:
-            out.append(_TEX_SPECIAL[ch])
-        elif ord(ch) < 128:
-            out.append(ch)
-        elif ch in _TEX_UNICODE:
-            out.append(_TEX_UNICODE[ch])
         else:
-            out.append(f"[{unicodedata.name(ch, hex(ord(ch)))}]")
+            piece = _tex_char(ch)
+            if out and out[-1][-1:] + piece[:1] in _TEX_LIGATURES:
+                out[-1] += "{}"
+            out.append(piece)
+        i += 1
     return "".join(out)
 
 
+def tex_packages(text: str) -> tuple[str, ...]:
+    r"""The LaTeX packages a document needs to set ``text`` as :func:`_tex_escape` writes it:
+    :data:`TEX_PACKAGES`, ``amssymb`` for a sign of :data:`TEX_EXTRA_PACKAGES`, ``CJKutf8`` for
+    Chinese.
+
+    Parameters
+    ----------
+    text : str
+        Every cell of an export.
+
+    Returns
+    -------
+    tuple of str
+        Package names, in the order of a ``\usepackage`` line.
+    """
+    extra = {p for ch, p in TEX_EXTRA_PACKAGES.items() if ch in text}
+    if any(_is_cjk(ch) for ch in text):
+        extra.add("CJKutf8")
+    return (*TEX_PACKAGES, *sorted(extra))
+
+
 TEX_PACKAGES = ("array", "longtable")
-r"""The LaTeX packages a document needs to ``\input`` an export ``tables/<id>.tex`` (both in
-LaTeX's tools bundle: Debian's ``texlive-latex-base``)."""
+r"""The LaTeX packages every export ``tables/<id>.tex`` needs (both in LaTeX's tools bundle:
+Debian's ``texlive-latex-base``); an export with Chinese text or a sign of
+:data:`TEX_EXTRA_PACKAGES` names more in its header (:func:`tex_packages`)."""
+
+_TEX_PACKAGE_SOURCES = {"CJKutf8": "CJKutf8: Debian's latex-cjk-common, its font gbsn: latex-cjk-chinese-arphic-gbsn00lp",
+                        "amssymb": "amssymb: texlive-base"}
 
 TEX_COLUMNS = (("quantity", 0.16), ("unit", 0.11), ("paper", 0.16), ("reproduced", 0.16),
                ("abs_error", 0.135), ("tolerance", 0.115), ("status", 0.16))
@@ -1009,28 +1154,32 @@ def _tex_breakable(text: str, long: int = _LONG_TOKEN) -> str:
 def _tex_cell(text: str, long: int = _LONG_TOKEN) -> str:
     """A cell of a ``.tex`` export: escaped (:func:`_tex_escape`), with break points in tokens
     longer than ``long`` characters."""
-    return _tex_escape(_tex_breakable(text, long)).replace(_CJK_NOTE, r"\allowbreak{}" + _CJK_NOTE + r"\allowbreak{}")
+    return _tex_escape(_tex_breakable(text, long))
 
 
 def _latex(df: pd.DataFrame, title: str, table_id: str) -> str:
     r"""The ``.tex`` export of a comparison table: a ``longtable`` that fits the text width of a
     plain ``article`` (``p`` columns, long cells wrapped) and breaks across pages, its header
     repeated; each row's reason (the ``note``) on a line of the full width below it.  Needs
-    ``\usepackage{array,longtable}`` (:data:`TEX_PACKAGES`)."""
+    ``\usepackage{array,longtable}`` (:data:`TEX_PACKAGES`), and the packages :func:`tex_packages`
+    adds (``CJKutf8`` for Chinese text, ``amssymb`` for ``≲ ≳``), all named in its header."""
     n = len(TEX_COLUMNS)
     # ragged right, and hyphenable from the first word of a cell on (``\hspace{0pt}``)
     left = r">{\raggedright\arraybackslash\hspace{0pt}}"
     spec = "".join(rf"{left}p{{\dimexpr {w}\linewidth-2\tabcolsep\relax}}" for _, w in TEX_COLUMNS)
     full = left + r"p{\dimexpr\linewidth-2\tabcolsep\relax}"
     header = " & ".join(_tex_escape(_HEADINGS.get(c, c)) for c, _ in TEX_COLUMNS) + r" \\"
+    rows = [[display_cell(r, c) for c, _ in TEX_COLUMNS] + [str(r.get("note", "") or "").strip()] for _, r in df.iterrows()]
+    packages = tex_packages(" ".join([title, *(cell for row in rows for cell in row)]))
     lines = [
         f"% tables/{table_id}.tex: {_tex_escape(title)}",
         "% Written by replication.registry.reproduction from tables/" + table_id + ".csv (which keeps every stored",
-        "% digit and the Chinese text); regenerate with `python -m replication index`.",
+        "% digit); regenerate with `python -m replication index`.  UTF-8; compiles with pdflatex.",
         "% Include with \\input{" + table_id + "} in a document whose preamble has",
-        "%   \\usepackage{" + ",".join(TEX_PACKAGES) + "}",
-        "% (both in LaTeX's tools bundle, Debian's texlive-latex-base); the table fits the text width of a",
-        "% plain article, breaks across pages and repeats its header.",
+        "%   \\usepackage{" + ",".join(packages) + "}",
+        "% (array and longtable: LaTeX's tools bundle, Debian's texlive-latex-base"
+        + "".join(f"; {_TEX_PACKAGE_SOURCES[p]}" for p in packages if p in _TEX_PACKAGE_SOURCES) + ");",
+        "% the table fits the text width of a plain article, breaks across pages and repeats its header.",
         r"\begingroup",
         r"\footnotesize",
         r"\setlength{\tabcolsep}{2pt}",
@@ -1041,9 +1190,8 @@ def _latex(df: pd.DataFrame, title: str, table_id: str) -> str:
         r"\hline", header, r"\hline", r"\endhead",
         r"\hline", r"\endfoot",
     ]
-    for _, r in df.iterrows():
-        cells = " & ".join(_tex_cell(display_cell(r, c), 4 if c == "unit" else _LONG_TOKEN) for c, _ in TEX_COLUMNS)
-        note = str(r.get("note", "") or "").strip()
+    for *shown, note in rows:
+        cells = " & ".join(_tex_cell(text, 4 if c == "unit" else _LONG_TOKEN) for text, (c, _) in zip(shown, TEX_COLUMNS))
         if note:
             lines.append(cells + r" \\*")
             lines.append(rf"\multicolumn{{{n}}}{{{full}}}{{\hspace*{{1em}}\emph{{reason:}} {_tex_cell(note)}}} \\[2pt]")
@@ -1243,6 +1391,7 @@ def refresh_exports(table_ids: Iterable[str] | None = None) -> list[str]:
     list of str
         The ids whose ``.md`` or ``.tex`` changed.
     """
+    project_root()                      # only a clone is written to: refuses outside one
     changed = []
     for tid in list_tables() if table_ids is None else list(table_ids):
         df = read_table(tid)
@@ -1368,7 +1517,7 @@ def load_artifacts() -> pd.DataFrame:
     RegistryError
         A missing column, a malformed or duplicated id.
     """
-    path = project_root() / "data" / "artifacts.csv"
+    path = data_root() / "data" / "artifacts.csv"
     df = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
     need = {"id", "source", "artifact", "description"}
     if not need <= set(df.columns):
@@ -1903,6 +2052,7 @@ def _status_row(tid: str, source: str, artifact: str, description: str, present:
 
 
 def _write_if_changed(path: Path, content: str) -> None:
+    project_root()                      # only a clone is written to: refuses outside one
     if not path.exists() or path.read_text(encoding="utf-8") != content:
         path.write_text(content, encoding="utf-8")
 
@@ -2324,7 +2474,7 @@ def source_bibtex(key: str) -> str:
     str
         The entry with a trailing newline; empty when ``data/sources.bib`` lacks it.
     """
-    path = project_root() / "data" / "sources.bib"
+    path = data_root() / "data" / "sources.bib"
     if not path.exists():
         return ""
     text = path.read_text(encoding="utf-8")
