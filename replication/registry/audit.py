@@ -51,7 +51,17 @@ CRITERIA = {
 
 @dataclass(frozen=True)
 class Problem:
-    """One refusal: the table, the row (empty for the table as a whole) and the reason."""
+    """One refusal of the audit.
+
+    Attributes
+    ----------
+    table : str
+        The table (or ``inventory of <key>``).
+    row : str
+        The row's quantity; empty for the table as a whole.
+    reason : str
+        Why, in words a chapter's author can act on.
+    """
 
     table: str
     row: str
@@ -128,7 +138,7 @@ def _paper_values(meta: Mapping[str, Any], table_id: str) -> list[float]:
     root = rp.data_root()
     files = [root / meta["paper_source"]] if meta.get("paper_source") else []
     if not files or not files[0].exists():
-        files = sorted((rp.paper_dir() / table_id.split("-", 1)[0]).glob("*.csv"))
+        files = sorted(f for f in (rp.paper_dir() / table_id.split("-", 1)[0]).glob("*.csv") if f.name != "inventory.csv")
     out = []
     for f in files:
         for line in f.read_text(encoding="utf-8").splitlines():
@@ -452,6 +462,11 @@ def audit(table_ids: Iterable[str] | None = None) -> list[Problem]:
                 out.append(Problem(csv.stem, "", "a CSV without its sidecar: tables are written by compare(), not by hand"))
     for tid in ids:
         out += audit_table(tid)
+    if table_ids is None:
+        from replication.registry import inventory
+
+        for key in rp.SOURCE_KEYS:
+            out += [Problem(f"inventory of {key}", "", msg) for msg in inventory.problems(key)]
     return out
 
 

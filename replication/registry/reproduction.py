@@ -408,7 +408,8 @@ def load_paper(table_id: str) -> PaperTable:
     key = table_id.split("-", 1)[0]
     path = paper_dir() / key / f"{table_id}.csv"
     if not path.exists():
-        known = sorted(p.stem for p in (paper_dir() / key).glob("*.csv")) if (paper_dir() / key).exists() else []
+        known = sorted(p.stem for p in (paper_dir() / key).glob("*.csv") if p.name != "inventory.csv") \
+            if (paper_dir() / key).exists() else []
         raise RegistryError(f"no paper values for {table_id!r} (looked for {path}); known for {key}: {known}")
     return parse_paper_file(path)
 
@@ -676,7 +677,11 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
     optional ``note``, ``evidence``, ``corrected`` (the corrected text for an erratum whose
     correction is not a single number), ``paper_text`` (the printed form where the paper printed
     a formula or a range) and ``digits`` (significant digits the computation determines, for a
-    long nonlinear run or a Monte-Carlo mean).  The status is computed, never typed: a numeric
+    long nonlinear run or a Monte-Carlo mean); ``basis``, ``agrees`` and ``rests_on`` (how the row
+    is judged and its evidence: :mod:`replication.registry.verdicts`); and, given to :func:`compare`,
+    ``group`` (rows that one reading must reach together, e.g. a column of a printed table: a
+    failing row that a reading reaches only by losing another printed value of its group is
+    ``inconsistent``, not ``unverifiable``; stored in the sidecar's ``groups``).  The status is computed, never typed: a numeric
     row is ``reproduced`` when its error is within the tolerance and ``not-reproduced``
     otherwise.  Numbers are stored by the precision policy of this module (see
     :data:`DEFAULT_DIGITS`); the status is decided on the stored values, so the CSV is
@@ -1215,7 +1220,6 @@ def compare(
     readings: Sequence[str] | None = None,
     ruled_out: Mapping[str, str] | None = None,
     summary: str = "",
-    groups: Mapping[str, Sequence[str]] | None = None,
 ) -> pd.DataFrame:
     """Compare reproduced with paper values and export ``tables/<table_id>.*``.
 
@@ -1265,11 +1269,6 @@ def compare(
         Reading (or prefix) to the printed evidence that excludes it.
     summary : str, optional
         The table's verdict in one line.
-    groups : mapping of str to sequence of str, optional
-        Rows that one reading must reach together (e.g. a column of a printed table): a failing
-        row that a reading reaches only by losing another printed value of its group is
-        ``inconsistent`` (the group contradicts itself), not ``unverifiable``
-        (:func:`replication.registry.verdicts.derive_status`).
 
     Returns
     -------
@@ -1293,14 +1292,13 @@ def compare(
         ruled[k] = v
     if isinstance(rows, pd.DataFrame):
         rows = rows.to_dict("records")
+    rows = [dict(r) for r in rows]
+    grouped: dict[str, list[str]] = {}
+    for r in rows:
+        g = r.pop("group", None)
+        if g not in (None, ""):
+            grouped.setdefault(str(g), []).append(str(r.get("quantity")))
     df = comparison_frame(rows)
-    grouped = {}
-    for g, qs in dict(groups or {}).items():
-        qs = [str(x) for x in qs]
-        unknown = sorted(set(qs) - set(df["quantity"]))
-        if unknown:
-            raise RegistryError(f"{table_id}: group {g!r} names rows that are not in the table: {unknown[:5]}")
-        grouped[str(g)] = qs
     if (df["basis"] != "").any() and (ledgers or readings_ledgers(table_id, {})):
         from replication.registry import audit as _audit  # reads the exported ledgers
 
@@ -1640,6 +1638,9 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
         _write_if_changed(d / "register.csv", register.to_csv(index=False, lineterminator="\n"))
         _write_if_changed(d / "status.md", _status_markdown(status))
         _write_if_changed(d / "status-criteria.md", _criteria_markdown())
+        from replication.registry import inventory as _inventory
+
+        _write_if_changed(d / "inventory.md", _inventory.markdown())
         _write_if_changed(d / "register.md", _register_markdown(register))
         for src in SOURCE_KEYS:
             _write_if_changed(d / f"status-{src}.md", _paper_summary_markdown(status, src))
@@ -1706,6 +1707,8 @@ REGISTER_FIELD_DESCRIPTIONS = {
     "quantity": "the quantity of that row",
     "printed": "what the source prints, as printed (paper_text, else the printed number in the row's unit: see "
                "the table's unit column)",
+    "printed_value": "where the print is a formula or text: its value evaluated at the row's point, in the row's "
+                     "unit (empty where the print is a number)",
     "reproduced": "what the package computes (reproduced_text, else the number in the row's unit)",
     "corrected": "the corrected expression or value of an erratum",
     "note": "why: the finding in words",
@@ -1943,7 +1946,7 @@ def check_verdicts(table_ids: Iterable[str] | None = None) -> None:
     _audit.check(table_ids)
 
 
-REGISTER_COLUMNS = ("kind", "source", "table", "quantity", "printed", "reproduced", "corrected", "note",
+REGISTER_COLUMNS = ("kind", "source", "table", "quantity", "printed", "printed_value", "reproduced", "corrected", "note",
                     "evidence")
 """Columns of ``tables/register.csv``: every ``erratum`` and ``inconsistent`` row of every table."""
 
@@ -1972,6 +1975,7 @@ def build_register(exported: Mapping[str, dict] | None = None) -> pd.DataFrame:
             rows.append({
                 "kind": r["status"], "source": tid.split("-")[0], "table": tid, "quantity": r["quantity"],
                 "printed": r["paper_text"] or r["paper"],
+                "printed_value": r["paper"] if r["paper_text"] else "",
                 "reproduced": r["reproduced_text"] or r["reproduced"],
                 "corrected": r["corrected"] if r["status"] == "erratum" else "",
                 "note": r["note"],

@@ -28,6 +28,7 @@ This module knows no files: :mod:`replication.registry.audit` reads the stored t
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from typing import Any, Iterable
 
@@ -103,10 +104,24 @@ class Evidence:
 
 def after_ledger(ledger: LedgerEvidence | None, failing: str) -> str:
     """A comparison that misses the print under the main reading, judged against the ledger:
-    ``not-reproduced`` (or ``failing``) when no reading reaches the print; ``unverifiable`` when a
-    reading the print leaves open reaches it and keeps the rest of its group (an unstated choice,
-    chosen to suit, reaches the print); ``inconsistent`` when every reading that reaches it loses
-    another printed value of the same group (the printed group contradicts itself)."""
+    ``failing`` when no reading reaches the print; ``unverifiable`` when a reading the print leaves
+    open reaches it and keeps the rest of its group (an unstated choice, chosen to suit, reaches the
+    print); ``inconsistent`` when every reading that reaches it loses another printed value of the
+    same group (the printed group contradicts itself), or when the row was an erratum (a printed
+    value that a faithful reading reproduces is another convention, not a misprint).
+
+    Parameters
+    ----------
+    ledger : LedgerEvidence or None
+        What the table's ledger says about the row.
+    failing : str
+        ``"not-reproduced"`` or ``"erratum"``: the status without a reaching reading.
+
+    Returns
+    -------
+    str
+        The status.
+    """
     if ledger is None or not ledger.reaching:
         return failing
     if ledger.grouped and not ledger.keeping_group:
@@ -232,7 +247,8 @@ def format_agrees(value: Any) -> str:
 
 
 def split_refs(text: str) -> list[str]:
-    """The row references of a ``rests_on`` cell: ``<table id>#<quantity>`` or a table id, separated by ``; ``.
+    """The row references of a ``rests_on`` cell: ``<table id>#<quantity>`` or a table id, separated by ``; ``
+    (a ``;`` inside a quantity stays: a reference starts with a table id).
 
     Parameters
     ----------
@@ -242,7 +258,8 @@ def split_refs(text: str) -> list[str]:
     -------
     list of str
     """
-    return [t.strip() for t in str(text or "").split(";") if t.strip()]
+    parts = re.split(r";\s*(?=[a-z][a-z0-9]*-[a-z0-9])", str(text or ""))   # a quantity may itself hold "; "
+    return [t.strip() for t in parts if t.strip()]
 
 
 def worst(statuses: Iterable[str]) -> str:
