@@ -20,6 +20,10 @@ def test_the_summaries_follow_the_tables(page):
     assert words.problems(page) == []
 
 
+def test_the_readme_counts_follow_the_tables():
+    assert words.problems(ROOT / "README.md", heading="") == []
+
+
 def _page(tmp_path, text):
     p = tmp_path / "book" / "intro.md"
     p.parent.mkdir(parents=True, exist_ok=True)

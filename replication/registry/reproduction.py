@@ -2330,13 +2330,18 @@ def _register_markdown(register: pd.DataFrame) -> str:
     is, what is printed, what the package computes (or the correction) and why."""
     if register.empty:
         return "No erratum or inconsistency has been recorded yet.\n"
+    paper_tables = {t for _, a in load_artifacts().iterrows() for t in artifact_tables(a)}
     lines = []
     for source in [k for k in SOURCE_KEYS if k in set(register["source"])] + \
             sorted(set(register["source"]) - set(SOURCE_KEYS)):
         part = register[register["source"] == source]
         n_e, n_i = int((part["kind"] == "erratum").sum()), int((part["kind"] == "inconsistent").sum())
+        supp = part[~part["table"].isin(paper_tables)]
+        s_e, s_i = int((supp["kind"] == "erratum").sum()), int((supp["kind"] == "inconsistent").sum())
+        split = (f" The status page counts the findings of the document's artifacts: {n_e - s_e} and {n_i - s_i}; "
+                 f"the other {s_e + s_i} are in the package's supplementary checks." if s_e + s_i else "")
         lines += [f"## {source}", "", f"{n_e} {'erratum' if n_e == 1 else 'errata'}, "
-                  f"{n_i} {'inconsistency' if n_i == 1 else 'inconsistencies'}.", ""]
+                  f"{n_i} {'inconsistency' if n_i == 1 else 'inconsistencies'}.{split}", ""]
         for kind, title, third in (("erratum", "Errata", "corrected"), ("inconsistent", "Inconsistencies", "reproduced")):
             sub = part[part["kind"] == kind]
             if sub.empty:

@@ -11,7 +11,9 @@ Each entry is a subject (a table id, an artifact id, or a source key) and ``name
 ``<status>=N``   rows with that status (of a table; of a source: over its paper artifacts);
 ``rows=N``       rows of a table;
 ``failing=N``    paper artifacts of a source that hold ``not-reproduced`` rows;
-``status=W``     the status of an artifact (``tables/status.csv``; ``mixed`` as the word).
+``status=W``     the status of an artifact (``tables/status.csv``; ``mixed`` as the word);
+``artifacts=N``  paper artifacts of a source; subject ``all``: ``paper=N`` and ``supplementary=N``,
+                 the artifacts of the four documents and the package's supplementary checks.
 
 :func:`problems` recomputes every note from the stored tables and refuses a note that disagrees
 with them, and a count in the paragraph (a number, in digits or words, followed by a counted noun —
@@ -33,7 +35,7 @@ NUMBER_WORDS = {"one": 1, "two": 2, "three": 3, "four": 4, "five": 5, "six": 6, 
                 "sixteen": 16, "seventeen": 17, "eighteen": 18, "nineteen": 19, "twenty": 20}
 """Counts written in words."""
 
-COUNTED = ("verdict", "bar", "row", "result", "coefficient", "element", "erratum", "errata", "inconsistenc",
+COUNTED = ("artifact", "verdict", "bar", "row", "result", "coefficient", "element", "erratum", "errata", "inconsistenc",
            "state", "artifact", "table", "header", "reading", "conclusion", "claim", "misprint", "count",
            "misalignment", "formula", "equation", "check", "cell", "run")
 """Stems of the nouns whose counts a summary states (a number followed, within three words, by one
@@ -103,7 +105,11 @@ def stated_counts(paragraph: str) -> list[int]:
 
 
 def _actual(subject: str, name: str, status: pd.DataFrame) -> str | None:
+    if subject == "all" and name in ("paper", "supplementary"):
+        return str(int((status["kind"] == name).sum()))
     if subject in rp.SOURCE_KEYS:
+        if name == "artifacts":
+            return str(int(((status["source"] == subject) & (status["kind"] == "paper")).sum()))
         paper = status[(status["source"] == subject) & (status["kind"] == "paper")]
         if name == "failing":
             return str(int((paper["not_reproduced"].astype(int) > 0).sum()))
@@ -129,15 +135,16 @@ def paragraphs(path: str | Path, heading: str = "## In short") -> list[str]:
     ----------
     path : str or pathlib.Path
     heading : str
+        The section's heading line; empty for the whole page (code blocks left out).
 
     Returns
     -------
     list of str
     """
     text = Path(path).read_text(encoding="utf-8")
-    if heading not in text:
+    if heading and heading not in text:
         return []
-    section = text.split(heading, 1)[1].split("\n## ", 1)[0]
+    section = text.split(heading, 1)[1].split("\n## ", 1)[0] if heading else re.sub(r"```.*?```", " ", text, flags=re.S)
     out = []
     for block in re.split(r"\n\s*\n", section):
         out += [b for b in re.split(r"\n(?=\* )", block) if b.strip()]
