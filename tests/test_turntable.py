@@ -89,8 +89,10 @@ def test_summary_and_ordering_rows():
     runs_exp[:, 5] = 1.0 + 0.01 * rng.standard_normal(8)               # height: no real difference
     rows = findings.ordering_rows(np.full(9, 2.0), ref, runs_exp, runs_ref, label="experiment 1")
     st = {r["quantity"]: r for r in rows}
-    assert st["heading error STD ratio to experiment 1"]["status"] == "qualitative"
-    assert st["up velocity error STD ratio to experiment 1"]["status"] == "not-reproduced"
+    assert all(r["basis"] == "verdict" and "status" not in r for r in rows)
+    assert st["heading error STD ratio to experiment 1"]["agrees"] is True
+    assert st["up velocity error STD ratio to experiment 1"]["agrees"] is False
+    assert st["height error STD ratio to experiment 1"]["agrees"] is False
     assert "opposite" in st["up velocity error STD ratio to experiment 1"]["note"]
     assert "no significant" in st["height error STD ratio to experiment 1"]["note"]
     assert len(rows) == 4

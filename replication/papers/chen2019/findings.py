@@ -222,10 +222,11 @@ def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indic
     """Comparison rows for the orderings between two experiments the printed tables show.
 
     For each index i: the printed ratio paper_exp[i] / paper_ref[i] and the ratio of the
-    Monte-Carlo means.  Status ``qualitative`` when the simulated means differ in the printed
-    direction by more than two standard errors of their difference (the ordering is reproduced);
-    ``not-reproduced`` otherwise (opposite direction, no significant difference, or equal printed
-    values).
+    Monte-Carlo means, a row of basis ``verdict`` (the ordering against the print) whose ``agrees``
+    is true when the simulated means differ in the printed direction by more than two standard
+    errors of their difference (the ordering is reproduced) and false otherwise (opposite
+    direction, no significant difference, or equal printed values); the registry derives the
+    status from it.
 
     Parameters
     ----------
@@ -247,7 +248,7 @@ def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indic
     rows : list of dict
         One row per index for :func:`replication.registry.reproduction.compare`: ``quantity``,
         ``unit`` (``"1"``, the ratios are dimensionless), ``paper`` (printed ratio), ``reproduced``
-        (ratio of the simulated means), ``status``, ``note``.
+        (ratio of the simulated means), ``basis`` (``"verdict"``), ``agrees``, ``note``.
 
     Raises
     ------
@@ -282,8 +283,7 @@ def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indic
         else:
             note = "simulated ordering opposite to the printed one"
         rows.append(dict(quantity=f"{name} STD ratio to {label}", unit="1", paper=round(float(p), 3),
-                         reproduced=round(float(s), 3), status="qualitative" if ok else "not-reproduced",
-                         note=note))
+                         reproduced=round(float(s), 3), basis="verdict", agrees=bool(ok), note=note))
     return rows
 
 
