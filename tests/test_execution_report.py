@@ -115,3 +115,40 @@ def test_the_configuration_names_another_record(tmp_path, monkeypatch):
     monkeypatch.setenv("REPLICATION_ROOT", str(tmp_path / "no-such-checkout"))
     html = _build(tmp_path / "conf", None, confoverrides={"execution_report": str(other)})
     assert "book/<wbr>y/<wbr>long_<wbr>name_<wbr>of_<wbr>a_<wbr>notebook<wbr>.ipynb" in html
+
+
+def test_the_usable_cpus_not_the_hosts(monkeypatch, tmp_path):
+    """The default number of notebooks at once: the CPUs granted to this process (affinity mask,
+    cgroup quota rounded up), not the host's count: 16 cores, one, and a quota of 1.5 of 16."""
+    rn = _run_notebooks()
+    cpu_max = tmp_path / "cpu.max"
+    monkeypatch.setattr(rn.os, "cpu_count", lambda: 64)
+    monkeypatch.setattr(rn.os, "sched_getaffinity", lambda pid: set(range(16)))
+    assert rn.usable_cpus(cpu_max) == 16                      # no cgroup file
+    cpu_max.write_text("max 100000\n", encoding="utf-8")
+    assert rn.usable_cpus(cpu_max) == 16
+    cpu_max.write_text("150000 100000\n", encoding="utf-8")
+    assert rn.usable_cpus(cpu_max) == 2
+    monkeypatch.setattr(rn.os, "sched_getaffinity", lambda pid: {3})
+    assert rn.usable_cpus(cpu_max) == 1
+    cpu_max.write_text("garbage\n", encoding="utf-8")
+    assert rn.usable_cpus(cpu_max) == 1
+
+
+def test_a_failed_or_timed_out_run_is_an_outcome(tmp_path):
+    """A cell that raises, and one that outlasts the cell timeout (a slow or busy machine): each is
+    an outcome of the run without a time (the report shows it), not an exception that stops the
+    other notebooks; the notebook is left as it was."""
+    import nbformat
+
+    rn = _run_notebooks()
+    runs = {}
+    # the raising cell has all the time a busy machine may need; the sleeping one outlasts 3 s anywhere
+    for name, code, timeout in (("raises", "raise ValueError('no')", 600), ("sleeps", "import time\ntime.sleep(600)", 3)):
+        nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(code)])
+        path = tmp_path / f"{name}.ipynb"
+        nbformat.write(nb, path)
+        before = path.read_text(encoding="utf-8")
+        runs[name] = rn._run_one(path, timeout=timeout, rms=rn.IMAGE_RMS)[1:3]
+        assert path.read_text(encoding="utf-8") == before
+    assert runs == {"raises": (None, "failed"), "sleeps": (None, "timeout")}
