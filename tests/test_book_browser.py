@@ -9,8 +9,8 @@ printed by a notebook may scroll).  Math renders with the local MathJax; figures
 What a reader sees first: the landing page states the verdicts (the "In short" sentences of
 ``book/intro.md``) and links the repository; on the register, the status page, the execution
 report and a few chapters with tables, no table or register is wider than the content column and
-the column itself does not scroll sideways (scrollWidth against clientWidth, measured).  The
-execution report shows what the machine that ran the book recorded: it is also built from a
+the column itself does not scroll sideways (scrollWidth against clientWidth, measured), with the
+system's fonts and with the widest common ones (:data:`WIDE_FONTS`).  The execution report shows what the machine that ran the book recorded: it is also built from a
 record of another machine (long CPU names, run times of hours, failed and timed-out runs, 1 and 16
 cores, 69 notebooks) and measured at 1280 and 390 px, so that no check depends on who ran the book.
 
@@ -199,6 +199,15 @@ WIDTH_JS = """() => {
 """The content column's width and overflow, and each table's width and its container's overflow.
 A data frame printed by a notebook (``.dataframe``) may scroll; a table of the book may not."""
 
+WIDE_FONTS = ("DejaVu Sans", "DejaVu Sans Mono")
+"""The widest of the common fonts of a Linux system (fontconfig's defaults on Debian), for text and
+code.  The theme asks for the system's fonts, which differ from machine to machine: the tables are
+measured with the system's fonts and again with these (:data:`WIDE_FONTS_CSS`), so that the verdict
+does not depend on which fonts the machine that runs the check would choose."""
+
+WIDE_FONTS_CSS = (f":root {{ --pst-font-family-base-system: '{WIDE_FONTS[0]}', sans-serif !important; "
+                  f"--pst-font-family-monospace-system: '{WIDE_FONTS[1]}', monospace !important; }}")
+
 LANDING = "intro.html"
 
 
@@ -256,6 +265,8 @@ def seen(server, browser):
                 page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot-status.png"), full_page=False)
         if rel in measured:
             r["widths_measured"] = page.evaluate(WIDTH_JS)
+            page.add_style_tag(content=WIDE_FONTS_CSS)     # last: the page is left in these fonts
+            r["widths_wide_fonts"] = page.evaluate(WIDTH_JS)
         if rel == LANDING:
             r["text"] = _normal(page.evaluate("() => document.querySelector('.bd-article').innerText"))
             r["repo_links"] = page.evaluate("""url => Array.from(document.querySelectorAll('a'))
@@ -284,17 +295,19 @@ def test_the_landing_page_states_the_verdicts_and_links_the_repository(seen):
 
 
 def test_no_table_or_register_is_wider_than_its_column(seen):
-    """At 1280 px: the content column does not scroll sideways, and no table of the register, the
-    status page, the execution report or a chapter is wider than it or scrolls inside it."""
+    """At 1280 px, with the system's fonts and with :data:`WIDE_FONTS`: the content column does not
+    scroll sideways, and no table of the register, the status page, the execution report or a
+    chapter is wider than it or scrolls inside it."""
     problems = []
-    for rel in WIDTH_PAGES:
-        m = seen[rel]["widths_measured"]
+    for rel, (key, fonts) in ((rel, k) for rel in WIDTH_PAGES
+                              for k in (("widths_measured", ""), ("widths_wide_fonts", f" in {WIDE_FONTS[0]}"))):
+        m = seen[rel][key]
         if m["column"]["scroll"] > m["column"]["client"] + 1:
-            problems.append(f"{rel}: the content column scrolls ({m['column']['scroll']} > {m['column']['client']} px)")
+            problems.append(f"{rel}{fonts}: the content column scrolls ({m['column']['scroll']} > {m['column']['client']} px)")
         for t in m["tables"]:
             if t["right"] > m["right"] + 2 or t["wrapScroll"] > 2:
-                problems.append(f"{rel}: table {t['head']!r} {t['width']} px in a {m['column']['width']} px column "
-                                f"(scrolls by {t['wrapScroll']} px)")
+                problems.append(f"{rel}{fonts}: table {t['head']!r} {t['width']} px in a {m['column']['width']} px "
+                                f"column (scrolls by {t['wrapScroll']} px)")
     assert any(seen[rel]["widths_measured"]["tables"] for rel in WIDTH_PAGES), "no table measured"
     assert not problems, "\n".join(problems)
 
@@ -487,17 +500,11 @@ def another_machine(tmp_path_factory):
     return record, build_report_page(tmp_path_factory.mktemp("report"), record)
 
 
-WIDE_FONT = "DejaVu Sans"
-"""The widest of the common sans-serif fonts of a Linux system (fontconfig's default on Debian):
-the theme asks for the system's font, so the check is also made with this one, whichever font the
-machine that runs it would choose."""
-
-
-@pytest.mark.parametrize("width, font", [(1280, None), (390, None), (1280, WIDE_FONT)])
+@pytest.mark.parametrize("width, font", [(1280, None), (390, None), (1280, WIDE_FONTS[0])])
 def test_the_execution_report_of_another_machine_fits(another_machine, browser, width, font):
     """The execution report of a machine unlike the reference one (:func:`synthetic_record`),
     built with the book's theme and CSS: at 1280 px its table fits the content column and does not
-    scroll (with the system's font and with :data:`WIDE_FONT`), at 390 px (a phone) neither the page
+    scroll (with the system's fonts and with :data:`WIDE_FONTS`), at 390 px (a phone) neither the page
     nor the column scrolls sideways (the table may scroll in its own box); at each no run time,
     date, time, outcome, count or word of a path is broken across lines, and no machine's
     description runs past the column."""
@@ -507,7 +514,7 @@ def test_the_execution_report_of_another_machine_fits(another_machine, browser, 
         page = browser.new_page(viewport={"width": width, "height": 900})
         page.goto(f"{url}/appendix/execution.html", wait_until="load", timeout=60_000)
         if font:
-            page.add_style_tag(content=f"body, body * {{ font-family: '{font}' !important; }}")
+            page.add_style_tag(content=WIDE_FONTS_CSS)
         m = page.evaluate(WIDTH_JS)
         r = page.evaluate(REPORT_JS)
         page.close()
