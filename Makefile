@@ -91,7 +91,7 @@ units: env
 unit-portable: env
 	$(PY) scripts/portability.py unit tests -m "not browser and not slow"
 
-# the unit tests and the perturbed notebooks as one queue of jobs on every core, slowest first,
+# the unit tests and the perturbed notebooks as one queue of jobs on every core this process may use, slowest first,
 # with the strict book build and the browser check beside them (what `make test` runs)
 suite: env
 	$(PY) scripts/portability.py suite --book $(NOTEBOOKS)

@@ -48,7 +48,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "scripts"))
-from run_notebooks import _order, book_notebooks, cost  # noqa: E402
+from run_notebooks import _order, book_notebooks, cost, usable_cpus  # noqa: E402
 
 CONFIGS: dict[str, dict[str, str]] = {
     "baseline": {
@@ -309,14 +309,14 @@ def main(argv: list[str] | None = None) -> int:
     sub = ap.add_subparsers(dest="cmd", required=True)
     p = sub.add_parser("nbval")
     p.add_argument("notebooks", nargs="*", type=Path)
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    p.add_argument("--jobs", type=int, default=usable_cpus())
     p.add_argument("--config", action="append", choices=list(CONFIGS), help="default: every configuration")
     p = sub.add_parser("unit")
     p.add_argument("pytest_args", nargs=argparse.REMAINDER)
     sub.add_parser("units")
     p = sub.add_parser("suite")
     p.add_argument("notebooks", nargs="*", type=Path)
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    p.add_argument("--jobs", type=int, default=usable_cpus())
     p.add_argument("--config", action="append", choices=list(CONFIGS), help="default: every configuration")
     p.add_argument("--book", action="store_true", help="also build the book strictly, run the browser check, print the PDF and check it")
     sub.add_parser("show")

@@ -4,13 +4,13 @@
 
 Each notebook is executed top to bottom in a fresh kernel from the repository root's
 environment; outputs are stored in place. Notebooks are independent (each writes its own
-tables), so they run in parallel across the cores (``--jobs``, default: every core); their
-outputs do not depend on it. Volatile metadata (execution timings, widget state, the Python
+tables), so they run in parallel across the cores (``--jobs``, default: every core this process
+may use, :func:`usable_cpus`); their outputs do not depend on it. Volatile metadata (execution timings, widget state, the Python
 version in ``language_info``) is stripped so that re-running a reproducing notebook leaves ``git status`` clean. A stored figure is kept when
 the new rendering differs from it by less than ``--image-rms`` (root-mean-square difference on
 the 0-255 scale, as matplotlib's own image comparison): anti-aliasing and font hinting move a
 few pixels between machines while the figure does not change. A failing cell is reported and
-the run fails.
+the run fails; so does a cell that runs longer than ``--timeout`` (recorded as ``timeout``).
 
 Each notebook's run (its time, when it finished and on what machine: CPU model, cores, Python and
 numpy versions) is recorded in ``.cache/execution-report.json`` (:data:`REPORT`), outside the
@@ -25,6 +25,7 @@ import base64
 import datetime
 import io
 import json
+import math
 import os
 import platform
 import sys
@@ -34,7 +35,7 @@ from pathlib import Path
 
 import nbformat
 from nbclient import NotebookClient
-from nbclient.exceptions import CellExecutionError
+from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
 
 ROOT = Path(__file__).resolve().parent.parent
 KEEP_NB_METADATA = ("kernelspec", "language_info")
@@ -55,6 +56,24 @@ def cpu_model() -> str:
     except OSError:
         pass
     return platform.processor() or platform.machine() or "unknown"
+
+
+def usable_cpus(cpu_max: Path = Path("/sys/fs/cgroup/cpu.max")) -> int:
+    """The CPUs this process may use: its affinity mask (what a container, ``taskset`` or a batch
+    system grants, where :func:`os.cpu_count` counts the host's), bounded by a cgroup v2 CPU quota
+    (``docker --cpus``, read from ``cpu_max``), rounded up; at least 1.  The default number of
+    notebooks run at once here and in ``scripts/portability.py``."""
+    try:
+        n = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        n = os.cpu_count() or 1
+    try:
+        quota, period = Path(cpu_max).read_text(encoding="utf-8").split()[:2]
+        if quota != "max":
+            n = min(n, math.ceil(int(quota) / int(period)))
+    except (OSError, ValueError):
+        pass
+    return max(1, n)
 
 
 def machine() -> dict:
@@ -212,18 +231,23 @@ def _order(paths: list[Path]) -> list[Path]:
     return sorted(paths, key=lambda p: (-cost(p), p.as_posix()))
 
 
-def _run_one(path: Path, timeout: int, rms: float) -> tuple[Path, float | None, str]:
+def _run_one(path: Path, timeout: int, rms: float) -> tuple[Path, float | None, str, str]:
+    """Execute one notebook: ``(path, seconds, outcome, error)``, the outcome ``ok``, ``failed``
+    (a cell raised, or the kernel died) or ``timeout`` (a cell ran longer than ``timeout`` seconds:
+    a slow or busy machine); a failed or timed-out run has no time and leaves the notebook as it was."""
     try:
-        return path, execute(path, timeout, rms), ""
-    except CellExecutionError as exc:
-        return path, None, str(exc)
+        return path, execute(path, timeout, rms), "ok", ""
+    except CellTimeoutError as exc:
+        return path, None, "timeout", str(exc)
+    except (CellExecutionError, DeadKernelError) as exc:
+        return path, None, "failed", str(exc)
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("notebooks", nargs="*", type=Path)
     ap.add_argument("--timeout", type=int, default=900, help="seconds per cell")
-    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="notebooks executed at once")
+    ap.add_argument("--jobs", type=int, default=usable_cpus(), help="notebooks executed at once (default: the usable CPUs)")
     ap.add_argument("--image-rms", type=float, default=IMAGE_RMS, help="keep a stored figure within this RMS")
     args = ap.parse_args(argv)
     if args.jobs < 1:
@@ -244,16 +268,16 @@ def main(argv: list[str] | None = None) -> int:
     with ProcessPoolExecutor(max_workers=jobs) as pool:
         futures = [pool.submit(_run_one, p, args.timeout, args.image_rms) for p in _order(paths)]
         for fut in as_completed(futures):
-            p, dt, err = fut.result()
+            p, dt, outcome, err = fut.result()
             rel = p.relative_to(ROOT) if p.is_relative_to(ROOT) else p
             if dt is None:
                 failed.append(rel)
-                print(f"FAILED {rel}:\n{err}", file=sys.stderr)
+                print(f"{outcome.upper()} {rel}:\n{err}", file=sys.stderr)
             else:
                 print(f"executed {rel} in {dt:.1f} s", flush=True)
             if p.is_relative_to(ROOT):
                 record_runs({rel.as_posix(): {
-                    "seconds": None if dt is None else round(dt, 1), "outcome": "failed" if dt is None else "ok",
+                    "seconds": None if dt is None else round(dt, 1), "outcome": outcome,
                     "finished": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
                     "jobs": jobs, "machine": host}})
     print(f"{len(paths) - len(failed)} of {len(paths)} notebooks in {time.perf_counter() - t0:.1f} s wall")

@@ -9,7 +9,10 @@ printed by a notebook may scroll).  Math renders with the local MathJax; figures
 What a reader sees first: the landing page states the verdicts (the "In short" sentences of
 ``book/intro.md``) and links the repository; on the register, the status page, the execution
 report and a few chapters with tables, no table or register is wider than the content column and
-the column itself does not scroll sideways (scrollWidth against clientWidth, measured).
+the column itself does not scroll sideways (scrollWidth against clientWidth, measured), with the
+system's fonts and with the widest common ones (:data:`WIDE_FONTS`).  The execution report shows what the machine that ran the book recorded: it is also built from a
+record of another machine (long CPU names, run times of hours, failed and timed-out runs, 1 and 16
+cores, 69 notebooks) and measured at 1280 and 390 px, so that no check depends on who ran the book.
 
 Run after the book is built (``make html-strict``); ``make test`` does both. Every request the
 pages make is recorded: any request that leaves the local server, or fails, is an error. A
@@ -18,12 +21,15 @@ screenshot of one chapter is kept in ``book/_build/screenshot.png``.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import html as html_lib
 import http.server
 import os
 import re
 import shutil
+import subprocess
+import sys
 import threading
 from pathlib import Path
 from urllib.parse import urlparse
@@ -43,16 +49,25 @@ def _pages() -> list[Path]:
     return pages
 
 
+@contextlib.contextmanager
+def _serving(directory: Path):
+    """A local HTTP server of ``directory``; yields its address."""
+    handler = functools.partial(_QuietHandler, directory=str(directory))
+    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{httpd.server_address[1]}"
+    finally:
+        httpd.shutdown()
+
+
 @pytest.fixture(scope="module")
 def server():
     if not (HTML / "index.html").exists():
         pytest.fail("the book is not built: run `make html-strict` (part of `make test`) first")
-    handler = functools.partial(_QuietHandler, directory=str(HTML))
-    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
-    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
-    thread.start()
-    yield f"http://127.0.0.1:{httpd.server_address[1]}"
-    httpd.shutdown()
+    with _serving(HTML) as url:
+        yield url
 
 
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):
@@ -184,6 +199,15 @@ WIDTH_JS = """() => {
 """The content column's width and overflow, and each table's width and its container's overflow.
 A data frame printed by a notebook (``.dataframe``) may scroll; a table of the book may not."""
 
+WIDE_FONTS = ("DejaVu Sans", "DejaVu Sans Mono")
+"""The widest of the common fonts of a Linux system (fontconfig's defaults on Debian), for text and
+code.  The theme asks for the system's fonts, which differ from machine to machine: the tables are
+measured with the system's fonts and again with these (:data:`WIDE_FONTS_CSS`), so that the verdict
+does not depend on which fonts the machine that runs the check would choose."""
+
+WIDE_FONTS_CSS = (f":root {{ --pst-font-family-base-system: '{WIDE_FONTS[0]}', sans-serif !important; "
+                  f"--pst-font-family-monospace-system: '{WIDE_FONTS[1]}', monospace !important; }}")
+
 LANDING = "intro.html"
 
 
@@ -241,6 +265,8 @@ def seen(server, browser):
                 page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot-status.png"), full_page=False)
         if rel in measured:
             r["widths_measured"] = page.evaluate(WIDTH_JS)
+            page.add_style_tag(content=WIDE_FONTS_CSS)     # last: the page is left in these fonts
+            r["widths_wide_fonts"] = page.evaluate(WIDTH_JS)
         if rel == LANDING:
             r["text"] = _normal(page.evaluate("() => document.querySelector('.bd-article').innerText"))
             r["repo_links"] = page.evaluate("""url => Array.from(document.querySelectorAll('a'))
@@ -269,17 +295,19 @@ def test_the_landing_page_states_the_verdicts_and_links_the_repository(seen):
 
 
 def test_no_table_or_register_is_wider_than_its_column(seen):
-    """At 1280 px: the content column does not scroll sideways, and no table of the register, the
-    status page, the execution report or a chapter is wider than it or scrolls inside it."""
+    """At 1280 px, with the system's fonts and with :data:`WIDE_FONTS`: the content column does not
+    scroll sideways, and no table of the register, the status page, the execution report or a
+    chapter is wider than it or scrolls inside it."""
     problems = []
-    for rel in WIDTH_PAGES:
-        m = seen[rel]["widths_measured"]
+    for rel, (key, fonts) in ((rel, k) for rel in WIDTH_PAGES
+                              for k in (("widths_measured", ""), ("widths_wide_fonts", f" in {WIDE_FONTS[0]}"))):
+        m = seen[rel][key]
         if m["column"]["scroll"] > m["column"]["client"] + 1:
-            problems.append(f"{rel}: the content column scrolls ({m['column']['scroll']} > {m['column']['client']} px)")
+            problems.append(f"{rel}{fonts}: the content column scrolls ({m['column']['scroll']} > {m['column']['client']} px)")
         for t in m["tables"]:
             if t["right"] > m["right"] + 2 or t["wrapScroll"] > 2:
-                problems.append(f"{rel}: table {t['head']!r} {t['width']} px in a {m['column']['width']} px column "
-                                f"(scrolls by {t['wrapScroll']} px)")
+                problems.append(f"{rel}{fonts}: table {t['head']!r} {t['width']} px in a {m['column']['width']} px "
+                                f"column (scrolls by {t['wrapScroll']} px)")
     assert any(seen[rel]["widths_measured"]["tables"] for rel in WIDTH_PAGES), "no table measured"
     assert not problems, "\n".join(problems)
 
@@ -377,3 +405,129 @@ def test_chinese_terms_of_the_sources_are_searchable(server, browser):
         hits = page.eval_on_selector_all("ul.search li a", "els => els.map(e => e.getAttribute('href'))")
         assert any("05_gravity_time_series" in h for h in hits), (query, hits)
     page.close()
+
+
+# ---------------------------------------------------------------- the execution report of another machine
+
+def synthetic_record() -> dict:
+    """An execution record as another machine may write it: a CPU name of 150 characters with a
+    word of 80 and none, 16 cores and 1, two machines, run times from 0.4 s to 12345.6 s, failed
+    and timed-out runs without a time, finishes in three time zones, every notebook of the book
+    and 51 that it does not list (paths outside ``book/``, one name of 36 characters without a
+    separator): 69 rows."""
+    book = sorted(p.relative_to(ROOT).as_posix() for p in (ROOT / "book").rglob("*.ipynb")
+                  if not {"_build", ".ipynb_checkpoints"} & set(p.parts))
+    extra = ([f"book/an_unlisted_part_of_the_book/{i:02d}_a_notebook_that_the_table_of_contents_omits.ipynb"
+              for i in range(40)]
+             + [f"scratch/experiments_2027/{i:02d}_sensitivity_of_the_closed_loop_filter.ipynb" for i in range(10)]
+             + ["notebooks/averylongnotebooknamewithnoseparator.ipynb"])
+    machines = [{"cpu": "Intel(R) Xeon(R) CPU Max 9480 @ 1.90GHz (QEMU Virtual CPU version 2.5+) "
+                        "AMD-EPYC-9654-96-Core-Processor-with-a-model-string-that-has-no-space-inside-it",
+                 "cores": 16, "system": "Linux 6.8.0-1012-azure-fips-preempt-rt", "python": "3.12.11",
+                 "numpy": "2.1.3", "numba": "0.61.2"},
+                {"cpu": "QEMU Virtual CPU version 2.5+", "cores": 1, "system": "Linux 5.10.0-33-amd64",
+                 "python": "3.11.2", "numpy": "1.26.4", "numba": "0.60.0"}]
+    runs = [(12345.6, "ok"), (3600.0, "ok"), (0.4, "ok"), (987.6, "ok"), (None, "failed"), (None, "timeout"),
+            (45.0, "ok")]
+    finished = ["2027-12-31T23:59:59+00:00", "2028-01-01T05:29:58+05:30", "2027-12-31T18:59:57-05:00"]
+    notebooks = {}
+    for i, nb in enumerate(book + extra):
+        seconds, outcome = runs[i % len(runs)]
+        notebooks[nb] = {"seconds": seconds, "outcome": outcome, "finished": finished[i % 3],
+                         "jobs": (1, 16)[i % 2], "machine": machines[i % 2]}
+    return {"notebooks": notebooks}
+
+
+def build_report_page(tmp: Path, record: dict) -> Path:
+    """The execution report page built with the book's configuration, theme, extensions and CSS
+    (``book/_config.yml``, ``book/_static``) from ``record``, beside a one-line page for each
+    notebook of the book (so that its rows link as in the book); returns the HTML directory."""
+    import json
+
+    import yaml
+
+    src = tmp / "book"
+    src.mkdir(parents=True)
+    for name in ("_ext", "_static", "_extra"):
+        shutil.copytree(ROOT / "book" / name, src / name, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(ROOT / "book" / "references.bib", src / "references.bib")
+    (tmp / "record.json").write_text(json.dumps(record), encoding="utf-8")
+    config = yaml.safe_load((ROOT / "book" / "_config.yml").read_text(encoding="utf-8"))
+    config["sphinx"]["config"]["execution_report"] = str(tmp / "record.json")
+    (src / "_config.yml").write_text(yaml.safe_dump(config, allow_unicode=True), encoding="utf-8")
+    docs = sorted(nb[len("book/"):-len(".ipynb")] for nb in record["notebooks"]
+                  if nb.startswith("book/") and (ROOT / nb).exists())
+    (src / "intro.md").write_text("# Report\n\nThe execution report of another machine.\n", encoding="utf-8")
+    for doc in docs:
+        (src / doc).parent.mkdir(parents=True, exist_ok=True)
+        (src / f"{doc}.md").write_text(f"# {doc}\n\nA chapter.\n", encoding="utf-8")
+    (src / "appendix").mkdir(exist_ok=True)
+    shutil.copy(ROOT / "book" / "appendix" / "execution.md", src / "appendix" / "execution.md")
+    toc = {"format": "jb-book", "root": "intro",
+           "parts": [{"caption": "Chapters", "numbered": True,
+                      "chapters": [{"file": d} for d in docs] + [{"file": "appendix/execution"}]}]}
+    (src / "_toc.yml").write_text(yaml.safe_dump(toc), encoding="utf-8")
+    r = subprocess.run([str(Path(sys.executable).parent / "jupyter-book"), "build", str(src), "--path-output",
+                        str(tmp), "--warningiserror", "--nitpick", "--quiet"], capture_output=True, text=True,
+                       cwd=tmp)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    return tmp / "_build" / "html"
+
+
+REPORT_JS = """() => {
+  const t = document.querySelector('table.execution-report');
+  const lines = e => { const r = document.createRange(); r.selectNodeContents(e); return r.getClientRects().length; };
+  const words = [];
+  t.querySelectorAll('p.execution-notebook').forEach(p => {
+    const walk = document.createTreeWalker(p, NodeFilter.SHOW_TEXT);
+    for (let n = walk.nextNode(); n; n = walk.nextNode()) words.push(n);
+  });
+  return {rows: t.tBodies[0].rows.length, links: t.querySelectorAll('p.execution-notebook a').length,
+          broken: Array.from(t.querySelectorAll('.nowrap')).filter(e => lines(e) > 1).map(e => e.innerText)
+                  .concat(words.filter(n => lines(n) > 1).map(n => n.textContent)),
+          page: {client: document.documentElement.clientWidth, scroll: document.documentElement.scrollWidth},
+          machines: Array.from(document.querySelectorAll('ul.execution-machines li')).map(li => {
+            const b = li.getBoundingClientRect(); return {right: b.right, text: li.innerText.slice(0, 40)}; })};
+}"""
+"""The execution report's table: its rows and links; the run times, dates, times, outcomes, counts
+and the words of paths (between two break opportunities) that stand on more than one line; the
+page's width and overflow; where the machines' descriptions end."""
+
+
+@pytest.fixture(scope="module")
+def another_machine(tmp_path_factory):
+    record = synthetic_record()
+    return record, build_report_page(tmp_path_factory.mktemp("report"), record)
+
+
+@pytest.mark.parametrize("width, font", [(1280, None), (390, None), (1280, WIDE_FONTS[0])])
+def test_the_execution_report_of_another_machine_fits(another_machine, browser, width, font):
+    """The execution report of a machine unlike the reference one (:func:`synthetic_record`),
+    built with the book's theme and CSS: at 1280 px its table fits the content column and does not
+    scroll (with the system's fonts and with :data:`WIDE_FONTS`), at 390 px (a phone) neither the page
+    nor the column scrolls sideways (the table may scroll in its own box); at each no run time,
+    date, time, outcome, count or word of a path is broken across lines, and no machine's
+    description runs past the column."""
+    record, html = another_machine
+    n_book = sum(nb.startswith("book/") and (ROOT / nb).exists() for nb in record["notebooks"])
+    with _serving(html) as url:
+        page = browser.new_page(viewport={"width": width, "height": 900})
+        page.goto(f"{url}/appendix/execution.html", wait_until="load", timeout=60_000)
+        if font:
+            page.add_style_tag(content=WIDE_FONTS_CSS)
+        m = page.evaluate(WIDTH_JS)
+        r = page.evaluate(REPORT_JS)
+        page.close()
+    assert r["rows"] == len(record["notebooks"]) >= 60 and r["links"] == n_book > 0, r
+    problems = []
+    if r["page"]["scroll"] > r["page"]["client"] + 1:
+        problems.append(f"the page scrolls sideways ({r['page']['scroll']} > {r['page']['client']} px)")
+    if m["column"]["scroll"] > m["column"]["client"] + 1:
+        problems.append(f"the content column scrolls ({m['column']['scroll']} > {m['column']['client']} px)")
+    for t in m["tables"] if width == 1280 else []:
+        if t["right"] > m["right"] + 2 or t["wrapScroll"] > 2:
+            problems.append(f"table {t['head']!r} {t['width']} px in a {m['column']['width']} px column "
+                            f"(scrolls by {t['wrapScroll']} px)")
+    problems += [f"broken across lines: {w!r}" for w in r["broken"][:5]]
+    problems += [f"machine description past the column: {li['text']!r}" for li in r["machines"] if li["right"] > m["right"] + 2]
+    assert not problems, f"at {width} px{f' in {font}' if font else ''}:\n" + "\n".join(problems)

@@ -10,7 +10,6 @@ Thirteen rows disagree; each is listed below with its cause, and is expected to 
 """
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
@@ -169,12 +168,24 @@ def test_closed_form_matches_kalman_recursion():
         assert abs(np.sqrt(p[i, i]) / d[i] - ratios[name]) < 2e-3, name
 
 
-def test_runtime_all_segments():
+def test_each_segment_is_computed_once(monkeypatch):
+    """What keeps the verdicts cheap, counted rather than timed (a wall-clock bound would depend on
+    the machine and its load): one batched transition series (every step of the segment at once)
+    and one SVD per segment and coupling, reused by every later verdict, ratio, noise level and
+    threshold."""
     xc._CACHE.clear()
-    start = time.perf_counter()
-    for seg in xc.SEGMENTS:
-        xc.observable_states(seg)
-    assert time.perf_counter() - start < 5.0
+    series, svds = [], []
+    transition, svd = xc._transition, np.linalg.svd
+    monkeypatch.setattr(xc, "_transition", lambda fdt, *a, **k: series.append(fdt.shape) or transition(fdt, *a, **k))
+    monkeypatch.setattr(xc.np.linalg, "svd", lambda m, *a, **k: svds.append(m.shape) or svd(m, *a, **k))
+    for _ in range(3):
+        for seg in xc.SEGMENTS:
+            xc.observable_states(seg)
+            xc.observable_states(seg, threshold=0.05, noise_scale=1.0)
+            xc.posterior_sd_ratio(seg, noise_scale=0.5)
+    assert len(series) == len(svds) == len(xc.SEGMENTS)
+    assert all(len(shape) == 3 and shape[0] > 1 for shape in series), series
+    xc._CACHE.clear()
 
 
 def test_table_2_2_coupling_changes_only_misalignment_verdicts():

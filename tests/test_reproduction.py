@@ -169,7 +169,7 @@ def test_compare_exports_all_formats_and_is_idempotent(sandbox):
     assert list(df.columns) == list(rp.TABLE_COLUMNS)
     for ext in (".csv", ".md", ".tex", ".json"):
         assert (sandbox / "tables" / f"chen2019-table-9-9{ext}").exists()
-    meta = json.loads((sandbox / "tables" / "chen2019-table-9-9.json").read_text())
+    meta = json.loads((sandbox / "tables" / "chen2019-table-9-9.json").read_text(encoding="utf-8"))
     assert meta["paper_source"] == "data/paper/chen2019/chen2019-table-9-9.csv"
     assert meta["seeds"] == {"mc": 1} and meta["packages"]["numpy"] != "absent"
     assert meta["status_counts"]["erratum"] == 1

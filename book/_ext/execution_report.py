@@ -10,12 +10,24 @@ directive renders that record when the book is built: one line per machine that 
 (CPU model, cores, operating system, Python, numpy and numba versions) and one table row per
 notebook (run time, when it finished, the outcome, how many notebooks ran at once).  Without a
 record it says so in a sentence.  The page is rebuilt whenever the record changes.
+
+The record is whatever the machine that ran the book wrote: a long CPU name, run times of
+thousands of seconds, runs that failed or timed out, dozens of notebooks, paths outside the book.
+The table is narrow by design whatever it holds (``book/_static/tables.css``,
+``.execution-report``): the machines are described in the list above it, not in its cells; the
+finish is a date and a time (UTC) that may stand on two lines; a notebook's path may break after
+each ``/`` and ``_`` and before a ``.`` (``<wbr>``, added when the page is written) and nowhere
+else; a run time, date, time, outcome or count never breaks.  ``tests/test_book_browser.py`` measures the page with
+such a record at 1280 and 390 px.  ``execution_report`` in the Sphinx configuration names another
+record (a test feeds one); by default it is the checkout's.
 """
 
 from __future__ import annotations
 
+import datetime
 import json
 import os
+import re
 from pathlib import Path
 
 from docutils import nodes
@@ -48,23 +60,88 @@ def load_report(path: str | os.PathLike) -> dict | None:
 
 
 def _machine_text(m: dict) -> str:
-    return (f"{m.get('cpu', 'unknown CPU')}, {m.get('cores', '?')} cores, {m.get('system', '')}, "
+    cores = m.get("cores", "?")
+    return (f"{m.get('cpu', 'unknown CPU')}, {cores} core{'' if str(cores) == '1' else 's'}, {m.get('system', '')}, "
             f"Python {m.get('python', '?')}, numpy {m.get('numpy', '?')}, numba {m.get('numba', '?')}")
+
+
+def finished_utc(value) -> str:
+    """``YYYY-MM-DD HH:MM:SS`` in UTC of an ISO 8601 time with an offset (``scripts/run_notebooks.py``
+    writes UTC); a time without an offset is taken as UTC; anything else is shown as written."""
+    text = str(value or "").strip()
+    try:
+        t = datetime.datetime.fromisoformat(text)
+    except ValueError:
+        return text
+    if t.tzinfo is not None:
+        t = t.astimezone(datetime.timezone.utc)
+    return t.strftime("%Y-%m-%d %H:%M:%S")
+
+
+def run_time(seconds) -> str:
+    """A run's time in seconds, one decimal (``-`` for a run that recorded none: failed, timed out)."""
+    try:
+        return f"{float(seconds):.1f} s"
+    except (TypeError, ValueError):
+        return "-"
 
 
 def report_rows(data: dict) -> tuple[list[str], list[list[str]]]:
     """The machines (described in words, in order of first appearance) and the table rows
-    ``[notebook, run time, finished, outcome, at once, machine]`` of a record, notebooks in path order."""
+    ``[notebook, run time, finished (UTC), outcome, at once, machine]`` of a record, notebooks in path order."""
     machines: list[str] = []
     rows = []
     for nb, run in sorted(data["notebooks"].items()):
-        text = _machine_text(run.get("machine", {}))
+        run = run if isinstance(run, dict) else {}
+        m = run.get("machine")
+        text = _machine_text(m if isinstance(m, dict) else {})
         if text not in machines:
             machines.append(text)
-        secs = run.get("seconds")
-        rows.append([nb, "-" if secs is None else f"{float(secs):.1f} s", str(run.get("finished", "")).replace("T", " "),
-                     str(run.get("outcome", "")), str(run.get("jobs", "")), chr(ord("A") + machines.index(text))])
+        rows.append([nb, run_time(run.get("seconds")), finished_utc(run.get("finished")), str(run.get("outcome", "")),
+                     str(run.get("jobs", "")), _letter(machines.index(text))])
     return machines, rows
+
+
+def _letter(i: int) -> str:
+    """A, B, ..., Z, AA, AB, ...: the name of the ``i``-th machine."""
+    return (_letter(i // 26 - 1) if i >= 26 else "") + chr(ord("A") + i % 26)
+
+
+BREAKS = re.compile(r"(?<=[/_])|(?=\.)")
+"""Where a notebook's path may break: after each ``/`` and ``_``, before a ``.`` (the browser also
+breaks after a ``-``); nowhere inside a word of a name."""
+
+NOTEBOOK_CELL = "execution-notebook"
+"""The class of a notebook cell's paragraph: :func:`add_break_opportunities` finds them."""
+
+
+def _cell(text: str, lines: bool = False) -> nodes.paragraph:
+    """A table cell's paragraph: ``text`` one unbreakable span or, with ``lines`` (a date and a
+    time), each space-separated word one, so that they may stand on two lines."""
+    para = nodes.paragraph()
+    for i, word in enumerate(text.split(" ") if lines else [text]):
+        if i:
+            para += nodes.Text(" ")
+        para += nodes.inline(word, word, classes=["nowrap"])
+    return para
+
+
+def add_break_opportunities(app, doctree, docname) -> None:
+    """Once references are resolved (a link's text is its target's path), a ``<wbr>`` at each of
+    :data:`BREAKS` in the notebook paths of the execution report's table."""
+    for para in list(doctree.findall(nodes.paragraph)):
+        if NOTEBOOK_CELL not in para["classes"]:
+            continue
+        for text in list(para.findall(nodes.Text)):
+            parts = [p for p in BREAKS.split(text.astext()) if p]
+            if len(parts) < 2:
+                continue
+            pieces: list[nodes.Node] = []
+            for i, part in enumerate(parts):
+                if i:
+                    pieces.append(nodes.raw("", "<wbr>", format="html"))
+                pieces.append(nodes.Text(part))
+            text.parent.replace(text, pieces)
 
 
 class ExecutionReport(Directive):
@@ -72,19 +149,24 @@ class ExecutionReport(Directive):
 
     def run(self):
         env = self.state.document.settings.env
-        path = report_path(env.app.confdir)
+        path = Path(env.config.execution_report) if env.config.execution_report else report_path(env.app.confdir)
         env.note_dependency(str(path))       # a missing or changed record rebuilds the page
         data = load_report(path)
         if data is None:
             return [nodes.paragraph(text=NO_RECORD)]
         machines, rows = report_rows(data)
-        total = sum(float(r.get("seconds") or 0) for r in data["notebooks"].values())
+        total = 0.0
+        for r in data["notebooks"].values():
+            try:
+                total += float(r.get("seconds") or 0) if isinstance(r, dict) else 0.0
+            except (TypeError, ValueError):
+                pass
         n = len(rows)
         out = [nodes.paragraph(text=f"{n} notebook{'' if n == 1 else 's'} recorded, {total:.0f} s of run time "
                                     "in all (several may run at once: see the last columns).")]
-        lst = nodes.bullet_list()
+        lst = nodes.bullet_list(classes=["execution-machines"])
         for i, m in enumerate(machines):
-            lst += nodes.list_item("", nodes.paragraph(text=f"Machine {chr(ord('A') + i)}: {m}"))
+            lst += nodes.list_item("", nodes.paragraph(text=f"Machine {_letter(i)}: {m}"))
         out.append(lst)
         table = nodes.table(classes=["execution-report"])
         group = nodes.tgroup(cols=6)
@@ -103,22 +185,24 @@ class ExecutionReport(Directive):
             row = nodes.row()
             nb = cells[0]
             docname = nb[len("book/"):-len(".ipynb")] if nb.startswith("book/") and nb.endswith(".ipynb") else None
-            para = nodes.paragraph()
+            para = nodes.paragraph(classes=[NOTEBOOK_CELL])
             if docname and docname in env.found_docs:
                 ref = addnodes.pending_xref("", refdomain="std", reftype="doc", reftarget="/" + docname,
                                             refexplicit=True, refwarn=True)
-                ref += nodes.literal(text=docname)
+                ref += nodes.Text(docname)
                 para += ref
             else:
-                para += nodes.literal(text=nb)
+                para += nodes.Text(nb)
             row += nodes.entry("", para)
-            for c in cells[1:]:
-                row += nodes.entry("", nodes.paragraph(text=c))
+            for i, c in enumerate(cells[1:], start=1):
+                row += nodes.entry("", _cell(c, lines=i == 2))
             body += row
         out.append(table)
         return out
 
 
 def setup(app):
+    app.add_config_value("execution_report", "", "env", types=[str])
     app.add_directive("execution-report", ExecutionReport)
+    app.connect("doctree-resolved", add_break_opportunities)
     return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}
