@@ -396,6 +396,29 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
                                            "print: that is not-reproduced"))
         if r.get("basis", "") != "":
             out += _basis_problems(tid, r, df, meta, readings, root)
+    out += _every_reading_problems(tid, df, meta, ledgers)
+    return out
+
+
+EVERY_READING = re.compile(r"\bunder\s+(every|any|all)\s+(faithful\s+)?readings?\b|"
+                           r"\b(every|any|all)\s+(faithful\s+)?readings?\s+(the print allows|tried)\b", re.I)
+"""Words that say a verdict holds under all the readings a print allows."""
+
+
+def _every_reading_problems(tid: str, df: pd.DataFrame, meta: Mapping[str, Any], ledgers: list[str]) -> list[Problem]:
+    """"Under every reading" is said only of a not-reproduced verdict of a table whose readings
+    ledger exists: the audit then knows that no reading of the ledger (not ruled out) reaches the print."""
+    out = []
+    if EVERY_READING.search(str(meta.get("summary", ""))) and not (ledgers and (df["status"] == "not-reproduced").any()):
+        out.append(Problem(tid, "", "its summary speaks of every reading, but no not-reproduced row of a table with a "
+                                    "readings ledger backs it"))
+    if _is_ledger(tid):
+        return out
+    for _, r in df.iterrows():
+        backed = r["status"] == "not-reproduced" and (ledgers or r.get("basis", "") == "claim")
+        if EVERY_READING.search(str(r["note"])) and not backed:
+            out.append(Problem(tid, r["quantity"], f"its note speaks of every reading, but the row is {r['status']}"
+                                                   + ("" if ledgers else " in a table without a readings ledger")))
     return out
 
 

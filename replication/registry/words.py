@@ -18,6 +18,9 @@ Each entry is a subject (a table id, an artifact id, or a source key) and ``name
 :func:`problems` recomputes every note from the stored tables and refuses a note that disagrees
 with them, and a count in the paragraph (a number, in digits or words, followed by a counted noun —
 "nine printed coefficients" — or "N of the M") whose value no note of the paragraph vouches for.
+A paragraph that says a verdict holds "under every reading" (or "any reading the print allows")
+must name, in a counts note, a table with a readings ledger and its ``not-reproduced`` rows: the
+audit has then checked that no reading of that ledger reaches the print.
 The findings boxes and the claim verdicts need no notes: the registry writes them from the tables.
 """
 
@@ -41,6 +44,8 @@ COUNTED = ("artifact", "verdict", "bar", "row", "result", "coefficient", "elemen
 """Stems of the nouns whose counts a summary states (a number followed, within three words, by one
 of them is a count that a note must vouch for)."""
 
+_EVERY_READING = re.compile(r"\bunder\s+(every|any|all)\s+(faithful\s+)?readings?\b|"
+                            r"\b(every|any|all)\s+(faithful\s+)?readings?\s+(the print allows|tried)\b", re.I)
 _NOTE_RE = re.compile(r"<!--\s*counts:(.*?)-->", re.S)
 _COUNT_RE = re.compile(r"(?<![\w.(§-])(\d+|" + "|".join(NUMBER_WORDS) + r")(?![\w.%°″′-])((?:\s+[\w-]+){1,3})",
                        re.I)
@@ -180,6 +185,12 @@ def problems(path: str | Path, heading: str = "## In short") -> list[str]:
                 out.append(f"{name}: '{start}…': the note says {subject} {key}={value}, the tables {actual}")
             if value.isdigit():
                 vouched.add(int(value))
+        if _EVERY_READING.search(_NOTE_RE.sub(" ", para)):
+            backed = [subj for subj, key, value in notes(para) if subj in rp.list_tables()
+                      and rp.readings_ledgers(subj) and key == "not-reproduced" and value.isdigit() and int(value) > 0]
+            if not backed:
+                out.append(f"{name}: '{start}…': says a verdict holds under every reading, but no counts note names a "
+                           "table with a readings ledger and its not-reproduced rows")
         for n in stated_counts(para):
             if n not in vouched:
                 out.append(f"{name}: '{start}…': states the count {n}, which no counts note of the paragraph vouches for")
