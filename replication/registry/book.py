@@ -184,7 +184,7 @@ def below(value, bound: float, digits: int = 2):
     return f"< {b:.0e}" if abs(v) < b else sig(v, digits)
 
 
-def claim_row(printed, quantity: str, *, holds, rests_on, note: str, reproduced="") -> dict:
+def claim_row(printed, quantity: str, *, holds, rests_on, note: str, reproduced="", unit: str = "text") -> dict:
     """A row of a claims table (``<key>-claim-abstract``, ``<key>-claim-conclusions``): one sentence
     of the print, judged by the one rule of every claim (CONTRIBUTING.md, "Statuses").
 
@@ -207,6 +207,8 @@ def claim_row(printed, quantity: str, *, holds, rests_on, note: str, reproduced=
         The reading and what the print and the reproduction show.
     reproduced : str or float, optional
         What the reproduction gives, when one value says it.
+    unit : str, default "text"
+        The unit of ``reproduced`` when it is a number.
 
     Returns
     -------
@@ -224,7 +226,7 @@ def claim_row(printed, quantity: str, *, holds, rests_on, note: str, reproduced=
     holds = plain(holds)
     if not isinstance(holds, bool):
         raise ValueError(f"claim {quantity!r}: holds must be a boolean computed from the print, not {holds!r}")
-    return dict(quantity=quantity, unit="text", paper=printed.value(quantity), reproduced=reproduced,
+    return dict(quantity=quantity, unit=unit, paper=printed.value(quantity), reproduced=reproduced,
                 basis="claim", agrees=holds, rests_on=refs, note=note)
 
 
