@@ -484,26 +484,58 @@ def test_accel_bias_axes_removes_the_up_bias_only(short_flight):
         ad.AirdataSetup(accel_bias_axes=(1, 0))
 
 
-def test_diagnostic_rows_state_runs_and_interval_without_a_printed_value(short_flight):
+def test_diagnostic_rows_are_judged_by_the_ledger_rule(short_flight):
     t1 = rp.load_paper("duan2023-table-1")
     setup = ad.AirdataSetup(correction_interval=30.0, threshold=1.0)
     diags = ad.diagnostic_runs(short_flight, setup, n_runs=3, seed=1)
     assert list(diags) == list(ad.BIAS_DIAGNOSTICS)
     rows = findings.diagnostic_ledger_rows(diags, t1)
-    assert len(rows) == 6 and all(r["paper"] == "" and "3-run mean" in r["note"] and "95 % CI" in r["note"]
-                                  for r in rows)
+    assert len(rows) == 6 and all("3-run mean" in r["note"] and "95 % CI" in r["note"] for r in rows)
     df = rp.comparison_frame(rows)
-    assert df["abs_error"].eq("").all() and df["paper"].eq("").all()
-    # the status follows the stated rule: qualitative iff the interval's lower end lies beyond
-    # (1 + LEDGER_TOLERANCE) x the printed proposed-method value
+    # every diagnostic compares the printed proposed-method value, with the ledger's tolerance
+    assert all(float(p) == t1.value(q.split(" | ", 1)[1]) for p, q in zip(df["paper"], df["quantity"]))
+    assert df["tolerance"].astype(float).eq(findings.LEDGER_TOLERANCE).all() and df["basis"].eq("value").all()
+    # the registry decides: reproduced (reaches the print) iff the mean lies within 50 % of it
     expect = []
     for lab, mc in diags.items():
         s = mc.summary("max")
         for q in ad.TABLE1_UNITS:
-            lo = ad.mean_interval(s[q])[1]
-            expect.append("qualitative" if lo > 1.5 * t1.value(f"proposed SINS/ADS / {q}") else "not-reproduced")
+            m = float(f"{ad.mean_interval(s[s['system'] == 'proposed SINS/ADS'][q])[0]:.2g}")
+            p = t1.value(f"proposed SINS/ADS / {q}")
+            expect.append("reproduced" if abs(m - p) <= findings.LEDGER_TOLERANCE * p * (1 + 1e-9) else "not-reproduced")
     assert list(df["status"]) == expect
-    # 3 minutes of flight stay below the printed position error: that statement fails
-    assert df.loc[df["quantity"].str.endswith("position error"), "status"].eq("not-reproduced").all()
     with pytest.raises(ValueError, match="n_runs"):
         ad.diagnostic_runs(short_flight, setup, n_runs=1)
+
+
+def test_first_order_agreement_separates_the_paper_order_from_errata():
+    eq22 = rp.load_paper("duan2023-eq-22")
+    c = ad.check_elements(eq22, "B").set_index("quantity")
+    agree = lambda q: ad.agree_to_first_order(c.loc[q, "printed"], c.loc[q, "derived_expr"])
+    # eq. (12) drops cos(theta_2): it misses the exact derivation, and agrees at first order
+    assert not c.loc["eq. (12) dV_U^c per phi^c", "match"] and agree("eq. (12) dV_U^c per phi^c")
+    # the factor 1/2 of eq. (6) and beta from east in eq. (19) differ already at zeroth / first order
+    assert not agree("eq. (6) phi_E^c per dh^c") and not agree("eq. (19) dS_x^c per dh^c")
+    # eq. (4) and the dh^c/S of assumption 1 differ by cos^2(theta_2) only
+    assert ad.agree_to_first_order("S/(S**2+h**2)", "1/S")
+    assert not ad.agree_to_first_order("h/S", "0") and ad.agree_to_first_order("h**2/S**3", "0")
+    with pytest.raises(ValueError):
+        ad.agree_to_first_order("S/(", "1/S")
+
+
+def test_startup_bound_and_its_rows():
+    b = findings.startup_tilt_bound(10.0, 200.0, 30.0, 9.8)
+    assert b["tilt"] == pytest.approx(10.0 / 6000.0) and b["velocity"] == pytest.approx(9.8 * 10.0 / 200.0)
+    half = findings.startup_tilt_bound(10.0, 200.0, 30.0, 9.8, printed_half=True)
+    assert half["velocity"] == pytest.approx(b["velocity"] / 2)
+    with pytest.raises(ValueError, match="speed"):
+        findings.startup_tilt_bound(10.0, 0.0, 30.0, 9.8)
+    t1 = rp.load_paper("duan2023-table-1")
+    main, ledger = findings.startup_tilt_rows(t1, dh=10.0, speed=192.9, interval=30.0, g=9.806)
+    assert [r["quantity"] for r in main] == ["proposed SINS/ADS / velocity error", "proposed SINS/ADS / misalignment"]
+    assert all(r["basis"] == "verdict" and "status" not in r for r in main + ledger)
+    v = {r["quantity"]: r for r in main + ledger}
+    # derived eq. (6): 0.51 m/s above the printed 0.3; with the printed 1/2: 0.25, admitted
+    assert not v["proposed SINS/ADS / velocity error"]["agrees"]
+    assert v["eq. (6) with its printed 1/2 | proposed SINS/ADS / velocity error"]["agrees"]
+    assert v["proposed SINS/ADS / misalignment"]["agrees"]

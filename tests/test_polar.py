@@ -409,3 +409,16 @@ def test_shared_truth_gives_the_same_bits_as_each_run_computing_its_own():
     assert np.all(out[0][0][:, :, 3] != 0.0), "the runs recorded no velocity error"
     for a, b in zip(*out):
         assert np.array_equal(a, b)
+
+
+def test_fix_drift_resolution_is_the_heading_error_over_the_baseline():
+    from replication.nav import units as u
+    r = polar.fix_drift_resolution(6 * u.ARCSEC, (2 * u.HOUR, 3.5 * u.HOUR))
+    # 6 arcsec over 1.5 h = 4 arcsec/h = 1.11e-3 deg/h, 11.1 % of the printed 0.01 deg/h
+    assert r / u.DEG_PER_H == pytest.approx(4.0 / 3600.0)
+    assert polar.fix_drift_resolution(-6 * u.ARCSEC, (0.0, 1.0)) == pytest.approx(6 * u.ARCSEC)
+    for bad in ((1.0, 1.0), (2.0, 1.0), (0.0,), (0.0, np.inf)):
+        with pytest.raises(ValueError, match="fix_times"):
+            polar.fix_drift_resolution(1e-5, bad)
+    with pytest.raises(ValueError, match="heading_error"):
+        polar.fix_drift_resolution(np.nan, (0.0, 1.0))

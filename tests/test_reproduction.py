@@ -646,3 +646,26 @@ def test_a_long_corrected_expression_is_set_as_formulas_that_wrap():
     assert rp._formula(r"\sin^2 2L") == r"$\sin^2 2L$"
     assert rp._formula("sin^2 2L, as printed") == "sin^2 2L, as printed"        # no TeX: text
     assert all(not p.endswith("\\") for p in f.split("$"))          # no piece ends in an escaped dollar
+
+
+def test_agrees_accepts_numpy_booleans():
+    from replication.registry import verdicts as vd
+    assert vd.parse_agrees(np.True_) is True and vd.parse_agrees(np.bool_(False)) is False
+    assert vd.format_agrees(np.float64(1.0) > 0.5) == "yes"
+    with pytest.raises(ValueError):
+        vd.parse_agrees(np.int64(1))
+
+
+def test_claim_rows_declare_their_basis():
+    from replication.registry import book
+    printed = rp.load_paper("chen2019-claim-abstract")
+    q = "45-state model validated by the flight experiment"
+    r = book.claim_row(printed, q, holds=np.True_, rests_on="chen2019-table-4-44", note="n")
+    assert r["basis"] == "claim" and r["agrees"] is True and r["rests_on"] == ["chen2019-table-4-44"]
+    assert r["paper"] == printed.value(q) and "status" not in r
+    with pytest.raises(ValueError, match="rests_on"):
+        book.claim_row(printed, q, holds=True, rests_on=[], note="n")
+    with pytest.raises(ValueError, match="boolean"):
+        book.claim_row(printed, q, holds="yes", rests_on=["x"], note="n")
+    u = book.unstated_claim_row(printed, q, note="the print lacks x")
+    assert u["basis"] == "unstated" and "status" not in u

@@ -182,3 +182,69 @@ def below(value, bound: float, digits: int = 2):
     if not np.isfinite(v):
         raise ValueError(f"below: {value!r} is not finite")
     return f"< {b:.0e}" if abs(v) < b else sig(v, digits)
+
+
+def claim_row(printed, quantity: str, *, holds, rests_on, note: str, reproduced="", unit: str = "text") -> dict:
+    """A row of a claims table (``<key>-claim-abstract``, ``<key>-claim-conclusions``): one sentence
+    of the print, judged by the one rule of every claim (CONTRIBUTING.md, "Statuses").
+
+    ``holds`` says whether the claim holds in the print's own numbers under the reading the note
+    states (computed by the chapter): if not, the sentence and the numbers it rests on are two
+    printed parts that disagree (``inconsistent``); if it does, the row takes the worst status of
+    the reproduction rows named in ``rests_on`` (``basis="claim"``,
+    :func:`replication.registry.verdicts.derive_status`).
+
+    Parameters
+    ----------
+    printed : PaperTable
+        The claims file (``rp.load_paper("<key>-claim-...")``); ``quantity`` names its row.
+    quantity : str
+    holds : bool
+        Whether the claim holds in the print's own numbers.
+    rests_on : sequence of str
+        ``"<table id>#<quantity>"`` or ``"<table id>"``: the exported rows it rests on.
+    note : str
+        The reading and what the print and the reproduction show.
+    reproduced : str or float, optional
+        What the reproduction gives, when one value says it.
+    unit : str, default "text"
+        The unit of ``reproduced`` when it is a number.
+
+    Returns
+    -------
+    dict
+        A row for :func:`replication.registry.reproduction.compare`.
+
+    Raises
+    ------
+    ValueError
+        If ``rests_on`` is empty or ``holds`` is not a boolean.
+    """
+    refs = [rests_on] if isinstance(rests_on, str) else list(rests_on)
+    if not refs:
+        raise ValueError(f"claim {quantity!r}: name the rows it rests on (rests_on)")
+    holds = plain(holds)
+    if not isinstance(holds, bool):
+        raise ValueError(f"claim {quantity!r}: holds must be a boolean computed from the print, not {holds!r}")
+    return dict(quantity=quantity, unit=unit, paper=printed.value(quantity), reproduced=reproduced,
+                basis="claim", agrees=holds, rests_on=refs, note=note)
+
+
+def unstated_claim_row(printed, quantity: str, *, note: str) -> dict:
+    """A claims-table row for a sentence on which no printed number bears (``basis="unstated"``:
+    unverifiable); the note names what the print lacks.
+
+    Parameters
+    ----------
+    printed : PaperTable
+        The claims file; ``quantity`` names its row.
+    quantity : str
+    note : str
+        What the print lacks that a check would need.
+
+    Returns
+    -------
+    dict
+        A row for :func:`replication.registry.reproduction.compare`.
+    """
+    return dict(quantity=quantity, unit="text", paper=printed.value(quantity), basis="unstated", note=note)

@@ -224,7 +224,7 @@ def parse_agrees(text: Any) -> bool | None:
     """
     if text is None or (isinstance(text, float) and math.isnan(text)) or text == "":
         return None
-    if isinstance(text, bool) or type(text).__name__ == "bool_":
+    if isinstance(text, bool) or (type(text).__module__ == "numpy" and type(text).__name__ in ("bool", "bool_")):
         return bool(text)
     if text in AGREES:
         return text == "yes"

@@ -9,6 +9,8 @@ the tests do.
 * :func:`compare_verdicts` — the verdicts of Table 2-3 under the main reading, and its ledger;
 * :func:`figure_4_14_ledger` — the readings ledger of the ranges stated after Fig. 4-14;
 * :func:`ordering_rows` — the orderings between two turntable experiments (Tables 4-37..4-39);
+* :func:`maneuver_claims`, :func:`model_claims`, :func:`compensation_claims` — the report's claims
+  about Tables 2-3, 4-44 and 4-50, each judged on the printed numbers under a stated reading;
 * :data:`PRINTED_CLOSED_FORM_DAMAGE` — the damaged printed closed forms (4-3)-(4-12);
 * :data:`TABLE_2_2_CORRECTED_TEXT` — the corrected blocks of Table 2-2.
 """
@@ -24,7 +26,7 @@ from replication.papers.chen2019.simulation import figure_4_14_estimates
 from replication.papers.chen2019.turntable import QUANTITIES
 
 __all__ = ["compare_verdicts", "figure_4_14_ledger", "ordering_rows", "PRINTED_CLOSED_FORM_DAMAGE",
-           "TABLE_2_2_CORRECTED_TEXT"]
+           "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims", "model_claims", "compensation_claims"]
 
 
 def _stored_degree(table, state, scenario) -> float:
@@ -333,3 +335,148 @@ TABLE_2_2_CORRECTED_TEXT = {
 
 :meta hide-value:
 """
+
+
+# --------------------------------------------------------------------------- the claims on the print
+
+MANEUVERS = ("U-turn", "figure-8", "S-turn")
+"""The maneuver columns of chen2019 Table 2-3 (the first column is the flight before them)."""
+
+
+def maneuver_claims(degrees: pd.DataFrame, *, before: str = "before maneuver", maneuvers=MANEUVERS,
+                    round_off: float = 1e-5) -> dict:
+    """The claims after chen2019 Table 2-3, judged on a table of observability degrees.
+
+    The sentence after Table 2-3 (在机动后 … 可观测度都有不同程度的提高，其中以 S 型机动最为突出)
+    makes two claims: every state's degree rises after the maneuvers, and the S-turn raises them
+    most.  Readings computed here: *rises* — each state's degree under each maneuver exceeds its
+    degree before the maneuvers; *most* — by the degree summed over the states (the overall raise
+    the sentence describes), and by the number of states whose largest degree a maneuver gives.
+
+    Parameters
+    ----------
+    degrees : pandas.DataFrame
+        Degrees (rows: states; columns: ``before`` and ``maneuvers``), non-negative; NaN where a
+        degree has no value.
+    before : str, default "before maneuver"
+        The column of the flight before the maneuvers.
+    maneuvers : sequence of str, default :data:`MANEUVERS`
+    round_off : float, default 1e-5
+        A degree at or below it counts as round-off (unobservable) in ``round_off_states``.
+
+    Returns
+    -------
+    dict
+        ``summed`` (Series: degree summed over the states, per maneuver), ``largest`` (Series:
+        states whose largest degree the maneuver gives), ``best_by_sum``, ``best_by_count`` (the
+        maneuver), ``not_risen`` (list of (state, maneuver) whose degree does not exceed the one
+        before), ``round_off_states`` (maneuver → states at or below ``round_off``) and
+        ``zero_under_all`` (states at or below ``round_off`` under every maneuver).
+
+    Raises
+    ------
+    ValueError
+        If a column is missing or a degree is negative.
+    """
+    cols = [before, *maneuvers]
+    missing = [c for c in cols if c not in degrees.columns]
+    if missing:
+        raise ValueError(f"degrees has no column {missing}: columns are {list(degrees.columns)}")
+    d = degrees[cols].astype(float)
+    if (d < 0).to_numpy().any():
+        raise ValueError("observability degrees are non-negative")
+    m = d[list(maneuvers)]
+    summed = m.sum()
+    largest = m.idxmax(axis=1).value_counts().reindex(list(maneuvers), fill_value=0)
+    not_risen = [(s, c) for s in d.index for c in maneuvers if not d.loc[s, c] > d.loc[s, before]]
+    low = {c: [s for s in d.index if d.loc[s, c] <= round_off] for c in maneuvers}
+    return {"summed": summed, "largest": largest, "best_by_sum": str(summed.idxmax()),
+            "best_by_count": str(largest.idxmax()), "not_risen": not_risen, "round_off_states": low,
+            "zero_under_all": [s for s in d.index if all(s in low[c] for c in maneuvers)]}
+
+
+def model_claims(t44, angles=("heading", "pitch", "roll"), not_obvious: str = "pitch") -> dict:
+    """The claims after chen2019 Table 4-44 (the 45-state model), on the printed accuracies.
+
+    Improvement of the 45-state model over another, as the text computes it:
+    100 (σ_other − σ_45)/σ_other.  The text calls the ``not_obvious`` angle's improvement not
+    obvious (不明显); an angle's improvement is read as *apparent* (the English abstract's
+    "apparently increased") when both its gains exceed the largest gain of that angle — the
+    report's own line between an obvious and a not-obvious gain.
+
+    Parameters
+    ----------
+    t44 : mapping
+        ``rp.load_paper("chen2019-table-4-44").numeric()``: "<angle> <n>-state" and
+        "<angle> POS AV 610 specification" [deg].
+    angles : tuple of str
+    not_obvious : str, default "pitch"
+        The angle the text calls not obvious.
+
+    Returns
+    -------
+    dict
+        ``gain`` ({angle: {15: %, 36: %}}), ``best45`` (the 45-state error the smallest of the three
+        on every angle), ``meets_spec`` (every 45-state error at or below the specification),
+        ``line`` (% : the largest gain of ``not_obvious``), ``apparent`` ({angle: bool}) and
+        ``not_obvious_smallest`` (both gains of ``not_obvious`` the smallest of the angles).
+    """
+    gain = {a: {m: float(100.0 * (t44[f"{a} {m}-state"] - t44[f"{a} 45-state"]) / t44[f"{a} {m}-state"])
+                for m in (15, 36)} for a in angles}
+    line = max(gain[not_obvious].values())
+    return {"gain": gain,
+            "best45": all(t44[f"{a} 45-state"] < min(t44[f"{a} 15-state"], t44[f"{a} 36-state"]) for a in angles),
+            "meets_spec": all(t44[f"{a} 45-state"] <= t44[f"{a} POS AV 610 specification"] for a in angles),
+            "line": line, "apparent": {a: min(gain[a].values()) > line for a in angles},
+            "not_obvious_smallest": all(gain[not_obvious][m] < min(gain[a][m] for a in angles if a != not_obvious)
+                                        for m in (15, 36))}
+
+
+def compensation_claims(t50, *, position_bound: float, methods=("normal", "direct", "state")) -> dict:
+    """The claims about chen2019 Table 4-50 (the gravity compensation), on the printed accuracies.
+
+    Readings: the *level attitude* (pitch, roll) improves *markedly* when the state-estimation
+    method (``methods[2]``) has the smallest pitch and roll error and its smallest gain over the
+    other two exceeds every relative change of position and heading between the methods — what the
+    text calls no obvious difference; *position and heading unchanged* when the largest spread of
+    a position accuracy between the methods lies below the printed bound (``position_bound``, the
+    text's 0.01 m) and the heading's relative spread below the smallest level-attitude gain;
+    *decisive effects on the accuracy of SINS/GNSS* when every accuracy of the table changes
+    between the methods by at least that smallest level-attitude gain (the report's own measure of
+    a marked change); the compensation gives a *more accurate gravity disturbance* than the direct
+    difference when, through the consequence the text names (a smaller equivalent accelerometer
+    bias, hence a better level attitude), the state method's pitch and roll beat the direct
+    difference's.
+
+    Parameters
+    ----------
+    t50 : mapping
+        ``rp.load_paper("chen2019-table-4-50").numeric()``: "<quantity> <method>" for latitude,
+        longitude, height [m], heading, pitch, roll [deg].
+    position_bound : float
+        The printed bound on the position differences [m].
+    methods : tuple of str
+        Normal gravity, direct difference, state estimation.
+
+    Returns
+    -------
+    dict
+        ``change`` ({quantity: largest relative change between the methods, %}), ``level_gain``
+        (the state method's smallest gain on pitch and roll, %), ``marked`` (bool),
+        ``position_spread`` (m), ``unchanged`` (bool), ``decisive`` (bool), ``changed_markedly``
+        (quantities whose change reaches ``level_gain``), ``better_than_direct`` (bool).
+    """
+    quantities = ("latitude", "longitude", "height", "heading", "pitch", "roll")
+    v = {q: [float(t50[f"{q} {m}"]) for m in methods] for q in quantities}
+    change = {q: 100.0 * (max(x) - min(x)) / max(x) for q, x in v.items()}
+    gains = [100.0 * (v[q][k] - v[q][2]) / v[q][k] for q in ("pitch", "roll") for k in (0, 1)]
+    level_gain = min(gains)
+    others = [change[q] for q in ("latitude", "longitude", "height", "heading")]
+    spread = max(max(v[q]) - min(v[q]) for q in ("latitude", "longitude", "height"))
+    return {"change": change, "level_gain": level_gain,
+            "marked": all(v[q][2] < min(v[q][:2]) for q in ("pitch", "roll")) and level_gain > max(others),
+            "position_spread": spread,
+            "unchanged": spread < position_bound and change["heading"] < level_gain,
+            "decisive": all(c >= level_gain for c in change.values()),
+            "changed_markedly": [q for q, c in change.items() if c >= level_gain],
+            "better_than_direct": all(v[q][2] < v[q][1] for q in ("pitch", "roll"))}

@@ -63,7 +63,7 @@ __all__ = [
     "misalignment_correction", "velocity_correction", "displacement_correction",
     "position_correction", "correction_vector", "exact_correction",
     "STATE_NAMES", "reference_state", "derived_coefficients", "printed_elements",
-    "check_elements", "manifold_residuals", "consistency_count",
+    "check_elements", "agree_to_first_order", "manifold_residuals", "consistency_count",
     "interval_motion", "integrate_eq21", "EQ21_ROWS", "EQ21_STARTS",
     "mean_interval", "BIAS_DIAGNOSTICS", "diagnostic_runs",
     "sins_error_matrix", "AirData", "ads_measurements", "duan2023_flight", "AirdataSetup",
@@ -776,6 +776,59 @@ def check_elements(paper, reading: str = "B", state: str = "climb", rel_tol: flo
     df["comparable"] = df["derived"].notna()
     df["match"] = df["comparable"] & (np.abs(df["paper"] - df["derived"].astype(float)) <= rel_tol * scale)
     return df
+
+
+def agree_to_first_order(printed: str, derived: str, reading: str = "B") -> bool:
+    """Whether two coefficients agree at the paper's first order in the flight-path angle.
+
+    duan2023 assumption 5 keeps first-order small quantities; the vertical components of the
+    displacement, velocity and acceleration (h, V_U, A_U) are first order in the flight-path
+    angle against the horizontal ones.  With h, V_U, A_U scaled by ε, the two expressions must
+    have the same terms in ε⁰ and ε¹ (they may differ at relative O(ε²), e.g. by
+    cos²θ₂ = S²/(S² + h²)).
+
+    Parameters
+    ----------
+    printed, derived : str
+        Expressions in the printed syntax of ``duan2023-eq-22`` (``S``, ``V``, ``Sx``, ``h``,
+        ``VE``, ..., ``beta``) or the sympy text of :func:`check_elements`'s ``derived_expr``.
+    reading : {"A", "B"}, default "B"
+        Reading of β (:func:`derived_coefficients`).
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    ValueError
+        If an expression does not parse or ``reading`` is unknown.
+    """
+    from sympy.parsing.sympy_parser import parse_expr
+
+    if reading not in READINGS:
+        raise ValueError(f"reading must be one of {READINGS}")
+    sp, k = _symbols()
+    ns, beta_sub = _printed_namespace(reading)
+    try:
+        a, b = (parse_expr(str(x), local_dict=ns).subs(beta_sub) for x in (printed, derived))
+    except Exception as exc:
+        raise ValueError(f"cannot parse {printed!r} or {derived!r} ({exc})") from exc
+    eps = sp.Symbol("eps", positive=True)
+    small = {k["h"]: eps * k["h"], k["VU"]: eps * k["VU"], k["AU"]: eps * k["AU"]}
+    diff = sp.series((a - b).subs(small, simultaneous=True), eps, 0, 2).removeO()
+    # sympy leaves sqrt((S_x²+S_y²)²) unsimplified for real symbols: evaluate the ε⁰ + ε¹ terms
+    # at states of all signs and sizes instead (a non-zero rational function vanishes on none)
+    scale = sp.Abs(a.subs(small, simultaneous=True).subs(eps, 0)) + sp.Abs(b.subs(small, simultaneous=True).subs(eps, 0))
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        st = dict(zip(_KIN, rng.uniform(0.5, 2.0, len(_KIN)) * rng.choice([-1.0, 1.0], len(_KIN))))
+        st.update(L=0.7, RMh=6.4e6, RNh=6.4e6)
+        sub = {k[n]: st[n] for n in _KIN}
+        for e in (0.3, 1.0):
+            if abs(float(diff.subs(sub).subs(eps, e))) > 1e-12 * (1.0 + float(scale.subs(sub))):
+                return False
+    return True
 
 
 def _true_derivative(a, convention):

@@ -1,14 +1,17 @@
 """duan2023's findings: the rows its chapter hands to the registry.
 
 :mod:`replication.papers.duan2023.airdata` computes; this module decides — it turns the Monte
-Carlo, the readings and the re-derivation into comparison rows with a status, a note, evidence
-and corrected text (CONTRIBUTING.md, "Statuses" and "Readings and the main reading"), and holds
+Carlo, the readings and the re-derivation into comparison rows that declare their basis and
+evidence (the registry derives each status: CONTRIBUTING.md, "Statuses" and "Readings and the
+main reading"), with a note, evidence and corrected text, and holds
 the printed elements of eqs. (4)-(21) recorded as errata or inconsistencies.  No method module
 imports it; the notebooks and the tests do.
 
-* :func:`table1_comparison` — Table 1 under the written criteria;
+* :func:`table1_comparison` — Table 1, each row with its basis;
 * :func:`readings_ledger_rows`, :func:`diagnostic_ledger_rows` — the readings ledger of Table 1
   (:data:`LEDGER_ID`, relative tolerance :data:`LEDGER_TOLERANCE`) and its diagnostic rows;
+* :func:`startup_tilt_rows` — the printed proposed-method values against the start-up bound of
+  eq. (6) (:func:`startup_tilt_bound`), under both readings of eq. (6);
 * :func:`eq22_rows`, :func:`eq22_readings_rows` — the printed elements of eqs. (4)-(21).
 """
 
@@ -20,6 +23,7 @@ from replication.papers.duan2023.airdata import (
     SYSTEMS,
     TABLE1_UNITS,
     MonteCarlo,
+    agree_to_first_order,
     check_elements,
     manifold_residuals,
     mean_interval,
@@ -28,7 +32,8 @@ from replication.papers.duan2023.airdata import (
 )
 
 __all__ = ["PROPOSED_REASON", "table1_comparison", "LEDGER_ID", "LEDGER_TOLERANCE", "LEDGER_QUANTITIES",
-           "readings_ledger_rows", "diagnostic_ledger_rows", "eq22_rows", "eq22_readings_rows"]
+           "readings_ledger_rows", "diagnostic_ledger_rows", "startup_tilt_bound", "STARTUP_READINGS",
+           "startup_tilt_rows", "eq22_rows", "eq22_readings_rows"]
 
 
 PROPOSED_REASON = (
@@ -41,17 +46,22 @@ PROPOSED_REASON = (
 
 
 def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> list[dict]:
-    """Rows of duan2023 Table 1 for :func:`replication.registry.reproduction.compare`.
+    """Rows of duan2023 Table 1 for :func:`replication.registry.reproduction.compare`, each with its basis.
 
-    With the statuses of the written criteria (CONTRIBUTING.md, "Statuses") and the 95 % interval
-    of every Monte-Carlo mean in the note:
+    The registry derives each status from the row's evidence (CONTRIBUTING.md, "Statuses"); the
+    note gives the 95 % interval of every Monte-Carlo mean:
 
-    * proposed SINS/ADS: not reproduced where the whole interval lies above ten times the print;
-    * pure SINS misalignment: not reproduced (no reading reaches the print);
-    * pure SINS velocity and position: inconsistent when the ideal-sensor reading reproduces the
-      print within 5 % while the printed sensor errors give more than twice it;
-    * literature SINS/ADS (refs. [15-17], unspecified in duan2023): unverifiable when the stand-in
-      lies more than ten times from the print, analog otherwise.
+    * proposed SINS/ADS and the pure-SINS misalignment: ``value`` rows, the run mean against the
+      print within :data:`LEDGER_TOLERANCE` (relative, the rule of the readings ledger
+      :data:`LEDGER_ID`, fixed before comparing): outside it, the ledger decides (not reproduced
+      when no reading of the method reaches the print);
+    * pure SINS velocity and position: when the ideal-sensor reading reproduces the print within
+      5 % while the printed sensor errors give more than twice it, a ``parts`` row (Table 1 against
+      the sensor errors of §3, ``agrees`` False: inconsistent); otherwise a ``value`` row as above;
+    * literature SINS/ADS (refs. [15-17], unspecified in duan2023): a ``stand-in`` row where the
+      stand-in lies within a factor of ten of the print (analog); an ``unstated`` row where it does
+      not: what sets that value — the filter's measurements, noise and tuning, and the initial
+      attitude error, which §3 does not list — is not printed (unverifiable).
 
     Parameters
     ----------
@@ -69,8 +79,8 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
     -------
     rows : list of dict
         One per system and quantity: ``quantity`` ("<system> / <quantity>"), ``unit``, ``paper``,
-        ``reproduced`` (run mean of the flight maxima, or the ideal-sensor value for an
-        inconsistent row, in ``unit``), ``status`` and ``note``.
+        ``reproduced`` (run mean of the flight maxima, or the ideal-sensor value for a ``parts``
+        row, in ``unit``), ``basis``, the evidence it needs (``tolerance``, ``agrees``) and ``note``.
     """
     early = {(r["system"], r["quantity"]): r for r in table1_rows(mc, paper, until=until)}
     n = len(mc.summary("max")) // len(SYSTEMS)
@@ -78,28 +88,33 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
     for r in table1_rows(mc, paper):
         q, p, m = r["quantity"], r["paper"], r["mean"]
         ci = f"{n}-run mean, 95 % CI {r['lo']:.3g}..{r['hi']:.3g}"
-        row = dict(quantity=f"{r['system']} / {q}", unit=r["unit"], paper=p, reproduced=round(m, 4),
-                   status="analog", note=f"unpublished trajectory, noise and implementation: a labelled "
-                                         f"simulation stands in; {ci}")
-        if r["system"] == "proposed SINS/ADS" and r["lo"] > 10 * p:
+        row = dict(quantity=f"{r['system']} / {q}", unit=r["unit"], paper=p, reproduced=round(m, 4))
+        value = dict(basis="value", tolerance=LEDGER_TOLERANCE, tolerance_kind="rel", digits=3)   # a 12-run mean
+        initial_errors_only = r["system"] == "SINS" and abs(ideal[q] / p - 1) < 0.05 and m > 2 * p
+        same_order = 0.1 < m / p < 10
+        if r["system"] == "proposed SINS/ADS":
             e = early[(r["system"], q)]
-            row.update(status="not-reproduced", note=f"{PROPOSED_REASON}; {ci}; max before the final deceleration "
-                                                     f"(t <= {until:.0f} s): {e['mean']:.3g} (CI {e['lo']:.3g}..{e['hi']:.3g}); "
-                                                     f"readings ledger: {LEDGER_ID}")
-        elif r["system"] == "SINS" and q == "misalignment":
-            row.update(status="not-reproduced", note=f"no reading reaches the print: with the printed sensor errors {ci}; "
-                                                     f"ideal sensors (initial errors only) {ideal[q]:.2g}; the linear "
-                                                     "error model of the second computation stays near 0.1 deg too; "
-                                                     f"readings ledger: {LEDGER_ID}")
-        elif r["system"] == "SINS" and abs(ideal[q] / p - 1) < 0.05 and m > 2 * p:
-            row.update(reproduced=round(ideal[q], 4), status="inconsistent",
+            row.update(value, note=f"{PROPOSED_REASON}; {ci}; max before the final deceleration "
+                                   f"(t <= {until:.0f} s): {e['mean']:.3g} (CI {e['lo']:.3g}..{e['hi']:.3g}); "
+                                   f"readings ledger: {LEDGER_ID}")
+        elif initial_errors_only:
+            row.update(reproduced=round(ideal[q], 4), basis="parts", agrees=not initial_errors_only,
                        note=f"the print is the pure SINS driven by the printed initial errors alone ({ideal[q]:.4g}, "
                             f"{abs(ideal[q] / p - 1):.1%} from the print: the free vertical channel); with the printed "
                             f"sensor errors (+100 ug up-bias) {m:.3g} ({ci}): Table 1 and the sensor errors of §3 disagree")
-        elif r["system"] == "literature SINS/ADS" and not 0.1 < m / p < 10:
-            row.update(status="unverifiable", note=f"the literature filter (refs. [15-17]) is not specified in duan2023 "
-                                                   f"(measurements, noise, tuning); the stand-in gives {ci}, more than "
-                                                   "ten times from the print, and nothing printed decides it")
+        elif r["system"] == "SINS":
+            row.update(value, note=f"with the printed sensor errors {ci}; ideal sensors (initial errors only) "
+                                   f"{ideal[q]:.2g}; the linear error model of the second computation stays near "
+                                   f"0.1 deg too; readings ledger: {LEDGER_ID}")
+        elif same_order:
+            row.update(basis="stand-in", agrees=same_order,
+                       note=f"unpublished trajectory, noise and implementation: a labelled simulation stands in, "
+                            f"within a factor of ten of the print; {ci}")
+        else:
+            row.update(basis="unstated",
+                       note=f"the print lacks what sets this value: the literature filter (refs. [15-17]: measurements, "
+                            f"noise, tuning) and the initial attitude error, which §3 does not list; the stand-in "
+                            f"(no initial attitude error) gives {ci}, more than ten times from the print")
         rows.append(row)
     return rows
 
@@ -158,14 +173,13 @@ def readings_ledger_rows(readings, table1, system="proposed SINS/ADS", *, runs=N
 def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> list[dict]:
     """Rows of the Table 1 readings ledger for the diagnostics of :func:`replication.papers.duan2023.airdata.diagnostic_runs`.
 
-    A diagnostic is not a reading of the method and is compared with no printed value: the paper
-    column stays empty; ``reproduced`` is the run mean of the flight maximum, stored with ``digits``
-    significant digits, and the note gives the run count and the 95 % Student-t interval of the
-    mean (:func:`replication.papers.duan2023.airdata.mean_interval`).  The statement checked: the diagnostic does not bring the
-    proposed method to the print by the ledger's rule (:data:`LEDGER_TOLERANCE`) — the lower end
-    of its interval lies above (1 + tolerance) × the printed proposed-method value.  ``qualitative``
-    where it holds; ``not-reproduced`` (the statement fails: the removed bias is what separates the
-    analog from the print) where it does not.
+    A diagnostic removes an error source that duan2023 §3 prints (the accelerometer bias): it is
+    not a reading of the method, but it is judged as every row of the ledger is — the run mean of
+    the flight maximum against the printed proposed-method value within :data:`LEDGER_TOLERANCE`
+    (relative): a diagnostic that reached the print would have to be ruled out by printed
+    evidence (``compare(..., ruled_out=)``); one that does not reach it needs none.  ``reproduced``
+    is stored with ``digits`` significant digits; the note gives the run count and the 95 %
+    Student-t interval of the mean (:func:`replication.papers.duan2023.airdata.mean_interval`).
 
     Parameters
     ----------
@@ -180,8 +194,9 @@ def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> lis
     -------
     rows : list of dict
         One per diagnostic and quantity: ``quantity`` ("diagnostic: <label> | proposed SINS/ADS /
-        <quantity>"), ``unit`` (deg, m/s, km), ``paper`` (empty), ``reproduced``, ``digits``,
-        ``status`` and ``note``.
+        <quantity>"), ``unit`` (deg, m/s, km), ``paper`` (the printed proposed-method value),
+        ``reproduced``, ``digits``, ``tolerance`` (:data:`LEDGER_TOLERANCE`), ``tolerance_kind``
+        "rel" and ``note``: the registry decides the status from the numbers.
 
     Raises
     ------
@@ -200,17 +215,107 @@ def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> lis
         for q, u in TABLE1_UNITS.items():
             m, lo, hi = mean_interval(s[q].to_numpy(float))
             p = float(table1.value(f"{sys_} / {q}"))
-            holds = lo > (1 + LEDGER_TOLERANCE) * p
             f = lambda v: f"{float(f'{v:.{digits}g}'):g}"
-            note = (f"diagnostic, not a reading of the method (duan2023 §3 prints the bias) and not a comparison with a "
-                    f"printed value; {len(s)}-run mean {f(m)}, 95 % CI {f(lo)}..{f(hi)} {u}; "
-                    + (f"stays beyond {1 + LEDGER_TOLERANCE:g} x the printed {p:g} {u}: this bias is not what "
-                       "separates the method from the print" if holds else
-                       f"reaches {1 + LEDGER_TOLERANCE:g} x the printed {p:g} {u}: this bias separates the method "
-                       "from the print"))
-            rows.append(dict(quantity=f"diagnostic: {label} | {sys_} / {q}", unit=u, paper="", reproduced=m,
-                             digits=digits, status="qualitative" if holds else "not-reproduced", note=note))
+            note = (f"diagnostic, not a reading of the method (duan2023 §3 prints the bias it removes); "
+                    f"{len(s)}-run mean {f(m)}, 95 % CI {f(lo)}..{f(hi)} {u}")
+            rows.append(dict(quantity=f"diagnostic: {label} | {sys_} / {q}", unit=u, paper=p, reproduced=m,
+                             digits=digits, tolerance=LEDGER_TOLERANCE, tolerance_kind="rel", note=note))
     return rows
+
+
+def startup_tilt_bound(dh: float, speed: float, interval: float, g: float, *, printed_half: bool = False) -> dict:
+    """The first correction of duan2023 eq. (6) in level flight and the velocity error it leaves.
+
+    In level flight eq. (6) turns a height discrepancy δh into a tilt δh/S (S = V T, the
+    displacement over one interval); with the factor 1/2 that eq. (6) prints, δh/(2S).  A tilt
+    φ held for one interval drives the along-track velocity by g φ T, which eq. (11) does not
+    correct in level flight: the velocity error after the first correction is at least
+    g δh / V (g δh / (2V) with the printed 1/2), whatever T.
+
+    Parameters
+    ----------
+    dh : float
+        The height discrepancy of the first correction [m] (the printed initial height error).
+    speed : float
+        Mean ground speed V [m/s], positive.
+    interval : float
+        Correction interval T [s], positive.
+    g : float
+        Gravity [m/s²], positive.
+    printed_half : bool, default False
+        Apply eq. (6)'s printed factor 1/2.
+
+    Returns
+    -------
+    dict
+        ``tilt`` [rad] and ``velocity`` [m/s].
+
+    Raises
+    ------
+    ValueError
+        If ``speed``, ``interval`` or ``g`` is not a positive finite number.
+    """
+    for name, v in (("speed", speed), ("interval", interval), ("g", g)):
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"{name} must be a positive finite number, not {v!r}")
+    tilt = dh / (speed * interval) * (0.5 if printed_half else 1.0)
+    return {"tilt": float(tilt), "velocity": float(g * tilt * interval)}
+
+
+STARTUP_READINGS = {"eq. (6) as derived (no 1/2)": False, "eq. (6) with its printed 1/2": True}
+"""The readings of eq. (6) for the start-up bound (:func:`startup_tilt_rows`): label → ``printed_half``.
+The first is the main reading (eqs. (7) and (21) print the coefficient without 1/2)."""
+
+
+def startup_tilt_rows(table1, *, dh: float, speed: float, interval: float, g: float):
+    """Rows of ``duan2023-check-startup-tilt`` and of its readings ledger.
+
+    The printed proposed-method maxima of Table 1 against the start-up bound of
+    :func:`startup_tilt_bound`: a ``verdict`` row per quantity, ``agrees`` when the printed value
+    admits the bound (printed ≥ bound).  The main table follows the first reading of
+    :data:`STARTUP_READINGS`; the ledger holds the other (eq. (6)'s printed 1/2) with the same
+    verdict, so that the registry decides whether a reading the print leaves open reaches it.
+
+    Parameters
+    ----------
+    table1 : PaperTable
+        ``rp.load_paper("duan2023-table-1")``.
+    dh, speed, interval, g : float
+        As :func:`startup_tilt_bound` (the printed initial height error, the printed mean speed
+        range/duration, the printed interval, normal gravity).
+
+    Returns
+    -------
+    main, ledger : list of dict
+        Rows for :func:`replication.registry.reproduction.compare`: ``quantity``, ``unit``,
+        ``paper``, ``reproduced`` (the bound, 3 decimals), ``basis`` "verdict", ``agrees`` and
+        ``note``; the ledger's quantities are "<reading> | <quantity>".
+    """
+    labels = list(STARTUP_READINGS)
+    main, ledger = [], []
+    for label in labels:
+        b = startup_tilt_bound(dh, speed, interval, g, printed_half=STARTUP_READINGS[label])
+        for q, unit, bound in (("proposed SINS/ADS / velocity error", "m/s", b["velocity"]),
+                               ("proposed SINS/ADS / misalignment", "deg", float(np.degrees(b["tilt"])))):
+            p = float(table1.value(q))
+            admits = p >= round(bound, 3)
+            note = (f"{label}: one tilt dh/S ({'halved, ' if STARTUP_READINGS[label] else ''}S = V T) from the printed "
+                    f"{dh:g}-m initial height error leaves "
+                    + (f"g*dh/{'(2V)' if STARTUP_READINGS[label] else 'V'} of along-track velocity error (eq. (11) "
+                       "does not correct it in level flight)" if unit == "m/s" else "that tilt in the attitude for one interval")
+                    + f": bound {bound:.3g} {unit}; the printed {p:g} {unit} "
+                    + ("admits it" if admits else "lies below it: the print needs other errors to cancel it or a "
+                       f"speed above g*dh/{p:g}"))
+            row = dict(quantity=q if label == labels[0] else f"{label} | {q}", unit=unit, paper=p,
+                       reproduced=round(bound, 3), basis="verdict", agrees=admits, note=note)
+            (main if label == labels[0] else ledger).append(row)
+    for row in main:   # what the other printed form of eq. (6) gives, in the main row's note
+        other = next(r for r in ledger if r["quantity"].endswith(row["quantity"]))
+        row["note"] += (f"; with eq. (6)'s printed 1/2 the bound is {other['reproduced']:g} {row['unit']}, "
+                        + ("which the printed value admits: eq. (6) and eqs. (7)/(21) print the two forms, and the bound "
+                           "alone does not decide between them" if other["agrees"] else "which the printed value "
+                           "does not admit either") + " (readings ledger)")
+    return main, ledger
 
 
 _EVID = "book/duan2023/01_sins_ads_error_correction.ipynb; tests/test_airdata.py::"
@@ -233,8 +338,9 @@ _ERRATA = {
 
 #: Printed elements that follow another convention for β than eqs. (20)-(21): eq. (16) takes the
 #: east component as cos β (β from east), while the text names β the yaw angle (偏航角, from
-#: north) and eq. (21) is right with β from north (reading B).  Two printed parts disagree; neither
-#: is blamed (status ``inconsistent``).
+#: north) and eq. (21) is right with β from north (reading B).  Judged as derivations against the
+#: readings ledger: reading A reproduces them, so the registry makes them ``inconsistent`` (two
+#: printed parts disagree), not errata.
 _INCONSISTENT = {
     "eq. (16) dS_x^c per dS^c": "eq. (16) gives the east component as cos(beta), i.e. beta from east; the text names beta the "
                                 "yaw angle (from north) and eq. (21) is right with beta from north (reading B): the two "
@@ -242,23 +348,29 @@ _INCONSISTENT = {
     "eq. (16) dS_y^c per dS^c": "sin(beta) for the north component: beta from east, as for dS_x^c; eq. (21) reads it from north",
     "eq. (19) dS_x^c per dh^c": "cos(beta) for the east component (beta from east, as eq. (16)); eq. (21) reads it from north",
     "eq. (19) dS_y^c per dh^c": "sin(beta) for the north component (beta from east, as eq. (16)); eq. (21) reads it from north",
-    "eq. (12) dV_U^c per phi^c": "eq. (12) writes phi^c V where turning V by phi^c changes its up component by phi^c V "
-                                 "cos(theta_2), and eq. (13) keeps that cos(theta_2) = S/sqrt(S^2+h^2): at the paper's first "
-                                 "order in h/S (the level of eq. (4)) both hold; the two printed parts differ at relative "
-                                 "O(h^2/S^2)",
 }
 
 
-#: Printed elements that match the re-derivation but disagree with another printed part at the
-#: paper's approximation level (status ``inconsistent``), as functions of the reference state
-#: (:func:`replication.papers.duan2023.airdata.reference_state`).
+#: Printed elements that the exact re-derivation does not match but that agree with it at the
+#: paper's first order (assumption 5: the flight-path angle small), checked by
+#: :func:`replication.papers.duan2023.airdata.agree_to_first_order`: a ``derivation`` row without
+#: a tolerance, ``agrees`` computed (``qualitative`` when they agree at that order).
+_FIRST_ORDER = {
+    "eq. (12) dV_U^c per phi^c": "eq. (12) writes phi^c V where turning V by phi^c changes its up component by phi^c V "
+                                 "cos(theta_2); eq. (13) keeps that cos(theta_2) = S/sqrt(S^2+h^2). The two differ at "
+                                 "relative O(h^2/S^2), beyond the paper's first order (assumption 5)",
+}
+
+
+#: Printed elements that match the re-derivation, with a remark on another printed part at the
+#: paper's approximation level (the row stays a ``value`` row: its numbers decide), as functions
+#: of the reference state (:func:`replication.papers.duan2023.airdata.reference_state`).
 _REMARKS = {
     "eq. (4) phi^c per dh^c": lambda st: (
-        "reproduced as printed (the first-order expansion of tan(theta_1 - theta_2) with S^c = S), but assumption 1 and "
-        "eq. (18) (SINS/ADS and SINS displacements of equal length) give dh^c/S instead: two printed parts differ by "
-        "cos^2(theta_2) = S^2/(S^2+h^2), a relative O(h^2/S^2) "
-        f"({st['h'] ** 2 / (st['Sx'] ** 2 + st['Sy'] ** 2):.1e} at this state, below 1e-2 for flight-path angles "
-        "under 6 deg), within the paper's first order: neither is a misprint"),
+        "the first-order expansion of tan(theta_1 - theta_2) with S^c = S, as printed; assumption 1 and eq. (18) "
+        "(SINS/ADS and SINS displacements of equal length) give dh^c/S instead, which differs by cos^2(theta_2) = "
+        f"S^2/(S^2+h^2), a relative O(h^2/S^2) ({st['h'] ** 2 / (st['Sx'] ** 2 + st['Sy'] ** 2):.1e} at this state): "
+        "the two printed forms agree at the paper's first order (assumption 5)"),
 }
 
 
@@ -282,23 +394,38 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
     Returns
     -------
     rows : list of dict
-        For :func:`replication.registry.reproduction.compare`: ``quantity``, ``unit``, ``paper``,
-        ``reproduced`` (values at the state in ``unit``), ``tolerance`` 1e-9, ``tolerance_kind``
-        "rel", and for the flagged elements ``status`` (erratum or inconsistent), ``note`` and,
-        for errata, ``evidence`` and ``corrected``.
+        For :func:`replication.registry.reproduction.compare`, each with ``basis`` "derivation"
+        (the registry derives the status): ``quantity``, ``unit``, ``paper``, ``reproduced``
+        (values at the state in ``unit``), ``tolerance`` 1e-9, ``tolerance_kind`` "rel" — except
+        the elements that agree with the derivation only at the paper's first order
+        (:data:`_FIRST_ORDER`), which carry ``agrees`` (computed by
+        :func:`replication.papers.duan2023.airdata.agree_to_first_order`) and no tolerance — and
+        for the flagged elements a ``note`` and, for errata, ``evidence`` and ``corrected``.  A
+        flagged element outside the tolerance is an erratum unless a reading of the ledger
+        (``duan2023-check-eq-22-readings``, to be exported first) reproduces it: then the registry
+        makes it inconsistent (:data:`_INCONSISTENT`).
     """
     df = check_elements(paper, reading, state)
     rows = []
     for _, r in df[df["comparable"]].iterrows():
-        row = {"quantity": r["quantity"], "unit": r["unit"], "paper": r["paper"], "reproduced": r["derived"],
-               "tolerance": 1e-9, "tolerance_kind": "rel"}
-        if not r["match"] and r["quantity"] in _ERRATA:
-            note, test, corr = _ERRATA[r["quantity"]]
-            row.update(status="erratum", note=note, evidence=_EVID + test, corrected=corr)
-        elif not r["match"] and r["quantity"] in _INCONSISTENT:
-            row.update(status="inconsistent", note=_INCONSISTENT[r["quantity"]])
-        elif r["match"] and r["quantity"] in _REMARKS:
-            row.update(status="inconsistent", note=_REMARKS[r["quantity"]](reference_state(state)))
+        q = r["quantity"]
+        row = {"quantity": q, "unit": r["unit"], "paper": r["paper"], "reproduced": r["derived"],
+               "tolerance": 1e-9, "tolerance_kind": "rel", "basis": "derivation"}
+        if not r["match"] and q in _ERRATA:
+            note, test, corr = _ERRATA[q]
+            row.update(note=note, evidence=_EVID + test, corrected=corr)
+        elif not r["match"] and q in _INCONSISTENT:
+            row.update(note=_INCONSISTENT[q])
+        elif not r["match"] and q in _FIRST_ORDER:
+            first = agree_to_first_order(r["printed"], r["derived_expr"], reading)
+            del row["tolerance"], row["tolerance_kind"]
+            row.update(agrees=first, note=_FIRST_ORDER[q] + (": the printed coefficient is the derivation at that "
+                       "order" if first else ": the printed coefficient differs from the derivation already at "
+                       "first order"))
+        elif r["match"] and q in _REMARKS:
+            row.update(note=_REMARKS[q](reference_state(state)))
+        elif not r["match"]:
+            row.update(note="the printed element differs from the re-derivation")
         rows.append(row)
     m = manifold_residuals(paper, reading, states=(state,), conventions=("C1",))
     notes = {"14": "right only if dh^c is held constant over the interval and the flight is level; with "
@@ -309,7 +436,7 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
         rows.append({"quantity": f"eq. ({r['equation']}) row d{r['row']}/dt on the correction manifold (per unit dh^c)",
                      "unit": "1/s^2" if r["row"] == "dV_U" else "1/s^2", "paper": r["printed"],
                      "reproduced": r["derived"], "tolerance": 1e-9, "tolerance_kind": "rel",
-                     "status": "erratum", "note": notes[r["equation"]], "evidence": _EVID + "test_manifold_rows",
+                     "basis": "derivation", "note": notes[r["equation"]], "evidence": _EVID + "test_manifold_rows",
                      "corrected": "d/dt of the coefficient of eq. (13)/(11) plus a dV_U^c term (derived_coefficients)"})
     return rows
 

@@ -672,6 +672,40 @@ def b_matrix(lat, sigma, convention="gyro-error"):
     return -c if convention == "gyro-error" else c
 
 
+def fix_drift_resolution(heading_error: float, fix_times) -> float:
+    """The drift the two-point scheme cannot tell from a heading-reference error at one fix.
+
+    The scheme (fang2020 eqs. (25)-(27)) reads the drift from the change of the platform drift
+    angle between the two fixes; an error e of the heading reference at one fix is read as a drift
+    e / (t_2 - t_1) about the vertical.  This is the loosest bound the printed external information
+    sets (fang2020 §3: 6″ over the 1.5 h between the fixes); the 5-m position errors bound the
+    level components far tighter (5 m / R ≈ 0.16″).
+
+    Parameters
+    ----------
+    heading_error : float
+        Error of the heading reference at a fix [rad].
+    fix_times : tuple of float
+        The two fix times (t_1, t_2) [s], t_2 > t_1.
+
+    Returns
+    -------
+    float
+        The drift [rad/s], non-negative.
+
+    Raises
+    ------
+    ValueError
+        If the fix times are not two finite numbers with t_2 > t_1, or ``heading_error`` is not finite.
+    """
+    t = np.asarray(fix_times, dtype=float)
+    if t.shape != (2,) or not np.all(np.isfinite(t)) or not t[1] > t[0]:
+        raise ValueError(f"fix_times must be two finite times with t_2 > t_1, not {fix_times!r}")
+    if not np.isfinite(heading_error):
+        raise ValueError(f"heading_error must be finite, not {heading_error!r}")
+    return float(abs(heading_error) / (t[1] - t[0]))
+
+
 def two_point_drift(p2, r2, c_b_g, tau, *, p1=None, r1=None, mean_c_b_e=None,
                     convention="gyro-error", radius=None):
     """Gyro constant drift in the body frame from two fixes, fang2020 eqs. (25)-(27).
