@@ -67,7 +67,7 @@ def column_groups(printed, symbols=None) -> dict:
 
 def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain: dict, symbols=None,
                      ruled_out=(), level_combinations=LEVEL_COMBINATIONS, before="before maneuver",
-                     printed_threshold: float = 1e-5, exact_name: str = EXACT_READING):
+                     printed_threshold: float = 1e-5, exact_name: str = EXACT_READING, outcomes: dict | None = None):
     """Every verdict of an observability table under its main reading, and the readings ledger
     that judges the verdicts that differ (chen2019 Table 2-3; CONTRIBUTING.md, "Readings and the
     main reading").
@@ -111,6 +111,11 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
         A printed degree above it is *observable*.
     exact_name : str
         The name of the second computation's reading in the ledger.
+    outcomes : dict, optional
+        Filled, when given, with quantity → what the ledger says of the value, by the rule the
+        registry applies: ``"agrees"``, ``"no verdict"`` (``unstated``), ``"no reading"``
+        (``not-reproduced``), ``"a reading keeps the column"`` (``unverifiable``) or ``"every reading
+        loses the column"`` (``inconsistent``) — e.g. for a summary written before the export.
 
     Returns
     -------
@@ -174,11 +179,13 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
             if vo is None or (vo != vp and c == before and s in level_combinations and not exact[k]):
                 why = (f"the state lies almost equally in two singular subspaces (projection ratio "
                        f"{readings[main].attrs['ambiguity'][c][s]:.2f})" if vo is None else explain[s])
+                oc = "no verdict"
                 row.update(basis="unstated", reproduced=None,
                            note=f"no verdict (printed {_word(vp)}): {why}; which member or subspace receives the "
                                 "degree is decided by the assignment of singular values to states (and the "
                                 "scaling), which the print does not state")
             elif vo == vp:
+                oc = "agrees"
                 row.update(basis="verdict", agrees=True,
                            note=f"verdict agrees ({_word(vp)}); magnitudes depend on unstated choices" + (
                                "" if exact[k] == vp else
@@ -189,6 +196,8 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
                 lost = {r: [kk for kk in column if not agrees(r, kk)] for r in reach}
                 keep = [r for r in reach if not lost[r]]
                 says = f"printed {_word(vp)}, reproduced {_word(vo)} under the main reading: {explain[s]}"
+                oc = ("no reading" if not reach else "a reading keeps the column" if keep else
+                      "every reading loses the column")
                 if not reach:
                     tail = "no reading of the ledger that the print does not rule out gives the printed verdict"
                 elif keep:
@@ -202,6 +211,8 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
                             "verdicts no one flight gives together")
                 row.update(basis="verdict", agrees=False, note=f"{says}; {tail}")
             lines.append(row)
+            if outcomes is not None:
+                outcomes[q] = oc
 
     ledger = []
     for r in others:
