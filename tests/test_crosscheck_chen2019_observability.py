@@ -10,6 +10,7 @@ Thirteen rows disagree; each is listed below with its cause, and is expected to 
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -20,16 +21,17 @@ from scipy.linalg import expm
 from replication.crosschecks import chen2019_observability as xc
 
 TABLE = Path(__file__).resolve().parents[1] / "tables" / "chen2019-table-2-3.csv"
+LEDGER = TABLE.parent / "chen2019-check-table-2-3-readings.csv"
 
 _COMBINATION = ("level flight: only a combination of this state with others is observable "
                 "(null-space component {r:.2f} of the prior); the SVD assigns the combination to "
                 "this state, the covariance criterion calls each member unobservable")
 _ROUND_OFF = ("observable alone (posterior ratio ~1e-12: it multiplies the turn rate ω_z), but the SVD assigns it "
-              "a singular value within a decade of the rank tolerance, which the chapter counts as round-off")
+              "a singular value within a decade of the rank tolerance, below the chapter's verdict threshold (round-off)")
 _WEAK = ("weakly but truly observable: it acts on the z gyro through a small body rate (ω_x = ψ̇ sin γ "
          "or the roll rate ω_y); the weakest observable directions have singular values ~1e-9 of "
-         "the largest, 7 decades above round-off, and the chapter's rank tolerance cuts them (its "
-         "note: 'below the rank tolerance'); printed degree {p}")
+         "the largest, 7 decades above round-off, and the chapter's verdict threshold (10 times the rank "
+         "tolerance) cuts them; printed degree {p}")
 KNOWN_DISAGREEMENTS = {
     "δK_az | before maneuver": _COMBINATION.replace("{r:.2f}", "0.98") + " (∇_z + g δK_az)",
     "ε_x | before maneuver": _COMBINATION.replace("{r:.2f}", "0.50") + " (ε_E with φ_U, δK_g, δG)",
@@ -91,6 +93,27 @@ def test_disagreements_are_exactly_the_known_ones(verdicts):
     disagree = {q for q, s in _ROWS if verdicts[q] != s}
     assert disagree == set(KNOWN_DISAGREEMENTS)
     assert len(_ROWS) - len(disagree) == 92
+
+
+def test_the_exact_criterion_is_a_reading_of_the_stored_ledger(verdicts):
+    """The second computation enters the Table 2-3 ledger as one reading, with its verdict on every value,
+    so that no row is held against the print while the exact criterion gives the printed verdict."""
+    from replication.papers.chen2019.findings import EXACT_READING
+    led = pd.read_csv(LEDGER, keep_default_na=False)
+    ex = led[led["quantity"].str.startswith(EXACT_READING + " | ")]
+    assert len(ex) == 27 * 4
+    for _, r in ex.iterrows():
+        q = r["quantity"].split(" | ", 1)[1]
+        assert r["basis"] == "verdict" and (r["agrees"] == "yes") == (verdicts[q] == (float(r["paper"]) > 1e-5))
+
+
+def test_table_2_3_rows_declare_their_basis_and_its_columns_are_groups():
+    table = pd.read_csv(TABLE, keep_default_na=False)
+    assert (table["basis"] != "").all()
+    assert set(table["basis"]) == {"verdict", "unstated", "parts"}
+    assert "not-reproduced" not in set(table["status"])          # every differing verdict is reached by a reading
+    groups = json.loads(TABLE.with_suffix(".json").read_text(encoding="utf-8"))["groups"]
+    assert set(groups) == set(xc.SEGMENTS) and all(len(g) == 27 for g in groups.values())
 
 
 def test_level_flight_vertical_degeneracy():

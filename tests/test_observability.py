@@ -293,25 +293,138 @@ def _degrees(values, tol=1e-9, amb=0.1):
     return t
 
 
-def test_compare_verdicts_follows_the_ledger_and_the_printed_evidence():
-    """A verdict that differs under the main reading is not-reproduced only when no reading that the
-    print does not rule out gives the printed verdict; a ruled-out reading never rescues it."""
+def _sandbox(tmp_path, monkeypatch):
+    """A throw-away project root (tables/ and the notebook the rows name) so compare() writes nothing real."""
+    (tmp_path / "tables").mkdir()
+    (tmp_path / "data" / "paper" / "chen2019").mkdir(parents=True)
+    (tmp_path / "book").mkdir()
+    (tmp_path / "book" / "x.ipynb").write_text("{}", encoding="utf-8")
+    monkeypatch.setenv("REPLICATION_ROOT", str(tmp_path))
+
+
+def test_compare_verdicts_rows_declare_their_basis_and_the_ledger_decides(tmp_path, monkeypatch):
+    """A verdict that differs under the main reading is a 'verdict' row that does not agree; the registry
+    then derives: unverifiable when a reading not ruled out reaches it and keeps the rest of its printed
+    column, inconsistent when every reaching reading loses another value of the column, not-reproduced
+    when none reaches it; a ruled-out reading never rescues a row."""
+    from replication.registry import audit
+    from replication.registry import reproduction as rp
+    _sandbox(tmp_path, monkeypatch)
     printed = _degrees({"before maneuver": [1.0, 1e-20], "turn": [2.0, 3.0]})
-    main = _degrees({"before maneuver": [1.0, 0.0], "turn": [0.0, 0.0]})
-    other = _degrees({"before maneuver": [1.0, 0.0], "turn": [0.0, 4.0]})          # reaches 'b | turn'
-    excluded = _degrees({"before maneuver": [1.0, 0.0], "turn": [5.0, 4.0]})       # would reach 'a | turn'
-    exact = {(s, c): False for s in "abc" for c in printed.columns}
-    exact[("a", "before maneuver")] = True
-    rows, ledger = findings.compare_verdicts(printed, {"main": main, "other": other, "old convention": excluded}, "main",
-                                      exact=exact, explain={"a": "why a", "b": "why b"}, ruled_out=["old"])
-    st = {r["quantity"]: r["status"] for r in rows if not r["quantity"].startswith("c")}
-    assert st == {"a | before maneuver": "qualitative", "a | turn": "not-reproduced",
-                  "b | before maneuver": "qualitative", "b | turn": "qualitative"}
-    assert "reading 'other'" in next(r["note"] for r in rows if r["quantity"] == "b | turn")
-    # the ledger: rank statistics without a printed value, and each reading's verdict on the differing values
-    q = {r["quantity"]: r for r in ledger}
-    assert q["main | Spearman ρ with the printed ranks, turn"]["paper"] is None
-    assert q["old convention | a | turn"]["status"] == "qualitative" and "ruled out" in q["old convention | a | turn"]["note"]
-    assert q["other | a | turn"]["status"] == "not-reproduced"
+    printed.loc["c", "turn"], printed.loc["d"] = 1e-20, [1e-20, 2.0]                  # c null in the turn; d observable
+    main = _degrees({"before maneuver": [1.0, 0.0], "turn": [0.0, 0.0]}).reindex(printed.index, fill_value=0.0)
+    other = main.copy(); other.loc["b", "turn"] = 4.0                                  # reaches b, keeps the column
+    lossy = main.copy(); lossy.loc[["a", "c"], "turn"] = 5.0                           # reaches a, loses c
+    old = main.copy(); old.loc[["a", "b", "d"], "turn"] = 5.0                          # reaches all, ruled out
+    for t in (main, other, lossy, old):
+        t.attrs = {"rank_tol": {c: 1e-9 for c in t.columns},
+                   "ambiguity": {c: dict.fromkeys(t.index, 0.1) for c in t.columns}}
+    exact = {(s, c): printed.loc[s, c] > 1e-5 and c == "before maneuver" for s in printed.index for c in printed.columns}
+    rows, ledger = findings.compare_verdicts(printed, {"main": main, "other": other, "lossy": lossy, "old convention": old},
+                                             "main", exact=exact, explain=dict.fromkeys("abcd", "why"), ruled_out=["old"])
+    assert {r["basis"] for r in rows} == {"verdict"}
+    assert {r["quantity"]: r["agrees"] for r in rows if r["quantity"].endswith("turn")} == {
+        "a | turn": False, "b | turn": False, "c | turn": True, "d | turn": False}
+    # the ledger: every reading but the main one (and the second computation) on every value
+    assert len(ledger) == 4 * len(rows) and not any(q["quantity"].startswith("main |") for q in ledger)
+    assert any(q["quantity"].startswith(findings.EXACT_READING) for q in ledger)
+    rp.compare("chen2019-check-table-9-9-readings", ledger, notebook="book/x.ipynb", title="ledger")
+    t = rp.compare("chen2019-table-9-9", rows, notebook="book/x.ipynb", title="main", main_reading="main",
+                   reading_evidence="the printed 2.0", ruled_out={"old": "the printed 2.0"},
+                   groups=findings.column_groups(printed)).set_index("quantity").status
+    assert t["a | turn"] == "inconsistent" and "loses c" in next(r["note"] for r in rows if r["quantity"] == "a | turn")
+    assert t["b | turn"] == "unverifiable" and "'other'" in next(r["note"] for r in rows if r["quantity"] == "b | turn")
+    assert t["c | turn"] == "qualitative"
+    assert t["d | turn"] == "not-reproduced"                                           # only the ruled-out reading reaches it
+    assert all("ruled_out" in p.reason or "quotes no printed value" in p.reason
+               for p in audit.audit(["chen2019-table-9-9", "chen2019-check-table-9-9-readings"]))
+    # a differing value on which the main reading gives no verdict (ambiguous assignment) is 'unstated'
+    amb = main.copy(); amb.attrs = {"rank_tol": main.attrs["rank_tol"],
+                                    "ambiguity": {c: dict.fromkeys(main.index, 0.99) for c in main.columns}}
+    rows2, _ = findings.compare_verdicts(printed, {"main": amb}, "main", exact=exact, explain=dict.fromkeys("abcd", "why"))
+    assert next(r for r in rows2 if r["quantity"] == "a | turn")["basis"] == "unstated"
     with pytest.raises(ValueError, match="ruled out"):
         findings.compare_verdicts(printed, {"old": main}, "old", exact=exact, explain={}, ruled_out=["old"])
+
+
+def test_one_threshold_for_tables_sweep_and_verdicts():
+    """degrees_table, sweep and verdict_under share one threshold, ROUND_OFF_MARGIN times the rank tolerance."""
+    assert O.verdict_threshold(2e-5) == pytest.approx(2e-4)
+    assert O.verdict_threshold({"a": 1e-9}) == {"a": pytest.approx(1e-8)}
+    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
+    m = M.model_45(misalignment_coupling="table-2-2")
+    st = m.labels[:9] + M.table_2_3_states()[3:]
+    raw = O.degrees_table(m, mv, states=st, n_segments=4, clip_null=False)
+    df = O.degrees_table(m, mv, states=st, n_segments=4)
+    for c in df.columns:
+        thr = df.attrs["threshold"][c]
+        assert thr == pytest.approx(O.ROUND_OFF_MARGIN * df.attrs["rank_tol"][c])
+        assert ((raw[c] > thr) == (df[c] > 0)).all()                                   # reported 0 at or below it
+        assert all(O.verdict_under(1.0, d, df.attrs["rank_tol"][c], 0.1)[1] == (d > thr) for d in raw[c])
+    sens = O.sweep(m, mv, df, {"same": dict(n_segments=4)}, states=st, progress=False)
+    assert [int(sens.loc["same", f"observable {c}"]) for c in df.columns] == [int((df[c] > 0).sum()) for c in df.columns]
+
+
+def test_speed_wave_excites_the_forward_axis():
+    """A speed wave of A m/s over a T-s turn gives a forward specific force f_y up to πA/T (plus
+    round-off), zero at constant speed, and the speed returns to its start."""
+    kw = dict(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=0.5)
+    const, wave = O.chen2019_maneuvers(**kw), O.chen2019_maneuvers(speed_wave=2.0, **kw)
+    t = wave["U-turn"].traj
+    assert np.abs(const["U-turn"].traj.f_b[:, 1]).max() < 1e-9
+    assert np.abs(t.f_b[:, 1]).max() == pytest.approx(np.pi * 2.0 / 100.0, rel=2e-3)
+    speed = np.hypot(t.v_enu[:, 0], t.v_enu[:, 1])
+    assert speed.max() == pytest.approx(102.0, abs=1e-6) and speed[-1] == pytest.approx(100.0, abs=1e-9)
+    assert np.degrees(t.hpr[-1, 0]) % 360 == pytest.approx(225.0, abs=1e-6)
+    with pytest.raises(ValueError, match="stop"):
+        tr.generate([tr.Turn(10.0, 1.0, speed_wave=-200.0)], 0.8, 2.0, 100.0, speed=100.0, dt=1.0)
+
+
+def test_constant_rate_turn_holds_its_rate_between_the_ramps():
+    """SteadyTurn: ψ̇ = angle / (T - ramp) between the ramps, the full heading change at the end,
+    continuous heading and rate at the ramp ends; flown, the body z rate varies only by the Earth and
+    transport rates as the heading turns (< 0.5 %)."""
+    turn = tr.SteadyTurn(100.0, np.pi, ramp=10.0)
+    tau = np.linspace(0.0, 100.0, 2001)
+    dpsi, rate, _ = turn.heading(tau)
+    mid = (tau >= 10.0) & (tau <= 90.0)
+    assert np.allclose(rate[mid], np.pi / 90.0, rtol=1e-12, atol=0.0)
+    assert dpsi[-1] == pytest.approx(np.pi, abs=1e-12) and rate[0] == 0.0 and rate[-1] == pytest.approx(0.0, abs=1e-15)
+    assert np.max(np.abs(np.diff(dpsi))) < 2 * np.pi / 90.0 * 0.05
+    t = tr.generate([tr.Straight(10.0), turn, tr.Straight(10.0)], 0.8, 2.0, 6000.0, speed=100.0, dt=0.5)
+    w = t.w_ib_b[(t.t >= 25.0) & (t.t <= 95.0), 2]
+    assert np.ptp(w) < 5e-3 * np.abs(w).mean()
+    const = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=0.5, turn_rate="constant")
+    assert np.degrees(const["figure-8"].traj.hpr[-1, 0]) % 360 == pytest.approx(45.0, abs=1e-6)
+    assert np.degrees(const["S-turn"].traj.hpr[-1, 0]) % 360 == pytest.approx(45.0, abs=1e-6)
+    with pytest.raises(ValueError, match="ramp"):
+        tr.SteadyTurn(10.0, 1.0, ramp=6.0)
+    with pytest.raises(ValueError, match="turn_rate"):
+        O.chen2019_maneuvers(turn_rate="steady")
+    with pytest.raises(ValueError, match="bank"):
+        O.chen2019_maneuvers(bank="flat")
+
+
+def test_maneuver_only_interval_and_the_flight_grid():
+    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
+    assert mv["U-turn"].spans(4, 0)[0][0] == 20.0 and len(mv["U-turn"].spans(4, 0)) == 4
+    assert mv["before maneuver"].spans(4, 0) == [(0.0, 20.0)]           # the straight scenario has nothing else
+    with pytest.raises(ValueError, match="before_segments"):
+        mv["U-turn"].spans(4, -1)
+    fl = O.flight_readings(speed_wave=2.0, base=mv, u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
+    assert len(fl) == 16 and next(iter(fl)) == "V const, ramped rate, banked, with straight leg"
+    assert fl["V const, ramped rate, banked, with straight leg"]["maneuvers"] is mv
+    assert fl["V wave 2 m/s, constant rate, unbanked, maneuver only"]["before_segments"] == 0
+    assert np.abs(fl["V wave 2 m/s, ramped rate, unbanked, maneuver only"]["maneuvers"]["U-turn"].traj.hpr[:, 2]).max() == 0.0
+    with pytest.raises(ValueError, match="speed_wave"):
+        O.flight_readings(speed_wave=0.0)
+
+
+def test_spearman_critical_value():
+    """The two-sided 5 % critical value of Spearman's ρ for 27 pairs is 0.381 (t approximation)."""
+    assert O.spearman_critical(27) == pytest.approx(0.381, abs=5e-4)
+    assert O.spearman_critical(27, 0.01) > O.spearman_critical(27)
+    with pytest.raises(ValueError):
+        O.spearman_critical(2)
+    with pytest.raises(ValueError, match="alpha"):
+        O.spearman_critical(27, 1.5)

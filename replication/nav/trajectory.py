@@ -36,7 +36,7 @@ from replication.nav.strapdown import NavState
 from replication.nav.units import DEG, G0
 
 __all__ = [
-    "Segment", "Straight", "Turn", "UTurn", "STurn", "FigureEight", "Climb", "Accelerate",
+    "Segment", "Straight", "Turn", "SteadyTurn", "UTurn", "STurn", "FigureEight", "Climb", "Accelerate",
     "Rotate", "move", "Dwell", "ShipRocking", "Trajectory", "generate", "chen2019_flight",
     "turntable_chen2019", "rotation_rich_turntable", "fang2020_ship",
 ]
@@ -112,6 +112,19 @@ def _raised_cos(tau, T):
     return R, r, rd
 
 
+def _speed_wave(tau, T, A):
+    """Speed wave over a segment of length T: the speed rises by A and returns, ΔV = A (1 - cos 2πτ/T)/2;
+    returns (ΔV, V̇), V̇ = πA/T sin 2πτ/T (largest |V̇| = π|A|/T), zero at both ends."""
+    w = 2 * np.pi / T
+    return 0.5 * A * (1 - np.cos(w * tau)), 0.5 * A * w * np.sin(w * tau)
+
+
+def _check_wave(seg):
+    A = getattr(seg, "speed_wave", 0.0)
+    if not (isinstance(A, (int, float, np.integer, np.floating)) and np.isfinite(A)):
+        raise ValueError(f"{seg.label()}: speed_wave must be a finite number of m/s, got {A!r}")
+
+
 class _Flight(Segment):
     """Flight-dynamics segment: heading, horizontal speed and vertical speed profiles."""
 
@@ -120,8 +133,11 @@ class _Flight(Segment):
         return z, z, z
 
     def speed(self, tau):
-        z = np.zeros_like(tau)
-        return z, z
+        A = float(getattr(self, "speed_wave", 0.0) or 0.0)
+        if A == 0.0:
+            z = np.zeros_like(tau)
+            return z, z
+        return _speed_wave(tau, self.duration, A)
 
     def vertical(self, tau):
         z = np.zeros_like(tau)
@@ -154,6 +170,10 @@ class _Flight(Segment):
         V0 = math.hypot(v0[0], v0[1])
         if V0 <= 0:
             raise ValueError(f"{self.label()}: a flight segment needs a non-zero horizontal speed at its start")
+        _check_wave(self)
+        if V0 + min(0.0, float(getattr(self, "speed_wave", 0.0) or 0.0)) <= 0:
+            raise ValueError(f"{self.label()}: speed_wave {self.speed_wave} m/s would stop the aircraft (start speed "
+                             f"{V0:.6g} m/s)")
         trk = math.atan2(v0[0], v0[1])
         if abs(math.remainder(trk - hpr0[0], 2 * math.pi)) > 1e-9:
             raise ValueError(f"{self.label()}: heading {hpr0[0]:.6g} rad differs from the track {trk:.6g} rad "
@@ -186,9 +206,14 @@ class Turn(_Flight):
         Length T of the turn [s].
     angle : float
         Heading change [rad], positive clockwise; default 0.
+    speed_wave : float
+        The horizontal speed rises by this much [m/s] and returns during the turn,
+        ΔV = speed_wave (1 - cos 2πτ/T)/2 (forward acceleration up to π·speed_wave/T); default 0
+        (constant speed).
     """
 
     angle: float = 0.0
+    speed_wave: float = 0.0
 
     def heading(self, tau):
         """Heading change, turn rate and its derivative over the turn.
@@ -241,10 +266,14 @@ class STurn(_Flight):
         Largest heading excursion [rad], default 0.
     cycles : int
         Number c of right-and-back cycles, default 1.
+    speed_wave : float
+        The horizontal speed rises by this much [m/s] and returns over the segment (see
+        :class:`Turn`); default 0.
     """
 
     swing: float = 0.0
     cycles: int = 1
+    speed_wave: float = 0.0
 
     def heading(self, tau):
         """Heading change, turn rate and its derivative over the S-turn.
@@ -277,17 +306,101 @@ class FigureEight(Segment):
     ----------
     duration : float
         Length of both turns together [s].
+    speed_wave : float
+        Speed wave of each turn [m/s] (see :class:`Turn`); default 0.
+    constant_rate : bool
+        Fly each turn at a constant rate (:class:`SteadyTurn`, ramped in and out over ``ramp``)
+        instead of the raised-cosine rate of :class:`Turn`; default False.
+    ramp : float
+        Roll-in and roll-out time of a constant-rate turn [s]; default 10.
     """
+
+    speed_wave: float = 0.0
+    constant_rate: bool = False
+    ramp: float = 10.0
 
     def pieces(self):
         """The two turns, each lasting half the duration.
 
         Returns
         -------
-        pieces : list of Turn
+        pieces : list of Turn or SteadyTurn
             Turns by +2π and -2π rad.
         """
-        return [Turn(self.duration / 2, 2 * np.pi), Turn(self.duration / 2, -2 * np.pi)]
+        T = self.duration / 2
+        if self.constant_rate:
+            return [SteadyTurn(T, a, ramp=self.ramp, speed_wave=self.speed_wave) for a in (2 * np.pi, -2 * np.pi)]
+        return [Turn(T, a, speed_wave=self.speed_wave) for a in (2 * np.pi, -2 * np.pi)]
+
+
+@dataclass
+class SteadyTurn(_Flight):
+    """Coordinated turn by ``angle`` rad at a constant rate, rolled in and out over ``ramp`` s.
+
+    ψ̇ = Ω s(τ), Ω = angle / (T - ramp): s rises from 0 to 1 as (1 - cos πτ/ramp)/2 over the first
+    ``ramp`` seconds, stays 1, and falls symmetrically over the last ``ramp`` seconds, so bank and
+    roll rate are continuous and the turn rate is constant between the ramps.
+
+    Attributes
+    ----------
+    duration : float
+        Length T of the turn [s], longer than 2 ``ramp``.
+    angle : float
+        Heading change [rad], positive clockwise; default 0.
+    ramp : float
+        Roll-in (and roll-out) time [s]; default 10.
+    speed_wave : float
+        Speed wave over the turn [m/s] (see :class:`Turn`); default 0.
+    """
+
+    angle: float = 0.0
+    ramp: float = 10.0
+    speed_wave: float = 0.0
+
+    def __post_init__(self):
+        if not (np.isfinite(self.ramp) and 0 < self.ramp and 2 * self.ramp < self.duration):
+            raise ValueError(f"SteadyTurn: ramp must be positive and shorter than half the duration "
+                             f"({self.duration} s), got {self.ramp!r}")
+
+    @property
+    def rate(self) -> float:
+        """The constant turn rate Ω between the ramps [rad/s]."""
+        return self.angle / (self.duration - self.ramp)
+
+    def heading(self, tau):
+        """Heading change, turn rate and its derivative over the turn.
+
+        Parameters
+        ----------
+        tau : ndarray, shape (n,)
+            Times since the segment start [s].
+
+        Returns
+        -------
+        dpsi : ndarray, shape (n,)
+            Heading change since the start [rad].
+        rate : ndarray, shape (n,)
+            ψ̇ [rad/s].
+        rate_dot : ndarray, shape (n,)
+            ψ̈ [rad/s²].
+        """
+        tau = np.asarray(tau, float)
+        a, T, W = self.ramp, self.duration, self.rate
+        k = np.pi / a
+
+        def ramp_in(u):        # ∫s, s, s' for u in [0, a]
+            return u / 2 - np.sin(k * u) / (2 * k), (1 - np.cos(k * u)) / 2, k * np.sin(k * u) / 2
+
+        u_in, u_out = np.clip(tau, 0.0, a), np.clip(T - tau, 0.0, a)
+        I1, s1, d1 = ramp_in(u_in)
+        I2, s2, d2 = ramp_in(u_out)
+        first, last = tau < a, tau > T - a
+        middle = ~(first | last)
+        dpsi = np.where(first, W * I1, np.where(last, self.angle - W * I2, W * (a / 2 + (tau - a))))
+        rate = np.where(first, W * s1, np.where(last, W * s2, W))
+        rate_dot = np.where(first, W * d1, np.where(last, -W * d2, 0.0))
+        rate_dot = np.where(middle, 0.0, rate_dot)
+        return dpsi, rate, rate_dot
 
 
 @dataclass

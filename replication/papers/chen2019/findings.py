@@ -6,7 +6,8 @@ their results into comparison rows with a status, a note, evidence and corrected
 the chapters record as errata or inconsistencies.  No method module imports it; the notebooks and
 the tests do.
 
-* :func:`compare_verdicts` — the verdicts of Table 2-3 under the main reading, and its ledger;
+* :func:`compare_verdicts` — the verdicts of Table 2-3 under the main reading, and its ledger
+  (:func:`column_groups`: its printed columns as groups);
 * :func:`figure_4_14_ledger` — the readings ledger of the ranges stated after Fig. 4-14;
 * :func:`ordering_rows` — the orderings between two turntable experiments (Tables 4-37..4-39);
 * :func:`maneuver_claims`, :func:`model_claims`, :func:`compensation_claims` — the report's claims
@@ -21,30 +22,70 @@ import numpy as np
 import pandas as pd
 
 from replication.nav._validate import nonnegative
-from replication.papers.chen2019.observability import LEVEL_COMBINATIONS, ROUND_OFF_MARGIN, _table, spearman, verdict_under
+from replication.papers.chen2019.observability import LEVEL_COMBINATIONS, _table, verdict_threshold, verdict_under
 from replication.papers.chen2019.simulation import figure_4_14_estimates
 from replication.papers.chen2019.turntable import QUANTITIES
 
-__all__ = ["compare_verdicts", "figure_4_14_ledger", "ordering_rows", "PRINTED_CLOSED_FORM_DAMAGE",
-           "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims", "model_claims", "compensation_claims"]
+__all__ = ["compare_verdicts", "column_groups", "EXACT_READING", "figure_4_14_ledger", "ordering_rows",
+           "PRINTED_CLOSED_FORM_DAMAGE", "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims", "model_claims",
+           "compensation_claims"]
 
 
 def _stored_degree(table, state, scenario) -> float:
-    """A degree to 6 significant digits, or 0 when it is round-off (see :func:`replication.papers.chen2019.observability.verdict_under`)."""
+    """A degree to 6 significant digits, or 0 at or below the verdict threshold (round-off, see
+    :func:`replication.papers.chen2019.observability.verdict_threshold`)."""
     d = float(table.loc[state, scenario])
-    return 0.0 if d <= ROUND_OFF_MARGIN * table.attrs["rank_tol"][scenario] else float(f"{d:.6g}")
+    return 0.0 if d <= verdict_threshold(table.attrs["rank_tol"][scenario]) else float(f"{d:.6g}")
 
 
 def _word(observable: bool) -> str:
     return "observable" if observable else "unobservable"
 
 
+EXACT_READING = "exact null-space criterion (second computation, its own flights)"
+"""The name of the second computation's verdicts in the readings ledger of Table 2-3
+(:mod:`replication.crosschecks.chen2019_observability`: the noise-free covariance, i.e. the rank in
+exact arithmetic, along constant-rate 3°/s turns between straight legs)."""
+
+
+def column_groups(printed, symbols=None) -> dict:
+    """The printed columns of an observability table as groups of row quantities
+    (``compare(..., groups=)``): one reading must reach the values of a printed column together.
+
+    Parameters
+    ----------
+    printed : pandas.DataFrame
+        The printed degrees (rows: states, columns: scenarios).
+    symbols : dict, optional
+        State → printed symbol used in the quantities (default: the state name).
+
+    Returns
+    -------
+    dict of str to list of str
+        Scenario → the quantities ``"<symbol> | <scenario>"`` of its column.
+    """
+    sym = symbols or {s: s for s in printed.index}
+    return {c: [f"{sym[s]} | {c}" for s in printed.index] for c in printed.columns}
+
+
 def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain: dict, symbols=None,
                      ruled_out=(), level_combinations=LEVEL_COMBINATIONS, before="before maneuver",
-                     printed_threshold: float = 1e-5):
-    """The status of every verdict of an observability table under its main reading, and the
-    readings ledger that supports it (chen2019 Table 2-3; CONTRIBUTING.md, "Readings and the main
-    reading").
+                     printed_threshold: float = 1e-5, exact_name: str = EXACT_READING, outcomes: dict | None = None):
+    """Every verdict of an observability table under its main reading, and the readings ledger
+    that judges the verdicts that differ (chen2019 Table 2-3; CONTRIBUTING.md, "Readings and the
+    main reading").
+
+    Every row declares its basis; the registry derives the status
+    (:func:`replication.registry.verdicts.derive_status`).  A value whose main-reading verdict
+    agrees with the print is a ``verdict`` row that agrees (``qualitative``); one that differs is a
+    ``verdict`` row that does not, and the ledger decides it: no reading reaches the print →
+    ``not-reproduced``; a reading reaches it and keeps every other value of its printed column
+    that the main reading reaches → ``unverifiable``; every reaching reading loses another value
+    of the column → ``inconsistent``.  A value on which the main reading gives no verdict — the
+    state lies almost equally in two singular subspaces, or level flight observes it only in a
+    combination that the SVD credits to another member — is ``unstated``: the assignment rule the
+    print does not give decides it.  The notes say which readings reach the print and which keep
+    the column, computed here by the rule the registry applies.
 
     Parameters
     ----------
@@ -52,37 +93,39 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
         The printed degrees (rows: states, columns: scenarios), dimensionless.
     readings : dict
         Reading name → degrees table of the same shape with ``attrs["rank_tol"]`` and
-        ``attrs["ambiguity"]`` (:func:`replication.papers.chen2019.observability.degrees_table`, or ``sweep(...).attrs["tables"]``).
+        ``attrs["ambiguity"]`` (:func:`replication.papers.chen2019.observability.degrees_table`, or
+        ``sweep(...).attrs["tables"]``).
     main : str
         The main reading, a key of ``readings``.
     exact : dict
         ``(state, scenario)`` → bool: the second computation's verdict (exact null-space
-        criterion) under the main reading.
+        criterion); a reading of the ledger named ``exact_name``.
     explain : dict
         State → the physical reason a verdict differs (one line).
     symbols : dict, optional
         State → printed symbol used in the quantities (default: the state name).
     ruled_out : iterable of str
-        Prefixes of readings that printed evidence excludes: shown in the ledger, never used to
-        reach the print.
+        Prefixes of readings that printed evidence excludes: in the ledger, never reaching the print.
     level_combinations : set of str
         States observable in level flight only in a combination (scenario ``before``).
     before : str
         The column of the straight, level scenario.
     printed_threshold : float
         A printed degree above it is *observable*.
+    exact_name : str
+        The name of the second computation's reading in the ledger.
+    outcomes : dict, optional
+        Filled, when given, with quantity → what the ledger says of the value, by the rule the
+        registry applies: ``"agrees"``, ``"no verdict"`` (``unstated``), ``"no reading"``
+        (``not-reproduced``), ``"a reading keeps the column"`` (``unverifiable``) or ``"every reading
+        loses the column"`` (``inconsistent``) — e.g. for a summary written before the export.
 
     Returns
     -------
     main_rows, ledger_rows : list of dict
-        Rows for :func:`replication.registry.reproduction.compare`.  A value whose verdict differs under the
-        main reading is ``not-reproduced`` only when it is decided (not ambiguous, not a level
-        combination), the second computation agrees with the main reading, and no reading that is
-        not ruled out gives the printed verdict; otherwise ``qualitative`` with the reason.  A value
-        without a verdict carries no reproduced degree.  The ledger holds, for every reading, the
-        Spearman rank correlation per scenario (a statistic of agreement with the printed ranks, not
-        a printed value) and its verdict on every value whose verdict under the main reading differs
-        from the print (the values whose status the ledger decides).
+        Rows for :func:`replication.registry.reproduction.compare`: the main table (one per value)
+        and the ledger (one per reading other than the main one and value, named
+        ``"<reading> | <symbol> | <scenario>"``), each with its ``basis`` and ``agrees``.
     """
     _table(printed, "printed")
     nonnegative(printed_threshold, "printed_threshold")
@@ -103,71 +146,93 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
     if missing:
         raise ValueError(f"exact has no verdict of the second computation for {missing[:3]} (one per state and "
                          "scenario of printed)")
+    if exact_name in readings:
+        raise ValueError(f"exact_name {exact_name!r} is already a reading")
     sym = symbols or {s: s for s in printed.index}
     ruled = tuple(ruled_out)
-    excluded = {r for r in readings if any(r.startswith(k) for k in ruled)}
+    excluded = {r for r in list(readings) + [exact_name] if any(r.startswith(k) for k in ruled)}
     if main in excluded:
         raise ValueError(f"the main reading {main!r} is itself ruled out")
+    pv = {(s, c): float(printed.loc[s, c]) > printed_threshold for s in printed.index for c in printed.columns}
 
-    def decide(r, s, c):
-        t = readings[r]
-        return verdict_under(printed.loc[s, c], t.loc[s, c], t.attrs["rank_tol"][c], t.attrs["ambiguity"][c][s],
-                             printed_threshold=printed_threshold)
+    # verdicts[reading][(s, c)] = (reproduced verdict or None when undecided, stored degree or None)
+    verdicts = {}
+    for r, t in readings.items():
+        v = {}
+        for s in printed.index:
+            for c in printed.columns:
+                _, vo, decided = verdict_under(printed.loc[s, c], t.loc[s, c], t.attrs["rank_tol"][c],
+                                               t.attrs["ambiguity"][c][s], printed_threshold=printed_threshold)
+                v[(s, c)] = (vo if decided else None, _stored_degree(t, s, c) if decided else None)
+        verdicts[r] = v
+    verdicts[exact_name] = {k: (bool(exact[k]), None) for k in pv}
+    others = [r for r in verdicts if r != main]
 
-    main_rows, differ = [], []
+    def agrees(r, k):
+        return verdicts[r][k][0] is not None and verdicts[r][k][0] == pv[k]
+
+    main_agree = {k for k in pv if agrees(main, k)}
+    lines = []
     for s in printed.index:
         for c in printed.columns:
-            vp, vo, decided = decide(main, s, c)
-            t, q = readings[main], f"{sym[s]} | {c}"
-            says = f"printed {_word(vp)}, reproduced {_word(vo)}"
-            value = _stored_degree(t, s, c)
-            ex = exact[(s, c)]
-            if vp != vo:
-                differ.append((s, c))
-            if vp == vo:
-                status, note = "qualitative", f"verdict agrees ({_word(vp)}); magnitudes depend on unstated choices" + (
-                    "" if ex == vp else f"; alone it is {_word(ex)} by the exact null-space criterion (second computation)")
-            elif not decided:
-                status, value = "qualitative", None
-                note = (f"no verdict ({says}): the state lies almost equally in two singular subspaces (projection ratio "
-                        f"{t.attrs['ambiguity'][c][s]:.2f}), so the assignment rule, not the model, decides")
-            elif c == before and s in level_combinations and not ex:
-                status, value = "qualitative", None
-                note = (f"no verdict ({says}): {explain[s]}; alone each member is unobservable (exact null-space "
-                        "criterion, second computation) and the member an SVD names depends on the scaling")
-            elif ex == vp:
-                status, note = "qualitative", (f"{says} with this chapter's rank tolerance; the exact null-space criterion "
-                                               f"(second computation) agrees with the print: {explain[s]}")
+            k, q = (s, c), f"{sym[s]} | {c}"
+            vo, value = verdicts[main][k]
+            vp = pv[k]
+            row = dict(quantity=q, unit="1", paper=printed.loc[s, c], reproduced=value)
+            if vo is None or (vo != vp and c == before and s in level_combinations and not exact[k]):
+                why = (f"the state lies almost equally in two singular subspaces (projection ratio "
+                       f"{readings[main].attrs['ambiguity'][c][s]:.2f})" if vo is None else explain[s])
+                oc = "no verdict"
+                row.update(basis="unstated", reproduced=None,
+                           note=f"no verdict (printed {_word(vp)}): {why}; which member or subspace receives the "
+                                "degree is decided by the assignment of singular values to states (and the "
+                                "scaling), which the print does not state")
+            elif vo == vp:
+                oc = "agrees"
+                row.update(basis="verdict", agrees=True,
+                           note=f"verdict agrees ({_word(vp)}); magnitudes depend on unstated choices" + (
+                               "" if exact[k] == vp else
+                               f"; alone it is {_word(exact[k])} by the exact null-space criterion (second computation)"))
             else:
-                reach = [r for r in readings if r not in excluded and r != main
-                         and (lambda v: v[0] == v[1] or not v[2])(decide(r, s, c))]
-                if reach:
-                    status, note = "qualitative", (f"{says} under the main reading, but the reading '{reach[0]}' of the "
-                                                   f"ledger does not contradict the print: {explain[s]}")
+                reach = [r for r in others if r not in excluded and agrees(r, k)]
+                column = [kk for kk in main_agree if kk[1] == c]
+                lost = {r: [kk for kk in column if not agrees(r, kk)] for r in reach}
+                keep = [r for r in reach if not lost[r]]
+                says = f"printed {_word(vp)}, reproduced {_word(vo)} under the main reading: {explain[s]}"
+                oc = ("no reading" if not reach else "a reading keeps the column" if keep else
+                      "every reading loses the column")
+                if not reach:
+                    tail = "no reading of the ledger that the print does not rule out gives the printed verdict"
+                elif keep:
+                    tail = (f"{len(keep)} of the {len(reach)} readings that give the printed verdict keep every other "
+                            f"verdict of the printed {c} column that the main reading reproduces, e.g. '{keep[0]}': "
+                            "an unstated choice, chosen to suit, reaches the print")
                 else:
-                    status, note = "not-reproduced", (f"{says} under every reading of the ledger not ruled out by the "
-                                                      f"print (the exact null-space criterion agrees): {explain[s]}")
-            main_rows.append(dict(quantity=q, unit="1", paper=printed.loc[s, c], reproduced=value, status=status,
-                                  note=note))
+                    ex = ", ".join(f"'{r}' loses {sym[lost[r][0][0]]}" for r in reach[:3])
+                    tail = (f"the {len(reach)} readings that give the printed verdict each lose another printed verdict "
+                            f"of the {c} column ({ex}{', …' if len(reach) > 3 else ''}): the printed column asks for "
+                            "verdicts no one flight gives together")
+                row.update(basis="verdict", agrees=False, note=f"{says}; {tail}")
+            lines.append(row)
+            if outcomes is not None:
+                outcomes[q] = oc
 
     ledger = []
-    for r, t in readings.items():
+    for r in others:
         tag = " (ruled out by the print)" if r in excluded else ""
-        for c in printed.columns:
-            rho = spearman(printed[c].to_numpy(float), t.loc[printed.index, c].to_numpy(float))  # paired by state
-            ledger.append(dict(quantity=f"{r} | Spearman ρ with the printed ranks, {c}", unit="1", paper=None,
-                               paper_text="ranks of the printed column", reproduced=round(float(rho), 2),
-                               status="qualitative" if rho >= 0.7 else "not-reproduced",
-                               note=f"a statistic of agreement, not a printed value: accepted when ρ ≥ 0.7{tag}"))
-        for s, c in differ:
-            vp, vo, decided = decide(r, s, c)
-            ok = vp == vo or not decided
-            ledger.append(dict(quantity=f"{r} | {sym[s]} | {c}", unit="1", paper=printed.loc[s, c],
-                               reproduced=_stored_degree(t, s, c) if decided else None,
-                               status="qualitative" if ok else "not-reproduced",
-                               note=("verdict agrees" if vp == vo else "no verdict (ambiguous assignment)" if ok
-                                     else f"SVD verdict: printed {_word(vp)}, reproduced {_word(vo)}") + tag))
-    return main_rows, ledger
+        for s in printed.index:
+            for c in printed.columns:
+                k = (s, c)
+                vo, value = verdicts[r][k]
+                q = f"{r} | {sym[s]} | {c}"
+                if vo is None:
+                    ledger.append(dict(quantity=q, unit="1", paper=printed.loc[s, c], basis="unstated",
+                                       note="no verdict (ambiguous assignment)" + tag))
+                else:
+                    ledger.append(dict(quantity=q, unit="1", paper=printed.loc[s, c], reproduced=value,
+                                       basis="verdict", agrees=vo == pv[k],
+                                       note=f"printed {_word(pv[k])}, reproduced {_word(vo)}" + tag))
+    return lines, ledger
 
 
 def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1000.0):

@@ -48,6 +48,7 @@ measurements taught nothing about the state, large when its uncertainty collapse
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from functools import partial
@@ -71,7 +72,8 @@ __all__ = ["observability_matrix", "stripped_observability_matrix", "total_obser
            "ObservabilityDegrees", "observability_degrees", "piecewise_systems", "pwcs_observability",
            "covariance_observability", "segment_bounds", "AMBIGUOUS", "spearman", "CHEN2019_MANEUVERS", "Maneuver",
            "chen2019_maneuvers", "degrees_table", "covariance_table", "rank_metrics", "best_scenario_counts", "unbanked", "coordinated", "sweep",
-           "verdict_under"]
+           "verdict_under", "verdict_threshold", "ROUND_OFF_MARGIN", "spearman_critical", "FLIGHT_CHOICES", "TURN_RATES",
+           "BANKS", "flight_readings"]
 
 
 # ----------------------------------------------------------------------------- validation
@@ -333,6 +335,34 @@ AMBIGUOUS = 0.95
 """A state whose second-largest projection on a singular subspace is above this fraction of its
 largest lies almost equally in two directions: its assignment (observable or not) hangs on a
 few per cent of its components and is no verdict (``ObservabilityDegrees.ambiguity``)."""
+
+ROUND_OFF_MARGIN = 10.0
+"""A degree within this factor above the numerical-rank tolerance is round-off: unobservable.
+Singular values of numerically zero directions reach just above the rank tolerance (a state whose
+columns of F and H are identically zero has been seen at 1.01 ``rank_tol``), so a verdict is drawn
+only a decade above it (:func:`verdict_threshold`)."""
+
+
+def verdict_threshold(rank_tol):
+    """The one threshold of the chen2019 verdicts: a degree above ``ROUND_OFF_MARGIN · rank_tol`` is
+    observable, at or below it unobservable (round-off).  Used alike by :func:`degrees_table` (which
+    reports degrees at or below it as 0), :func:`sweep` (its bar counts), :func:`verdict_under` and
+    the chapter's tables.
+
+    Parameters
+    ----------
+    rank_tol : float or dict of str to float
+        The numerical-rank tolerance (one, or one per scenario).
+
+    Returns
+    -------
+    float or dict of str to float
+        The threshold(s), same shape.
+    """
+    if isinstance(rank_tol, dict):
+        return {k: verdict_threshold(v) for k, v in rank_tol.items()}
+    return ROUND_OFF_MARGIN * nonnegative(rank_tol, "rank_tol")
+
 
 LEVEL_COMBINATIONS = frozenset({"accel_bias.z", "accel_scale.z", "gyro_bias.x", "gyro_bias.y", "gyro_bias.z"})
 """States that straight and level flight observes only in combinations (chen2019 Table 2-3, first
@@ -775,6 +805,38 @@ def spearman(a, b) -> float:
     return float(stats.spearmanr(a, b).statistic)
 
 
+def spearman_critical(n: int, alpha: float = 0.05) -> float:
+    """The two-sided critical value of Spearman's ρ for ``n`` pairs at level ``alpha``.
+
+    ρ_c = t / sqrt(n - 2 + t²) with t the 1 - alpha/2 quantile of Student's t with n - 2 degrees of
+    freedom (the t approximation of the null distribution of ρ): a ρ above it says the two rankings
+    agree beyond chance (0.381 for 27 pairs at 5 %).
+
+    Parameters
+    ----------
+    n : int
+        Number of pairs, at least 3.
+    alpha : float
+        Two-sided level, in (0, 1).
+
+    Returns
+    -------
+    float
+        The critical value.
+
+    Raises
+    ------
+    ValueError
+        When ``n`` < 3 or ``alpha`` is outside (0, 1).
+    """
+    integer(n, "n", minimum=3)
+    alpha = finite(alpha, "alpha")
+    if not 0.0 < alpha < 1.0:
+        raise ValueError(f"alpha must lie strictly between 0 and 1, got {alpha!r}")
+    t = float(stats.t.ppf(1.0 - alpha / 2.0, n - 2))
+    return t / math.sqrt(n - 2 + t * t)
+
+
 # ----------------------------------------------------------------------------- chen2019 Fig. 2-3 scenarios
 
 CHEN2019_MANEUVERS = ("before maneuver", "U-turn", "figure-8", "S-turn")
@@ -807,31 +869,52 @@ class Maneuver:
 
         ``before_segments`` equal segments over the straight leg [0, t_start] followed by
         ``n_segments`` over the maneuver [t_start, t_end] (none for the straight scenario).
+        ``before_segments = 0`` analyses the maneuver alone (the straight scenario keeps one
+        segment over its straight leg: it has nothing else).
 
         Parameters
         ----------
         n_segments : int
             Segments over the maneuver.
         before_segments : int
-            Segments over the straight leg.
+            Segments over the straight leg (0: the maneuver only).
 
         Returns
         -------
         spans : list of tuple (float, float)
             The segments (t_a, t_b) [s].
+
+        Raises
+        ------
+        ValueError
+            When ``before_segments`` is negative or ``n_segments`` not positive.
         """
-        out = segment_bounds(0.0, self.t_start, before_segments)
-        if self.t_end > self.t_start:
-            out += segment_bounds(self.t_start, self.t_end, n_segments)
-        return out
+        if before_segments < 0:
+            raise ValueError(f"before_segments must be 0 (the maneuver only) or more, got {before_segments!r}")
+        if self.t_end <= self.t_start:
+            return segment_bounds(0.0, self.t_start, max(1, before_segments))
+        out = segment_bounds(0.0, self.t_start, before_segments) if before_segments else []
+        return out + segment_bounds(self.t_start, self.t_end, n_segments)
+
+
+TURN_RATES = ("ramped", "constant")
+"""Turn-rate profiles of :func:`chen2019_maneuvers`: the raised-cosine rate of
+:class:`~replication.nav.trajectory.Turn` / :class:`~replication.nav.trajectory.STurn`, or constant-rate
+turns rolled in and out (:class:`~replication.nav.trajectory.SteadyTurn`)."""
+
+BANKS = ("banked", "unbanked", "coordinated")
+"""How the turns are flown: banked kinematically (tan γ = V ψ̇ / g), without bank (:func:`unbanked`),
+or banked so that no lateral specific force remains (:func:`coordinated`)."""
 
 
 def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure_eight: float = 1600.0,
                        s_turn: float = 1200.0, s_swing: float = math.pi, s_cycles: int = 2, total: float | None = None,
-                       dt: float = 1.0) -> dict:
+                       dt: float = 1.0, speed_wave: float = 0.0, turn_rate: str = "ramped", ramp: float = 10.0,
+                       bank: str = "banked") -> dict:
     """The maneuvers of chen2019 Fig. 2-3 at the flight conditions of Table 4-41/4-42.
 
-    47°N, 115°E, 6000 m, heading 45°, 100 m/s, constant speed and height, coordinated turns:
+    47°N, 115°E, 6000 m, heading 45°, 100 m/s, constant height; by default constant speed and
+    banked turns whose rate follows a raised cosine (none of which chapter 2 states):
 
     * ``before maneuver`` — straight and level flight;
     * ``U-turn`` — straight leg, clockwise 180° turn in ``u_turn`` s (Table 4-42: 400 s);
@@ -861,6 +944,18 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
         equal durations.
     dt : float
         Sampling interval [s].
+    speed_wave : float
+        0 (default): constant speed.  Otherwise the speed rises by ``speed_wave`` m/s and returns
+        during each turn (raised cosine; forward specific force f_y up to π·speed_wave/T for a turn
+        of T s), so that the forward axis is excited.
+    turn_rate : str
+        ``"ramped"`` (default): the raised-cosine turn rate of ``Turn``/``STurn``; ``"constant"``:
+        constant-rate turns rolled in and out over ``ramp`` s (``SteadyTurn``) — the U-turn one
+        turn, the figure-8 two, the S-maneuver ``2 s_cycles`` alternating turns by ±``s_swing``.
+    ramp : float
+        Roll-in/roll-out time of the constant-rate turns [s].
+    bank : str
+        One of :data:`BANKS`.
 
     Returns
     -------
@@ -870,8 +965,8 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
     Raises
     ------
     ValueError
-        When a duration or ``dt`` is not positive, or ``total`` is shorter than the longest
-        scenario.
+        When a duration or ``dt`` is not positive, ``total`` is shorter than the longest
+        scenario, or ``turn_rate``/``bank`` is not one of the choices.
     """
 
     for nm, v in (("straight", straight), ("u_turn", u_turn), ("figure_eight", figure_eight), ("s_turn", s_turn)):
@@ -881,9 +976,24 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
     positive(dt, "dt", "{name} must be a positive sample interval in seconds, got {value!r}")
     if total is not None:
         positive(total, "total", "{name} must be a positive duration in seconds, got {value!r}")
+    finite(speed_wave, "speed_wave")
+    if turn_rate not in TURN_RATES:
+        raise ValueError(f"turn_rate must be one of {TURN_RATES}, got {turn_rate!r}")
+    if bank not in BANKS:
+        raise ValueError(f"bank must be one of {BANKS}, got {bank!r}")
     _, init = tr.chen2019_flight()
-    man = {"before maneuver": [], "U-turn": [tr.UTurn(u_turn)], "figure-8": [tr.FigureEight(figure_eight)],
-           "S-turn": [tr.STurn(s_turn, swing=s_swing, cycles=int(s_cycles))]}
+    A = float(speed_wave)
+    if turn_rate == "ramped":
+        man = {"U-turn": [tr.Turn(u_turn, math.pi, speed_wave=A)],
+               "figure-8": [tr.FigureEight(figure_eight, speed_wave=A)],
+               "S-turn": [tr.STurn(s_turn, swing=s_swing, cycles=int(s_cycles), speed_wave=A)]}
+    else:
+        half = s_turn / (2 * int(s_cycles))
+        man = {"U-turn": [tr.SteadyTurn(u_turn, math.pi, ramp=ramp, speed_wave=A)],
+               "figure-8": [tr.FigureEight(figure_eight, speed_wave=A, constant_rate=True, ramp=ramp)],
+               "S-turn": [tr.SteadyTurn(half, sign * s_swing, ramp=ramp, speed_wave=A)
+                          for _ in range(int(s_cycles)) for sign in (1.0, -1.0)]}
+    man = {"before maneuver": [], **man}
     longest = straight + max(u_turn, figure_eight, s_turn)
     if total is not None and total < longest:
         raise ValueError(f"total ({total} s) must cover the longest scenario ({longest} s)")
@@ -892,7 +1002,62 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
         dur = straight + sum(s.duration for s in segs)
         extra = [] if total is None or total - dur <= 0 else [tr.Straight(total - dur)]
         traj = tr.generate([tr.Straight(straight)] + segs + extra, dt=dt, **init)
+        if bank != "banked" and segs:
+            traj = unbanked(traj) if bank == "unbanked" else coordinated(traj)
         out[name] = Maneuver(name, traj, straight, dur)
+    return out
+
+
+FLIGHT_CHOICES = {
+    "speed": ("V const", "V wave"),
+    "turn rate": ("ramped rate", "constant rate"),
+    "bank": ("banked", "unbanked"),
+    "interval": ("with straight leg", "maneuver only"),
+}
+"""The flight choices chen2019 ch. 2 leaves open for Fig. 2-3 (the first of each is the default of
+:func:`chen2019_maneuvers` and :func:`degrees_table`): constant speed or a speed wave during each
+turn; a raised-cosine or a constant turn rate; banked or unbanked turns; the PWCS analysis over the
+straight leg and the maneuver stacked, or over the maneuver only."""
+
+
+def flight_readings(*, speed_wave: float = 2.0, base: dict | None = None, **kw) -> dict:
+    """Every combination of :data:`FLIGHT_CHOICES`, as readings for :func:`sweep`.
+
+    Parameters
+    ----------
+    speed_wave : float
+        The speed wave of the ``"V wave"`` choice [m/s] (:func:`chen2019_maneuvers`).
+    base : dict of str to Maneuver, optional
+        The maneuvers of the all-default flight, when already flown (e.g. with ``total``).
+    **kw : dict, optional
+        Further keyword arguments of :func:`chen2019_maneuvers` (durations, S geometry, ``dt``).
+
+    Returns
+    -------
+    dict of str to dict
+        ``"<speed>, <turn rate>, <bank>, <interval>"`` (e.g. ``"V wave 2 m/s, constant rate, banked,
+        maneuver only"``) → ``{"maneuvers": ..., "before_segments": 1 or 0}``, the 16 combinations,
+        the all-default one first.
+
+    Raises
+    ------
+    ValueError
+        When ``speed_wave`` is zero or not finite (the two speed choices would coincide).
+    """
+    speed_wave = finite(speed_wave, "speed_wave")
+    if speed_wave == 0.0:
+        raise ValueError("speed_wave must be non-zero: the 'V wave' choice would be the constant speed")
+    if base is not None:
+        _maneuvers(base, "base")
+    out = {}
+    for sp, rate, bank in itertools.product(*(FLIGHT_CHOICES[k] for k in ("speed", "turn rate", "bank"))):
+        opts = dict(speed_wave=speed_wave if sp == "V wave" else 0.0, turn_rate=rate.split()[0],
+                    bank=bank)
+        default = sp == "V const" and rate == "ramped rate" and bank == "banked"
+        mv = base if default and base is not None else chen2019_maneuvers(**opts, **kw)
+        name = (f"V wave {speed_wave:g} m/s" if sp == "V wave" else sp) + f", {rate}, {bank}"
+        for interval, before in zip(FLIGHT_CHOICES["interval"], (1, 0)):
+            out[f"{name}, {interval}"] = dict(maneuvers=mv, before_segments=before)
     return out
 
 
@@ -1009,8 +1174,8 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
     """PWCS observability degrees of ``states`` for every scenario of ``maneuvers``.
 
     The straight scenario uses its straight leg only.  With ``clip_null`` degrees at or below the
-    numerical-rank tolerance — numerically zero, their digits are rounding noise — are reported
-    as 0.
+    verdict threshold (:func:`verdict_threshold`, a decade above the numerical-rank tolerance) —
+    round-off, their digits are rounding noise — are reported as 0.
 
     Parameters
     ----------
@@ -1023,9 +1188,9 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
     n_segments : int
         PWCS segments over each maneuver (:meth:`Maneuver.spans`).
     before_segments : int
-        PWCS segments over the straight leg.
+        PWCS segments over the straight leg (0: each maneuver analysed alone, :meth:`Maneuver.spans`).
     clip_null : bool
-        Report degrees at or below the rank tolerance as 0.
+        Report degrees at or below the verdict threshold as 0.
     **kw : dict, optional
         Keyword arguments of :func:`pwcs_observability`.
 
@@ -1034,8 +1199,9 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
     table : pandas.DataFrame
         Rows: states, columns: scenarios; degrees in the units set by ``normalize`` (dimensionless
         for ``"max"`` and ``"scale"``).  ``table.attrs["rank_tol"]`` holds each scenario's
-        tolerance, ``table.attrs["ambiguity"]`` (scenario → state → ratio) each state's
-        ``ambiguity`` (:class:`ObservabilityDegrees`).
+        tolerance, ``table.attrs["threshold"]`` each scenario's verdict threshold
+        (:func:`verdict_threshold`), ``table.attrs["ambiguity"]`` (scenario → state → ratio) each
+        state's ``ambiguity`` (:class:`ObservabilityDegrees`).
 
     Raises
     ------
@@ -1044,15 +1210,17 @@ def degrees_table(model, maneuvers: dict, *, states, n_segments: int = 16, befor
     """
 
     _maneuvers(maneuvers)
-    integer(n_segments, "n_segments"), integer(before_segments, "before_segments")
+    integer(n_segments, "n_segments"), integer(before_segments, "before_segments", minimum=0)
     cols, tols, amb = {}, {}, {}
     for name, mv in maneuvers.items():
         d = pwcs_observability(model, mv.traj, mv.spans(n_segments, before_segments), states=states, **kw)
-        cols[name] = np.where(d.degree > d.rank_tol, d.degree, 0.0) if clip_null else d.degree
+        thr = verdict_threshold(d.rank_tol)
+        cols[name] = np.where(d.degree > thr, d.degree, 0.0) if clip_null else d.degree
         tols[name] = d.rank_tol
         amb[name] = dict(zip(states, map(float, d.ambiguity)))
     df = pd.DataFrame(cols, index=list(states))
     df.attrs["rank_tol"] = tols
+    df.attrs["threshold"] = verdict_threshold(tols)
     df.attrs["ambiguity"] = amb
     return df
 
@@ -1212,8 +1380,8 @@ def sweep(model, maneuvers: dict, reference, variants: dict, *, states, referenc
     table : pandas.DataFrame
         One row per variant (index ``variant``): ``ρ <scenario>`` (Spearman ρ per scenario),
         ``verdicts agree`` (of states × scenarios), ``best maneuver`` (the scenario winning most
-        states) and ``observable <scenario>`` (the number of states above the rank tolerance, the
-        bar count of chen2019 Fig. 2-4).  ``table.attrs["tables"]`` keeps each variant's degrees
+        states) and ``observable <scenario>`` (the number of states above the verdict threshold,
+        :func:`verdict_threshold`: the bar count of chen2019 Fig. 2-4).  ``table.attrs["tables"]`` keeps each variant's degrees
         table (states of ``reference``), with its ``rank_tol`` and ``ambiguity`` attributes, for
         :func:`replication.papers.chen2019.findings.compare_verdicts`.
 
@@ -1255,7 +1423,7 @@ def _sweep_rows(model, maneuvers, reference, states, reference_threshold, r0, r1
         spec = dict(spec)
         mdl, mvs, sts = spec.pop("model", model), spec.pop("maneuvers", maneuvers), spec.pop("states", states)
         table = degrees_table(mdl, mvs, states=sts, **spec)
-        tol = table.attrs["rank_tol"]
+        tol = verdict_threshold(table.attrs["rank_tol"])
         table = table.loc[list(reference.index)]
         met = rank_metrics(reference, table, reference_threshold=reference_threshold, reproduced_threshold=tol)
         row = {"variant": name}
@@ -1267,16 +1435,12 @@ def _sweep_rows(model, maneuvers, reference, states, reference_threshold, r0, r1
     return out
 
 
-ROUND_OFF_MARGIN = 10.0
-"""A degree within this factor above the numerical-rank tolerance is round-off: unobservable."""
-
-
 def verdict_under(printed_value: float, degree: float, rank_tol: float, ambiguity: float, *,
                   printed_threshold: float = 1e-5) -> tuple[bool, bool, bool]:
     """The verdicts on one value of an observability table: ``(printed, reproduced, decided)``.
 
     *printed* is ``printed_value > printed_threshold`` (observable), *reproduced* is
-    ``degree > rank_tol``; *decided* is False when the two differ but the state lies almost equally
+    ``degree > verdict_threshold(rank_tol)``; *decided* is False when the two differ but the state lies almost equally
     in two singular subspaces (``ambiguity > AMBIGUOUS``): the assignment rule, not the model,
     decides such a value, which therefore neither agrees nor disagrees with the print.
     *reproduced* uses a margin: a degree within ``ROUND_OFF_MARGIN`` of the rank tolerance is
@@ -1314,7 +1478,7 @@ def verdict_under(printed_value: float, degree: float, rank_tol: float, ambiguit
     for name, v in (("printed_value", printed_value), ("degree", degree), ("rank_tol", rank_tol),
                     ("ambiguity", ambiguity), ("printed_threshold", printed_threshold)):
         nonnegative(v, name)
-    vp, vo = float(printed_value) > printed_threshold, float(degree) > ROUND_OFF_MARGIN * rank_tol
+    vp, vo = float(printed_value) > printed_threshold, float(degree) > verdict_threshold(float(rank_tol))
     return vp, vo, bool(vp == vo or float(ambiguity) <= AMBIGUOUS)
 
 
