@@ -112,20 +112,20 @@ def test_complete_unit_rows():
         cal.complete_unit_rows(np.array([[np.nan, np.nan, 0.1], [0, 1, 0], [0, 0, 1]]), {})
 
 
-def test_accel_scale_factor_unit_erratum_tables_4_14_22_30():
+def test_accel_scale_factor_header_against_entries_tables_4_14_22_30():
     """Tables 4-14/4-22/4-30 print g·s/pulse numbers under the header '1.0e-5 g·s/pulse'.
 
     Evidence: read in the header unit they are 1e-5 times Table 4-6 (same header). Bound on the
-    ratio to 1e-5, stated first: the scale-factor change over the 45 °C span, at most
-    ~20 ppm/°C for a quartz accelerometer → 1e-3 — against a discrepancy of a factor 1e5.
+    ratio to 1, stated first: the scale-factor change over the 45 °C span, at most ~20 ppm/°C for a
+    quartz accelerometer → 1e-3 (cal.ACCEL_SCALE_TEMPERATURE_BOUND) — against a factor 1e5: the
+    header and the entries disagree.
     """
-    ref = rp.load_paper("chen2019-table-4-6").numeric()
-    for a in "XYZ":
-        q = f"{a}-axis accelerometer scale factor"
-        for n in (14, 22, 30):
-            ratio = rp.load_paper(f"chen2019-table-4-{n}").numeric()[q] / ref[q]
-            assert abs(ratio / 1e-5 - 1) < 1e-3
-            assert abs(ratio - 1) > 0.99            # not the same unit as Table 4-6
+    assert cal.ACCEL_SCALE_TEMPERATURE_BOUND == 1e-3
+    for n in (14, 22, 30):
+        ratio = cal.accel_scale_header_ratio(rp.load_paper, n)
+        assert np.all(np.abs(ratio / 1e-5 - 1) < cal.ACCEL_SCALE_TEMPERATURE_BOUND)   # g·s/pulse entries
+        assert np.all(np.abs(ratio - 1) > 0.99)                                        # not the header's unit
+    assert np.allclose(cal.accel_scale_header_ratio(rp.load_paper, 6), 1.0)
 
 
 # ------------------------------------------------------------------------------ calibration
@@ -215,6 +215,29 @@ def test_printed_k_minus_of_eq_4_5_is_wrong(triads):
     assert np.all(np.abs(printed[1:] / k[1:] - 1) > 1e-9)  # wrong sign of the bias term
     fixed = cal.closed_form_gyro(y, RATE, LAT)["k_minus"]
     assert _rel(fixed, k) <= REL
+
+
+def test_printed_closed_forms_against_the_derivation(triads):
+    """The printed (4-3)-(4-12), transcribed once (cal.PRINTED_4_5 etc.), evaluated at noise-free
+    synthetic outputs against the derivation: the misprints return wrong values, the readings stated
+    for damaged symbols return the derived ones.  Tolerance: relative 1e-9 (cal.AGREE_REL)."""
+    checks = cal.printed_form_checks(triads[-10]["gyro"], triads[-10]["accel"], RATE, LAT)
+    by = {(c.equation, c.finding.split()[0]): c for c in checks}
+    assert [c.agrees for c in checks] == [False, False, False, False, False, False, True, True, True, True, False,
+                                          False, False]
+    # (4-3): the printed row 4 repeats run 3 (axis down, +ω) instead of run 4 (axis down, -ω)
+    assert checks[0].derived.endswith("(rows 4 differ)") and checks[0].printed_value < 0
+    # (4-3): Ω_e sin φ with φ turning with the table averages to zero; the vertical Earth rate does not
+    assert abs(checks[2].printed_value) < 1e-12 and checks[2].derived_value == pytest.approx(1.0, rel=1e-12)
+    # (4-5): the missing index can only be 8
+    assert checks[6].derived.endswith("[8]")
+    # (4-7) is 12 times the bias, (4-8) 4g times K_ax
+    assert checks[10].printed_value == pytest.approx(12.0, rel=1e-9)
+    g = earth.normal_gravity(LAT)
+    assert checks[11].printed_value == pytest.approx(4 * g, rel=1e-9)
+    # (4-9)-(4-12): i = 1 asks for T_0
+    assert "[1]" in checks[12].derived
+    assert by[("(4-5)", "captioned")].basis == "parts" and by[("(4-3)", "the")].basis == "parts"
 
 
 def test_whole_revolutions_matter(triads):

@@ -8,7 +8,7 @@ Contents, in the report's order:
 * the six-position forward/reverse rate calibration on a single-axis rate table — the general
   least-squares solution of the state equations (4-3)/(4-4) for any set of positions and rates,
   and the closed forms (4-5)-(4-8), re-derived (the printed ones are damaged, see
-  :data:`replication.papers.chen2019.findings.PRINTED_CLOSED_FORM_DAMAGE`);
+  :func:`printed_form_checks`, which evaluates the printed forms, transcribed once, against them);
 * a synthetic rate-table experiment (positions, rates, full revolutions, Earth rate at a stated
   latitude, white sensor noise) and the analytic covariance of the calibrated parameters;
 * the temperature model (4-9)-(4-12): piecewise-linear interpolation with an explicit
@@ -885,8 +885,8 @@ def closed_form_accel(outputs, gravity: float) -> dict[str, np.ndarray]:
 def printed_closed_form_gyro(outputs, rate: float) -> dict[str, np.ndarray]:
     """chen2019 eq. (4-5)/(4-6) evaluated literally as printed, to quantify the damage.
 
-    Printed: K_{x-} = (-2ω̄_{x2} - 2ω̄_{x3} - 4ω_{x0})/(4ω(i)) and K_{y-}, K_{z-} with -4ω_{y0},
-    -4ω_{z0}; K_{x+}, K_{y+}, K_{z+} and the cross terms as re-derived.
+    Printed (:data:`PRINTED_4_5`, the one transcription): K_{x-} = (-2ω̄_{x2} - 2ω̄_{x3} - 4ω_{x0})/(4ω(i))
+    and K_{y-}, K_{z-} with -4ω_{y0}, -4ω_{z0}; K_{x+}, K_{y+}, K_{z+} and the cross terms as re-derived.
 
     Parameters
     ----------
@@ -908,11 +908,8 @@ def printed_closed_form_gyro(outputs, rate: float) -> dict[str, np.ndarray]:
     """
     y = _standard_means(outputs, rate)
     n0 = y.mean(axis=0)
-    w = np.longdouble(rate)
-    km = np.empty(3, dtype=np.longdouble)
-    km[0] = (-2 * y[1, 0] - 2 * y[2, 0] - 4 * n0[0]) / (4 * w)
-    km[1] = (-2 * y[5, 1] - 2 * y[7, 1] - 4 * n0[1]) / (4 * w)
-    km[2] = (-2 * y[9, 2] - 2 * y[11, 2] - 4 * n0[2]) / (4 * w)
+    km = np.array([_eval_printed(PRINTED_4_5[f"K_{a}-"], y, rate, n0[j]) for j, a in enumerate("xyz")],
+                  dtype=np.longdouble)
     return {"null_output": n0.astype(float), "k_minus": km.astype(float)}
 
 
@@ -960,6 +957,293 @@ def symbolic_closed_forms() -> dict[str, object]:
     out["Kplus_45"] = sp.simplify((2 * y[0] + 2 * y[2] - 4 * n0) / (4 * w))
     out["Kminus_45"] = sp.simplify((4 * n0 - 2 * y[1] - 2 * y[3]) / (4 * w))
     out["symbols"] = (y, w, s)
+    return out
+
+
+# ----------------------------------------------------------------- the printed forms, transcribed
+
+PRINTED_FORMS_SOURCE = ("chen2019 ch. 4 §1 (六方位正反速率标定法 and 温度误差分段线性插值法), eqs. (4-3)-(4-12) "
+                        "as extracted in the source text 000_686a45e627dc86fa.txt")
+"""Where the transcriptions below come from (each transcribed once, here)."""
+
+PRINTED_4_3_CAPTION = "角速度通道系统状态方程"
+"""The caption printed above (4-3) (angular-rate channel state equation)."""
+
+PRINTED_4_5_CAPTION = "加速度通道系统状态方程"
+"""The caption printed above (4-5) (acceleration channel state equation) — the same words as above (4-4)."""
+
+PRINTED_4_3_DESIGN = ("ω_{i+}", "ω_{i-}", "ω̂_{i+}", "ω̂_{i+}", "ω_{i+}", "ω_{i-}", "ω̂_{i+}", "ω̂_{i-}",
+                      "ω_{i+}", "ω_{i-}", "ω̂_{i+}", "ω̂_{i-}")
+"""The input symbol of each of the 12 rows of the printed design matrix of (4-3) (row r, the
+non-zero column after the leading 1), as printed."""
+
+PRINTED_4_3_DEFINITIONS = {"ω_{e+}": (1, 1), "ω_{e-}": (-1, 1), "ω̂_{e+}": (1, -1), "ω̂_{e-}": (-1, -1)}
+"""The definitions printed below (4-3), ``ω_{e±} = ±ω(i) + Ω_e sin(φ)``, ``ω̂_{e±} = ±ω(i) - Ω_e sin(φ)``:
+symbol → (sign of ω(i), sign of Ω_e sin φ)."""
+
+PRINTED_4_3_PHI = "φ(t) 代表 t 时刻惯性系统与北向夹角"
+"""The printed meaning of φ in Ω_e sin(φ): the angle between the system and north at time t."""
+
+PRINTED_4_5 = {
+    "K_x+": "(2*wx1 + 2*wx3 - 4*wx0)/(4*omega)",
+    "K_x-": "(-2*wx2 - 2*wx3 - 4*wx0)/(4*omega)",
+    "K_y-": "(-2*wy6 - 2*wy8 - 4*wy0)/(4*omega)",
+    "K_z-": "(-2*wz10 - 2*wz12 - 4*wz0)/(4*omega)",
+    "E_zy": "(wz5 + wz7 - wz6 - wz_)/(4*omega)",
+}
+"""Entries of the printed (4-5), as printed (``wj r`` = ω̄_{j r}, the mean output of channel j in run r;
+``wj0`` = ω_{j0}, the bias of (4-6); ``omega`` = ω(i); ``wz_`` the ω̄ printed without an index)."""
+
+PRINTED_4_5_TEXT = {
+    "K_x-": "K_{x-} = (-2ω_{x2} - 2ω_{x3} - 4ω_{x0}) / (4ω(i))",
+    "K_y-": "K_{y-} = (-2ω̄_{y6} - 2ω̄_{y8} - 4ω_{y0}) / (4ω(i))",
+    "K_z-": "K_{z-} = (-2ω_{z10} - 2ω̄_{z12} - 4ω_{z0}) / (4ω(i))",
+    "E_zy": "E_{zy} = (ω̄_{z5} + ω_{z7} - ω̄_{z6} - ω̄) / (4ω(i))",
+}
+"""The same entries in the printed notation (bars where the print has them; 1/(4·ω(i)) as the factor the print sets
+in front of the matrix)."""
+
+PRINTED_4_6 = "(wx1 + wx2 + wx3 + wx4 + wx5 + wx6 + wx7 + wx8 + wx9 + wx10 + wx11 + wx12)/12"
+"""The printed (4-6), channel x, with every ω and ω̄ read as the run mean (the bars are printed on
+some symbols only)."""
+
+PRINTED_4_6_TEXT = ("ω_{x0} = (1/12)(ω̄_{x1} + ω̄_{x2} + ω̄_{x3} + ω̄_{x4} + ω̄_{x5} + ω̄_{x6} + ω_{x7} + ω̄_{x8} + ω̄_{x9} "
+                    "+ ω̄_{x10} + ω̄_{x11} + ω̄_{x12})")
+
+PRINTED_4_7 = "ax1 + ax2 + ax3 + ax4 + ax5 + ax6 + ax7 + ax8 + ax9 + ax10 + ax11 + ax12"
+"""The printed (4-7), channel x (no factor in front of the sum)."""
+
+PRINTED_4_7_TEXT = ("a_{x0} = ā_{x1} + ā_{x2} + ā_{x3} + ā_{x4} + ā_{x5} + ā_{x6} + ā_{x7} + ā_{x8} + a_{x9} + ā_{x10} "
+                    "+ ā_{x11} + a_{x12}")
+
+PRINTED_4_8 = "ax1 + ax2 - ax3 - ax4"
+"""The printed (4-8), the entry printed beside K_ax (no '=' and no factor between them)."""
+
+PRINTED_4_8_TEXT = "K_{ax}  M_{xy}  M_{xz}  a_{x1} + a_{x2} - a_{x3} - a_{x4}  …"
+
+PRINTED_4_9_RANGE = (1, "n")
+"""The printed index range of the interval T ∈ [T_{i-1}, T_i] of (4-9)-(4-12): i = 1, 2, …, n,
+with the nodes T = [T_1 … T_n]."""
+
+PRINTED_4_9_TEXT = "T ∈ [T_{i-1}, T_i] (i = 1, 2, …, n), T = [T_1 T_2 … T_n]"
+
+AGREE_REL = 1e-9
+"""A printed form agrees with the derivation when, at the probe point (noise-free synthetic outputs),
+it returns the same value to this relative precision: the noise-free recovery precision of the
+synthetic experiment (its outputs carry ~1e-7 of gyro bias, resolved to ~1e-9 in float64)."""
+
+
+@dataclass(frozen=True)
+class FormCheck:
+    """One printed closed form (or its text) against the derivation, evaluated at a probe point.
+
+    Attributes
+    ----------
+    equation : str
+        The printed equation, e.g. ``'(4-5)'``.
+    finding : str
+        The finding in words.
+    basis : str
+        ``'derivation'`` (a printed form against the derived one) or ``'parts'`` (two printed parts
+        against each other).
+    agrees : bool
+        Computed: the printed form returns the derived value at the probe (relative
+        :data:`AGREE_REL`), or the two printed parts say the same.
+    printed : str
+        The printed form, as printed.
+    derived : str
+        The derived (corrected) form.
+    printed_value : float
+        The printed form at the probe point, relative to the true value of the synthetic sensor
+        (NaN where the print is no formula to evaluate).
+    derived_value : float
+        The derived form at the probe point, relative to the true value (NaN likewise).
+    test : str
+        The test that checks the same finding (``tests/test_calibration.py::<name>``).
+    """
+
+    equation: str
+    finding: str
+    basis: str
+    agrees: bool
+    printed: str
+    derived: str
+    printed_value: float = float("nan")
+    derived_value: float = float("nan")
+    test: str = ""
+
+
+def _eval_printed(expr: str, outputs, rate: float, bias) -> np.longdouble:
+    """A printed expression of :data:`PRINTED_4_5` etc. at the probe: ``wj r`` the mean output of channel j
+    in run r (``outputs[r-1, j]``), ``wj0`` the bias ``bias``, ``omega`` the rate; evaluated in extended
+    precision (the gyro bias is ~1e-7 of the table output)."""
+    import sympy as sp
+
+    e = sp.sympify(expr)
+    syms = sorted(e.free_symbols, key=lambda x: x.name)
+    y = np.asarray(outputs, dtype=np.longdouble)
+    vals = []
+    for sym in syms:
+        name = sym.name
+        if name == "omega":
+            vals.append(np.longdouble(rate))
+        elif name[2:] == "0":
+            vals.append(np.longdouble(bias))
+        else:
+            vals.append(y[int(name[2:]) - 1, "xyz".index(name[1])])
+    return sp.lambdify(syms, e, modules="numpy")(*vals)
+
+
+def printed_form_checks(gyro: SensorTriad, accel: SensorTriad, rate: float, lat: float) -> list[FormCheck]:
+    """The printed six-position closed forms (4-3)-(4-8) and the temperature model's index range
+    (4-9)-(4-12) against their derivation, each evaluated at one probe point.
+
+    The probe point: the noise-free synthetic outputs of the 12 runs of :func:`six_position_runs`
+    (``rate``, latitude ``lat``) of the given triads, whose true parameters are known.  Each
+    printed form (transcribed once, :data:`PRINTED_4_5` etc., source :data:`PRINTED_FORMS_SOURCE`)
+    and its derived counterpart (:func:`closed_form_gyro`, :func:`closed_form_accel`, checked
+    against least squares and the sympy derivation :func:`symbolic_closed_forms`) are evaluated
+    there and divided by the true value; a printed form agrees when it returns the true value to
+    :data:`AGREE_REL`.  Two printed parts (a symbol and its definition, a caption and its content)
+    agree when they say the same.
+
+    Parameters
+    ----------
+    gyro, accel : SensorTriad
+        The synthetic sensors (e.g. :func:`paper_triads` of one temperature).
+    rate : float
+        The calibration rate ω(i) [rad/s].
+    lat : float
+        The latitude of the synthetic rate table [rad].
+
+    Returns
+    -------
+    list of FormCheck
+        In the printed order of the findings.
+    """
+    import sympy as sp
+
+    runs = six_position_runs(rate)
+    exp = simulate_rate_table(gyro, accel, runs, lat=lat)
+    yg, ya = exp["gyro"].noise_free, exp["accel"].noise_free
+    cg = closed_form_gyro(exp["gyro"].noise_free, rate, lat)
+    ca = closed_form_accel(exp["accel"].noise_free, exp["accel"].gravity)
+    k_true, m_true = np.diag(gyro.matrix), gyro.matrix
+    same = lambda a, b: bool(abs(np.longdouble(a) / np.longdouble(b) - 1) <= AGREE_REL)  # noqa: E731
+    out = []
+    t = "tests/test_calibration.py::"
+
+    # (4-3): the design's inputs, printed symbols through the printed definitions, against the runs
+    s = vertical_earth_rate(lat)
+    u_true = run_inputs(runs, channel="gyro", lat=lat).astype(float)
+    sign = {k.replace("e", "i"): v for k, v in PRINTED_4_3_DEFINITIONS.items()}
+    u_printed = np.array([sign[n][0] * rate + sign[n][1] * s for n in PRINTED_4_3_DESIGN])   # read through the definitions
+    u_axis = np.array([u_true[r, runs[r].axis] for r in range(12)])
+    bad = [r + 1 for r in range(12) if not same(u_printed[r], u_axis[r])]
+    out.append(FormCheck("(4-3)", "row 4 of the design prints ω̂_{i+}; it is ω̂_{i-} = -ω(i) - Ω_e sin φ (axis down, "
+                         "reverse rate): the printed rows 3 and 4 repeat one run", "derivation", not bad,
+                         "row 4: [1, ω̂_{i+}, 0, 0]",
+                         "row 4: [1, ω̂_{i-}, 0, 0] (rows " + ", ".join(map(str, bad)) + " differ)",
+                         float(u_printed[3] / u_axis[3]), 1.0, t + "test_printed_closed_forms_against_the_derivation"))
+    subs_design = sorted({n[n.index("_{") + 2] for n in PRINTED_4_3_DESIGN})
+    subs_defined = sorted({n[n.index("_{") + 2] for n in PRINTED_4_3_DEFINITIONS})
+    out.append(FormCheck("(4-3)", f"the design uses ω_{{{subs_design[0]}±}} while the definitions below it name "
+                         f"ω_{{{subs_defined[0]}±}}: the same four inputs under two names", "parts",
+                         set(PRINTED_4_3_DESIGN) <= set(PRINTED_4_3_DEFINITIONS),
+                         "design: " + ", ".join(sorted(set(PRINTED_4_3_DESIGN))),
+                         "definitions: " + ", ".join(PRINTED_4_3_DEFINITIONS)))
+    # φ as printed: the angle to north of the system turning with the table; its mean over a revolution
+    ph = 2 * np.pi * np.arange(3600) / 3600
+    mean_phi = float(np.mean(earth.OMEGA_IE * np.sin(ph)))
+    w_up = float(static_inputs("Z+", lat=lat)[0][2])
+    out.append(FormCheck("(4-3)", "φ is described as the angle to north at time t; Ω_e sin φ is the vertical Earth "
+                         "rate, φ = latitude (an angle to north turning with the table averages Ω_e sin φ to zero "
+                         "over a revolution)", "derivation", abs(mean_phi - w_up) <= AGREE_REL * abs(w_up),
+                         PRINTED_4_3_PHI, "Ω_e sin φ with φ the latitude (the vertical component of the Earth rate)",
+                         mean_phi / w_up, float(s / w_up), t + "test_printed_closed_forms_against_the_derivation"))
+    # (4-5): caption against content
+    channel = lambda caption: "gyro" if "角速度" in caption else "accel" if "加速度" in caption else "?"  # noqa: E731
+    content = "gyro" if all("w" in PRINTED_4_5[k] and "omega" in PRINTED_4_5[k] for k in PRINTED_4_5) else "accel"
+    out.append(FormCheck("(4-5)", "captioned as the accelerometer channel (加速度通道系统状态方程) but it solves the "
+                         "gyro channel: ω inputs, gyro K and E", "parts", channel(PRINTED_4_5_CAPTION) == content,
+                         PRINTED_4_5_CAPTION, f"content: the {content} channel of (4-3) ({PRINTED_4_3_CAPTION})"))
+    # (4-5): K_{j-} as printed against the derivation, at the probe
+    for keys, finding, corr in ((("K_x-",), "K_{x-} prints -2ω̄_{x2} - 2ω̄_{x3} - 4ω_{x0}; it is -2ω̄_{x2} - 2ω̄_{x4} "
+                                 "+ 4ω_{x0}", "K_{x-} = (4ω_{x0} - 2ω̄_{x2} - 2ω̄_{x4}) / (4ω(i))"),
+                                (("K_y-", "K_z-"), "K_{y-} and K_{z-} print -4ω_{y0}, -4ω_{z0}; the bias enters with "
+                                 "+4ω_{j0}", "K_{j-} = (4ω_{j0} - 2ω̄_{j,4g-2} - 2ω̄_{j,4g}) / (4ω(i))")):
+        pv, dv = [], []
+        for k in keys:
+            j = "xyz".index(k[2])
+            pv.append(float(_eval_printed(PRINTED_4_5[k], yg, rate, cg["null_output"][j]) / k_true[j]))
+            dv.append(float(cg["k_minus"][j] / k_true[j]))
+        worst = int(np.argmax([abs(p - 1) for p in pv]))
+        out.append(FormCheck("(4-5)", finding, "derivation", all(same(p, 1.0) for p in pv),
+                             "; ".join(PRINTED_4_5_TEXT[k] for k in keys), corr, pv[worst], dv[worst],
+                             t + "test_printed_k_minus_of_eq_4_5_is_wrong"))
+    # (4-5): the ω̄ printed without an index: which index makes E_zy the derived cross term
+    ok_idx = [r for r in range(1, 13)
+              if same(_eval_printed(PRINTED_4_5["E_zy"].replace("wz_", f"wz{r}"), yg, rate, 0.0), m_true[2, 1])]
+    out.append(FormCheck("(4-5)", "the last cross term of row z ends in ω̄ without index (possibly lost in the "
+                         "extraction); the only consistent reading is -ω̄_{z8}", "derivation", ok_idx == [8],
+                         PRINTED_4_5_TEXT["E_zy"], "E_{zy} = (ω̄_{z5} + ω̄_{z7} - ω̄_{z6} - ω̄_{z8}) / (4ω(i)); indices "
+                         f"that return E_zy: {ok_idx}",
+                         float(_eval_printed(PRINTED_4_5["E_zy"].replace("wz_", "wz8"), yg, rate, 0.0) / m_true[2, 1]),
+                         float(cg["matrix_earth_free"][2, 1] / m_true[2, 1]),
+                         t + "test_printed_closed_forms_against_the_derivation"))
+    # (4-5): Earth-rate free because every axis runs up and down at ±ω (sympy, exact)
+    d = symbolic_closed_forms()
+    y, w, sv = d["symbols"]
+    n0, kk, e1, e2 = sp.symbols("N0 K E1 E2")
+    model = {y[r]: n0 + [kk, e1, e2][r // 4] * [w + sv, -w + sv, w - sv, -w - sv][r % 4] for r in range(12)}
+    free = sp.simplify(d["Kplus_45"].subs(model) - kk)                        # K_{x+} of (4-5): runs 1 (up) and 3 (down)
+    up_only = sp.simplify(((y[0] - sum(y) / 12) / w).subs(model) - kk)        # the same from the up run alone
+    out.append(FormCheck("(4-5)", "a property of the method, not a misprint: the Earth-rate terms cancel in (4-5) only "
+                         "because every axis is run up and down at ±ω", "derivation", free == 0 and up_only != 0,
+                         "K_{x+} = (2ω_{x1} + 2ω_{x3} - 4ω_{x0}) / (4ω(i)) (no Ω_e term)",
+                         f"K_{{x+}} - K = {free} from the up and down runs; from the up run alone K_{{x+}} - K = "
+                         f"{up_only}", float(_eval_printed(PRINTED_4_5["K_x+"], yg, rate, cg["null_output"][0]) / k_true[0]),
+                         float(cg["k_plus"][0] / k_true[0]),
+                         t + "test_symbolic_derivation_matches_numeric_closed_forms"))
+    # (4-6): exact under one K, biased by ω(K+ - K-)/6 with two
+    kp, km = sp.symbols("Kp Km")
+    u4 = [w + sv, -w + sv, w - sv, -w - sv]
+    asym = {y[r]: n0 + (kp if r in (0, 2) else km) * u4[r] for r in range(4)}
+    asym.update({y[r]: n0 + [e1, e2][r // 4 - 1] * u4[r % 4] for r in range(4, 12)})
+    bias_asym = sp.simplify(d["N0"].subs(asym) - n0)
+    bias_sym = sp.simplify(bias_asym.subs(km, kp))
+    out.append(FormCheck("(4-6)", "a property of the method, not a misprint: (4-6) is exact under the report's single-K "
+                         "model; with K+ ≠ K- the 1/12 mean is biased by ω(K+ - K-)/6 and the unbiased form averages "
+                         "the 8 rows with axis j horizontal", "derivation", bias_sym == 0,
+                         PRINTED_4_6_TEXT, f"bias of the 1/12 mean: {bias_sym} with one K, {bias_asym} with K+, K-",
+                         float(_eval_printed(PRINTED_4_6, yg, rate, 0.0) / gyro.null_output[0]),
+                         float(cg["null_output"][0] / gyro.null_output[0]),
+                         t + "test_asymmetric_scale_factor_biases_the_1_12_mean"))
+    out.append(FormCheck("(4-6)/(4-7)", "over-bars (averaged outputs) are missing on some ω̄, ā symbols (possibly lost in "
+                         "the extraction); every symbol is read as the run mean", "derivation",
+                         same(_eval_printed(PRINTED_4_6, yg, rate, 0.0), cg["null_output"][0]),
+                         PRINTED_4_6_TEXT, "every ω, ω̄ the run mean: (4-6) then returns the derived bias",
+                         float(_eval_printed(PRINTED_4_6, yg, rate, 0.0) / gyro.null_output[0]),
+                         float(cg["null_output"][0] / gyro.null_output[0]),
+                         t + "test_printed_closed_forms_against_the_derivation"))
+    a47 = _eval_printed(PRINTED_4_7.replace("a", "w"), ya, rate, 0.0)
+    out.append(FormCheck("(4-7)", "the factor 1/12 is missing", "derivation", same(a47, ca["null_output"][0]),
+                         PRINTED_4_7_TEXT, "a_{x0} = (1/12) Σ_r ā_{x r}", float(a47 / accel.null_output[0]),
+                         float(ca["null_output"][0] / accel.null_output[0]),
+                         t + "test_printed_closed_forms_against_the_derivation"))
+    a48 = _eval_printed(PRINTED_4_8.replace("a", "w"), ya, rate, 0.0)
+    out.append(FormCheck("(4-8)", "the left-hand matrix and the right-hand side are printed side by side without '=' "
+                         "and without the factor 1/(4g)", "derivation", same(a48, ca["matrix"][0, 0]),
+                         PRINTED_4_8_TEXT, "K_{ax} = (ā_{x1} + ā_{x2} - ā_{x3} - ā_{x4}) / (4g)",
+                         float(a48 / accel.matrix[0, 0]), float(ca["matrix"][0, 0] / accel.matrix[0, 0]),
+                         t + "test_printed_closed_forms_against_the_derivation"))
+    n_nodes = len(TEMPERATURE_TABLES)
+    first = PRINTED_4_9_RANGE[0]
+    undefined = [i for i in range(first, n_nodes + 1) if not 1 <= i - 1 <= n_nodes]
+    out.append(FormCheck("(4-9)-(4-12)", "'T ∈ [T_{i-1}, T_i], i = 1..n' must start at i = 2", "derivation",
+                         not undefined, PRINTED_4_9_TEXT,
+                         f"i = 2, …, n (with i = {undefined} the node T_{{i-1}} = T_0 is not one of T_1 … T_n)",
+                         test=t + "test_printed_closed_forms_against_the_derivation"))
     return out
 
 
@@ -1751,6 +2035,49 @@ def bias_stability(y, sample_rate: float, window: float) -> float:
 # =============================================================================================
 # Paper tables → sensor descriptions
 # =============================================================================================
+
+ACCEL_SCALE_TEMPERATURE_BOUND = 1e-3
+"""Largest relative change of a quartz accelerometer's scale factor between two printed calibration
+temperatures (at most ~20 ppm/°C over the 45 °C span): the bound on the ratio of two tables' scale
+factors read in the same unit, stated before the comparison."""
+
+
+def accel_scale_header_ratio(load, table: int, reference: int = 6) -> np.ndarray:
+    """The printed accelerometer scale factors of one table over those of a reference table, both read
+    in the unit their headers print (1.0e-5 g·s/pulse for Tables 4-6, 4-14, 4-22, 4-30; the pulse glyph
+    is extracted as ^ or °, the printed factor 1.0e-5 is compared).
+
+    Read in one unit, two tables of the same sensor differ by the temperature change of its scale
+    factor, below :data:`ACCEL_SCALE_TEMPERATURE_BOUND`; a ratio far from 1 says that a header and
+    its entries disagree.
+
+    Parameters
+    ----------
+    load : callable
+        :func:`replication.registry.reproduction.load_paper`.
+    table : int
+        The table number n of Table 4-n.
+    reference : int
+        The reference table (default Table 4-6, -25 °C).
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        Ratio per axis X, Y, Z.
+
+    Raises
+    ------
+    ValueError
+        When the two headers print different units.
+    """
+    t, r = load(f"chen2019-table-4-{table}"), load(f"chen2019-table-4-{reference}")
+    q = [f"{a}-axis accelerometer scale factor" for a in "XYZ"]
+    factor = lambda unit: float(re.match(r"[0-9.]+(?:e-?[0-9]+)?", unit).group(0))  # noqa: E731  (the glyph after
+    if {factor(t.unit(x)) for x in q} != {factor(r.unit(x)) for x in q}:            # g.s/ is extraction noise)
+        raise ValueError(f"Tables 4-{table} and 4-{reference} print different scale-factor units")
+    tn, rn = t.numeric(), r.numeric()
+    return np.array([tn[x] / rn[x] for x in q])
+
 
 TEMPERATURE_TABLES = {-25: 1, -10: 9, 5: 17, 20: 25}
 """First table number of each printed calibration temperature (°C): bias, scale factor,

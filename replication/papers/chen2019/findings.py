@@ -12,7 +12,7 @@ the tests do.
 * :func:`ordering_rows` — the orderings between two turntable experiments (Tables 4-37..4-39);
 * :func:`maneuver_claims`, :func:`model_claims`, :func:`compensation_claims` — the report's claims
   about Tables 2-3, 4-44 and 4-50, each judged on the printed numbers under a stated reading;
-* :data:`PRINTED_CLOSED_FORM_DAMAGE` — the damaged printed closed forms (4-3)-(4-12);
+* :func:`closed_form_rows` — the printed six-position and temperature formulas against their derivation;
 * :data:`TABLE_2_2_CORRECTED_TEXT` — the corrected blocks of Table 2-2.
 """
 
@@ -26,8 +26,8 @@ from replication.papers.chen2019.observability import LEVEL_COMBINATIONS, _table
 from replication.papers.chen2019.simulation import figure_4_14_estimates
 from replication.papers.chen2019.turntable import QUANTITIES
 
-__all__ = ["compare_verdicts", "column_groups", "EXACT_READING", "figure_4_14_ledger", "ordering_rows",
-           "PRINTED_CLOSED_FORM_DAMAGE", "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims", "model_claims",
+__all__ = ["closed_form_rows", "compare_verdicts", "column_groups", "EXACT_READING", "figure_4_14_ledger",
+           "ordering_rows", "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims", "model_claims",
            "compensation_claims"]
 
 
@@ -354,34 +354,48 @@ def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indic
     return rows
 
 
-PRINTED_CLOSED_FORM_DAMAGE = (
-    ("(4-3)", "row 4 of the design prints ω̂_{i+}; it is ω̂_{i-} = -ω(i) - Ω_e sin φ (axis down, reverse rate)",
-     "erratum"),
-    ("(4-3)", "the design uses ω_{i±} while the definitions below it name ω_{e±}: the same four inputs", "inconsistent"),
-    ("(4-3)", "φ is described as the angle to north at time t; Ω_e sin φ is the vertical Earth rate, φ = latitude",
-     "erratum"),
-    ("(4-5)", "captioned as the accelerometer channel (加速度通道系统状态方程) but it solves the gyro channel: ω inputs, "
-              "gyro K and E", "inconsistent"),
-    ("(4-5)", "K_{x-} prints -2ω̄_{x2} - 2ω̄_{x3} - 4ω_{x0}; it is -2ω̄_{x2} - 2ω̄_{x4} + 4ω_{x0}", "erratum"),
-    ("(4-5)", "K_{y-} and K_{z-} print -4ω_{y0}, -4ω_{z0}; the bias enters with +4ω_{j0}", "erratum"),
-    ("(4-5)", "the last cross term of row z ends in ω̄ without index (possibly lost in the extraction); the only "
-              "consistent reading is -ω̄_{z8}", "qualitative"),
-    ("(4-5)", "a property of the method, not a misprint: the Earth-rate terms cancel in (4-5) only because every "
-              "axis is run up and down at ±ω", "qualitative"),
-    ("(4-6)", "a property of the method, not a misprint: (4-6) is exact under the report's single-K model; with "
-              "K+ ≠ K- the 1/12 mean is biased by ω(K+ - K-)/6 and the unbiased form averages the 8 rows with "
-              "axis j horizontal", "qualitative"),
-    ("(4-6)/(4-7)", "over-bars (averaged outputs) are missing on some ω̄, ā symbols (possibly lost in the "
-                    "extraction); every symbol is read as the run mean", "qualitative"),
-    ("(4-7)", "the factor 1/12 is missing", "erratum"),
-    ("(4-8)", "the left-hand matrix and the right-hand side are printed side by side without '=' and "
-              "without the factor 1/(4g)", "erratum"),
-    ("(4-9)-(4-12)", "'T ∈ [T_{i-1}, T_i], i = 1..n' must start at i = 2", "erratum"),
-)
-"""What the printed six-position and temperature formulas get wrong (equation, finding, status):
-``erratum`` where the derivation proves the print wrong, ``inconsistent`` where two printed parts
-disagree, ``qualitative`` for a property of the method or a symbol the extraction may have lost
-(the only consistent reading stated)."""
+def closed_form_rows(checks, *, probe: str, evidence_prefix: str) -> list[dict]:
+    """The rows of the printed six-position and temperature formulas (4-3)-(4-12) against their
+    derivation (:func:`replication.papers.chen2019.calibration.printed_form_checks`).
+
+    Each row carries the printed form as printed (``paper_text``), its value at the probe point
+    (``paper``, relative to the true parameter; empty where the print is no formula to evaluate),
+    the derived value or text (``reproduced``), its basis and the computed ``agrees``; a row that
+    disagrees names its test and the corrected form.
+
+    Parameters
+    ----------
+    checks : list of FormCheck
+        :func:`replication.papers.chen2019.calibration.printed_form_checks`.
+    probe : str
+        The probe point in words (sensor, rate, latitude), quoted in every note.
+    evidence_prefix : str
+        The notebook, ``'book/...ipynb; '``, put before each check's test.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.reproduction.compare`.
+    """
+    from replication.papers.chen2019.calibration import AGREE_REL
+
+    rows = []
+    for k, c in enumerate(checks, 1):
+        numeric = np.isfinite(c.printed_value)
+        rel = f"{AGREE_REL:.0e}".replace("e-0", "e-")
+        crit = (f"printed form at {probe}, relative to the true parameter; agrees within {rel} of the derived form"
+                if numeric else "the two printed parts compared as printed" if c.basis == "parts"
+                else "the printed text against the derivation")
+        row = dict(quantity=f"{c.equation} finding {k}", unit="1" if numeric else "",
+                   paper=c.printed_value if numeric else "", paper_text=c.printed,
+                   reproduced=c.derived_value if numeric else c.derived, basis=c.basis, agrees=c.agrees,
+                   note=f"{c.finding} ({crit}" + (f"; derived: {c.derived})" if numeric else ")"))
+        if c.test:
+            row["evidence"] = evidence_prefix + c.test
+        if not c.agrees and c.basis == "derivation":
+            row["corrected"] = c.derived
+        rows.append(row)
+    return rows
 
 
 TABLE_2_2_CORRECTED_TEXT = {
