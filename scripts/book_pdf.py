@@ -32,6 +32,7 @@ import argparse
 import datetime
 import functools
 import http.server
+import logging
 import os
 import shutil
 import subprocess
@@ -167,7 +168,7 @@ PREPARE_JS = """(a) => {
     const c = el('span'); c.append(r.label.cloneNode(true));
     c.querySelectorAll('mjx-container').forEach(m => {
       const mml = m.querySelector('mjx-assistive-mml'); m.replaceWith(mml ? mml.textContent : ''); });
-    return c.textContent.replace(/\s+/g, ' ').trim(); };
+    return c.textContent.replace(/\\s+/g, ' ').trim(); };
   return {removed: gone.size, to_source, to_repository, unlinked, local,
           rows: rows.map((r, i) => ({level: r.level, number: r.number, title: plain(r), target: r.id || rows[i + 1].id}))};
 }"""
@@ -380,6 +381,9 @@ def add_outline(pdf: Path, rows: list[dict], pages: dict[str, int], front: dict)
     contents = 1                         # the page after the title page
     if not (PdfReader(pdf).pages[contents].extract_text() or "").lstrip().startswith("Contents"):
         raise SystemExit("book_pdf: the title page ran over one page: the contents do not start on page 2")
+    quiet = logging.Filter()
+    quiet.filter = lambda record: not record.getMessage().startswith("Object count")   # counts the clone's own
+    logging.getLogger("pypdf._writer").addFilter(quiet)                                   # additions, not a defect
     writer = PdfWriter(clone_from=str(pdf))
     writer.add_outline_item(title="Contents", page_number=contents)
     parents: dict[int, object] = {}
