@@ -116,7 +116,8 @@ PREPARE_JS = """(a) => {
   const facts = el('dl', 'print-title-facts');
   for (const [k, v, href] of a.facts) {
     const dd = el('dd');
-    if (href) { const l = el('a', '', v); l.href = href; dd.append(l); } else dd.textContent = v;
+    dd.textContent = v === href ? '' : v;
+    if (href) { const l = el('a', '', href); l.href = href; dd.append(v === href ? '' : ' ', l); }
     facts.append(el('dt', '', k), dd);
   }
   title.append(facts, el('p', 'print-title-note', a.note));
@@ -329,7 +330,7 @@ def front_matter(today: datetime.date) -> dict:
     ref = sha or BRANCH
     built = f"{today.isoformat()}, from commit {sha[:12]}" + (" + local changes" if dirty else "") if sha \
         else f"{today.isoformat()}, outside a git clone (links lead to the branch {BRANCH})"
-    cite = f"{authors} ({today.year}). {cff['title']}, version {__version__}. {repo}"
+    cite = f"{authors} ({today.year}). {cff['title']}, version {__version__}."
     parts = {}
     for part in toc.get("parts", []):
         first = (part.get("chapters") or [{}])[0].get("file")
@@ -339,7 +340,7 @@ def front_matter(today: datetime.date) -> dict:
                 subject=f"{cff['title']}, version {__version__}, printed {built}",
                 facts=[["Version", f"replication {__version__}", None], ["Printed", built, None],
                        ["Repository", repo, repo], ["Licence", "code MIT; the tables in tables/ CC-BY-4.0", None],
-                       ["Cite as", cite, None]])
+                       ["Cite as", cite, repo]])
 
 
 def destination_pages(pdf: Path, ids: list[str]) -> dict[str, int]:
