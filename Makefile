@@ -30,7 +30,9 @@ help:
 	@echo "              re-executed under two perturbed numerical configurations, tables unchanged, strict book build,"
 	@echo "              browser check, the PDF printed and checked (first installs Debian's chromium, fonts-wqy-zenhei and texlive-latex-base"
 	@echo "              where the user may: make sysdeps)"
-	@echo "make pdf    - the whole book as one PDF, book/_build/pdf/book.pdf (single-page HTML of the stored outputs, printed by Chromium)"
+	@echo "make pdf    - the book as one PDF for readers, book/_build/pdf/book.pdf: title page, numbered contents with page numbers,"
+	@echo "              every chapter without the library reference's module pages, links into the repository (printed by Chromium"
+	@echo "              from the single-page HTML of the stored outputs); the next make html links it from the landing page"
 	@echo "make nbval  - strict nbval of every notebook on this machine's native code path"
 	@echo "make notebook NB=book/part/file.ipynb - execute one notebook in place"
 	@echo "make lock   - recompile requirements.lock from requirements.in (needs network to PyPI)"
@@ -123,8 +125,10 @@ html-strict: env
 browser: env
 	$(PY) -m pytest -q tests/test_book_browser.py -m browser
 
-# the whole book as one PDF (book/_build/pdf/book.pdf): the single-page HTML build of the stored
-# outputs (execution off), printed on A4 by headless Chromium, offline, maths typeset by the local MathJax
+# the book as one PDF for readers (book/_build/pdf/book.pdf): the single-page HTML build of the stored
+# outputs (execution off), printed on A4 by headless Chromium, offline, maths typeset by the local MathJax;
+# scripts/book_pdf.py leaves out the library reference's module pages, adds the title page and the
+# contents (a second print fills in their page numbers) and points every link at the repository
 pdf: env
 	$(VENV)/bin/jupyter-book build book --path-output book --builder singlehtml --quiet
 	$(PY) scripts/book_pdf.py
