@@ -106,6 +106,28 @@ def test_printed_m_equals_corrected_n_times_c_and_numerical():
             assert np.max(np.abs(polar.n_matrix(r, printed=True) @ c - m)) > 1e-4 * np.max(np.abs(m))
 
 
+def test_grid_transport_rate_is_the_turn_of_the_grid_axes():
+    # against a central difference of the grid axes along the track (±5 s): truncation (ω·5 s)² ≈ 1e-10
+    # and round-off 1e-16/(ω·10 s) ≈ 1e-11 of the rate, so 1e-7 relative is a wide margin
+    for lat_deg, lon_deg, ve, vn in [(85.0, 18.0, 10.0, 0.0), (88.868, 168.0, 0.0, 10.0), (60.0, -75.0, 7.0, -4.0)]:
+        lat, lon = np.radians(lat_deg), np.radians(lon_deg)
+        rm, rn = earth.radii(lat)
+        rate = np.array([vn / float(rm), ve / (float(rn) * np.cos(lat))])
+        pos = lambda t: earth.geodetic_to_ecef(lat + rate[0] * t, lon + rate[1] * t, 0.0)
+        v = (pos(1e-3) - pos(-1e-3)) / 2e-3
+        d = polar.grid_frame(pos(5.0)) @ polar.grid_frame(pos(-5.0)).T          # C_{G-}^{G+} = I - [θ×]
+        theta = -0.5 * np.array([d[2, 1] - d[1, 2], d[0, 2] - d[2, 0], d[1, 0] - d[0, 1]]) / 10.0
+        w = polar.grid_transport_rate(pos(0.0), v)
+        assert np.linalg.norm(w - theta) < 1e-7 * np.linalg.norm(w)
+    # on the prime meridian, moving north, the grid frame is the geographic one: |ω| = V / R_M
+    lat = np.radians(60.0)
+    r0 = earth.geodetic_to_ecef(lat, 0.0, 0.0)
+    w = polar.grid_transport_rate(r0, 10.0 * np.array([-np.sin(lat), 0.0, np.cos(lat)]))
+    assert np.linalg.norm(w) == pytest.approx(10.0 / float(earth.radii(lat)[0]), rel=1e-9)
+    with pytest.raises(ValueError):
+        polar.grid_transport_rate(np.zeros((2, 3)) + r0, np.zeros((2, 3)))
+
+
 # ----------------------------------------------------------------------------- ψ equation
 
 def test_t_and_u_solve_the_psi_equation():

@@ -289,6 +289,40 @@ def gaussian_radius(lat):
     return np.sqrt(rm * rn)
 
 
+def grid_transport_rate(r, v):
+    """ω_eG^G: the angular velocity of the grid frame relative to the Earth [rad/s], grid axes.
+
+    The rate the navigator's kernel computes (exact on the ellipsoid surface, regular at the poles),
+    for one point: the rate fang2020 neglects before (23) ("Ω ≫ ω_eg", the ship being slow) when
+    ω_ic of (21)-(22), the computer frame being grid-aligned, is replaced by Ω.
+
+    Parameters
+    ----------
+    r : array_like, shape (3,)
+        ECEF position on the ellipsoid [m].
+    v : array_like, shape (3,)
+        ECEF velocity [m/s].
+
+    Returns
+    -------
+    omega : numpy.ndarray, shape (3,)
+        ω_eG in grid axes (E, N, U) [rad/s].
+
+    Raises
+    ------
+    ValueError
+        If ``r`` or ``v`` is not one finite 3-vector, or the grid frame is undefined at ``r``.
+    """
+    r, v = vector3(r, "r (ECEF position, m)"), vector3(v, "v (ECEF velocity, m/s)")
+    if r.shape != (3,) or v.shape != (3,):
+        raise ValueError("r and v must each be one 3-vector")
+    grid_frame(r)                                   # refuses the points where grid north is undefined
+    ge, gn, u, out = (np.empty(3) for _ in range(4))
+    n = _k.grid_axes(r, ge, gn, u)
+    _k.grid_transport_rate(v, ge, gn, u, n, out)
+    return out
+
+
 def grid_heading(c_b_g):
     """Grid heading of the body forward axis, clockwise from grid north, from C_b^G.
 
