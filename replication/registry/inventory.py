@@ -5,12 +5,15 @@ unnumbered display a later step uses, every table, every figure, every stated pa
 evaluative or quantitative sentence (abstract, introduction, results, conclusions) and every cited
 reference of a document, with where it is printed and its *disposition*:
 
-``checked``        the tables (``rows``: ``<table id>`` or ``<table id>#<quantity>``, ``; ``-separated)
-                   that compare it;
-``not checkable``  the reason a reader accepts (a figure whose data are lost and whose text states
-                   nothing checkable, a reference that is only cited);
-``unchecked``      checkable in principle, compared by no table yet; the reason says what a check
-                   would need.  The status page counts these: the print not yet accounted for.
+``checked``
+    the tables that compare it (the ``rows`` column: a table id, or a table id, ``#`` and a
+    quantity; several separated by semicolons);
+``not checkable``
+    the reason a reader accepts (a figure whose data are lost and whose text states nothing
+    checkable, a reference that is only cited);
+``unchecked``
+    checkable in principle, compared by no table yet; the reason says what a check would need.
+    The status page counts these: the print not yet accounted for.
 
 The file starts with ``#`` provenance lines, among them ``# numbered: equations=N tables=N
 figures=N`` (the counts read off the document) and, where the document skips a number,

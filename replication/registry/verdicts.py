@@ -4,15 +4,22 @@ A comparison row declares its *basis* — the kind of comparison it makes — an
 kind needs; its status is then a pure function of that evidence (:func:`derive_status`), never a
 word a chapter types.  The bases:
 
-``value``        a number against a tolerance stated before the comparison;
-``verdict``      a verdict or pattern (observable or not, an ordering, a sign, a shape) against the
-                 print, with the readings ledger where the print leaves a choice open;
-``parts``        two printed parts against each other (an equation and a table, a header and its
-                 entries, the text and a table);
-``derivation``   a printed formula or value against a derivation from first principles;
-``claim``        a sentence of the print against the rows it rests on (``rests_on``);
-``stand-in``     a labelled simulation standing in for data or settings the print does not publish;
-``unstated``     the print lacks a quantity the check needs (the note names it).
+``value``
+    a number against a tolerance stated before the comparison;
+``verdict``
+    a verdict or pattern (observable or not, an ordering, a sign, a shape) against the print,
+    with the readings ledger where the print leaves a choice open;
+``parts``
+    two printed parts against each other (an equation and a table, a header and its entries,
+    the text and a table);
+``derivation``
+    a printed formula or value against a derivation from first principles;
+``claim``
+    a sentence of the print against the rows it rests on (``rests_on``);
+``stand-in``
+    a labelled simulation standing in for data or settings the print does not publish;
+``unstated``
+    the print lacks a quantity the check needs (the note names it).
 
 The evidence: ``agrees`` (computed by the chapter's code: does the row's own comparison agree with
 the print — a verdict equal to the printed one, a claim that holds in the print's own numbers, a

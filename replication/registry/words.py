@@ -8,12 +8,17 @@ an invisible note that says which tables it counts::
 
 Each entry is a subject (a table id, an artifact id, or a source key) and ``name=value`` pairs:
 
-``<status>=N``   rows with that status (of a table; of a source: over its paper artifacts);
-``rows=N``       rows of a table;
-``failing=N``    paper artifacts of a source that hold ``not-reproduced`` rows;
-``status=W``     the status of an artifact (``tables/status.csv``; ``mixed`` as the word);
-``artifacts=N``  paper artifacts of a source; subject ``all``: ``paper=N`` and ``supplementary=N``,
-                 the artifacts of the four documents and the package's supplementary checks.
+``<status>=N``
+    rows with that status (of a table; of a source: over its paper artifacts);
+``rows=N``
+    rows of a table;
+``failing=N``
+    paper artifacts of a source that hold ``not-reproduced`` rows;
+``status=W``
+    the status of an artifact (``tables/status.csv``; ``mixed`` as the word);
+``artifacts=N``
+    paper artifacts of a source; with the subject ``all``: ``paper=N`` and ``supplementary=N``,
+    the artifacts of the four documents and the package's supplementary checks.
 
 :func:`problems` recomputes every note from the stored tables and refuses a note that disagrees
 with them, and a count in the paragraph (a number, in digits or words, followed by a counted noun —
