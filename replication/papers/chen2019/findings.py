@@ -50,7 +50,7 @@ exact arithmetic, along constant-rate 3°/s turns between straight legs)."""
 
 def column_groups(printed, symbols=None) -> dict:
     """The printed columns of an observability table as groups of row quantities
-    (``compare(..., groups=)``): one reading must reach the values of a printed column together.
+    (each row's ``group`` key, given to ``compare``): one reading must reach the values of a printed column together.
 
     Parameters
     ----------
