@@ -333,3 +333,74 @@ def test_the_stored_tables_pass_the_audit():
     """Every stored table of the project: no problem (what `python -m replication index` checks)."""
     problems = audit.audit()
     assert not problems, "\n".join(map(str, problems[:20]))
+
+
+# ------------------------------------------------------------------ plants found by an independent tester
+
+def test_a_printed_value_edited_in_the_table(copy):
+    """The paper column is the paper file's: a 'printed' value changed to meet the reproduction is refused."""
+    before = _problems()
+
+    def pred(t, r):
+        src = rp._sidecar(t).get("paper_source")
+        if not src or r["paper"] == "" or r["reproduced"] == "" or r["status"] != "erratum":
+            return False
+        vals = rp.parse_paper_file(rp.data_root() / src).numeric()
+        return r["quantity"] in vals.index and vals[r["quantity"]] == vals[r["quantity"]] and \
+            float(r["reproduced"]) != vals[r["quantity"]]
+
+    tid, i, df = _pick(_tables(copy), pred)
+    df.loc[i, "paper"] = df.loc[i, "reproduced"]
+    df.loc[i, ["abs_error", "rel_error"]] = ["0", "0"]
+    df.loc[i, "status"] = "reproduced"
+    _write(copy, tid, df, True)
+    _refused(before, tid, df.loc[i, "quantity"], "is not the printed")
+
+
+def test_a_failure_redeclared_unstated_where_the_ledger_tries_it(copy):
+    before = _problems()
+    tables = _tables(copy)
+
+    def pred(t, r):
+        if _is_ledger(t) or r["status"] != "not-reproduced" or not _has_ledger(t):
+            return False
+        rows = audit._ledger_rows(rp.readings_ledgers(t))
+        return any(r["quantity"] in per for per in rows.values())
+
+    tid, i, df = _pick(tables, pred)
+    df.loc[i, ["basis", "status", "tolerance", "tolerance_kind", "abs_error", "rel_error"]] = \
+        ["unstated", "unverifiable", "", "", "", ""]
+    _write(copy, tid, df, True)
+    _refused(before, tid, df.loc[i, "quantity"], "no reading reaches")
+
+
+def test_the_main_reading_renamed_away_from_its_ledger_rows(copy):
+    """A main reading renamed so that its ledger rows are no longer compared with the main rows: the
+    reading whose results are the main table's must be the one named."""
+    before = _problems()
+    for tid in rp.list_tables():
+        meta = rp._sidecar(tid)
+        if _is_ledger(tid) or not meta.get("main_reading") or not rp.readings_ledgers(tid, meta):
+            continue
+        rows = audit._ledger_rows(rp.readings_ledgers(tid, meta))
+        main = rp.read_table(tid)
+        per = rows.get(meta["main_reading"], {})
+        vals = {r["quantity"]: (r["reproduced"], r["reproduced_text"]) for _, r in main.iterrows()}
+        shared = [q for q in per if q in vals]
+        if len(shared) >= 5 and all((per[q]["reproduced"], per[q]["reproduced_text"]) == vals[q] for q in shared):
+            break
+    else:
+        pytest.skip("no ledger holding its main reading with the main table's results")
+    meta["main_reading"] = meta["main_reading"] + " (renamed)"
+    (copy / "tables" / f"{tid}.json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    _refused(before, tid, None, "name it as the main reading")
+
+
+def test_the_sidecar_counts_follow_the_csv(copy):
+    before = _problems()
+    tid = next(t for t in rp.list_tables() if not _is_ledger(t))
+    side = copy / "tables" / f"{tid}.json"
+    meta = json.loads(side.read_text(encoding="utf-8"))
+    meta["status_counts"] = dict(meta["status_counts"], reproduced=meta["status_counts"].get("reproduced", 0) + 7)
+    side.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    _refused(before, tid, None, "status_counts")

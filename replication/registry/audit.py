@@ -335,7 +335,23 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
                                             "holds (name the printed numbers that exclude the reading)"))
             if not any(r == k or r.startswith(k) for r in readings):
                 out.append(Problem(tid, "", f"ruled_out names {k!r}, which is no reading of {', '.join(ledgers) or 'a ledger'}"))
+    counts = {k: int((df["status"] == k).sum()) for k in rp.STATUSES}
+    if meta.get("status_counts") not in (None, counts):
+        out.append(Problem(tid, "", f"the sidecar's status_counts {meta.get('status_counts')} are not the CSV's {counts}"))
+    out += _paper_problems(tid, df, meta)
     main_reading = meta.get("main_reading", "")
+    if main_reading and ledgers and readings and main_reading not in readings:
+        # a ledger may leave the main reading out (the main table is its result); then no reading of the
+        # ledger may be the main computation under another name
+        main_values = {r["quantity"]: (r["reproduced"], r["reproduced_text"]) for _, r in df.iterrows()}
+        for reading, per_q in readings.items():
+            shared = [q for q in per_q if q in main_values]
+            if len(shared) >= 5 and all((per_q[q]["reproduced"], per_q[q]["reproduced_text"]) == main_values[q]
+                                        for q in shared):
+                out.append(Problem(tid, "", f"the main reading {main_reading!r} is no reading of {', '.join(ledgers)}, "
+                                            f"but reading {reading!r} gives every main row's result: name it as the "
+                                            "main reading"))
+                break
     if main_reading and not ledger and not ledgers:
         out.append(Problem(tid, "", f"records the main reading {main_reading!r} but no readings ledger is exported "
                                     "(a missing ledger switches no check off)"))
@@ -354,6 +370,13 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
                 out.append(Problem(tid, q, f"the main reading's ledger row says {lr['status']} "
                                            f"({lr['reproduced'] or lr['reproduced_text']}), the table {r['status']} "
                                            f"({r['reproduced'] or r['reproduced_text']}): the two must be one computation"))
+        in_ledger = any(q in per for per in readings.values())
+        if ledgers and r["status"] == "unverifiable" and in_ledger and \
+                not ledger_evidence(q, df, meta, readings).reaching:
+            out.append(Problem(tid, q, "unverifiable although the ledger tries this value and no reading reaches the "
+                                       "print: that is not-reproduced"))
+        if ledgers and r["status"] == "not-reproduced" and r.get("basis", "") != "" and not in_ledger:
+            out.append(Problem(tid, q, f"not-reproduced but no reading of {', '.join(ledgers)} shows it"))
         if ledgers and r["status"] in ("not-reproduced", "erratum", "unverifiable") and r.get("basis", "") == "":
             ev = ledger_evidence(q, df, meta, readings)
             if r["status"] in ("not-reproduced", "erratum") and ev.reaching:
@@ -391,6 +414,34 @@ def _every_reading_problems(tid: str, df: pd.DataFrame, meta: Mapping[str, Any],
         if EVERY_READING.search(str(r["note"])) and not backed:
             out.append(Problem(tid, r["quantity"], f"its note speaks of every reading, but the row is {r['status']}"
                                                    + ("" if ledgers else " in a table without a readings ledger")))
+    return out
+
+
+def _paper_problems(tid: str, df: pd.DataFrame, meta: Mapping[str, Any]) -> list[Problem]:
+    """The printed values of a table are the paper file's: its digest is the sidecar's, and every row
+    whose quantity the file holds carries the file's number (to the digits stored)."""
+    src = meta.get("paper_source")
+    if not src:
+        return []
+    path = rp.data_root() / src
+    if not path.exists():
+        return [Problem(tid, "", f"its paper source {src} does not exist")]
+    out = []
+    if meta.get("paper_digest") and hashlib.sha256(path.read_bytes()).hexdigest() != meta["paper_digest"]:
+        out.append(Problem(tid, "", f"{src} changed since the table was computed (paper_digest): rerun its notebook"))
+    try:
+        paper = rp.parse_paper_file(path)
+    except rp.RegistryError:
+        return out
+    values = paper.numeric()
+    for _, r in df.iterrows():
+        q = r["quantity"]
+        if q not in values.index or r["paper"] == "" or not math.isfinite(values[q]):
+            continue
+        printed, stored = float(values[q]), _num(r["paper"])
+        if not math.isclose(printed, stored, rel_tol=1e-6, abs_tol=1e-300) and \
+                rp.round_sig(printed, max(1, _sig(r["paper"]))) != stored:
+            out.append(Problem(tid, q, f"paper value {r['paper']} is not the printed {printed:g} of {src}"))
     return out
 
 
