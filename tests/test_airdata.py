@@ -1,5 +1,7 @@
 """Tests of replication.papers.duan2023.airdata: duan2023 correction geometry, derivation checks, simulation."""
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -539,3 +541,62 @@ def test_startup_bound_and_its_rows():
     assert not v["proposed SINS/ADS / velocity error"]["agrees"]
     assert v["eq. (6) with its printed 1/2 | proposed SINS/ADS / velocity error"]["agrees"]
     assert v["proposed SINS/ADS / misalignment"]["agrees"]
+
+
+# --------------------------------------------------------------------------- initial attitude error
+
+def test_attitude_readings_span_heading_level_and_both():
+    att = ad.attitude_readings((0.5, 1.0))
+    assert list(att) == ["initial heading error 0.5 deg", "initial heading error 1 deg",
+                         "initial level errors 0.5 deg (E, N)", "initial level errors 1 deg (E, N)",
+                         "initial attitude errors 0.5 deg (E, N, U)", "initial attitude errors 1 deg (E, N, U)"]
+    np.testing.assert_allclose(att["initial heading error 1 deg"], (0.0, 0.0, np.radians(1.0)))
+    np.testing.assert_allclose(att["initial level errors 0.5 deg (E, N)"], (np.radians(0.5),) * 2 + (0.0,))
+    assert len(ad.attitude_readings()) == 3 * len(ad.ATTITUDE_SIZES_DEG)
+    with pytest.raises(ValueError, match="positive"):
+        ad.attitude_readings((0.0,))
+    with pytest.raises(ValueError, match="initial_attitude_error"):
+        ad.AirdataSetup(initial_attitude_error=(1.0, 2.0))
+
+
+def test_initial_attitude_error_is_the_misalignment_at_the_start_and_drives_schuler(short_flight):
+    """The start misalignment equals the setting (attitude_error convention); a level error makes the
+    horizontal velocity error grow at g|phi| (f^n ~ g e_U), a heading error in straight level flight barely."""
+    phi = (2e-3, -1e-3, 0.0)
+    ideal = ad.ideal_sensors(ad.AirdataSetup(initial_velocity_error=0.0, initial_position_error=0.0))
+    runs = ad.attitude_runs(short_flight, ideal, {"level": phi, "heading": (0.0, 0.0, 2e-3)}, n_runs=1,
+                            systems=("SINS",))
+    e = runs["level"].errors["SINS"]
+    np.testing.assert_allclose(e["phi"][0, 0], phi, atol=1e-12)
+    k = int(np.searchsorted(runs["level"].t, 30.0))
+    vh = np.linalg.norm(e["v"][0, k, :2])
+    g = 9.806
+    assert vh / runs["level"].t[k] == pytest.approx(g * np.hypot(*phi[:2]), rel=0.02)
+    vh_heading = np.linalg.norm(runs["heading"].errors["SINS"]["v"][0, k, :2])
+    assert vh_heading < 0.01 * vh
+    ch = ad.attitude_channels(runs, {"level": phi, "heading": (0.0, 0.0, 2e-3)})
+    assert ch.loc["level", "g|phi| (m/s2)"] == pytest.approx(g * np.hypot(*phi[:2]), rel=1e-3)
+    # the default setting is bit-identical to the aligned start
+    st0, st1 = ad._initial_state(short_flight, ideal), ad._initial_state(short_flight, replace(ideal))
+    np.testing.assert_array_equal(st0.C_bn, st1.C_bn)
+    with pytest.raises(ValueError, match="filter_readings"):
+        ad.attitude_runs(short_flight, ideal, {"a": phi}, n_runs=1, filter_readings=["b"])
+
+
+def test_attitude_ledger_rows_and_verdicts(short_flight):
+    t1 = rp.load_paper("duan2023-table-1")
+    setup = ad.AirdataSetup(correction_interval=30.0, threshold=1.0)
+    att = {"initial heading error 0.8 deg": (0.0, 0.0, np.radians(0.8))}
+    runs = ad.attitude_runs(short_flight, setup, att, n_runs=2, systems=("SINS", "proposed SINS/ADS"))
+    rows = findings.attitude_ledger_rows(runs, t1, setting="printed sensor errors")
+    assert len(rows) == 6 and rows[0]["quantity"] == "initial heading error 0.8 deg, printed sensor errors | SINS / misalignment"
+    assert all("2-run mean, 95 % CI" in r["note"] for r in rows)
+    df = rp.comparison_frame(rows)
+    v = findings.attitude_verdicts(df, readings=att)
+    row = v.loc["initial heading error 0.8 deg, printed sensor errors"]
+    m = float(df["reproduced"].iloc[0])
+    assert row["misalignment reached"] == (abs(m - 0.8) <= 0.5 * 0.8) and m >= 0.8 - 1e-3
+    with pytest.raises(ValueError, match="setting"):
+        findings.attitude_ledger_rows(runs, t1, setting=" ")
+    with pytest.raises(ValueError, match="no initial-attitude reading"):
+        findings.attitude_verdicts(df, system="literature SINS/ADS", readings=att)

@@ -404,3 +404,21 @@ def test_the_sidecar_counts_follow_the_csv(copy):
     meta["status_counts"] = dict(meta["status_counts"], reproduced=meta["status_counts"].get("reproduced", 0) + 7)
     side.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n", encoding="utf-8")
     _refused(before, tid, None, "status_counts")
+
+
+def test_reading_outcomes_says_what_each_reading_alone_gives_a_row():
+    """Each reading of a stored ledger, alone, by the registry's rule: a reading that reaches the print
+    and keeps its group gives unverifiable, one that reaches nothing not-reproduced; the row's stored
+    status is the one the whole ledger gives."""
+    tid, q = "duan2023-table-1", "SINS / misalignment"
+    out = audit.reading_outcomes(tid, q)
+    assert list(out.columns) == ["reading", "counted", "reaches", "keeps_group", "status"]
+    assert set(out["status"]) <= {"not-reproduced", "unverifiable", "inconsistent"}
+    assert (out.loc[~out["reaches"], "status"] == "not-reproduced").all()
+    assert (out.loc[out["reaches"] & out["keeps_group"], "status"] == "unverifiable").all()
+    stored = rp.read_table(tid).set_index("quantity").loc[q, "status"]
+    whole = vd.after_ledger(vd.LedgerEvidence(tuple(out.loc[out["reaches"], "reading"]),
+                                              tuple(out.loc[out["keeps_group"], "reading"]), True), "not-reproduced")
+    assert stored == whole
+    with pytest.raises(rp.RegistryError, match="no row"):
+        audit.reading_outcomes(tid, "no such row")

@@ -258,6 +258,55 @@ def ledger_evidence(q: str, main: pd.DataFrame, meta: Mapping[str, Any],
     return vd.LedgerEvidence(tuple(reaching), tuple(keeping), bool(mine))
 
 
+def reading_outcomes(table_id: str, quantity: str) -> pd.DataFrame:
+    """What each reading of a table's readings ledger, taken alone, says about one row of the table,
+    by the rule of :func:`ledger_evidence` and :func:`replication.registry.verdicts.after_ledger`.
+
+    A chapter shows with it why a row is ``unverifiable`` or ``inconsistent``: which readings reach
+    the print, which of them keep the rest of the row's group (the other rows of the group that the
+    main reading reaches), and the status each would give the row were it the only reading.
+
+    Parameters
+    ----------
+    table_id : str
+        An exported main table with a readings ledger.
+    quantity : str
+        One of its rows.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One line per reading that shows the row (in the ledger's order): ``reading``, ``counted``
+        (False for the main reading and a reading ruled out by printed evidence), ``reaches``,
+        ``keeps_group``, ``status`` (what the reading alone gives a row that misses the print under the
+        main reading: ``not-reproduced``, ``unverifiable`` or ``inconsistent``).
+
+    Raises
+    ------
+    RegistryError
+        If the table is not exported, has no readings ledger, or has no row ``quantity``.
+    """
+    if not (rp.tables_dir() / f"{table_id}.csv").exists():
+        raise rp.RegistryError(f"{table_id} is not exported")
+    meta = rp._sidecar(table_id)
+    main = rp.read_table(table_id)
+    if quantity not in set(main["quantity"]):
+        raise rp.RegistryError(f"{table_id} has no row {quantity!r}")
+    ledgers = rp.readings_ledgers(table_id, meta)
+    if not ledgers:
+        raise rp.RegistryError(f"{table_id} has no readings ledger")
+    ruled = dict(meta.get("ruled_out") or {})
+    rows = []
+    for reading, per_q in _ledger_rows(ledgers).items():
+        if quantity not in per_q:
+            continue
+        ev = ledger_evidence(quantity, main, meta, {reading: per_q})
+        counted = reading != meta.get("main_reading", "") and not _excluded(reading, ruled)
+        rows.append({"reading": reading, "counted": counted, "reaches": bool(ev.reaching),
+                     "keeps_group": bool(ev.keeping_group), "status": vd.after_ledger(ev, "not-reproduced")})
+    return pd.DataFrame(rows, columns=["reading", "counted", "reaches", "keeps_group", "status"])
+
+
 def _row_problems(tid: str, r: Mapping[str, Any], root: Path, ledger: bool, has_ledger: bool,
                   notebook: str = "") -> list[str]:
     """The status criteria (:data:`CRITERIA`) that a stored row breaks."""

@@ -65,7 +65,8 @@ __all__ = [
     "STATE_NAMES", "reference_state", "derived_coefficients", "printed_elements",
     "check_elements", "agree_to_first_order", "manifold_residuals", "consistency_count",
     "interval_motion", "integrate_eq21", "EQ21_ROWS", "EQ21_STARTS",
-    "mean_interval", "BIAS_DIAGNOSTICS", "diagnostic_runs",
+    "mean_interval", "BIAS_DIAGNOSTICS", "diagnostic_runs", "ATTITUDE_SIZES_DEG", "attitude_readings",
+    "ideal_sensors", "attitude_runs", "attitude_channels",
     "sins_error_matrix", "AirData", "ads_measurements", "duan2023_flight", "AirdataSetup",
     "run_pure_sins", "error_correction_step", "run_error_correction", "correction_experiment_flight", "correction_experiment",
     "bias_experiment", "correction_experiment_table", "schuler_response", "literature_filter_model", "literature_filter",
@@ -1268,7 +1269,8 @@ class AirdataSetup:
     accelerometer bias and random drift 100 μg; ADS error 1 m; initial velocity error 0.1 m/s
     and position error 10 m on each axis.  Choices (not printed): the constant terms are
     +value on every axis (the convention of the PSINS toolbox of ref. [21]); "random drift" is
-    white noise whose 1-s average has the printed 1σ (PSD = σ² · 1 s); initial attitude error 0;
+    white noise whose 1-s average has the printed 1σ (PSD = σ² · 1 s); initial attitude error 0
+    (``initial_attitude_error``, which the chapter's readings ledger spans);
     airspeed noise 0.5 m/s; the Kalman filter of refs. [15-17] updates at 1 Hz.
 
     Attributes
@@ -1312,6 +1314,12 @@ class AirdataSetup:
         Factors on the constant accelerometer bias per body axis (x right, y forward, z up):
         (1, 1, 1) is the printed bias on every axis, (1, 1, 0) removes the up (z) bias only — a
         diagnostic of this package, not a reading of duan2023 §3.
+    initial_attitude_error : tuple of float, default (0.0, 0.0, 0.0)
+        Initial misalignment φ_E, φ_N, φ_U [rad] of every system (Ĉ = exp(-φ×) C at the start;
+        :func:`replication.nav.rotations.attitude_error` returns it): §3 prints none, so the
+        readings ledger spans it.  The literature filter's initial attitude σ is raised to
+        ``abs(φ)`` on an axis where it exceeds the default (1e-4, 1e-4, 1e-3 rad): the filter is
+        told the size of the error it starts with.
 
     Raises
     ------
@@ -1336,6 +1344,7 @@ class AirdataSetup:
     attitude_sign: float = -1.0
     printed_half: bool = False
     accel_bias_axes: tuple = (1.0, 1.0, 1.0)
+    initial_attitude_error: tuple = (0.0, 0.0, 0.0)
 
     @classmethod
     def from_paper(cls, paper_setup, **overrides):
@@ -1384,6 +1393,10 @@ class AirdataSetup:
             raise ValueError("accel_bias_axes must be three finite factors (body x, y, z) of the constant "
                              "accelerometer bias, e.g. (1, 1, 0) to remove the up bias only")
         self.accel_bias_axes = tuple(float(a) for a in axes)
+        att = np.asarray(self.initial_attitude_error, dtype=float)
+        if att.shape != (3,) or not np.all(np.isfinite(att)):
+            raise ValueError("initial_attitude_error must be three finite angles phi_E, phi_N, phi_U [rad]")
+        self.initial_attitude_error = tuple(float(a) for a in att)
 
 
 def _initial_state(traj, setup):
@@ -1391,8 +1404,10 @@ def _initial_state(traj, setup):
     st = traj.initial_state()
     rm, rn = earth.radii(st.lat)
     dp = setup.initial_position_error
+    phi = np.asarray(setup.initial_attitude_error, dtype=float)
+    C = rotvec_to_dcm(-phi) @ st.C_bn if np.any(phi) else st.C_bn   # C^ = exp(-phi x) C: attitude_error gives phi
     return NavState(st.lat + dp / (rm + st.h), st.lon + dp / ((rn + st.h) * np.cos(st.lat)), st.h + dp,
-                    st.v_enu + setup.initial_velocity_error, st.C_bn)
+                    st.v_enu + setup.initial_velocity_error, C)
 
 
 def _corrupt(traj, setup, rng):
@@ -1446,7 +1461,8 @@ def run_pure_sins(traj, dth, dv, setup, *, every: int = 50):
     """Pure SINS: strapdown with a free vertical channel from the perturbed initial state.
 
     The initial state is the true one plus ``setup.initial_velocity_error`` and
-    ``setup.initial_position_error`` on each of E, N, U (no attitude error).
+    ``setup.initial_position_error`` on each of E, N, U and the misalignment
+    ``setup.initial_attitude_error`` (zero by default).
 
     Parameters
     ----------
@@ -1855,7 +1871,8 @@ def literature_filter_model(setup):
     """
     rm, rn = earth.radii(np.radians(45.0))
     m = model_15(position_sd=setup.initial_position_error, velocity_sd=setup.initial_velocity_error,
-                 attitude_sd=(1e-4, 1e-4, 1e-3), accel_bias_sd=2 * setup.accel_bias,
+                 attitude_sd=tuple(max(d, abs(a)) for d, a in zip((1e-4, 1e-4, 1e-3), setup.initial_attitude_error)),
+                 accel_bias_sd=2 * setup.accel_bias,
                  gyro_bias_sd=2 * setup.gyro_bias, accel_psd=setup.accel_random**2,
                  gyro_psd=setup.gyro_random**2, lat=np.radians(45.0))
     tau = setup.markov_tau
@@ -2248,7 +2265,7 @@ def pure_sins_initial_errors_only(traj, setup: AirdataSetup) -> dict:
         Final 3-axis norms: ``misalignment`` [°], ``velocity error`` [m/s], ``position error`` [km].
     """
 
-    ideal = replace(setup, gyro_bias=0.0, gyro_random=0.0, accel_bias=0.0, accel_random=0.0)
+    ideal = ideal_sensors(setup)
     dth, dv = _corrupt(traj, ideal, np.random.default_rng(0))  # zero noise: the draws do not enter
     e = navigation_errors(traj, run_pure_sins(traj, dth, dv, ideal))
     return {"misalignment": float(np.degrees(np.linalg.norm(e["phi"][-1]))),
@@ -2429,6 +2446,161 @@ def diagnostic_runs(traj, setup: AirdataSetup, diagnostics=None, *, n_runs: int 
     return {lab: simulate(traj, replace(setup, **ch), n_runs=n_runs, seed=seed, systems=("proposed SINS/ADS",),
                           executor=executor, chunk_runs=chunk_runs, progress=progress)
             for lab, ch in diagnostics.items()}
+
+
+ATTITUDE_SIZES_DEG = (0.1, 0.5, 0.8, 1.0)
+"""Sizes [°] of the initial attitude errors the Table 1 readings ledger spans (duan2023 §3 prints none)."""
+
+_ATTITUDE_KINDS = {"initial heading error {a:g} deg": (0.0, 0.0, 1.0),
+                   "initial level errors {a:g} deg (E, N)": (1.0, 1.0, 0.0),
+                   "initial attitude errors {a:g} deg (E, N, U)": (1.0, 1.0, 1.0)}
+
+
+def attitude_readings(sizes_deg=ATTITUDE_SIZES_DEG) -> dict:
+    """The initial attitude errors of the Table 1 readings ledger: label → (φ_E, φ_N, φ_U) [rad].
+
+    duan2023 §3 prints the initial velocity and position errors "on each axis" and no attitude
+    error.  The readings: a heading error alone (φ_U), level errors alone (φ_E = φ_N, the printed
+    per-axis convention) and both (φ_E = φ_N = φ_U), each of every size, positive as the package's
+    other constant errors.
+
+    Parameters
+    ----------
+    sizes_deg : iterable of float, default :data:`ATTITUDE_SIZES_DEG`
+        The sizes [°], positive.
+
+    Returns
+    -------
+    readings : dict of str to tuple of float
+        Label (heading first, then level, then both; sizes in the given order) → the initial
+        misalignment [rad] (``AirdataSetup.initial_attitude_error``).
+
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite, or none is given.
+    """
+    sizes = [float(a) for a in sizes_deg]
+    if not sizes or not all(np.isfinite(a) and a > 0 for a in sizes):
+        raise ValueError("sizes_deg must be positive, finite angles in degrees (at least one)")
+    return {lab.format(a=a): tuple(float(np.radians(a) * k) for k in axes)
+            for lab, axes in _ATTITUDE_KINDS.items() for a in sizes}
+
+
+def ideal_sensors(setup: AirdataSetup) -> AirdataSetup:
+    """``setup`` with every sensor error zero (its initial errors kept).
+
+    Parameters
+    ----------
+    setup : AirdataSetup
+        Simulation parameters.
+
+    Returns
+    -------
+    AirdataSetup
+        The same setup without gyro and accelerometer constant or random errors.
+    """
+    return replace(setup, gyro_bias=0.0, gyro_random=0.0, accel_bias=0.0, accel_random=0.0)
+
+
+def attitude_runs(traj, setup: AirdataSetup, readings: dict, *, n_runs: int, seed: int = 2023,
+                  systems=SYSTEMS, filter_readings=None) -> dict:
+    """Monte Carlo of ``systems`` under each initial attitude error of ``readings``.
+
+    Every reading draws from ``SeedSequence(seed)`` as :func:`simulate` does: with the main run's
+    seed its runs share the main run's noise (common random numbers), so a difference from the
+    main run is the attitude error's.  With ideal sensors (:func:`ideal_sensors`) one run is the
+    whole answer (no noise enters).
+
+    Parameters
+    ----------
+    traj : replication.nav.trajectory.Trajectory
+        The true flight (N increments, N + 1 samples).
+    setup : AirdataSetup
+        The base setting; each reading sets its ``initial_attitude_error``.
+    readings : dict of str to tuple of float
+        Label → (φ_E, φ_N, φ_U) [rad] (:func:`attitude_readings`).
+    n_runs : int
+        Runs per reading, at least 1.
+    seed : int, default 2023
+        Seed of the ``SeedSequence``.
+    systems : sequence of str, default SYSTEMS
+        The systems simulated.
+    filter_readings : iterable of str, optional
+        The labels under which the literature filter runs (when in ``systems``); ``None``: all.
+
+    Returns
+    -------
+    runs : dict of str to MonteCarlo
+        Label → the Monte Carlo of that reading.
+
+    Raises
+    ------
+    ValueError
+        If ``readings`` is empty or not a dict (and as :func:`simulate` and :class:`AirdataSetup`).
+    """
+    if not isinstance(readings, dict) or not readings:
+        raise ValueError("readings must be a non-empty dict: label -> (phi_E, phi_N, phi_U) in rad")
+    keep = set(readings) if filter_readings is None else set(filter_readings)
+    if keep - set(readings):
+        raise ValueError(f"filter_readings names no reading: {sorted(keep - set(readings))}")
+    lit = "literature SINS/ADS"
+    return {lab: simulate(traj, replace(setup, initial_attitude_error=tuple(phi)), n_runs=n_runs, seed=seed,
+                          systems=[s for s in systems if s != lit or lab in keep]) for lab, phi in readings.items()}
+
+
+def attitude_channels(runs: dict, readings: dict, system: str = "SINS", *, early: float = 60.0) -> pd.DataFrame:
+    """How an initial attitude error drives the horizontal and vertical channels of one system.
+
+    A level error φ meets f^n ≈ g e_U at once (M_vφ = (f^n ×) of duan2023 eq. (1)): the horizontal
+    velocity error grows at g|φ| and swings with the Schuler period to √(gR)|φ| at a quarter
+    period (:func:`schuler_response`); a heading error meets only a horizontal specific force
+    (accelerations, turns).  The free vertical channel amplifies whatever reaches it.
+
+    Parameters
+    ----------
+    runs : dict of str to MonteCarlo
+        Reading label → its Monte Carlo (:func:`attitude_runs`) holding ``system``.
+    readings : dict of str to tuple of float
+        Reading label → (φ_E, φ_N, φ_U) [rad] (:func:`attitude_readings`).
+    system : str, default "SINS"
+        The system whose errors are read.
+    early : float, default 60.0
+        The time [s] over which the initial slope of the horizontal velocity error is taken.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        Indexed by reading, run means: ``level error (deg)`` |(φ_E, φ_N)|, ``heading error (deg)``,
+        ``slope, first minute (m/s2)`` (horizontal velocity error at ``early`` over ``early``),
+        ``g|phi| (m/s2)``, ``max horizontal velocity, t <= Ts/4 (m/s)``, ``sqrt(gR)|phi| (m/s)``,
+        ``max up velocity (m/s)`` and ``max 3-D velocity (m/s)`` over the flight.
+
+    Raises
+    ------
+    ValueError
+        If a reading of ``runs`` is missing from ``readings`` or lacks ``system``.
+    """
+    rows = {}
+    for lab, mc in runs.items():
+        if lab not in readings or system not in mc.errors:
+            raise ValueError(f"reading {lab!r}: no initial attitude error in readings, or no {system!r} runs")
+        phi = np.asarray(readings[lab], dtype=float)
+        tilt = float(np.hypot(phi[0], phi[1]))
+        sch = schuler_response(tilt)
+        quarter = float(sch["period"]) / 4
+        e = mc.errors[system]
+        vh = np.linalg.norm(e["v"][..., :2], axis=2)
+        k = int(np.searchsorted(mc.t, early))
+        q = mc.t <= quarter
+        rows[lab] = {"level error (deg)": np.degrees(tilt), "heading error (deg)": np.degrees(abs(phi[2])),
+                     "slope, first minute (m/s2)": float(np.mean(vh[:, k])) / float(mc.t[k]),
+                     "g|phi| (m/s2)": float(sch["velocity_rate"]),
+                     "max horizontal velocity, t <= Ts/4 (m/s)": float(np.mean(np.nanmax(vh[:, q], axis=1))),
+                     "sqrt(gR)|phi| (m/s)": float(sch["velocity_amplitude"]),
+                     "max up velocity (m/s)": float(np.mean(np.nanmax(np.abs(e["v"][..., 2]), axis=1))),
+                     "max 3-D velocity (m/s)": float(np.mean(np.nanmax(np.linalg.norm(e["v"], axis=2), axis=1)))}
+    return pd.DataFrame(rows).T
 
 
 def eq1_checks(point):

@@ -8,8 +8,10 @@ the printed elements of eqs. (4)-(21) recorded as errata or inconsistencies.  No
 imports it; the notebooks and the tests do.
 
 * :func:`table1_comparison` — Table 1, each row with its basis;
-* :func:`readings_ledger_rows`, :func:`diagnostic_ledger_rows` — the readings ledger of Table 1
-  (:data:`LEDGER_ID`, relative tolerance :data:`LEDGER_TOLERANCE`) and its diagnostic rows;
+* :func:`readings_ledger_rows`, :func:`diagnostic_ledger_rows`, :func:`attitude_ledger_rows` — the
+  readings ledger of Table 1 (:data:`LEDGER_ID`, relative tolerance :data:`LEDGER_TOLERANCE`), its
+  diagnostic rows and the initial attitude errors that §3 does not print; :func:`attitude_verdicts`
+  reads the exported ledger back, reading by reading;
 * :func:`startup_tilt_rows` — the printed proposed-method values against the start-up bound of
   eq. (6) (:func:`startup_tilt_bound`), under both readings of eq. (6);
 * :func:`eq22_rows`, :func:`eq22_readings_rows` — the printed elements of eqs. (4)-(21).
@@ -18,12 +20,14 @@ imports it; the notebooks and the tests do.
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 from replication.papers.duan2023.airdata import (
     SYSTEMS,
     TABLE1_UNITS,
     MonteCarlo,
     agree_to_first_order,
+    attitude_readings,
     check_elements,
     manifold_residuals,
     mean_interval,
@@ -32,7 +36,8 @@ from replication.papers.duan2023.airdata import (
 )
 
 __all__ = ["PROPOSED_REASON", "table1_comparison", "LEDGER_ID", "LEDGER_TOLERANCE", "LEDGER_QUANTITIES",
-           "readings_ledger_rows", "diagnostic_ledger_rows", "startup_tilt_bound", "STARTUP_READINGS",
+           "readings_ledger_rows", "diagnostic_ledger_rows", "attitude_ledger_rows", "attitude_verdicts",
+           "startup_tilt_bound", "STARTUP_READINGS", "STARTUP_GROUP",
            "startup_tilt_rows", "eq22_rows", "eq22_readings_rows"]
 
 
@@ -45,11 +50,13 @@ PROPOSED_REASON = (
 """Why the proposed method's rows of Table 1 are not reproduced (the chapter's experiments)."""
 
 
-def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> list[dict]:
+def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict, ledger=None) -> list[dict]:
     """Rows of duan2023 Table 1 for :func:`replication.registry.reproduction.compare`, each with its basis.
 
     The registry derives each status from the row's evidence (CONTRIBUTING.md, "Statuses"); the
-    note gives the 95 % interval of every Monte-Carlo mean:
+    note gives the 95 % interval of every Monte-Carlo mean.  Each printed column of Table 1 is one
+    group (row key ``group``, the system): a reading that reaches a row of a column only by losing
+    another row of it that the main reading reaches does not reconcile the print.
 
     * proposed SINS/ADS and the pure-SINS misalignment: ``value`` rows, the run mean against the
       print within :data:`LEDGER_TOLERANCE` (relative, the rule of the readings ledger
@@ -74,6 +81,10 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
         reported beside the maximum over the flight.
     ideal : dict of str to float
         The pure SINS with ideal sensors (``pure_sins_initial_errors_only``).
+    ledger : pandas.DataFrame, optional
+        The exported readings ledger (:data:`LEDGER_ID`): the notes of the misalignment rows of pure
+        SINS and of the literature filter name the initial-attitude readings that reach the print
+        (:func:`attitude_verdicts`).
 
     Returns
     -------
@@ -88,7 +99,8 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
     for r in table1_rows(mc, paper):
         q, p, m = r["quantity"], r["paper"], r["mean"]
         ci = f"{n}-run mean, 95 % CI {r['lo']:.3g}..{r['hi']:.3g}"
-        row = dict(quantity=f"{r['system']} / {q}", unit=r["unit"], paper=p, reproduced=round(m, 4))
+        row = dict(quantity=f"{r['system']} / {q}", unit=r["unit"], paper=p, reproduced=round(m, 4), group=r["system"])
+        att = _attitude_reach(ledger, r["system"], q) if ledger is not None and q == "misalignment" else ""
         value = dict(basis="value", tolerance=LEDGER_TOLERANCE, tolerance_kind="rel", digits=3)   # a 12-run mean
         initial_errors_only = r["system"] == "SINS" and abs(ideal[q] / p - 1) < 0.05 and m > 2 * p
         same_order = 0.1 < m / p < 10
@@ -103,9 +115,9 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
                             f"{abs(ideal[q] / p - 1):.1%} from the print: the free vertical channel); with the printed "
                             f"sensor errors (+100 ug up-bias) {m:.3g} ({ci}): Table 1 and the sensor errors of §3 disagree")
         elif r["system"] == "SINS":
-            row.update(value, note=f"with the printed sensor errors {ci}; ideal sensors (initial errors only) "
-                                   f"{ideal[q]:.2g}; the linear error model of the second computation stays near "
-                                   f"0.1 deg too; readings ledger: {LEDGER_ID}")
+            row.update(value, note=f"§3 prints no initial attitude error; without one: with the printed sensor errors {ci}; "
+                                   f"ideal sensors (initial errors only) {ideal[q]:.2g}; the linear error model of the "
+                                   f"second computation stays near 0.1 deg too{att}; readings ledger: {LEDGER_ID}")
         elif same_order:
             row.update(basis="stand-in", agrees=same_order,
                        note=f"unpublished trajectory, noise and implementation: a labelled simulation stands in, "
@@ -114,9 +126,30 @@ def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict) -> li
             row.update(basis="unstated",
                        note=f"the print lacks what sets this value: the literature filter (refs. [15-17]: measurements, "
                             f"noise, tuning) and the initial attitude error, which §3 does not list; the stand-in "
-                            f"(no initial attitude error) gives {ci}, more than ten times from the print")
+                            f"(no initial attitude error) gives {ci}, more than ten times from the print{att}")
         rows.append(row)
     return rows
+
+
+def _attitude_reach(ledger, system: str, q: str) -> str:
+    """The note's clause naming the initial-attitude readings of the ledger that reach the print of ``system / q``,
+    by sensor setting; for the pure SINS also how many of them reach the printed velocity and position too."""
+    v = attitude_verdicts(ledger, system)
+    col = f"{q} ({TABLE1_UNITS[q]})"
+    hit = v[[q in r.split(", ") for r in v["reaches"]]]
+    if hit.empty:
+        return f"; no initial attitude error of the ledger ({len(v)} readings) reaches the print"
+    by_setting = {}
+    for lab in hit.index:
+        reading, setting = lab.rsplit(", ", 1)
+        short = reading.replace("initial ", "").replace(" errors ", " ").replace(" error ", " ")
+        by_setting.setdefault(setting, []).append(f"{short} ({hit.loc[lab, col]:.3g})")
+    text = (f"; initial attitude errors that reach the print within {100 * LEDGER_TOLERANCE:.0f} %: "
+            + "; ".join(f"with {k}: " + ", ".join(x) for k, x in by_setting.items()))
+    if system == "SINS":
+        both = int(hit["velocity and position reached"].sum())
+        text += f"; {both} of these {len(hit)} also reach the printed velocity and position"
+    return text
 
 
 LEDGER_ID = "duan2023-check-table-1-readings"
@@ -223,6 +256,107 @@ def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> lis
     return rows
 
 
+def attitude_ledger_rows(runs: dict, table1, *, setting: str, digits: int = 3) -> list[dict]:
+    """Rows of the Table 1 readings ledger for the initial attitude errors that duan2023 §3 does not print.
+
+    Each reading (:func:`replication.papers.duan2023.airdata.attitude_readings`, run by
+    :func:`replication.papers.duan2023.airdata.attitude_runs`) on every row of Table 1 of each
+    system its Monte Carlo holds (in the order of Table 1): the run mean of the flight maximum against the printed value within
+    :data:`LEDGER_TOLERANCE` (relative), the registry deciding the status from the numbers; the
+    note gives the run count and the 95 % Student-t interval of the mean (one run: no interval,
+    the setting has no noise).
+
+    Parameters
+    ----------
+    runs : dict of str to MonteCarlo
+        Reading label → its Monte Carlo.
+    table1 : PaperTable
+        ``rp.load_paper("duan2023-table-1")``.
+    setting : str
+        The sensor setting the readings share (e.g. "printed sensor errors"), appended to each label.
+    digits : int, default 3
+        Significant digits of ``reproduced`` and of the note's numbers.
+
+    Returns
+    -------
+    rows : list of dict
+        One per reading, system and quantity: ``quantity`` ("<label>, <setting> | <system> /
+        <quantity>"), ``unit``, ``paper``, ``reproduced``, ``digits``, ``tolerance``,
+        ``tolerance_kind`` "rel" and ``note``.
+
+    Raises
+    ------
+    ValueError
+        If ``runs`` is empty or ``setting`` is empty.
+    """
+    if not isinstance(runs, dict) or not runs:
+        raise ValueError("runs must be a non-empty dict: reading label -> MonteCarlo of attitude_runs")
+    if not str(setting).strip():
+        raise ValueError("setting must name the sensor setting of the readings (e.g. 'printed sensor errors')")
+    f = lambda v: f"{float(f'{v:.{digits}g}'):g}"
+    rows = []
+    for label, mc in runs.items():
+        s = mc.summary("max")
+        for sys_ in [x for x in SYSTEMS if x in mc.errors]:
+            sub = s[s["system"] == sys_]
+            for q, u in TABLE1_UNITS.items():
+                m, lo, hi = mean_interval(sub[q].to_numpy(float))
+                note = (f"{len(sub)}-run mean, 95 % CI {f(lo)}..{f(hi)} {u}" if len(sub) > 1 else
+                        "one run: no sensor noise enters")
+                rows.append(dict(quantity=f"{label}, {setting} | {sys_} / {q}", unit=u,
+                                 paper=float(table1.value(f"{sys_} / {q}")), reproduced=m, digits=digits,
+                                 tolerance=LEDGER_TOLERANCE, tolerance_kind="rel", note=note))
+    return rows
+
+
+def attitude_verdicts(ledger, system: str = "SINS", readings=None) -> pd.DataFrame:
+    """The exported Table 1 readings ledger read back, one line per initial-attitude reading of a system.
+
+    Parameters
+    ----------
+    ledger : pandas.DataFrame
+        The exported ledger (``rp.compare(LEDGER_ID, ...)`` or ``rp.read_table(LEDGER_ID)``):
+        ``quantity`` "<reading> | <system> / <quantity>", ``reproduced``, ``status``.
+    system : str, default "SINS"
+        The Table 1 column.
+    readings : iterable of str, optional
+        The initial-attitude reading labels kept, each followed in the ledger by ", <setting>"
+        (default: those of :func:`replication.papers.duan2023.airdata.attitude_readings`).
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        Indexed by reading: the three stored values (``misalignment (deg)``, ``velocity error (m/s)``,
+        ``position error (km)``), ``reaches`` (the quantities the registry judged within the ledger's
+        tolerance of the print, as stored: status ``reproduced``) and ``misalignment reached``,
+        ``velocity and position reached`` (bool).
+
+    Raises
+    ------
+    ValueError
+        If the ledger holds no such reading of ``system``.
+    """
+    keep = set(attitude_readings() if readings is None else readings)
+    out = {}
+    for _, r in ledger.iterrows():
+        reading, _, rest = str(r["quantity"]).partition(" | ")
+        sys_, _, q = rest.partition(" / ")
+        if sys_ != system or reading.rsplit(", ", 1)[0] not in keep or q not in TABLE1_UNITS:
+            continue
+        d = out.setdefault(reading, {})
+        d[f"{q} ({TABLE1_UNITS[q]})"] = float(r["reproduced"])
+        d[q] = r["status"] == "reproduced"
+    if not out:
+        raise ValueError(f"the ledger holds no initial-attitude reading of {system!r}")
+    rows = []
+    for reading, d in out.items():
+        reached = [q for q in TABLE1_UNITS if d.get(q)]
+        rows.append({"reading": reading, **{f"{q} ({u})": d.get(f"{q} ({u})", np.nan) for q, u in TABLE1_UNITS.items()},
+                     "reaches": ", ".join(reached) or "none", "misalignment reached": bool(d.get("misalignment")),
+                     "velocity and position reached": bool(d.get("velocity error")) and bool(d.get("position error"))})
+    return pd.DataFrame(rows).set_index("reading")
+
+
 def startup_tilt_bound(dh: float, speed: float, interval: float, g: float, *, printed_half: bool = False) -> dict:
     """The first correction of duan2023 eq. (6) in level flight and the velocity error it leaves.
 
@@ -267,6 +401,10 @@ STARTUP_READINGS = {"eq. (6) as derived (no 1/2)": False, "eq. (6) with its prin
 The first is the main reading (eqs. (7) and (21) print the coefficient without 1/2)."""
 
 
+STARTUP_GROUP = "Table 1, proposed SINS/ADS"
+"""The group of the start-up rows: the printed proposed-method column of Table 1, which one reading must reach whole."""
+
+
 def startup_tilt_rows(table1, *, dh: float, speed: float, interval: float, g: float):
     """Rows of ``duan2023-check-startup-tilt`` and of its readings ledger.
 
@@ -289,7 +427,8 @@ def startup_tilt_rows(table1, *, dh: float, speed: float, interval: float, g: fl
     main, ledger : list of dict
         Rows for :func:`replication.registry.reproduction.compare`: ``quantity``, ``unit``,
         ``paper``, ``reproduced`` (the bound, 3 decimals), ``basis`` "verdict", ``agrees`` and
-        ``note``; the ledger's quantities are "<reading> | <quantity>".
+        ``note``, the main rows also ``group`` (:data:`STARTUP_GROUP`); the ledger's quantities are
+        "<reading> | <quantity>".
     """
     labels = list(STARTUP_READINGS)
     main, ledger = [], []
@@ -308,6 +447,8 @@ def startup_tilt_rows(table1, *, dh: float, speed: float, interval: float, g: fl
                        f"speed above g*dh/{p:g}"))
             row = dict(quantity=q if label == labels[0] else f"{label} | {q}", unit=unit, paper=p,
                        reproduced=round(bound, 3), basis="verdict", agrees=admits, note=note)
+            if label == labels[0]:
+                row["group"] = STARTUP_GROUP   # the printed proposed-method column of Table 1
             (main if label == labels[0] else ledger).append(row)
     for row in main:   # what the other printed form of eq. (6) gives, in the main row's note
         other = next(r for r in ledger if r["quantity"].endswith(row["quantity"]))
