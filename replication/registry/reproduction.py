@@ -1102,7 +1102,7 @@ def _tex_escape(s: str) -> str:
 
 
 def tex_packages(text: str) -> tuple[str, ...]:
-    r"""The LaTeX packages a document needs to set ``text`` as :func:`_tex_escape` writes it:
+    r"""The LaTeX packages a document needs to set ``text`` as ``_tex_escape`` writes it:
     :data:`TEX_PACKAGES`, ``amssymb`` for a sign of :data:`TEX_EXTRA_PACKAGES`, ``CJKutf8`` for
     Chinese.
 

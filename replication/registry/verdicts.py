@@ -83,7 +83,7 @@ class LedgerEvidence:
 
 @dataclass(frozen=True)
 class Evidence:
-    """The evidence of one row, as stored (see :func:`row_evidence` in the audit).
+    """The evidence of one row, as stored (read from the stored tables by :mod:`replication.registry.audit`).
 
     Attributes
     ----------

@@ -539,12 +539,12 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
         (the registry derives the status): ``quantity``, ``unit``, ``paper``, ``reproduced``
         (values at the state in ``unit``), ``tolerance`` 1e-9, ``tolerance_kind`` "rel" — except
         the elements that agree with the derivation only at the paper's first order
-        (:data:`_FIRST_ORDER`), which carry ``agrees`` (computed by
+        (``_FIRST_ORDER``), which carry ``agrees`` (computed by
         :func:`replication.papers.duan2023.airdata.agree_to_first_order`) and no tolerance — and
         for the flagged elements a ``note`` and, for errata, ``evidence`` and ``corrected``.  A
         flagged element outside the tolerance is an erratum unless a reading of the ledger
         (``duan2023-check-eq-22-readings``, to be exported first) reproduces it: then the registry
-        makes it inconsistent (:data:`_INCONSISTENT`).
+        makes it inconsistent (``_INCONSISTENT``).
     """
     df = check_elements(paper, reading, state)
     rows = []
