@@ -27,8 +27,8 @@ from replication.papers.chen2019.simulation import figure_4_14_estimates
 from replication.papers.chen2019.turntable import QUANTITIES
 
 __all__ = ["closed_form_rows", "compare_verdicts", "column_groups", "EXACT_READING", "figure_4_14_ledger",
-           "ordering_rows", "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims", "model_claims",
-           "compensation_claims"]
+           "figure_4_14_range_text", "ordering_rows", "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims",
+           "model_claims", "compensation_claims"]
 
 
 def _stored_degree(table, state, scenario) -> float:
@@ -235,6 +235,23 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
     return lines, ledger
 
 
+def figure_4_14_range_text(v) -> str:
+    """The stored range of estimates ``min~max`` (three significant digits), the same text for a
+    reading's ledger row and for the main row that reading computes.
+
+    Parameters
+    ----------
+    v : array_like
+        Estimates (any shape), finite.
+
+    Returns
+    -------
+    str
+    """
+    v = np.asarray(v, dtype=float)
+    return f"{v.min():.3g}~{v.max():.3g}"
+
+
 def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1000.0):
     """Readings ledger of the ranges stated after chen2019 Fig. 4-14.
 
@@ -257,7 +274,9 @@ def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1
     -------
     rows : list of dict
         Rows for :func:`replication.registry.reproduction.compare` (``quantity``, ``unit``,
-        ``paper``, ``reproduced`` (the runs' range as text), ``status``, ``note``).
+        ``paper``, ``reproduced`` (the runs' range as text, :func:`figure_4_14_range_text`),
+        ``basis`` ``"verdict"`` with ``agrees`` true when the reading reaches the print (the
+        registry derives the status), ``note``).
     reached : dict
         (label, quantity) -> True when the reading reaches the print.
 
@@ -280,7 +299,7 @@ def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1
             ok = bool(inside.mean() >= 0.5)
             reached[(label, q)] = ok
             rows.append(dict(quantity=f"{label} | {q}", unit=claim.loc[q, "unit"], paper=claim.loc[q, "value"],
-                             reproduced=f"{v.min():.2g}~{v.max():.2g}", status="analog" if ok else "not-reproduced",
+                             reproduced=figure_4_14_range_text(v), basis="verdict", agrees=ok,
                              note=f"runs with every axis inside: {int(inside.sum())} of {inside.size}"))
     return rows, reached
 
