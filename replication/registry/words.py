@@ -98,7 +98,7 @@ def stated_counts(paragraph: str) -> list[int]:
     """
     text = _NOTE_RE.sub(" ", paragraph)
     ref = r"\(?\d+(?:-\d+)?[a-z]?\)?"
-    text = re.sub(rf"(?:\b(?:Tables?|Figs?\.|eqs?\.|ch\.)|§)\s*{ref}(?:\s*(?:,|and|–|-|/)\s*{ref})*", " ", text)
+    text = re.sub(rf"(?:\b(?:Tables?|Figs?\.|eqs?\.|ch\.|[Cc]hapters?|[Ss]ections?)|§)\s*{ref}(?:\s*(?:,|and|–|-|/)\s*{ref})*", " ", text)
     text = re.sub(r"\b(?:the|no|a)\s+one\b", " ", text, flags=re.I)   # "the one reading" names, it does not count
     out = []
     for m in _COUNT_RE.finditer(text):
