@@ -354,7 +354,8 @@ def quat_normalize(q):
     1e-200) is first divided by its largest |component|, so that its direction is kept.
     """
     q = _quat(q)
-    n = np.linalg.norm(q, axis=-1, keepdims=True)
+    with np.errstate(over="ignore", under="ignore"):
+        n = np.linalg.norm(q, axis=-1, keepdims=True)
     odd = ~np.isfinite(n) | (n < 1e-150)          # squares beyond the float range: rescale first
     if not np.any(odd):
         return q / n
@@ -531,16 +532,20 @@ def orthonormalize(c):
     Raises
     ------
     ValueError
-        If det ``c`` ≤ 0: a reflection (a flipped axis, a left-handed frame) or a singular matrix is
-        near no rotation, and U V^T would be a reflection or arbitrary.
+        If ``c`` is a reflection (det < 0: a flipped axis, a left-handed frame) or singular (a singular
+        value below 1e-8 of the largest): near no rotation, U V^T would be a reflection or arbitrary.
     """
     c = matrix3(finite_array(c, "c"), "c")
-    det = np.linalg.det(c) if c.size else np.ones(c.shape[:-2])
-    if np.any(det <= 0):
-        k = np.unravel_index(int(np.argmin(det)), det.shape) if det.ndim else ()
-        at = f" at index {tuple(int(i) for i in k)}" if det.ndim else ""
-        raise ValueError(f"c must be near a rotation (det > 0), got det = {float(det[k]):.6g}{at}: a "
-                         f"{'singular matrix' if det[k] == 0 else 'reflection (a flipped axis or a left-handed frame)'} "
-                         "is near no rotation; check the signs and the order of its axes")
-    u, _, vt = np.linalg.svd(c)
-    return u @ vt
+    u, sv, vt = np.linalg.svd(c)
+    r = u @ vt
+    sign = np.linalg.det(r) if r.size else np.ones(c.shape[:-2])
+    flat = sv <= 1e-8 * sv[..., :1]             # the sign of a vanishing direction is round-off
+    bad = (sign < 0) | np.any(flat, axis=-1)
+    if np.any(bad):
+        k = np.unravel_index(int(np.argmax(bad)), bad.shape) if bad.ndim else ()
+        at = f" at index {tuple(int(i) for i in k)}" if bad.ndim else ""
+        what = ("singular or nearly so (singular values " + ", ".join(f"{x:.3g}" for x in sv[k]) + ")"
+                if np.any(flat[k]) else "a reflection (det < 0: a flipped axis or a left-handed frame)")
+        raise ValueError(f"c must be near a rotation, got a matrix that is {what}{at}; no rotation is near it: "
+                         "check the signs and the order of its axes")
+    return r

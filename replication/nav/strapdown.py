@@ -283,7 +283,9 @@ def validate_increments(dtheta, dv):
         raise ValueError(f"dtheta and dv must have the same shape (one gyro and one accelerometer increment "
                          f"per interval), got {dtheta.shape} and {dv.shape}")
     if not (_all_finite(dtheta) and _all_finite(dv)):
-        raise ValueError("increments contain NaN or infinite values")
+        name, a = ("dtheta", dtheta) if not _all_finite(dtheta) else ("dv", dv)
+        k = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+        raise ValueError(f"increments contain NaN or infinite values: {name}[{k[0]}, {k[1]}] = {a[k]!r}")
     if len(dtheta) and np.abs(dtheta).max() > np.pi:
         raise ValueError(f"dtheta must be angle increments of at most π rad per sample, got {np.abs(dtheta).max():.6g} "
                          "rad: a turn of more than half a revolution between two samples cannot be integrated (pass "
