@@ -45,6 +45,12 @@ def _cmd_status(args) -> int:
 
 def _cmd_show(args) -> int:
     tables = rp.resolve_table_ids(args.id)
+    for table_id in tables:                      # every table readable (CSV and sidecar) before any is printed
+        rp.load_table(table_id)
+        export = rp.tables_dir() / f"{table_id}.{args.format}"
+        if args.format != "csv" and not export.is_file():
+            raise rp.RegistryError(f"{export} does not exist: rebuild the exports with "
+                                   "replication.registry.reproduction.refresh_exports(), or restore it (git checkout)")
     for i, table_id in enumerate(tables):
         if len(tables) > 1:                      # an artifact covered by several tables: each in turn
             heading = f"{table_id} ({i + 1} of {len(tables)} tables covering {args.id})"
@@ -98,6 +104,10 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:                      # e.g. `python -m replication status | head`
         sys.stderr.close()
         return 0
+    except OSError as exc:                       # a file of the tables that cannot be read or written
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"error: {where}{exc.strerror or exc}; check the file's permissions and REPLICATION_ROOT", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

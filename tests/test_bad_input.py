@@ -129,6 +129,7 @@ PROBES = [
 
 _T1 = trajectory.generate([trajectory.Straight(1.0)], LAT, LON, H, speed=10.0)     # 1 s straight, 100 Hz
 _M15 = errors.model_15()
+_MC15 = errors.model_15(accel_bias_sd=1e-3, gyro_bias_sd=1e-6)   # every state with a variance: a defined NEES
 _R6 = np.diag([1.0, 1.0, 1.0, 0.01, 0.01, 0.01])
 _MV = {"straight": observability.Maneuver("straight", _T1, 1.0, 1.0)}
 _G1 = sensors.gnss_measurements(_T1, rate_hz=10.0, rng=0)
@@ -296,16 +297,16 @@ PROBES += [
     ("closed_loop(gnss sigma_pos = 0)", "sigma_pos",
      lambda: _closed_loop(gnss=sensors.gnss_measurements(_T1, rate_hz=10.0, sigma_pos=0.0, rng=0))),
     ("monte_carlo(model with a scale-factor block)", "accel_scale",
-     lambda: kalman.monte_carlo(_T1, _M15.extend(errors.accel_scale(100e-6)), n_runs=2)),
-    ("monte_carlo(n_runs = 0)", "n_runs", lambda: kalman.monte_carlo(_T1, _M15, n_runs=0)),
-    ("monte_carlo(n_runs = 2.5)", "n_runs", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2.5)),
-    ("monte_carlo(n_runs = '20')", "n_runs", lambda: kalman.monte_carlo(_T1, _M15, n_runs="20")),
-    ("monte_carlo(seed = -1)", "seed", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, seed=-1)),
-    ("monte_carlo(sigma_pos = -0.03)", "sigma_pos", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, sigma_pos=-0.03)),
-    ("monte_carlo(sigma_vel = nan)", "sigma_vel", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, sigma_vel=np.nan)),
+     lambda: kalman.monte_carlo(_T1, _MC15.extend(errors.accel_scale(100e-6)), n_runs=2)),
+    ("monte_carlo(n_runs = 0)", "n_runs", lambda: kalman.monte_carlo(_T1, _MC15, n_runs=0)),
+    ("monte_carlo(n_runs = 2.5)", "n_runs", lambda: kalman.monte_carlo(_T1, _MC15, n_runs=2.5)),
+    ("monte_carlo(n_runs = '20')", "n_runs", lambda: kalman.monte_carlo(_T1, _MC15, n_runs="20")),
+    ("monte_carlo(seed = -1)", "seed", lambda: kalman.monte_carlo(_T1, _MC15, n_runs=2, seed=-1)),
+    ("monte_carlo(sigma_pos = -0.03)", "sigma_pos", lambda: kalman.monte_carlo(_T1, _MC15, n_runs=2, sigma_pos=-0.03)),
+    ("monte_carlo(sigma_vel = nan)", "sigma_vel", lambda: kalman.monte_carlo(_T1, _MC15, n_runs=2, sigma_vel=np.nan)),
     ("monte_carlo(gnss_rate_hz = inf)", "gnss_rate_hz",
-     lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, gnss_rate_hz=np.inf)),
-    ("monte_carlo(workers = 0)", "workers", lambda: kalman.monte_carlo(_T1, _M15, n_runs=2, workers=0)),
+     lambda: kalman.monte_carlo(_T1, _MC15, n_runs=2, gnss_rate_hz=np.inf)),
+    ("monte_carlo(workers = 0)", "workers", lambda: kalman.monte_carlo(_T1, _MC15, n_runs=2, workers=0)),
     ("monte_carlo(model = '15-state')", "model", lambda: kalman.monte_carlo(_T1, "15-state", n_runs=2)),
     ("closedloop.build_spec(R_pos with NaN)", "R_pos",
      lambda: _build_spec(model=_M15, R_pos=np.diag([np.nan, 1.0, 1.0]))),
@@ -668,7 +669,7 @@ _CALLS = {
                            {"record_every": "count", "chunk_epochs": "count", "workers": "count",
                             "series_order": "count", "store_nav": "option", "store_P": "option"}),
     "closedloop.Smoother": (closedloop.Smoother, dict(), {"form": "option", "covariance": "option"}),
-    "kalman.monte_carlo": (kalman.monte_carlo, dict(traj=_T1, model=_M15, n_runs=2, workers=1),
+    "kalman.monte_carlo": (kalman.monte_carlo, dict(traj=_T1, model=_MC15, n_runs=2, workers=1),
                            {"traj": "object", "model": "object", "n_runs": "count", "seed": "seed",
                             "gnss_rate_hz": "rate", "sigma_pos": "gnss_sd", "sigma_vel": "gnss_sd",
                             "vertical": "option", "workers": "count"}),

@@ -202,6 +202,9 @@ def test_mechanize_refuses_non_finite_inputs_with_their_name():
         h[3] = bad
         with pytest.raises(ValueError, match="h_ref contains NaN"):
             sd.mechanize(traj.t, traj.dtheta, traj.dv, init, vertical=sd.VerticalChannel("hold", h_ref=h))
-    # large finite increments are finite, even where their sum overflows
+    # large finite increments (whose sum overflows) are refused for their size, not taken for NaN
     big = np.full_like(traj.dv, 1e308)
-    assert sd.validate_increments(traj.dtheta, big)[1] is not None
+    with pytest.raises(ValueError, match=r"dv must be velocity increments of at most .* got 1e\+308"):
+        sd.validate_increments(traj.dtheta, big)
+    with pytest.raises(ValueError, match=r"dtheta must be angle increments of at most π rad"):
+        sd.validate_increments(np.full_like(traj.dtheta, 4.0), traj.dv)

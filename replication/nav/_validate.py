@@ -18,8 +18,9 @@ from typing import Any, Collection
 import numpy as np
 
 __all__ = ["positive", "nonnegative", "finite", "vector3", "matrix3", "components", "choice", "numeric",
-           "finite_array", "nonnegative_array", "rotation", "covariance", "integer", "probability",
-           "ORTHONORMAL_TOL", "COVARIANCE_TOL"]
+           "finite_array", "nonnegative_array", "rotation", "covariance", "positive_definite", "integer", "probability",
+           "angle_array", "finite_result", "series_order", "ORTHONORMAL_TOL", "COVARIANCE_TOL", "ANGLE_LIMIT",
+           "MAX_SERIES_ORDER"]
 
 ORTHONORMAL_TOL = 1e-6
 """Largest element of |C Cᵀ - I| (and |det C - 1|) accepted for a rotation matrix. Float64 round-off of a
@@ -33,9 +34,22 @@ COVARIANCE_TOL = 1e-9
 (≈ 1e-14 for n ≤ 45), and a propagated covariance carries a few such round-offs; a negative
 eigenvalue beyond 1e-9 of the largest is a wrong input (a negative variance, a sign lost)."""
 
+ANGLE_LIMIT = 1e7
+"""Largest |angle| (rad) accepted where an angle is turned into a rotation: 1e7 rad is 1.6 million turns,
+where float64 numbers are still spaced 1.9e-9 rad (0.4 mas) apart, finer than any gyro resolves; beyond
+2**52 rad (4.5e15) their spacing exceeds a radian and the angle no longer has a direction at all, and
+1e300 rad is a unit mistake or an integration that overflowed, not an angle."""
+
+MAX_SERIES_ORDER = 64
+"""Most terms of the truncated exponential series Φ = Σ (F dt)^k / k! (``kalman.discretize_series``,
+``ErrorModel.propagate_linear``): the k-th term is ‖F dt‖^k / k!, below float64 round-off of the first
+for k ≈ 20 when ‖F dt‖ ≤ 1 and for k = 64 when ‖F dt‖ ≤ 8; a step that needs more is one for the matrix
+exponential (``kalman.van_loan``), and an order of 1e9 would only keep the compiled loop busy."""
+
 
 def numeric(value, name: str) -> np.ndarray:
-    """``value`` as a float array; ``TypeError`` naming the argument for text, ``None`` and objects.
+    """``value`` as a float array; ``TypeError`` naming the argument for text, ``None``, objects, complex
+    numbers and booleans (a mask passed where values belong would count as 0 and 1).
 
     Parameters
     ----------
@@ -55,9 +69,12 @@ def numeric(value, name: str) -> np.ndarray:
         a = np.asarray(value)
     except ValueError as exc:                                   # ragged nested sequences
         raise ValueError(f"{name} must be a number or a rectangular array of numbers: {exc}") from None
-    if a.dtype.kind not in "biuf":
-        raise TypeError(f"{name} must be a number or an array of numbers, got {type(value).__name__} "
-                        f"{value!r:.40}")
+    if a.dtype.kind == "b":
+        raise TypeError(f"{name} must be a number or an array of numbers, got booleans {value!r:.40}; "
+                        "pass the numbers themselves (a mask or a flag is not a value)")
+    if a.dtype.kind not in "iuf":
+        what = "complex numbers" if a.dtype.kind == "c" else f"{type(value).__name__}"
+        raise TypeError(f"{name} must be a number or an array of real numbers, got {what} {value!r:.40}")
     return a.astype(float, copy=False)
 
 
@@ -198,12 +215,133 @@ def covariance(value, name: str, n: int | None = None, tol: float = COVARIANCE_T
     return m
 
 
+def positive_definite(value, name: str, n: int | None = None, tol: float = COVARIANCE_TOL) -> np.ndarray:
+    """Covariance matrices that can be inverted: finite, symmetric, positive definite (any leading axes).
+
+    What a normalised error eᵀ P⁻¹ e (NEES, NIS) or a gain needs: a zero variance (a prior that
+    fixes a state exactly, a measurement without noise of a state without uncertainty) or a
+    correlation of ±1 makes the inverse, and the statistic, undefined. Symmetry as in
+    :func:`covariance`; definiteness by a Cholesky factorization of each matrix scaled to its
+    correlation matrix, so that variances spanning many decades do not matter.
+
+    Parameters
+    ----------
+    value : array_like
+        The argument, shape (..., n, n).
+    name : str
+        Its name for the error message.
+    n : int, optional
+        The required size.
+    tol : float, optional
+        Relative tolerance of the symmetry (default :data:`COVARIANCE_TOL`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``value`` as a float array (unchanged).
+
+    Raises
+    ------
+    TypeError
+        For text, booleans or complex numbers.
+    ValueError
+        For another shape, a non-finite element, asymmetry, a variance that is not positive or a
+        matrix that is singular or indefinite (naming the first such matrix of a batch).
+    """
+    m = finite_array(value, name)
+    if m.ndim < 2 or m.shape[-1] != m.shape[-2] or (n is not None and m.shape[-1] != n):
+        size = "square matrices" if n is None else f"{n}×{n}"
+        raise ValueError(f"{name} must be {size} (trailing shape), got shape {m.shape}")
+    if m.size == 0:
+        return m
+    where = (lambda k: "" if m.ndim == 2 else f" (matrix {tuple(int(i) for i in np.unravel_index(k, m.shape[:-2]))})")
+    flat = m.reshape(-1, m.shape[-1], m.shape[-1])
+    diag = np.diagonal(flat, axis1=-2, axis2=-1)
+    low = diag <= 0
+    if np.any(low):
+        k, i = (int(j) for j in np.argwhere(low)[0])
+        raise ValueError(f"{name} must be positive definite: its variance [{i}, {i}] is {diag[k, i]:.6g}{where(k)}; "
+                         "a zero variance (a prior or a noise that fixes a state exactly) makes the inverse, "
+                         "and the normalised error, undefined: give that state a positive variance")
+    asym = np.abs(flat - np.swapaxes(flat, -1, -2)).max(axis=(-2, -1))
+    bad = asym > tol * np.abs(diag).max(axis=-1)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        raise ValueError(f"{name} must be symmetric (a covariance), max|M - Mᵀ| = {asym[k]:.3g}{where(k)}")
+    d = np.sqrt(diag)
+    corr = flat / (d[:, :, None] * d[:, None, :])
+    try:
+        np.linalg.cholesky(corr)
+    except np.linalg.LinAlgError:
+        lam = np.linalg.eigvalsh(corr)[:, 0]
+        k = int(np.argmin(lam))
+        raise ValueError(f"{name} must be positive definite: its correlation matrix has the eigenvalue "
+                         f"{lam[k]:.3g}{where(k)} (a correlation of ±1, or beyond: a singular or indefinite "
+                         "covariance); the normalised error is undefined") from None
+    return m
+
+
+def angle_array(value, name: str, limit: float = ANGLE_LIMIT) -> np.ndarray:
+    """Finite angles (rad) no larger in magnitude than ``limit`` (default :data:`ANGLE_LIMIT`).
+
+    Parameters
+    ----------
+    value : float or array_like
+        The argument (radians).
+    name : str
+        Its name for the error message.
+    limit : float, optional
+        The largest accepted |angle| (rad).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``value`` as a float array; ``TypeError`` as :func:`numeric`, ``ValueError`` for NaN,
+        infinity or an angle beyond the limit.
+    """
+    a = finite_array(value, name)
+    big = np.abs(a) > limit
+    if np.any(big):
+        raise ValueError(f"{name} must be an angle of at most {limit:g} rad in magnitude, got {a[big].flat[0]!r}: "
+                         "beyond it float64 cannot hold its direction (radians expected; a value this large is a "
+                         "unit mistake or an overflowed integration)")
+    return a
+
+
+def finite_result(value, message: str) -> np.ndarray:
+    """``value`` (a result computed from finite, checked inputs) if every element is finite.
+
+    The one guard against overflow of a product or an exponential that no single input shows:
+    finite inputs whose result is infinite or NaN raise ``ValueError`` with ``message``, which
+    should name the inputs and what to pass instead.
+
+    Parameters
+    ----------
+    value : float or array_like
+        The result.
+    message : str
+        The error message.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``value`` unchanged.
+    """
+    if not np.all(np.isfinite(value)):
+        raise ValueError(message)
+    return value
+
+
 def _number(value, name: str, what: str, ok, message: str | None) -> float:
     """``float(value)`` if it is finite and ``ok(value)``; else ``ValueError`` saying ``what`` it must be
     (``TypeError`` for text)."""
     if isinstance(value, (str, bytes)):
         raise TypeError(f"{name} must be {what}, got text {value!r:.40}")
-    value = float(value)
+    if isinstance(value, (bool, np.bool_, complex, np.complexfloating)) or value is None:
+        raise TypeError(f"{name} must be {what}, got {type(value).__name__} {value!r:.40}")
+    if np.ndim(value) != 0:
+        raise ValueError(f"{name} must be a single number ({what}), got shape {np.shape(value)}")
+    value = float(numeric(value, name))
     if not (np.isfinite(value) and ok(value)):
         text = f"{{name}} must be {what}, got {{value!r}}" if message is None else message
         raise ValueError(text.format(name=name, value=value))
@@ -270,6 +408,28 @@ def integer(value, name: str, minimum: int = 1, message: str | None = None) -> i
     return int(value)
 
 
+def series_order(value, name: str = "order") -> int:
+    """The number of terms of a truncated exponential series: a whole number in 1 … :data:`MAX_SERIES_ORDER`.
+
+    Parameters
+    ----------
+    value : int-like
+        The argument.
+    name : str, optional
+        Its name for the error message.
+
+    Returns
+    -------
+    int
+        ``int(value)``; errors as :func:`integer`, and ``ValueError`` above the limit.
+    """
+    order = integer(value, name, 1, "{name} must be a positive integer (terms of the series), got {value!r}")
+    if order > MAX_SERIES_ORDER:
+        raise ValueError(f"{name} must be at most {MAX_SERIES_ORDER} terms, got {order}: where the series needs more, "
+                         "‖F dt‖ is too large for it; use kalman.van_loan (the matrix exponential) or shorter steps")
+    return order
+
+
 def probability(value, name: str, message: str | None = None) -> float:
     """A number strictly between 0 and 1 (a significance level, a confidence, a probability of a band).
 
@@ -325,10 +485,12 @@ def matrix3(value, name: str) -> np.ndarray:
 
     Raises
     ------
+    TypeError
+        For text, booleans, complex numbers and objects.
     ValueError
         If the trailing shape is not (3, 3).
     """
-    m = np.asarray(value, dtype=float)
+    m = numeric(value, name)
     if m.shape[-2:] != (3, 3):
         raise ValueError(f"{name} must have trailing shape (3, 3), got shape {m.shape}")
     return m

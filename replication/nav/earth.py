@@ -14,7 +14,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from replication.nav._validate import vector3
+from replication.nav._validate import numeric, vector3
 
 # --- defining and derived WGS-84 constants (NIMA TR8350.2 tables 3.1, 3.3) ---------------
 A = 6378137.0
@@ -46,11 +46,12 @@ POLAR_LIMIT_DEG = 89.9
 
 
 def _numbers(x, name):
-    """``x`` as a float array; refuses text and other non-numbers instead of converting them."""
-    a = np.asarray(x)
-    if a.dtype.kind not in "biuf":
-        raise ValueError(f"{name} must be a number or an array of numbers, not {type(x).__name__} {x!r:.40}")
-    return a.astype(float)
+    """``x`` as a (new) float array; refuses text, booleans, complex numbers and other non-numbers
+    (:func:`replication.nav._validate.numeric`) with this module's ``ValueError``."""
+    try:
+        return numeric(x, name).astype(float)
+    except TypeError as exc:
+        raise ValueError(str(exc)) from None
 
 
 HEIGHT_RANGE = (-11000.0, 100000.0)

@@ -42,9 +42,21 @@ import numpy as np
 
 from replication.nav import _kernels as K
 from replication.nav import earth
-from replication.nav._validate import choice, covariance, finite_array, nonnegative_array, numeric, positive, rotation, vector3
+from replication.nav._validate import (
+    choice,
+    covariance,
+    finite_array,
+    finite_result,
+    nonnegative_array,
+    numeric,
+    positive,
+    rotation,
+    series_order,
+    vector3,
+)
 from replication.nav.rotations import euler_to_dcm, rotvec_to_dcm
 from replication.nav.strapdown import NavState, navigation_rates
+from replication.nav.trajectory import Trajectory
 
 __all__ = ["StateBlock", "ErrorModel", "NavPoint", "nav_block_labels", "accel_bias", "gyro_bias",
            "accel_markov", "gyro_markov", "accel_scale", "gyro_scale", "accel_misalignment",
@@ -138,7 +150,7 @@ class StateBlock:
             object.__setattr__(self, attr, arr)
         finite_array(self.dynamics, f"block {self.name!r}: dynamics")
         covariance(self.noise_psd, f"block {self.name!r}: noise_psd")
-        nonnegative_array(self.sd, f"block {self.name!r}: sd")
+        _variances(self.sd, f"block {self.name!r}: sd")
         if self.target == "gravity":
             out = np.eye(3, k) if self.output is None else np.asarray(self.output, float)
             if out.shape != (3, k):
@@ -270,7 +282,7 @@ class ErrorModel:
         self.nav_sd = numeric(self.nav_sd, "nav_sd")
         if self.nav_sd.shape != (9,):
             raise ValueError("nav_sd needs 9 standard deviations (δL, δλ, δh, δv ENU, φ ENU)")
-        nonnegative_array(self.nav_sd, "nav_sd")
+        _variances(self.nav_sd, "nav_sd")
 
     # -- layout
     @property
@@ -533,15 +545,22 @@ class ErrorModel:
 
         Raises
         ------
+        TypeError
+            For a ``traj`` that is not a Trajectory, or text, booleans or complex numbers in ``x0``.
         ValueError
-            For an ``x0`` of another length or a ``step`` that is not a positive integer.
+            For an ``x0`` of another length or with a NaN or an infinity, a ``step`` that is not a
+            positive integer, an ``order`` outside 1 … 64.
         """
-        x = np.asarray(x0, float).copy()
+        if not isinstance(traj, Trajectory):
+            raise TypeError(f"traj must be a trajectory.Trajectory (trajectory.generate), got {type(traj).__name__}")
+        x = finite_array(x0, "x0").copy()
         if x.shape != (self.n,):
-            raise ValueError(f"x0 must have {self.n} components ({self.labels})")
-        if isinstance(step, bool) or int(step) != step or step < 1:
+            raise ValueError(f"x0 must have {self.n} components ({self.labels}), got shape {x.shape}")
+        if isinstance(step, bool) or not isinstance(step, (int, float, np.integer, np.floating)) \
+                or int(step) != step or step < 1:
             raise ValueError(f"step must be a positive integer number of samples per interval, got {step!r}")
         step = int(step)
+        order = series_order(order, "order")
         fconst, _, tg, kd, st, sz = self.kernel_encoding()
         n = self.n
         idx = np.arange(0, traj.n + 1, step)
@@ -570,10 +589,20 @@ class ErrorModel:
             K.discretize_series(Fa, Z, traj.t[k1] - traj.t[k0], order, Phi, Qd, w1, w2)
             x = Phi @ x
             out[j] = x
-        return idx, out
+        return idx, finite_result(out, "the propagated error state overflows the float range: check the units of x0 "
+                                       "(state units: rad, m, m/s, rad, then the blocks')")
 
 
 # ----------------------------------------------------------------------------- block factories
+
+def _variances(sd, name):
+    """Non-negative standard deviations whose squares (the variances of P0) stay in the float range."""
+    sd = nonnegative_array(sd, name)
+    with np.errstate(over="ignore"):
+        finite_result(sd * sd, f"{name} holds standard deviations up to {float(np.max(sd, initial=0)):.3g}: their "
+                               "squares (the variances of P0) overflow the float range; check the unit")
+    return sd
+
 
 def _diag3(x, name):
     return np.diag(np.broadcast_to(nonnegative_array(x, name), (3,)))
@@ -628,6 +657,8 @@ def gyro_bias(sd=0.0, *, name="gyro_bias", random_walk_psd=0.0):
 
 def _markov(target, sigma, tau, name):
     tau = positive(tau, "tau", "correlation time {name} must be positive (seconds), got {value!r}")
+    if tau < 1e-300:
+        raise ValueError(f"correlation time tau = {tau!r} s is too small: the rate 1/tau overflows the float range")
     s = _sd(sigma, "sigma")
     return StateBlock(name, ("x", "y", "z"), target, "identity", dynamics=-np.eye(3) / tau,
                       noise_psd=np.diag(2 * s**2 / tau), sd=s, fd_step=1e-2 if target == "accel" else 1e-5)

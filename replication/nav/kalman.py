@@ -28,7 +28,19 @@ from replication.nav import _kernels as K
 from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import parallel as PAR
-from replication.nav._validate import choice, components, covariance, finite_array, integer, numeric, positive
+from replication.nav._validate import (
+    choice,
+    components,
+    covariance,
+    finite_array,
+    finite_result,
+    integer,
+    numeric,
+    positive,
+    positive_definite,
+    probability,
+    series_order,
+)
 from replication.nav.errors import ErrorModel
 from replication.nav.rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from replication.nav.sensors import GnssMeasurements, ImuErrors, gnss_measurements
@@ -95,10 +107,20 @@ def van_loan(F, GQGt, dt):
     M[:n, :n] = -F
     M[:n, n:] = Q
     M[n:, n:] = F.T
-    E = scipy.linalg.expm(M * dt)
-    Phi = E[n:, n:].T
-    Qd = Phi @ E[:n, n:]
+    with np.errstate(over="ignore", invalid="ignore"):
+        E = scipy.linalg.expm(M * dt)
+        Phi = E[n:, n:].T
+        Qd = Phi @ E[:n, n:]
+    _finite_transition(Phi, Qd, F, dt)
     return Phi, 0.5 * (Qd + Qd.T)
+
+
+def _finite_transition(Phi, Qd, F, dt):
+    """Refuse a (Φ, Q_d) that overflowed: exp(F dt) beyond the float range."""
+    finite_result(Phi, f"Phi = exp(F dt) overflows the float range (max|F| dt = {np.abs(F).max() * dt:.3g}): "
+                       "check the units of F (1/s) and dt (s), or split dt into shorter steps")
+    finite_result(Qd, f"Qd overflows the float range (max|F| dt = {np.abs(F).max() * dt:.3g}): check the units "
+                      "of F (1/s), GQGt and dt (s), or split dt into shorter steps")
 
 
 def discretize_series(F, GQGt, dt, order: int = 4):
@@ -116,7 +138,7 @@ def discretize_series(F, GQGt, dt, order: int = 4):
     dt : float
         Time step [s], positive.
     order : int, optional
-        Number of terms of the series (≥ 1), default 4.
+        Number of terms of the series (1 … ``_validate.MAX_SERIES_ORDER`` = 64), default 4.
 
     Returns
     -------
@@ -130,10 +152,12 @@ def discretize_series(F, GQGt, dt, order: int = 4):
     if Q.shape != F.shape:
         raise ValueError(f"F {F.shape} and GQGt {Q.shape} must have the same shape")
     dt = positive(dt, "dt", "{name} must be a positive finite time step (s), got {value!r}")
-    order = integer(order, "order", 1, "{name} must be a positive integer (terms of the series), got {value!r}")
+    order = series_order(order, "order")
     n = F.shape[0]
     Phi, Qd, w1, w2 = (np.empty((n, n)) for _ in range(4))
-    K.discretize_series(F, Q, float(dt), int(order), Phi, Qd, w1, w2)
+    with np.errstate(over="ignore", invalid="ignore"):
+        K.discretize_series(F, Q, float(dt), int(order), Phi, Qd, w1, w2)
+    _finite_transition(Phi, Qd, F, dt)
     return Phi, Qd
 
 
@@ -163,8 +187,11 @@ def predict(x, P, Phi, Qd):
     P = covariance(P, "P", n)
     Phi = finite_array(Phi, "Phi", (n, n))
     Qd = covariance(Qd, "Qd", n)
-    x = Phi @ x
-    P = Phi @ P @ Phi.T + Qd
+    with np.errstate(over="ignore", invalid="ignore"):
+        x = Phi @ x
+        P = Phi @ P @ Phi.T + Qd
+    finite_result(x, "the predicted state Phi x overflows the float range: check the units of x and Phi")
+    finite_result(P, "the predicted covariance Phi P Phiᵀ + Qd overflows the float range: check the units of P and Phi")
     return x, 0.5 * (P + P.T)
 
 
@@ -219,7 +246,11 @@ def update(x, P, z, H, R):
     nu = z - H @ x
     S = H @ P @ H.T + R
     S = 0.5 * (S + S.T)
-    Kg = scipy.linalg.solve(S, H @ P, assume_a="pos").T
+    try:
+        Kg = scipy.linalg.solve(S, H @ P, assume_a="pos").T
+    except np.linalg.LinAlgError:
+        raise ValueError("the innovation covariance S = H P Hᵀ + R is singular: a measurement without noise (R) of "
+                         "states without variance (P) has no gain; give R or P a positive variance") from None
     x = x + Kg @ nu
     A = np.eye(n) - Kg @ H
     P = A @ P @ A.T + Kg @ R @ Kg.T
@@ -254,13 +285,29 @@ def rts_smoother(x_f, P_f, x_p, P_p, Phi):
 
     Raises
     ------
+    TypeError
+        For text, booleans or complex numbers.
     ValueError
-        When the inputs do not have one entry per epoch (N - 1 transitions).
+        When the inputs do not have one entry per epoch (N - 1 transitions), hold a NaN or an
+        infinity, a P_f that is not a covariance or a P_p (from index 1) that cannot be inverted.
     """
-    x_f, P_f, x_p, P_p, Phi = (np.asarray(a, float) for a in (x_f, P_f, x_p, P_p, Phi))
-    N = len(x_f)
-    if not (len(P_f) == len(x_p) == len(P_p) == N) or len(Phi) < N - 1:
-        raise ValueError("x_f, P_f, x_p, P_p need one entry per epoch and Phi one per transition (N-1)")
+    x_f = finite_array(x_f, "x_f")
+    if x_f.ndim != 2:
+        raise ValueError(f"x_f must have shape (N, n): one filtered state per epoch, got shape {x_f.shape}")
+    N, n = x_f.shape
+    x_p = finite_array(x_p, "x_p", (N, n))
+    P_f = finite_array(P_f, "P_f", (N, n, n))
+    P_p = numeric(P_p, "P_p")
+    if P_p.shape != (N, n, n):
+        raise ValueError(f"P_p must have shape {(N, n, n)}, got shape {P_p.shape}")
+    Phi = finite_array(Phi, "Phi")
+    if Phi.ndim != 3 or Phi.shape[1:] != (n, n) or len(Phi) < N - 1:
+        raise ValueError(f"Phi must have shape ({N - 1}, {n}, {n}): one transition per pair of epochs, got shape "
+                         f"{Phi.shape}")
+    for k in range(N):
+        covariance(P_f[k], f"P_f[{k}]")
+    if N > 1:
+        positive_definite(P_p[1:], "P_p[1:]")      # index 0 unused
     x_s = x_f.copy()
     P_s = P_f.copy()
     for k in range(N - 2, -1, -1):
@@ -291,18 +338,21 @@ def nees(e, P):
     Raises
     ------
     ValueError
-        For mismatched shapes or a non-positive variance.
+        For mismatched shapes, a NaN, or a P that cannot be inverted (a zero variance, a
+        correlation of ±1, an indefinite or asymmetric matrix), for which the NEES is undefined.
     """
     e = finite_array(e, "e")
     P = finite_array(P, "P")
     if P.shape[-2:] != e.shape[-1:] * 2:
         raise ValueError(f"P must have trailing shape {e.shape[-1:] * 2} for e of shape {e.shape}, got {P.shape}")
-    if np.any(np.diagonal(P, axis1=-2, axis2=-1) <= 0):
-        raise ValueError("P must have a positive diagonal (variances) to normalise the error")
+    positive_definite(P, "P")
     d = np.sqrt(np.diagonal(P, axis1=-2, axis2=-1))
     Rn = P / (d[..., :, None] * d[..., None, :])
-    y = np.linalg.solve(Rn, (e / d)[..., None])[..., 0]
-    return np.sum((e / d) * y, -1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        y = np.linalg.solve(Rn, (e / d)[..., None])[..., 0]
+        out = np.sum((e / d) * y, -1)
+    return finite_result(out, "the NEES eᵀ P⁻¹ e overflows the float range: e is beyond 1e150 standard deviations; "
+                              "check that e and P are in the same units")
 
 
 def nis(nu, S):
@@ -319,10 +369,21 @@ def nis(nu, S):
     -------
     nis : ndarray, shape (...)
         νᵀ S⁻¹ ν (dimensionless).
+
+    Raises
+    ------
+    ValueError
+        For mismatched shapes, a NaN, or an S that cannot be inverted (the NIS is undefined).
     """
     nu = finite_array(nu, "nu")
     S = finite_array(S, "S")
-    return np.sum(nu * np.linalg.solve(S, nu[..., None])[..., 0], -1)
+    if S.shape[-2:] != nu.shape[-1:] * 2:
+        raise ValueError(f"S must have trailing shape {nu.shape[-1:] * 2} for nu of shape {nu.shape}, got {S.shape}")
+    positive_definite(S, "S")
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = np.sum(nu * np.linalg.solve(S, nu[..., None])[..., 0], -1)
+    return finite_result(out, "the NIS νᵀ S⁻¹ ν overflows the float range: nu is beyond 1e150 standard deviations; "
+                              "check that nu and S are in the same units")
 
 
 def chi2_band(dof: int, n_runs: int = 1, prob: float = 0.95):
@@ -346,11 +407,16 @@ def chi2_band(dof: int, n_runs: int = 1, prob: float = 0.95):
 
     Raises
     ------
+    TypeError
+        For text or booleans.
     ValueError
-        For ``dof`` or ``n_runs`` below 1 or ``prob`` outside (0, 1).
+        For ``dof`` or ``n_runs`` not a whole number ≥ 1 or ``prob`` outside (0, 1).
     """
-    if dof < 1 or n_runs < 1 or not 0 < prob < 1:
-        raise ValueError("dof and n_runs must be ≥ 1 and 0 < prob < 1")
+    dof, n_runs = integer(dof, "dof"), integer(n_runs, "n_runs")
+    prob = probability(prob, "prob")
+    if dof * n_runs > 2**53:
+        raise ValueError(f"n_runs × dof = {dof * n_runs:.3g} is beyond 2**53, where the χ² quantiles cannot be "
+                         "computed; pass the number of runs averaged (n_runs) and one run's degrees of freedom (dof)")
     a = (1 - prob) / 2
     N = n_runs * dof
     return stats.chi2.ppf(a, N) / n_runs, stats.chi2.ppf(1 - a, N) / n_runs
@@ -501,6 +567,16 @@ def _reference(value, name: str, n: int) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(value, (n,)), float)
 
 
+def _nees_prior(P0, model: ErrorModel, name: str) -> None:
+    """Refuse a prior for which the NEES is undefined (a zero variance or a singular P0), naming the states."""
+    d = np.diagonal(P0)
+    zero = [model.labels[i] for i in np.flatnonzero(d <= 0)]
+    if zero:
+        raise ValueError(f"{name} gives the states {zero} zero variance: the NEES eᵀ P⁻¹ e is then undefined; give "
+                         "them a positive standard deviation in the model (e.g. model_15(position_sd=...))")
+    positive_definite(P0, name)
+
+
 def _gnss_noise(value, name: str) -> np.ndarray:
     """The filter's GNSS noise covariance diag(sd²) (3×3) from positive finite standard deviations ``value``."""
     sd = components(value, name)
@@ -578,6 +654,7 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     _prepare(t, dtheta, dv, gnss, model, n)
     if not isinstance(initial, NavState):
         raise TypeError(f"initial must be a strapdown.NavState, got {type(initial).__name__}")
+    initial.validate(name="initial")
     use = _gnss_rows_used(use)
     vc = vertical_channel(vertical)
     href, vuref = _reference(vc.h_ref, "h_ref", n + 1), _reference(vc.vu_ref, "vu_ref", n + 1)
@@ -598,6 +675,7 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
             raise TypeError(f"truth must be a trajectory.Trajectory on the IMU samples, got {type(truth).__name__}")
         if len(truth.t) != n + 1:
             raise ValueError("truth must have the same samples as the IMU record")
+        _nees_prior(P0, model, "P0 (the model's prior when P0 is not given)")
         tst = np.column_stack([truth.lat[idx], truth.lon[idx], truth.h[idx], truth.v_enu[idx]])
         tq = dcm_to_quat(euler_to_dcm(truth.hpr[idx, 0], truth.hpr[idx, 1], truth.hpr[idx, 2]))
         if true_params is not None:
@@ -667,6 +745,10 @@ def perturb_state(state: NavState, model: ErrorModel, rng=None) -> NavState:
     state : NavState
         The perturbed state.
     """
+    if not isinstance(state, NavState):
+        raise TypeError(f"state must be a strapdown.NavState, got {type(state).__name__}")
+    if not isinstance(model, ErrorModel):
+        raise TypeError(f"model must be an errors.ErrorModel, got {type(model).__name__}")
     rng = np.random.default_rng(rng)
     d = model.nav_sd * rng.standard_normal(9)
     C = rotvec_to_dcm(-d[6:9]) @ state.C_bn
@@ -876,6 +958,7 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
         raise ValueError(f"monte_carlo puts only the constant accel_bias and gyro_bias into the simulated data; the "
                          f"model's other blocks {others} would be estimated against truths the data do not carry "
                          "(use a model_15 model here; chen2019.simulation.run_batch simulates the extended models)")
+    _nees_prior(model.P0(), model, "model.P0()")
     n = traj.n
     _reference(vertical.h_ref, "h_ref", n + 1), _reference(vertical.vu_ref, "vu_ref", n + 1)
     opts = dict(gnss_rate_hz=gnss_rate_hz, sigma_pos=sigma_pos, sigma_vel=sigma_vel, vertical=vertical)

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from replication.nav._validate import finite_array, matrix3, rotation, vector3
+from replication.nav._validate import angle_array, finite_array, finite_result, matrix3, rotation, vector3
 
 __all__ = [
     "skew", "vee", "euler_to_dcm", "dcm_to_euler", "rotvec_to_dcm", "dcm_to_rotvec",
@@ -41,6 +41,11 @@ __all__ = [
 
 def _vec3(v, name):
     return vector3(v, name)
+
+
+def _rotvec(phi, name="phi"):
+    """A rotation vector: finite 3-vectors whose components are angles (:func:`_validate.angle_array`)."""
+    return angle_array(vector3(phi, name), name)
 
 
 def _quat(q, name="q"):
@@ -111,10 +116,11 @@ def euler_to_dcm(heading, pitch, roll):
     Raises
     ------
     ValueError
-        If a pitch exceeds ±90° (e.g. degrees passed instead of radians).
+        If an angle is not finite, a pitch exceeds ±90° (e.g. degrees passed instead of radians) or a
+        heading or roll exceeds ``_validate.ANGLE_LIMIT`` in magnitude.
     """
-    h, p, r = np.broadcast_arrays(*(finite_array(a, n) for a, n in ((heading, "heading"), (pitch, "pitch"),
-                                                                   (roll, "roll"))))
+    h, p, r = np.broadcast_arrays(*(angle_array(a, n) for a, n in ((heading, "heading"), (pitch, "pitch"),
+                                                                  (roll, "roll"))))
     if np.any(np.abs(p) > np.pi / 2 + 1e-12):
         raise ValueError("pitch must lie within ±90° (radians expected; convert degrees with np.radians)")
     sh, ch = np.sin(h), np.cos(h)
@@ -171,8 +177,13 @@ def rotvec_to_dcm(phi):
     -------
     C : ndarray, shape (..., 3, 3)
         The rotation matrix exp(φ×).
+
+    Raises
+    ------
+    ValueError
+        If a component is not finite or exceeds ``_validate.ANGLE_LIMIT`` in magnitude.
     """
-    phi = _vec3(phi, "phi")
+    phi = _rotvec(phi)
     a2 = np.sum(phi * phi, -1)
     a = np.sqrt(a2)
     small = a2 < 1e-8
@@ -291,12 +302,15 @@ def quat_multiply(p, q):
     p, q = _quat(p, "p"), _quat(q, "q")
     a1, b1, c1, d1 = (p[..., i] for i in range(4))
     a2, b2, c2, d2 = (q[..., i] for i in range(4))
-    return np.stack([
-        a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2,
-        a1 * b2 + b1 * a2 + c1 * d2 - d1 * c2,
-        a1 * c2 - b1 * d2 + c1 * a2 + d1 * b2,
-        a1 * d2 + b1 * c2 - c1 * b2 + d1 * a2,
-    ], -1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        pq = np.stack([
+            a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2,
+            a1 * b2 + b1 * a2 + c1 * d2 - d1 * c2,
+            a1 * c2 - b1 * d2 + c1 * a2 + d1 * b2,
+            a1 * d2 + b1 * c2 - c1 * b2 + d1 * a2,
+        ], -1)
+    return finite_result(pq, "p ⊗ q overflows the float range: the magnitudes of p and q multiply; normalise "
+                             "them first (quat_normalize)")
 
 
 def quat_conjugate(q):
@@ -333,12 +347,23 @@ def quat_normalize(q):
     ------
     ValueError
         If a quaternion is zero.
+
+    Notes
+    -----
+    A quaternion whose squared components overflow or underflow the float range (|q| near 1e200 or
+    1e-200) is first divided by its largest |component|, so that its direction is kept.
     """
     q = _quat(q)
-    n = np.linalg.norm(q, axis=-1, keepdims=True)
-    if np.any(n == 0):
-        raise ValueError("a zero quaternion cannot represent an attitude")
-    return q / n
+    with np.errstate(over="ignore", under="ignore"):
+        n = np.linalg.norm(q, axis=-1, keepdims=True)
+    odd = ~np.isfinite(n) | (n < 1e-150)          # squares beyond the float range: rescale first
+    if not np.any(odd):
+        return q / n
+    s = np.max(np.abs(q), axis=-1, keepdims=True)
+    if np.any(s == 0):
+        raise ValueError("q must be a non-zero quaternion: a zero quaternion cannot represent an attitude")
+    qs = q / s
+    return np.where(odd, qs / np.linalg.norm(qs, axis=-1, keepdims=True), q / np.where(odd, 1.0, n))
 
 
 def rotvec_to_quat(phi):
@@ -353,8 +378,13 @@ def rotvec_to_quat(phi):
     -------
     q : ndarray, shape (..., 4)
         Unit quaternion, scalar first.
+
+    Raises
+    ------
+    ValueError
+        If a component is not finite or exceeds ``_validate.ANGLE_LIMIT`` in magnitude.
     """
-    phi = _vec3(phi, "phi")
+    phi = _rotvec(phi)
     a = np.linalg.norm(phi, axis=-1)
     half = 0.5 * a
     small = a < 1e-6
@@ -471,8 +501,8 @@ def body_rate_from_euler_rates(heading, pitch, roll, heading_rate, pitch_rate, r
     w_nb_b : ndarray, shape (..., 3)
         Body rate ω_nb^b [rad/s] relative to the navigation frame, body axes (R, F, U).
     """
-    finite_array(heading, "heading")
-    p, r = np.broadcast_arrays(finite_array(pitch, "pitch"), finite_array(roll, "roll"))
+    angle_array(heading, "heading")
+    p, r = np.broadcast_arrays(angle_array(pitch, "pitch"), angle_array(roll, "roll"))
     hd, pd, rd = np.broadcast_arrays(*(finite_array(a, n) for a, n in (
         (heading_rate, "heading_rate"), (pitch_rate, "pitch_rate"), (roll_rate, "roll_rate"))))
     sp, cp, sr, cr = np.sin(p), np.cos(p), np.sin(r), np.cos(r)
@@ -482,7 +512,8 @@ def body_rate_from_euler_rates(heading, pitch, roll, heading_rate, pitch_rate, r
     wx = cr * ux - sr * uz
     wy = uy + rd
     wz = sr * ux + cr * uz
-    return np.stack([wx, wy, wz], -1)
+    return finite_result(np.stack([wx, wy, wz], -1), "the body rate overflows the float range: heading_rate, "
+                                                      "pitch_rate and roll_rate must be rates in rad/s")
 
 
 def orthonormalize(c):
@@ -496,8 +527,25 @@ def orthonormalize(c):
     Returns
     -------
     C : ndarray, shape (..., 3, 3)
-        The orthonormal matrix U V^T nearest to ``c`` in the Frobenius norm.
+        The orthonormal matrix U V^T nearest to ``c`` in the Frobenius norm, a rotation (det +1).
+
+    Raises
+    ------
+    ValueError
+        If ``c`` is a reflection (det < 0: a flipped axis, a left-handed frame) or singular (a singular
+        value below 1e-8 of the largest): near no rotation, U V^T would be a reflection or arbitrary.
     """
     c = matrix3(finite_array(c, "c"), "c")
-    u, _, vt = np.linalg.svd(c)
-    return u @ vt
+    u, sv, vt = np.linalg.svd(c)
+    r = u @ vt
+    sign = np.linalg.det(r) if r.size else np.ones(c.shape[:-2])
+    flat = sv <= 1e-8 * sv[..., :1]             # the sign of a vanishing direction is round-off
+    bad = (sign < 0) | np.any(flat, axis=-1)
+    if np.any(bad):
+        k = np.unravel_index(int(np.argmax(bad)), bad.shape) if bad.ndim else ()
+        at = f" at index {tuple(int(i) for i in k)}" if bad.ndim else ""
+        what = ("singular or nearly so (singular values " + ", ".join(f"{x:.3g}" for x in sv[k]) + ")"
+                if np.any(flat[k]) else "a reflection (det < 0: a flipped axis or a left-handed frame)")
+        raise ValueError(f"c must be near a rotation, got a matrix that is {what}{at}; no rotation is near it: "
+                         "check the signs and the order of its axes")
+    return r

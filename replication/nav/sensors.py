@@ -31,7 +31,17 @@ import numpy as np
 from scipy.signal import lfilter
 
 from replication.nav import earth
-from replication.nav._validate import components, finite_array, nonnegative, nonnegative_array, numeric, positive, rotation
+from replication.nav._validate import (
+    components,
+    finite,
+    finite_array,
+    finite_result,
+    nonnegative,
+    nonnegative_array,
+    numeric,
+    positive,
+    rotation,
+)
 from replication.nav.rotations import euler_to_dcm
 from replication.nav.strapdown import validate_increments, validate_time
 from replication.nav.units import ARCSEC, DEG_PER_H, MICRO_G, PPM, deg_per_h2
@@ -76,7 +86,10 @@ def markov_sigma_from_driving_psd(q_drive, tau):
         Stationary standard deviation σ = sqrt(q τ / 2), in the unit of x.
     """
     tau = positive(tau, "tau", "the correlation time {name} must be positive (seconds), got {value!r}")
-    return np.sqrt(nonnegative_array(q_drive, "q_drive") * tau / 2)
+    with np.errstate(over="ignore"):
+        sigma = np.sqrt(nonnegative_array(q_drive, "q_drive") * tau / 2)
+    return finite_result(sigma, "sigma = sqrt(q_drive tau / 2) overflows the float range: check the units of q_drive "
+                                "(x²/s) and tau (s)")
 
 
 @dataclass
@@ -226,10 +239,10 @@ def gauss_markov_coefficients(dt, tau) -> tuple[float, float]:
     q : float
         sqrt(1 - a²): the driving standard deviation per unit of σ.
     """
-    dt = float(numeric(dt, "dt")) if np.ndim(dt) == 0 else dt
-    tau = float(numeric(tau, "tau")) if np.ndim(tau) == 0 else tau
-    if not dt > 0 or not math.isfinite(dt):
-        raise ValueError(f"dt must be a positive sample interval, got {dt!r}")
+    dt = positive(dt, "dt", "{name} must be a positive sample interval, got {value!r}")
+    if np.ndim(tau) != 0:
+        raise ValueError(f"tau must be one correlation time, got shape {np.shape(tau)}")
+    tau = float(numeric(tau, "tau"))
     if not tau > 0:
         raise ValueError(f"tau must be a positive correlation time (inf for a random constant), got {tau!r}")
     a = math.exp(-dt / tau)
@@ -248,7 +261,8 @@ def gauss_markov_recursion(w, a, x_prev=None) -> np.ndarray:
     w : array_like, shape (n, ...)
         Driving noise w_0 .. w_{n-1}, n >= 1; the trailing axes are independent sequences.
     a : float
-        Transition coefficient (|a| <= 1 for a process that does not grow).
+        Transition coefficient exp(-dt/τ), 0 <= a <= 1 (1 a random walk, 0 white noise; a > 1 would
+        grow without bound and a < 0 alternate in sign: refused).
     x_prev : array_like, shape ``w.shape[1:]``, optional
         The value x_{-1} before the first sample; by default the recursion starts at x_0 = w_0
         (a stationary start draws x_0 ~ N(0, σ²) into ``w[0]``).
@@ -257,19 +271,35 @@ def gauss_markov_recursion(w, a, x_prev=None) -> np.ndarray:
     -------
     numpy.ndarray
         x_0 .. x_{n-1}, float, the shape of ``w``.
+
+    Raises
+    ------
+    TypeError
+        For text, booleans, complex numbers or objects in ``w``, ``a`` or ``x_prev``.
+    ValueError
+        For a NaN or an infinity, an ``a`` outside [0, 1], a ``x_prev`` of another shape, or a
+        result that overflows.
     """
-    w = np.asarray(w, dtype=float)
+    w = finite_array(w, "w")
     if w.ndim < 1 or w.shape[0] < 1:
         raise ValueError(f"w must have at least one sample along its first axis, got shape {w.shape}")
-    if np.ndim(a) != 0 or not np.isfinite(a):
+    if np.ndim(a) != 0:
         raise ValueError(f"a must be a finite number, got {a!r}")
-    if x_prev is None:
-        return lfilter([1.0], [1.0, -a], w, axis=0)
-    x_prev = np.asarray(x_prev, dtype=float)
-    if x_prev.shape != w.shape[1:]:
-        raise ValueError(f"x_prev must have the shape {w.shape[1:]} of one sample of w, got {x_prev.shape}")
-    x, _ = lfilter([1.0], [1.0, -a], w, axis=0, zi=(a * x_prev)[None, ...])
-    return x
+    a = finite(a, "a")
+    if not 0.0 <= a <= 1.0:
+        raise ValueError(f"a must lie in [0, 1] (a = exp(-dt/tau) of a Gauss-Markov process: 1 a random walk, 0 white "
+                         f"noise), got {a!r}; |a| > 1 grows without bound and a < 0 alternates in sign "
+                         "(gauss_markov_coefficients gives a from dt and tau)")
+    with np.errstate(over="ignore", invalid="ignore"):
+        if x_prev is None:
+            x = lfilter([1.0], [1.0, -a], w, axis=0)
+        else:
+            x_prev = finite_array(x_prev, "x_prev")
+            if x_prev.shape != w.shape[1:]:
+                raise ValueError(f"x_prev must have the shape {w.shape[1:]} of one sample of w, got {x_prev.shape}")
+            x, _ = lfilter([1.0], [1.0, -a], w, axis=0, zi=(a * x_prev)[None, ...])
+    return finite_result(x, "the Gauss-Markov recursion overflows the float range: w accumulates beyond 1e308; "
+                            "check the units of w")
 
 
 def _markov_path(n, T, sigma, tau, rng, x0=None):
@@ -482,7 +512,11 @@ def gnss_measurements(traj, *, rate_hz: float = 10.0, sigma_pos=(0.03, 0.03, 0.1
     sv = nonnegative_array(components(sigma_vel, "sigma_vel"), "sigma_vel")
     dt = float(np.median(np.diff(traj.t)))
     step = 1.0 / (rate_hz * dt)
-    if rate_hz <= 0 or abs(step - round(step)) > 1e-6:
+    duration = float(traj.t[-1] - traj.t[0])
+    if not 1.0 - 1e-6 <= step <= (len(traj.t) - 1) + 1e-6:
+        raise ValueError(f"GNSS rate rate_hz = {rate_hz:g} Hz must lie between one fix in the trajectory's "
+                         f"{duration:g} s ({1 / duration:g} Hz) and the IMU rate {1 / dt:g} Hz")
+    if abs(step - round(step)) > 1e-6:
         raise ValueError(f"GNSS rate {rate_hz} Hz must divide the IMU rate {1 / dt:g} Hz")
     step = int(round(step))
     idx = np.arange(step, len(traj.t), step)

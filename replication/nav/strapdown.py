@@ -268,6 +268,12 @@ def validate_increments(dtheta, dv):
     -------
     dtheta, dv : numpy.ndarray, shape (N, 3)
         C-contiguous float arrays (the inputs themselves when they already are).
+
+    Raises
+    ------
+    TypeError, ValueError
+        For text, booleans or complex numbers, another shape, a NaN or an infinity, an angle
+        increment beyond π rad or a velocity increment beyond ``earth.SPEED_LIMIT``.
     """
     dtheta = np.ascontiguousarray(numeric(dtheta, "dtheta"))
     dv = np.ascontiguousarray(numeric(dv, "dv"))
@@ -277,7 +283,17 @@ def validate_increments(dtheta, dv):
         raise ValueError(f"dtheta and dv must have the same shape (one gyro and one accelerometer increment "
                          f"per interval), got {dtheta.shape} and {dv.shape}")
     if not (_all_finite(dtheta) and _all_finite(dv)):
-        raise ValueError("increments contain NaN or infinite values")
+        name, a = ("dtheta", dtheta) if not _all_finite(dtheta) else ("dv", dv)
+        k = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+        raise ValueError(f"increments contain NaN or infinite values: {name}[{k[0]}, {k[1]}] = {a[k]!r}")
+    if len(dtheta) and np.abs(dtheta).max() > np.pi:
+        raise ValueError(f"dtheta must be angle increments of at most π rad per sample, got {np.abs(dtheta).max():.6g} "
+                         "rad: a turn of more than half a revolution between two samples cannot be integrated (pass "
+                         "increments in rad, not rates or degrees)")
+    if len(dv) and np.abs(dv).max() > earth.SPEED_LIMIT:
+        raise ValueError(f"dv must be velocity increments of at most {earth.SPEED_LIMIT:g} m/s per sample "
+                         f"(earth.SPEED_LIMIT), got {np.abs(dv).max():.6g} m/s (pass increments in m/s, not a velocity "
+                         "or another unit)")
     return dtheta, dv
 
 
@@ -305,6 +321,9 @@ def vertical_damping_gains(tau: float = 100.0, lat: float = 0.0, h: float = 0.0)
     g = float(earth.normal_gravity(lat, h))
     rm, rn = earth.radii(lat)
     ws2 = 2 * g / float(np.sqrt(rm * rn) + h)
+    if tau < 1e-100:                             # 1/τ³ beyond the float range
+        raise ValueError(f"the damping time constant tau = {tau!r} s is too small: the gain 1/tau³ overflows; "
+                         "tau is a time constant of the loop in seconds (tens to hundreds)")
     return np.array([3 / tau, 3 / tau**2 + ws2, 1 / tau**3])
 
 

@@ -52,7 +52,14 @@ class StationarityWarning(UserWarning):
     """The stationarity tests disagree (ADF cannot reject a unit root, KPSS accepts stationarity)."""
 
 
-def _series(y, name: str = "y", min_length: int = 3) -> np.ndarray:
+SERIES_LIMIT = 1e150
+"""Largest |value| of a series the statistics accept: their squares (variances, sums of squares)
+must stay inside the float range (1.8e308)."""
+
+
+def _series(y, name: str = "y", min_length: int = 3, varying: bool = True) -> np.ndarray:
+    """A finite 1-D series of at least ``min_length`` samples whose squares stay in the float range;
+    with ``varying`` also not constant (a constant has no autocorrelation, AR fit or AIC: 0/0)."""
     y = numeric(y, name)
     if y.ndim != 1:
         raise ValueError(f"{name} must be a one-dimensional series, got shape {y.shape}")
@@ -60,7 +67,20 @@ def _series(y, name: str = "y", min_length: int = 3) -> np.ndarray:
         raise ValueError(f"{name} needs at least {min_length} samples, got {y.size}")
     if not np.all(np.isfinite(y)):
         raise ValueError(f"{name} contains NaN or infinite values; remove or interpolate them first")
+    big = float(np.max(np.abs(y)))
+    if big > SERIES_LIMIT:
+        raise ValueError(f"{name} holds values up to {big:.3g}: their squares overflow the float range; rescale the "
+                         f"series (another unit) to below {SERIES_LIMIT:g}")
+    if varying:
+        _not_constant(y, name)
     return y
+
+
+def _not_constant(y: np.ndarray, name: str = "y") -> None:
+    if np.ptp(y) == 0:
+        raise ValueError(f"{name} is constant ({float(y[0])!r} throughout): it has no stochastic part, and its "
+                         "stationarity, autocorrelation, an AR fit or an AIC are undefined (0/0); pass the measured "
+                         "series")
 
 
 def ar_coefficients(phi) -> np.ndarray:
@@ -229,14 +249,13 @@ def inversion_test(y, segments: int, *, alpha: float = 0.05) -> InversionTest:
     ValueError
         For a series too short for ``segments``, a constant series or an invalid ``alpha``.
     """
-    y = _series(y)
+    y = _series(y, varying=False)
     m = integer(segments, "segments", 2)
     if y.size < 2 * m:
         raise ValueError(f"a series of {y.size} samples (y) cannot be cut into {m} segments of >= 2 samples; use "
                          "fewer segments")
     probability(alpha, "alpha", "{name} must lie in (0, 1), got {value!r}")
-    if np.ptp(y) == 0:
-        raise ValueError("the series is constant: it has no stochastic part whose stationarity could be tested")
+    _not_constant(y)
     L = y.size // m
     means = y[: L * m].reshape(m, L).mean(axis=1)
     A = inversion_count(means)
@@ -310,7 +329,7 @@ def difference(y, d: int = 1) -> np.ndarray:
     yd : ndarray, shape (n - d,)
         The differenced series, in the unit of ``y``.
     """
-    y = _series(y)
+    y = _series(y, varying=False)
     integer(d, "d", 0, "the differencing order {name} must be a non-negative integer, got {value!r}")
     if y.size <= d + 2:
         raise ValueError(f"y: a series of {y.size} samples is too short to difference {d} times")
@@ -838,7 +857,11 @@ def ar_least_squares(y, p: int) -> tuple[np.ndarray, float]:
         Residual variance, in the unit of ``y`` squared.
     """
     C, D = ar_design(y, p)
-    phi, *_ = np.linalg.lstsq(C, D, rcond=None)
+    phi, _, rank, _ = np.linalg.lstsq(C, D, rcond=None)
+    if rank < C.shape[1]:
+        raise ValueError(f"y: the {C.shape[1]} lagged copies of the series are linearly dependent (rank {rank}), so "
+                         f"the AR({C.shape[1]}) least squares has no unique solution: the series is a trend, a "
+                         "constant or a pure sinusoid; demean or difference it, or lower p")
     res = D - C @ phi
     return phi, float(res @ res / D.size)
 
@@ -1198,7 +1221,7 @@ def _require_stationary(phi, what: str = "the AR model") -> np.ndarray:
     phi = ar_coefficients(phi)
     if not is_stationary(phi):
         raise NonStationaryError(
-            f"{what} is not stationary (largest pole modulus {np.max(np.abs(ar_poles(phi))):.4f} >= 1): "
+            f"phi: {what} is not stationary (largest pole modulus {np.max(np.abs(ar_poles(phi))):.4f} >= 1): "
             f"it has no stationary autocorrelation or variance"
         )
     return phi
@@ -1416,6 +1439,8 @@ def aic_batch(Y, max_order: int, *, chunk: int = 16) -> np.ndarray:
     Y = finite_array(Y, "Y")
     if Y.ndim != 2:
         raise ValueError("Y must have shape (n_series, n)")
+    for k in range(Y.shape[0]):
+        _series(Y[k], f"Y[{k}]")
     K, n = Y.shape
     P = integer(max_order, "max_order")
     integer(chunk, "chunk")
@@ -1434,7 +1459,12 @@ def aic_batch(Y, max_order: int, *, chunk: int = 16) -> np.ndarray:
         rss = np.empty((Yc.shape[0], P + 1))
         rss[:, 0] = tt
         for p in range(1, P + 1):
-            beta = np.linalg.solve(G[:, :p, :p], b[:, :p, None])[..., 0]
+            try:
+                beta = np.linalg.solve(G[:, :p, :p], b[:, :p, None])[..., 0]
+            except np.linalg.LinAlgError:
+                raise ValueError(f"Y: the {p} lagged copies of a series of rows {s}..{s + Yc.shape[0] - 1} are linearly "
+                                 "dependent (a trend or a pure sinusoid): its AR least squares has no unique "
+                                 "solution; difference it or lower max_order") from None
             rss[:, p] = tt - np.einsum("ki,ki->k", b[:, :p], beta)
         sig = rss / N
         out[s : s + chunk] = N * (np.log(2 * np.pi * sig) + 1) + 2 * (np.arange(P + 1) + 1)

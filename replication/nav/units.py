@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import math
 
+from replication.nav._validate import nonnegative
+
 DEG = math.pi / 180.0
 """One degree in radians."""
 ARCMIN = DEG / 60.0
@@ -58,9 +60,12 @@ def deg_per_h2(variance_deg2_per_h2: float) -> float:
 
     Raises
     ------
+    TypeError
+        For text, booleans or complex numbers.
     ValueError
-        If the variance is negative.
+        If the variance is negative, NaN or infinite.
     """
-    if variance_deg2_per_h2 < 0:
-        raise ValueError("a variance cannot be negative")
-    return variance_deg2_per_h2 * DEG_PER_H**2
+    v = nonnegative(variance_deg2_per_h2, "variance_deg2_per_h2",
+                    "{name} must be a non-negative finite variance in (°/h)², got {value!r} (a variance cannot be "
+                    "negative)")
+    return v * DEG_PER_H**2

@@ -26,6 +26,7 @@ Status vocabulary (:data:`STATUSES`):
 
 from __future__ import annotations
 
+import difflib
 import hashlib
 import io
 import json
@@ -155,6 +156,10 @@ def data_root() -> Path:
         Neither a clone nor an installed package with its data.
     """
     root = _clone_root()
+    env = os.environ.get("REPLICATION_ROOT")
+    if env and root is not None and not root.is_dir():
+        raise RegistryError(f"REPLICATION_ROOT={env} is not a directory: set it to the root of a clone of the "
+                            "repository (the folder holding tables/ and data/), or unset it")
     if root is not None:
         return root
     if PACKAGED_DATA.is_dir():
@@ -1426,10 +1431,61 @@ def read_table(table_id: str) -> pd.DataFrame:
     validate_id(table_id)
     path = tables_dir() / f"{table_id}.csv"
     if not path.exists():
-        near = [k for k in list_tables() if k.split("-")[0] == table_id.split("-")[0]]
-        raise RegistryError(f"no exported table {table_id!r}; the {len(near)} exported tables of that source: "
-                            f"{', '.join(near) or 'none'}")
-    return pd.read_csv(path, dtype=str, keep_default_na=False)
+        raise RegistryError(_unknown_id(table_id))
+    df = _read_csv(path, "re-run the notebook that exports it, or restore it from the repository (git checkout)")
+    missing = [c for c in READ_COLUMNS if c not in df.columns]
+    if missing:
+        raise RegistryError(f"{path}: not a comparison table: it lacks the columns {missing}; re-run the notebook "
+                            "that exports it, or restore it from the repository (git checkout)")
+    return df
+
+
+READ_COLUMNS = ("quantity", "unit", "paper", "reproduced", "status")
+"""The columns of :data:`TABLE_COLUMNS` every reader relies on; :func:`read_table` refuses a CSV without them."""
+
+
+def _read_csv(path: Path, fix: str, **kw) -> pd.DataFrame:
+    """``path`` read as text columns; a file that is empty, not CSV or not UTF-8 raises :class:`RegistryError`
+    naming it and ``fix``."""
+    try:
+        return pd.read_csv(path, dtype=str, keep_default_na=False, encoding="utf-8", **kw)
+    except pd.errors.EmptyDataError:
+        why = "is empty"
+    except (pd.errors.ParserError, UnicodeDecodeError) as exc:
+        why = f"is not a readable UTF-8 CSV file ({str(exc).splitlines()[0][:120]})"
+    except OSError as exc:
+        why = f"cannot be read ({exc.strerror or exc})"
+    raise RegistryError(f"{path} {why}: {fix}")
+
+
+def _known_ids() -> list[str]:
+    """Every id the read side answers to: the exported tables and the artifacts of ``data/artifacts.csv``."""
+    ids = set(list_tables())
+    try:
+        ids.update(load_artifacts()["id"])
+    except RegistryError:
+        pass
+    return sorted(ids)
+
+
+def _near_ids(ident: str) -> list[str]:
+    """The known ids nearest to ``ident`` (at most five, by ``difflib``; case and spaces ignored)."""
+    known = _known_ids()
+    return (difflib.get_close_matches(ident, known, n=5, cutoff=0.6)
+            or difflib.get_close_matches(ident.strip().lower(), known, n=5, cutoff=0.6))
+
+
+def _unknown_id(ident: str) -> str:
+    """The message for an id that names no table: the nearest known ids (at most five), or where to find them."""
+    d = tables_dir()
+    if not d.is_dir():
+        env = os.environ.get("REPLICATION_ROOT")
+        where = f" (REPLICATION_ROOT={env})" if env else ""
+        return (f"no exported table {ident!r}: {d} does not exist{where}; run inside a clone of the repository or "
+                "set REPLICATION_ROOT to its root")
+    near = _near_ids(ident)
+    hint = f"did you mean {', '.join(near)}?" if near else "no known id is close to it;"
+    return f"no exported table {ident!r}: {hint} (python -m replication status lists every id)"
 
 
 def list_tables() -> list[str]:
@@ -1516,13 +1572,21 @@ def load_artifacts() -> pd.DataFrame:
         A missing column, a malformed or duplicated id.
     """
     path = data_root() / "data" / "artifacts.csv"
-    df = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    if not path.is_file():
+        env = os.environ.get("REPLICATION_ROOT")
+        hint = (f"REPLICATION_ROOT={env} is not the root of a clone: set it to the clone (the folder holding "
+                "tables/ and data/), or unset it" if env and not (path.parents[1] / "tables").is_dir()
+                else "restore it from the repository (git checkout data/artifacts.csv)")
+        raise RegistryError(f"{path} does not exist: {hint}")
+    df = _read_csv(path, "restore it from the repository (git checkout data/artifacts.csv)", comment="#")
     need = {"id", "source", "artifact", "description"}
     if not need <= set(df.columns):
-        raise RegistryError(f"{path}: needs columns {sorted(need)}")
+        raise RegistryError(f"{path}: needs the columns {sorted(need)}, has {sorted(df.columns)}; restore it from "
+                            "the repository (git checkout data/artifacts.csv)")
     bad = [i for i in df["id"] if not _ID_RE.match(i)]
     if bad:
-        raise RegistryError(f"{path}: malformed ids {bad}")
+        raise RegistryError(f"{path}: malformed ids {bad[:5]}{' …' if len(bad) > 5 else ''} (expected "
+                            "'<key>-table-<n>', '<key>-eq-<n>' …); correct them or restore the file (git checkout)")
     if df["id"].duplicated().any():
         raise RegistryError(f"{path}: duplicated ids {df['id'][df['id'].duplicated()].tolist()}")
     return df
@@ -1617,7 +1681,7 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
         ``(status, register)``.
     """
     arts = load_artifacts()
-    exported = {tid: json.loads((tables_dir() / f"{tid}.json").read_text(encoding="utf-8")) for tid in list_tables()}
+    exported = {tid: _sidecar(tid) for tid in list_tables()}
     rows = []
     covered: set[str] = set()
     for _, a in arts.iterrows():
@@ -1827,9 +1891,7 @@ def load_table(table_id: str) -> pd.DataFrame:
     for c in NUMERIC_COLUMNS:
         if c in df.columns:
             df[c] = pd.to_numeric(df[c].replace("", np.nan), errors="coerce")
-    side = tables_dir() / f"{table_id}.json"
-    if side.exists():
-        df.attrs.update(json.loads(side.read_text(encoding="utf-8")))
+    df.attrs.update(_sidecar(table_id))
     return df
 
 
@@ -1880,8 +1942,20 @@ READING_SEPARATOR = " | "
 
 
 def _sidecar(table_id: str) -> dict:
+    """The sidecar ``tables/<id>.json`` of a table as a dict (empty when there is none); a sidecar that is
+    not a JSON object raises :class:`RegistryError` naming the file."""
     path = tables_dir() / f"{table_id}.json"
-    return json.loads(path.read_text(encoding="utf-8")) if path.exists() else {}
+    if not path.exists():
+        return {}
+    try:
+        meta = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise RegistryError(f"{path} is not valid JSON ({str(exc).splitlines()[0][:100]}): re-run the notebook that "
+                            "exports the table, or restore it from the repository (git checkout)") from None
+    if not isinstance(meta, dict):
+        raise RegistryError(f"{path} holds a {type(meta).__name__}, not a table's sidecar (a JSON object): re-run "
+                            "the notebook that exports the table, or restore it from the repository (git checkout)")
+    return meta
 
 
 def readings_ledgers(table_id: str, meta: Mapping[str, Any] | None = None) -> list[str]:
@@ -2377,12 +2451,21 @@ def resolve_table_ids(ident: str) -> list[str]:
     list of str
         The exported table ids.
     """
-    validate_id(ident)
+    try:
+        validate_id(ident)
+    except RegistryError as exc:
+        near = _near_ids(ident) if isinstance(ident, str) and tables_dir().is_dir() else []
+        if near:
+            raise RegistryError(f"malformed table id {ident!r}: did you mean {', '.join(near)}?") from None
+        raise exc from None
     if (tables_dir() / f"{ident}.csv").exists():
         return [ident]
     status_path = tables_dir() / "status.csv"
     if status_path.exists():
-        st = pd.read_csv(status_path, dtype=str, keep_default_na=False)
+        fix = "rebuild it with python -m replication index (in a clone), or restore it (git checkout)"
+        st = _read_csv(status_path, fix)
+        if not {"id", "status", "tables"} <= set(st.columns):
+            raise RegistryError(f"{status_path}: needs the columns id, status, tables; {fix}")
         hit = st[st["id"] == ident]
         if len(hit):
             tables = hit.iloc[0]["tables"].split()
@@ -2446,7 +2529,7 @@ def bibtex_for(ident: str) -> str:
 def _table_bibtex(table_id: str) -> tuple[str, str]:
     """The ``@misc`` entry of one exported table, and the source key it reproduces."""
     df = read_table(table_id)
-    meta = json.loads((tables_dir() / f"{table_id}.json").read_text(encoding="utf-8"))
+    meta = _sidecar(table_id)
     source = meta.get("source", table_id.split("-")[0])
     commit = meta.get("git_commit") or "unknown"
     version = meta.get("library_version", __version__)
