@@ -20,6 +20,7 @@ Each problem names the table, the row and the reason.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 import re
@@ -153,7 +154,7 @@ def _test_exists(root: Path, ref: str) -> bool:
     if not p.is_file():
         return False
     name = name.strip().split("[")[0]
-    return not name or re.search(rf"^\s*(async\s+)?def {re.escape(name)}\b", p.read_text(encoding="utf-8"),
+    return not name or re.search(rf"^\s*(async\s+)?def {re.escape(name)}\b", _text_at(str(p), p.stat().st_mtime_ns),
                                  re.M) is not None
 
 
@@ -186,6 +187,23 @@ def evidence_ok(root: Path, evidence: str, notebook: str = "") -> bool:
         any((root / f).exists() for f in files)
 
 
+@functools.lru_cache(maxsize=512)
+def _records_at(path: str, mtime_ns: int, size: int) -> tuple[dict, ...]:
+    return tuple(pd.read_csv(path, dtype=str, keep_default_na=False).to_dict("records"))
+
+
+def _records(table_id: str) -> tuple[dict, ...]:
+    """The rows of a stored table as dictionaries, read once per version of the file."""
+    path = rp.tables_dir() / f"{table_id}.csv"
+    st = path.stat()
+    return _records_at(str(path), st.st_mtime_ns, st.st_size)
+
+
+@functools.lru_cache(maxsize=256)
+def _text_at(path: str, mtime_ns: int) -> str:
+    return Path(path).read_text(encoding="utf-8")
+
+
 def _is_ledger(table_id: str) -> bool:
     return "-check-" in table_id and table_id.endswith("-readings")
 
@@ -207,7 +225,7 @@ def _ledger_rows(ledger_ids: list[str]) -> dict[str, dict[str, Mapping[str, Any]
     for lid in ledger_ids:
         if not (rp.tables_dir() / f"{lid}.csv").exists():
             continue
-        for _, lr in rp.read_table(lid).iterrows():
+        for lr in _records(lid):
             q = lr["quantity"]
             if rp.READING_SEPARATOR not in q:
                 continue
@@ -221,7 +239,8 @@ def _excluded(reading: str, ruled: Mapping[str, str]) -> bool:
 
 
 def ledger_evidence(q: str, main: pd.DataFrame, meta: Mapping[str, Any],
-                    readings: Mapping[str, Mapping[str, Mapping[str, Any]]]) -> vd.LedgerEvidence:
+                    readings: Mapping[str, Mapping[str, Mapping[str, Any]]],
+                    by_q: Mapping[str, Mapping[str, Any]] | None = None) -> vd.LedgerEvidence:
     """What the ledger says about the failing row ``q`` of a main table (see
     :class:`replication.registry.verdicts.LedgerEvidence`).
 
@@ -235,12 +254,15 @@ def ledger_evidence(q: str, main: pd.DataFrame, meta: Mapping[str, Any],
         Its sidecar (``main_reading``, ``ruled_out``, ``groups``).
     readings : mapping
         ``{reading: {quantity: ledger row}}``.
+    by_q : mapping, optional
+        The main table's rows by quantity, when already built.
 
     Returns
     -------
     LedgerEvidence
     """
-    by_q = {r["quantity"]: r for _, r in main.iterrows()}
+    if by_q is None:
+        by_q = {r["quantity"]: r for r in main.to_dict("records")}
     ruled = dict(meta.get("ruled_out") or {})
     main_reading = meta.get("main_reading", "")
     groups = {k: list(v) for k, v in dict(meta.get("groups") or {}).items()}
@@ -368,6 +390,8 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
         out.append(Problem(tid, "", "the CSV differs from the table its notebook computed (its content does not match "
                                     "the sidecar's table_digest): rerun the notebook, never edit a table by hand"))
     df = rp.read_table(tid)
+    records = _records(tid)
+    by_q = {r["quantity"]: r for r in records}
     ledger = _is_ledger(tid)
     named = list(meta.get("readings") or [])
     for lid in named:
@@ -392,7 +416,7 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
     if main_reading and ledgers and readings and main_reading not in readings:
         # a ledger may leave the main reading out (the main table is its result); then no reading of the
         # ledger may be the main computation under another name
-        main_values = {r["quantity"]: (r["reproduced"], r["reproduced_text"]) for _, r in df.iterrows()}
+        main_values = {r["quantity"]: (r["reproduced"], r["reproduced_text"]) for r in records}
         for reading, per_q in readings.items():
             shared = [q for q in per_q if q in main_values]
             if len(shared) >= 5 and all((per_q[q]["reproduced"], per_q[q]["reproduced_text"]) == main_values[q]
@@ -407,7 +431,7 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
     if ledgers and not (main_reading and meta.get("main_reading_evidence")):
         out.append(Problem(tid, "", f"has the readings ledger {', '.join(ledgers)} but records no main_reading with "
                                     "its printed evidence (compare(..., main_reading=, reading_evidence=))"))
-    for _, r in df.iterrows():
+    for r in records:
         q = r["quantity"]
         for reason in _row_problems(tid, r, root, ledger, bool(ledgers), meta.get("notebook", "")):
             out.append(Problem(tid, q, reason))
@@ -421,13 +445,13 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
                                            f"({r['reproduced'] or r['reproduced_text']}): the two must be one computation"))
         in_ledger = any(q in per for per in readings.values())
         if ledgers and r["status"] == "unverifiable" and in_ledger and \
-                not ledger_evidence(q, df, meta, readings).reaching:
+                not ledger_evidence(q, df, meta, readings, by_q).reaching:
             out.append(Problem(tid, q, "unverifiable although the ledger tries this value and no reading reaches the "
                                        "print: that is not-reproduced"))
         if ledgers and r["status"] == "not-reproduced" and r.get("basis", "") != "" and not in_ledger:
             out.append(Problem(tid, q, f"not-reproduced but no reading of {', '.join(ledgers)} shows it"))
         if ledgers and r["status"] in ("not-reproduced", "erratum", "unverifiable") and r.get("basis", "") == "":
-            ev = ledger_evidence(q, df, meta, readings)
+            ev = ledger_evidence(q, df, meta, readings, by_q)
             if r["status"] in ("not-reproduced", "erratum") and ev.reaching:
                 what = ("a misprint that a faithful reading reproduces is an inconsistency or another convention"
                         if r["status"] == "erratum" else "not-reproduced needs every faithful reading to miss the print")
@@ -439,7 +463,7 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
                 out.append(Problem(tid, q, "unverifiable in a table with a ledger although no reading reaches the "
                                            "print: that is not-reproduced"))
         if r.get("basis", "") != "":
-            out += _basis_problems(tid, r, df, meta, readings, root)
+            out += _basis_problems(tid, r, df, meta, readings, root, by_q)
     out += _every_reading_problems(tid, df, meta, ledgers)
     return out
 
@@ -458,7 +482,7 @@ def _every_reading_problems(tid: str, df: pd.DataFrame, meta: Mapping[str, Any],
                                     "readings ledger backs it"))
     if _is_ledger(tid):
         return out
-    for _, r in df.iterrows():
+    for r in df.to_dict("records"):
         backed = r["status"] == "not-reproduced" and (ledgers or r.get("basis", "") == "claim")
         if EVERY_READING.search(str(r["note"])) and not backed:
             out.append(Problem(tid, r["quantity"], f"its note speaks of every reading, but the row is {r['status']}"
@@ -483,7 +507,7 @@ def _paper_problems(tid: str, df: pd.DataFrame, meta: Mapping[str, Any]) -> list
     except rp.RegistryError:
         return out
     values = paper.numeric()
-    for _, r in df.iterrows():
+    for r in df.to_dict("records"):
         q = r["quantity"]
         if q not in values.index or r["paper"] == "" or not math.isfinite(values[q]):
             continue
@@ -502,16 +526,16 @@ def _rests_on_statuses(refs: list[str]) -> tuple[list[str], list[str]]:
         if not (rp.tables_dir() / f"{tid}.csv").exists():
             missing.append(ref)
             continue
-        t = rp.read_table(tid)
-        sub = t[t["quantity"] == q] if q else t
-        if sub.empty:
+        sub = [r["status"] for r in _records(tid) if not q or r["quantity"] == q]
+        if not sub:
             missing.append(ref)
-        statuses += list(sub["status"])
+        statuses += sub
     return statuses, missing
 
 
 def _basis_problems(tid: str, r: Mapping[str, Any], df: pd.DataFrame, meta: Mapping[str, Any],
-                    readings: Mapping[str, Mapping[str, Mapping[str, Any]]], root: Path) -> list[Problem]:
+                    readings: Mapping[str, Mapping[str, Mapping[str, Any]]], root: Path,
+                    by_q: Mapping[str, Mapping[str, Any]]) -> list[Problem]:
     q = r["quantity"]
     try:
         agrees = vd.parse_agrees(r.get("agrees", ""))
@@ -522,7 +546,7 @@ def _basis_problems(tid: str, r: Mapping[str, Any], df: pd.DataFrame, meta: Mapp
     if missing:
         return [Problem(tid, q, f"rests_on names rows that do not exist: {', '.join(missing)}")]
     within = _within(r)
-    led = ledger_evidence(q, df, meta, readings) if readings else None
+    led = ledger_evidence(q, df, meta, readings, by_q) if readings else None
     ev = vd.Evidence(basis=r["basis"], agrees=agrees, within=within, ledger=led, rests_on=tuple(statuses),
                      has_test=evidence_ok(root, r["evidence"], meta.get("notebook", "")))
     try:
