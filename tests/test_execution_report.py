@@ -91,9 +91,12 @@ def _build(tmp_path, record, confoverrides=None):
         path.parent.mkdir(parents=True)
         path.write_text(json.dumps(record), encoding="utf-8")
     out = tmp_path / "out"
-    app = Sphinx(str(src), str(src), str(out), str(tmp_path / "doctrees"), "html", status=None, warning=None,
-                 freshenv=True, confoverrides=confoverrides or {})
-    app.build()
+    from sphinx.util.docutils import docutils_namespace
+
+    with docutils_namespace():   # the build's nodes and directives are forgotten afterwards, as in a new process
+        app = Sphinx(str(src), str(src), str(out), str(tmp_path / "doctrees"), "html", status=None, warning=None,
+                     freshenv=True, confoverrides=confoverrides or {})
+        app.build()
     return (out / "index.html").read_text(encoding="utf-8")
 
 

@@ -329,9 +329,10 @@ def test_compare_verdicts_rows_declare_their_basis_and_the_ledger_decides(tmp_pa
     assert len(ledger) == 4 * len(rows) and not any(q["quantity"].startswith("main |") for q in ledger)
     assert any(q["quantity"].startswith(findings.EXACT_READING) for q in ledger)
     rp.compare("chen2019-check-table-9-9-readings", ledger, notebook="book/x.ipynb", title="ledger")
+    group_of = {q: g for g, qs in findings.column_groups(printed).items() for q in qs}
+    rows = [dict(r, group=group_of.get(r["quantity"])) for r in rows]
     t = rp.compare("chen2019-table-9-9", rows, notebook="book/x.ipynb", title="main", main_reading="main",
-                   reading_evidence="the printed 2.0", ruled_out={"old": "the printed 2.0"},
-                   groups=findings.column_groups(printed)).set_index("quantity").status
+                   reading_evidence="the printed 2.0", ruled_out={"old": "the printed 2.0"}).set_index("quantity").status
     assert t["a | turn"] == "inconsistent" and "loses c" in next(r["note"] for r in rows if r["quantity"] == "a | turn")
     assert t["b | turn"] == "unverifiable" and "'other'" in next(r["note"] for r in rows if r["quantity"] == "b | turn")
     assert t["c | turn"] == "qualitative"
