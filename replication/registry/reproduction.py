@@ -78,7 +78,7 @@ TRACKED_PACKAGES = (
     "numpy", "scipy", "pandas", "statsmodels", "control", "matplotlib", "sympy", "numba",
 )
 
-_ID_RE = re.compile(r"^(chen2019|fang2020|duan2023|an2021|toolkit)-(table|figure|eq|claim|check)-[0-9a-z][0-9a-z.-]*$")
+_ID_RE = re.compile(r"^(chen2019|fang2020|duan2023|an2021|toolkit)-(table|figure|eq|claim|check|print)-[0-9a-z][0-9a-z.-]*$")
 
 
 class RegistryError(ValueError):
@@ -193,7 +193,8 @@ def tables_dir() -> Path:
 
 
 def validate_id(table_id: str) -> str:
-    """Check a table id against ``<key>-(table|figure|eq|claim|check)-<n>``.
+    """Check a table id against ``<key>-(table|figure|eq|claim|check|print)-<n>`` (``print``: an item
+    of the document as a whole, e.g. its reference list).
 
     Parameters
     ----------
@@ -213,7 +214,7 @@ def validate_id(table_id: str) -> str:
     if not isinstance(table_id, str) or not _ID_RE.match(table_id):
         raise RegistryError(
             f"malformed table id {table_id!r}: expected '<key>-table-<n>', '<key>-figure-<n>', "
-            f"'<key>-eq-<n>', '<key>-claim-<name>' or '<key>-check-<name>' with key one of "
+            f"'<key>-eq-<n>', '<key>-claim-<name>', '<key>-print-<name>' or '<key>-check-<name>' with key one of "
             f"{', '.join(SOURCE_KEYS)} (lower case, e.g. 'chen2019-table-2-3')"
         )
     return table_id

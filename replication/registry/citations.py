@@ -1,0 +1,204 @@
+"""A document's reference list against its citations: the sweep of the print's bibliography.
+
+The transcription is data: ``data/paper/<key>/<key>-print-references.csv``, one row per entry of
+the list (``kind`` ``entry``: ``number``, the entry as printed in ``value``, ``line``) and one per
+citation of the text (``kind`` ``citation``: the citation as printed in ``value``, ``line``,
+``object``), written by ``scripts/transcribe_citations.py`` and checked by hand.  Each entry of the list is compared with
+the text (is it cited?) and with the rest of the list (is the same work listed twice? does its
+page range end before it starts?); each cited number with the list (is there such an entry?);
+and each table or figure whose caption and text both cite a source, caption against text.
+Every disagreement is two printed parts that disagree (basis ``parts``), so ``inconsistent``.
+
+Criteria, fixed before comparing:
+
+* **the same work twice**: two entries whose normalized text (lower case, letters and digits
+  only) has a :class:`difflib.SequenceMatcher` ratio of at least :data:`SAME_WORK` = 0.85; the
+  function reports the largest ratio among the other pairs, so a reader sees the margin;
+* **a reversed page range**: the last ``a-b`` page range of an entry with ``b < a`` (a date such as
+  ``2008-04-30`` is not a range).
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from typing import Any
+
+import pandas as pd
+
+__all__ = ["SAME_WORK", "cited_numbers", "duplicate_pairs", "reversed_pages", "reference_rows"]
+
+SAME_WORK = 0.85
+"""The similarity ratio from which two entries of a list are the same work (see the module docstring)."""
+
+_RANGE = re.compile(r"(\d+)\s*[-–]\s*(\d+)")
+_PAGES = re.compile(r"(?<![\d.\-–])(\d{1,5})\s*[-–]\s*(\d{1,5})(?![\d.\-–])")
+
+
+def cited_numbers(cited: str) -> tuple[int, ...]:
+    """The entry numbers of one printed citation (``"20-26"``, ``"37,38"``, ``"6"``).
+
+    Parameters
+    ----------
+    cited : str
+        The citation's content as printed, without brackets.
+
+    Returns
+    -------
+    tuple of int
+        The numbers, ranges expanded, in order.
+
+    Raises
+    ------
+    ValueError
+        When the text is not a list of numbers and ranges, or a range runs backwards.
+    """
+    out: list[int] = []
+    for part in str(cited).replace(" ", "").split(","):
+        if m := _RANGE.fullmatch(part):
+            a, b = int(m[1]), int(m[2])
+            if b < a:
+                raise ValueError(f"citation range {part!r} runs backwards")
+            out += range(a, b + 1)
+        elif part.isdigit():
+            out.append(int(part))
+        else:
+            raise ValueError(f"cannot read the citation {cited!r}: give numbers and ranges such as '20-26' or '37,38'")
+    return tuple(out)
+
+
+def _normal(text: str) -> str:
+    return re.sub(r"[\W_]+", "", str(text).lower())
+
+
+def duplicate_pairs(references: pd.DataFrame, *, threshold: float = SAME_WORK) -> tuple[list[tuple[int, int, float]], float]:
+    """Pairs of entries that list the same work (normalized-text similarity ≥ ``threshold``).
+
+    Parameters
+    ----------
+    references : pandas.DataFrame
+        The list: ``number`` and ``entry``.
+    threshold : float
+        The similarity ratio from which two entries are the same work, in (0, 1].
+
+    Returns
+    -------
+    pairs : list of (int, int, float)
+        ``(first, second, ratio)`` for each pair at or above the threshold.
+    margin : float
+        The largest ratio among the other pairs.
+
+    Raises
+    ------
+    ValueError
+        When ``threshold`` is outside (0, 1] or the columns are missing.
+    """
+    if not 0 < threshold <= 1:
+        raise ValueError(f"threshold must lie in (0, 1], got {threshold!r}")
+    if not {"number", "entry"} <= set(references.columns):
+        raise ValueError("references needs the columns 'number' and 'entry'")
+    texts = [(int(n), _normal(e)) for n, e in zip(references["number"], references["entry"])]
+    pairs, margin = [], 0.0
+    for i, (a, ta) in enumerate(texts):
+        for b, tb in texts[i + 1:]:
+            r = difflib.SequenceMatcher(None, ta, tb, autojunk=False).ratio()
+            if r >= threshold:
+                pairs.append((a, b, r))
+            else:
+                margin = max(margin, r)
+    return pairs, margin
+
+
+def reversed_pages(entry: str) -> tuple[int, int] | None:
+    """The page range of an entry when it ends before it starts (its last ``a-b``), else ``None``.
+
+    Parameters
+    ----------
+    entry : str
+        One entry of a reference list, as printed.
+
+    Returns
+    -------
+    tuple of int or None
+        ``(first, last)`` of a reversed range.
+    """
+    found = _PAGES.findall(str(entry))
+    if not found:
+        return None
+    a, b = (int(x) for x in found[-1])
+    return (a, b) if b < a else None
+
+
+def reference_rows(printed: pd.DataFrame) -> list[dict[str, Any]]:
+    """Comparison rows (``basis="parts"``) of a reference list against the citations of its text.
+
+    One row per entry (cited? listed once? a page range that runs forward?), one per cited
+    number the list lacks, and one per table or figure whose caption and text cite different
+    sources.
+
+    Parameters
+    ----------
+    printed : pandas.DataFrame
+        The transcription (the module docstring): ``quantity``, ``value``, ``kind`` (``entry`` or
+        ``citation``), ``number``, ``line`` and ``object``.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.reproduction.compare`, each entry's row named like
+        its paper quantity (``reference [n]``).
+
+    Raises
+    ------
+    ValueError
+        When a column is missing or an entry number is listed twice.
+    """
+    need = {"quantity", "value", "kind", "number", "line", "object"}
+    if not need <= set(printed.columns):
+        raise ValueError(f"the transcription needs the columns {sorted(need)}; it has {list(printed.columns)}")
+    refs = printed[printed["kind"] == "entry"]
+    cites = printed[printed["kind"] == "citation"]
+    nums = [int(n) for n in refs["number"]]
+    if len(set(nums)) != len(nums):
+        raise ValueError("an entry number appears twice in the reference list")
+    where: dict[int, list[int]] = {}
+    for line, cited in zip(cites["line"], cites["value"]):
+        for n in cited_numbers(cited):
+            where.setdefault(n, []).append(int(line))
+    pairs, margin = duplicate_pairs(pd.DataFrame({"number": nums, "entry": list(refs["value"])}))
+    twin = {a: b for a, b, _ in pairs} | {b: a for a, b, _ in pairs}
+    ratio = {a: r for a, _, r in pairs} | {b: r for _, b, r in pairs}
+    rows = []
+    for n, q, entry, line in zip(nums, refs["quantity"], refs["value"], refs["line"]):
+        problems = []
+        if n not in where:
+            problems.append("never cited in the text")
+        if n in twin:
+            problems.append(f"the same work as [{twin[n]}] (similarity {ratio[n]:.2f} ≥ {SAME_WORK}; the largest among "
+                            f"the other pairs {margin:.2f})")
+        if pages := reversed_pages(entry):
+            problems.append(f"its page range {pages[0]}-{pages[1]} ends before it starts")
+        cited_at = ", ".join(str(x) for x in sorted(set(where.get(n, []))))
+        rows.append(dict(quantity=q, unit="", paper_text=str(entry),
+                         reproduced=f"cited at seed line {cited_at}" if cited_at else "not cited",
+                         basis="parts", agrees=not problems,
+                         note=("; ".join(problems) + f" (list entry at seed line {line})") if problems else
+                         f"cited, listed once (seed line {line})"))
+    for n in sorted(set(where) - set(nums)):
+        rows.append(dict(quantity=f"citation [{n}]", unit="", paper_text=f"[{n}]", reproduced="no such entry",
+                         basis="parts", agrees=False,
+                         note=f"cited at seed line {', '.join(map(str, sorted(set(where[n]))))}; the list ends at "
+                              f"[{max(nums)}] and has no entry [{n}]"))
+    by_obj: dict[str, dict[str, set[int]]] = {}
+    for obj, cited in zip(cites["object"], cites["value"]):
+        if str(obj).strip():
+            name, part = str(obj).rsplit(" ", 1)
+            by_obj.setdefault(name, {}).setdefault(part, set()).update(cited_numbers(cited))
+    for name, parts in by_obj.items():
+        if {"caption", "text"} <= set(parts):
+            cap, txt = sorted(parts["caption"]), sorted(parts["text"])
+            rows.append(dict(quantity=f"source of {name}: caption against text", unit="",
+                             paper_text=f"caption cites {cap}", reproduced=f"text cites {txt}", basis="parts",
+                             agrees=cap == txt, note="the caption and the sentence that introduces it cite "
+                             + ("the same source" if cap == txt else "different sources")))
+    return rows

@@ -1,0 +1,71 @@
+"""The reference-list sweep (replication.registry.citations) on small lists whose answer is known,
+and on chen2019's transcription against what an independent reading of the report found."""
+
+import pandas as pd
+import pytest
+
+from replication.registry import citations as C
+from replication.registry import reproduction as rp
+
+
+def _printed(entries, cites):
+    rows = [dict(quantity=f"reference [{n}]", value=e, kind="entry", number=n, line=100 + n, object="")
+            for n, e in entries]
+    rows += [dict(quantity=f"citation {i}", value=c, kind="citation", number="", line=i, object=o)
+             for i, (c, o) in enumerate(cites, 1)]
+    return pd.DataFrame(rows)
+
+
+def test_cited_numbers_expand_ranges_and_lists():
+    assert C.cited_numbers("20-26") == tuple(range(20, 27))
+    assert C.cited_numbers("37,38") == (37, 38)
+    assert C.cited_numbers(" 6 ") == (6,)
+    for bad in ("26-20", "a", "3;4"):
+        with pytest.raises(ValueError):
+            C.cited_numbers(bad)
+
+
+def test_reversed_page_ranges_are_found_and_dates_are_not_ranges():
+    assert C.reversed_pages("Trans. 61(11): 3916-2923") == (3916, 2923)
+    assert C.reversed_pages("2010, 58(7): 3692 -3075") == (3692, 3075)
+    assert C.reversed_pages("13(6): 301 -315") is None
+    assert C.reversed_pages("Brochure, 2008 -04-30") is None
+
+
+def test_a_small_list_with_every_kind_of_disagreement():
+    entries = [(1, "A. Author. One title[J]. J. Nav., 2001, 3(2): 10-20"),
+               (2, "B. Writer. Another study of gravity[J]. Geod., 1999, 4: 50-40"),
+               (3, "A. Author, One title [J]. J. Nav. , 2001, 3(2): 10 - 20"),
+               (4, "C. Nobody. Never cited[M]. Press, 2010")]
+    cites = [("1", "Table 1-1 text"), ("2", "Table 1-1 caption"), ("1-3", ""), ("9", "")]
+    rows = {r["quantity"]: r for r in C.reference_rows(_printed(entries, cites))}
+    assert not rows["reference [1]"]["agrees"] and "same work as [3]" in rows["reference [1]"]["note"]
+    assert not rows["reference [2]"]["agrees"] and "50-40" in rows["reference [2]"]["note"]
+    assert not rows["reference [4]"]["agrees"] and "never cited" in rows["reference [4]"]["note"]
+    assert not rows["citation [9]"]["agrees"]
+    assert not rows["source of Table 1-1: caption against text"]["agrees"]
+    assert {r["basis"] for r in rows.values()} == {"parts"}
+
+
+def test_a_clean_list_agrees_everywhere():
+    entries = [(1, "A. Author. Inertial navigation[M]. Press, 2001"), (2, "B. Writer. Gravity[J]. Geod., 1999, 4: 40-50")]
+    rows = C.reference_rows(_printed(entries, [("1", "Figure 2-1 text"), ("1", "Figure 2-1 caption"), ("2", "")]))
+    assert all(r["agrees"] for r in rows) and len(rows) == 3
+
+
+def test_bad_input_is_refused_with_a_message():
+    with pytest.raises(ValueError, match="columns"):
+        C.reference_rows(pd.DataFrame({"quantity": ["x"]}))
+    with pytest.raises(ValueError, match="twice"):
+        C.reference_rows(_printed([(1, "a"), (1, "b")], []))
+    with pytest.raises(ValueError, match="threshold"):
+        C.duplicate_pairs(pd.DataFrame({"number": [1], "entry": ["a"]}), threshold=0)
+
+
+def test_chen2019_list_holds_what_an_independent_reading_found():
+    """data/paper/chen2019/reading.md, F43, F44 and F70-F73: found by a reader of the report alone."""
+    rows = {r["quantity"]: r for r in C.reference_rows(rp.load_paper("chen2019-print-references").data)}
+    failing = {q for q, r in rows.items() if not r["agrees"]}
+    assert failing == {f"reference [{n}]" for n in (21, 36, 39, 56, 59, 75, 76, 77, 78)} | {
+        "citation [109]", "source of Table 1-1: caption against text", "source of Figure 3-1: caption against text"}
+    assert "same work as [59]" in rows["reference [36]"]["note"]
