@@ -3,7 +3,7 @@
 Each correction of the method is a coefficient times δh^c (:mod:`replication.papers.duan2023.geometry`);
 :func:`derived_coefficients` re-derives the coefficients of eqs. (4)-(19) and their time
 derivatives (the elements of the differential equations (7), (14), (15), (20), (21)) with sympy,
-under each reading of the printed angle β (:data:`READINGS`), at the kinematic states of
+under each reading of the printed angle β (``READINGS``), at the kinematic states of
 :func:`reference_state`.  The printed elements are compared with these in
 :mod:`replication.papers.duan2023.printed`.
 

@@ -1,6 +1,6 @@
 """duan2023's findings: the rows its chapter hands to the registry.
 
-The method modules of :mod:`replication.papers.duan2023` compute (the derivation, the flight,
+The method modules of ``replication.papers.duan2023`` compute (the derivation, the flight,
 the Monte Carlo, the readings); this module decides — it turns the Monte Carlo, the readings and
 the re-derivation into comparison rows that declare their basis and evidence (the registry
 derives each status: CONTRIBUTING.md, "Statuses" and "Readings and the main reading"), with a

@@ -1,12 +1,12 @@
 """The Monte Carlo comparison of duan2023 §3: pure SINS, literature SINS/ADS and the proposed SINS/ADS.
 
-:func:`simulate` runs the three systems (:data:`SYSTEMS`) on one flight for a batch of seeded
+:func:`simulate` runs the three systems (``SYSTEMS``) on one flight for a batch of seeded
 runs (on any ``concurrent.futures`` executor, :mod:`replication.nav.parallel`) and returns a
 :class:`MonteCarlo` of their error histories (:func:`navigation_errors`).  :func:`table1_rows`
 reduces them to the rows of Table 1 with intervals (:func:`mean_interval`, Student t), and
 :func:`pure_sins_initial_errors_only` gives the pure-SINS errors of the initial errors alone.
 
-Units: SI and radians; Table 1 in degrees, m/s and km (:data:`TABLE1_UNITS`).
+Units: SI and radians; Table 1 in degrees, m/s and km (``TABLE1_UNITS``).
 """
 
 from __future__ import annotations
