@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from replication.nav import closedloop, earth, errors, kalman, rotations, sensors, strapdown, timeseries, trajectory
 from replication.nav.units import DEG
 from replication.papers.an2021 import transfer
-from replication.papers.chen2019 import calibration, findings, gravity, models, observability, simulation
+from replication.papers.chen2019 import findings, gravity, models, observability, simulation, static_tests
 from replication.papers.fang2020 import polar
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
@@ -101,13 +101,13 @@ PROBES = [
     ("kalman.discretize_series(Q = -I)", "GQGt", lambda: kalman.discretize_series(np.zeros((2, 2)), -np.eye(2), 1.0)),
     ("kalman.predict(P with NaN)", "P", lambda: kalman.predict(X2, np.diag([np.nan, 1.0]), np.eye(2), np.eye(2))),
     ("simulate_static_sensor(white_density=nan)", "white_density",
-     lambda: calibration.simulate_static_sensor(10.0, 10.0, white_density=np.nan, rng=np.random.default_rng(0))),
+     lambda: static_tests.simulate_static_sensor(10.0, 10.0, white_density=np.nan, rng=np.random.default_rng(0))),
     ("simulate_static_sensor(duration='10')", "duration",
-     lambda: calibration.simulate_static_sensor("10", 10.0, rng=np.random.default_rng(0))),
+     lambda: static_tests.simulate_static_sensor("10", 10.0, rng=np.random.default_rng(0))),
     ("allan_deviation(sample_rate=-100)", "sample_rate",
-     lambda: calibration.allan_deviation(np.random.default_rng(0).standard_normal(1000), -100.0)),
+     lambda: static_tests.allan_deviation(np.random.default_rng(0).standard_normal(1000), -100.0)),
     ("allan_deviation(sample_rate=0)", "sample_rate",
-     lambda: calibration.allan_deviation(np.random.default_rng(0).standard_normal(1000), 0.0)),
+     lambda: static_tests.allan_deviation(np.random.default_rng(0).standard_normal(1000), 0.0)),
     ("euler_to_dcm(nan, 0, 0)", "heading", lambda: rotations.euler_to_dcm(np.nan, 0.0, 0.0)),
     ("euler_to_dcm('a', 0, 0)", "heading", lambda: rotations.euler_to_dcm("a", 0.0, 0.0)),
     ("dcm_to_euler(2 I)", "c", lambda: rotations.dcm_to_euler(2 * I3)),
@@ -570,13 +570,13 @@ _CALLS = {
                         {"F": "mat2", "GQGt": "cov2", "dt": "rate"}),
     "kalman.discretize_series": (kalman.discretize_series, dict(F=np.zeros((2, 2)), GQGt=np.eye(2), dt=1.0),
                                  {"F": "mat2", "GQGt": "cov2", "dt": "rate"}),
-    "calibration.simulate_static_sensor": (
-        lambda **kw: calibration.simulate_static_sensor(rng=_RNG(0), **kw),
+    "static_tests.simulate_static_sensor": (
+        lambda **kw: static_tests.simulate_static_sensor(rng=_RNG(0), **kw),
         dict(duration=10.0, sample_rate=10.0, white_density=1e-3, gm_sigma=1e-3, gm_tau=5.0),
         {"duration": "rate", "sample_rate": "rate", "white_density": "sd", "gm_sigma": "sd", "gm_tau": "rate"}),
-    "calibration.allan_deviation": (calibration.allan_deviation, dict(y=_Y, sample_rate=100.0),
+    "static_tests.allan_deviation": (static_tests.allan_deviation, dict(y=_Y, sample_rate=100.0),
                                     {"y": "series", "sample_rate": "rate"}),
-    "calibration.bias_stability": (calibration.bias_stability, dict(y=_Y, sample_rate=10.0, window=1.0),
+    "static_tests.bias_stability": (static_tests.bias_stability, dict(y=_Y, sample_rate=10.0, window=1.0),
                                    {"y": "series", "sample_rate": "rate", "window": "rate"}),
     "sensors.markov_sigma_from_driving_psd": (sensors.markov_sigma_from_driving_psd, dict(q_drive=1e-6, tau=100.0),
                                               {"q_drive": "sd", "tau": "rate"}),

@@ -375,7 +375,7 @@ def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indic
 
 def closed_form_rows(checks, *, probe: str, evidence_prefix: str) -> list[dict]:
     """The rows of the printed six-position and temperature formulas (4-3)-(4-12) against their
-    derivation (:func:`replication.papers.chen2019.calibration.printed_form_checks`).
+    derivation (:func:`replication.papers.chen2019.closed_forms.printed_form_checks`).
 
     Each row carries the printed form as printed (``paper_text``), its value at the probe point
     (``paper``, relative to the true parameter; empty where the print is no formula to evaluate),
@@ -385,7 +385,7 @@ def closed_form_rows(checks, *, probe: str, evidence_prefix: str) -> list[dict]:
     Parameters
     ----------
     checks : list of FormCheck
-        :func:`replication.papers.chen2019.calibration.printed_form_checks`.
+        :func:`replication.papers.chen2019.closed_forms.printed_form_checks`.
     probe : str
         The probe point in words (sensor, rate, latitude), quoted in every note.
     evidence_prefix : str
@@ -396,7 +396,7 @@ def closed_form_rows(checks, *, probe: str, evidence_prefix: str) -> list[dict]:
     list of dict
         Rows for :func:`replication.registry.reproduction.compare`.
     """
-    from replication.papers.chen2019.calibration import AGREE_REL
+    from replication.papers.chen2019.closed_forms import AGREE_REL
 
     rows = []
     for k, c in enumerate(checks, 1):
