@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 from replication.nav import closedloop, earth, errors, kalman, rotations, sensors, strapdown, timeseries, trajectory
 from replication.nav.units import DEG
-from replication.papers.an2021 import transfer
+from replication.papers.an2021 import integrated, transfer
 from replication.papers.chen2019 import findings, gravity, models, observability, simulation, static_tests
 from replication.papers.fang2020 import polar
 
@@ -263,13 +263,13 @@ PROBES += [
      lambda: findings.compare_verdicts(_deg_table((np.nan, 0.0, 0.0)), {"m": _deg_table()}, "m", exact=_EXACT,
                                             explain={})),
     ("kalman_gain_by_iteration(steps = 0)", "steps",
-     lambda: transfer.kalman_gain_by_iteration(-np.eye(2), np.eye(2), np.eye(2), np.eye(2), dt=1.0, steps=0, p0=np.eye(2))),
+     lambda: integrated.kalman_gain_by_iteration(-np.eye(2), np.eye(2), np.eye(2), np.eye(2), dt=1.0, steps=0, p0=np.eye(2))),
     ("kalman_gain_by_iteration(c of the wrong width)", "c",
-     lambda: transfer.kalman_gain_by_iteration(-np.eye(2), np.eye(3), np.eye(2), np.eye(3), dt=1.0, steps=3,
+     lambda: integrated.kalman_gain_by_iteration(-np.eye(2), np.eye(3), np.eye(2), np.eye(3), dt=1.0, steps=3,
                                                p0=np.eye(2))),
     ("kalman_gain_by_iteration(dt = 0)", "dt",
-     lambda: transfer.kalman_gain_by_iteration(-np.eye(2), np.eye(2), np.eye(2), np.eye(2), dt=0.0, steps=3, p0=np.eye(2))),
-    ("NoiseSettings.scaled(unknown field)", "gyro_typo", lambda: transfer.NoiseSettings(1e-6, 1e-4, 1e-8, 1e-6, 10.0).scaled(gyro_typo=2.0)),
+     lambda: integrated.kalman_gain_by_iteration(-np.eye(2), np.eye(2), np.eye(2), np.eye(2), dt=0.0, steps=3, p0=np.eye(2))),
+    ("NoiseSettings.scaled(unknown field)", "gyro_typo", lambda: integrated.NoiseSettings(1e-6, 1e-4, 1e-8, 1e-6, 10.0).scaled(gyro_typo=2.0)),
     ("fraction_in_band(prob = 1.5)", "prob", lambda: simulation.fraction_in_band(np.ones((3, 4)), 3, prob=1.5)),
     ("fraction_in_band(mask of the wrong length)", "mask",
      lambda: simulation.fraction_in_band(np.ones((3, 4)), 3, mask=np.ones(5, bool))),
@@ -593,7 +593,7 @@ _CALLS = {
     "transfer.system_matrix": (transfer.system_matrix, dict(lat=LAT, v_east=100.0, v_north=0.0),
                                {"lat": "lat", "v_east": "speed", "v_north": "speed"}),
     "transfer.schuler_frequency": (transfer.schuler_frequency, dict(lat=LAT), {"lat": "lat"}),
-    "transfer.NoiseSettings": (transfer.NoiseSettings,
+    "integrated.NoiseSettings": (integrated.NoiseSettings,
                                dict(gyro_arw=1e-5, accel_vrw=1e-4, gyro_bias_rw=1e-8, accel_bias_rw=1e-7,
                                     position_sigma=1.0),
                                {"gyro_arw": "sd", "accel_vrw": "sd", "gyro_bias_rw": "sd", "accel_bias_rw": "sd",
