@@ -32,7 +32,7 @@ from replication.papers.chen2019 import observability as O
 from replication.papers.chen2019 import simulation as sim
 from replication.papers.chen2019 import turntable as tt
 from replication.papers.duan2023 import flight, montecarlo, sweeps
-from replication.papers.fang2020 import polar
+from replication.papers.fang2020 import polar, sensitivity
 from replication.registry import reproduction as rp
 
 FIELDS = ("t_epoch", "nees", "nis", "final_estimates", "true_params", "final_sigma", "P_diag_run0")
@@ -185,8 +185,8 @@ def test_fang2020_sensitivity_on_dask_equals_in_process(cluster):
     base = dict(polar.FANG2020_READING, fix_times=(600.0, 1200.0))
     variants = {"nominal": base, "no accel bias": dict(base, accel_bias=(0.0, 0.0, 0.0)),
                 "Euler-heading observation": dict(base, heading_observation="euler")}
-    ref = polar.sensitivity(1, variants, n_runs=2)
-    got = polar.sensitivity(1, variants, n_runs=2, executor=client.get_executor(), chunk_runs=1)
+    ref = sensitivity.sensitivity(1, variants, n_runs=2)
+    got = sensitivity.sensitivity(1, variants, n_runs=2, executor=client.get_executor(), chunk_runs=1)
     pd.testing.assert_frame_equal(got, ref, check_exact=True)
 
 
