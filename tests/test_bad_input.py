@@ -20,7 +20,17 @@ from hypothesis import strategies as st
 from replication.nav import closedloop, earth, errors, kalman, rotations, sensors, strapdown, timeseries, trajectory
 from replication.nav.units import DEG
 from replication.papers.an2021 import integrated, transfer
-from replication.papers.chen2019 import findings, gravity, models, observability, simulation, static_tests
+from replication.papers.chen2019 import (
+    findings,
+    gravity,
+    maneuvers,
+    models,
+    observability,
+    observability_tables,
+    simulation,
+    static_tests,
+    table_2_2,
+)
 from replication.papers.fang2020 import polar
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
@@ -131,13 +141,13 @@ _T1 = trajectory.generate([trajectory.Straight(1.0)], LAT, LON, H, speed=10.0)  
 _M15 = errors.model_15()
 _MC15 = errors.model_15(accel_bias_sd=1e-3, gyro_bias_sd=1e-6)   # every state with a variance: a defined NEES
 _R6 = np.diag([1.0, 1.0, 1.0, 0.01, 0.01, 0.01])
-_MV = {"straight": observability.Maneuver("straight", _T1, 1.0, 1.0)}
+_MV = {"straight": maneuvers.Maneuver("straight", _T1, 1.0, 1.0)}
 _G1 = sensors.gnss_measurements(_T1, rate_hz=10.0, rng=0)
 _F2, _H12 = np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[1.0, 0.0]])
 
 
 def _deg_table(values=(1.0, 1e-3, 0.0), scenarios=("before maneuver", "turn"), states=("a", "b", "c")):
-    """A degrees table of three states (as observability.degrees_table returns it)."""
+    """A degrees table of three states (as observability_tables.degrees_table returns it)."""
     t = pd.DataFrame({c: list(values) for c in scenarios}, index=list(states))
     t.attrs["rank_tol"] = dict.fromkeys(scenarios, 1e-9)
     t.attrs["ambiguity"] = {c: dict.fromkeys(t.index, 0.1) for c in scenarios}
@@ -223,37 +233,37 @@ PROBES += [
      lambda: observability.covariance_observability(_M15, _T1, 0.0, np.nan, update_interval=0.5, R=_R6)),
     ("covariance_observability(series_order = 0)", "series_order",
      lambda: observability.covariance_observability(_M15, _T1, 0.0, 1.0, update_interval=0.5, R=_R6, series_order=0)),
-    ("spearman(a = 'abc')", "a", lambda: observability.spearman("abc", [1, 2, 3])),
-    ("spearman(b with NaN)", "b", lambda: observability.spearman([1, 2, 3], [1, np.nan, 3])),
-    ("chen2019_maneuvers(u_turn = '400')", "u_turn", lambda: observability.chen2019_maneuvers(u_turn="400")),
-    ("chen2019_maneuvers(total = nan)", "total", lambda: observability.chen2019_maneuvers(total=np.nan)),
-    ("chen2019_maneuvers(s_cycles = 0)", "s_cycles", lambda: observability.chen2019_maneuvers(s_cycles=0)),
-    ("chen2019_maneuvers(dt = -1)", "dt", lambda: observability.chen2019_maneuvers(dt=-1.0)),
-    ("unbanked(traj = array)", "traj", lambda: observability.unbanked(np.zeros((10, 3)))),
-    ("coordinated(traj = None)", "traj", lambda: observability.coordinated(None)),
+    ("spearman(a = 'abc')", "a", lambda: observability_tables.spearman("abc", [1, 2, 3])),
+    ("spearman(b with NaN)", "b", lambda: observability_tables.spearman([1, 2, 3], [1, np.nan, 3])),
+    ("chen2019_maneuvers(u_turn = '400')", "u_turn", lambda: maneuvers.chen2019_maneuvers(u_turn="400")),
+    ("chen2019_maneuvers(total = nan)", "total", lambda: maneuvers.chen2019_maneuvers(total=np.nan)),
+    ("chen2019_maneuvers(s_cycles = 0)", "s_cycles", lambda: maneuvers.chen2019_maneuvers(s_cycles=0)),
+    ("chen2019_maneuvers(dt = -1)", "dt", lambda: maneuvers.chen2019_maneuvers(dt=-1.0)),
+    ("unbanked(traj = array)", "traj", lambda: maneuvers.unbanked(np.zeros((10, 3)))),
+    ("coordinated(traj = None)", "traj", lambda: maneuvers.coordinated(None)),
     ("degrees_table(maneuvers = list)", "maneuvers",
-     lambda: observability.degrees_table(_M15, [_T1], states=_M15.labels)),
+     lambda: observability_tables.degrees_table(_M15, [_T1], states=_M15.labels)),
     ("degrees_table(n_segments = 0)", "n_segments",
-     lambda: observability.degrees_table(_M15, _MV, states=_M15.labels, n_segments=0)),
+     lambda: observability_tables.degrees_table(_M15, _MV, states=_M15.labels, n_segments=0)),
     ("covariance_table(R with NaN)", "R",
-     lambda: observability.covariance_table(_M15, _MV, np.diag([np.nan, 1, 1, 1, 1, 1]), states=_M15.labels)),
+     lambda: observability_tables.covariance_table(_M15, _MV, np.diag([np.nan, 1, 1, 1, 1, 1]), states=_M15.labels)),
     ("rank_metrics(reference_threshold = -1)", "reference_threshold",
-     lambda: observability.rank_metrics(_deg_table(), _deg_table(), reference_threshold=-1.0, reproduced_threshold=0.0)),
+     lambda: observability_tables.rank_metrics(_deg_table(), _deg_table(), reference_threshold=-1.0, reproduced_threshold=0.0)),
     ("rank_metrics(reproduced_threshold = nan)", "reproduced_threshold",
-     lambda: observability.rank_metrics(_deg_table(), _deg_table(), reference_threshold=0.0,
+     lambda: observability_tables.rank_metrics(_deg_table(), _deg_table(), reference_threshold=0.0,
                                         reproduced_threshold=np.nan)),
     ("rank_metrics(reference with NaN)", "reference",
-     lambda: observability.rank_metrics(_deg_table((1.0, np.nan, 0.0)), _deg_table(), reference_threshold=0.0,
+     lambda: observability_tables.rank_metrics(_deg_table((1.0, np.nan, 0.0)), _deg_table(), reference_threshold=0.0,
                                         reproduced_threshold=0.0)),
     ("rank_metrics(reproduced = array)", "reproduced",
-     lambda: observability.rank_metrics(_deg_table(), np.eye(3), reference_threshold=0.0, reproduced_threshold=0.0)),
+     lambda: observability_tables.rank_metrics(_deg_table(), np.eye(3), reference_threshold=0.0, reproduced_threshold=0.0)),
     ("sweep(reference_threshold = nan)", "reference_threshold",
-     lambda: observability.sweep(_M15, _MV, _deg_table(scenarios=("straight",), states=_DV), {"v": {}}, states=_DV,
+     lambda: observability_tables.sweep(_M15, _MV, _deg_table(scenarios=("straight",), states=_DV), {"v": {}}, states=_DV,
                                  reference_threshold=np.nan)),
     ("sweep(variants = list)", "variants",
-     lambda: observability.sweep(_M15, _MV, _deg_table(scenarios=("straight",), states=_DV), [{}], states=_DV)),
-    ("verdict_under(rank_tol = -1e-9)", "rank_tol", lambda: observability.verdict_under(1.0, 1.0, -1e-9, 0.1)),
-    ("verdict_under(degree = '1')", "degree", lambda: observability.verdict_under(1.0, "1", 1e-9, 0.1)),
+     lambda: observability_tables.sweep(_M15, _MV, _deg_table(scenarios=("straight",), states=_DV), [{}], states=_DV)),
+    ("verdict_under(rank_tol = -1e-9)", "rank_tol", lambda: observability_tables.verdict_under(1.0, 1.0, -1e-9, 0.1)),
+    ("verdict_under(degree = '1')", "degree", lambda: observability_tables.verdict_under(1.0, "1", 1e-9, 0.1)),
     ("compare_verdicts(printed_threshold = -1)", "printed_threshold",
      lambda: findings.compare_verdicts(_deg_table(), {"m": _deg_table()}, "m", exact=_EXACT, explain={},
                                             printed_threshold=-1.0)),
@@ -276,7 +286,7 @@ PROBES += [
     ("rms_with_ci(prob = 0)", "prob", lambda: simulation.rms_with_ci(np.ones((3, 4)), np.ones(4, bool), prob=0.0)),
     ("rms_with_ci(mask of the wrong length)", "mask", lambda: simulation.rms_with_ci(np.ones((3, 4)), np.ones(2, bool))),
     ("table_2_2_differences(model = 'model_45')", "ErrorModel",
-     lambda: models.table_2_2_differences("model_45", models.table_2_2_reference_point())),
+     lambda: table_2_2.table_2_2_differences("model_45", table_2_2.table_2_2_reference_point())),
     ("closed_loop(P0 = -I)", "P0", lambda: _closed_loop(P0=-np.eye(15))),
     ("closed_loop(P0 with NaN)", "P0", lambda: _closed_loop(P0=np.diag([np.nan] + [1.0] * 14))),
     ("closed_loop(vertical = 'up')", "vertical", lambda: _closed_loop(vertical="up")),
@@ -625,32 +635,32 @@ _CALLS = {
                                                {"model": "object", "traj": "object", "t0": "angle", "t1": "angle",
                                                 "update_interval": "rate", "R": "cov6", "P0": "cov15",
                                                 "lever_arm_b": "vec3", "series_order": "count"}),
-    "observability.spearman": (observability.spearman, dict(a=[1.0, 2.0, 3.0], b=[1.0, 3.0, 2.0]),
+    "observability_tables.spearman": (observability_tables.spearman, dict(a=[1.0, 2.0, 3.0], b=[1.0, 3.0, 2.0]),
                                {"a": "vec2", "b": "vec2"}),
-    "observability.chen2019_maneuvers": (observability.chen2019_maneuvers,
+    "maneuvers.chen2019_maneuvers": (maneuvers.chen2019_maneuvers,
                                          dict(straight=2.0, u_turn=4.0, figure_eight=8.0, s_turn=8.0, dt=1.0),
                                          {"straight": "rate", "u_turn": "rate", "figure_eight": "rate", "s_turn": "rate",
                                           "s_swing": "angle", "s_cycles": "count", "total": "rate", "dt": "rate"}),
-    "observability.unbanked": (observability.unbanked, dict(traj=_T1), {"traj": "object"}),
-    "observability.coordinated": (observability.coordinated, dict(traj=_T1), {"traj": "object"}),
-    "observability.degrees_table": (observability.degrees_table, dict(model=_M15, maneuvers=_MV, states=_M15.labels),
+    "maneuvers.unbanked": (maneuvers.unbanked, dict(traj=_T1), {"traj": "object"}),
+    "maneuvers.coordinated": (maneuvers.coordinated, dict(traj=_T1), {"traj": "object"}),
+    "observability_tables.degrees_table": (observability_tables.degrees_table, dict(model=_M15, maneuvers=_MV, states=_M15.labels),
                                     {"model": "object", "maneuvers": "object", "n_segments": "count",
                                      "before_segments": "count", "states": "labels"}),
-    "observability.covariance_table": (observability.covariance_table,
+    "observability_tables.covariance_table": (observability_tables.covariance_table,
                                        dict(model=_M15, maneuvers=_MV, R=_R6, states=_M15.labels, update_interval=0.5),
                                        {"model": "object", "maneuvers": "object", "R": "cov6", "P0": "cov15",
                                         "update_interval": "rate", "states": "labels"}),
-    "observability.rank_metrics": (observability.rank_metrics,
+    "observability_tables.rank_metrics": (observability_tables.rank_metrics,
                                    dict(reference=_deg_table(), reproduced=_deg_table(), reference_threshold=1e-5,
                                         reproduced_threshold=1e-5),
                                    {"reference": "table", "reproduced": "table", "reference_threshold": "sd",
                                     "reproduced_threshold": "sd"}),
-    "observability.sweep": (observability.sweep,
+    "observability_tables.sweep": (observability_tables.sweep,
                             dict(model=_M15, maneuvers=_MV, reference=_deg_table(scenarios=("straight",), states=_DV),
                                  variants={"default": {}}, states=_DV),
                             {"model": "object", "maneuvers": "object", "reference": "table", "variants": "object",
                              "reference_threshold": "sd"}),
-    "observability.verdict_under": (observability.verdict_under,
+    "observability_tables.verdict_under": (observability_tables.verdict_under,
                                     dict(printed_value=1.0, degree=1.0, rank_tol=1e-9, ambiguity=0.1),
                                     {"printed_value": "sd", "degree": "sd", "rank_tol": "sd", "ambiguity": "sd",
                                      "printed_threshold": "sd"}),

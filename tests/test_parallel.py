@@ -27,8 +27,8 @@ from replication.nav import trajectory as tr
 from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, DEG_PER_SQRT_H, MGAL, MICRO_G
 from replication.papers.chen2019 import error_effects as ee
 from replication.papers.chen2019 import gravity as gr
+from replication.papers.chen2019 import maneuvers, observability_tables
 from replication.papers.chen2019 import models as M
-from replication.papers.chen2019 import observability as O
 from replication.papers.chen2019 import simulation as sim
 from replication.papers.chen2019 import turntable as tt
 from replication.papers.duan2023 import flight, montecarlo, sweeps
@@ -445,21 +445,21 @@ def _same_frame_and_attrs(got, ref):
 def test_chen2019_observability_readings_on_threads_in_chunks_and_on_processes():
     """sweep computes one reading per chunk: the rows and every reading's degrees table (with its
     rank tolerances and ambiguities) equal the in-process sweep bit for bit."""
-    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
+    mv = maneuvers.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
     m = M.model_45()
     st = m.labels[:9] + M.table_2_3_states()[3:]
-    reference = O.degrees_table(m, mv, states=st, n_segments=4)
+    reference = observability_tables.degrees_table(m, mv, states=st, n_segments=4)
     variants = {"r = 4": dict(n_segments=4), "r = 2": dict(n_segments=2), "max-normalized": dict(normalize="max"),
                 "assignment by singular vector": dict(assignment="singular", n_segments=4)}
-    ref = O.sweep(m, mv, reference, variants, states=st)
+    ref = observability_tables.sweep(m, mv, reference, variants, states=st)
     assert list(ref.index) == list(variants) and list(ref.attrs["tables"]) == list(variants)
     with ThreadPoolExecutor(2) as ex:
-        _same_frame_and_attrs(O.sweep(m, mv, reference, variants, states=st, executor=ex, chunk_runs=1), ref)
-    _same_frame_and_attrs(O.sweep(m, mv, reference, variants, states=st, chunk_runs=3), ref)
+        _same_frame_and_attrs(observability_tables.sweep(m, mv, reference, variants, states=st, executor=ex, chunk_runs=1), ref)
+    _same_frame_and_attrs(observability_tables.sweep(m, mv, reference, variants, states=st, chunk_runs=3), ref)
     with ProcessPoolExecutor(2) as ex:
-        _same_frame_and_attrs(O.sweep(m, mv, reference, variants, states=st, executor=ex), ref)
+        _same_frame_and_attrs(observability_tables.sweep(m, mv, reference, variants, states=st, executor=ex), ref)
     with pytest.raises(TypeError, match="executor must be a concurrent.futures.Executor"):
-        O.sweep(m, mv, reference, variants, states=st, executor="dask")
+        observability_tables.sweep(m, mv, reference, variants, states=st, executor="dask")
 
 
 def test_chen2019_error_effects_on_threads_in_chunks_and_on_processes():

@@ -22,7 +22,8 @@ import numpy as np
 import pandas as pd
 
 from replication.nav._validate import nonnegative
-from replication.papers.chen2019.observability import LEVEL_COMBINATIONS, _table, verdict_threshold, verdict_under
+from replication.papers.chen2019.observability import LEVEL_COMBINATIONS, verdict_threshold
+from replication.papers.chen2019.observability_tables import _table, verdict_under
 from replication.papers.chen2019.simulation import figure_4_14_estimates
 from replication.papers.chen2019.turntable import QUANTITIES
 
@@ -93,7 +94,7 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
         The printed degrees (rows: states, columns: scenarios), dimensionless.
     readings : dict
         Reading name → degrees table of the same shape with ``attrs["rank_tol"]`` and
-        ``attrs["ambiguity"]`` (:func:`replication.papers.chen2019.observability.degrees_table`, or
+        ``attrs["ambiguity"]`` (:func:`replication.papers.chen2019.observability_tables.degrees_table`, or
         ``sweep(...).attrs["tables"]``).
     main : str
         The main reading, a key of ``readings``.
@@ -429,7 +430,7 @@ TABLE_2_2_CORRECTED_TEXT = {
     "F53": r"columns G_zx, G_yz, G_zy: [-C_{\cdot 2}\omega_z,\ -C_{\cdot 1}\omega_y,\ C_{\cdot 1}\omega_z]",
 }
 """Corrected expressions of the Table 2-2 blocks whose printed form differs (see
-:func:`replication.papers.chen2019.models.table_2_2_corrected`), in LaTeX; the chapter renders them.
+:func:`replication.papers.chen2019.table_2_2.table_2_2_corrected`), in LaTeX; the chapter renders them.
 
 :meta hide-value:
 """
