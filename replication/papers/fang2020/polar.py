@@ -2,7 +2,7 @@
 
 Implements the simulation of fang2020 (Fang, Huang & Wang 2020, *Comprehensive calibration
 method of shipborne grid inertial navigation system*) on the method modules of
-:mod:`replication.papers.fang2020`: frames (:mod:`replication.papers.fang2020.frames`), the
+``replication.papers.fang2020``: frames (:mod:`replication.papers.fang2020.frames`), the
 damping network (:mod:`replication.papers.fang2020.damping`), the P and ψ equations
 (:mod:`replication.papers.fang2020.error_equations`) and the two-point calibration
 (:mod:`replication.papers.fang2020.two_point`).
