@@ -74,7 +74,7 @@ def literature_filter(traj, dth, dv, ads, setup, *, every: int = 50, workers: in
     dth, dv : (R, N, 3) array_like
         Every run's corrupted gyro and accelerometer increments (rad, m/s).
     ads : sequence of AirData
-        Every run's air-data measurements (:func:`ads_measurements`).
+        Every run's air-data measurements (:func:`~replication.papers.duan2023.flight.ads_measurements`).
     setup : AirdataSetup
         Initial errors, sensor noise, ``filter_interval``, ``markov_tau``.
     every : int
