@@ -18,7 +18,7 @@ The disturbance vector is delta g^n = g^n - g_m^n (chen2019 eq. 3-6), i.e. the g
 disturbing potential T: [dT/dx, dT/dy, dT/dz]; its up component is minus the scalar gravity
 disturbance of geodesy (a stronger downward pull gives a negative up component).
 
-**Why this module is long.**  It holds chen2019 ch. 3 as one pipeline whose steps hand each other
+Why this module is long: it holds chen2019 ch. 3 as one pipeline whose steps hand each other
 their own objects: the synthetic field (:class:`PlanarGravityField`, :class:`SurveyLayout`) is
 sampled along the survey flight, the direct difference (3-7) of that flight is low-pass filtered
 into the series the AR model is identified on, the AR model becomes the gravity block of the

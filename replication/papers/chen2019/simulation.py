@@ -45,7 +45,7 @@ the adjoint λ_k and its covariance Λ_k carried back through the updates' rows,
 innovations and through Φ — no inverse of P_{k+1}⁻, and the O(n³) products only at the recorded
 epochs; the test suite checks it against the RTS form.
 
-**Why this module is long.**  It is the one Monte Carlo of chen2019 ch. 4 §2 and the statistics
+Why this module is long: it is the one Monte Carlo of chen2019 ch. 4 §2 and the statistics
 read from it: the setup (:class:`SimulationSetup`, Table 4-41), the per-run truth, the batched
 closed-loop runs (:func:`run_batch`, the module's one call into :mod:`replication.nav.closedloop`)
 and their result (:class:`BatchResult`), then the diagnostics that read that result's fields —
