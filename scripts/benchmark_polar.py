@@ -25,7 +25,7 @@ sys.path.insert(0, str(ROOT))
 import numba  # noqa: E402
 
 from replication.nav import units  # noqa: E402
-from replication.papers.fang2020 import polar  # noqa: E402
+from replication.papers.fang2020 import polar, sensitivity  # noqa: E402
 
 BUDGET_SECONDS = 180.0
 
@@ -48,7 +48,7 @@ def main():
         cases[f"case {case}"] = {"seconds": round(dt, 2), "runs": n, "steps_per_run": k_total,
                                  "reset_only_runs": int(res.errors_reset_only.shape[0]), "step_runs": sr,
                                  "microseconds_per_step_run": round(dt / sr * 1e6, 4),
-                                 "x_mean_deg_h": round(polar.drift_summary(res)["X"][0], 7)}
+                                 "x_mean_deg_h": round(sensitivity.drift_summary(res)["X"][0], 7)}
         total += dt
         step_runs += sr
     out = {"workload": "fang2020 §3: 2 × 20 runs × 10 h × 100 Hz (+ 1 reset-only continuation per case)",

@@ -5,7 +5,7 @@ import pytest
 
 from replication.nav import trajectory as tr
 from replication.nav.sensors import ImuErrors, TriadErrors
-from replication.papers.chen2019 import findings
+from replication.papers.chen2019 import findings, maneuvers, observability_tables
 from replication.papers.chen2019 import models as M
 from replication.papers.chen2019 import observability as O
 
@@ -117,8 +117,8 @@ def test_normalizations_and_sign_invariance():
 
 
 def test_spearman():
-    assert O.spearman([1, 2, 3, 4], [10, 20, 30, 40]) == pytest.approx(1.0)
-    assert O.spearman([1, 2, 3, 4], [4, 3, 2, 1]) == pytest.approx(-1.0)
+    assert observability_tables.spearman([1, 2, 3, 4], [10, 20, 30, 40]) == pytest.approx(1.0)
+    assert observability_tables.spearman([1, 2, 3, 4], [4, 3, 2, 1]) == pytest.approx(-1.0)
 
 
 @pytest.fixture(scope="module")
@@ -183,7 +183,7 @@ def test_bad_inputs():
     with pytest.raises(TypeError, match="ErrorModel"):
         O.piecewise_systems("model", None, [(0, 1)])
     with pytest.raises(ValueError, match="spearman"):
-        O.spearman([1, 2], [2, 1])
+        observability_tables.spearman([1, 2], [2, 1])
 
 
 def test_series_discretization_matches_expm(flight):
@@ -204,8 +204,8 @@ def test_series_discretization_matches_expm(flight):
 
 
 def test_chen2019_maneuvers_and_tables():
-    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
-    assert list(mv) == list(O.CHEN2019_MANEUVERS)
+    mv = maneuvers.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
+    assert list(mv) == list(maneuvers.CHEN2019_MANEUVERS)
     assert all(abs(m.traj.t[-1] - 260.0) < 1e-9 for m in mv.values())
     # headings: the U-turn reverses the course, the figure-8 and the S-turn return to it
     h = {k: np.degrees(m.traj.hpr[int(m.t_end), 0]) % 360 for k, m in mv.items()}
@@ -215,25 +215,25 @@ def test_chen2019_maneuvers_and_tables():
     assert len(mv["U-turn"].spans(8, 2)) == 10
     m = M.model_45()
     st = m.labels[:9] + M.table_2_3_states()[3:]
-    df = O.degrees_table(m, mv, states=st, n_segments=4)
-    assert df.shape == (33, 4) and set(df.attrs["rank_tol"]) == set(O.CHEN2019_MANEUVERS)
-    met = O.rank_metrics(df, df, reference_threshold=1e-5, reproduced_threshold=1e-5)
+    df = observability_tables.degrees_table(m, mv, states=st, n_segments=4)
+    assert df.shape == (33, 4) and set(df.attrs["rank_tol"]) == set(maneuvers.CHEN2019_MANEUVERS)
+    met = observability_tables.rank_metrics(df, df, reference_threshold=1e-5, reproduced_threshold=1e-5)
     assert np.allclose(met["spearman"], 1.0) and (met["verdicts_agree"] == 33).all()
-    best = O.best_scenario_counts(df)
+    best = observability_tables.best_scenario_counts(df)
     assert list(best.index) == ["U-turn", "figure-8", "S-turn"]
     # a state whose largest degree is shared (zero everywhere: never excited) counts for none
     shared = int(((df.iloc[:, 1:] == df.iloc[:, 1:].max(axis=1).to_numpy()[:, None]).sum(axis=1) > 1).sum())
     assert best.sum() == 33 - shared and shared >= 1
     with pytest.raises(ValueError, match="total"):
-        O.chen2019_maneuvers(total=10.0)
+        maneuvers.chen2019_maneuvers(total=10.0)
     with pytest.raises(ValueError, match="same states"):
-        O.rank_metrics(df, df.iloc[:5], reference_threshold=1e-5, reproduced_threshold=1e-5)
+        observability_tables.rank_metrics(df, df.iloc[:5], reference_threshold=1e-5, reproduced_threshold=1e-5)
 
 
 def test_goshen_meskin_condition_on_the_45_state_segments():
     """Along a U-turn every segment's unobservable directions are not moved by F (|F N| at
     rounding level), so the SOM has the rank of the TOM; a system violating it is detected."""
-    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
+    mv = maneuvers.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
     m = M.model_45()
     st = m.labels[:9] + M.table_2_3_states()[3:]
     sy = O.piecewise_systems(m, mv["U-turn"].traj, mv["U-turn"].spans(4), states=st)
@@ -263,9 +263,9 @@ def test_coordinated_turns_leave_no_lateral_specific_force():
     """observability.coordinated: the bank absorbs the ~0.01 m/s² Coriolis/transport residual of a
     kinematically banked turn (f_x below 1e-9 m/s², round-off of the rotation), f^n unchanged to
     round-off, and the roll changes by less than 0.1° (0.0119/9.8 rad ≈ 0.07°)."""
-    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
+    mv = maneuvers.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
     t = mv["U-turn"].traj
-    c = O.coordinated(t)
+    c = maneuvers.coordinated(t)
     assert np.abs(t.f_b[:, 0]).max() > 1e-3                       # the residual is there before
     assert np.abs(c.f_b[:, 0]).max() < 1e-9
     f_n, f_n_c = (np.einsum("kij,kj->ki", x.C_bn, x.f_b) for x in (t, c))
@@ -274,14 +274,14 @@ def test_coordinated_turns_leave_no_lateral_specific_force():
 
 
 def test_verdict_under_decides_with_a_round_off_margin():
-    assert O.verdict_under(2.0, 5.0, 1e-9, 0.1) == (True, True, True)
+    assert observability_tables.verdict_under(2.0, 5.0, 1e-9, 0.1) == (True, True, True)
     # a degree within a decade of the rank tolerance is round-off: unobservable
-    assert O.verdict_under(1e-18, 5e-9, 1e-9, 0.1) == (False, False, True)
-    assert O.verdict_under(3.0, 5e-9, 1e-9, 0.1) == (True, False, True)
+    assert observability_tables.verdict_under(1e-18, 5e-9, 1e-9, 0.1) == (False, False, True)
+    assert observability_tables.verdict_under(3.0, 5e-9, 1e-9, 0.1) == (True, False, True)
     # verdicts differ but the assignment is ambiguous: no verdict
-    assert O.verdict_under(3.0, 0.0, 1e-9, 0.99)[2] is False
+    assert observability_tables.verdict_under(3.0, 0.0, 1e-9, 0.99)[2] is False
     with pytest.raises(ValueError, match="degree"):
-        O.verdict_under(1.0, float("nan"), 1e-9, 0.1)
+        observability_tables.verdict_under(1.0, float("nan"), 1e-9, 0.1)
 
 
 def _degrees(values, tol=1e-9, amb=0.1):
@@ -352,17 +352,17 @@ def test_one_threshold_for_tables_sweep_and_verdicts():
     """degrees_table, sweep and verdict_under share one threshold, ROUND_OFF_MARGIN times the rank tolerance."""
     assert O.verdict_threshold(2e-5) == pytest.approx(2e-4)
     assert O.verdict_threshold({"a": 1e-9}) == {"a": pytest.approx(1e-8)}
-    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
+    mv = maneuvers.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
     m = M.model_45(misalignment_coupling="table-2-2")
     st = m.labels[:9] + M.table_2_3_states()[3:]
-    raw = O.degrees_table(m, mv, states=st, n_segments=4, clip_null=False)
-    df = O.degrees_table(m, mv, states=st, n_segments=4)
+    raw = observability_tables.degrees_table(m, mv, states=st, n_segments=4, clip_null=False)
+    df = observability_tables.degrees_table(m, mv, states=st, n_segments=4)
     for c in df.columns:
         thr = df.attrs["threshold"][c]
         assert thr == pytest.approx(O.ROUND_OFF_MARGIN * df.attrs["rank_tol"][c])
         assert ((raw[c] > thr) == (df[c] > 0)).all()                                   # reported 0 at or below it
-        assert all(O.verdict_under(1.0, d, df.attrs["rank_tol"][c], 0.1)[1] == (d > thr) for d in raw[c])
-    sens = O.sweep(m, mv, df, {"same": dict(n_segments=4)}, states=st, progress=False)
+        assert all(observability_tables.verdict_under(1.0, d, df.attrs["rank_tol"][c], 0.1)[1] == (d > thr) for d in raw[c])
+    sens = observability_tables.sweep(m, mv, df, {"same": dict(n_segments=4)}, states=st, progress=False)
     assert [int(sens.loc["same", f"observable {c}"]) for c in df.columns] == [int((df[c] > 0).sum()) for c in df.columns]
 
 
@@ -370,7 +370,7 @@ def test_speed_wave_excites_the_forward_axis():
     """A speed wave of A m/s over a T-s turn gives a forward specific force f_y up to πA/T (plus
     round-off), zero at constant speed, and the speed returns to its start."""
     kw = dict(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=0.5)
-    const, wave = O.chen2019_maneuvers(**kw), O.chen2019_maneuvers(speed_wave=2.0, **kw)
+    const, wave = maneuvers.chen2019_maneuvers(**kw), maneuvers.chen2019_maneuvers(speed_wave=2.0, **kw)
     t = wave["U-turn"].traj
     assert np.abs(const["U-turn"].traj.f_b[:, 1]).max() < 1e-9
     assert np.abs(t.f_b[:, 1]).max() == pytest.approx(np.pi * 2.0 / 100.0, rel=2e-3)
@@ -395,37 +395,37 @@ def test_constant_rate_turn_holds_its_rate_between_the_ramps():
     t = tr.generate([tr.Straight(10.0), turn, tr.Straight(10.0)], 0.8, 2.0, 6000.0, speed=100.0, dt=0.5)
     w = t.w_ib_b[(t.t >= 25.0) & (t.t <= 95.0), 2]
     assert np.ptp(w) < 5e-3 * np.abs(w).mean()
-    const = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=0.5, turn_rate="constant")
+    const = maneuvers.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=0.5, turn_rate="constant")
     assert np.degrees(const["figure-8"].traj.hpr[-1, 0]) % 360 == pytest.approx(45.0, abs=1e-6)
     assert np.degrees(const["S-turn"].traj.hpr[-1, 0]) % 360 == pytest.approx(45.0, abs=1e-6)
     with pytest.raises(ValueError, match="ramp"):
         tr.SteadyTurn(10.0, 1.0, ramp=6.0)
     with pytest.raises(ValueError, match="turn_rate"):
-        O.chen2019_maneuvers(turn_rate="steady")
+        maneuvers.chen2019_maneuvers(turn_rate="steady")
     with pytest.raises(ValueError, match="bank"):
-        O.chen2019_maneuvers(bank="flat")
+        maneuvers.chen2019_maneuvers(bank="flat")
 
 
 def test_maneuver_only_interval_and_the_flight_grid():
-    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
+    mv = maneuvers.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
     assert mv["U-turn"].spans(4, 0)[0][0] == 20.0 and len(mv["U-turn"].spans(4, 0)) == 4
     assert mv["before maneuver"].spans(4, 0) == [(0.0, 20.0)]           # the straight scenario has nothing else
     with pytest.raises(ValueError, match="before_segments"):
         mv["U-turn"].spans(4, -1)
-    fl = O.flight_readings(speed_wave=2.0, base=mv, u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
+    fl = maneuvers.flight_readings(speed_wave=2.0, base=mv, u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, dt=1.0)
     assert len(fl) == 16 and next(iter(fl)) == "V const, ramped rate, banked, with straight leg"
     assert fl["V const, ramped rate, banked, with straight leg"]["maneuvers"] is mv
     assert fl["V wave 2 m/s, constant rate, unbanked, maneuver only"]["before_segments"] == 0
     assert np.abs(fl["V wave 2 m/s, ramped rate, unbanked, maneuver only"]["maneuvers"]["U-turn"].traj.hpr[:, 2]).max() == 0.0
     with pytest.raises(ValueError, match="speed_wave"):
-        O.flight_readings(speed_wave=0.0)
+        maneuvers.flight_readings(speed_wave=0.0)
 
 
 def test_spearman_critical_value():
     """The two-sided 5 % critical value of Spearman's ρ for 27 pairs is 0.381 (t approximation)."""
-    assert O.spearman_critical(27) == pytest.approx(0.381, abs=5e-4)
-    assert O.spearman_critical(27, 0.01) > O.spearman_critical(27)
+    assert observability_tables.spearman_critical(27) == pytest.approx(0.381, abs=5e-4)
+    assert observability_tables.spearman_critical(27, 0.01) > observability_tables.spearman_critical(27)
     with pytest.raises(ValueError):
-        O.spearman_critical(2)
+        observability_tables.spearman_critical(2)
     with pytest.raises(ValueError, match="alpha"):
-        O.spearman_critical(27, 1.5)
+        observability_tables.spearman_critical(27, 1.5)

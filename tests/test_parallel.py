@@ -27,12 +27,12 @@ from replication.nav import trajectory as tr
 from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, DEG_PER_SQRT_H, MGAL, MICRO_G
 from replication.papers.chen2019 import error_effects as ee
 from replication.papers.chen2019 import gravity as gr
+from replication.papers.chen2019 import maneuvers, observability_tables
 from replication.papers.chen2019 import models as M
-from replication.papers.chen2019 import observability as O
 from replication.papers.chen2019 import simulation as sim
 from replication.papers.chen2019 import turntable as tt
-from replication.papers.duan2023 import airdata as ad
-from replication.papers.fang2020 import polar
+from replication.papers.duan2023 import flight, montecarlo, sweeps
+from replication.papers.fang2020 import polar, sensitivity
 from replication.registry import reproduction as rp
 
 FIELDS = ("t_epoch", "nees", "nis", "final_estimates", "true_params", "final_sigma", "P_diag_run0")
@@ -185,19 +185,19 @@ def test_fang2020_sensitivity_on_dask_equals_in_process(cluster):
     base = dict(polar.FANG2020_READING, fix_times=(600.0, 1200.0))
     variants = {"nominal": base, "no accel bias": dict(base, accel_bias=(0.0, 0.0, 0.0)),
                 "Euler-heading observation": dict(base, heading_observation="euler")}
-    ref = polar.sensitivity(1, variants, n_runs=2)
-    got = polar.sensitivity(1, variants, n_runs=2, executor=client.get_executor(), chunk_runs=1)
+    ref = sensitivity.sensitivity(1, variants, n_runs=2)
+    got = sensitivity.sensitivity(1, variants, n_runs=2, executor=client.get_executor(), chunk_runs=1)
     pd.testing.assert_frame_equal(got, ref, check_exact=True)
 
 
 def test_duan2023_sweep_on_process_pool_equals_in_process():
     traj = tr.generate([tr.Straight(60.0), tr.Climb(60.0, height_change=300.0)], 45 * DEG, 110 * DEG, 1000.0,
                        dt=0.1, heading=0.3, speed=180.0)
-    setup = ad.AirdataSetup(correction_interval=30.0, threshold=1.0)
+    setup = flight.AirdataSetup(correction_interval=30.0, threshold=1.0)
     changes = [dict(threshold=1.2 / 30.0), dict(gate="height-only"), dict(sigma_height=0.0)]
-    ref = ad.sweep(traj, setup, changes, n_runs=1, seed=3)
+    ref = sweeps.sweep(traj, setup, changes, n_runs=1, seed=3)
     with ProcessPoolExecutor(2) as ex:
-        got = ad.sweep(traj, setup, changes, n_runs=1, seed=3, executor=ex, chunk_runs=2)
+        got = sweeps.sweep(traj, setup, changes, n_runs=1, seed=3, executor=ex, chunk_runs=2)
     pd.testing.assert_frame_equal(got, ref, check_exact=True)
 
 
@@ -206,9 +206,9 @@ def duan_case():
     """3 min of duan2023's kind of flight (straight, climb, straight at 10 Hz), three runs of the three systems."""
     traj = tr.generate([tr.Straight(60.0), tr.Climb(60.0, height_change=300.0), tr.Straight(60.0)], 45 * DEG,
                        110 * DEG, 1000.0, dt=0.1, heading=0.3, speed=180.0)
-    setup = ad.AirdataSetup(correction_interval=30.0, threshold=1.0)
+    setup = flight.AirdataSetup(correction_interval=30.0, threshold=1.0)
     kw = dict(n_runs=3, seed=11, every=10)
-    return traj, setup, kw, ad.simulate(traj, setup, **kw)
+    return traj, setup, kw, montecarlo.simulate(traj, setup, **kw)
 
 
 def test_duan2023_simulate_on_threads_in_chunks_and_on_processes(duan_case):
@@ -219,14 +219,14 @@ def test_duan2023_simulate_on_threads_in_chunks_and_on_processes(duan_case):
     lit = ref.errors["literature SINS/ADS"]["enu"]
     assert not np.array_equal(lit[1], lit[2])                     # three different runs
     with ThreadPoolExecutor(2) as ex:
-        _same_tree(ad.simulate(traj, setup, executor=ex, chunk_runs=1, **kw), ref)
-    _same_tree(ad.simulate(traj, setup, chunk_runs=2, **kw), ref)
+        _same_tree(montecarlo.simulate(traj, setup, executor=ex, chunk_runs=1, **kw), ref)
+    _same_tree(montecarlo.simulate(traj, setup, chunk_runs=2, **kw), ref)
     with ProcessPoolExecutor(2) as ex:
-        _same_tree(ad.simulate(traj, setup, executor=ex, **kw), ref)
+        _same_tree(montecarlo.simulate(traj, setup, executor=ex, **kw), ref)
     with pytest.raises(ValueError, match="chunk_runs"):
-        ad.simulate(traj, setup, chunk_runs=0, **kw)
+        montecarlo.simulate(traj, setup, chunk_runs=0, **kw)
     with pytest.raises(TypeError, match="executor must be a concurrent.futures.Executor"):
-        ad.simulate(traj, setup, executor="dask", **kw)
+        montecarlo.simulate(traj, setup, executor="dask", **kw)
 
 
 def test_duan2023_diagnostic_runs_on_threads_in_chunks_and_on_processes(duan_case):
@@ -234,17 +234,17 @@ def test_duan2023_diagnostic_runs_on_threads_in_chunks_and_on_processes(duan_cas
     in-process one bit for bit, and with the main run's seed its runs share the main run's noise."""
     traj, setup, kw, ref = duan_case
     kw = dict(n_runs=3, seed=11)
-    one = ad.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}}, **kw)
+    one = sweeps.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}}, **kw)
     for s in ("enu", "v", "phi"):
         assert np.array_equal(one["as is"].errors["proposed SINS/ADS"][s],
                               ref.errors["proposed SINS/ADS"][s][:, ::5])  # every=50 against every=10
     with ThreadPoolExecutor(2) as ex:
-        _same_tree(ad.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}},
+        _same_tree(sweeps.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}},
                                       executor=ex, chunk_runs=1, **kw), one)
-    _same_tree(ad.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}},
+    _same_tree(sweeps.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}},
                                   chunk_runs=2, **kw), one)
     with ProcessPoolExecutor(2) as ex:
-        _same_tree(ad.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}},
+        _same_tree(sweeps.diagnostic_runs(traj, setup, {"as is": {}, "no accelerometer bias": {"accel_bias": 0.0}},
                                       executor=ex, **kw), one)
 
 
@@ -445,21 +445,21 @@ def _same_frame_and_attrs(got, ref):
 def test_chen2019_observability_readings_on_threads_in_chunks_and_on_processes():
     """sweep computes one reading per chunk: the rows and every reading's degrees table (with its
     rank tolerances and ambiguities) equal the in-process sweep bit for bit."""
-    mv = O.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
+    mv = maneuvers.chen2019_maneuvers(u_turn=100.0, figure_eight=200.0, s_turn=200.0, straight=20.0, total=260.0, dt=1.0)
     m = M.model_45()
     st = m.labels[:9] + M.table_2_3_states()[3:]
-    reference = O.degrees_table(m, mv, states=st, n_segments=4)
+    reference = observability_tables.degrees_table(m, mv, states=st, n_segments=4)
     variants = {"r = 4": dict(n_segments=4), "r = 2": dict(n_segments=2), "max-normalized": dict(normalize="max"),
                 "assignment by singular vector": dict(assignment="singular", n_segments=4)}
-    ref = O.sweep(m, mv, reference, variants, states=st)
+    ref = observability_tables.sweep(m, mv, reference, variants, states=st)
     assert list(ref.index) == list(variants) and list(ref.attrs["tables"]) == list(variants)
     with ThreadPoolExecutor(2) as ex:
-        _same_frame_and_attrs(O.sweep(m, mv, reference, variants, states=st, executor=ex, chunk_runs=1), ref)
-    _same_frame_and_attrs(O.sweep(m, mv, reference, variants, states=st, chunk_runs=3), ref)
+        _same_frame_and_attrs(observability_tables.sweep(m, mv, reference, variants, states=st, executor=ex, chunk_runs=1), ref)
+    _same_frame_and_attrs(observability_tables.sweep(m, mv, reference, variants, states=st, chunk_runs=3), ref)
     with ProcessPoolExecutor(2) as ex:
-        _same_frame_and_attrs(O.sweep(m, mv, reference, variants, states=st, executor=ex), ref)
+        _same_frame_and_attrs(observability_tables.sweep(m, mv, reference, variants, states=st, executor=ex), ref)
     with pytest.raises(TypeError, match="executor must be a concurrent.futures.Executor"):
-        O.sweep(m, mv, reference, variants, states=st, executor="dask")
+        observability_tables.sweep(m, mv, reference, variants, states=st, executor="dask")
 
 
 def test_chen2019_error_effects_on_threads_in_chunks_and_on_processes():

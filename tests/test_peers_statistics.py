@@ -1,5 +1,5 @@
 """The AR tools of replication.nav.timeseries held against statsmodels, and the Allan deviation of
-replication.papers.chen2019.calibration against the published NBS14 reference values (Riley, NIST SP 1065
+replication.papers.chen2019.static_tests against the published NBS14 reference values (Riley, NIST SP 1065
 "Handbook of Frequency Stability Analysis", 2008, §12.3-12.4).
 
 Already held against statsmodels in tests/test_timeseries.py (not repeated here): the printed
@@ -19,7 +19,7 @@ from statsmodels.tsa.ar_model import ar_select_order
 from statsmodels.tsa.arima_process import ArmaProcess, arma_acovf
 
 from replication.nav import timeseries as ts
-from replication.papers.chen2019 import calibration as cal
+from replication.papers.chen2019 import static_tests
 from replication.registry import reproduction as rp
 
 
@@ -87,7 +87,7 @@ def _nbs14_1000():
 def test_overlapping_allan_deviation_of_the_10_point_nbs14_set():
     # source: NIST SP 1065 Table 31 (overlapping ADEV 91.22945 at τ = 1, 85.95287 at τ = 2);
     # tolerance: half a unit of the last printed digit (5e-6)
-    tau, adev = cal.allan_deviation(NBS14_10_FREQ, 1.0, taus=np.array([1.0, 2.0]))
+    tau, adev = static_tests.allan_deviation(NBS14_10_FREQ, 1.0, taus=np.array([1.0, 2.0]))
     np.testing.assert_allclose(tau, [1.0, 2.0])
     np.testing.assert_allclose(adev, [91.22945, 85.95287], rtol=0, atol=5e-6)
 
@@ -95,6 +95,6 @@ def test_overlapping_allan_deviation_of_the_10_point_nbs14_set():
 def test_overlapping_allan_deviation_of_the_1000_point_nbs14_set():
     # source: NIST SP 1065 Table 32 (overlapping ADEV at τ = 1, 10, 100 s: 2.922319e-1,
     # 9.159953e-2, 3.241343e-2); tolerance: half a unit of the 7th printed digit
-    tau, adev = cal.allan_deviation(_nbs14_1000(), 1.0, taus=np.array([1.0, 10.0, 100.0]))
+    tau, adev = static_tests.allan_deviation(_nbs14_1000(), 1.0, taus=np.array([1.0, 10.0, 100.0]))
     np.testing.assert_allclose(tau, [1.0, 10.0, 100.0])
     assert np.all(np.abs(adev - [2.922319e-1, 9.159953e-2, 3.241343e-2]) <= [5e-8, 5e-9, 5e-9]), adev

@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 
 from replication.nav import earth, units
 from replication.papers.fang2020 import _polar_kernels as K
-from replication.papers.fang2020 import polar
+from replication.papers.fang2020 import damping, error_equations, frames, polar, two_point
 
 R_SPHERE = 6371000.0
 RNG = np.random.default_rng(20200458)
@@ -36,40 +36,40 @@ def test_grid_frame_is_geographic_rotated_by_sigma():
     # fang2020 eq. (2)/(8): C_e^G = C_g^G(σ) C_e^g, exactly (tolerance: rounding, 1e-13)
     for lat, lon in zip(LATS, LONS):
         r = earth.geodetic_to_ecef(lat, lon, 0.0)
-        c = polar.grid_frame(r)
-        expected = polar.geographic_to_grid(polar.grid_azimuth(lat, lon)) @ enu_frame(lat, lon)
+        c = frames.grid_frame(r)
+        expected = frames.geographic_to_grid(frames.grid_azimuth(lat, lon)) @ enu_frame(lat, lon)
         assert np.max(np.abs(c - expected)) < 1e-13
         assert np.max(np.abs(c @ c.T - np.eye(3))) < 1e-14
 
 
 def test_grid_north_parallel_to_prime_meridian_plane_and_regular_at_pole():
     r = earth.geodetic_to_ecef(np.radians(89.9999999), np.radians(168.0), 0.0)
-    c = polar.grid_frame(r)
+    c = frames.grid_frame(r)
     assert abs(c[1, 1]) < 1e-15                      # G_N has no e_y component (§2.1, Fig. 2)
-    pole = polar.grid_frame(np.array([0.0, 0.0, earth.B]))
+    pole = frames.grid_frame(np.array([0.0, 0.0, earth.B]))
     assert np.allclose(pole, [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], atol=1e-15)
     # continuity through the pole: frames just before/after the crossing along 168°/348° agree
-    a = polar.grid_frame(earth.geodetic_to_ecef(np.radians(89.99999), np.radians(168.0), 0.0))
-    b = polar.grid_frame(earth.geodetic_to_ecef(np.radians(89.99999), np.radians(348.0), 0.0))
+    a = frames.grid_frame(earth.geodetic_to_ecef(np.radians(89.99999), np.radians(168.0), 0.0))
+    b = frames.grid_frame(earth.geodetic_to_ecef(np.radians(89.99999), np.radians(348.0), 0.0))
     assert np.max(np.abs(a - b)) < 1e-6              # 2 × 1.7e-7 rad apart
 
 
 def test_oepq_to_grid_eq16_matches_axis_definitions():
     for lat, lon in zip(LATS, LONS):
         r = earth.geodetic_to_ecef(lat, lon, 0.0)
-        c_num = polar.grid_frame(r) @ polar.oepq_frame(lon).T
-        c_16 = polar.oepq_to_grid(lat, polar.grid_azimuth(lat, lon))
+        c_num = frames.grid_frame(r) @ frames.oepq_frame(lon).T
+        c_16 = frames.oepq_to_grid(lat, frames.grid_azimuth(lat, lon))
         assert np.max(np.abs(c_num - c_16)) < 1e-13
 
 
 def test_computer_frame_angle_eq2_matches_exact_frame_rotation():
     lat, lon, d = np.radians(86.0), np.radians(40.0), 1e-7
-    g0 = polar.grid_frame_sphere(polar.sphere_point(lat, lon, R_SPHERE))
-    g1 = polar.grid_frame_sphere(polar.sphere_point(lat + d, lon - 2 * d, R_SPHERE))
+    g0 = frames.grid_frame_sphere(frames.sphere_point(lat, lon, R_SPHERE))
+    g1 = frames.grid_frame_sphere(frames.sphere_point(lat + d, lon - 2 * d, R_SPHERE))
     dm = g1 @ g0.T
     theta = -0.5 * np.array([dm[2, 1] - dm[1, 2], dm[0, 2] - dm[2, 0], dm[1, 0] - dm[0, 1]])
-    dsig = polar.grid_azimuth(lat + d, lon - 2 * d) - polar.grid_azimuth(lat, lon)
-    th = polar.computer_frame_angle(d, -2 * d, dsig, lat, polar.grid_azimuth(lat, lon))
+    dsig = frames.grid_azimuth(lat + d, lon - 2 * d) - frames.grid_azimuth(lat, lon)
+    th = frames.computer_frame_angle(d, -2 * d, dsig, lat, frames.grid_azimuth(lat, lon))
     assert np.max(np.abs(th - theta)) < 1e-12          # second order in 1e-7 rad
 
 
@@ -79,31 +79,31 @@ def test_n_matrix_matches_numerical_differentiation_and_printed_n22_is_wrong():
     # central differences of the exact geometry, step balancing truncation and round-off:
     # relative accuracy below P_EQUATION_ACCURACY (1e-7) from 1°N to the pole
     for lat, lon in zip(LATS, LONS):
-        n_num, c_num = polar.p_equation_numeric(lat, lon, R_SPHERE)
-        r = polar.sphere_point(lat, lon, R_SPHERE)
-        n_corr = polar.n_matrix(r)
+        n_num, c_num = error_equations.p_equation_numeric(lat, lon, R_SPHERE)
+        r = frames.sphere_point(lat, lon, R_SPHERE)
+        n_corr = error_equations.n_matrix(r)
         scale = np.max(np.abs(n_corr), axis=1, keepdims=True)          # row scale
-        assert np.max(np.abs(n_num - n_corr) / scale) < polar.P_EQUATION_ACCURACY
-        n_print = polar.n_matrix(r, printed=True)
+        assert np.max(np.abs(n_num - n_corr) / scale) < error_equations.P_EQUATION_ACCURACY
+        n_print = error_equations.n_matrix(r, printed=True)
         rel22 = abs(n_print[1, 1] - n_num[1, 1]) / abs(n_num[1, 1])
         # printed -Rz/√(x²+z²) vs -√(x²+z²): they differ by the factor Rz/(x²+z²) ≠ 1
         expected = abs(R_SPHERE * r[2] / (r[0] ** 2 + r[2] ** 2) - 1)
         assert rel22 == pytest.approx(expected, rel=1e-5, abs=1e-6)
-        assert np.max(np.abs(c_num - polar.oepq_to_grid(lat, polar.grid_azimuth(lat, lon)))) < 1e-13
+        assert np.max(np.abs(c_num - frames.oepq_to_grid(lat, frames.grid_azimuth(lat, lon)))) < 1e-13
 
 
 def test_printed_m_equals_corrected_n_times_c_and_numerical():
     for lat, lon in zip(LATS, LONS):
-        r = polar.sphere_point(lat, lon, R_SPHERE)
-        m = polar.m_matrix(r)
-        c = polar.oepq_to_grid(lat, polar.grid_azimuth(lat, lon))
-        assert np.max(np.abs(m - polar.n_matrix(r) @ c) / (np.abs(m) + 1)) < 1e-12
-        n_num, c_num = polar.p_equation_numeric(lat, lon, R_SPHERE)
-        assert np.max(np.abs(m - n_num @ c_num) / (np.abs(m) + 1)) < polar.P_EQUATION_ACCURACY
+        r = frames.sphere_point(lat, lon, R_SPHERE)
+        m = error_equations.m_matrix(r)
+        c = frames.oepq_to_grid(lat, frames.grid_azimuth(lat, lon))
+        assert np.max(np.abs(m - error_equations.n_matrix(r) @ c) / (np.abs(m) + 1)) < 1e-12
+        n_num, c_num = error_equations.p_equation_numeric(lat, lon, R_SPHERE)
+        assert np.max(np.abs(m - n_num @ c_num) / (np.abs(m) + 1)) < error_equations.P_EQUATION_ACCURACY
         # the printed N would not give the printed M (except near the pole, where Rz → x² + z²)
         factor = R_SPHERE * r[2] / (r[0] ** 2 + r[2] ** 2)
         if abs(factor - 1) > 1e-3:
-            assert np.max(np.abs(polar.n_matrix(r, printed=True) @ c - m)) > 1e-4 * np.max(np.abs(m))
+            assert np.max(np.abs(error_equations.n_matrix(r, printed=True) @ c - m)) > 1e-4 * np.max(np.abs(m))
 
 
 def test_grid_transport_rate_is_the_turn_of_the_grid_axes():
@@ -115,30 +115,30 @@ def test_grid_transport_rate_is_the_turn_of_the_grid_axes():
         rate = np.array([vn / float(rm), ve / (float(rn) * np.cos(lat))])
         pos = lambda t: earth.geodetic_to_ecef(lat + rate[0] * t, lon + rate[1] * t, 0.0)
         v = (pos(1e-3) - pos(-1e-3)) / 2e-3
-        d = polar.grid_frame(pos(5.0)) @ polar.grid_frame(pos(-5.0)).T          # C_{G-}^{G+} = I - [θ×]
+        d = frames.grid_frame(pos(5.0)) @ frames.grid_frame(pos(-5.0)).T          # C_{G-}^{G+} = I - [θ×]
         theta = -0.5 * np.array([d[2, 1] - d[1, 2], d[0, 2] - d[2, 0], d[1, 0] - d[0, 1]]) / 10.0
-        w = polar.grid_transport_rate(pos(0.0), v)
+        w = frames.grid_transport_rate(pos(0.0), v)
         assert np.linalg.norm(w - theta) < 1e-7 * np.linalg.norm(w)
     # on the prime meridian, moving north, the grid frame is the geographic one: |ω| = V / R_M
     lat = np.radians(60.0)
     r0 = earth.geodetic_to_ecef(lat, 0.0, 0.0)
-    w = polar.grid_transport_rate(r0, 10.0 * np.array([-np.sin(lat), 0.0, np.cos(lat)]))
+    w = frames.grid_transport_rate(r0, 10.0 * np.array([-np.sin(lat), 0.0, np.cos(lat)]))
     assert np.linalg.norm(w) == pytest.approx(10.0 / float(earth.radii(lat)[0]), rel=1e-9)
     with pytest.raises(ValueError):
-        polar.grid_transport_rate(np.zeros((2, 3)) + r0, np.zeros((2, 3)))
+        frames.grid_transport_rate(np.zeros((2, 3)) + r0, np.zeros((2, 3)))
 
 
 # ----------------------------------------------------------------------------- ψ equation
 
 def test_t_and_u_solve_the_psi_equation():
     tau = 1.5 * units.HOUR
-    a_mat = polar.psi_system_matrix()
-    assert np.allclose(polar.transition_t(polar.OMEGA * tau), scipy.linalg.expm(a_mat * tau), atol=1e-14)
+    a_mat = error_equations.psi_system_matrix()
+    assert np.allclose(error_equations.transition_t(error_equations.OMEGA * tau), scipy.linalg.expm(a_mat * tau), atol=1e-14)
     u_num = scipy.integrate.quad_vec(lambda s: scipy.linalg.expm(a_mat * s), 0, tau, epsabs=1e-12)[0]
-    assert np.allclose(polar.input_u(polar.OMEGA * tau) / polar.OMEGA, u_num, rtol=1e-9, atol=1e-6)
+    assert np.allclose(error_equations.input_u(error_equations.OMEGA * tau) / error_equations.OMEGA, u_num, rtol=1e-9, atol=1e-6)
     psi0, eps = np.array([1e-5, -2e-5, 3e-5]), np.array([4.8e-8, -2e-8, 1e-8])
     sol = scipy.integrate.solve_ivp(lambda t, y: a_mat @ y + eps, (0, tau), psi0, rtol=1e-12, atol=1e-16)
-    assert np.allclose(polar.propagate_psi(psi0, eps, tau), sol.y[:, -1], rtol=1e-9, atol=1e-15)
+    assert np.allclose(error_equations.propagate_psi(psi0, eps, tau), sol.y[:, -1], rtol=1e-9, atol=1e-15)
 
 
 # ----------------------------------------------------------------------------- calibration
@@ -152,22 +152,22 @@ def test_two_point_calibration_recovers_drift_exactly_noise_free(lat_deg, lon_de
     eps_b = np.array([0.01, -0.02, 0.015]) * units.DEG_PER_H
     c_b_g = Rotation.from_euler("zxy", [-0.7, 0.05, -0.08]).as_matrix()
     r = earth.geodetic_to_ecef(lat, lon, 0.0)
-    rad = float(polar.gaussian_radius(lat))
-    sig = polar.grid_azimuth(lat, lon)
-    eps_oepq = polar.b_matrix(lat, sig).T @ c_b_g @ eps_b          # B orthogonal: B⁻¹ = Bᵀ
+    rad = float(frames.gaussian_radius(lat))
+    sig = frames.grid_azimuth(lat, lon)
+    eps_oepq = two_point.b_matrix(lat, sig).T @ c_b_g @ eps_b          # B orthogonal: B⁻¹ = Bᵀ
     psi1 = np.array([2e-5, -1e-5, 3e-5])
-    psi2 = polar.propagate_psi(psi1, eps_oepq, tau)
-    m = polar.m_matrix(polar.sphere_point(lat, lon, rad))
-    est27 = polar.two_point_drift(m @ (psi2 - polar.transition_t(polar.OMEGA * tau) @ psi1), r, c_b_g, tau)
-    est26 = polar.two_point_drift(m @ psi2, r, c_b_g, tau, p1=m @ psi1, r1=r)
+    psi2 = error_equations.propagate_psi(psi1, eps_oepq, tau)
+    m = error_equations.m_matrix(frames.sphere_point(lat, lon, rad))
+    est27 = two_point.two_point_drift(m @ (psi2 - error_equations.transition_t(error_equations.OMEGA * tau) @ psi1), r, c_b_g, tau)
+    est26 = two_point.two_point_drift(m @ psi2, r, c_b_g, tau, p1=m @ psi1, r1=r)
     for est in (est27, est26):
         assert np.max(np.abs(est - eps_b)) < 1e-10 * np.max(np.abs(eps_b))
     # the interval-mean form reduces to (27) for a constant attitude
-    est_mean = polar.two_point_drift(m @ psi2, r, None, tau, p1=m @ psi1, r1=r,
-                                     mean_c_b_e=polar.grid_frame(r).T @ c_b_g)
+    est_mean = two_point.two_point_drift(m @ psi2, r, None, tau, p1=m @ psi1, r1=r,
+                                     mean_c_b_e=frames.grid_frame(r).T @ c_b_g)
     assert np.max(np.abs(est_mean - est26)) < 1e-10 * np.max(np.abs(eps_b))
     # the platform-drift convention flips the sign
-    assert np.allclose(polar.two_point_drift(m @ psi2, r, c_b_g, tau, p1=m @ psi1, r1=r,
+    assert np.allclose(two_point.two_point_drift(m @ psi2, r, c_b_g, tau, p1=m @ psi1, r1=r,
                                              convention="platform-drift"), -eps_b, rtol=1e-9)
 
 
@@ -186,9 +186,9 @@ def test_calibration_in_the_undamped_ins_with_exact_psi_recovers_drift():
     polar.run_segment(sc, k1, k2, traj, sens, st)
     psi2, re2 = polar.true_psi(sc, sc.fix_times[1], phases, st.cbp, st.r)
     tau = sc.fix_times[1] - sc.fix_times[0]
-    dpsi = psi2 - psi1 @ polar.transition_t(polar.OMEGA * tau).T
+    dpsi = psi2 - psi1 @ error_equations.transition_t(error_equations.OMEGA * tau).T
     lat, lon, _ = earth.ecef_to_geodetic(re2)
-    est = polar.drift_from_psi(dpsi, lat, lon, st.cbp, tau)
+    est = two_point.drift_from_psi(dpsi, lat, lon, st.cbp, tau)
     truth = np.array(sc.gyro_drift)
     assert np.max(np.abs(est - truth)) < 1e-3 * truth[0]
 
@@ -204,7 +204,7 @@ def test_calibration_in_the_damped_ins_without_accelerometer_bias():
     import control as ct
 
     z3 = (0.0, 0.0, 0.0)
-    bound = abs(complex(ct.evalfr(polar.damping_network(), 1j * polar.OMEGA)) - 1)
+    bound = abs(complex(ct.evalfr(damping.damping_network(), 1j * error_equations.OMEGA)) - 1)
     err = {}
     for pv in polar.POSITION_VELOCITIES:
         sc = polar.fang2020_scenario(1, speed=0.0, accel_bias=z3, gyro_white=0.0, accel_white=0.0,
@@ -234,9 +234,9 @@ def test_rocking_phases_shared_by_all_runs_and_validated():
 # ----------------------------------------------------------------------------- damping network
 
 def test_damping_network_poles_zeros_and_loop():
-    info = polar.damping_analysis()
-    assert np.allclose(info["zeros"], sorted(polar.DAMPING_ZEROS), rtol=1e-9)
-    assert np.allclose(info["poles"], sorted(polar.DAMPING_POLES), rtol=1e-9)
+    info = damping.damping_analysis()
+    assert np.allclose(info["zeros"], sorted(damping.DAMPING_ZEROS), rtol=1e-9)
+    assert np.allclose(info["poles"], sorted(damping.DAMPING_POLES), rtol=1e-9)
     assert info["dc_gain"] == pytest.approx(8.5e-4 * 9.412e-2 / 8e-5, rel=1e-12)
     und = info["undamped"]
     assert np.max(np.abs(np.real(und["poles"]))) < 1e-12           # Schuler poles on the jω axis
@@ -253,8 +253,8 @@ def test_discretized_network_matches_continuous_response():
     import control as ct
 
     dt = 0.01
-    b0, b1, b2, a1, a2 = polar.discretize_damping(dt)
-    h = polar.damping_network()
+    b0, b1, b2, a1, a2 = damping.discretize_damping(dt)
+    h = damping.damping_network()
     for w in (1e-4, 1e-3, 1e-2, 1e-1):
         z = np.exp(1j * w * dt)
         hd = (b0 + b1 / z + b2 / z**2) / (1 + a1 / z + a2 / z**2)
@@ -282,7 +282,7 @@ def test_kernel_gravity_and_truth_kinematics():
             assert abs(h_t) < 1e-6
             # attitude (28): Euler angles relative to geographic north
             c_b_n = enu_frame(lat_t, lon_t) @ cbe[0]                          # C_b^g (ENU)
-            head, pitch, roll = polar.euler_from_attitude(c_b_n)
+            head, pitch, roll = frames.euler_from_attitude(c_b_n)
             tw = 2 * np.pi * t
             assert pitch == pytest.approx(sc.rocking_amplitude[0] * np.sin(tw / 7.0 + 0.3), abs=1e-9)
             assert roll == pytest.approx(sc.rocking_amplitude[1] * np.sin(tw / 9.0 + 1.1), abs=1e-9)
@@ -305,17 +305,17 @@ def test_truth_rocking_matches_trajectory_ship_rocking():
     for j, t in enumerate(tau):
         cbe, re, rde = polar.true_state(sc, t, ph[None])
         lat, lon, _ = earth.ecef_to_geodetic(re[0])
-        head, pitch, roll = polar.euler_from_attitude(enu_frame(lat, lon) @ cbe[0])
+        head, pitch, roll = frames.euler_from_attitude(enu_frame(lat, lon) @ cbe[0])
         assert np.allclose([head, pitch, roll], hpr[j], atol=1e-9)
         assert np.allclose(enu_frame(lat, lon) @ rde[0], v[j], atol=1e-9)
 
 
 def test_attitude_convention_matches_scipy():
     h, p, r = 0.7, -0.05, 0.08
-    c = polar.attitude_from_euler(h, p, r)
+    c = frames.attitude_from_euler(h, p, r)
     ref = Rotation.from_euler("ZXY", [-h, p, r]).as_matrix()
     assert np.allclose(c, ref, atol=1e-15)
-    assert np.allclose(polar.euler_from_attitude(c), (h, p, r), atol=1e-14)
+    assert np.allclose(frames.euler_from_attitude(c), (h, p, r), atol=1e-14)
 
 
 def test_rng_stream_is_standard_normal():
@@ -377,24 +377,24 @@ def test_continuing_fewer_runs_past_the_second_fix_leaves_them_unchanged():
 
 def test_bad_inputs_are_refused_with_messages():
     with pytest.raises(ValueError, match="last axis of length 3"):
-        polar.grid_frame([1.0, 2.0])
+        frames.grid_frame([1.0, 2.0])
     with pytest.raises(ValueError, match="undefined"):
-        polar.grid_frame([0.0, earth.A, 0.0])
+        frames.grid_frame([0.0, earth.A, 0.0])
     with pytest.raises(ValueError, match="radians"):
-        polar.grid_azimuth(85.0, 0.3)
+        frames.grid_azimuth(85.0, 0.3)
     with pytest.raises(ValueError, match="equator"):
-        polar.n_matrix([R_SPHERE, 0.0, 0.0])
+        error_equations.n_matrix([R_SPHERE, 0.0, 0.0])
     with pytest.raises(ValueError, match="polar axis"):
-        polar.m_matrix([0.0, 0.0, R_SPHERE])
+        error_equations.m_matrix([0.0, 0.0, R_SPHERE])
     with pytest.raises(ValueError, match="positive"):
-        polar.input_u(-0.1)
+        error_equations.input_u(-0.1)
     r = earth.geodetic_to_ecef(np.radians(85), 0.3, 0.0)
     with pytest.raises(ValueError, match="tau"):
-        polar.two_point_drift([1.0, 2.0, 3e-5], r, np.eye(3), -5.0)
+        two_point.two_point_drift([1.0, 2.0, 3e-5], r, np.eye(3), -5.0)
     with pytest.raises(ValueError, match="both p1 and r1"):
-        polar.two_point_drift([1.0, 2.0, 3e-5], r, np.eye(3), 5400.0, p1=[0, 0, 0])
+        two_point.two_point_drift([1.0, 2.0, 3e-5], r, np.eye(3), 5400.0, p1=[0, 0, 0])
     with pytest.raises(ValueError, match="convention"):
-        polar.b_matrix(1.0, 0.2, convention="other")
+        two_point.b_matrix(1.0, 0.2, convention="other")
     with pytest.raises(ValueError, match="fix_times"):
         polar.fang2020_scenario(1, fix_times=(4 * 3600.0, 3600.0))
     with pytest.raises(ValueError, match="two simulation cases"):
@@ -421,7 +421,7 @@ def test_shared_truth_gives_the_same_bits_as_each_run_computing_its_own():
     for shared in (False, True):
         _, traj, sens, st = polar.initial_state(sc, 3, 11)
         rec = np.zeros((3, k1 // every + 1, K.N_REC))
-        rest = (polar.discretize_damping(sc.dt), 1, 1, rec, every, 10)
+        rest = (damping.discretize_damping(sc.dt), 1, 1, rec, every, 10)
         if shared:
             polar._run_grid(0, k1, sc.dt, traj, sens, st, *rest)
         else:
@@ -435,12 +435,12 @@ def test_shared_truth_gives_the_same_bits_as_each_run_computing_its_own():
 
 def test_fix_drift_resolution_is_the_heading_error_over_the_baseline():
     from replication.nav import units as u
-    r = polar.fix_drift_resolution(6 * u.ARCSEC, (2 * u.HOUR, 3.5 * u.HOUR))
+    r = two_point.fix_drift_resolution(6 * u.ARCSEC, (2 * u.HOUR, 3.5 * u.HOUR))
     # 6 arcsec over 1.5 h = 4 arcsec/h = 1.11e-3 deg/h, 11.1 % of the printed 0.01 deg/h
     assert r / u.DEG_PER_H == pytest.approx(4.0 / 3600.0)
-    assert polar.fix_drift_resolution(-6 * u.ARCSEC, (0.0, 1.0)) == pytest.approx(6 * u.ARCSEC)
+    assert two_point.fix_drift_resolution(-6 * u.ARCSEC, (0.0, 1.0)) == pytest.approx(6 * u.ARCSEC)
     for bad in ((1.0, 1.0), (2.0, 1.0), (0.0,), (0.0, np.inf)):
         with pytest.raises(ValueError, match="fix_times"):
-            polar.fix_drift_resolution(1e-5, bad)
+            two_point.fix_drift_resolution(1e-5, bad)
     with pytest.raises(ValueError, match="heading_error"):
-        polar.fix_drift_resolution(np.nan, (0.0, 1.0))
+        two_point.fix_drift_resolution(np.nan, (0.0, 1.0))

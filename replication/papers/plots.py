@@ -4,7 +4,7 @@ Each function takes the result of a chapter's computation and returns a matplotl
 nothing here computes a number that a table or a test uses.
 
 * :func:`state_estimates` — chen2019 Fig. 4-14 analog (:func:`replication.papers.chen2019.simulation.run_batch`);
-* :func:`airdata_error_histories` — duan2023 Figs. 3-5 analog (``replication.papers.duan2023.airdata.simulate``);
+* :func:`airdata_error_histories` — duan2023 Figs. 3-5 analog (``replication.papers.duan2023.montecarlo.simulate``);
 * :func:`polar_error_histories`, :func:`polar_drift_estimates` — fang2020 Figs. 4-10
   (:func:`replication.papers.fang2020.polar.simulate`).
 """
@@ -18,7 +18,7 @@ import numpy as np
 
 from replication.nav import units
 from replication.papers.chen2019 import simulation as sim
-from replication.papers.duan2023 import airdata as ad
+from replication.papers.duan2023 import montecarlo
 from replication.papers.fang2020 import polar
 
 __all__ = ["state_estimates", "airdata_error_histories", "polar_error_histories", "polar_drift_estimates"]
@@ -92,16 +92,16 @@ def state_estimates(result: sim.BatchResult, run: int = 0, *, ncols: int = 5, ev
     return fig
 
 
-def airdata_error_histories(mc: ad.MonteCarlo, quantity: str, *, scale=1.0, unit="", axes_labels=("E", "N", "U")):
+def airdata_error_histories(mc: montecarlo.MonteCarlo, quantity: str, *, scale=1.0, unit="", axes_labels=("E", "N", "U")):
     """duan2023 Figs. 3-5 analog: per axis, the run mean of each system with a ±1σ band.
 
     One panel per axis (symmetric-log vertical scale), one curve per system of
-    ``replication.papers.duan2023.airdata.SYSTEMS``, time in minutes
-    (``replication.papers.duan2023.airdata.simulate``).
+    ``replication.papers.duan2023.montecarlo.SYSTEMS``, time in minutes
+    (``replication.papers.duan2023.montecarlo.simulate``).
 
     Parameters
     ----------
-    mc : replication.papers.duan2023.airdata.MonteCarlo
+    mc : replication.papers.duan2023.montecarlo.MonteCarlo
         The Monte Carlo of the three systems; ``mc.errors[system][quantity]`` has shape
         (runs, records, 3).
     quantity : {"phi", "v", "enu"}
@@ -128,7 +128,7 @@ def airdata_error_histories(mc: ad.MonteCarlo, quantity: str, *, scale=1.0, unit
         raise ValueError("quantity must be 'phi', 'v' or 'enu'")
     fig, axs = plt.subplots(3, 1, figsize=(7, 6.5), sharex=True)
     for ax, i, lab in zip(axs, range(3), axes_labels):
-        for sys_, c in zip(ad.SYSTEMS, ("C0", "C1", "C2")):
+        for sys_, c in zip(montecarlo.SYSTEMS, ("C0", "C1", "C2")):
             a = mc.errors[sys_][quantity][:, :, i] * scale
             m, sd = np.nanmean(a, 0), np.nanstd(a, 0)
             ax.plot(mc.t / 60, m, color=c, lw=1, label=sys_)

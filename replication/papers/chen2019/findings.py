@@ -22,7 +22,8 @@ import numpy as np
 import pandas as pd
 
 from replication.nav._validate import nonnegative
-from replication.papers.chen2019.observability import LEVEL_COMBINATIONS, _table, verdict_threshold, verdict_under
+from replication.papers.chen2019.observability import LEVEL_COMBINATIONS, verdict_threshold
+from replication.papers.chen2019.observability_tables import _table, verdict_under
 from replication.papers.chen2019.simulation import figure_4_14_estimates
 from replication.papers.chen2019.turntable import QUANTITIES
 
@@ -93,7 +94,7 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
         The printed degrees (rows: states, columns: scenarios), dimensionless.
     readings : dict
         Reading name → degrees table of the same shape with ``attrs["rank_tol"]`` and
-        ``attrs["ambiguity"]`` (:func:`replication.papers.chen2019.observability.degrees_table`, or
+        ``attrs["ambiguity"]`` (:func:`replication.papers.chen2019.observability_tables.degrees_table`, or
         ``sweep(...).attrs["tables"]``).
     main : str
         The main reading, a key of ``readings``.
@@ -375,7 +376,7 @@ def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indic
 
 def closed_form_rows(checks, *, probe: str, evidence_prefix: str) -> list[dict]:
     """The rows of the printed six-position and temperature formulas (4-3)-(4-12) against their
-    derivation (:func:`replication.papers.chen2019.calibration.printed_form_checks`).
+    derivation (:func:`replication.papers.chen2019.closed_forms.printed_form_checks`).
 
     Each row carries the printed form as printed (``paper_text``), its value at the probe point
     (``paper``, relative to the true parameter; empty where the print is no formula to evaluate),
@@ -385,7 +386,7 @@ def closed_form_rows(checks, *, probe: str, evidence_prefix: str) -> list[dict]:
     Parameters
     ----------
     checks : list of FormCheck
-        :func:`replication.papers.chen2019.calibration.printed_form_checks`.
+        :func:`replication.papers.chen2019.closed_forms.printed_form_checks`.
     probe : str
         The probe point in words (sensor, rate, latitude), quoted in every note.
     evidence_prefix : str
@@ -396,7 +397,7 @@ def closed_form_rows(checks, *, probe: str, evidence_prefix: str) -> list[dict]:
     list of dict
         Rows for :func:`replication.registry.reproduction.compare`.
     """
-    from replication.papers.chen2019.calibration import AGREE_REL
+    from replication.papers.chen2019.closed_forms import AGREE_REL
 
     rows = []
     for k, c in enumerate(checks, 1):
@@ -429,7 +430,7 @@ TABLE_2_2_CORRECTED_TEXT = {
     "F53": r"columns G_zx, G_yz, G_zy: [-C_{\cdot 2}\omega_z,\ -C_{\cdot 1}\omega_y,\ C_{\cdot 1}\omega_z]",
 }
 """Corrected expressions of the Table 2-2 blocks whose printed form differs (see
-:func:`replication.papers.chen2019.models.table_2_2_corrected`), in LaTeX; the chapter renders them.
+:func:`replication.papers.chen2019.table_2_2.table_2_2_corrected`), in LaTeX; the chapter renders them.
 
 :meta hide-value:
 """

@@ -17,6 +17,18 @@ Frames: local-level ENU (x east, y north, z up), SI units inside; ``units.MGAL``
 The disturbance vector is delta g^n = g^n - g_m^n (chen2019 eq. 3-6), i.e. the gradient of the
 disturbing potential T: [dT/dx, dT/dy, dT/dz]; its up component is minus the scalar gravity
 disturbance of geodesy (a stronger downward pull gives a negative up component).
+
+Why this module is long: it holds chen2019 ch. 3 as one pipeline whose steps hand each other
+their own objects: the synthetic field (:class:`PlanarGravityField`, :class:`SurveyLayout`) is
+sampled along the survey flight, the direct difference (3-7) of that flight is low-pass filtered
+into the series the AR model is identified on, the AR model becomes the gravity block of the
+augmented filter (3-14)-(3-18), and :func:`compensation_run` flies the whole chain once per seed;
+the frame helpers (``_coriolis_transport``) and the window weights of the specific-force
+measurement are shared by the direct difference, the consistency check and the filter.  The one
+closed-loop filter call (:func:`augmented_filter`, built on :mod:`replication.nav.closedloop`) sits
+at the end of the chain.  The seams, when the module is divided, fall between the field and
+survey (about 400 lines), the direct difference and its noise (about 300), the AR shaping and
+augmentation (about 350) and the compensation experiment with its filter (about 850).
 """
 
 from __future__ import annotations

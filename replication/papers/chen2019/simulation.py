@@ -44,6 +44,15 @@ default backward pass is the same smoother in the modified Bryson-Frazier form
 the adjoint λ_k and its covariance Λ_k carried back through the updates' rows, gains and
 innovations and through Φ — no inverse of P_{k+1}⁻, and the O(n³) products only at the recorded
 epochs; the test suite checks it against the RTS form.
+
+Why this module is long: it is the one Monte Carlo of chen2019 ch. 4 §2 and the statistics
+read from it: the setup (:class:`SimulationSetup`, Table 4-41), the per-run truth, the batched
+closed-loop runs (:func:`run_batch`, the module's one call into :mod:`replication.nav.closedloop`)
+and their result (:class:`BatchResult`), then the diagnostics that read that result's fields —
+NEES and χ² bands, RMS with Monte-Carlo intervals, improvement percentages, the Fig. 4-14
+estimates and their display scales (about 700 lines, from ``navigation_errors`` on).  The
+diagnostics depend on :class:`BatchResult` alone; they are the part that leaves first when the
+module is divided, into a module of the chapter's Monte-Carlo statistics.
 """
 
 from __future__ import annotations

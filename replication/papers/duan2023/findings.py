@@ -1,10 +1,10 @@
 """duan2023's findings: the rows its chapter hands to the registry.
 
-:mod:`replication.papers.duan2023.airdata` computes; this module decides — it turns the Monte
-Carlo, the readings and the re-derivation into comparison rows that declare their basis and
-evidence (the registry derives each status: CONTRIBUTING.md, "Statuses" and "Readings and the
-main reading"), with a note, evidence and corrected text, and holds
-the printed elements of eqs. (4)-(21) recorded as errata or inconsistencies.  No method module
+The method modules of ``replication.papers.duan2023`` compute (the derivation, the flight,
+the Monte Carlo, the readings); this module decides — it turns the Monte Carlo, the readings and
+the re-derivation into comparison rows that declare their basis and evidence (the registry
+derives each status: CONTRIBUTING.md, "Statuses" and "Readings and the main reading"), with a
+note, evidence and corrected text, and holds the printed elements of eqs. (4)-(21) recorded as errata or inconsistencies.  No method module
 imports it; the notebooks and the tests do.
 
 * :func:`table1_comparison` — Table 1, each row with its basis;
@@ -22,18 +22,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from replication.papers.duan2023.airdata import (
-    SYSTEMS,
-    TABLE1_UNITS,
-    MonteCarlo,
-    agree_to_first_order,
-    attitude_readings,
-    check_elements,
-    manifold_residuals,
-    mean_interval,
-    reference_state,
-    table1_rows,
-)
+from replication.papers.duan2023.derivation import reference_state
+from replication.papers.duan2023.montecarlo import SYSTEMS, TABLE1_UNITS, MonteCarlo, mean_interval, table1_rows
+from replication.papers.duan2023.printed import agree_to_first_order, check_elements, manifold_residuals
+from replication.papers.duan2023.sweeps import attitude_readings
 
 __all__ = ["PROPOSED_REASON", "table1_comparison", "LEDGER_ID", "LEDGER_TOLERANCE", "LEDGER_QUANTITIES",
            "readings_ledger_rows", "diagnostic_ledger_rows", "attitude_ledger_rows", "attitude_verdicts",
@@ -204,7 +196,7 @@ def readings_ledger_rows(readings, table1, system="proposed SINS/ADS", *, runs=N
 
 
 def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> list[dict]:
-    """Rows of the Table 1 readings ledger for the diagnostics of :func:`replication.papers.duan2023.airdata.diagnostic_runs`.
+    """Rows of the Table 1 readings ledger for the diagnostics of :func:`replication.papers.duan2023.sweeps.diagnostic_runs`.
 
     A diagnostic removes an error source that duan2023 §3 prints (the accelerometer bias): it is
     not a reading of the method, but it is judged as every row of the ledger is — the run mean of
@@ -212,12 +204,12 @@ def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> lis
     (relative): a diagnostic that reached the print would have to be ruled out by printed
     evidence (``compare(..., ruled_out=)``); one that does not reach it needs none.  ``reproduced``
     is stored with ``digits`` significant digits; the note gives the run count and the 95 %
-    Student-t interval of the mean (:func:`replication.papers.duan2023.airdata.mean_interval`).
+    Student-t interval of the mean (:func:`replication.papers.duan2023.montecarlo.mean_interval`).
 
     Parameters
     ----------
     diagnostics : dict of str to MonteCarlo
-        Output of :func:`replication.papers.duan2023.airdata.diagnostic_runs` (at least two runs each).
+        Output of :func:`replication.papers.duan2023.sweeps.diagnostic_runs` (at least two runs each).
     table1 : PaperTable
         ``rp.load_paper("duan2023-table-1")``.
     digits : int, default 2
@@ -259,8 +251,8 @@ def diagnostic_ledger_rows(diagnostics: dict, table1, *, digits: int = 2) -> lis
 def attitude_ledger_rows(runs: dict, table1, *, setting: str, digits: int = 3) -> list[dict]:
     """Rows of the Table 1 readings ledger for the initial attitude errors that duan2023 §3 does not print.
 
-    Each reading (:func:`replication.papers.duan2023.airdata.attitude_readings`, run by
-    :func:`replication.papers.duan2023.airdata.attitude_runs`) on every row of Table 1 of each
+    Each reading (:func:`replication.papers.duan2023.sweeps.attitude_readings`, run by
+    :func:`replication.papers.duan2023.sweeps.attitude_runs`) on every row of Table 1 of each
     system its Monte Carlo holds (in the order of Table 1): the run mean of the flight maximum against the printed value within
     :data:`LEDGER_TOLERANCE` (relative), the registry deciding the status from the numbers; the
     note gives the run count and the 95 % Student-t interval of the mean (one run: no interval,
@@ -321,7 +313,7 @@ def attitude_verdicts(ledger, system: str = "SINS", readings=None) -> pd.DataFra
         The Table 1 column.
     readings : iterable of str, optional
         The initial-attitude reading labels kept, each followed in the ledger by ", <setting>"
-        (default: those of :func:`replication.papers.duan2023.airdata.attitude_readings`).
+        (default: those of :func:`replication.papers.duan2023.sweeps.attitude_readings`).
 
     Returns
     -------
@@ -494,7 +486,7 @@ _INCONSISTENT = {
 
 #: Printed elements that the exact re-derivation does not match but that agree with it at the
 #: paper's first order (assumption 5: the flight-path angle small), checked by
-#: :func:`replication.papers.duan2023.airdata.agree_to_first_order`: a ``derivation`` row without
+#: :func:`replication.papers.duan2023.printed.agree_to_first_order`: a ``derivation`` row without
 #: a tolerance, ``agrees`` computed (``qualitative`` when they agree at that order).
 _FIRST_ORDER = {
     "eq. (12) dV_U^c per phi^c": "eq. (12) writes phi^c V where turning V by phi^c changes its up component by phi^c V "
@@ -505,7 +497,7 @@ _FIRST_ORDER = {
 
 #: Printed elements that match the re-derivation, with a remark on another printed part at the
 #: paper's approximation level (the row stays a ``value`` row: its numbers decide), as functions
-#: of the reference state (:func:`replication.papers.duan2023.airdata.reference_state`).
+#: of the reference state (:func:`replication.papers.duan2023.derivation.reference_state`).
 _REMARKS = {
     "eq. (4) phi^c per dh^c": lambda st: (
         "the first-order expansion of tan(theta_1 - theta_2) with S^c = S, as printed; assumption 1 and eq. (18) "
@@ -528,9 +520,9 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
     paper : PaperTable
         ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
     reading : {"A", "B"}, default "B"
-        Reading of β and of the position-state order (:func:`replication.papers.duan2023.airdata.derived_coefficients`).
+        Reading of β and of the position-state order (:func:`replication.papers.duan2023.derivation.derived_coefficients`).
     state : {"climb", "level", "steep"}, default "climb"
-        Reference state (:func:`replication.papers.duan2023.airdata.reference_state`).
+        Reference state (:func:`replication.papers.duan2023.derivation.reference_state`).
 
     Returns
     -------
@@ -540,7 +532,7 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
         (values at the state in ``unit``), ``tolerance`` 1e-9, ``tolerance_kind`` "rel" — except
         the elements that agree with the derivation only at the paper's first order
         (``_FIRST_ORDER``), which carry ``agrees`` (computed by
-        :func:`replication.papers.duan2023.airdata.agree_to_first_order`) and no tolerance — and
+        :func:`replication.papers.duan2023.printed.agree_to_first_order`) and no tolerance — and
         for the flagged elements a ``note`` and, for errata, ``evidence`` and ``corrected``.  A
         flagged element outside the tolerance is an erratum unless a reading of the ledger
         (``duan2023-check-eq-22-readings``, to be exported first) reproduces it: then the registry
@@ -596,7 +588,7 @@ def eq22_readings_rows(paper, state: str = "climb"):
     paper : PaperTable
         ``duan2023-eq-22`` (the transcribed elements of eqs. (4)-(21)).
     state : {"climb", "level", "steep"}, default "climb"
-        Reference state (:func:`replication.papers.duan2023.airdata.reference_state`).
+        Reference state (:func:`replication.papers.duan2023.derivation.reference_state`).
 
     Returns
     -------
