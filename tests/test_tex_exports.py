@@ -170,8 +170,8 @@ def pattern(expected: str) -> str:
 
 def expected_cells(table_id: str) -> tuple[str, list[str], list[list[str]]]:
     """What an export shows, from its CSV: the title (the sidecar's), the header, and per row the
-    cells of :data:`~replication.registry.reproduction.TEX_COLUMNS` as
-    :func:`~replication.registry.reproduction.display_cell` shows them (text columns verbatim;
+    cells of :data:`~replication.registry.tex.TEX_COLUMNS` as
+    :func:`~replication.registry.digits.display_cell` shows them (text columns verbatim;
     numbers with the digits the row's tolerance supports) followed by ``reason:`` and the note."""
     df = pd.read_csv(rp.tables_dir() / f"{table_id}.csv", dtype=str, keep_default_na=False)
     title = json.loads((rp.tables_dir() / f"{table_id}.json").read_text(encoding="utf-8"))["title"]

@@ -640,7 +640,7 @@ def eq_3_1_coefficients(paper) -> dict:
     Parameters
     ----------
     paper : PaperTable
-        The :class:`~replication.registry.reproduction.PaperTable` of ``chen2019-eq-3-1``
+        The :class:`~replication.registry.paper.PaperTable` of ``chen2019-eq-3-1``
         (printed mantissa × ``si_factor``).
 
     Returns

@@ -2054,7 +2054,7 @@ def accel_scale_header_ratio(load, table: int, reference: int = 6) -> np.ndarray
     Parameters
     ----------
     load : callable
-        :func:`replication.registry.reproduction.load_paper`.
+        :func:`replication.registry.paper.load_paper`.
     table : int
         The table number n of Table 4-n.
     reference : int
@@ -2094,7 +2094,7 @@ def paper_triads(load, temperature: int, *, missing_signs: Mapping[str, float] |
     Parameters
     ----------
     load : callable
-        :func:`replication.registry.reproduction.load_paper`.
+        :func:`replication.registry.paper.load_paper`.
     temperature : int
         A printed calibration temperature [°C] (:data:`TEMPERATURE_TABLES`).
     missing_signs : Mapping[str, float] or None
