@@ -242,7 +242,7 @@ def test_the_comparison_catches_a_wrong_character():
 
 def test_export_header_names_the_packages_and_keeps_the_reason():
     df = rp.comparison_frame([
-        dict(quantity="q", unit="m", paper=1.0, reproduced=1.5, tolerance=0.1, status="erratum",
+        dict(quantity="q", unit="m", paper=1.0, reproduced=1.5, tolerance=0.1, basis="derivation",
              note="a reason/with/a/very_long_unbreakable_path/in.it", evidence="nb"),
     ])
     tex = rp._latex(df, "t", "chen2019-table-9")

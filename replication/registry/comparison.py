@@ -26,7 +26,7 @@ from replication.registry.digits import (
     tolerance_grid,
 )
 from replication.registry.reading import read_table
-from replication.registry.schema import ROW_KEYS, STATUSES, TABLE_COLUMNS, RegistryError
+from replication.registry.schema import ROW_KEYS, TABLE_COLUMNS, RegistryError
 
 
 def _row_errors(paper: Any, reproduced: Any) -> tuple[float, float]:
@@ -36,44 +36,6 @@ def _row_errors(paper: Any, reproduced: Any) -> tuple[float, float]:
     ae = abs(r - p)
     re_ = ae / abs(p) if p != 0 else float("nan")
     return ae, re_
-
-
-def _decide(row: Mapping[str, Any], ae: float, re_: float) -> str:
-    explicit = row.get("status")
-    tol = row.get("tolerance")
-    kind = row.get("tolerance_kind", "abs")
-    if kind not in ("abs", "rel"):
-        raise RegistryError(f"row {row.get('quantity')!r}: tolerance_kind must be 'abs' or 'rel', not {kind!r}")
-    if explicit not in (None, ""):
-        if explicit not in STATUSES:
-            raise RegistryError(f"row {row.get('quantity')!r}: unknown status {explicit!r}; use one of {STATUSES}")
-        if explicit != "reproduced" and explicit != "pending" and not str(row.get("note", "")).strip():
-            raise RegistryError(f"row {row.get('quantity')!r}: status {explicit!r} needs a note saying why")
-        if explicit == "erratum" and not str(row.get("evidence", "")).strip():
-            raise RegistryError(f"row {row.get('quantity')!r}: an erratum needs evidence (notebook and test)")
-        if explicit == "reproduced":
-            if tol is None or math.isnan(ae):
-                raise RegistryError(f"row {row.get('quantity')!r}: 'reproduced' needs numeric values and a tolerance")
-        if explicit == "reproduced" or (explicit == "erratum" and tol is not None and not math.isnan(ae)):
-            # an explicit 'reproduced' must still be within tolerance; for an erratum the printed
-            # value must be *outside* tolerance (otherwise it is not wrong)
-            err = ae if kind == "abs" else re_
-            within = err <= float(tol)
-            if explicit == "reproduced" and not within:
-                raise RegistryError(f"row {row.get('quantity')!r}: error {err:.3g} exceeds tolerance {tol}")
-            if explicit == "erratum" and within:
-                raise RegistryError(
-                    f"row {row.get('quantity')!r}: printed value is within tolerance, so it is not an erratum"
-                )
-        return explicit
-    if tol is None:
-        raise RegistryError(
-            f"row {row.get('quantity')!r}: give a tolerance (stated before comparing) or an explicit status"
-        )
-    if math.isnan(ae):
-        raise RegistryError(f"row {row.get('quantity')!r}: non-numeric values need an explicit status")
-    err = ae if kind == "abs" else re_
-    return "reproduced" if err <= float(tol) else "not-reproduced"
 
 
 def _derive(row: Mapping[str, Any], q: Any, basis: str, p_num: float, r_num: float, ae: float, re_: float,
@@ -126,11 +88,13 @@ def _text_or_number(v: Any) -> tuple[float, str]:
     return f, ""
 
 
-def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
+def comparison_frame(rows: Iterable[Mapping[str, Any]], table_id: str = "") -> pd.DataFrame:
     """Build the long-format comparison table from row mappings.
 
-    Each row gives ``quantity``, ``unit``, ``paper``, ``reproduced`` and either ``tolerance``
-    (with ``tolerance_kind`` ``'abs'`` — the default — or ``'rel'``) or an explicit ``status``;
+    Each row gives ``quantity``, ``unit``, ``paper``, ``reproduced`` and its ``basis`` (how it is
+    judged: :data:`replication.registry.verdicts.BASES`); a row with a ``tolerance`` (with
+    ``tolerance_kind`` ``'abs'`` — the default — or ``'rel'``) and no basis is a ``value`` row.  A
+    row with neither is refused, and so is a typed ``status``: the status follows from the evidence;
     optional ``note``, ``evidence``, ``corrected`` (the corrected text for an erratum whose
     correction is not a single number), ``paper_text`` (the printed form where the paper printed
     a formula or a range) and ``digits`` (significant digits the computation determines, for a
@@ -148,6 +112,8 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
     ----------
     rows : iterable of mappings
         One mapping per compared quantity, with the keys of :data:`~replication.registry.schema.ROW_KEYS`.
+    table_id : str, optional
+        The table the rows belong to, named in the messages.
 
     Returns
     -------
@@ -157,8 +123,8 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
     Raises
     ------
     RegistryError
-        A row without a quantity, a duplicate, an unknown key, a missing tolerance and status, an
-        explicit status that its numbers contradict, an erratum without evidence.
+        A row without a quantity, a duplicate, an unknown key, a row without basis (and not a
+        value row with a tolerance), a typed status, evidence its basis needs and lacks.
     """
     out = []
     seen = set()
@@ -196,10 +162,13 @@ def comparison_frame(rows: Iterable[Mapping[str, Any]]) -> pd.DataFrame:
             if math.isfinite(p_num) and p_num == 0:
                 re_dec = 0.0 if ae == 0 else float("inf")
         basis = row.get("basis") or ("value" if tol is not None and row.get("status") in (None, "") else "")
-        if basis:
-            status = _derive(row, q, basis, p_num, r_num, ae, re_dec, tol, kind)
-        else:
-            status = _decide(row, ae, re_dec)
+        if not basis:
+            where = f"{table_id}: " if table_id else ""
+            typed = f" (status={row.get('status')!r} is not evidence)" if row.get("status") not in (None, "") else ""
+            raise RegistryError(f"{where}row {q!r} declares no basis{typed}: give basis= (one of "
+                                f"{', '.join(_verdicts.BASES)}) with the evidence it needs, or a tolerance "
+                                "(stated before comparing) for a value row")
+        status = _derive(row, q, basis, p_num, r_num, ae, re_dec, tol, kind)
         if tol is None:
             # no comparison was made (an explicit status without a tolerance): no error is shown
             ae = float("nan")

@@ -167,7 +167,7 @@ def compare(
         g = r.pop("group", None)
         if g not in (None, ""):
             grouped.setdefault(str(g), []).append(str(r.get("quantity")))
-    df = comparison_frame(rows)
+    df = comparison_frame(rows, table_id)
     if (df["basis"] != "").any() and (ledgers or readings_ledgers(table_id, {})):
         from replication.registry import audit as _audit  # reads the exported ledgers
 

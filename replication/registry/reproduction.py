@@ -66,7 +66,6 @@ from replication.registry.cite import (
     source_bibtex,
 )
 from replication.registry.comparison import (
-    _decide,
     _derive,
     _row_errors,
     _text_or_number,
