@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from replication.nav import closedloop, earth, errors, kalman, rotations, sensors, strapdown, timeseries, trajectory
 from replication.nav.units import DEG
 from replication.papers.an2021 import transfer
-from replication.papers.chen2019 import calibration, findings, gravity, models, observability, simulation
+from replication.papers.chen2019 import calibration, findings, gravity, models, observability, simulation, table_2_2
 from replication.papers.fang2020 import polar
 
 LAT, LON, H = 40 * DEG, 116 * DEG, 100.0
@@ -276,7 +276,7 @@ PROBES += [
     ("rms_with_ci(prob = 0)", "prob", lambda: simulation.rms_with_ci(np.ones((3, 4)), np.ones(4, bool), prob=0.0)),
     ("rms_with_ci(mask of the wrong length)", "mask", lambda: simulation.rms_with_ci(np.ones((3, 4)), np.ones(2, bool))),
     ("table_2_2_differences(model = 'model_45')", "ErrorModel",
-     lambda: models.table_2_2_differences("model_45", models.table_2_2_reference_point())),
+     lambda: table_2_2.table_2_2_differences("model_45", table_2_2.table_2_2_reference_point())),
     ("closed_loop(P0 = -I)", "P0", lambda: _closed_loop(P0=-np.eye(15))),
     ("closed_loop(P0 with NaN)", "P0", lambda: _closed_loop(P0=np.diag([np.nan] + [1.0] * 14))),
     ("closed_loop(vertical = 'up')", "vertical", lambda: _closed_loop(vertical="up")),

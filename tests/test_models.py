@@ -9,6 +9,7 @@ from replication.nav import trajectory as tr
 from replication.nav.sensors import ImuErrors, TriadErrors
 from replication.nav.units import DEG
 from replication.papers.chen2019 import models as M
+from replication.papers.chen2019 import table_2_2 as T22
 
 
 @pytest.fixture(scope="module")
@@ -84,9 +85,10 @@ def test_imu_sd_fields_enter_their_blocks():
         m = M.model_45(imu_sd=sd, gravity_sigma=grav, gravity_beta=2e-3, lever_arm_sd=lever,
                        misalignment_coupling=coupling, **nav)
         blocks = (E.accel_bias(acc["bias"]), E.accel_markov(acc["markov_sigma"], 900.0), E.accel_scale(acc["scale"]),
-                  E.accel_misalignment(a_mis, coupling=coupling), E.gyro_bias(gyr["bias"]),
+                  E.accel_misalignment(a_mis, coupling=M.MISALIGNMENT_COUPLINGS[coupling]), E.gyro_bias(gyr["bias"]),
                   E.gyro_markov(gyr["markov_sigma"], 300.0), E.gyro_scale(gyr["scale"]),
-                  E.gyro_misalignment(g_mis, coupling=coupling), E.gravity_shaping(grav, 2e-3), E.lever_arm(lever))
+                  E.gyro_misalignment(g_mis, coupling=M.MISALIGNMENT_COUPLINGS[coupling]), E.gravity_shaping(grav, 2e-3),
+                  E.lever_arm(lever))
         ref = E.ErrorModel(blocks=blocks, accel_psd=acc["white_psd"], gyro_psd=gyr["white_psd"], nav_sd=m.nav_sd)
         assert _same_model(m, ref), coupling
     m = M.model_36(imu_sd=ImuErrors(accel=TriadErrors(**acc), gyro=TriadErrors(**gyr)), accel_random_walk_psd=arw,
@@ -299,7 +301,7 @@ def _points(traj):
     """Maneuvering points plus a generic one (climbing, all velocity/force/rate components
     non-zero) so that no element vanishes by accident."""
     pts = [E.NavPoint.from_trajectory(traj, k) for k in (150, 420, 780)]
-    pts.append(M.table_2_2_reference_point())
+    pts.append(T22.table_2_2_reference_point())
     return pts
 
 
@@ -328,9 +330,9 @@ def test_table_2_2_corrected_blocks_match_the_verified_blocks(maneuvering):
     the attitude rows; measured natively and under the perturbed configurations)."""
     m = M.model_45(imu_sd=_imu(dict(markov_tau=9000.0), dict(markov_tau=300.0)))
     for p in _points(maneuvering):
-        Cb = M.table_2_2_corrected(p, accel_markov_tau=9000.0, gyro_markov_tau=300.0)
-        Vb = M.table_2_2_verified(m, p)
-        for name in M.TABLE_2_2_BLOCKS:
+        Cb = T22.table_2_2_corrected(p, accel_markov_tau=9000.0, gyro_markov_tau=300.0)
+        Vb = T22.table_2_2_verified(m, p)
+        for name in T22.TABLE_2_2_BLOCKS:
             c, v = Cb[name], Vb[name]
             assert np.all(np.abs(c - v) <= 3e-9 * np.abs(v).max()), name
 
@@ -352,12 +354,12 @@ def test_printed_table_2_2_differs_exactly_at_the_listed_elements(maneuvering):
     agrees within the finite-difference accuracy."""
     m = M.model_45(imu_sd=_imu(dict(markov_tau=9000.0), dict(markov_tau=300.0)))
     p = _points(maneuvering)[-1]
-    diffs = M.table_2_2_differences(m, p)
+    diffs = T22.table_2_2_differences(m, p)
     flagged = {(d["block"], d["row"], d["col"]) for d in diffs if d["differs"]}
     assert flagged == ERRATA_ELEMENTS
     # the misalignment columns are a permutation of the correct ones up to sign (order and signs
     # lost), not new terms: every printed column appears among the verified ones with |sign|
-    Pb, Vb = M.table_2_2_printed(p), M.table_2_2_verified(m, p)
+    Pb, Vb = T22.table_2_2_printed(p), T22.table_2_2_verified(m, p)
     for a, b in (("F32", "F33"), ("F52", "F53")):
         pc = np.hstack([Pb[a], Pb[b]]).T
         vc = np.hstack([Vb[a], Vb[b]]).T
@@ -369,11 +371,11 @@ def test_table_2_2_misalignment_blocks_follow_the_table_coupling():
     """With misalignment_coupling="table-2-2" the model's F32/F33/F52/F53 are the printed blocks at
     a generic point (the same analytic columns: rounding), with the eq. (2-8) default they are not
     (order and signs differ: up to 100 % of the block scale)."""
-    p = M.table_2_2_reference_point()
-    printed = M.table_2_2_printed(p, accel_markov_tau=3600.0, gyro_markov_tau=600.0)
+    p = T22.table_2_2_reference_point()
+    printed = T22.table_2_2_printed(p, accel_markov_tau=3600.0, gyro_markov_tau=600.0)
     for coupling, agree in (("table-2-2", True), ("eq-2-8", False)):
         m = M.model_45(imu_sd=_imu(gyro=dict(markov_tau=600.0)), misalignment_coupling=coupling)
-        v = M.table_2_2_verified(m, p)
+        v = T22.table_2_2_verified(m, p)
         for b in ("F32", "F33", "F52", "F53"):
             rel = np.max(np.abs(v[b] - printed[b])) / np.max(np.abs(printed[b]))
             assert (rel < 1e-12) == agree, (coupling, b, rel)

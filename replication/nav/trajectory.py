@@ -19,6 +19,14 @@ a smooth integrand.
 Conventions: see :mod:`replication.nav.rotations` (heading clockwise from north, pitch nose-up,
 roll right-wing-down; C_b^n = R_z(-ψ) R_x(θ) R_y(γ)).  Coordinated turns bank by
 tan γ = V ψ̇ / g_0 with g_0 = 9.80665 m/s².
+
+Why this module is long: it is one concept, the true motion, in two halves that are only correct
+together.  Every segment class implements the same closed-form protocol (:class:`Segment`: attitude,
+rates, velocity and acceleration as functions of time, continuous at its ends), and
+:func:`generate` integrates the position and the sensor increments of any sequence of them; a new
+segment is checked against the generator's quadrature, and the generator's continuity assumptions
+are those the segments guarantee.  Splitting the segment zoo from the generator would put that
+contract in two places.  The scenarios of a paper are built in ``replication.papers.<key>``.
 """
 
 from __future__ import annotations

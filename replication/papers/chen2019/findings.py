@@ -429,7 +429,7 @@ TABLE_2_2_CORRECTED_TEXT = {
     "F53": r"columns G_zx, G_yz, G_zy: [-C_{\cdot 2}\omega_z,\ -C_{\cdot 1}\omega_y,\ C_{\cdot 1}\omega_z]",
 }
 """Corrected expressions of the Table 2-2 blocks whose printed form differs (see
-:func:`replication.papers.chen2019.models.table_2_2_corrected`), in LaTeX; the chapter renders them.
+:func:`replication.papers.chen2019.table_2_2.table_2_2_corrected`), in LaTeX; the chapter renders them.
 
 :meta hide-value:
 """
