@@ -79,8 +79,8 @@ from replication.nav._validate import choice, components, numeric, positive
 from replication.nav.rotations import rotvec_to_dcm, skew
 from replication.nav.sensors import ImuErrors, TriadErrors
 
-__all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "EXTEND_ORDER_45", "NAV_SYMBOLS", "model_45", "model_36",
-           "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
+__all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "MISALIGNMENT_COUPLINGS", "EXTEND_ORDER_45", "NAV_SYMBOLS",
+           "model_45", "model_36", "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
            "measurement_function", "lever_arm_correction", "table_2_3_states", "frozen_earth_jacobian",
            "jacobian_agreement"]
 
