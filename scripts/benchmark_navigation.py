@@ -43,13 +43,14 @@ from replication.nav import sensors as se
 from replication.nav import strapdown as sd
 from replication.nav import trajectory as tr
 from replication.nav.units import DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G  # noqa: E402
+from replication.papers.chen2019 import scenarios
 
 TARGETS = {"strapdown_speedup_min": 8.0, "filter_speedup_min": 20.0, "monte_carlo_seconds_max": 20.0}
 SEED = 20240
 
 
 def hour_flight():
-    segs, init = tr.chen2019_flight()
+    segs, init = scenarios.chen2019_flight()
     hour = segs[:4] + [tr.Straight(900.0)]          # Table 4-42 up to 3600 s
     return tr.generate(hour, **init)
 

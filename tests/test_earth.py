@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from replication.nav import earth
+from replication.papers.chen2019 import normal_gravity as ng
 from replication.registry import reproduction as rp
 
 TOL_GRAVITY = 0.1 * earth.MGAL  # m/s^2
@@ -29,7 +30,7 @@ H_GRID = np.linspace(0.0, H_MAX, 101)[None, :]
 
 @pytest.fixture(scope="module")
 def printed():
-    return earth.eq_3_1_coefficients(rp.load_paper("chen2019-eq-3-1"))
+    return ng.eq_3_1_coefficients(rp.load_paper("chen2019-eq-3-1"))
 
 
 @pytest.fixture(scope="module")
@@ -92,7 +93,7 @@ def test_series_form_rejects_incomplete_coefficients(derived):
     with pytest.raises(ValueError, match="h2"):
         earth.gravity_series_form(0.3, 0.0, c)
     with pytest.raises(ValueError, match="third_term"):
-        earth.gravity_series_form(0.3, 0.0, derived.numeric, third_term="cos")
+        ng.printed_series_form(0.3, 0.0, derived.numeric, third_term="cos")
     with pytest.raises(ValueError, match="height_model"):
         earth.normal_gravity_series_coefficients("spherical")
 
@@ -286,8 +287,8 @@ def test_printed_third_term_must_be_sin2_2L(printed, derived):
     lat = np.radians(np.linspace(0, 90, 901))
     c = dict(printed, k1=derived["k1"])
     somigliana = earth.normal_gravity_ellipsoid(lat)
-    as_printed = earth.gravity_series_form(lat, 0.0, c, third_term="sin2L")
-    repaired = earth.gravity_series_form(lat, 0.0, c, third_term="sin2_2L")
+    as_printed = ng.printed_series_form(lat, 0.0, c, third_term="sin2L")
+    repaired = ng.printed_series_form(lat, 0.0, c, third_term="sin2_2L")
     assert np.max(np.abs(as_printed - somigliana)) > 50 * TOL_GRAVITY  # 5.7 mGal at the pole
     assert np.max(np.abs(repaired - somigliana)) < TOL_GRAVITY
 
@@ -295,9 +296,9 @@ def test_printed_third_term_must_be_sin2_2L(printed, derived):
 def test_printed_trailing_L_is_spurious(printed):
     # as printed, γ vanishes at the equator and exceeds 15 m/s^2 at the pole
     # the trailing factor L multiplies the whole series: exactly 0 at L = 0 by construction
-    assert earth.normal_gravity_chen2019_printed(0.0, 0.0, printed) == 0.0
-    assert earth.normal_gravity_chen2019_printed(np.pi / 2, 0.0, printed) > 15.0
-    repaired = earth.normal_gravity_chen2019_repaired(0.0, 0.0, printed)
+    assert ng.normal_gravity_chen2019_printed(0.0, 0.0, printed) == 0.0
+    assert ng.normal_gravity_chen2019_printed(np.pi / 2, 0.0, printed) > 15.0
+    repaired = ng.normal_gravity_chen2019_repaired(0.0, 0.0, printed)
     assert abs(repaired - earth.GAMMA_E) < TOL_GRAVITY
 
 
@@ -305,22 +306,22 @@ def test_printed_sin2L_coefficient_0_0053022_is_off_by_0_24_mgal(printed, derive
     assert abs(printed["k1"] - derived["k1"]) * earth.GAMMA_E > 2 * TOL_GRAVITY
     lat = np.radians(np.linspace(0, 90, 901))
     c = dict(printed)
-    err = earth.normal_gravity_chen2019_repaired(lat, 0.0, c) - earth.normal_gravity_ellipsoid(lat)
+    err = ng.normal_gravity_chen2019_repaired(lat, 0.0, c) - earth.normal_gravity_ellipsoid(lat)
     assert np.max(np.abs(err)) > 2 * TOL_GRAVITY
     c["k1"] = round(derived["k1"], 7)  # 0.0053024: the derived value at the printed precision
-    err = earth.normal_gravity_chen2019_repaired(lat, 0.0, c) - earth.normal_gravity_ellipsoid(lat)
+    err = ng.normal_gravity_chen2019_repaired(lat, 0.0, c) - earth.normal_gravity_ellipsoid(lat)
     assert np.max(np.abs(err)) < TOL_GRAVITY
 
 
 def test_defect_effects_are_separated(printed, derived, first_order):
     corrected = dict(printed, k1=derived["k1"], h2=first_order["h2"])
-    eff = earth.eq_3_1_defect_effects(LAT_GRID, H_GRID, printed, corrected)
+    eff = ng.eq_3_1_defect_effects(LAT_GRID, H_GRID, printed, corrected)
     assert eff["trailing_L"] / 1e3 == pytest.approx(earth.GAMMA_E / earth.MGAL / 1e3, rel=1e-6)
     assert eff["third_term_sin2L"] == pytest.approx(printed["k2"] * earth.GAMMA_E / earth.MGAL, rel=1e-3)
     assert eff["h2"] == pytest.approx((first_order["h2"] - printed["h2"]) * H_MAX**2 / earth.MGAL, rel=1e-9)
     assert eff["k1"] == pytest.approx((derived["k1"] - printed["k1"]) * earth.GAMMA_E / earth.MGAL, rel=1e-7)
     with pytest.raises(ValueError, match="unknown defects"):
-        earth.eq_3_1_variant(0.1, 0.0, printed, corrected, ("typo",))
+        ng.eq_3_1_variant(0.1, 0.0, printed, corrected, ("typo",))
 
 
 # --------------------------------------------------------------------------- chen2019 Tables 1-1…1-4

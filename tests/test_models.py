@@ -85,9 +85,10 @@ def test_imu_sd_fields_enter_their_blocks():
         m = M.model_45(imu_sd=sd, gravity_sigma=grav, gravity_beta=2e-3, lever_arm_sd=lever,
                        misalignment_coupling=coupling, **nav)
         blocks = (E.accel_bias(acc["bias"]), E.accel_markov(acc["markov_sigma"], 900.0), E.accel_scale(acc["scale"]),
-                  E.accel_misalignment(a_mis, coupling=coupling), E.gyro_bias(gyr["bias"]),
+                  E.accel_misalignment(a_mis, coupling=M.MISALIGNMENT_COUPLINGS[coupling]), E.gyro_bias(gyr["bias"]),
                   E.gyro_markov(gyr["markov_sigma"], 300.0), E.gyro_scale(gyr["scale"]),
-                  E.gyro_misalignment(g_mis, coupling=coupling), E.gravity_shaping(grav, 2e-3), E.lever_arm(lever))
+                  E.gyro_misalignment(g_mis, coupling=M.MISALIGNMENT_COUPLINGS[coupling]), E.gravity_shaping(grav, 2e-3),
+                  E.lever_arm(lever))
         ref = E.ErrorModel(blocks=blocks, accel_psd=acc["white_psd"], gyro_psd=gyr["white_psd"], nav_sd=m.nav_sd)
         assert _same_model(m, ref), coupling
     m = M.model_36(imu_sd=ImuErrors(accel=TriadErrors(**acc), gyro=TriadErrors(**gyr)), accel_random_walk_psd=arw,

@@ -5,7 +5,7 @@ import pytest
 
 from replication.nav import trajectory as tr
 from replication.nav.sensors import ImuErrors, TriadErrors
-from replication.papers.chen2019 import findings, maneuvers, observability_tables
+from replication.papers.chen2019 import findings, maneuvers, observability_tables, scenarios
 from replication.papers.chen2019 import models as M
 from replication.papers.chen2019 import observability as O
 
@@ -123,7 +123,7 @@ def test_spearman():
 
 @pytest.fixture(scope="module")
 def flight():
-    _, init = tr.chen2019_flight()
+    _, init = scenarios.chen2019_flight()
     return tr.generate([tr.Straight(60.0), tr.Turn(120.0, np.pi)], dt=0.5, **init)
 
 

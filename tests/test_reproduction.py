@@ -102,8 +102,8 @@ def test_status_is_computed_from_the_tolerance():
 
 def test_numeric_columns_hold_only_numbers():
     df = rp.comparison_frame([
-        dict(quantity="range", unit="m", paper="4.0~6.0", reproduced=5.0, status="qualitative", note="inside"),
-        dict(quantity="word", unit="", paper=1.0, reproduced="decreasing", status="qualitative", note="shape"),
+        dict(quantity="range", unit="m", paper="4.0~6.0", reproduced=5.0, basis="verdict", agrees=True, note="inside"),
+        dict(quantity="word", unit="", paper=1.0, reproduced="decreasing", basis="verdict", agrees=True, note="shape"),
         dict(quantity="num", unit="m", paper=2.0, reproduced=2.0, tolerance=0.1),
     ])
     for col in rp.NUMERIC_COLUMNS:
@@ -125,8 +125,8 @@ def test_precision_policy_stores_only_determined_digits():
     assert a.loc[0, "reproduced"] == "0" and a.loc[1, "reproduced"] == "0"  # grids 1e-3 m and 1e-14
     assert a.loc[1, "tolerance"] == "7.35e-13"
     # a row without a tolerance keeps DEFAULT_DIGITS significant digits, ``digits`` overrides
-    c = rp.comparison_frame([dict(quantity="x", unit="", paper=1.0, reproduced=1.23456789, status="analog", note="n"),
-                             dict(quantity="y", unit="", paper=1.0, reproduced=1.23456789, status="analog", note="n",
+    c = rp.comparison_frame([dict(quantity="x", unit="", paper=1.0, reproduced=1.23456789, basis="stand-in", agrees=True, note="n"),
+                             dict(quantity="y", unit="", paper=1.0, reproduced=1.23456789, basis="stand-in", agrees=True, note="n",
                                   digits=3)])
     assert c.loc[0, "reproduced"] == "1.23457" and c.loc[1, "reproduced"] == "1.23"
     # a tight tolerance keeps the digits it needs: the comparison is read to a tenth of it
@@ -141,28 +141,42 @@ def test_precision_policy_stores_only_determined_digits():
         rp.comparison_frame([dict(quantity="z", unit="", paper=1, reproduced=1, tolerence=1)])
 
 
-def test_explicit_statuses_are_checked():
+def test_every_row_declares_its_basis():
+    """A row's status follows from its basis and evidence; a row without basis (and not a value row
+    with a tolerance, which gets basis ``value``) is refused, a typed status with it."""
+    for row in (dict(quantity="q", unit="", paper="up", reproduced="up", status="qualitative", note="n"),
+                dict(quantity="q", unit="", paper=1, reproduced=2, status="erratum", note="typo", evidence="e"),
+                dict(quantity="q", unit="", paper=1, reproduced=1.0, tolerance=0.1, status="reproduced"),
+                dict(quantity="q", unit="", paper=1, reproduced=2)):
+        with pytest.raises(rp.RegistryError, match="chen2019-table-9-9: row 'q' declares no basis"):
+            rp.comparison_frame([row], "chen2019-table-9-9")
+    with pytest.raises(rp.RegistryError, match="status='qualitative' is not evidence"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper="up", reproduced="up", status="qualitative", note="n")])
+    with pytest.raises(rp.RegistryError, match="drop status"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper="up", reproduced="up", status="qualitative",
+                                  basis="verdict", agrees=True, note="n")])
     with pytest.raises(rp.RegistryError, match="needs a note"):
-        rp.comparison_frame([dict(quantity="q", unit="", paper="up", reproduced="up", status="qualitative")])
-    with pytest.raises(rp.RegistryError, match="needs evidence"):
-        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=2, status="erratum", note="typo")])
-    with pytest.raises(rp.RegistryError, match="not an erratum"):
-        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=1.0, tolerance=0.1,
-                                  status="erratum", note="n", evidence="e")])
-    with pytest.raises(rp.RegistryError, match="exceeds tolerance"):
-        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=2, tolerance=0.1, status="reproduced")])
-    with pytest.raises(rp.RegistryError, match="unknown status"):
-        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=2, status="fine", note="x")])
-    with pytest.raises(rp.RegistryError, match="give a tolerance"):
-        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=2)])
+        rp.comparison_frame([dict(quantity="q", unit="", paper="up", reproduced="down", basis="verdict", agrees=False)])
+    with pytest.raises(rp.RegistryError, match="unknown basis"):
+        rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=2, basis="fine", note="x")])
     with pytest.raises(rp.RegistryError, match="appears twice"):
         rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=1, tolerance=1)] * 2)
+    assert rp.comparison_frame([dict(quantity="q", unit="", paper=1, reproduced=1, tolerance=1)])["basis"].tolist() \
+        == ["value"]
+
+
+def test_compare_refuses_a_row_without_basis_and_writes_nothing(sandbox):
+    with pytest.raises(rp.RegistryError, match="chen2019-table-9-9: row 'q' declares no basis"):
+        rp.compare("chen2019-table-9-9", [dict(quantity="q", unit="", paper="up", reproduced="up",
+                                               status="qualitative", note="shape")],
+                   title="T", notebook="book/x.ipynb")
+    assert not (sandbox / "tables" / "chen2019-table-9-9.csv").exists()
 
 
 def test_compare_exports_all_formats_and_is_idempotent(sandbox):
     rows = [
         dict(quantity="alpha", unit="m", paper=1.5, reproduced=1.5000001, tolerance=1e-6),
-        dict(quantity="beta", unit="°", paper=0.0025, reproduced=0.0035, status="erratum",
+        dict(quantity="beta", unit="°", paper=0.0025, reproduced=0.0035, basis="derivation",
              note="prose says 0.0035", evidence="tests/test_x.py::test_beta", tolerance=1e-4),
     ]
     df = rp.compare("chen2019-table-9-9", rows, title="Test table", notebook="book/x.ipynb", seeds={"mc": 1})
@@ -181,10 +195,10 @@ def test_compare_exports_all_formats_and_is_idempotent(sandbox):
 
 
 def test_index_lists_every_artifact_and_collects_the_register(sandbox):
-    rows = [dict(quantity="beta", unit="°", paper=0.0025, reproduced=0.0035, status="erratum",
+    rows = [dict(quantity="beta", unit="°", paper=0.0025, reproduced=0.0035, basis="derivation", agrees=False,
                  note="prose says 0.0035", evidence="tests/test_x.py::test_beta"),
             dict(quantity="alpha", unit="m", paper=1.5, paper_text="1.5 (caption: 2.5)", reproduced=1.5,
-                 status="inconsistent", note="the caption prints 2.5, the table 1.5")]
+                 basis="parts", agrees=False, note="the caption prints 2.5, the table 1.5")]
     rp.compare("chen2019-table-9-9", rows, title="T", notebook="book/x.ipynb")
     rp.compare("chen2019-check-extra", [dict(quantity="q", unit="", paper=1, reproduced=1, tolerance=0)],
                title="Extra", notebook="book/x.ipynb")
@@ -203,13 +217,17 @@ def test_index_lists_every_artifact_and_collects_the_register(sandbox):
     assert desc["kind"] and desc["printed"]
 
 
+LEDGER_ROW = {"qualitative": dict(basis="verdict", agrees=True), "not-reproduced": dict(basis="verdict", agrees=False)}
+"""The evidence of a ledger row that reaches the print (``qualitative``) or misses it."""
+
+
 def _main_and_ledger(ledger_status="qualitative", ledger_value=2.0, **kw):
     """A main table with one row that misses the print under its main reading, and a readings
     ledger with the main reading and one other; the ledger is exported first, as a chapter must."""
     rp.compare("chen2019-check-table-9-9-readings",
                [dict(quantity="main | alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1, note="misses"),
                 dict(quantity="other convention | alpha", unit="m", paper=1.5, reproduced=ledger_value,
-                     **({"tolerance": 0.1} if ledger_status is None else {"status": ledger_status, "note": "n"}))],
+                     **({"tolerance": 0.1} if ledger_status is None else {**LEDGER_ROW[ledger_status], "note": "n"}))],
                title="ledger", notebook="book/x.ipynb")
     return rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0,
                                                   tolerance=0.1, note="misses the print")],
@@ -285,11 +303,10 @@ def test_verdict_rule_refuses_an_erratum_that_a_reading_reproduces(sandbox):
     rp.compare("chen2019-check-table-9-9-readings",
                [dict(quantity="the table's convention | alpha", unit="m", paper=1.5, reproduced=1.5, tolerance=0.1)],
                title="ledger", notebook="book/x.ipynb")
-    rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1,
-                                           status="erratum", note="n", evidence="tests/t.py::t")],
-               title="T", notebook="book/x.ipynb", main_reading="main", reading_evidence="e")
-    bad = rp.verdict_violations()
-    assert len(bad) == 1 and "is erratum" in bad[0] and "inconsistency" in bad[0]
+    with pytest.raises(rp.RegistryError, match="chen2019-table-9-9: row 'alpha' declares no basis"):
+        rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1,
+                                               status="erratum", note="n", evidence="tests/t.py::t")],
+                   title="T", notebook="book/x.ipynb", main_reading="main", reading_evidence="e")
     df = rp.compare("chen2019-table-9-9", [dict(quantity="alpha", unit="m", paper=1.5, reproduced=3.0, tolerance=0.1,
                                                 basis="derivation", note="n", evidence="tests/t.py::t")],
                     title="T", notebook="book/x.ipynb", main_reading="main", reading_evidence="e")
@@ -405,11 +422,11 @@ def test_one_repository_address_everywhere():
         import source_links
     finally:
         sys.path.remove(str(ROOT / "book" / "_ext"))
-    link = source_links.source_url({"module": "replication.registry.reproduction", "fullname": "resolve_table_ids"},
+    link = source_links.source_url({"module": "replication.registry.reading", "fullname": "resolve_table_ids"},
                                    base=url, ref="abc", root=ROOT)
-    first, last = (int(n) for n in re.fullmatch(re.escape(url) + r"/blob/abc/replication/registry/reproduction\.py#L(\d+)-L(\d+)",
+    first, last = (int(n) for n in re.fullmatch(re.escape(url) + r"/blob/abc/replication/registry/reading\.py#L(\d+)-L(\d+)",
                                                 link).groups())
-    lines = (ROOT / "replication" / "registry" / "reproduction.py").read_text(encoding="utf-8").splitlines()
+    lines = (ROOT / "replication" / "registry" / "reading.py").read_text(encoding="utf-8").splitlines()
     assert lines[first - 1].startswith("def resolve_table_ids(") and lines[last - 1].strip() == "return [ident]"
     assert source_links.source_url({"module": "replication.registry.reproduction", "fullname": "PACKAGE_YEAR"},
                                    base=url, ref="abc", root=ROOT) is None          # data has no source lines
@@ -612,7 +629,7 @@ def test_part_summary_links_every_artifact_of_its_paper():
 def test_numbers_are_shown_with_the_digits_their_tolerance_supports():
     df = rp.comparison_frame([
         # a count: whole, never 44.0
-        dict(quantity="states", unit="", paper=44.0, reproduced=45.0, status="inconsistent", note="two parts"),
+        dict(quantity="states", unit="", paper=44.0, reproduced=45.0, basis="parts", agrees=False, note="two parts"),
         # a closed form at a relative 1e-12: the CSV keeps 14 digits, a reader sees DISPLAY_DIGITS
         dict(quantity="A", unit="1/s", paper=3.7367302193658e-5, reproduced=3.7367302193658e-5, tolerance=1e-12,
              tolerance_kind="rel"),

@@ -8,6 +8,7 @@ from replication.nav import earth
 from replication.nav import strapdown as sd
 from replication.nav import trajectory as tr
 from replication.nav.units import DEG
+from replication.papers.chen2019 import scenarios
 
 
 def test_compiled_earth_formulas_equal_the_earth_module():
@@ -33,7 +34,7 @@ def test_compiled_earth_formulas_equal_the_earth_module():
 
 @pytest.fixture(scope="module")
 def chen_flight():
-    segs, init = tr.chen2019_flight()
+    segs, init = scenarios.chen2019_flight()
     return tr.generate(segs, **init)
 
 

@@ -170,8 +170,8 @@ def pattern(expected: str) -> str:
 
 def expected_cells(table_id: str) -> tuple[str, list[str], list[list[str]]]:
     """What an export shows, from its CSV: the title (the sidecar's), the header, and per row the
-    cells of :data:`~replication.registry.reproduction.TEX_COLUMNS` as
-    :func:`~replication.registry.reproduction.display_cell` shows them (text columns verbatim;
+    cells of :data:`~replication.registry.tex.TEX_COLUMNS` as
+    :func:`~replication.registry.digits.display_cell` shows them (text columns verbatim;
     numbers with the digits the row's tolerance supports) followed by ``reason:`` and the note."""
     df = pd.read_csv(rp.tables_dir() / f"{table_id}.csv", dtype=str, keep_default_na=False)
     title = json.loads((rp.tables_dir() / f"{table_id}.json").read_text(encoding="utf-8"))["title"]
@@ -242,7 +242,7 @@ def test_the_comparison_catches_a_wrong_character():
 
 def test_export_header_names_the_packages_and_keeps_the_reason():
     df = rp.comparison_frame([
-        dict(quantity="q", unit="m", paper=1.0, reproduced=1.5, tolerance=0.1, status="erratum",
+        dict(quantity="q", unit="m", paper=1.0, reproduced=1.5, tolerance=0.1, basis="derivation",
              note="a reason/with/a/very_long_unbreakable_path/in.it", evidence="nb"),
     ])
     tex = rp._latex(df, "t", "chen2019-table-9")

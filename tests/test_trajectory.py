@@ -7,6 +7,8 @@ from replication.nav import earth
 from replication.nav import trajectory as tr
 from replication.nav.rotations import euler_to_dcm
 from replication.nav.units import DEG
+from replication.papers.chen2019 import scenarios
+from replication.papers.fang2020 import scenarios as ship
 
 
 @pytest.fixture(scope="module")
@@ -95,7 +97,7 @@ def test_position_is_the_integral_of_velocity(maneuvers):
 
 
 def test_chen2019_flight_layout():
-    segs, init = tr.chen2019_flight()
+    segs, init = scenarios.chen2019_flight()
     assert sum(s.duration for s in segs) == 5100.0
     assert [type(s).__name__ for s in segs] == ["Straight", "STurn", "Straight", "Turn", "Straight", "Turn", "Straight"]
     assert segs[3].angle == np.pi and segs[5].angle == -np.pi
@@ -103,7 +105,7 @@ def test_chen2019_flight_layout():
 
 
 def test_ship_rocking_follows_fang2020_eq28():
-    segs = tr.fang2020_ship(20.0, rng=3)
+    segs = ship.fang2020_ship(20.0, rng=3)
     traj = tr.generate(segs, 85 * DEG, 18 * DEG, 0.0)
     s = segs[0]
     t = traj.t
@@ -114,14 +116,14 @@ def test_ship_rocking_follows_fang2020_eq28():
 
 
 def test_turntable_sequences():
-    segs, h0 = tr.turntable_chen2019(2, dwell=5.0, repeats=1)
+    segs, h0 = scenarios.turntable_chen2019(2, dwell=5.0, repeats=1)
     traj = tr.generate(segs, 40 * DEG, 116 * DEG, 50.0, heading=h0, speed=0.0)
     # after the full step sequence the table is back at zero attitude
     C_end = euler_to_dcm(*traj.hpr[-1])
     assert np.allclose(C_end, np.eye(3), atol=1e-12)
     # the maximum roll of the coordinated-turn simulation is 10°
     assert np.isclose(traj.hpr[:, 2].max(), 10 * DEG, atol=1e-12)
-    segs3, h3 = tr.turntable_chen2019(3, dwell=5.0, repeats=1)
+    segs3, h3 = scenarios.turntable_chen2019(3, dwell=5.0, repeats=1)
     assert np.isclose(h3, -90 * DEG)
     rr, _ = tr.rotation_rich_turntable(600.0)
     assert np.isclose(sum(s.duration for s in rr), 600.0)

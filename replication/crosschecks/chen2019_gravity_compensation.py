@@ -38,6 +38,13 @@ x⁺ = (I - C K H_t) x⁻ - C K v  with the filter's gain K, C mapping each filt
 truth state.  The filter's gains come from its own Riccati recursion (time-varying, since the
 random-constant bias state keeps converging over the flight).
 
+Why this module is long: a cross-check is one module per headline verdict (CONTRIBUTING.md,
+"Library"), written from the paper's equations with numpy and scipy only, so that an error of the
+chapter's code path cannot repeat itself here; it may not share helpers with the chapter's
+modules, and so it carries its own disturbance model, truth and filter models, sensitivity
+propagation and photo-epoch geometry for the one verdict (the height rows of Table 4-50 and the
+level channel behind them).
+
 Two routes evaluate the same closed loop:
 
 * :func:`predicted_height_rms`: the disturbance as a stationary process in time (shaping-filter

@@ -66,10 +66,11 @@ NAV_LABELS = ("dL", "dlon", "dh", "dvE", "dvN", "dvU", "phiE", "phiN", "phiU")
 _TARGETS = {"accel": K.TARGET_ACCEL, "gyro": K.TARGET_GYRO, "gravity": K.TARGET_GRAVITY,
             "lever_arm": K.TARGET_LEVER, "none": K.TARGET_NONE}
 _KINDS = {"identity": K.KIND_IDENTITY, "scale": K.KIND_SCALE, "misalignment": K.KIND_MISALIGN,
-          "misalignment-table-2-2": K.KIND_MISALIGN_T22}
-MISALIGNMENT_COUPLINGS = {"eq-2-8": "misalignment", "table-2-2": "misalignment-table-2-2"}
-"""How the six misalignment parameters [xy, yx, xz, zx, yz, zy] couple: as eq. (2-8) lays out δC,
-or as Table 2-2 prints F32/F33 and F52/F53 (chen2019 — the two printed parts disagree)."""
+          "misalignment-cross-axis": K.KIND_MISALIGN_T22}
+MISALIGNMENT_COUPLINGS = {"axis-angles": "misalignment", "cross-axis": "misalignment-cross-axis"}
+"""How the six misalignment parameters [xy, yx, xz, zx, yz, zy] couple: axis angles, δC = [[0, -yz, zy],
+[xz, 0, -zx], [-xy, yx, 0]] (chen2019 eq. (2-8)), or cross-axis coefficients, δC = [[0, xy, xz], [yx, 0, yz],
+[zx, zy, 0]] (chen2019 Table 2-2's F32/F33, F52/F53)."""
 _MIS_LABELS = ("xy", "yx", "xz", "zx", "yz", "zy")
 
 
@@ -97,10 +98,10 @@ class StateBlock:
     target : {"accel", "gyro", "gravity", "lever_arm", "none"}
         What it perturbs: ``"accel"`` (f^b), ``"gyro"`` (ω_ib^b), ``"gravity"`` (g^n),
         ``"lever_arm"`` (GNSS antenna offset, measurement only) or ``"none"``.
-    kind : {"identity", "scale", "misalignment", "misalignment-table-2-2"}
-        Coupling B(u) for accel/gyro targets: ``"identity"``, ``"scale"``, ``"misalignment"``
-        (chen2019 eq. (2-8)) or ``"misalignment-table-2-2"`` (as Table 2-2 prints it); default
-        ``"identity"``.  An identity or scale block has 3 states, a misalignment block 6.
+    kind : {"identity", "scale", "misalignment", "misalignment-cross-axis"}
+        Coupling B(u) for accel/gyro targets: ``"identity"``, ``"scale"`` or a misalignment
+        (:data:`MISALIGNMENT_COUPLINGS`); default ``"identity"``.  An identity or scale block has
+        3 states, a misalignment block 6.
     dynamics : ndarray, shape (k, k)
         Matrix A of ẋ = A x + w [1/s] (zeros, the default: random constant).
     noise_psd : ndarray, shape (k, k)
@@ -137,7 +138,7 @@ class StateBlock:
             raise ValueError(f"block {self.name!r}: target must be one of {sorted(_TARGETS)}, got {self.target!r}")
         if self.kind not in _KINDS:
             raise ValueError(f"block {self.name!r}: kind must be one of {sorted(_KINDS)}, got {self.kind!r}")
-        need = {"identity": 3, "scale": 3, "misalignment": 6, "misalignment-table-2-2": 6}[self.kind]
+        need = {"identity": 3, "scale": 3, "misalignment": 6, "misalignment-cross-axis": 6}[self.kind]
         if self.target in ("accel", "gyro") and k != need:
             raise ValueError(f"block {self.name!r}: a {self.kind} block has {need} states, got {k} labels")
         if self.target == "lever_arm" and k != 3:
@@ -749,7 +750,7 @@ def _coupling_kind(coupling):
     return MISALIGNMENT_COUPLINGS[coupling]
 
 
-def accel_misalignment(sd=0.0, *, name="accel_misalignment", coupling="eq-2-8"):
+def accel_misalignment(sd=0.0, *, name="accel_misalignment", coupling="axis-angles"):
     """Accelerometer non-orthogonality δA (eqs. (2-8), (2-9)).
 
     Parameters
@@ -758,8 +759,8 @@ def accel_misalignment(sd=0.0, *, name="accel_misalignment", coupling="eq-2-8"):
         Initial standard deviations of [xy, yx, xz, zx, yz, zy] [rad], default 0.
     name : str, optional
         Block name, default ``"accel_misalignment"``.
-    coupling : {"eq-2-8", "table-2-2"}, optional
-        How the six angles couple (:data:`MISALIGNMENT_COUPLINGS`), default ``"eq-2-8"``.
+    coupling : {"axis-angles", "cross-axis"}, optional
+        How the six angles couple (:data:`MISALIGNMENT_COUPLINGS`), default ``"axis-angles"``.
 
     Returns
     -------
@@ -769,7 +770,7 @@ def accel_misalignment(sd=0.0, *, name="accel_misalignment", coupling="eq-2-8"):
     return StateBlock(name, _MIS_LABELS, "accel", _coupling_kind(coupling), sd=_sd(sd, "sd", 6), fd_step=1e-3)
 
 
-def gyro_misalignment(sd=0.0, *, name="gyro_misalignment", coupling="eq-2-8"):
+def gyro_misalignment(sd=0.0, *, name="gyro_misalignment", coupling="axis-angles"):
     """Gyro non-orthogonality δG (eqs. (2-8), (2-9)).
 
     Parameters
@@ -778,8 +779,8 @@ def gyro_misalignment(sd=0.0, *, name="gyro_misalignment", coupling="eq-2-8"):
         Initial standard deviations of [xy, yx, xz, zx, yz, zy] [rad], default 0.
     name : str, optional
         Block name, default ``"gyro_misalignment"``.
-    coupling : {"eq-2-8", "table-2-2"}, optional
-        How the six angles couple (:data:`MISALIGNMENT_COUPLINGS`), default ``"eq-2-8"``.
+    coupling : {"axis-angles", "cross-axis"}, optional
+        How the six angles couple (:data:`MISALIGNMENT_COUPLINGS`), default ``"axis-angles"``.
 
     Returns
     -------

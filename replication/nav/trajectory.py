@@ -19,6 +19,14 @@ a smooth integrand.
 Conventions: see :mod:`replication.nav.rotations` (heading clockwise from north, pitch nose-up,
 roll right-wing-down; C_b^n = R_z(-ψ) R_x(θ) R_y(γ)).  Coordinated turns bank by
 tan γ = V ψ̇ / g_0 with g_0 = 9.80665 m/s².
+
+Why this module is long: it is one concept, the true motion, in two halves that are only correct
+together.  Every segment class implements the same closed-form protocol (:class:`Segment`: attitude,
+rates, velocity and acceleration as functions of time, continuous at its ends), and
+:func:`generate` integrates the position and the sensor increments of any sequence of them; a new
+segment is checked against the generator's quadrature, and the generator's continuity assumptions
+are those the segments guarantee.  Splitting the segment zoo from the generator would put that
+contract in two places.  The scenarios of a paper are built in ``replication.papers.<key>``.
 """
 
 from __future__ import annotations
@@ -37,8 +45,7 @@ from replication.nav.units import DEG, G0
 
 __all__ = [
     "Segment", "Straight", "Turn", "SteadyTurn", "UTurn", "STurn", "FigureEight", "Climb", "Accelerate",
-    "Rotate", "move", "Dwell", "ShipRocking", "Trajectory", "generate", "chen2019_flight",
-    "turntable_chen2019", "rotation_rich_turntable", "fang2020_ship",
+    "Rotate", "move", "Dwell", "ShipRocking", "Trajectory", "generate", "rotation_rich_turntable",
 ]
 
 
@@ -965,90 +972,6 @@ def generate(segments, lat0: float, lon0: float, h0: float, *, dt: float = 0.01,
 
 # ----------------------------------------------------------------------------- scenarios
 
-def chen2019_flight(*, s_swing: float = np.pi, s_cycles: int = 2):
-    """Segments of chen2019 Table 4-42 (the 5100-s survey flight) and its initial state.
-
-    Table 4-42: 0-100 s straight; 100-1300 s S-maneuver; 1300-2300 s straight; 2300-2700 s
-    clockwise 180° U-turn; 2700-3700 s straight; 3700-4100 s counter-clockwise 180° U-turn;
-    4100-5100 s straight; constant speed and height, bank in the turns.  Initial state of
-    Table 4-41's text: 47°N, 115°E, 6000 m, heading 45° (north-east), 100 m/s.
-    The S-maneuver's amplitude is not printed: ``s_swing`` (default 180°) and ``s_cycles``
-    (default 2) are this package's choice.
-
-    Parameters
-    ----------
-    s_swing : float, optional
-        Heading excursion of the S-maneuver [rad], default π.
-    s_cycles : int, optional
-        Its number of cycles, default 2.
-
-    Returns
-    -------
-    segments : list of Segment
-        The flight.
-    initial : dict
-        The keyword arguments of :func:`generate` (``lat0``, ``lon0`` [rad], ``h0`` [m],
-        ``heading`` [rad], ``speed`` [m/s]).
-    """
-    segs = [Straight(100.0), STurn(1200.0, swing=s_swing, cycles=s_cycles), Straight(1000.0),
-            UTurn(400.0, clockwise=True), Straight(1000.0), UTurn(400.0, clockwise=False), Straight(1000.0)]
-    init = dict(lat0=47 * DEG, lon0=115 * DEG, h0=6000.0, heading=45 * DEG, speed=100.0)
-    return segs, init
-
-
-def turntable_chen2019(experiment: int = 2, *, dwell: float = 300.0, repeats: int = 3,
-                       outer_rate: float = 9 * DEG, middle_rate: float = 1 * DEG, ramp: float = 1.0):
-    """Three-axis turntable sequences of chen2019 §4.1.3 (ch. 4, "SINS/GNSS 姿态仿真测试").
-
-    experiment 1: no roll — outer axis to -180° and back to 0° at 9°/s, dwelling ``dwell`` s;
-    experiment 2: coordinated-turn simulation — outer to -90° then -180° (9°/s), dwell, outer to
-    -90° with middle (roll) to 10° (1°/s) simultaneously, then both back to 0°, dwell;
-    experiment 3: as 2 with the IMU initially north-west-up ([90, 0, 0] in the report's
-    counter-clockwise yaw, i.e. heading -90°).  Steps repeated ``repeats`` times.
-    The outer angle α maps to heading ψ = -α, the middle (roll) axis to roll γ.  Each move
-    accelerates and decelerates smoothly over ``ramp`` seconds (:func:`move`).
-
-    Parameters
-    ----------
-    experiment : {1, 2, 3}, optional
-        Which experiment, default 2.
-    dwell : float, optional
-        Rest between moves [s], default 300.
-    repeats : int, optional
-        Repetitions of the steps, default 3.
-    outer_rate : float, optional
-        Outer-axis (heading) rate [rad/s], default 9°/s.
-    middle_rate : float, optional
-        Middle-axis (roll) rate [rad/s], default 1°/s.
-    ramp : float, optional
-        Ramp of each move [s], default 1.
-
-    Returns
-    -------
-    segments : list of Segment
-        An initial dwell, then the moves and dwells.
-    initial_heading : float
-        Initial heading [rad]: 0, or -π/2 for experiment 3.
-
-    Raises
-    ------
-    ValueError
-        For another experiment number.
-    """
-    if experiment not in (1, 2, 3):
-        raise ValueError("experiment must be 1, 2 or 3 (chen2019 §4.1.3)")
-    segs = [Dwell(dwell)]
-    a, m = outer_rate, middle_rate
-    for _ in range(repeats):
-        if experiment == 1:
-            segs += [move((np.pi, 0, 0), a, ramp), Dwell(dwell), move((-np.pi, 0, 0), a, ramp), Dwell(dwell)]
-        else:
-            segs += [move((np.pi / 2, 0, 0), a, ramp), move((np.pi / 2, 0, 0), a, ramp), Dwell(dwell),
-                     move((-np.pi / 2, 0, 10 * DEG), (a, 0, m), ramp), move((-np.pi / 2, 0, -10 * DEG), (a, 0, m), ramp),
-                     Dwell(dwell)]
-    return segs, (0.0 if experiment in (1, 2) else -90 * DEG)
-
-
 def rotation_rich_turntable(duration: float = 3600.0, *, dwell: float = 20.0, tumble: bool = False):
     """A rotation-rich turntable hour built from chen2019 §4.1.3 moves with short dwells.
 
@@ -1098,29 +1021,3 @@ def rotation_rich_turntable(duration: float = 3600.0, *, dwell: float = 20.0, tu
     if duration - total > 1e-9:
         segs.append(Dwell(round(duration - total, 6)))
     return segs, 0.0
-
-
-def fang2020_ship(duration: float, rng=None, *, northward: bool = False):
-    """fang2020 §3 ship motion: eq. (28) rocking (3°, 5°, 4°; 7, 9, 12 s; random phases).
-
-    10 m/s east along the parallel (heading 90°) or, with ``northward``, north along the meridian
-    (heading 0°).
-
-    Parameters
-    ----------
-    duration : float
-        Length [s].
-    rng : numpy.random.Generator or int or None, optional
-        Draws the three phases (uniform on [0, 2π)).
-    northward : bool, optional
-        Sail north instead of east, default False.
-
-    Returns
-    -------
-    segments : list of ShipRocking
-        One rocking segment.
-    """
-    rng = np.random.default_rng(rng)
-    ph = tuple(rng.uniform(0, 2 * np.pi, 3))
-    head = 0.0 if northward else 90 * DEG
-    return [ShipRocking(duration, phases=ph, heading0=head, course=head)]

@@ -590,7 +590,7 @@ def audit(table_ids: Iterable[str] | None = None) -> list[Problem]:
 
 
 def check(table_ids: Iterable[str] | None = None) -> None:
-    """Raise :class:`replication.registry.reproduction.RegistryError` listing every problem of the stored tables.
+    """Raise :class:`replication.registry.schema.RegistryError` listing every problem of the stored tables.
 
     Parameters
     ----------

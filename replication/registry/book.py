@@ -213,7 +213,7 @@ def claim_row(printed, quantity: str, *, holds, rests_on, note: str, reproduced=
     Returns
     -------
     dict
-        A row for :func:`replication.registry.reproduction.compare`.
+        A row for :func:`replication.registry.exports.compare`.
 
     Raises
     ------
@@ -245,6 +245,6 @@ def unstated_claim_row(printed, quantity: str, *, note: str) -> dict:
     Returns
     -------
     dict
-        A row for :func:`replication.registry.reproduction.compare`.
+        A row for :func:`replication.registry.exports.compare`.
     """
     return dict(quantity=quantity, unit="text", paper=printed.value(quantity), basis="unstated", note=note)

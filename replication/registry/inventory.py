@@ -62,7 +62,7 @@ def inventory_path(key: str):
     Parameters
     ----------
     key : str
-        One of :data:`replication.registry.reproduction.SOURCE_KEYS`.
+        One of :data:`replication.registry.schema.SOURCE_KEYS`.
 
     Returns
     -------

@@ -124,7 +124,7 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
     Returns
     -------
     main_rows, ledger_rows : list of dict
-        Rows for :func:`replication.registry.reproduction.compare`: the main table (one per value)
+        Rows for :func:`replication.registry.exports.compare`: the main table (one per value)
         and the ledger (one per reading other than the main one and value, named
         ``"<reading> | <symbol> | <scenario>"``), each with its ``basis`` and ``agrees``.
     """
@@ -274,7 +274,7 @@ def figure_4_14_ledger(readings: dict, claim: pd.DataFrame, *, window: float = 1
     Returns
     -------
     rows : list of dict
-        Rows for :func:`replication.registry.reproduction.compare` (``quantity``, ``unit``,
+        Rows for :func:`replication.registry.exports.compare` (``quantity``, ``unit``,
         ``paper``, ``reproduced`` (the runs' range as text, :func:`figure_4_14_range_text`),
         ``basis`` ``"verdict"`` with ``agrees`` true when the reading reaches the print (the
         registry derives the status), ``note``).
@@ -333,7 +333,7 @@ def ordering_rows(paper_exp, paper_ref, runs_exp, runs_ref, *, label: str, indic
     Returns
     -------
     rows : list of dict
-        One row per index for :func:`replication.registry.reproduction.compare`: ``quantity``,
+        One row per index for :func:`replication.registry.exports.compare`: ``quantity``,
         ``unit`` (``"1"``, the ratios are dimensionless), ``paper`` (printed ratio), ``reproduced``
         (ratio of the simulated means), ``basis`` (``"verdict"``), ``agrees``, ``note``.
 
@@ -395,7 +395,7 @@ def closed_form_rows(checks, *, probe: str, evidence_prefix: str) -> list[dict]:
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`.
+        Rows for :func:`replication.registry.exports.compare`.
     """
     from replication.papers.chen2019.closed_forms import AGREE_REL
 

@@ -81,7 +81,8 @@ from replication.nav._validate import choice, components, numeric, positive
 from replication.nav.rotations import rotvec_to_dcm, skew
 from replication.nav.sensors import ImuErrors, TriadErrors
 
-__all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "EXTEND_ORDER_45", "NAV_SYMBOLS", "model_45", "model_36",
+__all__ = ["CHEN2019_45_ORDER", "CHEN2019_36_ORDER", "MISALIGNMENT_COUPLINGS", "EXTEND_ORDER_45", "NAV_SYMBOLS",
+           "model_45", "model_36",
            "state_symbols", "state_permutation", "reorder", "noise_input", "measurement_matrix",
            "measurement_function", "lever_arm_correction", "table_2_3_states"]
 
@@ -101,6 +102,11 @@ EXTEND_ORDER_45 = ("accel_bias", "gyro_bias", "accel_markov", "gyro_markov", "ac
 """Block order of ``errors.model_15(...).extend(accel_markov, gyro_markov, accel_scale, gyro_scale,
 accel_misalignment, gyro_misalignment, gravity_shaping, lever_arm)`` — see :func:`state_permutation`."""
 
+MISALIGNMENT_COUPLINGS = {"eq-2-8": "axis-angles", "table-2-2": "cross-axis"}
+"""The report's two layouts of the misalignment parameters, by the printed part that shows each,
+and the coupling of :data:`replication.nav.errors.MISALIGNMENT_COUPLINGS` that implements it: eq.
+(2-8) lays out δC by axis angles, Table 2-2 prints F32/F33 and F52/F53 by cross-axis coefficients
+(the two printed parts disagree)."""
 
 NAV_SYMBOLS = ("δL", "δλ", "δh", "δV_E", "δV_N", "δV_U", "φ_E", "φ_N", "φ_U")
 
@@ -240,7 +246,7 @@ def model_45(*, imu_sd: ImuErrors | None = None, position_sd=(10.0, 10.0, 10.0),
     misalignment_coupling : str
         ``"eq-2-8"`` (the layout of δC in eq. (2-8), default) or ``"table-2-2"`` (the F32/F33,
         F52/F53 columns as Table 2-2 prints them) — the report's two printed parts disagree on it
-        (:data:`replication.nav.errors.MISALIGNMENT_COUPLINGS`).
+        (:data:`MISALIGNMENT_COUPLINGS`).
 
     Returns
     -------
@@ -260,16 +266,17 @@ def model_45(*, imu_sd: ImuErrors | None = None, position_sd=(10.0, 10.0, 10.0),
     acc, gyr = _imu_triads(imu_sd)
     a, g = _triad_sd(acc, "accel", "45-state"), _triad_sd(gyr, "gyro", "45-state")
     beta = positive(gravity_beta, "gravity_beta", _SECONDS)
-    choice(misalignment_coupling, sorted(E.MISALIGNMENT_COUPLINGS), "misalignment_coupling")
+    choice(misalignment_coupling, sorted(MISALIGNMENT_COUPLINGS), "misalignment_coupling")
+    coupling = MISALIGNMENT_COUPLINGS[misalignment_coupling]
     blocks = (
         E.accel_bias(a["bias"]),
         E.accel_markov(a["markov_sigma"], a["markov_tau"]),
         E.accel_scale(a["scale"]),
-        E.accel_misalignment(a["misalignment"], coupling=misalignment_coupling),
+        E.accel_misalignment(a["misalignment"], coupling=coupling),
         E.gyro_bias(g["bias"]),
         E.gyro_markov(g["markov_sigma"], g["markov_tau"]),
         E.gyro_scale(g["scale"]),
-        E.gyro_misalignment(g["misalignment"], coupling=misalignment_coupling),
+        E.gyro_misalignment(g["misalignment"], coupling=coupling),
         E.gravity_shaping(_nonneg(gravity_sigma, "gravity_sigma"), beta),
         E.lever_arm(_nonneg(lever_arm_sd, "lever_arm_sd")),
     )

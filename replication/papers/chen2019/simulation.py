@@ -11,7 +11,7 @@ filter of the package.
   (``misalignment_unit``) and the meaning of the Markov "驱动白噪声方差强度" (``markov_reading``);
   the parameters the report does not print (initial navigation errors, gravity disturbance,
   lever arm) are this package's stated choices;
-* :func:`simulated_flight` — the Table 4-42 flight from :func:`replication.nav.trajectory.chen2019_flight`;
+* :func:`simulated_flight` — the Table 4-42 flight from :func:`replication.papers.chen2019.scenarios.chen2019_flight`;
 * :func:`filter_model` — the 15-state (:func:`replication.nav.errors.model_15`), 36-state
   (:func:`replication.papers.chen2019.models.model_36`) and 45-state (:func:`replication.papers.chen2019.models.model_45`) models
   built from one setup;
@@ -73,9 +73,10 @@ from replication.nav import sensors as se
 from replication.nav._validate import choice, integer, probability
 from replication.nav.rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from replication.nav.sensors import gauss_markov_coefficients, gauss_markov_recursion, lever_arm_offset, misalignment_matrix
-from replication.nav.trajectory import chen2019_flight, generate
+from replication.nav.trajectory import generate
 from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, HOUR, MGAL, MICRO_G
 from replication.papers.chen2019 import models as M
+from replication.papers.chen2019.scenarios import chen2019_flight
 
 __all__ = ["SimulationSetup", "table_4_41_setup", "MISALIGNMENT_UNITS", "MARKOV_READINGS",
            "simulated_flight", "segment_summary", "filter_model", "BatchResult", "run_batch",
@@ -320,7 +321,7 @@ def simulated_flight(paper=None, *, imu_rate_hz: float = 100.0, s_swing: float =
     """The chen2019 Table 4-42 flight (5100 s) sampled at ``imu_rate_hz``.
 
     Initial state from ``paper`` (47°N, 115°E, 6000 m, heading 45°, 100 m/s) or, without it, the
-    same numbers built into :func:`replication.nav.trajectory.chen2019_flight`.  The S-maneuver
+    same numbers built into :func:`replication.papers.chen2019.scenarios.chen2019_flight`.  The S-maneuver
     amplitude (``s_swing``) and its number of cycles are not printed (this package's choice).
 
     Parameters

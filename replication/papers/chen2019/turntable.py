@@ -2,7 +2,7 @@
 turntable attitude experiments of Tables 4-37, 4-38 and 4-39.
 
 The report mounts the SINS/GNSS system on a three-axis turntable, runs the rotation sequences
-printed in the text (:func:`replication.nav.trajectory.turntable_chen2019`) and prints the standard
+printed in the text (:func:`replication.papers.chen2019.scenarios.turntable_chen2019`) and prints the standard
 deviation of the post-processed (smoothed) attitude, position and velocity errors
 (后处理平滑 STD).  The raw data are unpublished; this module builds the analog on the batched
 closed-loop filter and RTS smoother of :mod:`replication.papers.chen2019.simulation`:
@@ -36,9 +36,10 @@ import numpy as np
 
 from replication.nav import closedloop as CL
 from replication.nav import earth
-from replication.nav.trajectory import generate, turntable_chen2019
+from replication.nav.trajectory import generate
 from replication.nav.units import DEG, DEG_PER_H, G0
 from replication.papers.chen2019 import simulation as S
+from replication.papers.chen2019.scenarios import turntable_chen2019
 
 __all__ = ["QUANTITIES", "UNITS", "SITE", "tested_imu_setup", "scenario", "run_scenario", "error_std",
            "summary"]
@@ -155,7 +156,7 @@ def scenario(experiment: int, *, imu_rate_hz: float = 100.0, dwell: float = 300.
     """Experiment ``experiment`` (1, 2 or 3) of chen2019 §4.1.3 at :data:`SITE`, sampled at ``imu_rate_hz``.
 
     5-min dwells (采集 5 分钟) and the printed rotations (outer axis 9°/s, middle axis 1°/s), steps
-    repeated 3 times (:func:`replication.nav.trajectory.turntable_chen2019`).
+    repeated 3 times (:func:`replication.papers.chen2019.scenarios.turntable_chen2019`).
 
     Parameters
     ----------

@@ -43,7 +43,7 @@ PROPOSED_REASON = (
 
 
 def table1_comparison(mc: MonteCarlo, paper, *, until: float, ideal: dict, ledger=None) -> list[dict]:
-    """Rows of duan2023 Table 1 for :func:`replication.registry.reproduction.compare`, each with its basis.
+    """Rows of duan2023 Table 1 for :func:`replication.registry.exports.compare`, each with its basis.
 
     The registry derives each status from the row's evidence (CONTRIBUTING.md, "Statuses"); the
     note gives the 95 % interval of every Monte-Carlo mean.  Each printed column of Table 1 is one
@@ -160,7 +160,7 @@ LEDGER_QUANTITIES = {"misalignment": "max misalignment (deg)", "velocity error":
 
 
 def readings_ledger_rows(readings, table1, system="proposed SINS/ADS", *, runs=None):
-    """Rows of duan2023 Table 1's readings ledger for :func:`replication.registry.reproduction.compare`.
+    """Rows of duan2023 Table 1's readings ledger for :func:`replication.registry.exports.compare`.
 
     Parameters
     ----------
@@ -417,7 +417,7 @@ def startup_tilt_rows(table1, *, dh: float, speed: float, interval: float, g: fl
     Returns
     -------
     main, ledger : list of dict
-        Rows for :func:`replication.registry.reproduction.compare`: ``quantity``, ``unit``,
+        Rows for :func:`replication.registry.exports.compare`: ``quantity``, ``unit``,
         ``paper``, ``reproduced`` (the bound, 3 decimals), ``basis`` "verdict", ``agrees`` and
         ``note``, the main rows also ``group`` (:data:`STARTUP_GROUP`); the ledger's quantities are
         "<reading> | <quantity>".
@@ -527,7 +527,7 @@ def eq22_rows(paper, reading: str = "B", state: str = "climb"):
     Returns
     -------
     rows : list of dict
-        For :func:`replication.registry.reproduction.compare`, each with ``basis`` "derivation"
+        For :func:`replication.registry.exports.compare`, each with ``basis`` "derivation"
         (the registry derives the status): ``quantity``, ``unit``, ``paper``, ``reproduced``
         (values at the state in ``unit``), ``tolerance`` 1e-9, ``tolerance_kind`` "rel" — except
         the elements that agree with the derivation only at the paper's first order
