@@ -18,6 +18,7 @@ import numpy as np
 
 from replication.nav import earth
 from replication.nav import trajectory as tr
+from replication.papers.chen2019 import scenarios
 from replication.nav._validate import finite, integer, positive
 from replication.nav.rotations import body_rate_from_euler_rates, euler_to_dcm
 from replication.nav.trajectory import Trajectory
@@ -112,7 +113,7 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
       in Table 4-42; the default 1600 s keeps the U-turn's mean turn rate, 0.45°/s);
     * ``S-turn`` — straight leg, S-maneuver of ``s_turn`` s (Table 4-42: 1200 s) swinging
       ``s_swing`` rad ``s_cycles`` times (not printed;
-      :func:`replication.nav.trajectory.chen2019_flight`'s choice).
+      :func:`replication.papers.chen2019.scenarios.chen2019_flight`'s choice).
 
     Parameters
     ----------
@@ -171,7 +172,7 @@ def chen2019_maneuvers(*, straight: float = 100.0, u_turn: float = 400.0, figure
         raise ValueError(f"turn_rate must be one of {TURN_RATES}, got {turn_rate!r}")
     if bank not in BANKS:
         raise ValueError(f"bank must be one of {BANKS}, got {bank!r}")
-    _, init = tr.chen2019_flight()
+    _, init = scenarios.chen2019_flight()
     A = float(speed_wave)
     if turn_rate == "ramped":
         man = {"U-turn": [tr.Turn(u_turn, math.pi, speed_wave=A)],
