@@ -243,13 +243,13 @@ def journal_volume(entry: str) -> tuple[str, int, int] | None:
     Returns
     -------
     tuple or None
-        ``(journal, year, volume)``, the journal with its spaces removed; ``None`` for an entry of
+        ``(journal, year, volume)``, the journal with its runs of spaces made one; ``None`` for an entry of
         another form (a book, a thesis, an article printed with an issue but no volume).
     """
     m = _JOURNAL.search(str(entry))
     if not m:
         return None
-    return re.sub(r"\s+", "", m["journal"]), int(m["year"]), int(m["volume"])
+    return re.sub(r"\s+", " ", m["journal"]).strip(), int(m["year"]), int(m["volume"])
 
 
 def volume_rows(printed: pd.DataFrame, *, same_step: int = SAME_STEP) -> list[dict[str, Any]]:
