@@ -40,3 +40,17 @@ def test_chen2019_captions_hold_what_an_independent_reading_found():
                                    dict(caption="Table 4-38 caption", against="Table 4-38 section", **ROLL),
                                    dict(caption="Table 4-37 caption", against="Table 4-37 section", **ROLL)])
     assert [r["agrees"] for r in rows] == [False, False, True]
+
+
+def test_chen2019_print_parts_hold_what_an_independent_reading_found():
+    """data/paper/chen2019/reading.md F37, F48, F50, F64, F75 and F78: the exported printed-parts table."""
+    t = rp.load_table("chen2019-print-parts").set_index("quantity")
+    found = ["Table 4-5 caption against Table 4-5 column header", "Table 4-29 caption against Table 4-29 column header",
+             "Table 4-5 axis row against Table 4-13 axis row", "Table 4-48 PACF label against Table 3-1 PACF label",
+             "symbols of the 45-state list", "sign of the gyro C[2,2] across temperature",
+             "sign of the accelerometer C[1,1] across temperature", "volume of [55] against Navigation",
+             "volume of [62] against 中国惯性技术学报"]
+    assert (t.loc[found, "status"] == "inconsistent").all()
+    assert (t.status == "inconsistent").sum() == len(found) + 2  # Tables 4-13 and 4-21 as 4-5 and 4-29
+    assert t.loc["Table 4-44 15-state row against Table 4-50 normal-gravity column", "status"] == "qualitative"
+    assert (t[t.basis == "unstated"].status == "unverifiable").all()

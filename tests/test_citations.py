@@ -69,3 +69,28 @@ def test_chen2019_list_holds_what_an_independent_reading_found():
     assert failing == {f"reference [{n}]" for n in (21, 36, 39, 56, 59, 75, 76, 77, 78)} | {
         "citation [109]", "source of Table 1-1: caption against text", "source of Figure 3-1: caption against text"}
     assert "same work as [59]" in rows["reference [36]"]["note"]
+
+
+def test_volumes_out_of_step_with_their_journal_are_found():
+    printed = _printed([(1, "A. X[J]. Jour, 2004, 12(3): 1-2"), (2, "B. Y[J]. Jour, 2007, 15(5): 3-4"),
+                        (3, "C. Z[J]. Jour, 2005, 31(6): 5-6"), (4, "D. W[J]. Other, 2006, 32(2): 7-8"),
+                        (5, "E. V[J]. Other, 2010, 35(1): 9-10"), (6, "F. U[M]. Press, 2001.")], [])
+    rows = {r["quantity"]: r for r in C.volume_rows(printed)}
+    assert set(rows) == {"volume of [1] against Jour", "volume of [2] against Jour", "volume of [3] against Jour"}
+    assert rows["volume of [3] against Jour"]["agrees"] is False and rows["volume of [3] against Jour"]["reproduced"] == 13
+    assert rows["volume of [1] against Jour"]["agrees"] and rows["volume of [2] against Jour"]["agrees"]
+    with pytest.raises(ValueError):
+        C.volume_rows(printed, same_step=1)
+
+
+def test_entry_year_and_journal_volume_read_the_printed_form():
+    assert C.entry_year("Moritz H. Report, 1978, No.277") == 1978
+    assert C.entry_year("no year") is None
+    assert C.journal_volume("陈永冰. 影响[J]. 中国惯性技术学报, 2005, 31(6): 21 -25") == ("中国惯性技术学报", 2005, 31)
+    assert C.journal_volume("董绪荣. 影响[J]. 中国惯性技术学报, 1991, 2: 50 -55") is None
+
+
+def test_chen2019_volumes_out_of_step():
+    rows = C.volume_rows(rp.load_paper("chen2019-print-references").data)
+    bad = sorted(r["quantity"] for r in rows if not r["agrees"])
+    assert bad == ["volume of [55] against Navigation", "volume of [62] against 中国惯性技术学报"]

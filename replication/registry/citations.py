@@ -15,7 +15,12 @@ Criteria, fixed before comparing:
   only) has a :class:`difflib.SequenceMatcher` ratio of at least :data:`SAME_WORK` = 0.85; the
   function reports the largest ratio among the other pairs, so a reader sees the margin;
 * **a reversed page range**: the last ``a-b`` page range of an entry with ``b < a`` (a date such as
-  ``2008-04-30`` is not a range).
+  ``2008-04-30`` is not a range);
+* **a volume out of step with its year** (:func:`volume_rows`): the journal articles of the list
+  printed as ``[J]. <journal>, <year>, <volume>(<issue>)``, grouped by journal; a journal with one
+  volume a year has one value of year minus volume, so where at least :data:`SAME_STEP` = 2 entries
+  of a journal share that value, an entry of the same journal with another value disagrees with them;
+* **the year of an entry**: the first four-digit year 19xx or 20xx that it prints (:func:`entry_year`).
 """
 
 from __future__ import annotations
@@ -26,11 +31,17 @@ from typing import Any
 
 import pandas as pd
 
-__all__ = ["SAME_WORK", "cited_numbers", "duplicate_pairs", "reversed_pages", "reference_rows"]
+__all__ = ["SAME_WORK", "SAME_STEP", "cited_numbers", "duplicate_pairs", "entry_year", "journal_volume",
+           "reversed_pages", "reference_rows", "volume_rows"]
 
 SAME_WORK = 0.85
 """The similarity ratio from which two entries of a list are the same work (see the module docstring)."""
 
+SAME_STEP = 2
+"""How many entries of one journal must share one year minus volume before another entry is judged by it."""
+
+_JOURNAL = re.compile(r"\[J\]\.?\s*(?P<journal>[^,，\[\]]+?)\s*[,，]\s*(?P<year>(?:19|20)\d{2})\s*[,，]\s*(?P<volume>\d+)\s*\(")
+_YEAR = re.compile(r"(?<!\d)((?:19|20)\d{2})(?!\d)")
 _RANGE = re.compile(r"(\d+)\s*[-–]\s*(\d+)")
 _PAGES = re.compile(r"(?<![\d.\-–])(\d{1,5})\s*[-–]\s*(\d{1,5})(?![\d.\-–])")
 
@@ -201,4 +212,99 @@ def reference_rows(printed: pd.DataFrame) -> list[dict[str, Any]]:
                              paper_text=f"caption cites {cap}", reproduced=f"text cites {txt}", basis="parts",
                              agrees=cap == txt, note="the caption and the sentence that introduces it cite "
                              + ("the same source" if cap == txt else "different sources")))
+    return rows
+
+
+def entry_year(entry: str) -> int | None:
+    """The year an entry prints: its first four-digit 19xx or 20xx, else ``None``.
+
+    Parameters
+    ----------
+    entry : str
+        One entry of a reference list, as printed.
+
+    Returns
+    -------
+    int or None
+        The year.
+    """
+    m = _YEAR.search(str(entry))
+    return int(m[1]) if m else None
+
+
+def journal_volume(entry: str) -> tuple[str, int, int] | None:
+    """Journal, year and volume of a journal article printed ``[J]. <journal>, <year>, <volume>(<issue>)``.
+
+    Parameters
+    ----------
+    entry : str
+        One entry of a reference list, as printed.
+
+    Returns
+    -------
+    tuple or None
+        ``(journal, year, volume)``, the journal with its runs of spaces made one; ``None`` for an entry of
+        another form (a book, a thesis, an article printed with an issue but no volume).
+    """
+    m = _JOURNAL.search(str(entry))
+    if not m:
+        return None
+    return re.sub(r"\s+", " ", m["journal"]).strip(), int(m["year"]), int(m["volume"])
+
+
+def volume_rows(printed: pd.DataFrame, *, same_step: int = SAME_STEP) -> list[dict[str, Any]]:
+    """Comparison rows (``basis="parts"``): each journal article's volume against its journal's other entries.
+
+    A journal with one volume a year has one value of year minus volume.  Where at least
+    ``same_step`` entries of a journal share one such value (the step the list itself shows), each
+    entry of that journal is compared with it: the entries that share it agree, an entry with
+    another value disagrees (two printed parts of the list, so ``inconsistent``).  Journals with
+    fewer entries, or whose entries share no value, give no row: the list alone does not fix their
+    step.
+
+    Parameters
+    ----------
+    printed : pandas.DataFrame
+        The transcription (the module docstring): ``quantity``, ``value``, ``kind``, ``number``, ``line``.
+    same_step : int, optional
+        The entries that must share one year minus volume, at least 2.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.reproduction.compare`, named
+        ``"volume of [n] against <journal>"``.
+
+    Raises
+    ------
+    ValueError
+        When a column is missing or ``same_step`` is below 2.
+    """
+    need = {"quantity", "value", "kind", "number", "line"}
+    if not need <= set(printed.columns):
+        raise ValueError(f"the transcription needs the columns {sorted(need)}; it has {list(printed.columns)}")
+    if int(same_step) < 2:
+        raise ValueError(f"same_step must be at least 2 entries (one entry fixes no step); got {same_step}")
+    refs = printed[printed["kind"] == "entry"]
+    by_journal: dict[str, list[tuple[int, int, int, int]]] = {}
+    for n, entry, line in zip(refs["number"], refs["value"], refs["line"]):
+        if (jv := journal_volume(entry)) is not None:
+            by_journal.setdefault(jv[0], []).append((int(n), jv[1], jv[2], int(line)))
+    rows = []
+    for journal, items in by_journal.items():
+        steps = pd.Series([y - v for _, y, v, _ in items])
+        counts = steps.value_counts()
+        if counts.iloc[0] < same_step or (len(counts) > 1 and counts.iloc[1] == counts.iloc[0]):
+            continue
+        step = int(counts.index[0])
+        agree_with = [f"[{n}] {y}, vol. {v}" for n, y, v, _ in items if y - v == step]
+        for n, y, v, line in items:
+            ok = y - v == step
+            others = ", ".join(a for a in agree_with if not a.startswith(f"[{n}] "))
+            rows.append(dict(quantity=f"volume of [{n}] against {journal}", unit="", paper=v,
+                             paper_text=f"[{n}] {journal}, {y}, vol. {v} (seed line {line})",
+                             reproduced=y - step, basis="parts", agrees=ok,
+                             note=(f"year minus volume {y - v}, as {others}: one volume a year" if ok else
+                                   f"year minus volume {y - v}; {others} give {step}: by them the volume of {y} "
+                                   f"is {y - step}, not {v}")))
     return rows
