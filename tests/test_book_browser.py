@@ -273,11 +273,16 @@ READER_JS = r"""(args) => {
     }
   });
   // the text of the output areas, without inline code and rendered maths
-  const outputs = Array.from(art.querySelectorAll('.cell_output')).filter(shown).map(o => {
+  const outputText = tables => Array.from(art.querySelectorAll('.cell_output')).filter(shown).map(o => {
     const c = o.cloneNode(true);
-    c.querySelectorAll('code, mjx-container, .MathJax, .math, script, style').forEach(e => e.remove());
-    return c.innerText;
+    c.querySelectorAll('code, mjx-container, .MathJax, .math, script, style' + (tables ? '' : ', table'))
+      .forEach(e => e.remove());
+    document.body.appendChild(c);        // innerText of a detached element has no line breaks
+    const text = c.innerText;
+    c.remove();
+    return text;
   });
+  const outputs = outputText(true), prose = outputText(false);
   // output table cells whose column counts something
   const countCells = [];
   art.querySelectorAll('.cell_output table').forEach(t => {
@@ -292,7 +297,7 @@ READER_JS = r"""(args) => {
   const code = Array.from(art.querySelectorAll('.cell_input pre')).flatMap(p => p.innerText.split('\n'))
       .filter(l => l.length > args.maxCode);
   const page = document.scrollingElement;
-  return {broken, outputs, countCells, code, scroll: page.scrollWidth, client: page.clientWidth};
+  return {broken, outputs, prose, countCells, code, scroll: page.scrollWidth, client: page.clientWidth};
 }"""
 """What a reader of a page sees, measured: the tokens of table cells broken across lines (a number,
 a status word, or anything in code or marked ``.nowrap``: the rectangles of the token's range stand
@@ -306,7 +311,7 @@ COUNT_COLUMN = r"^(n|count|counts|number( of \w+)?|runs|rank|ranks|states|sample
 RAW_OUTPUT = {
     "a dict or a set printed as Python writes it": re.compile(r"\{'|\{\"\w"),
     "a numpy scalar's repr": re.compile(r"np\.(?:float|int|bool|str)\w*\(|np\.(?:True|False)_|\barray\(\["),
-    "a bare True/False": re.compile(r"^\s*(?:[^\n]*:\s*)?(?:True|False)\s*$", re.M),
+    "a bare True/False": re.compile(r"^[ \t]*(?:[^\n]*:[ \t]*)?(?:True|False)[ \t]*$", re.M),
     "a Python power (**) outside code and maths": re.compile(r"\w\*\*\w"),
     "a truncation marker (...)": re.compile(r"(?:^|[\s,\[(])\.\.\.(?:[\s,\])]|$)|\w\.\.\.(?:\n|$)|\[\d+ rows x \d+ columns\]"),
     "a negative zero": re.compile(r"(?<![\w.])[-\u2212]0\.0+(?![\d])(?!e[-+]?0*[1-9])"),
@@ -320,6 +325,11 @@ Python power, e.g. a sympy string); ``...`` standing alone or in a list (pandas 
 truncation, not the Unicode ellipsis of a quotation, nor the ``..`` of a range), or ending a line
 right after a word (a truncated pandas cell), or pandas' ``[n rows x m columns]``; ``-0.0`` (any
 number of zeros; not ``-0.05`` nor ``-0.0e-5``)."""
+
+
+LINE_RULES = ("a bare True/False",)
+"""Rules of :data:`RAW_OUTPUT` read on the lines of the output text outside tables (a table's row
+is a line of its cells; a boolean column of a data frame is a column, not a printed line)."""
 
 
 def _statuses() -> list[str]:
@@ -351,7 +361,8 @@ def reader_problems(m: dict) -> list[str]:
         if r["broken"]:
             out.append(f"at {width}, broken across lines: {sorted(set(r['broken']))[:5]}")
     for what, rx in RAW_OUTPUT.items():
-        hits = [mm.group(0).strip() for text in m["wide"]["outputs"] for mm in rx.finditer(text)]
+        texts = m["wide"]["prose" if what in LINE_RULES else "outputs"]
+        hits = [mm.group(0).strip() for text in texts for mm in rx.finditer(text)]
         if hits:
             out.append(f"raw output, {what}: {hits[:3]}")
     if m["wide"]["countCells"]:
