@@ -96,8 +96,10 @@ class _Visitor:
     recording per visit the requests that leave the machine, the failed requests and the
     JavaScript errors."""
 
+    SIZE = {"width": 1280, "height": 900}
+
     def __init__(self, browser):
-        self.page = browser.new_page(viewport={"width": 1280, "height": 900})
+        self.page = browser.new_page(viewport=dict(self.SIZE))
         self.external, self.failed, self.errors = [], [], []
         self.page.on("pageerror", lambda exc: self.errors.append(str(exc)))
         self.page.on("console", lambda msg: self.errors.append(msg.text) if msg.type == "error" else None)
@@ -113,7 +115,11 @@ class _Visitor:
             self.external.append(req.url)
 
     def visit(self, url: str):
-        """Load ``url`` until the network is idle; returns the page (the same tab every time)."""
+        """Load ``url`` until the network is idle, at 1280 px; returns the page (the same tab every
+        time)."""
+        if self.page.viewport_size != self.SIZE:     # left at a phone's width by the last page
+            self.page.goto("about:blank")
+            self.page.set_viewport_size(self.SIZE)
         self.external, self.failed, self.errors = [], [], []
         self.page.goto(url, wait_until="networkidle", timeout=60_000)
         return self.page
@@ -340,16 +346,11 @@ def _statuses() -> list[str]:
 
 def read_as_a_reader(page, statuses: list[str]) -> dict:
     """Measure ``page`` (loaded, maths rendered) with :data:`READER_JS` at its width and at
-    :data:`PHONE` px, and restore its viewport; returns the measures of both widths."""
+    :data:`PHONE` px; the page is left at the phone's width.  Returns the measures of both widths."""
     args = {"statuses": statuses, "maxCode": MAX_CODE, "countColumn": COUNT_COLUMN}
-    size = page.viewport_size
     wide = page.evaluate(READER_JS, args)
-    page.set_viewport_size({"width": PHONE, "height": size["height"]})
-    try:
-        phone = page.evaluate(READER_JS, args)
-    finally:
-        page.set_viewport_size(size)
-    return {"wide": wide, "phone": phone}
+    page.set_viewport_size({"width": PHONE, "height": page.viewport_size["height"]})
+    return {"wide": wide, "phone": page.evaluate(READER_JS, args)}
 
 
 def reader_problems(m: dict) -> list[str]:
@@ -409,8 +410,7 @@ def seen(server, browser):
         text = p.read_text(encoding="utf-8")
         page = tab.visit(f"{server}/{rel}")
         page.evaluate(WAIT_MATH_JS)
-        reader = reader_problems(read_as_a_reader(page, statuses))
-        r = dict(reader=reader, external=tab.external, failed=tab.failed, js_errors=tab.errors,
+        r = dict(external=tab.external, failed=tab.failed, js_errors=tab.errors,
                  raw=sorted(set(m.group(0) for m in RAW_TEX.finditer(page.evaluate(VISIBLE_TEXT_JS)))),
                  imgs=page.evaluate("Array.from(document.images).map(i => i.getAttribute('src'))"
                                     ".filter(s => s && s.includes('_images/'))"),
@@ -438,6 +438,7 @@ def seen(server, browser):
             r["repo_links"] = page.evaluate("""url => Array.from(document.querySelectorAll('a'))
                 .filter(a => a.href.replace(/\\/$/, '') === url && a.getClientRects().length > 0).length""",
                                             _repository_url())
+        r["reader"] = reader_problems(read_as_a_reader(page, statuses))    # last: leaves a phone's width
         out[rel] = r
     tab.page.close()
     return out
@@ -770,6 +771,7 @@ def test_the_reader_checks_catch_what_they_look_for(tmp_path, browser):
     with _serving(html) as url:
         page = browser.new_page(viewport={"width": 1280, "height": 900})
         for name in ("clean", "broken", "wide", "raw"):
+            page.set_viewport_size({"width": 1280, "height": 900})
             page.goto(f"{url}/{name}.html", wait_until="load", timeout=60_000)
             page.evaluate(WAIT_MATH_JS)
             found[name] = reader_problems(read_as_a_reader(page, statuses))

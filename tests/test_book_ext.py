@@ -13,7 +13,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "book" / "_ext")
 from cjk_search import SearchEnglishCJK, cjk_terms  # noqa: E402
 from figure_alt import MAX_CHARS, first_sentence  # noqa: E402
 from napoleon_scope import process_docstring  # noqa: E402
-from table_tokens import protected, split_text, status_words  # noqa: E402
+from table_tokens import protect_html, protected, split_text, status_words  # noqa: E402
 
 
 def test_first_sentence_skips_the_periods_of_abbreviations():
@@ -78,3 +78,13 @@ def test_numbers_status_words_and_ids_of_a_table_cell_are_kept_whole():
 def test_a_token_that_is_not_a_string_is_refused():
     with pytest.raises(TypeError, match="token must be a str"):
         protected(3)
+
+
+def test_the_text_cells_of_a_notebook_table_are_marked_too():
+    html = ('<table><tr><th>1.5e-05</th><td>±5/±10/±20 °/s</td><td class="x">not-reproduced</td>'
+            '<td><b>x 1</b></td></tr></table>')
+    out = protect_html(html, status_words())
+    assert ('<th><span class="nowrap">1.5e-05</span></th><td><span class="nowrap">±5/±10/±20</span> °/s</td>'
+            '<td class="x"><span class="nowrap">not-reproduced</span></td><td><b>x 1</b></td>') in out
+    with pytest.raises(TypeError, match="html must be a str"):
+        protect_html(None)

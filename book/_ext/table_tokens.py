@@ -6,7 +6,9 @@ around tokens that a reader reads and copies whole: numbers (``0.00011051871``, 
 (``chen2019-table-4-33``) and status words (``not-reproduced``).  In the HTML builds every
 whitespace-separated token of a table cell that holds a digit or is a status word is wrapped in
 ``<span class="nowrap">`` (``white-space: nowrap`` in ``_static/tables.css``); the other words
-wrap as prose (at spaces, and after the hyphen of a compound word).  A table wider than the content
+wrap as prose (at spaces, and after the hyphen of a compound word).  The tables that a notebook
+displays as HTML (a data frame, a styled frame) get the same marks in the cells that hold text only
+(:func:`protect_html`).  A table wider than the content
 column then scrolls inside its own box (tests/test_book_browser.py measures both).  The printed edition (LaTeX) is left alone.
 """
 
@@ -77,6 +79,35 @@ def split_text(text: str, statuses: frozenset[str] = frozenset()) -> list[tuple[
     return pieces
 
 
+HTML_CELL = re.compile(r"(<t[dh]\b[^>]*>)([^<]*)(</t[dh]>)")
+"""A cell of an HTML table whose content is text only."""
+
+
+def protect_html(html: str, statuses: frozenset[str] = frozenset()) -> str:
+    """``html`` with the protected tokens of its text-only table cells wrapped in
+    ``<span class="nowrap">`` (:func:`split_text`; the text is HTML-escaped already).
+
+    Parameters
+    ----------
+    html : str
+        HTML holding tables (a data frame's ``to_html``).
+    statuses : frozenset of str
+
+    Returns
+    -------
+    str
+    """
+    if not isinstance(html, str):
+        raise TypeError(f"html must be a str, not {type(html).__name__}")
+
+    def cell(m):
+        pieces = split_text(m.group(2), statuses)
+        body = "".join(f'<span class="nowrap">{t}</span>' if keep else t for t, keep in pieces)
+        return m.group(1) + body + m.group(3)
+
+    return HTML_CELL.sub(cell, html)
+
+
 def _protect_cells(app, doctree, docname):
     if app.builder.format != "html":
         return
@@ -95,6 +126,9 @@ def _protect_cells(app, doctree, docname):
                 continue
             new = [nodes.inline(s, s, classes=["nowrap"]) if p else nodes.Text(s) for s, p in pieces]
             parent.replace(text, new)
+    for raw in doctree.findall(nodes.raw):      # the HTML outputs of the notebooks
+        if "text_html" in raw["classes"] and "html" in raw.get("format", "").split() and "<table" in raw.astext():
+            raw[:] = [nodes.Text(protect_html(raw.astext(), statuses))]
 
 
 def setup(app):
