@@ -3,16 +3,22 @@
 Every page: loads without a request leaving the machine or failing, raises no JavaScript error,
 leaves no raw ``$``/LaTeX outside rendered maths, shows no figure twice, and every local link
 (with its ``#anchor``) resolves.  The status page, each part's page and one chapter per paper:
-no table wider than the content column at 1280 px (the status and reason columns visible), the
-status bars and the findings boxes present (a table with a status column must fit: data frames
-printed by a notebook may scroll).  Math renders with the local MathJax; figures decode.
-What a reader sees first: the landing page states the verdicts (the "In short" sentences of
-``book/intro.md``) and links the repository; on the register, the status page, the execution
-report and a few chapters with tables, no table or register is wider than the content column and
-the column itself does not scroll sideways (scrollWidth against clientWidth, measured), with the
-system's fonts and with the widest common ones (:data:`WIDE_FONTS`).  The execution report shows what the machine that ran the book recorded: it is also built from a
+at 1280 px no table with a status column wider than it needs to be and its status column in
+sight, the status bars and the findings boxes present.  Math renders with the local MathJax;
+figures decode.  What a reader sees first: the landing page states the verdicts (the "In short"
+sentences of ``book/intro.md``) and links the repository; on the register, the status page, the
+execution report and a few chapters with tables, no table or register is wider than the content
+column unless its numbers, status words and ids do not fit in it unbroken (then it scrolls in its
+own box), and the column itself does not scroll sideways (scrollWidth against clientWidth,
+measured), with the system's fonts and with the widest common ones (:data:`WIDE_FONTS`).  The execution report shows what the machine that ran the book recorded: it is also built from a
 record of another machine (long CPU names, run times of hours, failed and timed-out runs, 1 and 16
 cores, 69 notebooks) and measured at 1280 and 390 px, so that no check depends on who ran the book.
+Every page is also read as a reader reads it (:func:`reader_problems`), at 1280 px and on a phone
+(390 px): no number, status word or id of a table broken across lines, no raw Python output (a
+printed dict, a bare True/False, a sympy ``**``, a pandas ``...``, ``-0.0``, a count as ``12.0``),
+no code line over 88 characters, no page that scrolls sideways; a table too wide for the column
+scrolls inside its own box.  These checks are shown to catch what they look for on a small
+synthetic book (:func:`build_planted_book`).
 
 Run after the book is built (``make html-strict``); ``make test`` does both. Every request the
 pages make is recorded: any request that leaves the local server, or fails, is an error. A
@@ -96,8 +102,10 @@ class _Visitor:
     recording per visit the requests that leave the machine, the failed requests and the
     JavaScript errors."""
 
+    SIZE = {"width": 1280, "height": 900}
+
     def __init__(self, browser):
-        self.page = browser.new_page(viewport={"width": 1280, "height": 900})
+        self.page = browser.new_page(viewport=dict(self.SIZE))
         self.external, self.failed, self.errors = [], [], []
         self.page.on("pageerror", lambda exc: self.errors.append(str(exc)))
         self.page.on("console", lambda msg: self.errors.append(msg.text) if msg.type == "error" else None)
@@ -113,7 +121,11 @@ class _Visitor:
             self.external.append(req.url)
 
     def visit(self, url: str):
-        """Load ``url`` until the network is idle; returns the page (the same tab every time)."""
+        """Load ``url`` until the network is idle, at 1280 px; returns the page (the same tab every
+        time)."""
+        if self.page.viewport_size != self.SIZE:     # left at a phone's width by the last page
+            self.page.goto("about:blank")
+            self.page.set_viewport_size(self.SIZE)
         self.external, self.failed, self.errors = [], [], []
         self.page.goto(url, wait_until="networkidle", timeout=60_000)
         return self.page
@@ -161,18 +173,6 @@ def _chapter_of_each_paper() -> list[str]:
     return out
 
 
-CLIPPED_JS = """() => {
-  const art = document.querySelector('.bd-article');
-  const right = art.getBoundingClientRect().right;
-  const withStatus = t => Array.from(t.querySelectorAll('th')).some(h => h.innerText.trim() === 'status');
-  return Array.from(art.querySelectorAll('table')).filter(t => t.offsetParent !== null && withStatus(t)).map(t => {
-    const box = t.parentElement;
-    return {right: t.getBoundingClientRect().right, scroll: box.scrollWidth - box.clientWidth,
-            head: (t.tHead ? t.tHead.innerText : '').slice(0, 60)};
-  }).filter(t => t.right > right + 2 || t.scroll > 2);
-}"""
-
-
 FIGURES_JS = "Array.from(document.images).filter(i => i.src.includes('_images/')).map(i => i.naturalWidth)"
 MATHJAX_SRC_JS = "Array.from(document.scripts).map(s => s.src).filter(s => s.includes('mathjax'))"
 FINDINGS = ".admonition:has(.admonition-title:text('Findings of this chapter'))"
@@ -181,23 +181,64 @@ OVERVIEW = ["status.html"] + [f"{p}/index.html" for p in ("chen2019", "fang2020"
 WIDTH_PAGES = ["register.html", "status.html", "appendix/execution.html", "appendix/exports.html",
                "foundations/01_earth_normal_gravity.html", "chen2019/02_imu_error_model_and_calibration.html",
                "fang2020/01_polar_grid_calibration.html", "an2021/01_gravity_to_attitude.html"]
-"""Pages whose every table (registers, comparisons, the execution report) must fit at 1280 px."""
+"""Pages whose every table (registers, comparisons, the execution report) is measured at 1280 px
+(:func:`_table_problems`)."""
 
-WIDTH_JS = """() => {
+WIDTH_JS = """(withStatusOnly) => {
   const art = document.querySelector('.bd-article');
   const box = art.getBoundingClientRect();
+  const withStatus = t => Array.from(t.querySelectorAll('th')).some(h => h.innerText.trim() === 'status');
   const tables = Array.from(art.querySelectorAll('table')).filter(t => t.offsetParent !== null
-      && !t.closest('.cell_output .dataframe, .output .dataframe') && !t.classList.contains('dataframe'));
+      && !t.closest('details:not([open])')
+      && (withStatusOnly ? withStatus(t)
+          : !t.closest('.cell_output .dataframe, .output .dataframe') && !t.classList.contains('dataframe')));
   return {column: {client: art.clientWidth, scroll: art.scrollWidth, width: Math.round(box.width)},
           tables: tables.map(t => {
             const wrap = t.parentElement;
-            return {width: Math.round(t.getBoundingClientRect().width), right: t.getBoundingClientRect().right,
-                    wrapScroll: wrap.scrollWidth - wrap.clientWidth,
+            const rect = t.getBoundingClientRect();
+            const saved = t.style.width;
+            t.style.width = '1px';                 // a table is never narrower than its longest tokens
+            const narrowest = t.getBoundingClientRect().width;
+            t.style.width = saved;
+            const status = Array.from(t.tHead ? t.tHead.rows[0].cells : []).find(h => h.innerText.trim() === 'status');
+            return {width: Math.round(rect.width), right: rect.right, narrowest: Math.round(narrowest),
+                    wrapScroll: wrap.scrollWidth - wrap.clientWidth, box: wrap.clientWidth,
+                    scrolls: ['auto', 'scroll'].includes(getComputedStyle(wrap).overflowX),
+                    statusRight: status ? status.getBoundingClientRect().right : null,
+                    wrapRight: wrap.getBoundingClientRect().right,
                     head: (t.tHead ? t.tHead.innerText : t.innerText).replace(/\\s+/g, ' ').slice(0, 50)};
           }), right: box.right};
 }"""
-"""The content column's width and overflow, and each table's width and its container's overflow.
-A data frame printed by a notebook (``.dataframe``) may scroll; a table of the book may not."""
+"""The content column's width and overflow, and for each table shown (not in a closed dropdown; with
+``true``, only the tables with a status column): its width, its narrowest width (the width of its
+longest unbreakable tokens: numbers, status words, ids, see ``book/_ext/table_tokens.py``), its
+container's overflow and whether the container scrolls, and where its status column ends.  A data
+frame printed by a notebook (``.dataframe``) may scroll and is left out unless it has a status column."""
+
+
+def _table_problems(m: dict, where: str) -> list[str]:
+    """What is wrong with the tables of one measure of :data:`WIDTH_JS`: a table that is wider than
+    the content column or its own box (a box in a dropdown or a findings box is narrower) although
+    it could be narrower without breaking a token, a wide table whose
+    container does not scroll, a status column that a reader must scroll to see, or a content
+    column that scrolls sideways.  A table whose narrowest width exceeds the column scrolls inside
+    its own box: that is how a table too wide for the page is shown."""
+    out = []
+    col = m["column"]
+    if col["scroll"] > col["client"] + 1:
+        out.append(f"{where}: the content column scrolls ({col['scroll']} > {col['client']} px)")
+    for t in m["tables"]:
+        if not (t["right"] > m["right"] + 2 or t["wrapScroll"] > 2):
+            continue
+        name = f"{where}: table {t['head']!r} {t['width']} px in a {col['width']} px column"
+        if t["narrowest"] < min(col["width"], t["box"]) - 2 or t["width"] > t["narrowest"] + 2:
+            out.append(f"{name}, although it fits in {t['narrowest']} px without breaking a token")
+        if not t["scrolls"]:
+            out.append(f"{name} does not scroll inside its own box")
+        if t["statusRight"] is not None and t["statusRight"] > t["wrapRight"] + 2:
+            out.append(f"{name}: its status column is out of sight")
+    return out
+
 
 WIDE_FONTS = ("DejaVu Sans", "DejaVu Sans Mono")
 """The widest of the common fonts of a Linux system (fontconfig's defaults on Debian), for text and
@@ -209,6 +250,139 @@ WIDE_FONTS_CSS = (f":root {{ --pst-font-family-base-system: '{WIDE_FONTS[0]}', s
                   f"--pst-font-family-monospace-system: '{WIDE_FONTS[1]}', monospace !important; }}")
 
 LANDING = "intro.html"
+
+MAX_CODE = 88
+"""The longest line of an input cell a reader sees without scrolling sideways (characters)."""
+
+PHONE = 390
+"""A phone's width (CSS px): no page may scroll sideways at it."""
+
+READER_JS = r"""(args) => {
+  const art = document.querySelector('.bd-article') || document.body;
+  const statuses = new Set(args.statuses);
+  const shown = e => e.getClientRects().length > 0;
+  // a token broken across lines: the rectangles of its range stand on more than one line
+  const twoLines = (node, start, end) => {
+    const r = document.createRange(); r.setStart(node, start); r.setEnd(node, end);
+    const rects = Array.from(r.getClientRects()).filter(x => x.width > 0.5 && x.height > 0.5);
+    if (rects.length < 2) return false;
+    const firstBottom = Math.min(...rects.map(x => x.bottom));
+    return rects.some(x => x.top >= firstBottom - 1);
+  };
+  const broken = [];
+  art.querySelectorAll('td, th').forEach(cell => {
+    if (!shown(cell)) return;
+    const walk = document.createTreeWalker(cell, NodeFilter.SHOW_TEXT);
+    for (let n = walk.nextNode(); n; n = walk.nextNode()) {
+      if (n.parentElement.closest('mjx-container, .MathJax, script, style')) continue;
+      const whole = !!n.parentElement.closest('code, .nowrap');
+      const re = /\S+/g; let m;
+      while ((m = re.exec(n.textContent))) {
+        const tok = m[0];
+        const bare = tok.replace(/^[.,;:()\[\]]+|[.,;:()\[\]]+$/g, '');
+        if (!(whole || /\d/.test(tok) || statuses.has(bare))) continue;
+        if (twoLines(n, m.index, m.index + tok.length)) broken.push(tok);
+      }
+    }
+  });
+  // the text of the output areas, without inline code and rendered maths
+  const outputText = tables => Array.from(art.querySelectorAll('.cell_output')).filter(shown).map(o => {
+    const c = o.cloneNode(true);
+    c.querySelectorAll('code, mjx-container, .MathJax, .math, script, style' + (tables ? '' : ', table'))
+      .forEach(e => e.remove());
+    document.body.appendChild(c);        // innerText of a detached element has no line breaks
+    const text = c.innerText;
+    c.remove();
+    return text;
+  });
+  const outputs = outputText(true), prose = outputText(false);
+  // output table cells whose column counts something
+  const countCells = [];
+  art.querySelectorAll('.cell_output table').forEach(t => {
+    const head = t.tHead ? Array.from(t.tHead.rows).pop() : null;
+    if (!head || !t.tBodies.length) return;
+    const names = Array.from(head.cells).flatMap(h => Array(h.colSpan || 1).fill(h.innerText.trim()));
+    Array.from(t.tBodies[0].rows).forEach(row => Array.from(row.cells).forEach((cell, i) => {
+      if (new RegExp(args.countColumn, 'i').test(names[i] || '') && /^-?\d+\.0$/.test(cell.innerText.trim()))
+        countCells.push(`${names[i]}: ${cell.innerText.trim()}`);
+    }));
+  });
+  const code = Array.from(art.querySelectorAll('.cell_input pre')).flatMap(p => p.innerText.split('\n'))
+      .filter(l => l.length > args.maxCode);
+  const page = document.scrollingElement;
+  return {broken, outputs, prose, countCells, code, scroll: page.scrollWidth, client: page.clientWidth};
+}"""
+"""What a reader of a page sees, measured: the tokens of table cells broken across lines (a number,
+a status word, or anything in code or marked ``.nowrap``: the rectangles of the token's range stand
+on two lines), the text of the output areas (without inline code and rendered maths), the cells of
+output tables whose column counts something (:data:`COUNT_COLUMN`) written with a ``.0``, the
+lines of input cells longer than :data:`MAX_CODE`, and the page's width against the window's."""
+
+COUNT_COLUMN = r"^(n|count|counts|number( of \w+)?|runs|rank|ranks|states|samples|points|segments|fixes)$"
+"""Column headings of output tables whose cells are counts: a count is written whole (12, not 12.0)."""
+
+RAW_OUTPUT = {
+    "a dict or a set printed as Python writes it": re.compile(r"\{'|\{\"\w"),
+    "a numpy scalar's repr": re.compile(r"np\.(?:float|int|bool|str)\w*\(|np\.(?:True|False)_|\barray\(\["),
+    "a bare True/False": re.compile(r"^[ \t]*(?:[^\n]*:[ \t]*)?(?:True|False)[ \t]*$", re.M),
+    "a Python power (**) outside code and maths": re.compile(r"\w\*\*\w"),
+    "a truncation marker (...)": re.compile(r"(?:^|[\s,\[(])\.\.\.(?:[\s,\])]|$)|\w\.\.\.(?:\n|$)|\[\d+ rows x \d+ columns\]"),
+    "a negative zero": re.compile(r"(?<![\w.])[-\u2212]0\.0+(?![\d])(?!e[-+]?0*[1-9])"),
+}
+"""What a reader must not see in an output area.  Only the output areas are searched (never the
+prose or the code cells), without inline code and rendered maths: a ``{'`` or ``{"key`` is a printed
+dict (a set of braces in prose or a formula does not open with a quote); numpy reprs
+(``np.float64(``, ``np.True_``, ``array([``); a line that is, or ends after a colon in, ``True`` or
+``False``; ``**`` between two word characters (Markdown has made its bold by then, so one left is a
+Python power, e.g. a sympy string); ``...`` standing alone or in a list (pandas and numpy
+truncation, not the Unicode ellipsis of a quotation, nor the ``..`` of a range), or ending a line
+right after a word (a truncated pandas cell), or pandas' ``[n rows x m columns]``; ``-0.0`` (any
+number of zeros; not ``-0.05`` nor ``-0.0e-5``)."""
+
+
+LINE_RULES = ("a bare True/False", "a Python power (**) outside code and maths")
+"""Rules of :data:`RAW_OUTPUT` read on the output text outside tables: a table's row is a line of
+its cells, and a boolean column of a data frame is a column, not a printed line; the registry's
+comparison tables quote some formulas of their notes as the computer algebra writes them, a matter
+of the registry's text (its notes), not of a chapter's output."""
+
+
+def _statuses() -> list[str]:
+    from replication.registry import reproduction
+
+    return sorted(set(reproduction.STATUSES) | set(reproduction.STATUS_COLOURS))
+
+
+def read_as_a_reader(page, statuses: list[str]) -> dict:
+    """Measure ``page`` (loaded, maths rendered) with :data:`READER_JS` at its width and at
+    :data:`PHONE` px; the page is left at the phone's width.  Returns the measures of both widths."""
+    args = {"statuses": statuses, "maxCode": MAX_CODE, "countColumn": COUNT_COLUMN}
+    wide = page.evaluate(READER_JS, args)
+    page.set_viewport_size({"width": PHONE, "height": page.viewport_size["height"]})
+    return {"wide": wide, "phone": page.evaluate(READER_JS, args)}
+
+
+def reader_problems(m: dict) -> list[str]:
+    """What :func:`read_as_a_reader` found wrong: tokens broken at either width, raw Python
+    output (:data:`RAW_OUTPUT`), counts written with ``.0``, code lines over :data:`MAX_CODE`
+    characters, and a page that scrolls sideways at :data:`PHONE` px."""
+    out = []
+    for width, r in (("1280 px", m["wide"]), (f"{PHONE} px", m["phone"])):
+        if r["broken"]:
+            out.append(f"at {width}, broken across lines: {sorted(set(r['broken']))[:5]}")
+    for what, rx in RAW_OUTPUT.items():
+        texts = m["wide"]["prose" if what in LINE_RULES else "outputs"]
+        hits = [mm.group(0).strip() for text in texts for mm in rx.finditer(text)]
+        if hits:
+            out.append(f"raw output, {what}: {hits[:3]}")
+    if m["wide"]["countCells"]:
+        out.append(f"counts written as decimals: {m['wide']['countCells'][:3]}")
+    if m["wide"]["code"]:
+        out.append(f"{len(m['wide']['code'])} code lines over {MAX_CODE} characters: {m['wide']['code'][0][:60]!r}")
+    p = m["phone"]
+    if p["scroll"] > p["client"] + 1:
+        out.append(f"at {PHONE} px the page scrolls sideways ({p['scroll']} > {p['client']} px)")
+    return out
 
 
 def _in_short() -> list[str]:
@@ -238,6 +412,7 @@ def seen(server, browser):
     measured = set(WIDTH_PAGES)
     out = {}
     shot = False
+    statuses = _statuses()
     tab = _Visitor(browser)
     for p in _pages():
         rel = p.relative_to(HTML).as_posix()
@@ -259,19 +434,20 @@ def seen(server, browser):
                 page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot.png"), full_page=False)
                 shot = True
         if rel in wide:
-            r.update(clipped=page.evaluate(CLIPPED_JS), bars=page.locator(".status-bar").count(),
+            r.update(clipped=page.evaluate(WIDTH_JS, True), bars=page.locator(".status-bar").count(),
                      findings=page.locator(FINDINGS).count())
             if rel == "status.html":
                 page.screenshot(path=str(ROOT / "book" / "_build" / "screenshot-status.png"), full_page=False)
         if rel in measured:
-            r["widths_measured"] = page.evaluate(WIDTH_JS)
+            r["widths_measured"] = page.evaluate(WIDTH_JS, False)
             page.add_style_tag(content=WIDE_FONTS_CSS)     # last: the page is left in these fonts
-            r["widths_wide_fonts"] = page.evaluate(WIDTH_JS)
+            r["widths_wide_fonts"] = page.evaluate(WIDTH_JS, False)
         if rel == LANDING:
             r["text"] = _normal(page.evaluate("() => document.querySelector('.bd-article').innerText"))
             r["repo_links"] = page.evaluate("""url => Array.from(document.querySelectorAll('a'))
                 .filter(a => a.href.replace(/\\/$/, '') === url && a.getClientRects().length > 0).length""",
                                             _repository_url())
+        r["reader"] = reader_problems(read_as_a_reader(page, statuses))    # last: leaves a phone's width
         out[rel] = r
     tab.page.close()
     return out
@@ -294,20 +470,16 @@ def test_the_landing_page_states_the_verdicts_and_links_the_repository(seen):
     assert r["repo_links"] >= 1, f"no visible link to {_repository_url()} on {LANDING}"
 
 
-def test_no_table_or_register_is_wider_than_its_column(seen):
+def test_no_table_or_register_is_wider_than_it_needs_to_be(seen):
     """At 1280 px, with the system's fonts and with :data:`WIDE_FONTS`: the content column does not
-    scroll sideways, and no table of the register, the status page, the execution report or a
-    chapter is wider than it or scrolls inside it."""
+    scroll sideways, and a table of the register, the status page, the execution report or a
+    chapter is no wider than the column unless its numbers, status words and ids do not fit in it
+    unbroken; such a table scrolls inside its own box, its status column in sight
+    (:func:`_table_problems`)."""
     problems = []
     for rel, (key, fonts) in ((rel, k) for rel in WIDTH_PAGES
                               for k in (("widths_measured", ""), ("widths_wide_fonts", f" in {WIDE_FONTS[0]}"))):
-        m = seen[rel][key]
-        if m["column"]["scroll"] > m["column"]["client"] + 1:
-            problems.append(f"{rel}{fonts}: the content column scrolls ({m['column']['scroll']} > {m['column']['client']} px)")
-        for t in m["tables"]:
-            if t["right"] > m["right"] + 2 or t["wrapScroll"] > 2:
-                problems.append(f"{rel}{fonts}: table {t['head']!r} {t['width']} px in a {m['column']['width']} px "
-                                f"column (scrolls by {t['wrapScroll']} px)")
+        problems += _table_problems(seen[rel][key], f"{rel}{fonts}")
     assert any(seen[rel]["widths_measured"]["tables"] for rel in WIDTH_PAGES), "no table measured"
     assert not problems, "\n".join(problems)
 
@@ -335,13 +507,13 @@ def test_every_page_loads_offline(seen):
 
 
 def test_overview_and_chapters_fit_at_1280_px(seen):
-    """The status page, the part pages and one chapter per paper: no table clipped or scrolled at
-    1280 px; the status bars on the overview pages; a findings box at the top of each chapter."""
+    """The status page, the part pages and one chapter per paper: at 1280 px no table with a status
+    column wider than it needs to be, and its status column in sight (:func:`_table_problems`); the
+    status bars on the overview pages; a findings box at the top of each chapter."""
     problems = []
     for rel in OVERVIEW + _chapter_of_each_paper():
         r = seen[rel]
-        if r["clipped"]:
-            problems.append(f"{rel}: tables wider than the content column: {r['clipped'][:3]}")
+        problems += _table_problems(r["clipped"], rel)
         if rel in OVERVIEW and r["bars"] == 0:
             problems.append(f"{rel}: no status bar")
         if rel not in OVERVIEW and r["findings"] != 1:
@@ -515,7 +687,7 @@ def test_the_execution_report_of_another_machine_fits(another_machine, browser, 
         page.goto(f"{url}/appendix/execution.html", wait_until="load", timeout=60_000)
         if font:
             page.add_style_tag(content=WIDE_FONTS_CSS)
-        m = page.evaluate(WIDTH_JS)
+        m = page.evaluate(WIDTH_JS, False)
         r = page.evaluate(REPORT_JS)
         page.close()
     assert r["rows"] == len(record["notebooks"]) >= 60 and r["links"] == n_book > 0, r
@@ -531,3 +703,90 @@ def test_the_execution_report_of_another_machine_fits(another_machine, browser, 
     problems += [f"broken across lines: {w!r}" for w in r["broken"][:5]]
     problems += [f"machine description past the column: {li['text']!r}" for li in r["machines"] if li["right"] > m["right"] + 2]
     assert not problems, f"at {width} px{f' in {font}' if font else ''}:\n" + "\n".join(problems)
+
+
+# ---------------------------------------------------------------- what a reader sees, on every page
+
+def test_every_page_reads_like_a_paper(seen):
+    """Every page of the book, at 1280 px and at :data:`PHONE` px (:func:`reader_problems`): no
+    number, status word or id of a table broken across lines, no raw Python output in an output
+    area, no count written as a decimal, no code line over :data:`MAX_CODE` characters, and no page
+    that scrolls sideways on a phone (a wide table scrolls inside its own box)."""
+    problems = [f"{rel}: {p}" for rel, r in seen.items() for p in r["reader"]]
+    assert not problems, "\n".join(problems)
+
+
+PLANTED = {
+    "clean": ("# A page that reads well\n\n"
+              "| quantity | paper | reproduced | status | reason |\n|---|---|---|---|---|\n"
+              + "".join(f"| attitude error per mGal, case {i} | 0.000110518712{i} | -1.5e-05 | not-reproduced | "
+                        f"`chen2019-check-calibration-closed-forms-{i}` (4-3)-(4-8) differ |\n" for i in range(3))
+              + "\nA range 1 .. 2, a quotation … and -0.05 are words of prose.\n"),
+    "broken": ("# A number broken\n\n<table class=\"table\"><tbody><tr><td style=\"width: 3em; max-width: 3em; "
+               "overflow-wrap: anywhere; word-break: break-all\">0.00011051871234</td><td>ok</td></tr>"
+               "</tbody></table>\n"),
+    "wide": "# A page wider than a phone\n\n<div style=\"width: 640px; height: 2em\">a box of 640 px</div>\n",
+}
+"""Markdown pages of the synthetic book: one that must pass, one with a number broken mid-token,
+one wider than a phone."""
+
+
+def _planted_notebook():
+    """A notebook page whose stored output is a printed dict and whose code has a line of 100
+    characters."""
+    import nbformat
+
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.cells = [nbformat.v4.new_markdown_cell("# A raw dict"),
+                nbformat.v4.new_code_cell("counts = {'reproduced': 13}  # " + "x" * 70 + "\nprint(counts)",
+                                          outputs=[nbformat.v4.new_output("stream", name="stdout",
+                                                                          text="{'reproduced': 13}\n")])]
+    return nb
+
+
+def build_planted_book(tmp: Path) -> Path:
+    """A book of the pages of :data:`PLANTED` and :func:`_planted_notebook`, built with the book's
+    configuration, extensions and CSS; returns the HTML directory."""
+    import nbformat
+    import yaml
+
+    src = tmp / "book"
+    src.mkdir(parents=True)
+    for name in ("_ext", "_static", "_extra"):
+        shutil.copytree(ROOT / "book" / name, src / name, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(ROOT / "book" / "references.bib", src / "references.bib")
+    config = yaml.safe_load((ROOT / "book" / "_config.yml").read_text(encoding="utf-8"))
+    (src / "_config.yml").write_text(yaml.safe_dump(config, allow_unicode=True), encoding="utf-8")
+    for name, text in PLANTED.items():
+        (src / f"{name}.md").write_text(text, encoding="utf-8")
+    nbformat.write(_planted_notebook(), src / "raw.ipynb")
+    toc = {"format": "jb-book", "root": "clean", "chapters": [{"file": f} for f in ("broken", "wide", "raw")]}
+    (src / "_toc.yml").write_text(yaml.safe_dump(toc), encoding="utf-8")
+    r = subprocess.run([str(Path(sys.executable).parent / "jupyter-book"), "build", str(src), "--path-output",
+                        str(tmp), "--quiet"], capture_output=True, text=True, cwd=tmp)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    return tmp / "_build" / "html"
+
+
+def test_the_reader_checks_catch_what_they_look_for(tmp_path, browser):
+    """:func:`reader_problems` on a synthetic book (:func:`build_planted_book`): the clean page
+    passes (numbers, a status word and ids in a wide table, a range, an ellipsis and -0.05 in
+    prose); a number broken mid-token, a page wider than a phone, a printed dict and a code line
+    of 100 characters are each found."""
+    html = build_planted_book(tmp_path)
+    statuses = _statuses()
+    found = {}
+    with _serving(html) as url:
+        page = browser.new_page(viewport={"width": 1280, "height": 900})
+        for name in ("clean", "broken", "wide", "raw"):
+            page.set_viewport_size({"width": 1280, "height": 900})
+            page.goto(f"{url}/{name}.html", wait_until="load", timeout=60_000)
+            page.evaluate(WAIT_MATH_JS)
+            found[name] = reader_problems(read_as_a_reader(page, statuses))
+        page.close()
+    assert found["clean"] == [], found["clean"]
+    assert any("broken across lines" in p and "0.00011051871234" in p for p in found["broken"]), found["broken"]
+    assert any(f"at {PHONE} px the page scrolls sideways" in p for p in found["wide"]), found["wide"]
+    assert any("a dict" in p for p in found["raw"]), found["raw"]
+    assert any(f"over {MAX_CODE} characters" in p for p in found["raw"]), found["raw"]

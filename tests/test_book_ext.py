@@ -1,4 +1,5 @@
-"""The book's small Sphinx extensions (book/_ext): figure alt text, Chinese search terms, numpydoc scope."""
+"""The book's small Sphinx extensions (book/_ext): figure alt text, Chinese search terms, numpydoc scope,
+the tokens of table cells kept whole."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "book" / "_ext")
 from cjk_search import SearchEnglishCJK, cjk_terms  # noqa: E402
 from figure_alt import MAX_CHARS, first_sentence  # noqa: E402
 from napoleon_scope import process_docstring  # noqa: E402
+from table_tokens import protect_html, protected, split_text, status_words  # noqa: E402
 
 
 def test_first_sentence_skips_the_periods_of_abbreviations():
@@ -58,3 +60,31 @@ def test_napoleon_renders_sections_of_functions_and_leaves_constants_plain():
     process_docstring(app, "function", "m.radii", None, {}, lines)
     text = "\n".join(lines)
     assert ":Parameters: **lat** (*float*)" in text and ":returns: **r** (*float*)" in text
+
+
+def test_numbers_status_words_and_ids_of_a_table_cell_are_kept_whole():
+    statuses = status_words()
+    assert {"reproduced", "not-reproduced", "mixed"} <= statuses
+    assert protected("0.00011051871") and protected("-1.5e-05") and protected("(4-3)-(4-8)")
+    assert protected("chen2019-table-4-33") and protected("not-reproduced", statuses)
+    assert protected("reproduced;", statuses) and not protected("noise-free", statuses)
+    text = "printed 0.00011051871, not-reproduced: see chen2019-table-4-33 (noise-free)"
+    pieces = split_text(text, statuses)
+    assert "".join(p for p, _ in pieces) == text
+    assert [p for p, keep in pieces if keep] == ["0.00011051871,", "not-reproduced:", "chen2019-table-4-33"]
+    assert split_text("plain prose only", statuses) == [("plain prose only", False)]
+
+
+def test_a_token_that_is_not_a_string_is_refused():
+    with pytest.raises(TypeError, match="token must be a str"):
+        protected(3)
+
+
+def test_the_text_cells_of_a_notebook_table_are_marked_too():
+    html = ('<table><tr><th>1.5e-05</th><td>±5/±10/±20 °/s</td><td class="x">not-reproduced</td>'
+            '<td><b>x 1</b></td></tr></table>')
+    out = protect_html(html, status_words())
+    assert ('<th><span class="nowrap">1.5e-05</span></th><td><span class="nowrap">±5/±10/±20</span> °/s</td>'
+            '<td class="x"><span class="nowrap">not-reproduced</span></td><td><b>x 1</b></td>') in out
+    with pytest.raises(TypeError, match="html must be a str"):
+        protect_html(None)
