@@ -2266,59 +2266,10 @@ FINDING_REASON_STATUSES = ("not-reproduced", "analog", "unverifiable")
 
 
 def _findings_markdown(status: pd.DataFrame, notebook: str) -> str:
-    """The findings box at the top of a chapter: which of its artifacts reproduced, which did not
-    and why (the notes of their not-reproduced, analog and unverifiable rows), the errata and
-    inconsistencies found, each linked to the table that shows the evidence."""
-    root = project_root()
-    mine = status[status["notebook"].astype(str).str.split().apply(lambda ns: notebook in ns)]
-    shown = _notebook_targets(root, notebook)
+    """The findings box at the top of a chapter (:func:`replication.registry.boxes.findings_box`)."""
+    from replication.registry import boxes
 
-    def link(r):
-        tids = [t for t in str(r["tables"]).split() if t in shown]
-        name = f"{r['artifact']}" if r["kind"] == "paper" else f"check {r['id']}"
-        return f"{{ref}}`{name} <{tids[0]}>`" if tids else name
-
-    lines = [":::{admonition} Findings of this chapter", ":class: tip", ""]
-    for kind, title in (("paper", "Paper artifacts"), ("supplementary", "Supplementary checks")):
-        sub = mine[mine["kind"] == kind]
-        if sub.empty:
-            continue
-        lines.append(f"**{title}** ({len(sub)}): " + status_tally(sub)[kind].split(": ", 1)[1] + ".")
-        lines.append("")
-        ok = sub[sub["status"].isin(["reproduced", "qualitative"])]
-        if len(ok):
-            lines.append("- reproduced or checked: " + ", ".join(link(r) for _, r in ok.iterrows()))
-        for _, r in sub[~sub["status"].isin(["reproduced", "qualitative"])].iterrows():
-            notes, seen, summary = [], set(), ""
-            tids = str(r["tables"]).split()
-            tables = [read_table(tid) for tid in tids]
-            for tid in tids:
-                summary = summary or str(_sidecar(tid).get("summary") or "").strip()
-            for st in FINDING_REASON_STATUSES:  # the strongest reason first
-                for df in tables:
-                    for nt in df.loc[df["status"] == st, "note"]:
-                        key = re.sub(r"-?\d[\d.,e+-]*", "#", str(nt))  # the same reason with other numbers
-                        if nt and key not in seen:
-                            seen.add(key)
-                            notes.append(" ".join(str(nt).split()).replace("|", "/"))
-            # the table's one-line verdict (a sentence its chapter wrote) leads; every distinct reason
-            # follows in full, none cut
-            lead = summary or (notes[0] if notes else "differs from the print beyond the tolerance stated before "
-                               "comparing")
-            rest = notes if summary else notes[1:]
-            lines.append(f"- {link(r)}: **{status_label(r)}** ({_row_split(r)}) — {lead}")
-            if rest:
-                lines += [f"  - {n}" for n in rest]
-        n_e, n_i = int(sub["erratum"].sum()), int(sub["inconsistent"].sum())
-        if n_e or n_i:
-            lines.append(f"- {n_e} {'erratum' if n_e == 1 else 'errata'} and {n_i} "
-                         f"{'inconsistency' if n_i == 1 else 'inconsistencies'} recorded "
-                         "(listed in the {doc}`register </register>`)")
-        lines.append("")
-    if len(lines) == 3:
-        lines.append("This chapter exports no comparison table.")
-    lines += ["Statuses as defined on the {doc}`status page </status>`.", ":::"]
-    return "\n".join(lines) + "\n"
+    return boxes.findings_box(status, notebook)
 
 
 def findings_file(notebook: str) -> str:
