@@ -40,3 +40,47 @@ def test_polar_and_airdata_figures_refuse_unknown_kinds():
         plots.polar_error_histories(None, "heading")
     with pytest.raises(ValueError, match="quantity must be"):
         plots.airdata_error_histories(None, "attitude")
+
+
+def _degrees():
+    import pandas as pd
+
+    cols = ["before maneuver", "U-turn"]
+    printed = pd.DataFrame([[13.9, 22.5], [1e-17, 7.2], [0.5, 1e-20]], index=["a", "b", "c"], columns=cols)
+    reproduced = pd.DataFrame([[0.0, 67.3], [0.0, 3.0], [0.4, 0.003]], index=["a", "b", "c"], columns=cols)
+    return printed, reproduced
+
+
+def test_degree_heatmap_draws_both_tables_and_outlines_the_failing_cells():
+    printed, reproduced = _degrees()
+    status = {"a | before maneuver": "unverifiable", "c | U-turn": "inconsistent", "b | U-turn": "qualitative"}
+    fig = plots.degree_heatmap(printed, reproduced, status=status, reproduced_threshold={"before maneuver": 1e-6,
+                                                                                         "U-turn": 1e-4})
+    heat = [ax for ax in fig.axes if ax.images]
+    assert len(heat) == 2
+    # every cell carries its value or a dash (unobservable: round-off is not plotted as a colour)
+    assert [t.get_text() for t in heat[0].texts] == ["14", "22", "–", "7.2", "0.5", "–"]
+    assert [t.get_text() for t in heat[1].texts] == ["–", "67", "–", "3", "0.4", "0.003"]
+    outlined = [p for p in heat[0].patches if p.get_edgecolor()[:3] != (0, 0, 0)]
+    assert len(outlined) == 2 and len(heat[1].patches) == 2           # the two flagged cells, in both panels
+    with pytest.raises(ValueError, match="same states"):
+        plots.degree_heatmap(printed, reproduced.iloc[:2])
+    with pytest.raises(ValueError, match="positive"):
+        plots.degree_heatmap(printed, reproduced, printed_threshold=0.0)
+
+
+def test_side_by_side_bars_put_the_printed_value_beside_the_reproduced_one():
+    import pandas as pd
+
+    table = pd.DataFrame({"quantity": ["pitch normal", "pitch state", "height normal", "height state"],
+                          "unit": ["deg", "deg", "m", "m"], "paper": ["0.0051", "0.0030", "0.0373", "0.0318"],
+                          "reproduced": ["0.0016", "0.0015", "0.055", "0.012"],
+                          "status": ["unverifiable", "unverifiable", "analog", "reproduced"]})
+    fig = plots.side_by_side_bars(table, lambda q: tuple(q.split(" ")), intervals={"height state": (0.011, 0.013)})
+    panels = [ax for ax in fig.axes if ax.axison]
+    assert [ax.get_title() for ax in panels] == ["pitch (deg)", "height (m)"]
+    heights = [round(b.get_height(), 4) for b in panels[1].patches]
+    assert heights == [0.0373, 0.0318, 0.055, 0.012]                 # printed bars, then reproduced
+    assert len(panels[1].lines) + len(panels[1].collections) >= 1    # the interval of the Monte-Carlo mean
+    with pytest.raises(ValueError, match="missing"):
+        plots.side_by_side_bars(table.drop(columns="status"), lambda q: tuple(q.split(" ")))

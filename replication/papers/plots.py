@@ -6,22 +6,28 @@ nothing here computes a number that a table or a test uses.
 * :func:`state_estimates` — chen2019 Fig. 4-14 analog (:func:`replication.papers.chen2019.simulation.run_batch`);
 * :func:`airdata_error_histories` — duan2023 Figs. 3-5 analog (``replication.papers.duan2023.airdata.simulate``);
 * :func:`polar_error_histories`, :func:`polar_drift_estimates` — fang2020 Figs. 4-10
-  (:func:`replication.papers.fang2020.polar.simulate`).
+  (:func:`replication.papers.fang2020.polar.simulate`);
+* :func:`degree_heatmap` — chen2019 Table 2-3, printed and reproduced side by side;
+* :func:`side_by_side_bars` — any comparison table of printed numbers as bars (chen2019 Table 4-50,
+  duan2023 Table 1), the printed value beside the reproduced one.
 """
 
 from __future__ import annotations
 
 import math
+import textwrap
 
 import matplotlib.pyplot as plt
 import numpy as np
+import pandas as pd
 
 from replication.nav import units
 from replication.papers.chen2019 import simulation as sim
 from replication.papers.duan2023 import airdata as ad
 from replication.papers.fang2020 import polar
 
-__all__ = ["state_estimates", "airdata_error_histories", "polar_error_histories", "polar_drift_estimates"]
+__all__ = ["state_estimates", "airdata_error_histories", "polar_error_histories", "polar_drift_estimates",
+           "degree_heatmap", "side_by_side_bars"]
 
 
 def state_estimates(result: sim.BatchResult, run: int = 0, *, ncols: int = 5, every: int = 10):
@@ -237,3 +243,198 @@ def polar_drift_estimates(result, *, axis="X", paper_mean=None, estimators=polar
     ax.legend(fontsize=8)
     fig.tight_layout()
     return fig
+
+
+FLAG_STYLES = {"not-reproduced": ("#c62828", "-"), "inconsistent": ("#6a1b9a", "-"), "erratum": ("#6a1b9a", "--"),
+               "unverifiable": ("#ef6c00", "--"), "analog": ("#455a64", ":")}
+"""Outline colour and line style of a cell or bar whose row status is not ``reproduced`` or
+``qualitative`` (the failing part of a printed-vs-reproduced figure), the strongest first."""
+
+
+def _flag_handles(present):
+    from matplotlib.patches import Patch
+
+    return [Patch(facecolor="none", edgecolor=c, linestyle=ls, lw=1.6, label=s)
+            for s, (c, ls) in FLAG_STYLES.items() if s in present]
+
+
+def degree_heatmap(printed, reproduced, *, status=None, printed_threshold=1e-5, reproduced_threshold=None,
+                   labels=None, titles=("printed", "reproduced")):
+    """chen2019 Table 2-3 as two heat maps side by side: the printed and the reproduced observability
+    degree of each state (rows) under each maneuver (columns), on one logarithmic colour scale.
+
+    A degree at or below its verdict threshold (unobservable) is drawn grey, so that the round-off
+    of an unobservable state (printed values down to 1e-30) is not plotted as a colour; each cell
+    carries its value to two digits.  A cell whose row status (``status``) is one of
+    :data:`FLAG_STYLES` is outlined in both panels.
+
+    Parameters
+    ----------
+    printed, reproduced : pandas.DataFrame
+        Degrees, states × maneuvers, the same index and columns (``printed`` from
+        ``load_paper("chen2019-table-2-3")``, ``reproduced`` from
+        :func:`replication.papers.chen2019.observability.degrees_table`).
+    status : pandas.DataFrame or mapping, optional
+        Row status of each cell: a table of the same shape, or the stored comparison's
+        ``{quantity: status}`` with quantities ``"<label> | <maneuver>"`` (``chen2019-table-2-3``).
+    printed_threshold : float or mapping, default 1e-5
+        Verdict threshold of the printed degrees (a number, or one per column).
+    reproduced_threshold : float or mapping, optional
+        Verdict threshold of the reproduced degrees (one per column: ``degrees_table``'s
+        ``attrs["threshold"]``); default ``printed_threshold``.
+    labels : sequence of str, optional
+        Row labels (the printed symbols); default the index.
+    titles : tuple of str, default ("printed", "reproduced")
+        Titles of the two panels.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        Two panels and a colour bar of log10 of the degree.
+
+    Raises
+    ------
+    ValueError
+        If the two tables differ in shape, index or columns, or a threshold is not positive.
+    """
+    import matplotlib as mpl
+
+    if printed.shape != reproduced.shape or list(printed.index) != list(reproduced.index) or \
+            list(printed.columns) != list(reproduced.columns):
+        raise ValueError("degree_heatmap: printed and reproduced must have the same states (index) and maneuvers (columns)")
+    cols = list(printed.columns)
+    rows = list(labels) if labels is not None else [str(i) for i in printed.index]
+    if len(rows) != printed.shape[0]:
+        raise ValueError(f"degree_heatmap: {len(rows)} labels for {printed.shape[0]} states")
+    if isinstance(status, pd.DataFrame):
+        if status.shape != printed.shape:
+            raise ValueError(f"degree_heatmap: status must have the shape of the tables {printed.shape}, got {status.shape}")
+        status = {f"{rows[i]} | {c}": str(status.iat[i, j]) for i in range(len(rows)) for j, c in enumerate(cols)}
+    status = dict(status or {})
+
+    def per_column(thr):
+        thr = {c: float(thr[c]) for c in cols} if hasattr(thr, "keys") else {c: float(thr) for c in cols}
+        if min(thr.values()) <= 0:
+            raise ValueError("degree_heatmap: a verdict threshold must be positive")
+        return np.array([thr[c] for c in cols])
+
+    thr_p = per_column(printed_threshold)
+    thr_r = per_column(printed_threshold if reproduced_threshold is None else reproduced_threshold)
+    vp, vr = printed.to_numpy(float), reproduced.to_numpy(float)
+    shown = np.concatenate([vp[vp > thr_p], vr[vr > thr_r]])
+    lo, hi = np.log10(min(thr_p.min(), thr_r.min())), np.log10(shown.max()) if shown.size else 1.0
+    cmap = mpl.colormaps["viridis"].with_extremes(under="0.88")
+    norm = mpl.colors.Normalize(vmin=lo, vmax=hi)
+    n, m = printed.shape
+    fig, axs = plt.subplots(1, 2, figsize=(2.6 + 0.95 * 2 * m, 0.25 * n + 1.3), sharey=True, layout="constrained")
+    flags = set()
+    for ax, v, thr, title in zip(axs, (vp, vr), (thr_p, thr_r), titles):
+        logv = np.where(v > thr, np.log10(np.where(v > 0, v, 1.0)), lo - 1.0)
+        im = ax.imshow(logv, cmap=cmap, norm=norm, aspect="auto")
+        for i in range(n):
+            for j in range(m):
+                above = v[i, j] > thr[j]
+                light = above and norm(logv[i, j]) < 0.55
+                ax.text(j, i, f"{v[i, j]:.2g}" if above else "–", ha="center", va="center", fontsize=6,
+                        color="white" if light else "black")
+                st = status.get(f"{rows[i]} | {cols[j]}")
+                if st in FLAG_STYLES:
+                    c, ls = FLAG_STYLES[st]
+                    flags.add(st)
+                    ax.add_patch(mpl.patches.Rectangle((j - 0.47, i - 0.47), 0.94, 0.94, fill=False, edgecolor=c, ls=ls,
+                                                       lw=1.6))
+        ax.set_xticks(range(m), cols, rotation=30, ha="right", fontsize=8)
+        ax.set_title(title, fontsize=9)
+    axs[0].set_yticks(range(n), rows, fontsize=8)
+    cb = fig.colorbar(im, ax=list(axs), shrink=0.85, aspect=40, pad=0.02, extend="min")
+    cb.set_label("log10 observability degree (grey: at or below the verdict threshold)", fontsize=8)
+    if flags:
+        axs[1].legend(handles=_flag_handles(flags), fontsize=7, loc="upper left", bbox_to_anchor=(1.0, -0.02),
+                      title="row status", title_fontsize=7, frameon=False)
+    return fig
+
+
+def side_by_side_bars(table, parts, *, intervals=None, ncols=3, log=None):
+    """A comparison table as bars: for each panel (a printed component) and series (a printed
+    column), the printed value (hatched) beside the reproduced one, with its 95 % interval where
+    given; a reproduced bar whose row status is one of :data:`FLAG_STYLES` is outlined in its style.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The stored comparison (``quantity``, ``unit``, ``paper``, ``reproduced``, ``status``), as
+        ``compare``/``read_table`` give it; numbers may be text.
+    parts : callable
+        ``parts(quantity) -> (panel, series)``: e.g. ``"pitch normal"`` → ``("pitch", "normal")``.
+    intervals : mapping, optional
+        ``{quantity: (low, high)}``: the 95 % interval of a Monte-Carlo mean, drawn as an error bar.
+    ncols : int, default 3
+        Panels per row.
+    log : bool, optional
+        Logarithmic value axes; default: where a panel's values span more than a factor of 30.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        One panel per component, printed and reproduced side by side for each series.
+
+    Raises
+    ------
+    ValueError
+        If a column is missing, a value is not a positive number on a log axis, or ``ncols`` < 1.
+    """
+    need = {"quantity", "unit", "paper", "reproduced", "status"}
+    if not need <= set(table.columns):
+        raise ValueError(f"side_by_side_bars: table needs the columns {sorted(need)}; missing "
+                         f"{sorted(need - set(table.columns))}")
+    if int(ncols) < 1:
+        raise ValueError("side_by_side_bars: ncols must be at least 1")
+    rows = []
+    for _, r in table.iterrows():
+        panel, series = parts(str(r["quantity"]))
+        rows.append((panel, series, str(r["unit"]), float(r["paper"]), float(r["reproduced"]), str(r["status"]),
+                     (intervals or {}).get(r["quantity"])))
+    panels = list(dict.fromkeys(p for p, *_ in rows))
+    nrows = int(math.ceil(len(panels) / ncols))
+    fig, axs = plt.subplots(nrows, min(ncols, len(panels)), figsize=(3.0 * min(ncols, len(panels)) + 0.4, 2.7 * nrows + 0.5),
+                            squeeze=False)
+    flags = set()
+    for ax, panel in zip(axs.flat, panels):
+        mine = [r for r in rows if r[0] == panel]
+        x = np.arange(len(mine))
+        pv, rv = np.array([r[3] for r in mine]), np.array([r[4] for r in mine])
+        ax.bar(x - 0.2, pv, 0.38, color="white", edgecolor="0.25", hatch="///", lw=0.8, label="printed")
+        bars = ax.bar(x + 0.2, rv, 0.38, color="C0", lw=0, label="reproduced")
+        for b, r in zip(bars, mine):
+            if r[5] in FLAG_STYLES:
+                c, ls = FLAG_STYLES[r[5]]
+                flags.add(r[5])
+                b.set_edgecolor(c), b.set_linestyle(ls), b.set_linewidth(1.6)
+            if r[6] is not None:
+                lo_, hi_ = r[6]             # about the stored (rounded) value: never a negative length
+                ax.errorbar(b.get_x() + b.get_width() / 2, r[4], yerr=[[max(r[4] - lo_, 0.0)], [max(hi_ - r[4], 0.0)]],
+                            color="k", lw=0.9, capsize=2)
+        values = np.concatenate([pv, rv])
+        use_log = (values.max() / values.min() > 30 if values.min() > 0 else False) if log is None else bool(log)
+        if use_log:
+            if values.min() <= 0:
+                raise ValueError(f"side_by_side_bars: panel {panel!r} holds a value <= 0 on a log axis")
+            ax.set_yscale("log")
+        ax.set_xticks(x, [textwrap.fill(r[1], 12) for r in mine], fontsize=8)
+        ax.set_title(f"{panel} ({mine[0][2]})", fontsize=9)
+        ax.tick_params(axis="y", labelsize=7)
+        ax.grid(axis="y", alpha=0.3)
+    for ax in list(axs.flat)[len(panels):]:
+        ax.axis("off")
+    handles = [_patch(hatch="///"), _patch(color="C0")]
+    fig.legend(handles=handles + _flag_handles(flags), labels=["printed", "reproduced"] + [s for s in FLAG_STYLES if s in flags],
+               loc="lower center", ncol=2 + len(flags), fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    return fig
+
+
+def _patch(*, hatch=None, color="white"):
+    """A legend patch: the printed bar (``hatch``) or the reproduced one (``color``)."""
+    from matplotlib.patches import Patch
+
+    return Patch(facecolor=color, edgecolor="0.25", hatch=hatch, lw=0.8)
