@@ -84,3 +84,47 @@ def test_side_by_side_bars_put_the_printed_value_beside_the_reproduced_one():
     assert len(panels[1].lines) + len(panels[1].collections) >= 1    # the interval of the Monte-Carlo mean
     with pytest.raises(ValueError, match="missing"):
         plots.side_by_side_bars(table.drop(columns="status"), lambda q: tuple(q.split(" ")))
+
+
+def test_the_analog_figures_draw_the_printed_values_over_their_curves():
+    import pandas as pd
+
+    from replication.papers.duan2023 import airdata as ad
+
+    t = np.arange(0.0, 600.0, 60.0)
+    errors = {s: {"enu": np.full((2, t.size, 3), 100.0 * (k + 1))} for k, s in enumerate(ad.SYSTEMS)}
+    mc = ad.MonteCarlo(t=t, errors=errors, infos=[], setup=None, seed=0)
+    fig = plots.airdata_spatial_error(mc, printed={"SINS": 26.25})
+    dashed = [ln for ln in fig.axes[0].lines if ln.get_linestyle() == "--"]
+    assert [ln.get_ydata()[0] for ln in dashed] == [26.25]           # the printed value, where it was given
+    with pytest.raises(ValueError, match="unknown systems"):
+        plots.airdata_spatial_error(mc, printed={"INS": 1.0})
+
+    run = {m: {"pitch": np.array([1e-3, -2e-3]), "roll": np.array([0.0, 1e-3])} for m in ("normal", "state", "true-model")}
+    printed = pd.DataFrame({"normal": [0.0051, 0.0059], "state": [0.0030, 0.0031]}, index=["pitch", "roll"])
+    fig = plots.photo_attitude_errors(run, ["normal", "state", "true-model"], printed=printed)
+    assert len(fig.axes) == 6
+    printed_lines = [ln for ax in fig.axes for ln in ax.lines if ln.get_linestyle() == "--"]
+    assert len(printed_lines) == 4                                     # no printed line for the reference method
+    assert abs(printed_lines[0].get_ydata()[0] - 0.0051 * 3600) < 1e-9
+    with pytest.raises(ValueError, match="run lacks"):
+        plots.photo_attitude_errors(run, ["direct"])
+
+
+def test_bode_modes_draws_the_printed_edges_and_slopes():
+    from replication.papers.an2021 import transfer as tr
+
+    lat = np.radians(30.0)
+    pure = tr.gravity_to_attitude(lat, 0.0, 10.0)
+    w = np.logspace(-5, 0, 200)
+    fig = plots.bode_modes(pure, pure, w, edges={"upper edge": 0.05}, slopes={"pure": -40.0}, title="t")
+    mag = fig.axes[0]
+    guide = [ln for ln in mag.lines if ln.get_linestyle() == "--"]
+    assert len(guide) == 1
+    (w0, w1), (m0, m1) = guide[0].get_xdata(), guide[0].get_ydata()
+    assert (w0, w1) == (0.05, 0.5) and abs((m1 - m0) + 40.0) < 1e-12           # one decade at the printed slope
+    assert any(ln.get_linestyle() == ":" and ln.get_xdata()[0] == 0.05 for ln in mag.lines)
+    with pytest.raises(ValueError, match="increasing"):
+        plots.bode_modes(pure, pure, w[::-1])
+    with pytest.raises(ValueError, match="per mode"):
+        plots.bode_modes(pure, pure, w, slopes={"KF": -60.0})

@@ -4,9 +4,12 @@ Each function takes the result of a chapter's computation and returns a matplotl
 nothing here computes a number that a table or a test uses.
 
 * :func:`state_estimates` — chen2019 Fig. 4-14 analog (:func:`replication.papers.chen2019.simulation.run_batch`);
-* :func:`airdata_error_histories` — duan2023 Figs. 3-5 analog (``replication.papers.duan2023.airdata.simulate``);
+* :func:`airdata_error_histories`, :func:`airdata_spatial_error` — duan2023 Figs. 3-6 analog
+  (``replication.papers.duan2023.airdata.simulate``), Fig. 6 with the printed Table 1;
+* :func:`photo_attitude_errors` — chen2019 Figs. 4-30/4-31 analog with the printed Table 4-50;
 * :func:`polar_error_histories`, :func:`polar_drift_estimates` — fang2020 Figs. 4-10
   (:func:`replication.papers.fang2020.polar.simulate`);
+* :func:`bode_modes` — an2021 Figs. 5-6 with the printed band edges and slopes;
 * :func:`degree_heatmap` — chen2019 Table 2-3, printed and reproduced side by side;
 * :func:`side_by_side_bars` — any comparison table of printed numbers as bars (chen2019 Table 4-50,
   duan2023 Table 1), the printed value beside the reproduced one.
@@ -27,7 +30,7 @@ from replication.papers.duan2023 import airdata as ad
 from replication.papers.fang2020 import polar
 
 __all__ = ["state_estimates", "airdata_error_histories", "polar_error_histories", "polar_drift_estimates",
-           "degree_heatmap", "side_by_side_bars"]
+           "degree_heatmap", "side_by_side_bars", "airdata_spatial_error", "photo_attitude_errors", "bode_modes"]
 
 
 def state_estimates(result: sim.BatchResult, run: int = 0, *, ncols: int = 5, every: int = 10):
@@ -438,3 +441,171 @@ def _patch(*, hatch=None, color="white"):
     from matplotlib.patches import Patch
 
     return Patch(facecolor=color, edgecolor="0.25", hatch=hatch, lw=0.8)
+
+
+def airdata_spatial_error(mc: ad.MonteCarlo, *, printed=None):
+    """duan2023 Fig. 6 analog: the run mean of each system's 3-D position error (km, log axis), with
+    each system's printed Table 1 position error as a dashed line in its colour.
+
+    The chapter reads Table 1 as the maximum over the flight of the 3-axis error norm, so a printed
+    line is to be compared with the highest point of its curve.
+
+    Parameters
+    ----------
+    mc : replication.papers.duan2023.airdata.MonteCarlo
+        The Monte Carlo of the three systems (``replication.papers.duan2023.airdata.simulate``).
+    printed : mapping of str to float, optional
+        ``{system: position error (km)}`` from ``load_paper("duan2023-table-1")``; systems not
+        among ``replication.papers.duan2023.airdata.SYSTEMS`` are refused.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        One panel, time in minutes.
+
+    Raises
+    ------
+    ValueError
+        If ``printed`` names an unknown system or a value that is not positive.
+    """
+    printed = dict(printed or {})
+    unknown = set(printed) - set(ad.SYSTEMS)
+    if unknown:
+        raise ValueError(f"airdata_spatial_error: unknown systems {sorted(unknown)}; expected some of {list(ad.SYSTEMS)}")
+    if any(not float(v) > 0 for v in printed.values()):
+        raise ValueError("airdata_spatial_error: printed position errors must be positive (km, on a log axis)")
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    for sys_, c in zip(ad.SYSTEMS, ("C0", "C1", "C2")):
+        ax.plot(mc.t / 60, np.nanmean(np.linalg.norm(mc.errors[sys_]["enu"], axis=2), 0) / 1e3, color=c, label=sys_)
+        if sys_ in printed:
+            ax.axhline(float(printed[sys_]), color=c, ls="--", lw=1.0, label=f"{sys_}, printed (Table 1)")
+    ax.set_yscale("log")
+    ax.set_xlabel("time (min)")
+    ax.set_ylabel("3-D position error (km)")
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    return fig
+
+
+def photo_attitude_errors(run, methods, *, printed=None, components=("pitch", "roll"), scale=3600.0, unit="″"):
+    """chen2019 Figs. 4-30 and 4-31 analog: one panel per component (rows) and method (columns)
+    with the |error| at the photo epochs of one run, its RMS (solid) and, where the report prints
+    one, the RMS of Table 4-50 (dashed).
+
+    Parameters
+    ----------
+    run : mapping
+        ``{method: {component: errors at the photo epochs (deg)}}``, one run of
+        :func:`replication.papers.chen2019.gravity.compensation_run`.
+    methods : sequence of str
+        Methods shown, one column each.
+    printed : pandas.DataFrame, optional
+        The printed Table 4-50 (components × methods, deg), from ``load_paper``; a method it lacks
+        gets no dashed line.
+    components : tuple of str, default ("pitch", "roll")
+        Components shown, one row each.
+    scale : float, default 3600.0
+        Factor from degrees to the plotted unit.
+    unit : str, default "″"
+        The plotted unit.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        A grid of len(components) × len(methods) panels sharing both axes.
+
+    Raises
+    ------
+    ValueError
+        If a method or component is missing from ``run``.
+    """
+    missing = [(m, c) for m in methods for c in components if m not in run or c not in run[m]]
+    if missing:
+        raise ValueError(f"photo_attitude_errors: run lacks {missing[:3]}")
+    fig, axs = plt.subplots(len(components), len(methods), figsize=(1.9 * len(methods) + 0.6, 2.0 * len(components) + 0.4),
+                            sharex=True, sharey=True, squeeze=False)
+    for i, comp in enumerate(components):
+        for j, m in enumerate(methods):
+            ax = axs[i, j]
+            e = np.abs(np.asarray(run[m][comp], float)) * scale
+            ax.plot(np.arange(len(e)), e, lw=0.7, color="C0")
+            ax.axhline(float(np.sqrt(np.mean(e ** 2))), color="C0", lw=1.2, label="RMS, this run")
+            if printed is not None and comp in printed.index and m in printed.columns:
+                ax.axhline(float(printed.loc[comp, m]) * scale, color="C3", ls="--", lw=1.2, label="RMS, printed")
+            if i == 0:
+                ax.set_title(m, fontsize=9)
+            ax.tick_params(labelsize=7)
+        axs[i, 0].set_ylabel(f"{comp} |error| ({unit})", fontsize=8)
+    for ax in axs[-1]:
+        ax.set_xlabel("photo", fontsize=8)
+    handles, labels = axs[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
+    return fig
+
+
+def bode_modes(pure, integrated, omega, *, edges=None, slopes=None, title=None):
+    """an2021 Figs. 5-6: magnitude (dB) and phase of ϕ_E/g_dN and ϕ_N/g_dE (one column each) for
+    the pure inertial mode (blue) and the integrated mode (red), with what the paper reads off its
+    figures drawn over them: the band edges as dotted vertical lines and the slopes as dashed guide
+    lines over the decade above the highest edge, each starting on its mode's magnitude there.
+
+    Parameters
+    ----------
+    pure, integrated : control.StateSpace
+        The (g_dE, g_dN) → (ϕ_E, ϕ_N) systems of the two modes
+        (:func:`replication.papers.an2021.transfer.gravity_to_attitude`,
+        :func:`replication.papers.an2021.transfer.integrated_gravity_to_attitude`).
+    omega : array_like
+        Frequencies (rad/s), increasing and positive.
+    edges : mapping of str to float, optional
+        Printed band edges ``{label: ω (rad/s)}`` (``load_paper("an2021-figure-5")``).
+    slopes : mapping of str to float, optional
+        Printed slopes above the highest edge, ``{"pure": dB/dec, "integrated": dB/dec}``.
+    title : str, optional
+        Title of the figure.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        Two rows (magnitude, phase) by two columns (the two channels).
+
+    Raises
+    ------
+    ValueError
+        If ``omega`` is not positive and increasing, or ``slopes`` names another mode.
+    """
+    from replication.papers.an2021 import transfer as tr
+
+    w = np.asarray(omega, float)
+    if w.ndim != 1 or w.size < 2 or np.any(w <= 0) or np.any(np.diff(w) <= 0):
+        raise ValueError("bode_modes: omega must be positive and increasing (rad/s)")
+    slopes = dict(slopes or {})
+    if set(slopes) - {"pure", "integrated"}:
+        raise ValueError(f"bode_modes: slopes are given per mode, 'pure' or 'integrated'; got {sorted(slopes)}")
+    edges = {k: float(v) for k, v in (edges or {}).items()}
+    fig, axs = plt.subplots(2, 2, figsize=(9, 5), sharex=True)
+    for col, pair, label in zip((0, 1), tr.PAIRS, ("(a) $\\phi_E/g_{dN}$", "(b) $\\phi_N/g_{dE}$")):
+        for sys_, color, name in ((pure, "C0", "pure"), (integrated, "C3", "integrated")):
+            g = tr.frequency_response(sys_, w, pair)
+            axs[0, col].semilogx(w, 20 * np.log10(np.abs(g)), color=color, lw=1, label=name)
+            axs[1, col].semilogx(w, np.degrees(np.unwrap(np.angle(g))), color=color, lw=1)
+            if name in slopes and edges:
+                w0 = max(edges.values())
+                m0 = 20 * np.log10(np.abs(tr.frequency_response(sys_, w0, pair)))
+                axs[0, col].semilogx([w0, 10 * w0], [m0, m0 + slopes[name]], color=color, ls="--", lw=1.4,
+                                     label=f"{name}: printed {slopes[name]:g} dB/dec")
+        for lab, we in edges.items():
+            for ax in axs[:, col]:
+                ax.axvline(we, color="0.3", ls=":", lw=1.0, label=f"printed {lab}" if ax is axs[0, col] else None)
+        axs[0, col].set_title(label, fontsize=10)
+        axs[1, col].set_xlabel("$\\omega$ (rad/s)")
+    axs[0, 0].set_ylabel("magnitude (dB)")
+    axs[1, 0].set_ylabel("phase (deg)")
+    axs[0, 0].legend(fontsize=7)
+    for ax in axs.flat:
+        ax.grid(alpha=0.3, which="both")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return fig
