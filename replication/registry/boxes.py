@@ -57,17 +57,30 @@ def _pieces(text: str, seps: Sequence[str]) -> list[str]:
     return [p.strip() for p in out + [text[start:]] if p.strip()]
 
 
-def _clause(text: str, n: int = MAX_REASON) -> str:
-    """The reason a note gives, short: the clause after an ``unstated:`` label when the note has
-    one (what the print leaves out), else its first clause (cut at ". ", "; " or ": " outside
-    brackets; at ", " too when it still carries a number or is longer than ``n`` characters)."""
+REASON_WORDS = ("unpublished", "not published", "unstated", "does not print", "not printed", "prints no",
+                "does not state", "states neither", "not stated", "no reading", "lacks")
+"""Words that mark the clause of a note giving why a value cannot be checked or is not reached."""
+
+
+def _clause(text: str, n: int = MAX_REASON, why: bool = False) -> str:
+    """The reason a note gives, short.  The clause after an ``unstated:`` label when the note has one
+    (what the print leaves out); with ``why``, else the first clause holding one of
+    :data:`REASON_WORDS`; else the first clause.  Clauses are cut at ". " and "; " outside
+    brackets, then at ": " (a leading label of one or two words, "reading:", is passed over), and
+    at ", " too when the clause still carries a number or is longer than ``n`` characters."""
     t = " ".join(str(text).split()).replace("|", "/")
     clauses = _pieces(t, (". ", "; "))
     for c in clauses:
         if c.startswith("unstated: "):
             return c.rstrip(".")
-    head = _pieces(clauses[0], (": ",))[0] if clauses else t
-    if re.search(r"\d", head) or len(head) > n:
+    pick = clauses[0] if clauses else t
+    if why:
+        pick = next((c for c in clauses if any(w in c for w in REASON_WORDS)), pick)
+    parts = _pieces(pick, (": ",)) or [pick]
+    while len(parts) > 1 and len(parts[0].split()) <= 2:
+        parts = parts[1:]
+    head = parts[0]
+    if (re.search(r"\d", head) and not why) or len(head) > n:
         head = _pieces(head, (", ",))[0]
     if len(head) > n:
         head = head[:n].rsplit(" ", 1)[0]
@@ -133,7 +146,8 @@ def _render(groups: Sequence[tuple[list[str], list[str]]], limit: int) -> str:
     out, used = [], 0
     for i, (heads, tails) in enumerate(groups):
         if out and used > limit:
-            return "; ".join(out) + f"; and {len(groups) - i} more groups"
+            rest = len(groups) - i
+            return "; ".join(out) + f"; and {rest} more {'group' if rest == 1 else 'groups'}"
         part = _listed(heads, limit // 2) + (f" ({_listed(tails, limit // 2)})" if tails else "")
         out.append(part)
         used += len(part) + 2
@@ -175,10 +189,10 @@ def quantity_names(quantities: Sequence[str], limit: int = MAX_NAMES) -> str:
     return text.replace(" | ", " / ").replace("|", "/")
 
 
-def _how(notes: Sequence[str], most: int = 2) -> str:
+def _how(notes: Sequence[str], most: int = 2, why: bool = False) -> str:
     """How a group of rows fails: the ``most`` commonest reasons of their notes (:func:`_clause`;
     reasons that differ only in their numbers count as one; ties: the first)."""
-    clauses = [_clause(n) for n in notes if str(n).strip()]
+    clauses = [_clause(n, why=why) for n in notes if str(n).strip()]
     first: dict[str, str] = {}
     for c in clauses:
         first.setdefault(re.sub(r"-?\d[\d.,e+-]*", "#", c), c)
@@ -222,7 +236,7 @@ def _reason(tables: Sequence[pd.DataFrame], tids: Sequence[str]) -> str:
             return _clause(summary)
     for st in FAILING_ORDER:
         notes = [n for df in tables for n in df.loc[df["status"] == st, "note"]]
-        how = _how(notes, 1)
+        how = _how(notes, 1, why=True)
         if how:
             return how
     return "differs from the print beyond the tolerance stated before comparing"
