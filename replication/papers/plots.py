@@ -3,7 +3,8 @@
 Each function takes the result of a chapter's computation and returns a matplotlib figure;
 nothing here computes a number that a table or a test uses.
 
-* :func:`state_estimates` — chen2019 Fig. 4-14 analog (:func:`replication.papers.chen2019.simulation.run_batch`);
+* :func:`state_estimates` — chen2019 Fig. 4-14 analog (:func:`replication.papers.chen2019.simulation.run_batch`),
+  and :func:`figure_4_14_ranges`, the ranges its text prints against one run;
 * :func:`airdata_error_histories`, :func:`airdata_spatial_error` — duan2023 Figs. 3-6 analog
   (``replication.papers.duan2023.airdata.simulate``), Fig. 6 with the printed Table 1;
 * :func:`photo_attitude_errors` — chen2019 Figs. 4-30/4-31 analog with the printed Table 4-50;
@@ -30,7 +31,8 @@ from replication.papers.duan2023 import airdata as ad
 from replication.papers.fang2020 import polar
 
 __all__ = ["state_estimates", "airdata_error_histories", "polar_error_histories", "polar_drift_estimates",
-           "degree_heatmap", "side_by_side_bars", "airdata_spatial_error", "photo_attitude_errors", "bode_modes"]
+           "degree_heatmap", "side_by_side_bars", "airdata_spatial_error", "photo_attitude_errors", "bode_modes",
+           "figure_4_14_ranges"]
 
 
 def state_estimates(result: sim.BatchResult, run: int = 0, *, ncols: int = 5, every: int = 10):
@@ -104,7 +106,8 @@ def state_estimates(result: sim.BatchResult, run: int = 0, *, ncols: int = 5, ev
 def airdata_error_histories(mc: ad.MonteCarlo, quantity: str, *, scale=1.0, unit="", axes_labels=("E", "N", "U")):
     """duan2023 Figs. 3-5 analog: per axis, the run mean of each system with a ±1σ band.
 
-    One panel per axis (symmetric-log vertical scale), one curve per system of
+    One panel per axis (symmetric-log vertical scale, linear up to the power of ten above the
+    median |error| of the proposed system), one curve per system of
     ``replication.papers.duan2023.airdata.SYSTEMS``, time in minutes
     (``replication.papers.duan2023.airdata.simulate``).
 
@@ -143,7 +146,9 @@ def airdata_error_histories(mc: ad.MonteCarlo, quantity: str, *, scale=1.0, unit
             ax.plot(mc.t / 60, m, color=c, lw=1, label=sys_)
             ax.fill_between(mc.t / 60, m - sd, m + sd, color=c, alpha=0.2, lw=0)
         ax.set_ylabel(f"{lab} ({unit})")
-        ax.set_yscale("symlog", linthresh=abs(np.nanmedian(np.abs(mc.errors['proposed SINS/ADS'][quantity][:, :, i] * scale))) + 1e-12)
+        # the linear range ends at a power of ten, so that 0 and the first decade ticks stay a decade apart
+        med = abs(np.nanmedian(np.abs(mc.errors['proposed SINS/ADS'][quantity][:, :, i] * scale))) + 1e-12
+        ax.set_yscale("symlog", linthresh=10.0 ** math.ceil(math.log10(med)))
     axs[0].legend(fontsize=7, loc="upper left")
     axs[-1].set_xlabel("time (min)")
     fig.tight_layout()
@@ -608,4 +613,59 @@ def bode_modes(pure, integrated, omega, *, edges=None, slopes=None, title=None):
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
+    return fig
+
+
+def figure_4_14_ranges(result: sim.BatchResult, printed, *, run: int = 0):
+    """The ranges stated after chen2019 Fig. 4-14 against one run: per quantity (panel) and axis,
+    the |estimate| averaged over the last 1000 s, filtered (blue), smoothed (red) and true (black),
+    with the printed range shaded.
+
+    Parameters
+    ----------
+    result : replication.papers.chen2019.simulation.BatchResult
+        A 45-state run with the smoother
+        (:func:`replication.papers.chen2019.simulation.figure_4_14_estimates`).
+    printed : mapping of str to tuple of float
+        ``{quantity: (lower, upper)}`` for the quantities of
+        :data:`replication.papers.chen2019.simulation.FIGURE_4_14_QUANTITIES`, in the text's units
+        (``load_paper("chen2019-claim-figure-4-14-ranges")``, columns ``lower``, ``upper``).
+    run : int, default 0
+        The run shown.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+        One panel per quantity.
+
+    Raises
+    ------
+    ValueError
+        If a quantity is unknown, a range is not ``lower <= upper``, or ``run`` is out of range.
+    """
+    unknown = set(printed) - set(sim.FIGURE_4_14_QUANTITIES)
+    if unknown:
+        raise ValueError(f"figure_4_14_ranges: unknown quantities {sorted(unknown)}")
+    if any(not float(lo) <= float(hi) for lo, hi in printed.values()):
+        raise ValueError("figure_4_14_ranges: each printed range must be (lower, upper) with lower <= upper")
+    if not 0 <= run < result.n_runs:
+        raise ValueError(f"figure_4_14_ranges: run must lie in 0..{result.n_runs - 1}")
+    kinds = (("filtered", dict(smoothed=False), "C0", "o"), ("smoothed", dict(smoothed=True), "C3", "s"),
+             ("true", dict(truth=True), "k", "x"))
+    values = {name: sim.figure_4_14_estimates(result, **kw) for name, kw, _, _ in kinds}
+    fig, axs = plt.subplots(1, len(printed), figsize=(2.6 * len(printed) + 0.4, 3.0), squeeze=False)
+    for ax, (q, (lo, hi)) in zip(axs[0], printed.items()):
+        groups = sim.FIGURE_4_14_QUANTITIES[q]
+        labels = [f"{g[0].split('_')[0]} {a}" if len(groups) > 1 else a for g in groups for a in "xyz"]
+        ax.axhspan(float(lo), float(hi), color="C2", alpha=0.25, lw=0, label="printed range")
+        for k, (name, _, c, mk) in enumerate(kinds):
+            v = values[name][q][run]
+            ax.plot(np.arange(v.size) + (k - 1) * 0.2, v, mk, color=c, ms=4, ls="none", label=name)
+        ax.set_xticks(range(len(labels)), labels, rotation=60 if len(labels) > 3 else 0, fontsize=7)
+        ax.set_title(textwrap.fill(q, 26), fontsize=8)
+        ax.tick_params(axis="y", labelsize=7)
+        ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
+    handles, labels = axs[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     return fig
