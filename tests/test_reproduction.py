@@ -691,9 +691,10 @@ def test_findings_box_gives_one_line_per_artifact_and_marks_the_failing_part():
     mine = status[status["notebook"].str.contains(nb, regex=False)]
     for _, r in mine[mine["status"] == "mixed"].iterrows():
         line = next(l for l in box.splitlines() if r["artifact"] in l and "**mixed" in l)
-        for s in ("not-reproduced", "unverifiable", "analog"):   # each failing status names its rows
+        for s in ("not-reproduced", "unverifiable", "analog"):   # each failing status names its rows, counted once
             if int(r[s.replace("-", "_")]):
-                assert f"{int(r[s.replace('-', '_')])} {s}: " in line
+                assert f"— {s}: " in line or f"; {s}: " in line
+                assert line.count(f"{int(r[s.replace('-', '_')])} {s}") == 1
     assert box.count("errata and") == mine["kind"].nunique()     # the counts once per kind of artifact
     with pytest.raises(ValueError, match="chapter path"):
         boxes.findings_box(status, "book/chen2019")

@@ -6,7 +6,7 @@ artifacts once (paper artifacts and the package's supplementary checks apart), n
 reproduced ones on one line, and gives every other artifact one line: its status and the one
 reason.  A ``mixed`` artifact's line marks its failing part: for each failing status the rows
 that hold it (their quantities, grouped where they share a part: "height, pitch, roll (normal,
-direct, state)") and how they fail (the first clause of their notes).  The notes in full are in
+direct, state)") and how they fail (the first clause of their notes); every count is printed once.  The notes in full are in
 the tables the lines link to.
 """
 
@@ -197,12 +197,18 @@ def _how(notes: Sequence[str], most: int = 2, why: bool = False) -> str:
     for c in clauses:
         first.setdefault(re.sub(r"-?\d[\d.,e+-]*", "#", c), c)
     keys = Counter(re.sub(r"-?\d[\d.,e+-]*", "#", c) for c in clauses)
-    return "; ".join(first[k] for k, _ in keys.most_common(most))
+    kept: list[str] = []
+    for k, _ in keys.most_common():
+        c = first[k]
+        if not any(c.startswith(o) or o.startswith(c) for o in kept):   # a variant of a kept reason adds nothing
+            kept.append(c)
+    return "; ".join(kept[:most])
 
 
 def failing_part(tables: Sequence[pd.DataFrame]) -> str:
     """The failing part of an artifact: for each failing row status (:data:`FAILING_ORDER`) the
-    number of rows, their quantities (:func:`quantity_names`) and how they fail.
+    rows' quantities (:func:`quantity_names`) and how they fail (their counts are in the status
+    label the line starts with, :func:`replication.registry.reproduction.status_label`).
 
     Parameters
     ----------
@@ -212,7 +218,7 @@ def failing_part(tables: Sequence[pd.DataFrame]) -> str:
     Returns
     -------
     str
-        ``"3 not-reproduced: a, b, c (why); 2 unverifiable: d, e (why)"``, or ``""`` when no row
+        ``"not-reproduced: a, b, c (why); unverifiable: d, e (why)"``, or ``""`` when no row
         fails.
     """
     rows = pd.concat([t[["quantity", "status", "note"]] for t in tables], ignore_index=True) if tables else \
@@ -223,7 +229,7 @@ def failing_part(tables: Sequence[pd.DataFrame]) -> str:
         if sub.empty:
             continue
         how = _how(list(sub["note"]))
-        parts.append(f"{len(sub)} {st}: {quantity_names(list(sub['quantity']))}" + (f" ({how})" if how else ""))
+        parts.append(f"{st}: {quantity_names(list(sub['quantity']))}" + (f" ({how})" if how else ""))
     return "; ".join(parts)
 
 
