@@ -14,7 +14,7 @@ from replication.papers import plots
 from replication.papers.chen2019 import simulation as sim
 
 
-def test_state_estimates_has_one_panel_per_state():
+def _short_flight():
     traj = tr.generate([tr.Straight(20.0), tr.Turn(20.0, np.pi / 2)], 47 * DEG, 115 * DEG, 6000.0, speed=100.0,
                        dt=0.01)
     s = sim.SimulationSetup(imu_rate_hz=100.0, gnss_rate_hz=10.0, gyro_bias_sd=0.05 * DEG_PER_H, gyro_markov_sigma=0.0,
@@ -24,6 +24,11 @@ def test_state_estimates_has_one_panel_per_state():
                             sigma_pos=(0.05, 0.05, 0.1), sigma_vel=0.02, position_sd=(0.05, 0.05, 0.1),
                             velocity_sd=0.02, attitude_sd=(30 * ARCSEC, 30 * ARCSEC, 10 * ARCMIN), gravity_sigma=0.0,
                             lever_arm_b=(0.0, 0.0, 0.0), lever_arm_sd=0.0, flight_duration=40.0)
+    return traj, s
+
+
+def test_state_estimates_has_one_panel_per_state():
+    traj, s = _short_flight()
     m = sim.filter_model("15", s, traj.lat[0], traj.h[0])
     res = sim.run_batch(traj, s, m, n_runs=1, seed=1, options=cl.Options(record_every=5, smoother=True))
     fig = plots.state_estimates(res, every=1)
@@ -128,3 +133,19 @@ def test_bode_modes_draws_the_printed_edges_and_slopes():
         plots.bode_modes(pure, pure, w[::-1])
     with pytest.raises(ValueError, match="per mode"):
         plots.bode_modes(pure, pure, w, slopes={"KF": -60.0})
+
+
+def test_figure_4_14_ranges_shades_the_printed_range_of_each_quantity():
+    traj, s = _short_flight()
+    m = sim.filter_model("45", s, traj.lat[0], traj.h[0])
+    res = sim.run_batch(traj, s, m, n_runs=1, seed=1, options=cl.Options(record_every=5, smoother=True))
+    ranges = {"gyro total drift estimate range": (0.01, 0.02), "scale-factor estimate bound": (0.0, 2e-5)}
+    fig = plots.figure_4_14_ranges(res, ranges)
+    assert len(fig.axes) == 2
+    band = fig.axes[0].patches[0]                                     # the printed range, in data units
+    assert abs(band.get_y() - 0.01) < 1e-12 and abs(band.get_y() + band.get_height() - 0.02) < 1e-12
+    assert len(fig.axes[1].get_xticklabels()) == 6                    # gyro and accelerometer axes
+    with pytest.raises(ValueError, match="unknown quantities"):
+        plots.figure_4_14_ranges(res, {"heading": (0.0, 1.0)})
+    with pytest.raises(ValueError, match="lower <= upper"):
+        plots.figure_4_14_ranges(res, {"scale-factor estimate bound": (1.0, 0.0)})
