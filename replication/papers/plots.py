@@ -598,8 +598,8 @@ def bode_modes(pure, integrated, omega, *, edges=None, slopes=None, title=None):
             if name in slopes and edges:
                 w0 = max(edges.values())
                 m0 = 20 * np.log10(np.abs(tr.frequency_response(sys_, w0, pair)))
-                axs[0, col].semilogx([w0, 10 * w0], [m0, m0 + slopes[name]], color=color, ls="--", lw=1.4,
-                                     label=f"{name}: printed {slopes[name]:g} dB/dec")
+                axs[0, col].semilogx([w0, 10 * w0], [m0, m0 + slopes[name]], color=color, ls="--", lw=3.5, alpha=0.45,
+                                     zorder=1, label=f"{name}: printed {slopes[name]:g} dB/dec")   # under the curve
         for lab, we in edges.items():
             for ax in axs[:, col]:
                 ax.axvline(we, color="0.3", ls=":", lw=1.0, label=f"printed {lab}" if ax is axs[0, col] else None)
