@@ -149,3 +149,12 @@ def test_figure_4_14_ranges_shades_the_printed_range_of_each_quantity():
         plots.figure_4_14_ranges(res, {"heading": (0.0, 1.0)})
     with pytest.raises(ValueError, match="lower <= upper"):
         plots.figure_4_14_ranges(res, {"scale-factor estimate bound": (1.0, 0.0)})
+
+
+def test_figure_4_14_ranges_labels_every_misalignment_angle():
+    traj, s = _short_flight()
+    m = sim.filter_model("45", s, traj.lat[0], traj.h[0])
+    res = sim.run_batch(traj, s, m, n_runs=1, seed=1, options=cl.Options(record_every=5, smoother=True))
+    fig = plots.figure_4_14_ranges(res, {"misalignment estimate range": (1.0, 2.0)})
+    n = sim.figure_4_14_estimates(res)["misalignment estimate range"].shape[-1]
+    assert len(fig.axes[0].get_xticklabels()) == n                    # one label per plotted angle

@@ -656,7 +656,9 @@ def figure_4_14_ranges(result: sim.BatchResult, printed, *, run: int = 0):
     fig, axs = plt.subplots(1, len(printed), figsize=(2.6 * len(printed) + 0.4, 3.0), squeeze=False)
     for ax, (q, (lo, hi)) in zip(axs[0], printed.items()):
         groups = sim.FIGURE_4_14_QUANTITIES[q]
-        labels = [f"{g[0].split('_')[0]} {a}" if len(groups) > 1 else a for g in groups for a in "xyz"]
+        per = values["true"][q].shape[-1] // len(groups)            # components per triad: 3 axes, or 6 angles
+        names = "xyz" if per == 3 else [str(k + 1) for k in range(per)]
+        labels = [f"{g[0].split('_')[0]} {a}" if len(groups) > 1 else a for g in groups for a in names]
         ax.axhspan(float(lo), float(hi), color="C2", alpha=0.25, lw=0, label="printed range")
         for k, (name, _, c, mk) in enumerate(kinds):
             v = values[name][q][run]
