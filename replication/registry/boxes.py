@@ -221,14 +221,17 @@ def failing_part(tables: Sequence[pd.DataFrame]) -> str:
         ``"not-reproduced: a, b, c (why); unverifiable: d, e (why)"``, or ``""`` when no row
         fails.
     """
-    rows = pd.concat([t[["quantity", "status", "note"]] for t in tables], ignore_index=True) if tables else \
-        pd.DataFrame(columns=["quantity", "status", "note"])
+    cols = ["quantity", "status", "note", "basis"]
+    rows = pd.concat([t.reindex(columns=cols, fill_value="") for t in tables], ignore_index=True) if tables else \
+        pd.DataFrame(columns=cols)
     parts = []
     for st in FAILING_ORDER:
         sub = rows[rows["status"] == st]
         if sub.empty:
             continue
-        how = _how(list(sub["note"]))
+        # a claim's note first says how the claim reads (and that it holds in the print): its reason comes later
+        claims = bool((sub["basis"] == "claim").all())
+        how = _how(list(sub["note"]), 1 if claims else 2, why=claims)
         parts.append(f"{st}: {quantity_names(list(sub['quantity']))}" + (f" ({how})" if how else ""))
     return "; ".join(parts)
 
