@@ -107,7 +107,8 @@ def airdata_error_histories(mc: ad.MonteCarlo, quantity: str, *, scale=1.0, unit
     """duan2023 Figs. 3-5 analog: per axis, the run mean of each system with a ±1σ band.
 
     One panel per axis (symmetric-log vertical scale, linear up to the power of ten above the
-    median |error| of the proposed system), one curve per system of
+    median |error| of the proposed system; a linear scale where every curve stays inside that
+    range), one curve per system of
     ``replication.papers.duan2023.airdata.SYSTEMS``, time in minutes
     (``replication.papers.duan2023.airdata.simulate``).
 
@@ -140,15 +141,20 @@ def airdata_error_histories(mc: ad.MonteCarlo, quantity: str, *, scale=1.0, unit
         raise ValueError("quantity must be 'phi', 'v' or 'enu'")
     fig, axs = plt.subplots(3, 1, figsize=(7, 6.5), sharex=True)
     for ax, i, lab in zip(axs, range(3), axes_labels):
+        top = 0.0
         for sys_, c in zip(ad.SYSTEMS, ("C0", "C1", "C2")):
             a = mc.errors[sys_][quantity][:, :, i] * scale
             m, sd = np.nanmean(a, 0), np.nanstd(a, 0)
             ax.plot(mc.t / 60, m, color=c, lw=1, label=sys_)
             ax.fill_between(mc.t / 60, m - sd, m + sd, color=c, alpha=0.2, lw=0)
+            top = max(top, float(np.nanmax(np.abs(m) + sd)))
         ax.set_ylabel(f"{lab} ({unit})")
-        # the linear range ends at a power of ten, so that 0 and the first decade ticks stay a decade apart
+        # the linear range ends at a power of ten, so that 0 and the first decade ticks stay a decade apart;
+        # a panel whose curves stay inside it is drawn linear
         med = abs(np.nanmedian(np.abs(mc.errors['proposed SINS/ADS'][quantity][:, :, i] * scale))) + 1e-12
-        ax.set_yscale("symlog", linthresh=10.0 ** math.ceil(math.log10(med)))
+        linthresh = 10.0 ** math.ceil(math.log10(med))
+        if top > linthresh:
+            ax.set_yscale("symlog", linthresh=linthresh)
     axs[0].legend(fontsize=7, loc="upper left")
     axs[-1].set_xlabel("time (min)")
     fig.tight_layout()
