@@ -686,3 +686,32 @@ def test_claim_rows_declare_their_basis():
         book.claim_row(printed, q, holds="yes", rests_on=["x"], note="n")
     u = book.unstated_claim_row(printed, q, note="the print lacks x")
     assert u["basis"] == "unstated" and "status" not in u
+
+
+def test_findings_box_gives_one_line_per_artifact_and_marks_the_failing_part():
+    from replication.registry import boxes
+
+    # quantities that share a part are grouped; a long list is counted, never cut inside a name
+    assert boxes.quantity_names(["height normal", "height direct", "pitch normal", "pitch direct"]) == \
+        "height, pitch (normal, direct)"
+    assert boxes.quantity_names(["a | U-turn", "b | U-turn", "c"]) == "a, b (U-turn); c"
+    long = boxes.quantity_names([f"quantity number {i} of many" for i in range(40)], limit=60)
+    assert long.endswith("more") and "…" not in long
+    with pytest.raises(ValueError, match="at least one row"):
+        boxes.quantity_names([])
+    # the reason a note gives: after an "unstated:" label, else its first clause, brackets closed
+    assert boxes._clause("simulated flight, 14 runs; unstated: the field size; more") == "unstated: the field size"
+    assert boxes._clause("eqs. (4)-(6) tilt the attitude; then more") == "eqs. (4)-(6) tilt the attitude"
+    status, _ = rp.build_index(write=False)
+    nb = "book/chen2019/06_gravity_compensation_experiment.ipynb"
+    box = boxes.findings_box(status, nb)
+    mine = status[status["notebook"].str.contains(nb, regex=False)]
+    for _, r in mine[mine["status"] == "mixed"].iterrows():
+        line = next(l for l in box.splitlines() if r["artifact"] in l and "**mixed" in l)
+        for s in ("not-reproduced", "unverifiable", "analog"):   # each failing status names its rows, counted once
+            if int(r[s.replace("-", "_")]):
+                assert f"— {s}: " in line or f"; {s}: " in line
+                assert line.count(f"{int(r[s.replace('-', '_')])} {s}") == 1
+    assert box.count("errata and") == mine["kind"].nunique()     # the counts once per kind of artifact
+    with pytest.raises(ValueError, match="chapter path"):
+        boxes.findings_box(status, "book/chen2019")
