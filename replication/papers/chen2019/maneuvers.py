@@ -18,10 +18,10 @@ import numpy as np
 
 from replication.nav import earth
 from replication.nav import trajectory as tr
-from replication.papers.chen2019 import scenarios
 from replication.nav._validate import finite, integer, positive
 from replication.nav.rotations import body_rate_from_euler_rates, euler_to_dcm
 from replication.nav.trajectory import Trajectory
+from replication.papers.chen2019 import scenarios
 from replication.papers.chen2019.observability import _trajectory, segment_bounds
 
 __all__ = ["CHEN2019_MANEUVERS", "Maneuver", "chen2019_maneuvers", "unbanked", "coordinated",
