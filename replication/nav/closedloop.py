@@ -29,13 +29,14 @@ of one is the single-run filter.  The lead's pass records per epoch what the oth
 follow on other threads, chunk by chunk, while the lead goes on: the result does not depend on
 the number of threads.
 
-:func:`run` is the driver (chunks, threads, records, smoother); :func:`build_spec` bundles the
-configuration of an :class:`replication.nav.errors.ErrorModel` and the row kinds;
-:func:`chunk_inputs` and :func:`array_inputs` build its inputs.  The public entry points are
-:func:`replication.nav.kalman.closed_loop` (one run), :func:`replication.nav.kalman.monte_carlo`,
-:func:`replication.papers.chen2019.simulation.run_batch` (chen2019 §4.2),
-:func:`replication.papers.chen2019.gravity.augmented_filter` (chen2019 eq. (3-18)) and
-``replication.papers.duan2023.airdata.literature_filter``.
+The one public entry point is :func:`replication.nav.filter.run_filter` (used by
+:func:`replication.nav.kalman.closed_loop`, :func:`replication.nav.kalman.monte_carlo`,
+:func:`replication.papers.chen2019.simulation.run_batch`,
+:func:`replication.papers.chen2019.gravity.augmented_filter` and
+``replication.papers.duan2023.airdata.literature_filter``); here :func:`run` is the engine's
+driver (chunks, threads, records, smoother), :func:`build_spec` bundles the configuration of an
+:class:`replication.nav.errors.ErrorModel` and the measurements, :func:`chunk_inputs` and
+:func:`array_inputs` build its inputs.
 """
 
 from __future__ import annotations
@@ -53,15 +54,26 @@ from numba import njit
 from replication.nav import _kernels as K
 from replication.nav._validate import choice, covariance, finite_array, integer, numeric
 from replication.nav.errors import ErrorModel
+from replication.nav.measurements import (
+    CTX_FACC,
+    CTX_LEVER,
+    CTX_N,
+    CTX_PHAT,
+    CTX_RATE,
+    CTX_ST,
+    CTX_VACC,
+    Measurement,
+    compile_residual,
+    compile_rows,
+    ctx_size,
+    ctx_window,
+)
 from replication.nav.measurements.airdata import AirHeight, Airspeed
 from replication.nav.measurements.gnss import GnssPosition, GnssVelocity
 from replication.nav.measurements.specific_force import SpecificForce
-from replication.nav.measurements import (CTX_FACC, CTX_LEVER, CTX_N, CTX_PHAT, CTX_RATE, CTX_ST, CTX_VACC,
-                                          Measurement, compile_residual, compile_rows, ctx_size, ctx_window)
 
-__all__ = ["Options", "Smoother", "GnssRows", "resolve_options", "Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state",
-           "Records", "run", "filter_chunk", "rts_chunk", "mbf_chunk", "chunk_inputs", "array_inputs",
-           "counting_inputs", "MAX_MEASUREMENTS"]
+# the public entry point is replication.nav.filter.run_filter; the engine's bundles stay here
+__all__ = ["Options", "Smoother", "GnssRows", "FilterResult", "resolve_options", "MAX_MEASUREMENTS"]
 
 _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
@@ -115,7 +127,7 @@ class Options:
     store_nav : bool or None
         Keep the IMU-rate solution; run's default False.
     store_P : bool or None
-        Keep the covariance at the recorded epochs (``Records.P``; its diagonal is always kept);
+        Keep the covariance at the recorded epochs (``FilterResult.P``; its diagonal is always kept);
         run's default True.
     workers : int or None
         Threads for the runs that follow the lead (≥ 1; results do not depend on it); run's
@@ -1384,7 +1396,7 @@ def _split(bs: BatchState, sl) -> BatchState:
 # ----------------------------------------------------------------------------- driver
 
 @dataclass
-class Records:
+class FilterResult:
     """Outputs of :func:`run` at the recorded epochs (R runs × recorded epochs unless noted).
 
     Attributes
@@ -1463,11 +1475,11 @@ def _record_positions(n_ep: int, record_every: int):
 
 
 def _new_records(spec: Spec, rec_ep, R: int, n: int, n_ep: int, n_steps: int, store_P: bool,
-                 store_nav: bool) -> Records:
-    """Empty :class:`Records` for ``R`` runs of ``n`` states at the recorded epochs ``rec_ep``."""
+                 store_nav: bool) -> FilterResult:
+    """Empty :class:`FilterResult` for ``R`` runs of ``n`` states at the recorded epochs ``rec_ep``."""
     n_aug = n - 9
     m_rec = len(rec_ep)
-    return Records(epochs=rec_ep, st=np.empty((R, m_rec, 6)), q=np.empty((R, m_rec, 4)),
+    return FilterResult(epochs=rec_ep, st=np.empty((R, m_rec, 6)), q=np.empty((R, m_rec, 4)),
                    p_hat=np.empty((R, m_rec, n_aug)), nis=np.empty((R, m_rec)), innov=np.zeros((R, m_rec, spec.m_max)),
                    nees=np.full((R, m_rec), np.nan) if spec.nees else None,
                    P=np.empty((m_rec, n, n)) if store_P else None,
@@ -1596,7 +1608,7 @@ def _checkpoint(plan: _ChunkPlan, state: BatchState, row0):
     return ck, row0[1]
 
 
-def _forward_pass(plan: _ChunkPlan, state: BatchState, lead: LeadState, res: Records, smoother: bool):
+def _forward_pass(plan: _ChunkPlan, state: BatchState, lead: LeadState, res: FilterResult, smoother: bool):
     """The filter over every chunk, pipelined, into ``res``; returns the smoother's checkpoints and innovations.
 
     The lead runs chunk c while the followers finish chunk c − 1 and the inputs of chunk c + 1 are
@@ -1637,7 +1649,7 @@ def _forward_pass(plan: _ChunkPlan, state: BatchState, lead: LeadState, res: Rec
 def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *,
         lead_inputs: Callable[[int, int, int, np.ndarray], ChunkInputs] | None = None,
-        options: Options | None = None) -> Records:
+        options: Options | None = None) -> FilterResult:
     """Run the closed-loop filter of ``spec`` over ``n_steps`` IMU steps for the runs of ``state``.
 
     Parameters
@@ -1691,7 +1703,7 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     return res
 
 
-def _collect(res: Records, j0, j1, o, rec_pos, spec, k0):
+def _collect(res: FilterResult, j0, j1, o, rec_pos, spec, k0):
     """Copy one chunk's outputs at the recorded epochs into ``res`` (and its IMU-rate solution
     from step ``k0`` when it is kept)."""
     sel = o.flag >= 0
@@ -1713,7 +1725,7 @@ def _collect(res: Records, j0, j1, o, rec_pos, spec, k0):
         res.nav_q[:, k0:k0 + o.nav_q.shape[1]] = o.nav_q
 
 
-def _smooth(res: Records, chunks, replay, innov, rec_pos, R, n, m_rec, with_cov, rts):
+def _smooth(res: FilterResult, chunks, replay, innov, rec_pos, R, n, m_rec, with_cov, rts):
     """Smoother pass: chunks replayed (``replay(chunk)``, newest first) ahead on other threads
     while the backward recursion runs over the chunk replayed before: :func:`mbf_chunk` on the
     lead's records and the forward pass's innovations ``innov`` (per chunk; the lead's replays

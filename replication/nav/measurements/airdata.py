@@ -6,8 +6,7 @@ import math
 
 import numpy as np
 
-from replication.nav.measurements import (CTX_PHAT, CTX_ST, Measurement, compile_residual, compile_rows, state_column,
-                                          variances)
+from replication.nav.measurements import CTX_PHAT, CTX_ST, Measurement, compile_residual, compile_rows, state_column, variances
 
 __all__ = ["AirHeight", "Airspeed"]
 

@@ -6,8 +6,7 @@ import math
 
 import numpy as np
 
-from replication.nav.measurements import (CTX_PHAT, CTX_ST, Measurement, compile_residual, compile_rows, state_column,
-                                          variances)
+from replication.nav.measurements import CTX_PHAT, CTX_ST, Measurement, compile_residual, compile_rows, state_column, variances
 
 __all__ = ["BaroHeight", "pressure_height", "ISA_P0", "ISA_T0", "ISA_LAPSE", "ISA_R", "ISA_G0"]
 

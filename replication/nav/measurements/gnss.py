@@ -7,8 +7,17 @@ import math
 import numpy as np
 
 from replication.nav import _kernels as K
-from replication.nav.measurements import (CTX_LEVER, CTX_RATE, CTX_ST, ENC_START, ENC_TARGET, Measurement,
-                                          compile_residual, compile_rows, variances)
+from replication.nav.measurements import (
+    CTX_LEVER,
+    CTX_RATE,
+    CTX_ST,
+    ENC_START,
+    ENC_TARGET,
+    Measurement,
+    compile_residual,
+    compile_rows,
+    variances,
+)
 
 __all__ = ["GnssPosition", "GnssVelocity"]
 

@@ -7,8 +7,18 @@ import numpy as np
 
 from replication.nav import _kernels as K
 from replication.nav._validate import finite_array
-from replication.nav.measurements import (CTX_FACC, CTX_N, CTX_VACC, ENC_SIZE, ENC_START, ENC_TARGET, Measurement,
-                                          compile_residual, compile_rows, ctx_window)
+from replication.nav.measurements import (
+    CTX_FACC,
+    CTX_N,
+    CTX_VACC,
+    ENC_SIZE,
+    ENC_START,
+    ENC_TARGET,
+    Measurement,
+    compile_residual,
+    compile_rows,
+    ctx_window,
+)
 
 __all__ = ["SpecificForce"]
 
