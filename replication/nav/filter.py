@@ -14,7 +14,7 @@ by the Van Loan series; sequential Joseph updates; feedback) for one run or a ba
 * ``initial`` — the initial navigation state(s);
 * ``epochs`` — the IMU sample index of each filter epoch.
 
-It returns a :class:`FilterResult`: states, attitude, accumulated estimates, covariances,
+It returns a :class:`replication.nav.closedloop.FilterResult`: states, attitude, accumulated estimates, covariances,
 residuals, NIS/NEES and, with ``Options(smoother=...)``, the smoothed errors and covariances.
 """
 
@@ -164,13 +164,13 @@ def run_filter(model, measurements, imu, initial, epochs, *, P0=None, lever_arm=
     lever_arm : (3,) array_like
         Antenna lever arm in use, body frame, m (the GNSS rows; a lever-arm block corrects it).
     vertical : Vertical, optional
-        A held or damped vertical channel (free by default).
+        A held or damped vertical channel (:class:`Vertical`; free by default).
     ar : tuple (T, Q, ticks), optional
         A discrete transition (n × n) and its noise applied at the epochs where ``ticks`` (E,) is 1.
     truth : tuple, optional
         (true states (E × 6), quaternions (E × 4), augmented states (R × E × (n − 9))) for the NEES.
     options : Options, optional
-        Records, chunks, smoother, threads, series order (:class:`Options`).
+        Records, chunks, smoother, threads, series order (:class:`replication.nav.closedloop.Options`).
     progress : object, optional
         A bar with ``update(k)`` advanced by the IMU steps filtered.
 

@@ -40,7 +40,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from replication.nav._validate import finite_array
 
-__all__ = ["Measurement", "ROWS_SIGNATURE", "RESIDUAL_SIGNATURE", "compile_rows", "compile_residual",
+__all__ = ["Measurement", "variances", "state_column", "ROWS_SIGNATURE", "RESIDUAL_SIGNATURE", "compile_rows", "compile_residual",
            "CTX_ST", "CTX_LEVER", "CTX_RATE", "CTX_FACC", "CTX_VACC", "CTX_N", "CTX_PHAT", "ctx_size", "ctx_window",
            "ENC_TARGET", "ENC_KIND", "ENC_START", "ENC_SIZE"]
 
