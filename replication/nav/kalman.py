@@ -664,7 +664,7 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     opt = CL.resolve_options(options, dict(store_nav=True, store_P=False, workers=1))
     if opt.smoother is not None or opt.record_every != 1:
         raise ValueError("closed_loop records every epoch and has no smoother (options.smoother, options.record_every): "
-                         "chen2019.simulation.run_batch has both")
+                         "replication.nav.filter.run_filter has both")
     P0 = model.P0() if P0 is None else covariance(P0, "P0", model.n)
     R_pos = _gnss_noise(gnss.sigma_pos, "gnss.sigma_pos")
     R_vel = _gnss_noise(gnss.sigma_vel, "gnss.sigma_vel")
@@ -946,7 +946,8 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     if others:
         raise ValueError(f"monte_carlo puts only the constant accel_bias and gyro_bias into the simulated data; the "
                          f"model's other blocks {others} would be estimated against truths the data do not carry "
-                         "(use a model_15 model here; chen2019.simulation.run_batch simulates the extended models)")
+                         "(use a model_15 model here, or simulate the extended model's errors and call "
+                         "replication.nav.filter.run_filter)")
     _nees_prior(model.P0(), model, "model.P0()")
     n = traj.n
     _reference(vertical.h_ref, "h_ref", n + 1), _reference(vertical.vu_ref, "vu_ref", n + 1)
