@@ -59,7 +59,7 @@ def _measurement(x, st_hat, C_hat, lever_used, w_eb):
 
 @pytest.mark.parametrize("lever", [(0.0, 0.0, 0.0), (0.4, -1.2, 2.5)])
 def test_gnss_rows_are_the_jacobian_of_the_antenna_measurement(lever):
-    """chen2019 eq. (2-13): H of the GNSS row kinds (:func:`replication.nav._kernels.gnss_position_rows`,
+    """chen2019 eq. (2-13): H of the GNSS measurements (:func:`replication.nav._kernels.gnss_position_rows`,
     :func:`replication.nav._kernels.gnss_velocity_rows`: position and velocity at the
     antenna, lever-arm state columns) equals the central-difference Jacobian of the nonlinear
     measurement, column-relative difference < 1e-6 (steps 1e-7 of each state's scale: the

@@ -7,12 +7,12 @@ increments (chen2019 eq. (2-10)) and the strapdown of ``replication.nav._kernels
 ``replication.nav._kernels.build_F_core`` plus the sensor-block couplings C_b^n B(u) — both
 averaged over the interval's IMU steps (F is affine in them, so this is the interval mean of F)
 — gives (Φ, Q_d) by the Van Loan series; P⁻ = Φ P Φᵀ + Q_d; the measurement rows come from the
-*row kinds* in use (:data:`ROW_KINDS`): each kind writes its rows of H and their variances, and
-its residuals, in one place (``_kind_rows``, ``_kind_residuals``), chosen by a kind code the
-compiled loop dispatches on — GNSS antenna position and velocity with the lever arm (chen2019
-eq. (2-13), ``replication.nav._kernels.gnss_position_rows`` and ``gnss_velocity_rows``), the
-specific force of chen2019 eq. (3-18), the air-data height and airspeed (duan2023 refs. [15-17]
-as read by ``replication.papers.duan2023.airdata.literature_filter``); the update is the
+*measurements* in use (:mod:`replication.nav.measurements`): each is a value supplying two
+compiled kernels of one signature, its rows of H with their variances and its residuals, which
+the compiled loop calls in turn through a tuple of first-class functions and never names — GNSS
+antenna position and velocity with the lever arm (chen2019 eq. (2-13)), the specific force of
+chen2019 eq. (3-18), the air-data height and airspeed, a zero-velocity update, a barometric
+height, or an aid of the caller's own module; the update is the
 Joseph form one (independent) measurement at a time; then the navigation errors are fed back and
 the sensor-error estimates accumulated.  Optional: a vertical channel held or damped
 (:mod:`replication.nav.strapdown`), discrete AR transitions of a gravity block at chosen epochs, the
@@ -29,13 +29,14 @@ of one is the single-run filter.  The lead's pass records per epoch what the oth
 follow on other threads, chunk by chunk, while the lead goes on: the result does not depend on
 the number of threads.
 
-:func:`run` is the driver (chunks, threads, records, smoother); :func:`build_spec` bundles the
-configuration of an :class:`replication.nav.errors.ErrorModel` and the row kinds;
-:func:`chunk_inputs` and :func:`array_inputs` build its inputs.  The public entry points are
-:func:`replication.nav.kalman.closed_loop` (one run), :func:`replication.nav.kalman.monte_carlo`,
-:func:`replication.papers.chen2019.simulation.run_batch` (chen2019 §4.2),
-:func:`replication.papers.chen2019.gravity.augmented_filter` (chen2019 eq. (3-18)) and
-``replication.papers.duan2023.airdata.literature_filter``.
+The one public entry point is :func:`replication.nav.filter.run_filter` (used by
+:func:`replication.nav.kalman.closed_loop`, :func:`replication.nav.kalman.monte_carlo`,
+:func:`replication.papers.chen2019.simulation.run_batch`,
+:func:`replication.papers.chen2019.gravity.augmented_filter` and
+``replication.papers.duan2023.airdata.literature_filter``); here :func:`run` is the engine's
+driver (chunks, threads, records, smoother), :func:`build_spec` bundles the configuration of an
+:class:`replication.nav.errors.ErrorModel` and the measurements, :func:`chunk_inputs` and
+:func:`array_inputs` build its inputs.
 """
 
 from __future__ import annotations
@@ -53,10 +54,26 @@ from numba import njit
 from replication.nav import _kernels as K
 from replication.nav._validate import choice, covariance, finite_array, integer, numeric
 from replication.nav.errors import ErrorModel
+from replication.nav.measurements import (
+    CTX_FACC,
+    CTX_LEVER,
+    CTX_N,
+    CTX_PHAT,
+    CTX_RATE,
+    CTX_ST,
+    CTX_VACC,
+    Measurement,
+    compile_residual,
+    compile_rows,
+    ctx_size,
+    ctx_window,
+)
+from replication.nav.measurements.airdata import AirHeight, Airspeed
+from replication.nav.measurements.gnss import GnssPosition, GnssVelocity
+from replication.nav.measurements.specific_force import SpecificForce
 
-__all__ = ["Options", "Smoother", "GnssRows", "resolve_options", "Spec", "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state",
-           "Records", "run", "filter_chunk", "rts_chunk", "mbf_chunk", "chunk_inputs", "array_inputs",
-           "counting_inputs", "ROW_KINDS"]
+# the public entry point is replication.nav.filter.run_filter; the engine's bundles stay here
+__all__ = ["Options", "Smoother", "GnssRows", "FilterResult", "resolve_options", "MAX_MEASUREMENTS"]
 
 _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
@@ -110,7 +127,7 @@ class Options:
     store_nav : bool or None
         Keep the IMU-rate solution; run's default False.
     store_P : bool or None
-        Keep the covariance at the recorded epochs (``Records.P``; its diagonal is always kept);
+        Keep the covariance at the recorded epochs (``FilterResult.P``; its diagonal is always kept);
         run's default True.
     workers : int or None
         Threads for the runs that follow the lead (≥ 1; results do not depend on it); run's
@@ -236,8 +253,8 @@ class GnssRows:
 
 
 Spec = namedtuple("Spec", ["fconst", "qc", "q_accel", "q_gyro", "tg", "kd", "bs", "bz", "order", "dyn_rows",
-                           "rows", "row_R", "row_col", "row_aux", "m_max", "lever0", "vmode", "gains",
-                           "ar_T", "ar_Q", "sf_H", "use_pbar", "nees"])
+                           "meas_rows", "meas_residual", "n_meas", "meas_par", "meas_off", "meas_width", "enc",
+                           "m_max", "lever0", "vmode", "gains", "ar_T", "ar_Q", "use_pbar", "nees"])
 Spec.__doc__ = """Configuration of the filter (a numba-compatible bundle), built by :func:`build_spec`.
 
 Attributes
@@ -252,14 +269,18 @@ order : int
     Order of the Van Loan series.
 dyn_rows : (k,) ndarray of int
     The augmented states (index − 9) with dynamics.
-rows : (kinds,) ndarray of int
-    Codes of the measurement row kinds in use (:data:`ROW_KINDS`), in the order of their rows.
-row_R : (kinds, 3) ndarray
-    Per kind, the variances of its rows (unused entries zero).
-row_col : (kinds,) ndarray of int
-    Per kind, the error state modelling its measurement error (−1: none).
-row_aux : (kinds,) ndarray of int
-    Per kind, its column of ``ChunkInputs.aux`` (−1: none).
+meas_rows, meas_residual : tuple of compiled functions
+    The ``rows`` and ``residual`` kernels of the measurements in use
+    (:mod:`replication.nav.measurements`), in the order of their rows, padded to
+    :data:`MAX_MEASUREMENTS` (one compiled loop for any set of aids).
+n_meas : int
+    The number of measurements in use.
+meas_par : (MAX_MEASUREMENTS, p) ndarray
+    Per measurement, its constants (``Measurement.parameters``).
+meas_off, meas_width : (MAX_MEASUREMENTS,) ndarray of int
+    Per measurement, its first column and number of columns in ``ChunkInputs.obs``.
+enc : (4, blocks) ndarray of int
+    The block encoding ``tg``, ``kd``, ``bs``, ``bz`` as the measurement kernels take it.
 m_max : int
     The most measurement rows of an epoch.
 lever0 : (3,) ndarray
@@ -270,17 +291,14 @@ gains : (3,) ndarray
     Gains of the damped vertical channel.
 ar_T, ar_Q : (n, n) ndarray
     Discrete AR transition and its noise, applied at the ``ChunkInputs.ar_tick`` epochs.
-sf_H : (3, n − 9) ndarray
-    Gravity columns of the specific-force rows (chen2019 eq. (3-18)).
 use_pbar : bool
     Also propagate the covariance without measurements.
 nees : bool
     Compute the NEES against the truth of the inputs.
 """
 
-ChunkInputs = namedtuple("ChunkInputs", ["dt", "dth", "dvv", "h_ref", "vu_ref", "ep_step", "gpos", "gvel",
-                                         "sf_w", "sf_win", "sf_end", "sf_a", "sf_R", "ar_tick",
-                                         "truth_st", "truth_q", "truth_p", "aux"])
+ChunkInputs = namedtuple("ChunkInputs", ["dt", "dth", "dvv", "h_ref", "vu_ref", "ep_step", "obs",
+                                         "sf_w", "sf_win", "sf_end", "ar_tick", "truth_st", "truth_q", "truth_p"])
 ChunkInputs.__doc__ = """Inputs of one chunk of K IMU steps and E epochs for R runs, built by :func:`chunk_inputs`.
 
 Attributes
@@ -293,22 +311,18 @@ h_ref, vu_ref : (K + 1,) ndarray
     Vertical references of a held or damped vertical channel, m and m/s.
 ep_step : (E,) ndarray of int
     The step after which each epoch falls.
-gpos, gvel : (R, E, 3) ndarray
-    GNSS fixes [L, λ, h] (rad, m) and ENU velocities (m/s).
+obs : (R, E, D) ndarray
+    Per run and epoch, the measured values of every measurement (columns ``Spec.meas_off``).
 sf_w, sf_win : (K,) ndarray
     Per step, its weight in its specific-force window and the window's id (−1: none).
 sf_end : (E,) ndarray of int
     Per epoch, the id of the window ending there (−1: none).
-sf_a, sf_R : (windows, 3) ndarray
-    Per window, the GNSS acceleration (m/s²) and the variances of its rows ((m/s²)²).
 ar_tick : (E,) ndarray of int
     1 at the epochs of a discrete AR step.
 truth_st, truth_q : (E, 6), (E, 4) ndarray
     True navigation state and attitude quaternion at the epochs (for the NEES).
 truth_p : (R, E, n − 9) ndarray
     True augmented states.
-aux : (R, E, k) ndarray
-    Measured values of the kinds of ``build_spec(rows=...)`` (m, m/s).
 """
 
 BatchState = namedtuple("BatchState", ["st", "st_prev", "q", "p_hat", "lever", "g_extra", "dth_cp", "dv_cp",
@@ -397,145 +411,65 @@ rec_x : (R, E, n) ndarray
 """
 
 
-# ----------------------------------------------------------------------------- measurement row kinds
+# ----------------------------------------------------------------------------- measurements
 
-#: The measurement row kinds of the filter: name → (code, number of rows).  Each kind writes, in
-#: one place, its rows of H and their variances for the lead (``_kind_rows``) and its residuals
-#: for every run (``_kind_residuals``); :func:`build_spec` lists the kinds a filter uses, in
-#: the order of their rows, and the compiled loop dispatches on the code.  A new kind is an entry
-#: here and one branch in each of the two functions (and its test).
-ROW_KINDS = {"gnss_position": (0, 3), "gnss_velocity": (1, 3), "specific_force": (2, 3), "air_height": (3, 1),
-             "airspeed": (4, 1)}
-ROW_GNSS_POSITION = ROW_KINDS["gnss_position"][0]
-ROW_GNSS_VELOCITY = ROW_KINDS["gnss_velocity"][0]
-ROW_SPECIFIC_FORCE = ROW_KINDS["specific_force"][0]
-ROW_AIR_HEIGHT = ROW_KINDS["air_height"][0]
-ROW_AIRSPEED = ROW_KINDS["airspeed"][0]
+#: The most measurements of one filter: the kernel tuples of :class:`Spec` are padded to this length
+#: with kernels that write no row, so one compiled loop serves every set of aids.
+MAX_MEASUREMENTS = 8
+
+
+@compile_rows
+def _no_rows(par, data, ctx, c, enc, H, Rd, r):
+    """No rows (the padding of the kernel tuples)."""
+    return 0
+
+
+@compile_residual
+def _no_residual(par, data, ctx, c, z, m):
+    """No residuals (the padding of the kernel tuples)."""
+    return 0
 
 
 @njit(inline="always", **_NJ)
-def _specific_force_rows(H, r, facc, Cw, sf_H, tg, bs, bz):
-    """Rows r..r+2 of H for the specific-force measurement of chen2019 eq. (3-18): the window
-    mean of C_b^n f^b minus the GNSS acceleration = f^n × φ + C_b^n ∇ − δg^n: attitude columns
-    (f^n×) at the window mean ``facc``, accelerometer-block columns the window means ``Cw`` of
-    C_b^n B(f^b) (rows 0-2), gravity columns ``sf_H``."""
-    n_aug = sf_H.shape[1]
+def _fill_context(ctx, st, lever, wx, wy, wz, n):
+    """The epoch context's navigation part (:mod:`replication.nav.measurements`, ``CTX_*``): state,
+    lever arm in use, ω_eb^b and the number of error states."""
+    for i in range(6):
+        ctx[CTX_ST + i] = st[i]
     for i in range(3):
-        for jj in range(n_aug):
-            H[r + i, 9 + jj] = sf_H[i, jj]
-    H[r + 0, 7] = -facc[2]
-    H[r + 0, 8] = facc[1]
-    H[r + 1, 6] = facc[2]
-    H[r + 1, 8] = -facc[0]
-    H[r + 2, 6] = -facc[1]
-    H[r + 2, 7] = facc[0]
-    for b in range(tg.shape[0]):
-        if tg[b] == K.TARGET_ACCEL:
-            for i in range(3):
-                for jj in range(bz[b]):
-                    H[r + i, bs[b] + jj] += Cw[i, bs[b] + jj]
+        ctx[CTX_LEVER + i] = lever[i]
+    ctx[CTX_RATE] = wx
+    ctx[CTX_RATE + 1] = wy
+    ctx[CTX_RATE + 2] = wz
+    ctx[CTX_N] = n
 
 
 @njit(inline="always", **_NJ)
-def _kind_rows(rows, row_R, row_col, sf, sf_R, facc, Cw, sf_H, tg, bs, bz, c, lever, wx, wy, wz, st, H, Rd):
-    """The lead's measurement rows of one epoch: for each kind of ``rows`` (codes of
-    :data:`ROW_KINDS`, in order) its rows of H (zero on entry) and their variances ``Rd``; returns
-    the number of rows written.
-
-    The arguments are the arrays the kinds read, passed one by one (arrays, not a bundle) rather
-    than as the configuration bundles (a compiled helper that receives a bundle takes a reference to each of
-    its arrays, which costs more per epoch than the rows themselves): per kind its variances
-    ``row_R`` and error-state column ``row_col`` (−1: none); the specific-force window ending at
-    the epoch ``sf`` (−1: none), its variances ``sf_R`` and the lead's window sums ``facc``,
-    ``Cw``, the gravity columns ``sf_H``; the block encoding ``tg``, ``bs``, ``bz``; the lead's
-    C_b^n ``c``, lever arm in use, ω_eb^b (``wx``, ``wy``, ``wz``) and navigation state ``st``
-    [L, λ, h, v_E, v_N, v_U].
-
-    GNSS position and velocity at the antenna: chen2019 eqs. (3-17), (2-13)
-    (``replication.nav._kernels.gnss_position_rows``, ``gnss_velocity_rows``); specific force:
-    chen2019 eq. (3-18); air-data height ĥ − h_ADS = δh − b_h; airspeed |v̂| − V_TAS =
-    (v̂/|v̂|)·δv − b_V (b the kind's error state, if any)."""
+def _measurement_rows(kernels, n_meas, par, off, width, obs, ctx, c, enc, H, Rd, data):
+    """The lead's rows of one epoch: each measurement's ``rows`` kernel in turn (its constants
+    ``par[i]``, its values ``obs[off[i]:off[i] + width[i]]`` copied to ``data``); returns the
+    number of rows written into ``H`` (zero on entry) and ``Rd``.  Twelve arguments: the kernels,
+    their configuration (four arrays of :class:`Spec`), the run's values, the context and the
+    outputs — arrays, not a bundle (see :func:`_lead_time_update`)."""
     r = 0
-    for i in range(rows.shape[0]):
-        kind = rows[i]
-        if kind == ROW_GNSS_POSITION:
-            K.gnss_position_rows(H, r, c, lever, st[0], st[2], tg, bs)
-            for a in range(3):
-                Rd[r + a] = row_R[i, a]
-            r += 3
-        elif kind == ROW_GNSS_VELOCITY:
-            K.gnss_velocity_rows(H, r, c, lever, wx, wy, wz, tg, bs)
-            for a in range(3):
-                Rd[r + a] = row_R[i, a]
-            r += 3
-        elif kind == ROW_SPECIFIC_FORCE:
-            if sf >= 0:
-                _specific_force_rows(H, r, facc, Cw, sf_H, tg, bs, bz)
-                for a in range(3):
-                    Rd[r + a] = sf_R[sf, a]
-                r += 3
-        elif kind == ROW_AIR_HEIGHT or kind == ROW_AIRSPEED:
-            if kind == ROW_AIR_HEIGHT:
-                H[r, 2] = 1.0
-            else:
-                vn = math.sqrt(st[3] * st[3] + st[4] * st[4] + st[5] * st[5])
-                for a in range(3):
-                    H[r, 3 + a] = st[3 + a] / vn
-            if row_col[i] >= 0:
-                H[r, row_col[i]] = -1.0
-            Rd[r] = row_R[i, 0]
-            r += 1
+    for i in range(n_meas):
+        o = off[i]
+        for k in range(width[i]):
+            data[k] = obs[o + k]
+        r += kernels[i](par[i], data, ctx, c, enc, H, Rd, r)
     return r
 
 
 @njit(inline="always", **_NJ)
-def _kind_residuals(rows, row_col, row_aux, sf, sf_a, vacc, gpos, gvel, aux, p_hat, c, lever, wx, wy, wz, st, z):
-    """One run's residuals of one epoch (measured by the INS minus measured by the aid, with the
-    accumulated estimates applied), the rows of :func:`_kind_rows` in the same order; returns the
-    number of rows written.
-
-    The arguments are the arrays the kinds read (arrays, not a bundle: see :func:`_kind_rows` for
-    why one by one): the
-    kinds ``rows``, per kind its error-state column ``row_col`` and its column of the measured
-    values ``aux`` (``row_aux``); the specific-force window ``sf`` (−1: none), the GNSS
-    accelerations ``sf_a`` and the run's window sum of the INS acceleration ``vacc`` (reset here);
-    the run's GNSS fix ``gpos`` [L, λ, h] and velocity ``gvel``, its accumulated estimates
-    ``p_hat``, its C_b^n ``c``, lever arm in use, ω_eb^b and navigation state ``st``."""
+def _measurement_residuals(kernels, n_meas, par, off, width, obs, ctx, c, z, data):
+    """One run's residuals of one epoch, each measurement's ``residual`` kernel in turn, the rows of
+    :func:`_measurement_rows` in the same order; returns the number written."""
     m = 0
-    for i in range(rows.shape[0]):
-        kind = rows[i]
-        if kind == ROW_GNSS_POSITION:
-            rm, rn = K.radii_s(st[0])
-            h = st[2]
-            la0 = c[0, 0] * lever[0] + c[0, 1] * lever[1] + c[0, 2] * lever[2]
-            la1 = c[1, 0] * lever[0] + c[1, 1] * lever[1] + c[1, 2] * lever[2]
-            la2 = c[2, 0] * lever[0] + c[2, 1] * lever[1] + c[2, 2] * lever[2]
-            z[m + 0] = (st[1] - gpos[1]) * (rn + h) * math.cos(st[0]) + la0
-            z[m + 1] = (st[0] - gpos[0]) * (rm + h) + la1
-            z[m + 2] = (st[2] - gpos[2]) + la2
-            m += 3
-        elif kind == ROW_GNSS_VELOCITY:
-            cx = wy * lever[2] - wz * lever[1]
-            cy = wz * lever[0] - wx * lever[2]
-            cz = wx * lever[1] - wy * lever[0]
-            for a in range(3):
-                z[m + a] = st[3 + a] + c[a, 0] * cx + c[a, 1] * cy + c[a, 2] * cz - gvel[a]
-            m += 3
-        elif kind == ROW_SPECIFIC_FORCE:
-            if sf >= 0:
-                for a in range(3):
-                    z[m + a] = vacc[a] - sf_a[sf, a]
-                    vacc[a] = 0.0
-                m += 3
-        elif kind == ROW_AIR_HEIGHT or kind == ROW_AIRSPEED:
-            if kind == ROW_AIR_HEIGHT:
-                v = st[2] - aux[row_aux[i]]
-            else:
-                v = math.sqrt(st[3] * st[3] + st[4] * st[4] + st[5] * st[5]) - aux[row_aux[i]]
-            if row_col[i] >= 0:
-                v += p_hat[row_col[i] - 9]
-            z[m] = v
-            m += 1
+    for i in range(n_meas):
+        o = off[i]
+        for k in range(width[i]):
+            data[k] = obs[o + k]
+        m += kernels[i](par[i], data, ctx, c, z, m)
     return m
 
 
@@ -721,8 +655,9 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
 
     The runs advance one GNSS interval at a time (``_run_steps``); at each epoch the lead's time
     update (``_lead_time_update``), the sensor-error estimates carried by Φ, the lead's
-    measurement rows by kind (``_kind_rows``) and its sequential Joseph update (``_lead_gains``),
-    then every run's residuals by kind (``_kind_residuals``), correction, feedback and records.
+    measurement rows (``_measurement_rows``: each measurement's kernel) and its sequential Joseph
+    update (``_lead_gains``), then every run's residuals (``_measurement_residuals``),
+    correction, feedback and records.
 
     The epoch is written inline and its helpers take arrays, not the bundles: a compiled helper
     that receives a bundle takes a reference to each of its arrays, and splitting the epoch into
@@ -786,6 +721,9 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
     e = np.empty(n)
     tmp = np.empty(max(n_dyn, n))
     hz = np.empty(n, np.int64)
+    ctx = np.zeros(ctx_size(n))
+    cw = ctx_window(n)
+    dbuf = np.zeros(max(inp.obs.shape[2], 1))
     Ta = np.ascontiguousarray(spec.ar_T[9:, 9:])
     store_nav = out.nav_st.shape[1] > 0
     record = out.rec_Phi.shape[0] > 0
@@ -854,8 +792,14 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
                     for jj in range(n):
                         H[i, jj] = 0.0
                 wx, wy, wz = _body_rate(batch.dth_cp[0], T, c, batch.st[0], w_ie, w_en)
-                m = _kind_rows(spec.rows, spec.row_R, spec.row_col, sf, inp.sf_R, lead.facc, lead.Cw, spec.sf_H,
-                               spec.tg, spec.bs, spec.bz, c, batch.lever[0], wx, wy, wz, batch.st[0], H, Rd)
+                _fill_context(ctx, batch.st[0], batch.lever[0], wx, wy, wz, n)
+                for i in range(3):
+                    ctx[CTX_FACC + i] = lead.facc[i]
+                for i in range(6):
+                    for jj in range(n):
+                        ctx[cw + i * n + jj] = lead.Cw[i, jj]
+                m = _measurement_rows(spec.meas_rows, spec.n_meas, spec.meas_par, spec.meas_off, spec.meas_width,
+                                      inp.obs[0, j], ctx, c, spec.enc, H, Rd, dbuf)
                 gains.m[j] = m
                 _lead_gains(lead.P, H, m, Rd, gains.Kg[j], gains.s[j], tmp, hz)
                 for a in range(m):
@@ -877,8 +821,17 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
                 lev_r = batch.lever[r]
                 K.q2c(q_r, c)
                 wx, wy, wz = _body_rate(batch.dth_cp[r], T, c, st_r, w_ie, w_en)
-                _kind_residuals(spec.rows, spec.row_col, spec.row_aux, sf, inp.sf_a, batch.vacc[r], inp.gpos[r, j],
-                                inp.gvel[r, j], inp.aux[r, j], ph_r, c, lev_r, wx, wy, wz, st_r, z)
+                _fill_context(ctx, st_r, lev_r, wx, wy, wz, n)
+                for i in range(3):
+                    ctx[CTX_VACC + i] = batch.vacc[r, i]
+                for i in range(n_aug):
+                    ctx[CTX_PHAT + i] = ph_r[i]
+                _measurement_residuals(spec.meas_residual, spec.n_meas, spec.meas_par, spec.meas_off,
+                                       spec.meas_width, inp.obs[r, j], ctx, c, z, dbuf)
+                if sf >= 0:
+                    # the window ending here is used: the next one starts from zero
+                    for i in range(3):
+                        batch.vacc[r, i] = 0.0
                 for i in range(n):
                     xk[i] = 0.0
                 nis = 0.0
@@ -1267,20 +1220,85 @@ def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov,
 
 # ----------------------------------------------------------------------------- configuration
 
+#: Columns of ``ChunkInputs.obs`` when :func:`chunk_inputs` packs its ``gnss``, ``windows`` and ``aux``
+#: arguments: GNSS position, GNSS velocity, the specific-force values, then the one-row aids of
+#: ``build_spec(rows=...)``.
+_PACKED_POS, _PACKED_VEL, _PACKED_SF, _PACKED_AUX = 0, 3, 6, 13
+
+_ONE_ROW_AIDS = {"air_height": AirHeight, "airspeed": Airspeed}
+
+
+def _packed_measurements(model, gnss: GnssRows, rows, sf_H):
+    """The measurements of ``build_spec(gnss=..., rows=..., sf_H=...)`` and their columns in the
+    ``obs`` that :func:`chunk_inputs` packs."""
+    meas, offs = [], []
+    if gnss.R_pos is not None:
+        meas.append(GnssPosition(np.diag(gnss.R_pos)))
+        offs.append(_PACKED_POS)
+    if gnss.R_vel is not None:
+        meas.append(GnssVelocity(np.diag(gnss.R_vel)))
+        offs.append(_PACKED_VEL)
+    meas.append(SpecificForce(sf_H))           # rows only at the epochs where a window ends
+    offs.append(_PACKED_SF)
+    for k, entry in enumerate(rows):
+        if len(entry) != 3:
+            raise ValueError(f"rows[{k}] must be (kind, state column or None, variance), got {entry!r}")
+        kind, col, var = entry
+        choice(kind, tuple(_ONE_ROW_AIDS), f"rows[{k}] kind")
+        col = None if col is None else integer(col, f"rows[{k}] state column", 9)
+        var = float(numeric(var, f"rows[{k}] variance"))
+        if not (np.isfinite(var) and var > 0):
+            raise ValueError(f"rows[{k}] variance must be positive and finite, got {var!r}")
+        meas.append(_ONE_ROW_AIDS[kind](var, col))
+        offs.append(_PACKED_AUX + k)
+    if not (gnss.R_pos is not None or gnss.R_vel is not None or len(rows)):
+        raise ValueError("use at least one measurement: GNSS position (GnssRows.R_pos), velocity (R_vel) or a kind of "
+                         "rows")
+    return tuple(meas), offs
+
+
+def _measurement_spec(model, measurements, offsets):
+    """The measurement fields of :class:`Spec`: the kernel tuples (padded), constants, columns, m_max."""
+    measurements = tuple(measurements)
+    if not 1 <= len(measurements) <= MAX_MEASUREMENTS:
+        raise ValueError(f"use 1..{MAX_MEASUREMENTS} measurements, got {len(measurements)}")
+    for k, mz in enumerate(measurements):
+        if not isinstance(mz, Measurement) or type(mz).rows_kernel is None or type(mz).residual_kernel is None:
+            raise TypeError(f"measurements[{k}] must be a replication.nav.measurements.Measurement with its two "
+                            f"kernels, got {type(mz).__name__}")
+    if offsets is None:
+        offsets = np.cumsum([0] + [mz.width for mz in measurements])[:-1]
+    pars = [np.asarray(mz.parameters(model), float).ravel() for mz in measurements]
+    par = np.zeros((MAX_MEASUREMENTS, max([1] + [len(p) for p in pars])))
+    for k, p in enumerate(pars):
+        par[k, :len(p)] = p
+    pad = MAX_MEASUREMENTS - len(measurements)
+    off = np.zeros(MAX_MEASUREMENTS, np.int64)
+    off[:len(offsets)] = offsets
+    width = np.zeros(MAX_MEASUREMENTS, np.int64)
+    width[:len(measurements)] = [mz.width for mz in measurements]
+    # the kernels are class attributes (a compiled function read from an instance binds to it)
+    return (tuple(type(mz).rows_kernel for mz in measurements) + (_no_rows,) * pad,
+            tuple(type(mz).residual_kernel for mz in measurements) + (_no_residual,) * pad, len(measurements), par, off,
+            width, int(sum(mz.size for mz in measurements)))
+
+
 def build_spec(model: ErrorModel, *, gnss: GnssRows | None = None, rows=(), vmode: int = 0, gains=(0.0, 0.0, 0.0),
-               ar=None, sf_H=None, nees: bool = False, options: Options | None = None) -> Spec:
+               ar=None, sf_H=None, nees: bool = False, options: Options | None = None, measurements=None) -> Spec:
     """The filter's configuration for ``model``.
 
-    The measurement rows, in this order: GNSS antenna position and velocity (chen2019 eqs. (3-17),
-    (2-13)), the specific-force rows of chen2019 eq. (3-18) at the epochs where a window ends, then
-    the kinds of ``rows``.
+    The measurements, in the order of their rows: ``measurements`` (objects of
+    :mod:`replication.nav.measurements`, their values in ``ChunkInputs.obs`` side by side in
+    this order), or else the ones the other arguments name, in the layout :func:`chunk_inputs`
+    packs: GNSS antenna position and velocity (chen2019 eqs. (3-17), (2-13)), the specific-force
+    rows of chen2019 eq. (3-18) at the epochs where a window ends, then the one-row aids of ``rows``.
 
     Parameters
     ----------
     model : ErrorModel
         The error-state model (15 states or any extension, :mod:`replication.nav.errors`).
     gnss : GnssRows, optional
-        The GNSS position and velocity rows and the lever arm (none by default).
+        The lever arm and, without ``measurements``, the GNSS position and velocity rows.
     vmode : int
         Vertical channel: 0 free, 1 held, 2 damped with ``gains`` (:mod:`replication.nav.strapdown`).
     gains : (3,) array_like
@@ -1290,15 +1308,17 @@ def build_spec(model: ErrorModel, *, gnss: GnssRows | None = None, rows=(), vmod
     sf_H : (3, n - 9) array_like, optional
         Gravity columns of the specific-force rows (chen2019 eq. (3-18)).
     rows : sequence of (str, int or None, float)
-        Further one-row kinds of :data:`ROW_KINDS` (``"air_height"``, ``"airspeed"``): the kind,
-        the error state its measurement error is modelled by (column of ``model``, or None) and
-        the variance of its white noise (m², (m/s)²).  The k-th entry reads its measured values
-        from column k of ``ChunkInputs.aux``.
+        Further one-row aids (``"air_height"``, ``"airspeed"``): the kind, the error state its
+        measurement error is modelled by (column of ``model``, or None) and the variance of its
+        white noise (m², (m/s)²).  The k-th entry reads its measured values from column k of the
+        ``aux`` of :func:`chunk_inputs`.
     nees : bool
         Compute the NEES against the truth of the inputs.
     options : Options, optional
         Its ``series_order`` (order of the Van Loan series for (Φ, Q_d)) and ``prior_covariance``
         (also propagate the covariance without measurements).
+    measurements : sequence of Measurement, optional
+        The aids (at most :data:`MAX_MEASUREMENTS`); replaces ``rows`` and the GNSS rows of ``gnss``.
 
     Returns
     -------
@@ -1312,38 +1332,11 @@ def build_spec(model: ErrorModel, *, gnss: GnssRows | None = None, rows=(), vmod
         raise TypeError(f"gnss must be a closedloop.GnssRows, got {type(gnss).__name__}")
     opt = resolve_options(options)
     n = model.n
-    kinds, row_R, row_col, row_aux = [], [], [], []
-    for name, M in (("R_pos", gnss.R_pos), ("R_vel", gnss.R_vel)):      # checked by GnssRows
-        if M is None:
-            continue
-        kinds.append(ROW_GNSS_POSITION if name == "R_pos" else ROW_GNSS_VELOCITY)
-        row_R.append(np.diag(M).astype(float))
-        row_col.append(-1)
-        row_aux.append(-1)
-    kinds.append(ROW_SPECIFIC_FORCE)          # present only at the epochs where a window ends
-    row_R.append(np.zeros(3))
-    row_col.append(-1)
-    row_aux.append(-1)
-    for k, entry in enumerate(rows):
-        if len(entry) != 3:
-            raise ValueError(f"rows[{k}] must be (kind, state column or None, variance), got {entry!r}")
-        kind, col, var = entry
-        choice(kind, tuple(name for name, (_, size) in ROW_KINDS.items() if size == 1), f"rows[{k}] kind")
-        col = -1 if col is None else integer(col, f"rows[{k}] state column", 9)
-        if col >= n:
-            raise ValueError(f"rows[{k}] state column must be one of the model's augmented states 9..{n - 1}, got {col}")
-        var = float(numeric(var, f"rows[{k}] variance"))
-        if not (np.isfinite(var) and var > 0):
-            raise ValueError(f"rows[{k}] variance must be positive and finite, got {var!r}")
-        kinds.append(ROW_KINDS[kind][0])
-        row_R.append(np.array([var, 0.0, 0.0]))
-        row_col.append(col)
-        row_aux.append(k)
-    if not (gnss.R_pos is not None or gnss.R_vel is not None or len(rows)):
-        raise ValueError("use at least one measurement: GNSS position (GnssRows.R_pos), velocity (R_vel) or a kind of "
-                         "rows")
-    size = {code: m for code, m in ROW_KINDS.values()}
-    m_max = sum(size[k] for k in kinds)
+    if measurements is None:
+        measurements, offsets = _packed_measurements(model, gnss, rows, sf_H)
+    else:
+        offsets = None
+    kernels_rows, kernels_res, n_meas, par, off, width, m_max = _measurement_spec(model, measurements, offsets)
     series_order = opt.series_order
     lever = gnss.lever_arm_b
     finite_array(gains, "gains", (3,))
@@ -1356,13 +1349,10 @@ def build_spec(model: ErrorModel, *, gnss: GnssRows | None = None, rows=(), vmod
         arT, arQ = (np.ascontiguousarray(a, dtype=float) for a in ar)
         if arT.shape != (n, n) or arQ.shape != (n, n):
             raise ValueError(f"ar = (T, Q) must be {n}×{n}")
-    sfH = np.zeros((3, n - 9)) if sf_H is None else np.ascontiguousarray(sf_H, dtype=float)
-    if sfH.shape != (3, n - 9):
-        raise ValueError(f"sf_H must be 3×{n - 9}")
     return Spec(fconst, qc, np.asarray(model.accel_psd, float), np.asarray(model.gyro_psd, float), tg, kd, bs, bz,
-                int(series_order), dyn, np.array(kinds, np.int64), np.array(row_R, float), np.array(row_col, np.int64),
-                np.array(row_aux, np.int64), int(m_max), lever.copy(), int(vmode), np.asarray(gains, float), arT, arQ, sfH,
-                bool(opt.prior_covariance), bool(nees))
+                int(series_order), dyn, kernels_rows, kernels_res, n_meas, par, off, width,
+                np.ascontiguousarray(np.vstack([tg, kd, bs, bz]).reshape(4, -1), dtype=np.int64), int(m_max),
+                lever.copy(), int(vmode), np.asarray(gains, float), arT, arQ, bool(opt.prior_covariance), bool(nees))
 
 
 def initial_batch_state(st, q, lever0) -> BatchState:
@@ -1406,7 +1396,7 @@ def _split(bs: BatchState, sl) -> BatchState:
 # ----------------------------------------------------------------------------- driver
 
 @dataclass
-class Records:
+class FilterResult:
     """Outputs of :func:`run` at the recorded epochs (R runs × recorded epochs unless noted).
 
     Attributes
@@ -1485,11 +1475,11 @@ def _record_positions(n_ep: int, record_every: int):
 
 
 def _new_records(spec: Spec, rec_ep, R: int, n: int, n_ep: int, n_steps: int, store_P: bool,
-                 store_nav: bool) -> Records:
-    """Empty :class:`Records` for ``R`` runs of ``n`` states at the recorded epochs ``rec_ep``."""
+                 store_nav: bool) -> FilterResult:
+    """Empty :class:`FilterResult` for ``R`` runs of ``n`` states at the recorded epochs ``rec_ep``."""
     n_aug = n - 9
     m_rec = len(rec_ep)
-    return Records(epochs=rec_ep, st=np.empty((R, m_rec, 6)), q=np.empty((R, m_rec, 4)),
+    return FilterResult(epochs=rec_ep, st=np.empty((R, m_rec, 6)), q=np.empty((R, m_rec, 4)),
                    p_hat=np.empty((R, m_rec, n_aug)), nis=np.empty((R, m_rec)), innov=np.zeros((R, m_rec, spec.m_max)),
                    nees=np.full((R, m_rec), np.nan) if spec.nees else None,
                    P=np.empty((m_rec, n, n)) if store_P else None,
@@ -1512,7 +1502,7 @@ def _out_view(o: ChunkOut, sl) -> ChunkOut:
 
 def _inputs_view(x: ChunkInputs, sl) -> ChunkInputs:
     """The runs ``sl`` of a chunk's inputs (per-run fields sliced, shared fields as they are)."""
-    per_run = {"dth", "dvv", "gpos", "gvel", "truth_p", "aux"}
+    per_run = {"dth", "dvv", "obs", "truth_p"}
     return ChunkInputs(*(v[sl] if k in per_run else v for k, v in zip(ChunkInputs._fields, x)))
 
 
@@ -1618,7 +1608,7 @@ def _checkpoint(plan: _ChunkPlan, state: BatchState, row0):
     return ck, row0[1]
 
 
-def _forward_pass(plan: _ChunkPlan, state: BatchState, lead: LeadState, res: Records, smoother: bool):
+def _forward_pass(plan: _ChunkPlan, state: BatchState, lead: LeadState, res: FilterResult, smoother: bool):
     """The filter over every chunk, pipelined, into ``res``; returns the smoother's checkpoints and innovations.
 
     The lead runs chunk c while the followers finish chunk c − 1 and the inputs of chunk c + 1 are
@@ -1659,7 +1649,7 @@ def _forward_pass(plan: _ChunkPlan, state: BatchState, lead: LeadState, res: Rec
 def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
         inputs: Callable[[int, int, int, np.ndarray], ChunkInputs], *,
         lead_inputs: Callable[[int, int, int, np.ndarray], ChunkInputs] | None = None,
-        options: Options | None = None) -> Records:
+        options: Options | None = None) -> FilterResult:
     """Run the closed-loop filter of ``spec`` over ``n_steps`` IMU steps for the runs of ``state``.
 
     Parameters
@@ -1713,7 +1703,7 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     return res
 
 
-def _collect(res: Records, j0, j1, o, rec_pos, spec, k0):
+def _collect(res: FilterResult, j0, j1, o, rec_pos, spec, k0):
     """Copy one chunk's outputs at the recorded epochs into ``res`` (and its IMU-rate solution
     from step ``k0`` when it is kept)."""
     sel = o.flag >= 0
@@ -1735,7 +1725,7 @@ def _collect(res: Records, j0, j1, o, rec_pos, spec, k0):
         res.nav_q[:, k0:k0 + o.nav_q.shape[1]] = o.nav_q
 
 
-def _smooth(res: Records, chunks, replay, innov, rec_pos, R, n, m_rec, with_cov, rts):
+def _smooth(res: FilterResult, chunks, replay, innov, rec_pos, R, n, m_rec, with_cov, rts):
     """Smoother pass: chunks replayed (``replay(chunk)``, newest first) ahead on other threads
     while the backward recursion runs over the chunk replayed before: :func:`mbf_chunk` on the
     lead's records and the forward pass's innovations ``innov`` (per chunk; the lead's replays
@@ -1778,7 +1768,7 @@ def _smooth(res: Records, chunks, replay, innov, rec_pos, R, n, m_rec, with_cov,
 
 
 def chunk_inputs(dt, dth, dvv, ep_step, *, gnss=None, vertical=None, windows=None, ar_tick=None, truth=None,
-                 aux=None, n_aug: int = 0) -> ChunkInputs:
+                 aux=None, n_aug: int = 0, obs=None) -> ChunkInputs:
     """The :class:`ChunkInputs` of one chunk of ``K`` IMU steps and ``E`` epochs for ``R`` runs,
     with the unused fields filled.
 
@@ -1807,6 +1797,9 @@ def chunk_inputs(dt, dth, dvv, ep_step, *, gnss=None, vertical=None, windows=Non
         Measured values of the kinds of ``build_spec(rows=...)`` (m, m/s).
     n_aug : int
         Number of augmented states (the shape of the empty truth).
+    obs : (R, E, D) array_like, optional
+        The measured values of the measurements of ``build_spec(measurements=...)``, side by side;
+        replaces the values of ``gnss``, ``windows`` and ``aux``, which are packed otherwise.
 
     Returns
     -------
@@ -1825,21 +1818,29 @@ def chunk_inputs(dt, dth, dvv, ep_step, *, gnss=None, vertical=None, windows=Non
     if ep_step.ndim != 1 or np.any(ep_step < 0) or np.any(ep_step >= K_):
         raise ValueError(f"ep_step must be a 1-D array of steps in 0..{K_ - 1}")
     E_ = len(ep_step)
-    zero3 = np.zeros((R, E_, 3))
     sf_w, sf_win, sf_end, sf_a, sf_R = (windows if windows is not None else
                                         (np.zeros(K_), np.full(K_, -1, np.int64), np.full(E_, -1, np.int64),
                                          np.zeros((1, 3)), np.ones((1, 3))))
     truth_st, truth_q, truth_p = (truth if truth is not None else
                                   (np.zeros((E_, 6)), np.zeros((E_, 4)), np.zeros((R, E_, n_aug))))
+    if obs is None:
+        obs = np.zeros((R, E_, _PACKED_AUX + (0 if aux is None else np.shape(aux)[2])))
+        if gpos is not None:
+            obs[:, :, _PACKED_POS:_PACKED_POS + 3] = gpos
+        if gvel is not None:
+            obs[:, :, _PACKED_VEL:_PACKED_VEL + 3] = gvel
+        obs[:, :, _PACKED_SF:_PACKED_AUX] = SpecificForce.epoch_values(sf_end, sf_a, sf_R)
+        if aux is not None:
+            obs[:, :, _PACKED_AUX:] = aux
+    obs = c(obs, dtype=float)
+    if obs.ndim != 3 or obs.shape[:2] != (R, E_):
+        raise ValueError(f"obs must be (runs, epochs, columns) = ({R}, {E_}, ·), got {obs.shape}")
     return ChunkInputs(dt=c(dt, dtype=float), dth=dth, dvv=dvv,
                        h_ref=np.zeros(K_ + 1) if h_ref is None else c(h_ref, dtype=float),
                        vu_ref=np.zeros(K_ + 1) if vu_ref is None else c(vu_ref, dtype=float), ep_step=ep_step,
-                       gpos=zero3 if gpos is None else c(gpos, dtype=float),
-                       gvel=zero3 if gvel is None else c(gvel, dtype=float),
-                       sf_w=c(sf_w), sf_win=c(sf_win), sf_end=c(sf_end), sf_a=c(sf_a), sf_R=c(sf_R),
+                       obs=obs, sf_w=c(sf_w), sf_win=c(sf_win), sf_end=c(sf_end, dtype=np.int64),
                        ar_tick=np.zeros(E_, np.int64) if ar_tick is None else c(ar_tick),
-                       truth_st=c(truth_st), truth_q=c(truth_q), truth_p=c(truth_p),
-                       aux=np.zeros((R, E_, 0)) if aux is None else c(aux, dtype=float))
+                       truth_st=c(truth_st), truth_q=c(truth_q), truth_p=c(truth_p))
 
 
 def _pair(value, name, what):
@@ -1885,7 +1886,7 @@ def counting_inputs(inputs, bar):
 
 
 def array_inputs(t, dth, dvv, ep_samples, *, gnss=None, vertical=None, windows=None, ar_tick=None, truth=None,
-                 aux=None, n_aug: int = 0):
+                 aux=None, n_aug: int = 0, obs=None):
     """The ``inputs`` callable of :func:`run` for whole-flight arrays: each chunk's slices through
     :func:`chunk_inputs`.
 
@@ -1911,6 +1912,8 @@ def array_inputs(t, dth, dvv, ep_samples, *, gnss=None, vertical=None, windows=N
         ``truth_st`` (E × 6), ``truth_q`` (E × 4), ``truth_p`` (R × E × n_aug).
     n_aug : int
         Number of augmented states.
+    obs : (R, E, D) array_like, optional
+        The measured values of ``build_spec(measurements=...)``, side by side (see :func:`chunk_inputs`).
 
     Returns
     -------
@@ -1923,7 +1926,7 @@ def array_inputs(t, dth, dvv, ep_samples, *, gnss=None, vertical=None, windows=N
     dt = np.diff(np.asarray(t, float))
     if np.ndim(dth) != 3 or np.shape(dth)[1:] != (len(dt), 3) or np.shape(dvv) != np.shape(dth):
         raise ValueError(f"dth and dvv must be (runs, {len(dt)}, 3): one increment per interval of t")
-    for name, a in (("gpos", gpos), ("gvel", gvel), ("aux", aux)):
+    for name, a in (("gpos", gpos), ("gvel", gvel), ("aux", aux), ("obs", obs)):
         if a is not None and (np.ndim(a) != 3 or np.shape(a)[:2] != (np.shape(dth)[0], len(idx))):
             raise ValueError(f"{name} must be (runs, epochs, ·) = ({np.shape(dth)[0]}, {len(idx)}, ·), got {np.shape(a)}")
 
@@ -1939,5 +1942,6 @@ def array_inputs(t, dth, dvv, ep_samples, *, gnss=None, vertical=None, windows=N
                                                                   windows[2][ep], windows[3], windows[4]),
                             ar_tick=None if ar_tick is None else ar_tick[ep],
                             truth=None if truth is None else (truth[0][ep], truth[1][ep], truth[2][:, ep]),
-                            aux=None if aux is None else aux[:, ep], n_aug=n_aug)
+                            aux=None if aux is None else aux[:, ep], n_aug=n_aug,
+                            obs=None if obs is None else obs[:, ep])
     return inputs

@@ -27,6 +27,7 @@ from scipy import stats
 from replication.nav import _kernels as K
 from replication.nav import closedloop as CL
 from replication.nav import earth
+from replication.nav import filter as NF
 from replication.nav import parallel as PAR
 from replication.nav._validate import (
     choice,
@@ -42,6 +43,7 @@ from replication.nav._validate import (
     series_order,
 )
 from replication.nav.errors import ErrorModel
+from replication.nav.measurements.gnss import GnssPosition, GnssVelocity
 from replication.nav.rotations import dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from replication.nav.sensors import GnssMeasurements, ImuErrors, gnss_measurements
 from replication.nav.strapdown import (
@@ -662,7 +664,7 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
     opt = CL.resolve_options(options, dict(store_nav=True, store_P=False, workers=1))
     if opt.smoother is not None or opt.record_every != 1:
         raise ValueError("closed_loop records every epoch and has no smoother (options.smoother, options.record_every): "
-                         "chen2019.simulation.run_batch has both")
+                         "replication.nav.filter.run_filter has both")
     P0 = model.P0() if P0 is None else covariance(P0, "P0", model.n)
     R_pos = _gnss_noise(gnss.sigma_pos, "gnss.sigma_pos")
     R_vel = _gnss_noise(gnss.sigma_vel, "gnss.sigma_vel")
@@ -687,12 +689,11 @@ def closed_loop(t, dtheta, dv, initial: NavState, gnss: GnssMeasurements, model:
             np.asarray(true_params, float), (m_ep, n_aug))
     else:
         tst, tq, tp = np.zeros((m_ep, 6)), np.zeros((m_ep, 4)), np.zeros((m_ep, n_aug))
-    rows = CL.GnssRows(R_pos=R_pos if "position" in use else None, R_vel=R_vel if "velocity" in use else None,
-                       lever_arm_b=gnss.lever_arm_b)
-    spec = CL.build_spec(model, gnss=rows, vmode=vc.code, gains=gains, nees=compute_nees, options=opt)
-    state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], gnss.lever_arm_b)
-    rec = CL.run(spec, state, P0, idx, n, _single_run_inputs(t, dtheta, dv, (href, vuref), idx, gnss, (tst, tq, tp)),
-                 options=opt)
+    meas = tuple(aid for name, aid in (("position", GnssPosition(np.diag(R_pos), gnss.position)),
+                                       ("velocity", GnssVelocity(np.diag(R_vel), gnss.v_enu))) if name in use)
+    rec = NF.run_filter(model, meas, NF.Imu(t, dtheta, dv), initial, idx, P0=P0, lever_arm=gnss.lever_arm_b,
+                        vertical=NF.Vertical(vc.code, gains, href, vuref),
+                        truth=(tst, tq, np.asarray(tp)[None]) if compute_nees else None, options=opt)
     nm = 3 * len(use)
     sol = None
     if opt.store_nav:
@@ -715,15 +716,6 @@ def _gnss_rows_used(use) -> tuple:
     if not names:
         raise ValueError(f"use at least one of the GNSS rows {GNSS_ROWS} (use)")
     return tuple(u for u in GNSS_ROWS if u in names)
-
-
-def _single_run_inputs(t, dtheta, dv, vertical, idx, gnss, truth):
-    """The :class:`replication.nav.closedloop.ChunkInputs` of one recorded run, chunk by chunk."""
-    tst, tq, tp = truth
-    return CL.array_inputs(t, np.asarray(dtheta)[None], np.asarray(dv)[None], idx,
-                           gnss=(np.asarray(gnss.position, dtype=float)[None],
-                                 np.asarray(gnss.v_enu, dtype=float)[None]), vertical=vertical,
-                           truth=(tst, tq, np.asarray(tp)[None]), n_aug=np.shape(tp)[1])
 
 
 def perturb_state(state: NavState, model: ErrorModel, rng=None) -> NavState:
@@ -861,15 +853,12 @@ def _draw_runs(traj, model: ErrorModel, seeds, gnss_rate_hz, sigma_pos, sigma_ve
     return p_true, dth, dvv, gn, st0, q0
 
 
-def _batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref):
-    """The :class:`replication.nav.closedloop.ChunkInputs` of a batch of runs, chunk by chunk, with the NEES truth."""
+def _batch_truth(traj, idx, p_true):
+    """The NEES truth of a batch of runs at the epochs ``idx``: states, quaternions, augmented states."""
     n_runs, n_aug = p_true.shape
     tst = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
     tq = dcm_to_quat(euler_to_dcm(traj.hpr[idx, 0], traj.hpr[idx, 1], traj.hpr[idx, 2]))
-    tp = np.broadcast_to(p_true[:, None, :], (n_runs, len(idx), n_aug))
-    return CL.array_inputs(traj.t, dth, dvv, idx, gnss=(np.stack([g.position for g in gn]),
-                                                        np.stack([np.asarray(g.v_enu, float) for g in gn])),
-                           vertical=(href, vuref), truth=(tst, tq, tp), n_aug=n_aug)
+    return tst, tq, np.broadcast_to(p_true[:, None, :], (n_runs, len(idx), n_aug))
 
 
 def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gnss_rate_hz: float = 10.0,
@@ -957,7 +946,8 @@ def monte_carlo(traj, model: ErrorModel, *, n_runs: int = 20, seed: int = 0, gns
     if others:
         raise ValueError(f"monte_carlo puts only the constant accel_bias and gyro_bias into the simulated data; the "
                          f"model's other blocks {others} would be estimated against truths the data do not carry "
-                         "(use a model_15 model here; chen2019.simulation.run_batch simulates the extended models)")
+                         "(use a model_15 model here, or simulate the extended model's errors and call "
+                         "replication.nav.filter.run_filter)")
     _nees_prior(model.P0(), model, "model.P0()")
     n = traj.n
     _reference(vertical.h_ref, "h_ref", n + 1), _reference(vertical.vu_ref, "vu_ref", n + 1)
@@ -998,12 +988,13 @@ def _monte_carlo_batch(traj, model, seeds, *, gnss_rate_hz, sigma_pos, sigma_vel
     g0 = gn[0]
     idx = np.asarray(g0.index, np.int64)
     gains = vertical.gains(traj.lat[0], traj.h[0])
-    spec = CL.build_spec(model, gnss=CL.GnssRows(R_pos, R_vel, g0.lever_arm_b), vmode=vertical.code, gains=gains,
-                         nees=True)
+    meas = (GnssPosition(np.diag(R_pos), np.stack([g.position for g in gn])),
+            GnssVelocity(np.diag(R_vel), np.stack([np.asarray(g.v_enu, float) for g in gn])))
     with PAR.progress_bar(n, f"Monte Carlo, {n_runs} runs", progress, unit="step") as bar:
-        rec = CL.run(spec, CL.initial_batch_state(st0, q0, g0.lever_arm_b), model.P0(), idx, n,
-                     CL.counting_inputs(_batch_inputs(traj, idx, dth, dvv, gn, p_true, href, vuref), bar),
-                     options=CL.Options(store_P=False, workers=workers))
+        rec = NF.run_filter(model, meas, NF.Imu(traj.t, dth, dvv), (st0, q0), idx, lever_arm=g0.lever_arm_b,
+                            vertical=NF.Vertical(vertical.code, gains, href, vuref),
+                            truth=_batch_truth(traj, idx, p_true), options=CL.Options(store_P=False, workers=workers),
+                            progress=bar)
     return MonteCarloResult(
         t_epoch=traj.t[idx],
         nees=rec.nees,

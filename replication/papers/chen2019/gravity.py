@@ -47,12 +47,14 @@ from scipy.spatial.transform import Rotation
 from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import errors as er
+from replication.nav import filter as NF
 from replication.nav import kalman as kf
 from replication.nav import parallel as PAR
 from replication.nav import sensors as se
 from replication.nav import trajectory as tj
 from replication.nav._validate import positive
-from replication.nav.rotations import dcm_to_quat
+from replication.nav.measurements.gnss import GnssPosition, GnssVelocity
+from replication.nav.measurements.specific_force import SpecificForce
 from replication.nav.strapdown import NavSolution, validate_increments, validate_time
 from replication.nav.timeseries import (
     ar_coefficients,
@@ -1870,14 +1872,6 @@ def _discrete_gravity_steps(model, gblk, gs, discrete, sf_interval, m, n_epochs:
     return Tg, Qg, ar_tick
 
 
-def _augmented_filter_inputs(t, dtheta, dv, idx, gnss, n_aug: int, windows, ar_tick):
-    """The :class:`replication.nav.closedloop.ChunkInputs` of :func:`augmented_filter`, chunk by chunk."""
-    return CL.array_inputs(t, np.asarray(dtheta)[None], np.asarray(dv)[None], idx,
-                           gnss=(np.asarray(gnss.position, dtype=float)[None],
-                                 np.asarray(gnss.v_enu, dtype=float)[None]), windows=windows, ar_tick=ar_tick,
-                           n_aug=n_aug)
-
-
 def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float | None = None, P0=None,
                      discrete=None, use_specific_force: bool = True, series_order: int = 4):
     """Closed-loop INS/GNSS filter with the 9-dimensional measurement of chen2019 eq. (3-18).
@@ -1966,10 +1960,9 @@ def augmented_filter(t, dtheta, dv, initial, gnss, model, *, sf_interval: float 
     R_pos = np.diag(np.broadcast_to(np.asarray(gnss.sigma_pos, float), (3,)) ** 2)
     R_vel = np.diag(np.broadcast_to(np.asarray(gnss.sigma_vel, float), (3,)) ** 2)
     opt = CL.Options(store_nav=True, store_P=False, workers=1, series_order=series_order)
-    spec = CL.build_spec(model, gnss=CL.GnssRows(R_pos, R_vel), ar=(Tg, Qg) if discrete is not None else None, sf_H=Hg,
-                         options=opt)
-    inputs = _augmented_filter_inputs(t, dtheta, dv, idx, gnss, model.n - 9, (wgt, win, win_end, a_g, R_sf), ar_tick)
-    state = CL.initial_batch_state(initial.vector()[None, :], dcm_to_quat(initial.C_bn)[None, :], np.zeros(3))
-    rec = CL.run(spec, state, P0, idx, n, inputs, options=opt)
+    meas = (GnssPosition(np.diag(R_pos), gnss.position), GnssVelocity(np.diag(R_vel), gnss.v_enu),
+            SpecificForce(Hg, (wgt, win, win_end, a_g, R_sf)))
+    rec = NF.run_filter(model, meas, NF.Imu(t, dtheta, dv), initial, idx, P0=P0,
+                        ar=(Tg, Qg, ar_tick) if discrete is not None else None, options=opt)
     return NavSolution(t, rec.nav_st[0, :, 0], rec.nav_st[0, :, 1], rec.nav_st[0, :, 2], rec.nav_st[0, :, 3:6],
                        rec.nav_q[0])

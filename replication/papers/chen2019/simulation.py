@@ -68,9 +68,11 @@ from scipy import stats
 from replication.nav import closedloop as CL
 from replication.nav import earth
 from replication.nav import errors as E
+from replication.nav import filter as NF
 from replication.nav import parallel as PAR
 from replication.nav import sensors as se
 from replication.nav._validate import choice, integer, probability
+from replication.nav.measurements.gnss import GnssPosition, GnssVelocity
 from replication.nav.rotations import dcm_to_euler, dcm_to_quat, euler_to_dcm, rotvec_to_dcm
 from replication.nav.sensors import gauss_markov_coefficients, gauss_markov_recursion, lever_arm_offset, misalignment_matrix
 from replication.nav.trajectory import generate
@@ -899,9 +901,7 @@ def _run_rows(traj, setup, model, run_ids, opt: CL.Options, *, seed, fixed_const
     n = model.n
     n_aug = n - 9
     lever0 = np.asarray(setup.lever_arm_b, float)
-    gnss = CL.GnssRows(R_pos=np.diag(np.asarray(setup.sigma_pos, float) ** 2),
-                       R_vel=np.diag(np.full(3, setup.sigma_vel ** 2)), lever_arm_b=lever0)
-    spec = CL.build_spec(model, gnss=gnss, options=opt)
+    meas = (GnssPosition(np.asarray(setup.sigma_pos, float) ** 2), GnssVelocity(np.full(3, setup.sigma_vel ** 2)))
     st, q = truth.initial_states()
     idx = ep_samples
     truth_st = np.column_stack([traj.lat[idx], traj.lon[idx], traj.h[idx], traj.v_enu[idx]])
@@ -923,12 +923,12 @@ def _run_rows(traj, setup, model, run_ids, opt: CL.Options, *, seed, fixed_const
             pos = rec_pos[j0:j0 + len(eps)]
             for k in procs_rec:
                 procs_rec[k][:, pos[pos >= 0]] = procs[k][:, pos >= 0]
-        return CL.chunk_inputs(dtv[k0:k1], dth, dvv, np.asarray(eps) - 1 - k0, gnss=(gpos, gvel), n_aug=n_aug)
+        return CL.chunk_inputs(dtv[k0:k1], dth, dvv, np.asarray(eps) - 1 - k0, n_aug=n_aug,
+                               obs=np.concatenate([gpos, gvel], axis=2))
 
     with PAR.progress_bar(N, f"chen2019, {len(run_ids)} runs", progress, unit="step") as bar:
-        rec = CL.run(spec, CL.initial_batch_state(st, q, lever0), model.P0(), ep_samples, N,
-                     CL.counting_inputs(inputs, bar), lead_inputs=lambda ci, k0, k1, eps: inputs(ci, k0, k1, eps, runs=1),
-                     options=opt)
+        source = NF.ChunkSource(N, inputs, lead_inputs=lambda ci, k0, k1, eps: inputs(ci, k0, k1, eps, runs=1))
+        rec = NF.run_filter(model, meas, source, (st, q), ep_samples, lever_arm=lever0, options=opt, progress=bar)
     nav_err = navigation_errors(rec.st, rec.q, truth_st[rec_ep], truth_q[rec_ep])
     p_true = truth_parameters(model, truth.const, procs_rec)
     return BatchResult(model=model, setup=setup, t=traj.t[ep_samples[rec_ep]], epoch_index=ep_samples[rec_ep],

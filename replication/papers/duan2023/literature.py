@@ -14,7 +14,9 @@ import numpy as np
 
 from replication.nav import closedloop as CL
 from replication.nav import earth
+from replication.nav import filter as NF
 from replication.nav.errors import StateBlock, model_15
+from replication.nav.measurements.airdata import AirHeight, Airspeed
 from replication.nav.rotations import dcm_to_quat, quat_to_dcm
 from replication.papers.duan2023.flight import _initial_state
 from replication.papers.duan2023.method import _epochs, _Recorder
@@ -58,10 +60,10 @@ def literature_filter_model(setup):
 def literature_filter(traj, dth, dv, ads, setup, *, every: int = 50, workers: int = 2):
     """The literature SINS/ADS (refs. [15-17] as read by this package) for a batch of runs.
 
-    The closed-loop error-state Kalman filter of :func:`replication.nav.closedloop.run` on
+    The closed-loop error-state Kalman filter of :func:`replication.nav.filter.run_filter` on
     :func:`literature_filter_model` (15 core states and two first-order Markov states of the
-    air-data errors), updated every ``setup.filter_interval`` s by the row kinds ``air_height``
-    (z = ĥ − h_ADS = δh − b_h) and ``airspeed`` (z = |v̂| − V_TAS = (v̂/|v̂|)·δv − b_V), white noise
+    air-data errors), updated every ``setup.filter_interval`` s by the measurements ``AirHeight``
+    (z = ĥ − h_ADS = δh − b_h) and ``Airspeed`` (z = |v̂| − V_TAS = (v̂/|v̂|)·δv − b_V), white noise
     R = diag(σ_h², σ_V²) on top of the Markov states; δp, δv, φ fed back, ∇̂, ε̂ accumulated and
     removed from the increments.  Run 0 of the batch leads the covariance and the gains, the other
     runs follow them (the gains do not depend on the measured values, only on the state they are
@@ -96,16 +98,13 @@ def literature_filter(traj, dth, dv, ads, setup, *, every: int = 50, workers: in
     model = literature_filter_model(setup)
     col = model.slices["ads_markov"].start
     ep = _epochs(traj, setup.filter_interval)[1:]
-    spec = CL.build_spec(model, rows=(("air_height", col, setup.sigma_height ** 2),
-                               ("airspeed", col + 1, setup.sigma_airspeed ** 2)))
     init = _initial_state(traj, setup)
-    state = CL.initial_batch_state(np.tile(init.vector(), (R, 1)), np.tile(dcm_to_quat(init.C_bn), (R, 1)),
-                                   np.zeros(3))
-    aux = np.stack([np.column_stack([a.height[ep], a.airspeed[ep]]) for a in ads])
+    meas = (AirHeight(setup.sigma_height ** 2, col, np.stack([a.height[ep] for a in ads])),
+            Airspeed(setup.sigma_airspeed ** 2, col + 1, np.stack([a.airspeed[ep] for a in ads])))
     grid = np.arange(0, traj.n + 1, every)
     on_epochs = bool(np.all(np.isin(grid[1:], ep)))
-    rec = CL.run(spec, state, model.P0(), ep, traj.n, CL.array_inputs(traj.t, dth, dv, ep, aux=aux, n_aug=model.n - 9),
-                 options=CL.Options(store_nav=not on_epochs, store_P=False, workers=workers))
+    rec = NF.run_filter(model, meas, NF.Imu(traj.t, dth, dv), [init] * R, ep,
+                        options=CL.Options(store_nav=not on_epochs, store_P=False, workers=workers))
     out = []
     for r in range(R):
         if on_epochs:
