@@ -23,7 +23,7 @@ _NJ = dict(cache=True, nogil=True, fastmath=False, error_model="numpy")
 
 # block targets / couplings (see replication.nav.errors)
 TARGET_ACCEL, TARGET_GYRO, TARGET_GRAVITY, TARGET_LEVER, TARGET_NONE = 0, 1, 2, 3, 4
-KIND_IDENTITY, KIND_SCALE, KIND_MISALIGN, KIND_MISALIGN_T22 = 0, 1, 2, 3
+KIND_IDENTITY, KIND_SCALE, KIND_MISALIGN, KIND_MISALIGN_CROSS = 0, 1, 2, 3
 _TWELFTH = 1.0 / 12.0
 
 

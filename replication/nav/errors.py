@@ -66,7 +66,7 @@ NAV_LABELS = ("dL", "dlon", "dh", "dvE", "dvN", "dvU", "phiE", "phiN", "phiU")
 _TARGETS = {"accel": K.TARGET_ACCEL, "gyro": K.TARGET_GYRO, "gravity": K.TARGET_GRAVITY,
             "lever_arm": K.TARGET_LEVER, "none": K.TARGET_NONE}
 _KINDS = {"identity": K.KIND_IDENTITY, "scale": K.KIND_SCALE, "misalignment": K.KIND_MISALIGN,
-          "misalignment-cross-axis": K.KIND_MISALIGN_T22}
+          "misalignment-cross-axis": K.KIND_MISALIGN_CROSS}
 MISALIGNMENT_COUPLINGS = {"axis-angles": "misalignment", "cross-axis": "misalignment-cross-axis"}
 """How the six misalignment parameters [xy, yx, xz, zx, yz, zy] couple: axis angles, δC = [[0, -yz, zy],
 [xz, 0, -zx], [-xy, yx, 0]] (chen2019 eq. (2-8)), or cross-axis coefficients, δC = [[0, xy, xz], [yx, 0, yz],
