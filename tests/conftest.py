@@ -11,6 +11,8 @@ STORED = frozenset({
     "test_architecture.py",      # the import rules, read from the sources
     "test_audit.py",             # statuses planted in copies of the stored tables, refused by the index
     "test_book_ext.py",          # the book's Sphinx extensions on small projects
+    "test_captions.py",          # captions against the text around their tables
+    "test_citations.py",         # the reference-list sweep on transcribed lists
     "test_docstrings.py",        # numpydoc sections, read from the objects
     "test_execution_report.py",  # the notebook runner's record and its page
     "test_installed.py",         # a wheel of the clone, answering from its stored tables
