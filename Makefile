@@ -89,9 +89,10 @@ unit: env
 units: env
 	$(PY) scripts/portability.py units
 
-# the unit tests once more on a perturbed numerical code path (scripts/portability.py says why)
+# the unit tests once more on a perturbed numerical code path (scripts/portability.py says why), but for
+# those that run no numerical code path (the `stored` marker, tests/conftest.py)
 unit-portable: env
-	$(PY) scripts/portability.py unit tests -m "not browser and not slow"
+	$(PY) scripts/portability.py unit tests -m "not browser and not slow and not stored"
 
 # the unit tests and the perturbed notebooks as one queue of jobs on every core this process may use, slowest first,
 # with the strict book build and the browser check beside them (what `make test` runs)

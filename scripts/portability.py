@@ -160,11 +160,11 @@ def unit(args: list[str]) -> int:
 
 def units() -> int:
     """The unit tests natively (all but the browser test) and, at the same time on the other core,
-    under the first perturbed configuration (without the slow ones); both logs printed whole."""
+    under the first perturbed configuration (:data:`PERTURBED_UNITS`); both logs printed whole."""
     name = next(iter(CONFIGS))
     runs = {"natively": ([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests", "-m", "not browser"], None),
             f"under '{name}'": ([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests", "-m",
-                                 "not browser and not slow"], environment(name))}
+                                 PERTURBED_UNITS], environment(name))}
     with ThreadPoolExecutor(len(runs)) as pool:
         futures = {k: pool.submit(subprocess.run, cmd, cwd=ROOT, env=env, capture_output=True, text=True)
                    for k, (cmd, env) in runs.items()}
@@ -177,6 +177,11 @@ def units() -> int:
         rc |= r.returncode
     return rc
 
+
+PERTURBED_UNITS = "not browser and not slow and not stored"
+"""The unit tests run again under the first perturbed configuration: all but the browser checks, the
+slow numerical ones and those that run no numerical code path (the ``stored`` marker,
+tests/conftest.py: the same work to the same verdict on any configuration)."""
 
 SMALL_NOTEBOOK_S = 12.0
 """Notebooks estimated below this many seconds are run together, one job per configuration
@@ -207,7 +212,7 @@ def suite_jobs(paths: list[Path], configs: list[str]) -> list[tuple[str, list[st
         ("unit tests natively", [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests", "-m",
                                  "not browser"], None, 150.0),
         (f"unit tests under '{first}'", [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests",
-                                         "-m", "not browser and not slow"], environment(first), 50.0)]
+                                         "-m", PERTURBED_UNITS], environment(first), 50.0)]
     for name in configs:
         env = environment(name)
         small = [p for p in paths if cost(p) < SMALL_NOTEBOOK_S]

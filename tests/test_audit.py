@@ -10,6 +10,7 @@ reproduced row of a table without a ledger, ...), not by name, so the suite foll
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import shutil
@@ -39,6 +40,14 @@ def copy(tmp_path, monkeypatch):
 
 def _problems() -> set[str]:
     return set(map(str, audit.audit()))
+
+
+@functools.cache
+def _pristine() -> frozenset[str]:
+    """:func:`_problems` of an untouched copy of the stored tables: every copy is the same until a
+    test plants in it, so the audit before the plant is run once for the module (each test takes it
+    first thing, before it changes its copy)."""
+    return frozenset(_problems())
 
 
 def _tables(root: Path) -> dict[str, pd.DataFrame]:
@@ -83,7 +92,7 @@ def _has_ledger(tid: str) -> bool:
 
 @pytest.mark.parametrize("forge", [False, True])
 def test_a_status_flipped_in_a_table_without_a_ledger(copy, forge):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: not _is_ledger(t) and not _has_ledger(t)
                        and r["status"] == "reproduced")
     df.loc[i, "status"] = "not-reproduced"
@@ -94,7 +103,7 @@ def test_a_status_flipped_in_a_table_without_a_ledger(copy, forge):
 
 
 def test_a_reproduced_row_far_outside_its_tolerance(copy):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: r["status"] == "reproduced" and r["tolerance"] not in ("", "0")
                        and r["paper"] != "")
     p, tol = float(df.loc[i, "paper"]), float(df.loc[i, "tolerance"])
@@ -105,7 +114,7 @@ def test_a_reproduced_row_far_outside_its_tolerance(copy):
 
 
 def test_a_reproduced_row_without_a_tolerance(copy):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: r["status"] == "reproduced")
     df.loc[i, ["tolerance", "tolerance_kind"]] = ""
     _write(copy, tid, df, True)
@@ -114,7 +123,7 @@ def test_a_reproduced_row_without_a_tolerance(copy):
 
 @pytest.mark.parametrize("label", ["qualitative", "reproduced", "analog"])
 def test_a_failure_relabelled(copy, label):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: not _is_ledger(t) and r["status"] == "not-reproduced"
                        and r["tolerance"] != "")
     df.loc[i, "status"] = label
@@ -123,7 +132,7 @@ def test_a_failure_relabelled(copy, label):
 
 
 def test_a_failure_relabelled_unverifiable_where_no_reading_reaches_the_print(copy):
-    before = _problems()
+    before = _pristine()
     tables = _tables(copy)
 
     def pred(t, r):
@@ -140,7 +149,7 @@ def test_a_failure_relabelled_unverifiable_where_no_reading_reaches_the_print(co
 
 
 def test_an_inconsistency_relabelled_erratum(copy):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: r["status"] == "inconsistent" and r["evidence"] == "")
     df.loc[i, "status"] = "erratum"
     _write(copy, tid, df, True)
@@ -148,7 +157,7 @@ def test_an_inconsistency_relabelled_erratum(copy):
 
 
 def test_an_erratum_with_evidence_that_does_not_exist(copy):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: r["status"] == "erratum")
     df.loc[i, "evidence"] = "tests/test_nowhere.py::test_never_written"
     _write(copy, tid, df, True)
@@ -156,7 +165,7 @@ def test_an_erratum_with_evidence_that_does_not_exist(copy):
 
 
 def test_a_declared_basis_contradicted_by_the_stored_status(copy):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: r.get("basis", "") == "value" and r["status"] == "reproduced")
     df.loc[i, "status"] = "qualitative"
     _write(copy, tid, df, True)
@@ -164,7 +173,7 @@ def test_a_declared_basis_contradicted_by_the_stored_status(copy):
 
 
 def test_a_pending_row_and_an_unknown_status(copy):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: r["status"] == "qualitative")
     df.loc[i, "status"] = "pending"
     j = next(k for k in df.index if k != i)
@@ -175,7 +184,7 @@ def test_a_pending_row_and_an_unknown_status(copy):
 
 
 def test_an_analog_row_with_error_columns(copy):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: r["status"] == "analog")
     df.loc[i, ["abs_error", "rel_error"]] = ["0.1", "0.01"]
     _write(copy, tid, df, True)
@@ -183,7 +192,7 @@ def test_an_analog_row_with_error_columns(copy):
 
 
 def test_a_note_removed(copy):
-    before = _problems()
+    before = _pristine()
     tid, i, df = _pick(_tables(copy), lambda t, r: not _is_ledger(t) and r["status"] == "unverifiable")
     df.loc[i, "note"] = ""
     _write(copy, tid, df, True)
@@ -199,7 +208,7 @@ def _ledgered_table(copy) -> tuple[str, dict, str]:
 
 
 def test_a_ledger_deleted(copy):
-    before = _problems()
+    before = _pristine()
     tid, meta, lid = _ledgered_table(copy)
     (copy / "tables" / f"{lid}.csv").unlink()
     (copy / "tables" / f"{lid}.json").unlink()
@@ -209,7 +218,7 @@ def test_a_ledger_deleted(copy):
 def test_a_reading_renamed_with_the_diagnostic_prefix(copy):
     """The reading that ruled_out names, renamed 'diagnostic: …' in the ledger (digest forged):
     the ruled_out entry then names no reading, and the renamed reading still reaches the print."""
-    before = _problems()
+    before = _pristine()
     for tid in rp.list_tables():
         meta = rp._sidecar(tid)
         if meta.get("ruled_out") and rp.readings_ledgers(tid, meta):
@@ -225,7 +234,7 @@ def test_a_reading_renamed_with_the_diagnostic_prefix(copy):
 
 
 def test_a_ruled_out_reading_with_meaningless_evidence(copy):
-    before = _problems()
+    before = _pristine()
     for tid in rp.list_tables():
         meta = rp._sidecar(tid)
         if meta.get("ruled_out"):
@@ -239,7 +248,7 @@ def test_a_ruled_out_reading_with_meaningless_evidence(copy):
 
 
 def test_a_main_reading_ledger_row_flipped(copy):
-    before = _problems()
+    before = _pristine()
     for tid in rp.list_tables():
         meta = rp._sidecar(tid)
         if _is_ledger(tid) or not meta.get("main_reading") or not rp.readings_ledgers(tid, meta):
@@ -260,7 +269,7 @@ def test_a_main_reading_ledger_row_flipped(copy):
 
 
 def test_a_stray_csv_without_a_sidecar(copy):
-    before = _problems()
+    before = _pristine()
     src = next(iter(rp.list_tables()))
     shutil.copy(copy / "tables" / f"{src}.csv", copy / "tables" / "chen2019-table-99-9.csv")
     _refused(before, "chen2019-table-99-9", None, "sidecar")
@@ -339,7 +348,7 @@ def test_the_stored_tables_pass_the_audit():
 
 def test_a_printed_value_edited_in_the_table(copy):
     """The paper column is the paper file's: a 'printed' value changed to meet the reproduction is refused."""
-    before = _problems()
+    before = _pristine()
 
     def pred(t, r):
         src = rp._sidecar(t).get("paper_source")
@@ -358,7 +367,7 @@ def test_a_printed_value_edited_in_the_table(copy):
 
 
 def test_a_failure_redeclared_unstated_where_the_ledger_tries_it(copy):
-    before = _problems()
+    before = _pristine()
     tables = _tables(copy)
 
     def pred(t, r):
@@ -377,7 +386,7 @@ def test_a_failure_redeclared_unstated_where_the_ledger_tries_it(copy):
 def test_the_main_reading_renamed_away_from_its_ledger_rows(copy):
     """A main reading renamed so that its ledger rows are no longer compared with the main rows: the
     reading whose results are the main table's must be the one named."""
-    before = _problems()
+    before = _pristine()
     for tid in rp.list_tables():
         meta = rp._sidecar(tid)
         if _is_ledger(tid) or not meta.get("main_reading") or not rp.readings_ledgers(tid, meta):
@@ -397,7 +406,7 @@ def test_the_main_reading_renamed_away_from_its_ledger_rows(copy):
 
 
 def test_the_sidecar_counts_follow_the_csv(copy):
-    before = _problems()
+    before = _pristine()
     tid = next(t for t in rp.list_tables() if not _is_ledger(t))
     side = copy / "tables" / f"{tid}.json"
     meta = json.loads(side.read_text(encoding="utf-8"))

@@ -50,6 +50,18 @@ def test_ideal_sensors_chen2019_flight_height_held(chen_flight):
     assert np.abs(e["up"]).max() < 1e-9                      # held to truth
 
 
+def test_hpr_at_is_the_rows_of_hpr_bit_for_bit():
+    """The attitude at a few samples (what the chen2019 compensation runs compare at photo epochs)
+    equals the same rows of the whole solution's heading, pitch, roll, bit for bit."""
+    segs, h0 = tr.rotation_rich_turntable(600.0)
+    traj = tr.generate(segs, 40 * DEG, 116 * DEG, 50.0, heading=h0, speed=0.0)
+    sol = sd.mechanize(traj.t, traj.dtheta, traj.dv, traj.initial_state(), vertical=sd.VerticalChannel("hold", h_ref=traj.h))
+    whole = sol.hpr
+    rng = np.random.default_rng(7)
+    for idx in (0, slice(3, 40, 7), rng.choice(len(sol.t), 1), rng.choice(len(sol.t), 17), rng.choice(len(sol.t), 135)):
+        assert sol.hpr_at(idx).tobytes() == whole[idx].tobytes()
+
+
 def test_ideal_sensors_turntable_hour():
     """Requirement: a 1-h rotation-rich turntable sequence keeps attitude within 1e-7 rad."""
     segs, h0 = tr.rotation_rich_turntable(3600.0)

@@ -169,7 +169,24 @@ class NavSolution:
     @property
     def hpr(self):
         """numpy.ndarray, shape (N+1, 3): heading, pitch, roll (rad)."""
-        return np.stack(dcm_to_euler(self.C_bn), -1)
+        return self.hpr_at(slice(None))
+
+    def hpr_at(self, index):
+        """Heading, pitch, roll (rad) at the samples ``index`` alone: the rows ``index`` of :attr:`hpr`
+        (C_b^n of the quaternion, :func:`~replication.nav.rotations.quat_to_dcm`, then
+        :func:`~replication.nav.rotations.dcm_to_euler`), without converting the other samples.
+
+        Parameters
+        ----------
+        index : int, slice or array_like of int
+            Sample indices (numpy indexing of the N+1 samples).
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., 3)
+            Heading, pitch, roll (rad) at those samples.
+        """
+        return np.stack(dcm_to_euler(quat_to_dcm(self.q_bn[index])), -1)
 
     @property
     def position(self):

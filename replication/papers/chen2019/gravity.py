@@ -1209,7 +1209,7 @@ def attitude_position_errors(sol, traj, index) -> dict:
     """
     idx = np.asarray(index)
     rm, rn = earth.radii(traj.lat[idx])
-    d = np.degrees(sol.hpr[idx] - traj.hpr[idx])
+    d = np.degrees(sol.hpr_at(idx) - traj.hpr[idx])   # only the photo epochs converted to angles
     d[:, 0] = (d[:, 0] + 180.0) % 360.0 - 180.0
     return dict(latitude=(sol.lat[idx] - traj.lat[idx]) * (rm + traj.h[idx]),
                 longitude=(sol.lon[idx] - traj.lon[idx]) * (rn + traj.h[idx]) * np.cos(traj.lat[idx]),
