@@ -15,8 +15,7 @@ from replication.nav import earth
 from replication.nav import errors as E
 from replication.nav.rotations import euler_to_dcm
 from replication.papers.chen2019 import derivations as dv
-from replication.papers.chen2019 import findings
-from replication.papers.chen2019 import models
+from replication.papers.chen2019 import findings, models
 from replication.registry import reproduction as rp
 
 
