@@ -18,6 +18,8 @@ the tests do.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 
@@ -622,6 +624,14 @@ DERIVATION_GROUPS = {
 _PARTS_SPECS = ("markov", "H-position")
 
 
+def _spaced(text):
+    """A formula in sympy syntax with spaces around * and / (not **), so that a table cell can wrap."""
+    if not isinstance(text, str):
+        return text
+    text = re.sub(r"(?<!\*)([*/])(?!\*)", r" \1 ", text).replace("Matrix(", "Matrix( ")
+    return re.sub(r"  +", " ", text)
+
+
 def _entries(c, label=("printed", "derived")) -> str:
     return "; ".join(f"{w}: {label[0]} {p}, {label[1]} {d}" for w, p, d in c.differing)
 
@@ -717,4 +727,5 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
                      reproduced=3 * per_axis, tolerance=0, basis="parts",
                      note=(f"F prints 0_(6x15) under the gravity states; AR({ar_order}) of (4-13) for three axes in companion form has "
                            f"{3 * per_axis} states; the text also says the size depends on the identified model")))
-    return rows
+    return [{k: (_spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
+            for r in rows]
