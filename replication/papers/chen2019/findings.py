@@ -18,6 +18,8 @@ the tests do.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 
@@ -579,3 +581,152 @@ def compensation_claims(t50, *, position_bound: float, methods=("normal", "direc
             "decisive": all(c >= level_gain for c in change.values()),
             "changed_markedly": [q for q, c in change.items() if c >= level_gain],
             "better_than_direct": all(v[q][2] < v[q][1] for q in ("pitch", "roll"))}
+
+
+# --------------------------------------------------------------------------- the printed model, derived
+
+DERIVATION_TESTS = {
+    "(2-15) velocity line": "test_coriolis_terms_of_2_15_and_3_15_are_not_derivable",
+    "(3-15)": "test_coriolis_terms_of_2_15_and_3_15_are_not_derivable",
+    "(3-1) g_m^n": "test_gravity_vector_of_3_1_points_up_in_enu",
+}
+"""The test that holds each erratum of chen2019-check-derivations (blocks of F: the default)."""
+
+DERIVATION_PAIRS = {f"(3-17) {a}": f"Table 2-2 {b}" for a, b in (
+    ("F11", "F11"), ("F12", "F12"), ("F21", "F21"), ("F22", "F22"), ("F23", "F23"), ("F31", "F41"),
+    ("F32", "F42"), ("F33", "F43"))} | {"(3-15)": "(3-5)"}
+"""Printed parts printed again: the blocks of the F of §3.3 (-> the Table 2-2 block) and the velocity
+error equation (3-15) (-> (3-5), one page earlier)."""
+
+DERIVATION_REMARKS = {
+    "(2-15) velocity line": "(3-3) and (3-5) print the derived -(2δω_ie^n + δω_en^n) × V^n",
+    "(3-15)": "(3-3) and (3-5) print the derived -(2δω_ie^n + δω_en^n) × V^n; with that term (3-15) is (3-5)",
+    "(3-1) g_m^n": "with +γ up, (3-2) at rest gives dV_U/dt = 2γ and the Z of (3-18) measures 2γ instead of 0",
+}
+"""What the print says elsewhere about a part no convention derives."""
+
+DERIVATION_CORRECTED = {
+    "(2-15) velocity line": "-(2δω_ie^n + δω_en^n) × V^n in place of +(2δω_ie^n + 2ω_en^n) × V^n",
+    "(3-15)": "-(2δω_ie^n + δω_en^n) × V^n in place of +(2δω_ie^n + 2δω_en^n) × V^n",
+    "(3-1) g_m^n": "g_m^n = (0, 0, -γ)^T in the ENU frame",
+}
+"""Corrected forms stated as the term that replaces the printed one (the blocks: their corrected entries)."""
+
+DERIVATION_GROUPS = {
+    "(3-4) against (3-16): sign of the attitude error": ("(3-4)", "(3-16)"),
+    "(3-5) gravity term against Z = SINS - GNSS of (3-18)": ("(3-5)", "(3-18) H1 velocity rows"),
+    "(3-17) F23 against (3-18) H2": ("(3-17) F23", "(3-18) H2", "(3-18) H1 velocity rows"),
+    "(3-17) F2 against the bias block of (3-18) H": ("(3-17) F2, velocity rows", "(3-18) H bias block",
+                                                      "(3-18) H1 velocity rows"),
+    "(3-4) against (3-18) H2 and its bias block": ("(3-4)", "(3-18) H2", "(3-18) H bias block"),
+}
+"""Printed parts of one model that must hold under one sign convention (name -> the parts)."""
+
+_PARTS_SPECS = ("markov", "H-position")
+
+
+def _spaced(text):
+    """A formula in sympy syntax with spaces around * and / (not **), so that a table cell can wrap."""
+    if not isinstance(text, str):
+        return text
+    text = re.sub(r"(?<!\*)([*/])(?!\*)", r" \1 ", text).replace("Matrix(", "Matrix( ")
+    return re.sub(r"  +", " ", text)
+
+
+def _entries(c, label=("printed", "derived")) -> str:
+    return "; ".join(f"{w}: {label[0]} {p}, {label[1]} {d}" for w, p, d in c.differing)
+
+
+def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, notebook: str) -> list[dict]:
+    """The rows of chen2019-check-derivations: every printed part against its derivation, the
+    blocks printed twice against each other, and the parts of one model against a common convention.
+
+    A part no convention derives is an ``erratum`` (basis ``derivation``) unless it is defined by
+    another printed part (the Markov time constants of eq. (2-5), the radian Z of the H rows): then
+    the two printed parts disagree (basis ``parts``).  Parts that each hold under some convention
+    but under no common one are ``inconsistent`` (basis ``parts``): another convention is not a
+    misprint, a model that mixes two is.
+
+    Parameters
+    ----------
+    checks : dict of str to Check
+        :func:`replication.papers.chen2019.derivations.check_all` of the paper file.
+    printed : pandas.DataFrame
+        The paper file (columns quantity, value, spec, location, printed, note).
+    ar_order : int
+        The AR order of the disturbance model used (eq. (4-13)), for the size of F's lower block.
+    notebook : str
+        The chapter, quoted in the evidence.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.reproduction.compare`.
+
+    Raises
+    ------
+    ValueError
+        When ``checks`` lacks a part the pairs or groups need.
+    """
+    from replication.papers.chen2019 import derivations as dv
+
+    need = set(DERIVATION_PAIRS) | set(DERIVATION_PAIRS.values()) | {p for g in DERIVATION_GROUPS.values() for p in g}
+    missing = sorted(need - set(checks))
+    if missing:
+        raise ValueError(f"checks lack the printed parts {missing}")
+    meta = printed.set_index("quantity")
+    rows = []
+    for name, c in checks.items():
+        spec, where = meta.at[name, "spec"], meta.at[name, "location"]
+        reading = meta.at[name, "note"]
+        basis = "parts" if spec.split(":")[0] in _PARTS_SPECS else "derivation"
+        row = dict(quantity=name, unit="", paper_text=meta.at[name, "value"], basis=basis, agrees=c.agrees)
+        if c.agrees:
+            row["reproduced"] = "derivable: " + dv.convention_text(c.conventions)
+            row["note"] = (f"{where}: every term derived ({'the identity holds' if c.kind == 'generic' else 'conventions: ' + dv.convention_text(c.conventions)})"
+                           + (f"; reading: {reading}" if reading else ""))
+        else:
+            row["reproduced"] = "; ".join(f"{w} = {d}" for w, _, d in c.differing)
+            other = {"markov": "eq. (2-5) defines α as the gyro and β as the accelerometer correlation time",
+                     "H-position": "Z rows 1-3 are printed in radians (L_SINS - L_GPS), which H = I maps; H scales them to metres"}
+            why = other.get(spec.split(":")[0], "no sign convention of the 16 (errors computed/true, φ or ψ = -φ, sensor errors either sign) derives it")
+            sph = "" if c.spherical is None else ("; with R_n = R_m (sphere) it would be derivable" if c.spherical
+                                                   else "; not with R_n = R_m (sphere) either")
+            remark = f"; {DERIVATION_REMARKS[name]}" if name in DERIVATION_REMARKS else ""
+            row["note"] = f"{where}: {why}{sph}{remark}; {_entries(c)}" + (f"; reading: {reading}" if reading else "")
+            if basis == "derivation":
+                row["corrected"] = DERIVATION_CORRECTED.get(name, row["reproduced"])
+                row["evidence"] = f"{notebook}; tests/test_derivations.py::" + DERIVATION_TESTS.get(
+                    name, "test_printed_f_blocks_against_derivation")
+        rows.append(row)
+    for a, b in DERIVATION_PAIRS.items():
+        c = dv.check_item(f"{a} vs {b}", meta.at[a, "value"], f"pair:{b}", {b: meta.at[b, "value"]})
+        rows.append(dict(quantity=f"{a} against {b}", unit="", paper_text=meta.at[a, "value"],
+                         reproduced=meta.at[b, "value"], basis="parts", agrees=c.agrees,
+                         note=f"printed twice, {a} and {b}: " + ("identical" if c.agrees else _entries(c, (a, b)))))
+    va, vp = checks["(2-15) velocity line"].matches["attitude"], checks["(3-4)"].matches["attitude"]
+    rows.append(dict(quantity="attitude-error sign: φ of (2-15) against ψ of (3-4)", unit="",
+                     paper_text="(2-15): -φ^n × f^n | (3-4): ψ^n × f^n",
+                     reproduced=f"φ term sign {sorted(va)}, ψ term sign {sorted(vp)} relative to the derivation",
+                     basis="parts", agrees=bool(va) and bool(vp),
+                     note=("the two chapters count the attitude error with opposite signs (ψ = -φ for equal error signs), "
+                           "each under its own symbol and without saying so; not a contradiction" if va and vp and va != vp
+                           else "the attitude terms of the two chapters compared")))
+    for label, parts in DERIVATION_GROUPS.items():
+        common = dv.common_conventions([checks[p] for p in parts])
+        each = "; ".join(f"{p}: {dv.convention_text(checks[p].conventions)}" for p in parts)
+        rows.append(dict(quantity=label, unit="", paper_text=" | ".join(meta.at[p, "value"] for p in parts),
+                         reproduced="common conventions: " + dv.convention_text(common), basis="parts",
+                         agrees=bool(common), note=f"each part holds under: {each}"
+                         + ("" if common else "; no convention holds for all, so the printed model mixes two")))
+    ok, per_axis = dv.companion_check(ar_order)
+    n = int(meta.at["(3-17) rows of the lower-left zero block", "value"])
+    rows.append(dict(quantity="AR(p) of (3-11) in companion form: characteristic polynomial", unit="",
+                     paper_text="y_t = φ_1 y_{t-1} + ... + φ_p y_{t-p} + ω_t", reproduced=f"det(zI - A) = z^p - φ_1 z^(p-1) - ... - φ_p (p = {ar_order})",
+                     basis="derivation", agrees=ok, note="the companion realisation has the AR polynomial as characteristic polynomial (derived for the order of eq. (4-13))"))
+    rows.append(dict(quantity="(3-17) rows of the lower-left zero block against AR(p) states", unit="1", paper=n,
+                     reproduced=3 * per_axis, tolerance=0, basis="parts",
+                     note=(f"F prints 0_(6x15) under the gravity states; AR({ar_order}) of (4-13) for three axes in companion form has "
+                           f"{3 * per_axis} states; the text also says the size depends on the identified model")))
+    return [{k: (_spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
+            for r in rows]

@@ -1,0 +1,661 @@
+"""chen2019's printed error equations derived symbolically, term by term, under every sign convention.
+
+The derivation starts from the mechanization written here once, in the ENU navigation frame the
+report states (V^n = [V_E, V_N, V_U], ψ_U "天向失准角"), at the report's approximation level
+(Earth radii R_m, R_n and normal gravity γ frozen, as in Table 2-2 and the F of §3.3):
+
+* position (eq. (3-14)): L̇ = V_N/(R_m+h), λ̇ = V_E sec L/(R_n+h), ḣ = V_U;
+* velocity (eq. (3-2)): V̇ = C_b^n f^b − (2ω_ie^n + ω_en^n) × V + g, g = (0, 0, −γ) + δg with
+  δg = g − g_m the gravity disturbance of eq. (3-6), ω_ie^n = ω_ie(0, cos L, sin L),
+  ω_en^n = (−V_N/(R_m+h), V_E/(R_n+h), V_E tan L/(R_n+h));
+* attitude: Ċ_b^n = C_b^n (ω_ib^b ×) − (ω_in^n ×) C_b^n, ω_in = ω_ie + ω_en;
+* sensors (eqs. (2-4)-(2-6)): f̂^b = (I + δK_a) f^b + ∇, ω̂^b = (I + δK_g) ω^b + ε;
+* the first-order Gauss-Markov processes of eq. (2-5) and the AR(p) disturbance model of
+  eq. (3-11) in companion form.
+
+:func:`base_model` linearises the computed-minus-true rates (δx = x̂ − x, Ĉ = (I − φ×)C) with
+sympy and returns each row of F as a linear form in the states (C_b^n kept as nine symbols; its
+orthogonality enters only through :func:`rotation_lemma`, proved with a quaternion).  The print leaves four signs open,
+and every check is made under all sixteen combinations (:data:`CONVENTIONS`):
+
+``e``    the navigation errors computed − true (+1) or true − computed (−1);
+``a``    the printed attitude error a = φ (+1, Ĉ = (I − a×)C) or a = −φ (−1, Ĉ = (I + a×)C);
+``acc``  accelerometer errors counted measured − true (+1) or true − measured (−1);
+``gyro`` the same for the gyro errors.
+
+The sign of the gravity disturbance is not open: eq. (3-6) defines δg^n = g^n − g_m^n.  A
+convention multiplies a block of F by the product of the signs of its row and column states and
+a block of H (whose Z is printed as SINS − GNSS) by the sign of its column; so for each printed
+block and each state group the derivation gives the printed form, its negative or neither
+(:func:`judge`).  A printed part is derivable when one convention reproduces all its terms;
+two printed parts of one model contradict each other when no convention reproduces both
+(:func:`common_conventions`).  Trigonometric identities are applied exactly by :func:`is_zero`.
+
+The printed forms are read from ``data/paper/chen2019/chen2019-check-derivations.csv`` (column
+``value``: each printed block or equation in sympy syntax, names in :func:`namespace`); the
+chapter passes them in.  The findings module turns the results into table rows.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+__all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rotation_from_quaternion",
+           "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
+           "common_conventions", "companion_check", "convention_text", "check_all"]
+
+# ----------------------------------------------------------------------------- symbols
+
+_POS = dict(positive=True)
+L, h, Rm, Rn, w, gam = sp.symbols("L h R_m R_n omega_ie gamma", real=True)
+VE, VN, VU = sp.symbols("V_E V_N V_U", real=True)
+fE, fN, fU = sp.symbols("f_E f_N f_U", real=True)
+fx, fy, fz = sp.symbols("f_x f_y f_z", real=True)
+wx, wy, wz = sp.symbols("omega_x omega_y omega_z", real=True)
+alpha, beta = sp.symbols("alpha beta", **_POS)
+q0, q1, q2, q3 = sp.symbols("q0:4", real=True)
+
+_STATE_NAMES = {
+    "position": ("dL", "dlambda", "dh"),
+    "velocity": ("dV_E", "dV_N", "dV_U"),
+    "attitude": ("a_E", "a_N", "a_U"),
+    "accel": ("nabla_x", "nabla_y", "nabla_z"),
+    "accel scale": ("dK_ax", "dK_ay", "dK_az"),
+    "gyro": ("epsilon_x", "epsilon_y", "epsilon_z"),
+    "gyro scale": ("dK_gx", "dK_gy", "dK_gz"),
+    "gravity": ("dg_E", "dg_N", "dg_U"),
+}
+GROUPS = {g: sp.Matrix(sp.symbols(" ".join(n), real=True)) for g, n in _STATE_NAMES.items()}
+"""The error states by group (position, velocity, attitude, accelerometer bias and scale factor,
+gyro drift and scale factor, gravity disturbance), each a 3-vector of sympy symbols."""
+
+_SIGN_OF = {"position": "e", "velocity": "e", "attitude": "a", "accel": "acc", "accel scale": "acc",
+            "gyro": "gyro", "gyro scale": "gyro", "gravity": None}
+
+CONVENTIONS = tuple(dict(zip(("e", "a", "acc", "gyro"), s)) for s in itertools.product((1, -1), repeat=4))
+"""The sixteen sign conventions the text leaves open (module docstring), each a dict of ±1."""
+
+CONVENTION_WORDS = {
+    ("e", 1): "errors computed − true", ("e", -1): "errors true − computed",
+    ("a", 1): "attitude error φ (Ĉ = (I − φ×)C)", ("a", -1): "attitude error ψ = −φ (Ĉ = (I + ψ×)C)",
+    ("acc", 1): "accelerometer errors measured − true", ("acc", -1): "accelerometer errors true − measured",
+    ("gyro", 1): "gyro errors measured − true", ("gyro", -1): "gyro errors true − measured",
+}
+"""Each convention sign in words."""
+
+
+def symbols() -> dict:
+    """The scalar symbols of the derivation, by the names the printed readings use.
+
+    Returns
+    -------
+    dict of str to sympy.Symbol
+        L, h, Rm, Rn (R_m, R_n), w (ω_ie), gam (γ), VE, VN, VU, fE, fN, fU (f^n), fx, fy, fz
+        (f^b), wx, wy, wz (ω_ib^b), alpha, beta (the correlation times of eq. (2-5)).
+    """
+    return dict(L=L, h=h, Rm=Rm, Rn=Rn, w=w, gam=gam, VE=VE, VN=VN, VU=VU, fE=fE, fN=fN, fU=fU, fx=fx, fy=fy,
+                fz=fz, wx=wx, wy=wy, wz=wz, alpha=alpha, beta=beta)
+
+
+def _skew(v):
+    return sp.Matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+
+def _vee(m):
+    return sp.Matrix([m[2, 1], m[0, 2], m[1, 0]])
+
+
+def _cross(a, b):
+    return sp.Matrix(a).cross(sp.Matrix(b))
+
+
+def rotation_from_quaternion():
+    """C_b^n as the rotation of an unnormalised quaternion (q0, q1, q2, q3): R(q)/|q|².
+
+    Every entry is rational in q, and C Cᵀ = I and C (ω×) Cᵀ = ((Cω)×) hold as rational identities,
+    so orthogonality is applied exactly by :func:`is_zero` (``cancel``).
+
+    Returns
+    -------
+    C : sympy.Matrix, shape (3, 3)
+        The direction cosine matrix, same layout as :func:`replication.nav.rotations.quat_to_dcm`.
+    """
+    a, b, c, d = q0, q1, q2, q3
+    n = a**2 + b**2 + c**2 + d**2
+    R = sp.Matrix([[a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)],
+                   [2 * (b * c + a * d), a * a - b * b + c * c - d * d, 2 * (c * d - a * b)],
+                   [2 * (b * d - a * c), 2 * (c * d + a * b), a * a - b * b - c * c + d * d]])
+    return R / n
+
+
+C = sp.Matrix(3, 3, lambda i, j: sp.Symbol(f"C_{i + 1}{j + 1}", real=True))
+"""C_b^n as nine symbols; its orthogonality enters the derivation only through :func:`rotation_lemma`."""
+
+
+def rotation_lemma() -> bool:
+    """Whether C Cᵀ = I and C (ω×) Cᵀ = ((C ω)×) hold identically for :func:`rotation_from_quaternion`.
+
+    The two identities that turn the perturbed attitude update into φ̇ = −ω_in × φ + δω_in − C δω.
+
+    Returns
+    -------
+    bool
+        True when both differences cancel to zero.
+    """
+    u = sp.Matrix(sp.symbols("u1:4", real=True))
+    Q = rotation_from_quaternion()
+    ok1 = all(sp.cancel(x) == 0 for x in (Q * Q.T - sp.eye(3)))
+    ok2 = all(sp.cancel(x) == 0 for x in (Q * _skew(u) * Q.T - _skew(Q * u)))
+    return ok1 and ok2
+
+
+def _w_ie(lat):
+    return sp.Matrix([0, w * sp.cos(lat), w * sp.sin(lat)])
+
+
+def _w_en(lat, hh, v):
+    return sp.Matrix([-v[1] / (Rm + hh), v[0] / (Rn + hh), v[0] * sp.tan(lat) / (Rn + hh)])
+
+
+@dataclass(frozen=True)
+class _Base:
+    rows: dict
+    specific_force: sp.Matrix
+
+
+_BASE = None
+
+
+def base_model():
+    """The linearised error rates in the base convention (all signs +1), from first principles.
+
+    Perturbs the mechanization of the module docstring with δL, δh, δV (additive), Ĉ = (I − φ×)C,
+    f̂^b = (I + δK_a) f^b + ∇, ω̂^b = (I + δK_g) ω^b + ε and the disturbance δg of eq. (3-6)
+    (true gravity g_m + δg, the SINS using g_m), and differentiates the computed-minus-true rates
+    with respect to the perturbation at zero.  The attitude rate is read off
+    Φ̇ = [−ΦĊ − ∂(ĈΩ̂_ib − Ω̂_in Ĉ)] Cᵀ (Φ = φ×), which :func:`rotation_lemma` makes skew.
+
+    Returns
+    -------
+    rows : dict of str to sympy.Matrix
+        ``position``, ``velocity``, ``attitude``: 3-vectors linear in the states of
+        :data:`GROUPS`; ``specific force``: δf^n = Ĉ f̂^b − C f^b to first order (f^n = C f^b
+        written with its own symbols f_E, f_N, f_U).
+    """
+    global _BASE
+    if _BASE is not None:
+        return _BASE
+    e = sp.Symbol("e")
+    G = GROUPS
+    dp, dv, phi = G["position"], G["velocity"], G["attitude"]
+    V = sp.Matrix([VE, VN, VU])
+    fn = sp.Matrix([fE, fN, fU])
+    fb = sp.Matrix([fx, fy, fz])
+    wb = sp.Matrix([wx, wy, wz])
+    Lh, hh, Vh = L + e * dp[0], h + e * dp[2], V + e * dv
+    Phi = _skew(phi)
+    # position rates
+    prate = lambda lat, hgt, v: sp.Matrix([v[1] / (Rm + hgt), v[0] / ((Rn + hgt) * sp.cos(lat)), v[2]])
+    pos = sp.diff(prate(Lh, hh, Vh), e).subs(e, 0)
+    # specific force in n: Ĉ f̂^b = (I - eΦ) C ((I + e dKa) f^b + e ∇), with C f^b = f^n
+    dKa, dKg = sp.diag(*G["accel scale"]), sp.diag(*G["gyro scale"])
+    sf_hat = (sp.eye(3) - e * Phi) * (fn + e * C * (dKa * fb + G["accel"]))
+    sf = sp.diff(sf_hat, e).subs(e, 0)
+    g_m = sp.Matrix([0, 0, -gam])
+    vel_hat = sf_hat - _cross(2 * _w_ie(Lh) + _w_en(Lh, hh, Vh), Vh) + g_m
+    vel_true = fn - _cross(2 * _w_ie(L) + _w_en(L, h, V), V) + g_m + e * G["gravity"]
+    vel = sp.diff(vel_hat - vel_true, e).subs(e, 0)
+    # attitude: Ĉ = (I - eΦ) C, mechanization Ĉ' = Ĉ Ω̂_ib - Ω̂_in Ĉ, so that
+    # Φ̇ C = -ΦĊ - ∂_e(Ĉ Ω̂_ib - Ω̂_in Ĉ) =: M and Φ̇ = M Cᵀ (C orthogonal)
+    w_in = _w_ie(L) + _w_en(L, h, V)
+    Cdot = C * _skew(wb) - _skew(w_in) * C
+    Chat = (sp.eye(3) - e * Phi) * C
+    dw = dKg * wb + G["gyro"]
+    w_in_hat = _w_ie(Lh) + _w_en(Lh, hh, Vh)
+    M = (-Phi * Cdot - sp.diff(Chat * _skew(wb + e * dw) - _skew(w_in_hat) * Chat, e).subs(e, 0)).expand()
+    gyro0 = {s: 0 for s in list(G["gyro"]) + list(G["gyro scale"])}
+    # the gyro-free part of M is X C with X free of C, so Φ̇ = X C Cᵀ = X
+    X = M.subs(gyro0).subs({C[i, j]: int(i == j) for i in range(3) for j in range(3)})
+    if any(sp.expand(x) != 0 for x in (M.subs(gyro0) - X * C)):
+        raise ArithmeticError("the gyro-free part of the attitude rate is not X C")
+    # the gyro part of M is -C (δω×), so Φ̇ = -C (δω×) Cᵀ = -((C δω)×) (rotation_lemma)
+    if any(sp.expand(x) != 0 for x in (M - M.subs(gyro0) + C * _skew(dw))):
+        raise ArithmeticError("the gyro part of the attitude rate is not -C (δω×)")
+    Phidot = X - _skew(C * dw)
+    if not all(is_zero(x) for x in (Phidot + Phidot.T)):
+        raise ArithmeticError("the attitude-error rate is not skew")
+    att = _vee(Phidot)
+    _BASE = _Base(rows={"position": pos, "velocity": vel, "attitude": att}, specific_force=sf)
+    return _BASE
+
+
+# ----------------------------------------------------------------------------- printed readings
+
+def namespace(generic: bool = False) -> dict:
+    """The names a printed reading may use (column ``value`` of chen2019-check-derivations).
+
+    Parameters
+    ----------
+    generic : bool
+        For the perturbation equations (3-3), (3-7), (3-8): adds independent perturbations
+        ``df`` (δf^n), ``Dwie``, ``Dwen`` (δω_ie^n, δω_en^n), ``Dg`` (δg^n), ``Vdot``, ``dVdot``,
+        ``gm``, ``dgm`` (g_m^n and its perturbation).
+
+    Returns
+    -------
+    dict
+        Scalars of :func:`symbols`; the state vectors ``dp``, ``dV``, ``att`` (also ``phi``,
+        ``psi``), ``nabla``, ``eps``, ``dg`` and the diagonal ``dKa``, ``dKg``; the components
+        ``dL``, ``dl``, ``dh``, ``dVE``, ``dVN``, ``dVU``; ``V``, ``f`` (f^n), ``fb``, ``wb``, ``C``
+        and ``C11`` … ``C33``; ``wie``, ``wen`` and their error perturbations ``dwie``, ``dwen``;
+        ``cross``, ``Matrix``, ``eye``, ``zeros``, ``diag``, ``sec``, ``tan``, ``cos``, ``sin``.
+    """
+    G = GROUPS
+    V = sp.Matrix([VE, VN, VU])
+    dp, dv = G["position"], G["velocity"]
+    wie, wen = _w_ie(L), _w_en(L, h, V)
+    jac = lambda vec: vec.jacobian([L, h]) * sp.Matrix([dp[0], dp[2]]) + vec.jacobian([VE, VN, VU]) * dv
+    ns = dict(symbols())
+    ns.update(dp=dp, dV=dv, att=G["attitude"], phi=G["attitude"], psi=G["attitude"], nabla=G["accel"],
+              eps=G["gyro"], dg=G["gravity"], dKa=sp.diag(*G["accel scale"]), dKg=sp.diag(*G["gyro scale"]),
+              dL=dp[0], dl=dp[1], dh=dp[2], dVE=dv[0], dVN=dv[1], dVU=dv[2], V=V, f=sp.Matrix([fE, fN, fU]),
+              fb=sp.Matrix([fx, fy, fz]), wb=sp.Matrix([wx, wy, wz]), C=C, wie=wie, wen=wen, dwie=jac(wie),
+              dwen=jac(wen), cross=_cross, Matrix=sp.Matrix, eye=sp.eye, zeros=sp.zeros, diag=sp.diag, sec=sp.sec,
+              tan=sp.tan, cos=sp.cos, sin=sp.sin)
+    ns.update({f"C{i + 1}{j + 1}": C[i, j] for i in range(3) for j in range(3)})
+    if generic:
+        vec = lambda name: sp.Matrix(sp.symbols(f"{name}1:4", real=True))
+        ns.update(df=vec("df"), Dwie=vec("Dwie"), Dwen=vec("Dwen"), Dg=vec("Dg"), Vdot=vec("Vdot"),
+                  dVdot=vec("dVdot"), gm=vec("gm"), dgm=vec("dgm"))
+    return ns
+
+
+def parse(text: str, generic: bool = False) -> sp.Matrix:
+    """A printed reading (sympy syntax) as a sympy Matrix in the names of :func:`namespace`.
+
+    Parameters
+    ----------
+    text : str
+        The reading, e.g. ``"Matrix([[0, -fU, fN], [fU, 0, -fE], [-fN, fE, 0]])"``.
+    generic : bool
+        Use the namespace with independent perturbations (:func:`namespace`).
+
+    Returns
+    -------
+    sympy.Matrix
+        The expression (a scalar becomes a 1×1 matrix).
+
+    Raises
+    ------
+    ValueError
+        When the text is empty or names something the namespace lacks.
+    """
+    if not isinstance(text, str) or not text.strip():
+        raise ValueError("a printed reading must be non-empty sympy text")
+    try:
+        out = sp.sympify(text, locals=namespace(generic))
+    except (sp.SympifyError, TypeError, NameError) as exc:
+        raise ValueError(f"cannot read {text!r} in the names of derivations.namespace(): {exc}") from exc
+    return out if isinstance(out, sp.MatrixBase) else sp.Matrix([out])
+
+
+_S, _K = sp.symbols("_sinL _cosL")
+
+
+def is_zero(expr) -> bool:
+    """Whether a scalar expression vanishes identically (exact, not numerical).
+
+    tan L and sec L are written through sin L and cos L, the expression is brought over one
+    denominator (``cancel``), and the
+    numerator is reduced modulo sin²L + cos²L − 1.
+
+    Parameters
+    ----------
+    expr : sympy expression
+        The difference to test.
+
+    Returns
+    -------
+    bool
+        True when the expression is identically zero.
+    """
+    e = sp.sympify(expr)
+    if e == 0:
+        return True
+    e = e.subs({sp.sec(L): 1 / sp.cos(L), sp.tan(L): sp.sin(L) / sp.cos(L)}).subs({sp.sin(L): _S, sp.cos(L): _K})
+    num, _ = sp.fraction(sp.cancel(sp.together(e)))
+    num = sp.expand(num)
+    if num == 0:
+        return True
+    if not num.has(_S) and not num.has(_K):
+        return False
+    _, r = sp.reduced(num, [_S**2 + _K**2 - 1], _S, _K)
+    return sp.expand(r) == 0
+
+
+# ----------------------------------------------------------------------------- judging
+
+@dataclass
+class Check:
+    """One printed part against its derivation.
+
+    Attributes
+    ----------
+    name : str
+        The printed part (the quantity of chen2019-check-derivations).
+    kind : str
+        ``equation`` (a row group of F as a linear form), ``block`` (a block of F or H),
+        ``generic`` (a perturbation identity, no convention), ``vector`` or ``pair`` (two
+        printed parts compared with each other).
+    matches : dict
+        State group -> set of signs s (±1) with printed = s × derived for that group's terms.
+    conventions : list of dict
+        The conventions of :data:`CONVENTIONS` that reproduce every compared term.
+    differing : list of tuple of str
+        The entries no sign reproduces: (entry, printed, derived) in plain text; for a ``pair``,
+        (entry, this print, the other print).
+    spherical : bool or None
+        Whether the print is derivable when R_n is set equal to R_m (a spherical Earth), for a
+        block or equation that is not derivable otherwise; None when not tried.
+    derived : sympy.Matrix or None
+        The derived form in the base convention (or the derived expression of a generic check).
+    printed : sympy.Matrix or None
+        The printed reading.
+    """
+
+    name: str
+    kind: str
+    matches: dict = field(default_factory=dict)
+    conventions: list = field(default_factory=list)
+    differing: list = field(default_factory=list)
+    derived: object = None
+    printed: object = None
+    spherical: object = None
+
+    @property
+    def agrees(self) -> bool:
+        """Whether some convention (or, for a generic check, the identity) reproduces the print."""
+        return bool(self.conventions)
+
+
+def _short(x) -> str:
+    return sp.sstr(sp.simplify(x))
+
+
+def judge(name, printed, derived, *, row, groups, kind="block") -> Check:
+    """Compare a printed linear form (or block) with the derived one, group by group, under every convention.
+
+    For each state group the printed terms are compared with +1 and −1 times the derived terms;
+    a convention reproduces the print when, for every group, the product of the row sign and the
+    group's sign (:data:`CONVENTIONS`) is one that matches, and the state-free terms agree.
+
+    Parameters
+    ----------
+    name : str
+        The printed part.
+    printed, derived : sympy.Matrix
+        Column vectors linear in the states of ``groups`` (``kind='equation'``) or blocks
+        (``kind='block'``, then ``groups`` has one group: the block's columns).
+    row : str or None
+        The convention sign of the rows (``'e'`` for position/velocity rows, ``'a'`` for the
+        attitude rows, None for H rows, whose Z the print fixes as SINS − GNSS).
+    groups : sequence of str
+        State groups of :data:`GROUPS` compared.
+    kind : str
+        ``'equation'`` or ``'block'``.
+
+    Returns
+    -------
+    Check
+        The result, with the matching conventions and the differing entries.
+
+    Raises
+    ------
+    ValueError
+        For shapes that differ or an unknown group.
+    """
+    unknown = set(groups) - set(GROUPS)
+    if unknown:
+        raise ValueError(f"unknown state groups {sorted(unknown)}; known: {sorted(GROUPS)}")
+    if printed.shape != derived.shape:
+        raise ValueError(f"{name}: printed shape {printed.shape} differs from derived {derived.shape}")
+    chk = Check(name, kind, derived=derived, printed=printed)
+    const_ok = True
+    if kind == "equation":
+        zero = {s: 0 for g in GROUPS.values() for s in g}
+        const_ok = all(is_zero(x) for x in (printed.subs(zero) - derived.subs(zero)))
+        if not const_ok:
+            extra = printed.subs(zero) - derived.subs(zero)
+            chk.differing.append(("terms with no error state", _short(extra.T), "none"))
+        parts = {g: (printed.jacobian(GROUPS[g]), derived.jacobian(GROUPS[g])) for g in groups}
+    else:
+        parts = {groups[0]: (printed, derived)}
+    for g, (P, D) in parts.items():
+        chk.matches[g] = {s for s in (1, -1) if all(is_zero(x) for x in (P - s * D))}
+        if not chk.matches[g]:
+            best = max((1, -1), key=lambda s: sum(is_zero(x) for x in (P - s * D)))
+            for i in range(P.rows):
+                for j in range(P.cols):
+                    if not is_zero(P[i, j] - best * D[i, j]):
+                        where = f"{g} term ({i + 1},{j + 1})" if kind == "equation" else f"({i + 1},{j + 1})"
+                        chk.differing.append((where, _short(P[i, j]), _short(best * D[i, j])))
+    if const_ok:
+        for s in CONVENTIONS:
+            rs = s[row] if row else 1
+            if all(rs * (s[_SIGN_OF[g]] if _SIGN_OF[g] else 1) in chk.matches[g] for g in parts):
+                chk.conventions.append(s)
+    return chk
+
+
+def common_conventions(checks) -> list:
+    """The conventions under which every one of ``checks`` holds.
+
+    Parameters
+    ----------
+    checks : sequence of Check
+        Printed parts of one model.
+
+    Returns
+    -------
+    list of dict
+        The shared conventions; empty when the printed parts contradict each other.
+    """
+    out = list(CONVENTIONS)
+    for c in checks:
+        out = [s for s in out if s in c.conventions]
+    return out
+
+
+def convention_text(convs) -> str:
+    """The conventions of a list in words: the signs they all share, or ``'none'``.
+
+    Parameters
+    ----------
+    convs : sequence of dict
+        Conventions of :data:`CONVENTIONS`.
+
+    Returns
+    -------
+    str
+        E.g. ``'errors computed − true; attitude error ψ = −φ (Ĉ = (I + ψ×)C)'``; ``'any'`` when
+        every convention holds.
+    """
+    convs = list(convs)
+    if not convs:
+        return "none"
+    if len(convs) == len(CONVENTIONS):
+        return "any"
+    fixed = [k for k in ("e", "a", "acc", "gyro") if len({s[k] for s in convs}) == 1]
+    text = "; ".join(CONVENTION_WORDS[(k, convs[0][k])] for k in fixed)
+    if not fixed:
+        pairs = [f"{a}·{b} = {convs[0][a] * convs[0][b]:+d}" for a, b in itertools.combinations(("e", "a", "acc", "gyro"), 2)
+                 if len({s[a] * s[b] for s in convs}) == 1]
+        text = "sign products " + ", ".join(pairs)
+    return text
+
+
+# ----------------------------------------------------------------------------- the items
+
+def _generic_derivation(item):
+    ns = namespace(generic=True)
+    e = sp.Symbol("e")
+    cr = _cross
+    if item == "perturbation of (3-2)":
+        rhs = lambda f_, wie_, wen_, v_, g_: f_ - cr(2 * wie_ + wen_, v_) + g_
+        return sp.diff(rhs(ns["f"] + e * ns["df"], ns["wie"] + e * ns["Dwie"], ns["wen"] + e * ns["Dwen"],
+                           ns["V"] + e * ns["dV"], ns["gm"] + e * ns["Dg"]), e).subs(e, 0)
+    if item == "(3-2) solved for g, minus g_m":
+        # (3-2): Vdot = f - (2 wie + wen) x V + g ; (3-6): g = g_m + dg
+        return ns["Vdot"] - C * ns["fb"] + cr(2 * ns["wie"] + ns["wen"], ns["V"]) - ns["gm"]
+    if item == "perturbation of (3-7)":
+        rhs = lambda vd, f_, wie_, wen_, v_, g_: vd - f_ + cr(2 * wie_ + wen_, v_) - g_
+        return sp.diff(rhs(ns["Vdot"] + e * ns["dVdot"], ns["f"] + e * ns["df"], ns["wie"] + e * ns["Dwie"],
+                           ns["wen"] + e * ns["Dwen"], ns["V"] + e * ns["dV"], ns["gm"] + e * ns["dgm"]), e).subs(e, 0)
+    raise ValueError(f"unknown generic derivation {item!r}")
+
+
+def check_item(name, reading, spec, readings=None) -> Check:
+    """Check one printed part, given its reading and what it is (a row of the paper file).
+
+    Parameters
+    ----------
+    name : str
+        The printed part.
+    reading : str
+        Its printed form in sympy syntax (:func:`parse`).
+    spec : str
+        What the part is, ``<kind>:<arguments>``: ``equation:<row group>:<groups, comma-separated>``
+        (a row group of F as a linear form); ``block:<row group>:<column group>`` (a block of F);
+        ``H:<column group>`` or ``H:specific force:<column group>`` (a block of H for the position/
+        velocity rows or the specific-force rows of Z = SINS − GNSS); ``sf`` (δf^n, eq. (3-4));
+        ``markov:<accel|gyro>`` (the Gauss-Markov dynamics of eq. (2-5)); ``gravity`` (g^n in
+        ENU); ``H-position`` (Z position rows in radians); ``generic:<item>`` (a perturbation
+        identity, see :func:`check_all`); ``pair:<other name>`` (two printed parts, compared
+        with each other); ``substitute:<generic item>:<name of (3-4)>`` ((3-8): the perturbation
+        of (3-7) with the printed (3-4) substituted).
+    readings : dict, optional
+        Name -> reading of every printed part (needed by ``pair`` and ``substitute``).
+
+    Returns
+    -------
+    Check
+        The result.
+
+    Raises
+    ------
+    ValueError
+        For an unknown spec.
+    """
+    kind, _, rest = spec.partition(":")
+    if kind in ("generic", "substitute"):
+        item, _, other = rest.partition(":")
+        P = parse(reading, generic=True)
+        D = _generic_derivation(item)
+        if kind == "substitute":
+            ns = namespace(generic=True)
+            D = D.subs(dict(zip(ns["df"], parse(readings[other], generic=True))))
+        ok = all(is_zero(x) for x in (P - D))
+        diff = [] if ok else [(f"row {i + 1}", _short(P[i]), _short(D[i])) for i in range(P.rows)
+                              if not is_zero(P[i] - D[i])]
+        return Check(name, "generic", conventions=list(CONVENTIONS) if ok else [], differing=diff, derived=D, printed=P)
+    P = parse(reading)
+    if kind in ("equation", "block"):
+        rowgroup, _, cols = rest.partition(":")
+        D = base_model().rows[rowgroup]
+        D, k = (D, "equation") if kind == "equation" else (D.jacobian(GROUPS[cols]), "block")
+        chk = judge(name, P, D, row=_SIGN_OF[rowgroup], groups=cols.split(","), kind=k)
+        if not chk.agrees:
+            sph = {Rn: Rm}
+            chk.spherical = judge(name, P.subs(sph), D.subs(sph), row=_SIGN_OF[rowgroup], groups=cols.split(","),
+                                  kind=k).agrees
+        return chk
+    if kind == "sf":
+        return judge(name, P, base_model().specific_force, row="e", groups=["attitude", "accel"], kind="equation")
+    if kind == "H":
+        if rest.startswith("specific force:"):
+            col = rest.split(":", 1)[1]
+            z = base_model().specific_force - GROUPS["gravity"]       # Z_a = Ĉf̂ - C f - δg (true kinematics)
+            return judge(name, P, z.jacobian(GROUPS[col]), row=None, groups=[col])
+        D = sp.eye(3) if rest in ("position", "velocity") else sp.zeros(3)
+        return judge(name, P, D, row=None, groups=[rest])
+    if kind == "markov":
+        # eq. (2-5): ε_m' = -ε_m/α (gyro), ∇_m' = -∇_m/β (accelerometer)
+        D = -sp.eye(3) / (alpha if rest == "gyro" else beta)
+        ok = all(is_zero(x) for x in (P - D))
+        return Check(name, "generic", conventions=list(CONVENTIONS) if ok else [],
+                     differing=[] if ok else [("diagonal", _short(P[0, 0]), _short(D[0, 0]))],
+                     derived=D, printed=P)
+    if kind == "gravity":
+        # ENU: the third axis points up, gravity down
+        D = sp.Matrix([0, 0, -gam])
+        ok = all(is_zero(x) for x in (P - D))
+        return Check(name, "vector", conventions=list(CONVENTIONS) if ok else [],
+                     differing=[] if ok else [("vector", _short(P.T), _short(D.T))], derived=D, printed=P)
+    if kind == "H-position":
+        # Z rows 1-3 printed in radians (L_SINS - L_GPS ...): H = I
+        return judge(name, P, sp.eye(3), row=None, groups=["position"])
+    if kind == "pair":
+        Q = parse(readings[rest])
+        ok = P.shape == Q.shape and all(is_zero(x) for x in (P - Q))
+        diff = [] if ok else [(f"({i + 1},{j + 1})", _short(P[i, j]), _short(Q[i, j]))
+                              for i in range(P.rows) for j in range(P.cols) if not is_zero(P[i, j] - Q[i, j])]
+        return Check(name, "pair", conventions=list(CONVENTIONS) if ok else [], differing=diff, derived=Q, printed=P)
+    raise ValueError(f"unknown spec {spec!r} for {name!r}")
+
+
+def companion_check(order: int):
+    """The AR(p) model of eq. (3-11) in companion form, derived: its characteristic polynomial and size.
+
+    x_k = (y_k, y_{k−1}, …, y_{k−p+1}), x_{k+1} = A x_k + (ω, 0, …, 0) with A's first row
+    (φ_1 … φ_p) and ones below the diagonal; the output is y_k = (1, 0, …, 0) x_k.
+
+    Parameters
+    ----------
+    order : int
+        The AR order p (at least 1).
+
+    Returns
+    -------
+    agrees : bool
+        Whether det(zI − A) = z^p − φ_1 z^{p−1} − … − φ_p, the polynomial of (3-11).
+    states : int
+        The number of states per axis, p.
+
+    Raises
+    ------
+    ValueError
+        For an order below 1.
+    """
+    if int(order) != order or order < 1:
+        raise ValueError("the AR order must be a positive integer")
+    p = int(order)
+    ph = sp.symbols(f"phi1:{p + 1}")
+    z = sp.Symbol("z")
+    A = sp.zeros(p)
+    A[0, :] = sp.Matrix([ph])
+    for i in range(1, p):
+        A[i, i - 1] = 1
+    poly = (z * sp.eye(p) - A).det()
+    target = z**p - sum(ph[k] * z**(p - 1 - k) for k in range(p))
+    return sp.expand(poly - target) == 0, p
+
+
+def check_all(items) -> dict:
+    """Check every printed part of chen2019-check-derivations.
+
+    Parameters
+    ----------
+    items : sequence of (name, reading, spec)
+        The rows of the paper file: quantity, ``value`` (the reading) and ``spec`` (what the part
+        is, see :func:`check_item`).
+
+    Returns
+    -------
+    dict of str to Check
+        Name -> result, in the order given.
+    """
+    readings = {n: r for n, r, _ in items}
+    return {n: check_item(n, r, s, readings) for n, r, s in items}

@@ -1,0 +1,190 @@
+"""chen2019's printed error model against its symbolic derivation (replication.papers.chen2019.derivations).
+
+The derivation is held against the package's numerical matrices (the finite-difference Jacobian
+of the mechanization and ``ErrorModel.F``) at a random flight state; planted sign errors in the
+printed readings must be seen; the errata and the contradictions of the chapter are pinned.
+"""
+
+import math
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from replication.nav import earth
+from replication.nav import errors as E
+from replication.nav.rotations import euler_to_dcm
+from replication.papers.chen2019 import derivations as dv
+from replication.papers.chen2019 import findings, table_2_2
+from replication.registry import reproduction as rp
+
+
+@pytest.fixture(scope="module")
+def printed():
+    return rp.load_paper("chen2019-check-derivations").data
+
+
+@pytest.fixture(scope="module")
+def readings(printed):
+    return {r.quantity: (r.value, r.spec) for r in printed.itertuples() if r.spec != "ar-states"}
+
+
+@pytest.fixture(scope="module")
+def checks(readings):
+    return dv.check_all([(n, v, s) for n, (v, s) in readings.items()])
+
+
+def _point(seed):
+    rng = np.random.default_rng(seed)
+    lat = math.radians(rng.uniform(20, 60))
+    return E.NavPoint(lat, 0.3, rng.uniform(0, 8000), rng.uniform(-150, 150, 3) * np.array([1, 1, 0.05]),
+                      euler_to_dcm(*rng.uniform(-0.5, 0.5, 3) * np.array([6, 1, 1])),
+                      np.array([0.0, 0.0, 9.8]) + rng.normal(0, 1.0, 3), rng.normal(0, 0.05, 3))
+
+
+def _numeric(expr, p):
+    """A derived matrix evaluated at the NavPoint ``p``."""
+    rm, rn = earth.radii(p.lat)
+    fn = p.C_bn @ p.f_b
+    s = dv.symbols()
+    vals = {s["L"]: p.lat, s["h"]: p.h, s["Rm"]: rm, s["Rn"]: rn, s["w"]: earth.OMEGA_IE,
+            s["VE"]: p.v_enu[0], s["VN"]: p.v_enu[1], s["VU"]: p.v_enu[2], s["fE"]: fn[0], s["fN"]: fn[1],
+            s["fU"]: fn[2], s["fx"]: p.f_b[0], s["fy"]: p.f_b[1], s["fz"]: p.f_b[2], s["wx"]: p.w_ib_b[0],
+            s["wy"]: p.w_ib_b[1], s["wz"]: p.w_ib_b[2]}
+    vals.update({dv.C[i, j]: p.C_bn[i, j] for i in range(3) for j in range(3)})
+    return np.array(expr.subs(vals).evalf(), dtype=float)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_derived_navigation_block_equals_the_finite_difference_jacobian(seed):
+    p = _point(seed)
+    base = dv.base_model()
+    G = dv.GROUPS
+    nav = sp.Matrix.vstack(*(base.rows[r] for r in ("position", "velocity", "attitude")))
+    states = list(G["position"]) + list(G["velocity"]) + list(G["attitude"])
+    D = _numeric(nav.jacobian(states), p)
+    J = table_2_2.frozen_earth_jacobian(p)
+    # the Richardson-extrapolated differences agree with closed forms to ~3e-9 of each block's scale
+    for r in range(3):
+        for c in range(3):
+            blk = (slice(3 * r, 3 * r + 3), slice(3 * c, 3 * c + 3))
+            scale = max(np.abs(D[blk]).max(), 1e-30)
+            assert np.abs(D[blk] - J[blk]).max() <= 1e-7 * scale, (r, c)
+
+
+def test_derived_sensor_columns_equal_the_package_error_model():
+    p = _point(3)
+    m = E.model_15(accel_bias_sd=1e-3, gyro_bias_sd=1e-7).extend(E.accel_scale(1e-5), E.gyro_scale(1e-5))
+    F = m.F(p)
+    s = m.slices
+    base = dv.base_model()
+    G = dv.GROUPS
+    pairs = [("velocity", "accel", (slice(3, 6), s["accel_bias"])), ("velocity", "accel scale", (slice(3, 6), s["accel_scale"])),
+             ("attitude", "gyro", (slice(6, 9), s["gyro_bias"])), ("attitude", "gyro scale", (slice(6, 9), s["gyro_scale"]))]
+    for row, col, blk in pairs:
+        D = _numeric(base.rows[row].jacobian(G[col]), p)
+        # closed forms on both sides: equal to rounding
+        np.testing.assert_allclose(D, F[blk], rtol=0, atol=1e-12 * max(1.0, np.abs(F[blk]).max()), err_msg=f"{row}/{col}")
+
+
+def test_rotation_identities_and_exact_zero_test():
+    assert dv.rotation_lemma()
+    L = dv.symbols()["L"]
+    assert dv.is_zero(sp.sec(L) ** 2 - 1 - sp.tan(L) ** 2)
+    assert dv.is_zero(sp.sec(L) * sp.tan(L) - sp.sin(L) / sp.cos(L) ** 2)
+    assert not dv.is_zero(sp.sec(L) - 1)
+
+
+def test_printed_f_blocks_against_derivation(checks):
+    bad = {n for n, c in checks.items() if not c.agrees}
+    assert {"Table 2-2 F21", "Table 2-2 F22", "Table 2-2 F23", "Table 2-2 F43", "(3-17) F21", "(3-17) F22",
+            "(3-17) F33"} <= bad
+    where = lambda n: {w for w, _, _ in checks[n].differing}
+    assert where("(3-17) F22") == {"(1,1)", "(3,1)"}
+    assert where("Table 2-2 F22") == {"(1,1)", "(3,1)", "(3,2)", "(3,3)"}
+    assert where("Table 2-2 F21") == where("(3-17) F21") == {"(2,3)", "(3,3)"}
+    assert where("(3-17) F33") == {"(2,1)"}
+    for n in ("(3-17) F11", "(3-17) F12", "(3-17) F23", "(3-17) F31", "(3-17) F32", "Table 2-2 F41", "Table 2-2 F42"):
+        assert checks[n].agrees, n
+
+
+def test_corrected_blocks_are_derivable(readings):
+    v, s = readings["(3-17) F22"]
+    fixed = v.replace("(VN*tan(L) - VU)/(Rm + h)", "(VN*tan(L) - VU)/(Rn + h)").replace(
+        "[2*w*cos(L) + VE/(Rn + h),", "[2*w*cos(L) + 2*VE/(Rn + h),")
+    assert dv.check_item("F22 corrected", fixed, s).agrees
+    v, s = readings["(3-17) F33"]
+    assert dv.check_item("F33 corrected", v.replace("[-w*sin(L) - VE/(Rn + h)", "[-w*sin(L) - VE*tan(L)/(Rn + h)"), s).agrees
+
+
+@pytest.mark.parametrize("name, old, new", [
+    ("(3-17) F12", "[sec(L)/(Rn + h), 0, 0]", "[-sec(L)/(Rn + h), 0, 0]"),
+    ("(3-17) F23", "[[0, -fU, fN]", "[[0, fU, fN]"),
+    ("(3-17) F31", "[-w*sin(L), 0,", "[w*sin(L), 0,"),
+    ("(3-18) H2", "[-fU, 0, fE]", "[-fU, 0, -fE]"),
+    ("(3-14)", "+ dVN/(Rm + h)", "- dVN/(Rm + h)"),
+    ("(3-16)", "+ dwie + dwen", "+ dwie - dwen"),
+    ("(3-5)", "- cross(2*dwie + dwen, V)", "- cross(2*dwie + 2*dwen, V)"),
+    ("(3-4)", "+ C*nabla", "+ 2*C*nabla"),
+    ("(2-15) attitude line", "C*dKg*wb", "-C*dKg*wb"),
+])
+def test_a_planted_error_in_a_derivable_part_is_seen(readings, name, old, new):
+    v, s = readings[name]
+    assert old in v, "the plant must change the reading"
+    assert dv.check_item(name, v, s, {k: r for k, (r, _) in readings.items()}).agrees
+    assert not dv.check_item(name, v.replace(old, new), s, {k: r for k, (r, _) in readings.items()}).agrees
+
+
+def test_a_whole_block_negated_is_seen_unless_a_convention_absorbs_it(readings):
+    v, s = readings["(3-17) F12"]
+    assert not dv.check_item("F12 negated", f"-({v})", s).agrees        # e² = 1: no convention
+    v, s = readings["(3-17) F23"]
+    c = dv.check_item("F23 negated", f"-({v})", s)
+    assert c.agrees and all(x["e"] * x["a"] == -1 for x in c.conventions)  # the ψ = -φ reading
+
+
+def test_coriolis_terms_of_2_15_and_3_15_are_not_derivable(checks, readings):
+    assert not checks["(3-15)"].agrees and not checks["(2-15) velocity line"].agrees
+    assert checks["(3-3)"].agrees and checks["(3-5)"].agrees
+    v, s = readings["(3-15)"]
+    fixed = v.replace("+ cross(2*dwie + 2*dwen, V)", "- cross(2*dwie + dwen, V)")
+    assert dv.check_item("(3-15) fixed", fixed, s).agrees
+    v, s = readings["(2-15) velocity line"]
+    assert dv.check_item("(2-15) fixed", v.replace("+ cross(2*dwie + 2*wen, V)", "- cross(2*dwie + dwen, V)"), s).agrees
+
+
+def test_gravity_vector_of_3_1_points_up_in_enu(checks):
+    assert not checks["(3-1) g_m^n"].agrees
+    # the package's ENU gravity, used by its mechanization: down, of the size of γ
+    lat, h = math.radians(47.0), 100.0
+    g = np.asarray(earth.gravity_enu(lat, h), float)
+    gamma = float(earth.normal_gravity(lat, h))
+    assert g[2] < 0 and abs(g[2] + gamma) < 1e-3 * gamma
+    # and, from the derivation's side, the printed Z of (3-18) at rest would read 2γ with +γ
+    assert checks["(3-1) g_m^n"].derived == sp.Matrix([0, 0, -dv.symbols()["gam"]])
+
+
+def test_chapter_3_parts_need_conventions_that_exclude_each_other(checks):
+    for label, parts in findings.DERIVATION_GROUPS.items():
+        assert all(checks[p].agrees for p in parts), label
+        assert dv.common_conventions([checks[p] for p in parts]) == [], label
+    assert {(x["e"], x["a"], x["acc"]) for x in checks["(3-5)"].conventions} == {(-1, 1, -1)}
+    assert checks["(3-18) H2"].matches == {"attitude": {-1}}
+
+
+def test_markov_constants_of_table_2_2_swap_alpha_and_beta(checks):
+    assert not checks["Table 2-2 F6"].agrees and not checks["Table 2-2 F7"].agrees
+
+
+def test_companion_form_and_bad_input():
+    assert dv.companion_check(3) == (True, 3)
+    with pytest.raises(ValueError, match="AR order"):
+        dv.companion_check(0)
+    with pytest.raises(ValueError, match="non-empty"):
+        dv.parse("  ")
+    with pytest.raises(ValueError, match="cannot read"):
+        dv.parse("unknown_name(")
+    with pytest.raises(ValueError, match="unknown state groups"):
+        dv.judge("x", sp.eye(3), sp.eye(3), row=None, groups=["nonsense"])
+    with pytest.raises(ValueError, match="unknown spec"):
+        dv.check_item("x", "eye(3)", "nonsense")
