@@ -357,7 +357,7 @@ PROBES += [
     ("order_criteria(y too short for the grid)", "y", lambda: identification.order_criteria(_Y0[:30])),
     ("identification_rates(methods = 'aic')", "methods",
      lambda: identification.identification_rates(n_runs=2, seed=0, methods="aic")),
-    ("identification_rates(lengths = [30])", "lengths", lambda: identification.identification_rates([30], n_runs=2, seed=0)),
+    ("identification_rates(lengths = [30])", "lengths", lambda: identification.identification_rates(lengths=[30], n_runs=2, seed=0)),
     ("identification_rates(models: non-invertible MA)", "models",
      lambda: identification.identification_rates({"MA(1)": ((), (1.5,))}, n_runs=2, seed=0)),
     ("identification_rates(n_runs = 0)", "n_runs", lambda: identification.identification_rates(n_runs=0, seed=0)),
