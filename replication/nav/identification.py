@@ -635,7 +635,7 @@ def identification_rates(models=None, lengths=(60, 100, 300), *, n_runs: int, se
     The series are identified in chunks on ``executor`` (:func:`replication.nav.parallel.run_chunks`;
     each chunk is handed its own series, so the result is the same for any executor and chunking).
     The cost is the criteria's grid: (max_ar + 1)(max_ma + 1) exact-likelihood fits per series,
-    about 0.5 s of one core at n ≤ 300; the printed route costs a few per cent of that.
+    about 0.3 s of one core at n ≤ 300; the printed route costs a few per cent of that.
 
     Parameters
     ----------
