@@ -28,7 +28,18 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from replication import __main__ as cli
-from replication.nav import _validate, errors, kalman, rotations, sensors, strapdown, timeseries, trajectory
+from replication.nav import (
+    _validate,
+    errors,
+    identification,
+    kalman,
+    rotations,
+    sensors,
+    stationarity,
+    strapdown,
+    timeseries,
+    trajectory,
+)
 from replication.nav.units import DEG
 from replication.registry import reproduction as rp
 
@@ -151,7 +162,7 @@ _ARRAY_CALLS = {
     "gauss_markov_recursion": (lambda a: sensors.gauss_markov_recursion(a, 0.5), "w", (3,)),
     "NavState.v_enu": (lambda a: strapdown.NavState(LAT, LON, H, a, I3), "v_enu", (3,)),
     "NavState.C_bn": (lambda a: strapdown.NavState(LAT, LON, H, np.zeros(3), a), "C_bn", (3, 3)),
-    "timeseries.difference": (lambda a: timeseries.difference(np.resize(a, 60), 1), "y", (3,)),
+    "stationarity.difference": (lambda a: stationarity.difference(np.resize(a, 60), 1), "y", (3,)),
     "model_15.position_sd": (lambda a: errors.model_15(position_sd=a), "position_sd", (3,)),
     "earth-radii via NavState.lat": (lambda a: strapdown.NavState(a[0], LON, H, np.zeros(3), I3), "lat", (3,)),
     "rts_smoother": (lambda a: kalman.rts_smoother(np.resize(a, (2, 3)), np.tile(np.eye(3), (2, 1, 1)),
@@ -308,13 +319,13 @@ def test_a_constant_or_collinear_series_is_refused_by_the_ar_least_squares(level
 def test_a_constant_series_is_refused_by_every_statistic():
     y = np.full(200, 3.0)
     for call in (lambda: timeseries.fit_ar(y, 2, check=False), lambda: timeseries.aic_by_order(y, 3),
-                 lambda: timeseries.acf_printed(y, 5), lambda: timeseries.pacf_printed(y, 5),
-                 lambda: timeseries.correlogram(y, 5), lambda: timeseries.identify_model(y),
-                 lambda: timeseries.cutoff_aic(y, 1, 1), lambda: timeseries.select_order_checked(y, 3),
-                 lambda: timeseries.inversion_test(y, 10)):
+                 lambda: identification.acf_printed(y, 5), lambda: identification.pacf_printed(y, 5),
+                 lambda: identification.correlogram(y, 5), lambda: identification.identify_model(y),
+                 lambda: identification.cutoff_aic(y, 1, 1), lambda: timeseries.select_order_checked(y, 3),
+                 lambda: stationarity.inversion_test(y, 10)):
         _refused(call, "y")
     _refused(lambda: timeseries.aic_batch(np.ones((2, 100)), 3), "Y[0]")
-    np.testing.assert_array_equal(timeseries.difference(y, 1), np.zeros(199))      # a constant may be differenced
+    np.testing.assert_array_equal(stationarity.difference(y, 1), np.zeros(199))      # a constant may be differenced
 
 
 def test_a_valid_ar_fit_is_unchanged():

@@ -4,10 +4,13 @@ import itertools
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 from statsmodels.tsa.ar_model import AutoReg, ar_select_order
 from statsmodels.tsa.stattools import acf, pacf
 
+from replication.nav import identification as idn
+from replication.nav import stationarity as stn
 from replication.nav import timeseries as ts
 from replication.registry import reproduction as rp
 
@@ -33,25 +36,25 @@ def ar3():
 
 @pytest.mark.parametrize("m", [2, 3, 5, 7])
 def test_inversion_moments_equal_exact_permutation_moments(m):
-    counts = [ts.inversion_count(np.array(p, float)) for p in itertools.permutations(range(m))]
-    ea, da = ts.inversion_moments(m)
+    counts = [stn.inversion_count(np.array(p, float)) for p in itertools.permutations(range(m))]
+    ea, da = stn.inversion_moments(m)
     assert np.mean(counts) == pytest.approx(ea, abs=1e-12)
     assert np.var(counts) == pytest.approx(da, abs=1e-12)
 
 
 @pytest.mark.parametrize("m", [4, 20, 50])
 def test_inversion_distribution_moments(m):
-    pmf = ts.inversion_distribution(m)
+    pmf = stn.inversion_distribution(m)
     a = np.arange(pmf.size)
-    ea, da = ts.inversion_moments(m)
+    ea, da = stn.inversion_moments(m)
     assert pmf @ a == pytest.approx(ea, rel=1e-12)
     assert pmf @ (a - ea) ** 2 == pytest.approx(da, rel=1e-10)
 
 
 def test_inversion_count_counts_larger_later_values():
-    assert ts.inversion_count([1, 2, 3, 4]) == 6
-    assert ts.inversion_count([4, 3, 2, 1]) == 0
-    assert ts.inversion_count([2, 1, 3]) == 2
+    assert stn.inversion_count([1, 2, 3, 4]) == 6
+    assert stn.inversion_count([4, 3, 2, 1]) == 0
+    assert stn.inversion_count([2, 1, 3]) == 2
 
 
 def test_inversion_test_on_known_inputs():
@@ -60,11 +63,11 @@ def test_inversion_test_on_known_inputs():
     t = np.arange(4000)
     up = 0.002 * t + rng.standard_normal(4000)
     down = -0.002 * t + rng.standard_normal(4000)
-    w = ts.inversion_test(white, 20)
+    w = stn.inversion_test(white, 20)
     assert w.stationary and w.stationary_printed
-    u = ts.inversion_test(up, 20)
+    u = stn.inversion_test(up, 20)
     assert not u.stationary and not u.stationary_printed
-    d = ts.inversion_test(down, 20)
+    d = stn.inversion_test(down, 20)
     # the printed one-sided rule "stationary if B < 1.96" accepts a decreasing trend
     assert d.stationary_printed and d.statistic < -1.96
     assert not d.stationary
@@ -72,44 +75,44 @@ def test_inversion_test_on_known_inputs():
 
 def test_inversion_test_rejects_bad_segments():
     with pytest.raises(ValueError, match="segments"):
-        ts.inversion_test(np.zeros(10), 1)
+        stn.inversion_test(np.zeros(10), 1)
     with pytest.raises(ValueError, match="fewer segments"):
-        ts.inversion_test(np.zeros(10), 8)
+        stn.inversion_test(np.zeros(10), 8)
 
 
 @pytest.mark.slow
 def test_stationarity_report_on_white_noise_and_random_walks():
     rng = np.random.default_rng(7)
-    rep = ts.stationarity_report(rng.standard_normal(3000), 20).set_index("test")["stationary"]
+    rep = stn.stationarity_report(rng.standard_normal(3000), 20).set_index("test")["stationary"]
     assert rep.all()
     # 40 random walks: ADF keeps the unit root and KPSS rejects stationarity in ~95 % of cases each;
     # requiring >= 80 % leaves a binomial margin of > 3 sigma
     walks = np.cumsum(rng.standard_normal((40, 1000)), axis=1)
-    verdicts = np.array([ts.stationarity_report(w, 20)["stationary"].to_numpy() for w in walks])
+    verdicts = np.array([stn.stationarity_report(w, 20)["stationary"].to_numpy() for w in walks])
     assert (~verdicts[:, 2]).mean() >= 0.8 and (~verdicts[:, 3]).mean() >= 0.8
 
 
 def test_difference_and_make_stationary():
     rng = np.random.default_rng(3)
     rw = np.cumsum(rng.standard_normal(3000))
-    np.testing.assert_array_equal(ts.difference(rw, 1), np.diff(rw))
-    y, d, t = ts.make_stationary(rw, 20)
+    np.testing.assert_array_equal(stn.difference(rw, 1), np.diff(rw))
+    y, d, t = stn.make_stationary(rw, 20)
     assert d == 1 and t.stationary
     with pytest.raises(ValueError, match="non-negative"):
-        ts.difference(rw, -1)
+        stn.difference(rw, -1)
 
 
 # --------------------------------------------------------------------------- identification
 
 def test_acf_and_pacf_as_printed_equal_statsmodels(ar3):
     y = ar3 - ar3.mean()
-    np.testing.assert_allclose(ts.acf_printed(y, 12), acf(ar3, nlags=12, adjusted=False, fft=False), atol=1e-12)
-    np.testing.assert_allclose(ts.pacf_printed(y, 12), pacf(ar3, nlags=12, method="ywm"), atol=1e-10)
+    np.testing.assert_allclose(idn.acf_printed(y, 12), acf(ar3, nlags=12, adjusted=False, fft=False), atol=1e-12)
+    np.testing.assert_allclose(idn.pacf_printed(y, 12), pacf(ar3, nlags=12, method="ywm"), atol=1e-10)
 
 
 def test_correlogram_bands():
     y = np.random.default_rng(0).standard_normal(2500)
-    cg = ts.correlogram(y, 10)
+    cg = idn.correlogram(y, 10)
     np.testing.assert_allclose(cg["pacf_band"], 1.959964 / math.sqrt(2500), rtol=1e-5)
     assert cg["acf_band"].iloc[0] == pytest.approx(1.959964 / math.sqrt(2500), rel=1e-5)
     assert (np.diff(cg["acf_band"]) >= 0).all()  # Bartlett's band widens with the lag
@@ -119,12 +122,12 @@ def test_cutoff_lag_rule():
     band = np.full(30, 0.05)
     c = np.zeros(30)
     c[:2] = [0.5, 0.3]
-    assert ts.cutoff_lag(c, band, max_lag=10) == 2
+    assert idn.cutoff_lag(c, band, max_lag=10) == 2
     slow = 0.95 ** np.arange(1, 31)
-    assert ts.cutoff_lag(slow, band, max_lag=10) is None
+    assert idn.cutoff_lag(slow, band, max_lag=10) is None
     gap = c.copy()
     gap[4] = 0.5  # a strong value after a gap is not chance
-    assert ts.cutoff_lag(gap, band, max_lag=10) == 5
+    assert idn.cutoff_lag(gap, band, max_lag=10) == 5
 
 
 @pytest.mark.parametrize("kind", ["AR2", "MA1", "white"])
@@ -140,7 +143,7 @@ def test_identify_model_on_known_processes(kind):
     else:
         y = rng.standard_normal(5000)
         expect = ("white noise", 0)
-    ident = ts.identify_model(y)
+    ident = idn.identify_model(y)
     assert (ident.model, ident.order) == expect
 
 
@@ -167,10 +170,10 @@ def test_design_matrix_as_printed():
 def test_fit_ar_refuses_non_stationary_input():
     rng = np.random.default_rng(5)
     rw = np.cumsum(rng.standard_normal(5000))
-    with pytest.raises(ts.NonStationaryError, match="not stationary.*difference"):
+    with pytest.raises(stn.NonStationaryError, match="not stationary.*difference"):
         ts.fit_ar(rw, 2)
     trend = 0.001 * np.arange(5000) + rng.standard_normal(5000)
-    with pytest.raises(ts.NonStationaryError, match="inversion test"):
+    with pytest.raises(stn.NonStationaryError, match="inversion test"):
         ts.fit_ar(trend, 2)
     ts.fit_ar(np.diff(rw), 2)  # the differenced walk is accepted
 
@@ -238,7 +241,7 @@ def test_printed_east_model_is_not_stationary():
     c = ts.check_ar_model(phi, paper.value("noise variance dg_E"))
     assert not c["stationary"] and c["max_pole_modulus"] > 1.07
     assert ts.is_stationary(-np.asarray(phi))  # the sign-reversed (A-polynomial) reading is stable
-    with pytest.raises(ts.NonStationaryError):
+    with pytest.raises(stn.NonStationaryError):
         ts.ar_variance(phi, 1.0)
 
 
@@ -298,10 +301,10 @@ def test_order_recovery_of_a_clear_ar1():
 
 def test_identification_behaviours_follow_table_3_1():
     rng = np.random.default_rng(12)
-    ar2 = ts.identify_model(ts.simulate_ar([1.2, -0.5], 1.0, 7200, 1, rng)[0])
+    ar2 = idn.identify_model(ts.simulate_ar([1.2, -0.5], 1.0, 7200, 1, rng)[0])
     assert (ar2.acf_behaviour, ar2.pacf_behaviour) == ("tails off", "cuts off")
     e = rng.standard_normal(7201)
-    ma1 = ts.identify_model(e[1:] + 0.7 * e[:-1])
+    ma1 = idn.identify_model(e[1:] + 0.7 * e[:-1])
     assert (ma1.acf_behaviour, ma1.pacf_behaviour) == ("cuts off", "tails off")
 
 
@@ -323,11 +326,11 @@ def test_select_order_checked_flags_a_round_off_aic_column():
 def test_order_selection_and_stationarity_refuse_what_they_cannot_judge():
     rng = np.random.default_rng(12)
     walk = np.cumsum(rng.standard_normal(2000))
-    with pytest.raises(ts.NonStationaryError, match="not stationary"):
+    with pytest.raises(stn.NonStationaryError, match="not stationary"):
         ts.select_order(walk, 10)                      # as fit_ar: no order for a random walk
     assert ts.select_order(walk, 10, check=False) >= 1  # the unchecked AIC still runs when asked
     with pytest.raises(ValueError, match="constant"):
-        ts.inversion_test(np.full(200, 3.0), 10)
+        stn.inversion_test(np.full(200, 3.0), 10)
 
 
 # --------------------------------------------------------------------------- short oscillatory series
@@ -351,9 +354,9 @@ def test_sunspots_identified_as_ar2_in_agreement_with_information_criteria(sunsp
     from statsmodels.tsa.stattools import arma_order_select_ic
 
     assert len(sunspots) == 100
-    old = ts.identify_model(sunspots, rule="earliest")
+    old = idn.identify_model(sunspots, rule="earliest")
     assert (old.model, old.order) == ("MA", 1)
-    new = ts.identify_model(sunspots)
+    new = idn.identify_model(sunspots)
     assert (new.model, new.order) == ("AR", 2)
     assert (new.acf_behaviour, new.pacf_behaviour) == ("tails off", "cuts off")
     y = sunspots - sunspots.mean()
@@ -364,7 +367,7 @@ def test_sunspots_identified_as_ar2_in_agreement_with_information_criteria(sunsp
     assert sel.bic_min_order[0] == 2 and sel.aic_min_order[0] == 2
     # exact likelihood and the conditional sums of squares rank AR(2) far above MA(1): the
     # AIC gap (~70 exact) is many times the 4 units of the rule's margin
-    a = ts.cutoff_aic(sunspots, 2, 1)
+    a = idn.cutoff_aic(sunspots, 2, 1)
     assert sel.aic.loc[2, 0] < sel.aic.loc[0, 1] - 4 and a["AR"] < a["MA"] - 4
 
 
@@ -374,35 +377,105 @@ def test_identification_rate_at_100_samples():
     (the interval's lower end above 0.8), where the lag reading alone fails most of the time;
     on an ordinary AR(1) and MA(1) the rule loses nothing: its rate is not below the lower end
     of the lag reading's interval."""
-    osc = ts.identification_rate([1.0, -0.5], [], 100, n_series=500, seed=2019)
+    osc = idn.identification_rate([1.0, -0.5], [], 100, n_series=500, seed=2019)
     assert osc.loc["aic", "low"] >= 0.8 and osc.loc["earliest", "high"] < 0.5
     for phi, theta in (([0.7], []), ([], [0.7])):
-        r = ts.identification_rate(phi, theta, 100, n_series=500, seed=2019)
+        r = idn.identification_rate(phi, theta, 100, n_series=500, seed=2019)
         assert r.loc["aic", "rate"] >= r.loc["earliest", "low"]
     with pytest.raises(ValueError, match="rule"):
-        ts.identify_model(np.random.default_rng(0).standard_normal(200), rule="latest")
+        idn.identify_model(np.random.default_rng(0).standard_normal(200), rule="latest")
 
 
 def test_stationarity_gate_pairs_adf_with_kpss(sunspots):
     """ADF cannot reject a unit root on the sunspot numbers (p ~ 0.2: little power on a short
     pseudo-periodic series) but KPSS does not reject stationarity: accepted with a warning.
     A random walk that passes the inversion test (seed 4) fails both: refused."""
-    with pytest.warns(ts.StationarityWarning, match="KPSS"):
+    with pytest.warns(stn.StationarityWarning, match="KPSS"):
         fit = ts.fit_ar(sunspots, 2)
     assert ts.is_stationary(fit.params)
-    with pytest.warns(ts.StationarityWarning):
+    with pytest.warns(stn.StationarityWarning):
         assert ts.select_order(sunspots, 10) >= 2
     walk = np.cumsum(np.random.default_rng(4).standard_normal(2000))
-    assert ts.inversion_test(walk, 10).stationary       # so the unit-root pair decides
-    with pytest.raises(ts.NonStationaryError, match="KPSS test rejects stationarity"):
-        ts.require_stationary_series(walk, 10)
+    assert stn.inversion_test(walk, 10).stationary       # so the unit-root pair decides
+    with pytest.raises(stn.NonStationaryError, match="KPSS test rejects stationarity"):
+        stn.require_stationary_series(walk, 10)
 
 
 def test_stationarity_report_thresholds_follow_alpha():
     """The ADF and KPSS thresholds are the critical values at the requested level, never a silent 5 %."""
     y = np.random.default_rng(1).standard_normal(300)
-    at = {a: ts.stationarity_report(y, 10, alpha=a).set_index("test")["threshold"] for a in (0.01, 0.05, 0.10, 0.07)}
+    at = {a: stn.stationarity_report(y, 10, alpha=a).set_index("test")["threshold"] for a in (0.01, 0.05, 0.10, 0.07)}
     adf, kp = "ADF (null: unit root)", "KPSS (null: stationary)"
     assert at[0.01][adf] < at[0.05][adf] < at[0.10][adf] < 0          # more negative at a smaller level
     assert at[0.01][kp] > at[0.05][kp] > at[0.10][kp] > 0
     assert np.isnan(at[0.07][adf]) and np.isnan(at[0.07][kp])        # not tabulated: no threshold shown
+
+
+# --------------------------------------------------------------------------- information-criterion route
+
+@pytest.mark.parametrize("phi, theta, seed", [([0.75, -0.5], [], 1), ([], [0.6], 2), ([0.6], [0.4], 3)])
+def test_criteria_route_is_statsmodels_order_selection(phi, theta, seed):
+    """The route calls statsmodels' exact-likelihood grid: its AIC/BIC tables are the same fits
+    (identical up to round-off, 1e-9 relative, far below the 2-unit penalty that decides an order),
+    its chosen orders are statsmodels' minima, and one cell equals a direct ARIMA fit."""
+    import warnings
+
+    from statsmodels.tsa.arima.model import ARIMA
+    from statsmodels.tsa.stattools import arma_order_select_ic
+
+    y = idn.simulate_arma(phi, theta, 150, 1, np.random.default_rng(seed))[0]
+    crit = idn.order_criteria(y)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref = arma_order_select_ic(y - y.mean(), max_ar=4, max_ma=2, ic=["aic", "bic"], trend="n")
+        direct = ARIMA(y - y.mean(), order=(1, 0, 1), trend="n").fit()
+    assert not crit.isna().any().any()
+    for ic in ("aic", "bic"):
+        np.testing.assert_allclose(crit[ic].unstack().to_numpy(), ref[ic].to_numpy(), rtol=1e-9)
+        got = idn.identify_model(y, method=ic)
+        assert got.orders == tuple(int(v) for v in ref[f"{ic}_min_order"]) and got.method == ic
+    assert crit.loc[(1, 1), "aic"] == pytest.approx(direct.aic, rel=1e-9)
+    assert crit.loc[(1, 1), "bic"] == pytest.approx(direct.bic, rel=1e-9)
+
+
+def test_criteria_route_names_class_from_orders():
+    """(p, 0) is AR(p), (0, q) MA(q), (0, 0) white noise, anything else ARMA with its orders,
+    and the cut-offs are those Table 3-1 implies for the class; a failed fit (NaN) is never
+    the minimum, unlike statsmodels' own argmin over |AIC - min| (NaN first)."""
+    idx = pd.MultiIndex.from_product([range(3), range(2)], names=["p", "q"])
+    for best, want in (((2, 0), ("AR", 2, None, 2)), ((0, 1), ("MA", 1, 1, None)), ((0, 0), ("white noise", 0, 0, 0)),
+                       ((1, 1), ("ARMA", None, None, None))):
+        crit = pd.DataFrame({"aic": 10.0, "bic": 10.0}, index=idx)
+        crit.loc[best] = 1.0
+        crit.iloc[0 if best != (0, 0) else 1] = np.nan
+        got = idn._from_orders(crit, "bic")
+        assert (got.model, got.order, got.acf_cutoff, got.pacf_cutoff) == want and got.orders == best
+
+
+def test_identification_rates_intervals_are_wilson_and_chunking_free():
+    """Counts of discrete outcomes with Wilson 95 % intervals (statsmodels' proportion_confint),
+    the same for any chunking and executor; the routes see the same series."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from statsmodels.stats.proportion import proportion_confint
+
+    models = {"AR(1)": ((0.6,), ()), "MA(1)": ((), (0.6,))}
+    r = idn.identification_rates(models, (60,), n_runs=6, seed=5, methods=("printed", "bic"), max_ar=2, max_ma=1)
+    assert list(r.index.names) == ["model", "n", "method"] and len(r) == 4
+    for _, row in r.iterrows():
+        lo, hi = proportion_confint(row.hits, row.runs, alpha=0.05, method="wilson")
+        assert (row.low, row.high) == (lo, hi) and row.low <= row.rate <= row.high
+        assert row.rate == row.hits / row.runs and 0 <= row.hits <= row.runs == 6
+    with ThreadPoolExecutor(2) as ex:
+        again = idn.identification_rates(models, (60,), n_runs=6, seed=5, methods=("printed", "bic"), max_ar=2,
+                                         max_ma=1, executor=ex, chunk_runs=5)
+    pd.testing.assert_frame_equal(r, again)
+
+
+def test_identification_rates_score_arma_by_class_on_the_printed_route():
+    """The printed route names no ARMA orders: its ARMA(1,1) hits count the class, the criteria's
+    hits the class and the orders (1, 1); a long ARMA(1,1) series is ARMA(1,1) by BIC."""
+    y = idn.simulate_arma([0.6], [0.4], 2000, 1, np.random.default_rng(7))[0]
+    got = idn.identify_model(y, method="bic")
+    assert (got.model, got.orders) == ("ARMA", (1, 1))
+    assert idn.identify_model(y).orders is None

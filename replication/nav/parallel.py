@@ -4,7 +4,7 @@ One place for the chunking, submission and reassembly that the batch entry point
 (:func:`replication.nav.kalman.monte_carlo`, ``chen2019.simulation.run_batch`` and
 ``chen2019.turntable.run_scenario``, ``chen2019.gravity.compensation_runs``, ``chen2019.observability.sweep``,
 ``chen2019.error_effects.error_effects``, ``fang2020.polar.simulate`` and ``sensitivity``,
-``duan2023.airdata.simulate`` and ``sweep``).
+``duan2023.airdata.simulate`` and ``sweep``, ``nav.identification.identification_rates``).
 An entry point describes one chunk as a picklable callable ``task(r0, r1)`` (a module-level
 function bound with ``functools.partial``) that computes the runs ``r0 … r1−1`` and returns their
 results with the runs on the first axis; :func:`run_chunks` submits the chunks, waits for them in

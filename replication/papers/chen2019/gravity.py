@@ -55,6 +55,7 @@ from replication.nav import trajectory as tj
 from replication.nav._validate import positive
 from replication.nav.measurements.gnss import GnssPosition, GnssVelocity
 from replication.nav.measurements.specific_force import SpecificForce
+from replication.nav.stationarity import inversion_test
 from replication.nav.strapdown import NavSolution, validate_increments, validate_time
 from replication.nav.timeseries import (
     ar_coefficients,
@@ -62,7 +63,6 @@ from replication.nav.timeseries import (
     check_ar_model,
     fit_ar,
     gauss_markov,
-    inversion_test,
     is_stationary,
 )
 from replication.nav.units import MGAL
