@@ -21,7 +21,8 @@ A paragraph names its rows in one of these ways:
   row); ``register`` names the register ``tables/register.csv``.  A choice the print leaves open
   may also be backed by the readings ledger that spans it (a table id ending in ``-readings``,
   CONTRIBUTING.md "Readings and the main reading"): that ledger is the row of an unstated choice
-  that the print's own numbers decide;
+  that the print's own numbers decide; so may a row whose note names what the print leaves unstated
+  (an approximation or choice the print does not state, recorded and sized by the row);
 * an HTML comment ``<!-- no finding: <reason> -->`` where the words do not state a finding (a
   definition of a status, a method description, "not an erratum", a finding of the package's own
   analog rather than of the print).
@@ -53,6 +54,8 @@ PENDING_TABLES = {"chen2019-derivations"}
 
 WORDS = {kind: re.compile(rf"\b(?:{pat})\b", re.IGNORECASE) for kind, pat in FINDING_WORDS.items()}
 ROWS = re.compile(r"<!--\s*rows:\s*(.*?)-->", re.DOTALL)
+UNSTATED_NOTE = re.compile(rf"\b(?:{FINDING_WORDS['unverifiable']}|omission)\b", re.IGNORECASE)
+"""A row's note that names what the print leaves unstated."""
 SPEC_SEP = re.compile(r";\s*(?=[a-z0-9][a-z0-9-]*\s*(?:#|;|$))")
 """Between the rows of a note: a ``;`` followed by a table id (a quantity may hold ``;`` itself)."""
 NO_FINDING = re.compile(r"<!--\s*no finding:\s*(\S.*?)-->", re.DOTALL)
@@ -127,7 +130,7 @@ def _row_problems(spec: str, wanted: set[str]) -> list[str]:
     rows = df if not quantity else df[df["quantity"] == quantity]
     if rows.empty:
         return [f"no row {quantity!r} in {tid}"]
-    if "unverifiable" in wanted and tid.endswith("-readings"):
+    if "unverifiable" in wanted and (tid.endswith("-readings") or rows["note"].str.contains(UNSTATED_NOTE).any()):
         return []
     if not set(rows["status"]) & wanted:
         return [f"{spec}: status {sorted(set(rows['status']))}, the words call for {sorted(wanted)}"]
