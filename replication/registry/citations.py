@@ -334,8 +334,9 @@ def doi_rows(printed: pd.DataFrame) -> list[dict[str, Any]]:
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`, named ``DOI of reference [n]``,
-        then one ``DOI suffix shared by ...`` per suffix that two entries print.
+        Rows for :func:`replication.registry.reproduction.compare`, named ``DOI of reference [n]``, the
+        DOI in the note (a long DOI does not fit a table column) and, for a row that disagrees, as its
+        printed text (the register shows it), then one ``DOI suffix shared by ...`` per suffix that two entries print.
 
     Raises
     ------
@@ -364,10 +365,12 @@ def doi_rows(printed: pd.DataFrame) -> list[dict[str, Any]]:
             problems.append(f"the prefix {prefix} has no registrant code of four or more digits")
         if embedded and year is not None and int(embedded.group("year")) != year:
             problems.append(f"the DOI carries the year {embedded.group('year')}, the entry prints {year}")
-        rows.append(dict(quantity=f"DOI of {q}", unit="", paper_text=doi, reproduced=f"line {line}", basis="parts",
-                         agrees=not problems,
-                         note=("the DOI has the registered form" + (f" and the entry's year {year}" if embedded else "")
-                               if not problems else "; ".join(problems) + ": the DOI and its entry disagree")))
+        rows.append(dict(quantity=f"DOI of {q}", unit="", reproduced=f"line {line}", basis="parts", agrees=not problems,
+                         **({"paper_text": doi} if problems else {}),
+                         note=f"printed DOI:{doi}; " + ("the DOI has the registered form"
+                                                        + (f" and the entry's year {year}" if embedded else "")
+                                                        if not problems else "; ".join(problems)
+                                                        + ": the DOI and its entry disagree")))
     for suffix, qs in suffixes.items():
         if len(qs) > 1:
             rows.append(dict(quantity=f"DOI suffix shared by {' and '.join(qs)}", unit="", paper_text=suffix,
