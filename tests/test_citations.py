@@ -94,3 +94,20 @@ def test_chen2019_volumes_out_of_step():
     rows = C.volume_rows(rp.load_paper("chen2019-print-references").data)
     bad = sorted(r["quantity"] for r in rows if not r["agrees"])
     assert bad == ["volume of [55] against Navigation", "volume of [62] against 中国惯性技术学报"]
+
+
+def test_doi_rows_check_the_prefix_the_year_and_shared_suffixes():
+    from replication.registry import citations as C
+
+    df = pd.DataFrame({"quantity": ["reference [1]", "reference [2]", "reference [3]"],
+                       "value": ["A. X [J]. Ship Electronic Engineering, 2014, 34(2): 47. DOI:10.3969/j.issn.1672-9730.2014.02.013",
+                                 "B. Y [J]. J. Traffic, 2011, 11(3): 100. DOI:10.369/j.issn.1672-9730.2014.02.013",
+                                 "C. Z [J]. Sensors, 2017, 17(7): 1599. DOI:10.3390/s17071599"],
+                       "line": [1, 2, 3]})
+    rows = {r["quantity"]: r for r in C.doi_rows(df)}
+    assert rows["DOI of reference [1]"]["agrees"] and rows["DOI of reference [3]"]["agrees"]
+    bad = rows["DOI of reference [2]"]
+    assert not bad["agrees"] and "10.369" in bad["note"] and "2014" in bad["note"] and "2011" in bad["note"]
+    assert not rows["DOI suffix shared by reference [1] and reference [2]"]["agrees"]
+    with pytest.raises(ValueError, match="prints no 'DOI:'"):
+        C.doi_rows(df.assign(value="no doi here"))

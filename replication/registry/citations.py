@@ -32,7 +32,7 @@ from typing import Any
 import pandas as pd
 
 __all__ = ["SAME_WORK", "SAME_STEP", "cited_numbers", "duplicate_pairs", "entry_year", "journal_volume",
-           "reversed_pages", "reference_rows", "volume_rows"]
+           "reversed_pages", "reference_rows", "volume_rows", "doi_rows"]
 
 SAME_WORK = 0.85
 """The similarity ratio from which two entries of a list are the same work (see the module docstring)."""
@@ -307,4 +307,73 @@ def volume_rows(printed: pd.DataFrame, *, same_step: int = SAME_STEP) -> list[di
                              note=(f"year minus volume {y - v}, as {others}: one volume a year" if ok else
                                    f"year minus volume {y - v}; {others} give {step}: by them the volume of {y} "
                                    f"is {y - step}, not {v}")))
+    return rows
+
+
+_DOI = re.compile(r"DOI\s*[:：]\s*(?P<doi>10\.[^\s/]*/\S+?)[.。]?\s*$", re.IGNORECASE)
+_DOI_PREFIX = re.compile(r"^10\.\d{4,}(?:\.\d+)*$")
+_DOI_ISSN_YEAR = re.compile(r"j\.issn\.\d{4}-\d{3}[\dXx]\.(?P<year>(?:19|20)\d{2})\.")
+
+
+def doi_rows(printed: pd.DataFrame) -> list[dict[str, Any]]:
+    """Comparison rows (``basis="parts"``), one per entry that prints a DOI: the DOI against its entry.
+
+    Criteria, fixed before comparing: the DOI's prefix is ``10.`` and a registrant code of at least
+    four digits (the form of every registered prefix, DOI Handbook §2.2), and a DOI that carries an
+    ISSN and a year (``j.issn.<ISSN>.<year>.``, the form of Chinese journals) carries the entry's own
+    year (:func:`entry_year`): a DOI that fails one and the entry that prints it are two printed parts
+    that disagree.  Two entries that print one DOI suffix (the part after the ``/``) give one more
+    row, ``DOI suffix shared by ...``, which disagrees.
+
+    Parameters
+    ----------
+    printed : pandas.DataFrame
+        The transcription: ``quantity`` (``reference [n]``), ``value`` (the entry as printed, with its
+        ``DOI:``) and ``line``.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.reproduction.compare`, named ``DOI of reference [n]``, the
+        DOI in the note (a long DOI does not fit a table column) and, for a row that disagrees, as its
+        printed text (the register shows it), then one ``DOI suffix shared by ...`` per suffix that two entries print.
+
+    Raises
+    ------
+    ValueError
+        When a transcribed entry prints no ``DOI:``, or the columns are missing.
+    """
+    missing = {"quantity", "value", "line"} - set(printed.columns)
+    if missing:
+        raise ValueError(f"doi_rows: the transcription lacks the columns {sorted(missing)}")
+    found = {}
+    for q, v, line in printed[["quantity", "value", "line"]].itertuples(index=False):
+        m = _DOI.search(str(v).strip())
+        if not m:
+            raise ValueError(f"doi_rows: {q} (line {line}) prints no 'DOI:' at its end: {v!r}")
+        found[q] = (m.group("doi"), str(v), line)
+    suffixes: dict[str, list[str]] = {}
+    for q, (doi, _, _) in found.items():
+        suffixes.setdefault(doi.split("/", 1)[1].lower(), []).append(q)
+    rows = []
+    for q, (doi, entry, line) in found.items():
+        prefix, suffix = doi.split("/", 1)
+        year = entry_year(entry)
+        embedded = _DOI_ISSN_YEAR.search(suffix)
+        problems = []
+        if not _DOI_PREFIX.match(prefix):
+            problems.append(f"the prefix {prefix} has no registrant code of four or more digits")
+        if embedded and year is not None and int(embedded.group("year")) != year:
+            problems.append(f"the DOI carries the year {embedded.group('year')}, the entry prints {year}")
+        rows.append(dict(quantity=f"DOI of {q}", unit="", reproduced=f"line {line}", basis="parts", agrees=not problems,
+                         **({"paper_text": doi} if problems else {}),
+                         note=f"printed DOI:{doi}; " + ("the DOI has the registered form"
+                                                        + (f" and the entry's year {year}" if embedded else "")
+                                                        if not problems else "; ".join(problems)
+                                                        + ": the DOI and its entry disagree")))
+    for suffix, qs in suffixes.items():
+        if len(qs) > 1:
+            rows.append(dict(quantity=f"DOI suffix shared by {' and '.join(qs)}", unit="", paper_text=suffix,
+                             reproduced=f"{len(qs)} entries", basis="parts", agrees=False,
+                             note=f"{' and '.join(qs)} print one DOI suffix for different works: two printed parts disagree"))
     return rows

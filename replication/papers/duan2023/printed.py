@@ -30,7 +30,8 @@ from replication.papers.duan2023.derivation import (
 )
 
 __all__ = ["printed_elements", "check_elements", "agree_to_first_order", "manifold_residuals",
-           "consistency_count", "interval_motion", "integrate_eq21", "EQ21_ROWS", "EQ21_STARTS"]
+           "consistency_count", "interval_motion", "integrate_eq21", "EQ21_ROWS", "EQ21_STARTS",
+           "label_components", "symbol_components", "label_rows"]
 
 
 def _printed_namespace(reading: str):
@@ -505,3 +506,105 @@ def integrate_eq21(paper, *, reading: str = "B", state: str = "climb", interval:
                        index=pd.Index(STATE_NAMES, name="state"))
     out.attrs.update(t0=t0, height_gain=end[-1] / dh, nfev=int(sol.nfev), rows=rows, start=start)
     return out
+
+
+_LABEL_WORDS = {"纬": "latitude", "经": "longitude", "高": "height", "东": "east", "北": "north", "天": "up"}
+_SYMBOL_AXES = {"L": "latitude", r"\lambda": "longitude", "h": "height", "x": "east", "E": "east", "y": "north",
+                "N": "north", "z": "up", "U": "up"}
+
+
+def label_components(label: str) -> list[str]:
+    """The components a printed vector label names, in order (``"位置误差修正向量(经-纬-高)"`` → longitude, latitude, height).
+
+    The direction words 东/北/天 and the position words 纬/经/高 of the label, read left to right.
+
+    Parameters
+    ----------
+    label : str
+        The label as printed.
+
+    Returns
+    -------
+    list of str
+        The English names of the components, in the label's order.
+    """
+    return [_LABEL_WORDS[ch] for ch in label if ch in _LABEL_WORDS]
+
+
+def symbol_components(symbols: str) -> list[str]:
+    """The components a printed vector ``[a \\ b \\ c]`` lists, in order, from their symbols' letter or subscript.
+
+    ``\\delta L``, ``\\delta \\lambda``, ``\\delta h`` name latitude, longitude and height; a subscript
+    ``x``/``E``, ``y``/``N``, ``z``/``U`` names east, north and up (the ENU frame of duan2023 eq. (1)).
+
+    Parameters
+    ----------
+    symbols : str
+        The printed vector, LaTeX, e.g. ``[\\delta L^c \\ \\delta \\lambda^c \\ \\delta h^c]``.
+
+    Returns
+    -------
+    list of str
+        The English names of the components, in order.
+
+    Raises
+    ------
+    ValueError
+        When the text holds no bracketed vector, or a component names no known axis.
+    """
+    import re
+
+    m = re.search(r"\[(.*)\]", symbols)
+    if not m:
+        raise ValueError(f"no bracketed vector [...] in {symbols!r}")
+    out = []
+    for comp in re.split(r"\\quad|\\ |\\,|\s{2,}", m.group(1)):
+        comp = comp.strip()
+        if not comp:
+            continue
+        sub = re.search(r"_\{?([A-Za-z])\}?", comp)
+        core = re.sub(r"\^\{?\w\}?|\\delta|\\mathbf\{(\w)\}", r"\1", comp).strip()
+        key = sub.group(1) if sub else (r"\lambda" if r"\lambda" in core else core.strip("{} "))
+        if key not in _SYMBOL_AXES:
+            raise ValueError(f"the component {comp!r} of {symbols!r} names no known axis")
+        out.append(_SYMBOL_AXES[key])
+    return out
+
+
+def label_rows(printed: pd.DataFrame, pairs) -> list[dict]:
+    """Comparison rows (``basis="parts"``): a vector's printed label against the components it lists.
+
+    The label names its components (:func:`label_components`), the bracketed symbols list them
+    (:func:`symbol_components`); the two printed parts agree when they name the same components in
+    the same order.
+
+    Parameters
+    ----------
+    printed : pandas.DataFrame
+        The transcription: ``quantity``, ``value`` (as printed) and ``line``.
+    pairs : sequence of (str, str)
+        ``(label quantity, symbols quantity)`` of ``printed``.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.reproduction.compare`, named ``"<label> against <symbols>"``.
+
+    Raises
+    ------
+    ValueError
+        When a quantity is not in the transcription.
+    """
+    by = printed.set_index("quantity")
+    rows = []
+    for lab, sym in pairs:
+        for q in (lab, sym):
+            if q not in by.index:
+                raise ValueError(f"{q!r} is not in the transcription; it has {list(by.index)[:8]} ...")
+        a, b = label_components(by.loc[lab, "value"]), symbol_components(by.loc[sym, "value"])
+        rows.append(dict(quantity=f"{lab} against {sym}", unit="",
+                         paper=f"{', '.join(a)} (line {by.loc[lab, 'line']})",
+                         reproduced=f"{', '.join(b)} (line {by.loc[sym, 'line']})", basis="parts", agrees=a == b,
+                         note=(f"the label names {len(a)} components ({', '.join(a)}), the vector lists {len(b)} "
+                               f"({', '.join(b)})" + ("" if a == b else ": two printed parts disagree"))))
+    return rows
