@@ -417,7 +417,7 @@ def identify_model(y, *, method: str = "printed", nlags: int | None = None, max_
         Model class, order, cut-offs (implied by the chosen model on the criteria's routes), the
         route, the ARMA orders (criteria only) and a note.
     """
-    _choice(method, METHODS, "method", "{name} must be one of {allowed} (the printed rules of Table 3-1, or the order "
+    _choice(method, METHODS, "method", "{name} must be one of {allowed} (the cut-off rules of the ACF and PACF, or the order "
             "of least AIC or BIC over an ARMA grid), got {value!r}")
     integer(max_order, "max_order")
     if nlags is not None:
