@@ -5,8 +5,9 @@
 #   chromium          - the headless browser check of the built book (tests/test_book_browser.py)
 #   fonts-wqy-zenhei  - a CJK font, so the Chinese terms of the sources render in that check
 #   texlive-latex-base - pdflatex: every tables/*.tex compiles in a plain article (tests/test_tex_exports.py)
-#   latex-cjk-common, latex-cjk-chinese-arphic-gbsn00lp - CJKutf8 and its Chinese font gbsn, which the
-#                       exports with Chinese text name in their header
+#   latex-cjk-common, latex-cjk-chinese-arphic-gbsn00lp, -bsmi00lp - CJKutf8 and its Chinese fonts gbsn
+#                       (GB 2312) and bsmi (Big5, for traditional forms), which the exports with Chinese
+#                       text name in their header
 #   poppler-utils     - pdftotext: the text of the compiled exports is compared with the CSVs
 set -euo pipefail
 
@@ -19,6 +20,7 @@ fi
 command -v pdflatex >/dev/null 2>&1 || missing_plain+=(texlive-latex-base)
 { command -v kpsewhich >/dev/null 2>&1 && kpsewhich CJKutf8.sty >/dev/null 2>&1; } || missing_plain+=(latex-cjk-common)
 { command -v kpsewhich >/dev/null 2>&1 && kpsewhich c70gbsn.fd >/dev/null 2>&1; } || missing_plain+=(latex-cjk-chinese-arphic-gbsn00lp)
+{ command -v kpsewhich >/dev/null 2>&1 && kpsewhich c70bsmi.fd >/dev/null 2>&1; } || missing_plain+=(latex-cjk-chinese-arphic-bsmi00lp)
 command -v pdftotext >/dev/null 2>&1 || missing_plain+=(poppler-utils)
 missing=("${missing_recommends[@]}" "${missing_plain[@]}")
 [ "${#missing[@]}" -eq 0 ] && exit 0
@@ -34,7 +36,7 @@ else
     exit 1
 fi
 if ! command -v apt-get >/dev/null 2>&1; then
-    echo "make test needs what these Debian packages provide: ${missing[*]} (chromium, a CJK font, pdflatex with CJKutf8 and the gbsn font, pdftotext);" >&2
+    echo "make test needs what these Debian packages provide: ${missing[*]} (chromium, a CJK font, pdflatex with CJKutf8 and the gbsn and bsmi fonts, pdftotext);" >&2
     echo "this system has no apt-get: install the equivalents with its own package manager" >&2
     exit 1
 fi

@@ -55,6 +55,9 @@ def test_escaping_of_specials_and_unicode():
     assert rp._tex_escape("a--b ''c'' x,,y") == "a-{}-b '{}'c'{}' x,{},y"
     # Chinese is kept, in a CJK environment of CJKutf8
     assert rp._tex_escape("误差，ok") == r"\begin{CJK}{UTF8}{gbsn}误差，\end{CJK}ok"
+    # a traditional form the GB 2312 font lacks is set in the Big5 font
+    assert rp._tex_escape("北銜金") == (r"\begin{CJK}{UTF8}{gbsn}北\end{CJK}\begin{CJK}{UTF8}{bsmi}銜\end{CJK}"
+                                      r"\begin{CJK}{UTF8}{gbsn}金\end{CJK}")
     assert all(ord(c) < 128 for c in rp._tex_escape("Ω ≥ √2 ″ ∂ → ∈ ≠ ā Ā ² µ ⊕ ≲ − – —"))
     with pytest.raises(rp.RegistryError, match="U\\+263A"):
         rp._tex_escape("☺")
@@ -126,7 +129,7 @@ def test_every_tex_export_compiles_in_a_plain_article(compiled):
 def test_an_export_is_ascii_but_for_chinese_in_cjk_environments():
     for f in sorted(rp.tables_dir().glob("*.tex")):
         text = f.read_text(encoding="utf-8")
-        outside = re.sub(r"\\begin\{CJK\}\{UTF8\}\{gbsn\}[^\\]*\\end\{CJK\}", "", text)
+        outside = re.sub(r"\\begin\{CJK\}\{UTF8\}\{(gbsn|bsmi)\}[^\\]*\\end\{CJK\}", "", text)
         assert all(ord(c) < 128 for c in outside), f"{f.name}: non-ASCII outside a CJK environment"
         assert ("\\begin{CJK}" in text) == ("CJKutf8" in header_packages(text)), f.name
         assert "[" + "SECTION SIGN]" not in text and "see the CSV]" not in text

@@ -190,11 +190,13 @@ def reference_rows(printed: pd.DataFrame) -> list[dict[str, Any]]:
         if pages := reversed_pages(entry):
             problems.append(f"its page range {pages[0]}-{pages[1]} ends before it starts")
         cited_at = ", ".join(str(x) for x in sorted(set(where.get(n, []))))
-        rows.append(dict(quantity=q, unit="", paper_text=str(entry),
+        # the entry as printed goes into the note (a full-width line of the exports): a URL or a
+        # long word of an entry does not fit a table column
+        rows.append(dict(quantity=q, unit="", paper_text=f"entry [{n}], seed line {line}",
                          reproduced=f"cited at seed line {cited_at}" if cited_at else "not cited",
                          basis="parts", agrees=not problems,
-                         note=("; ".join(problems) + f" (list entry at seed line {line})") if problems else
-                         f"cited, listed once (seed line {line})"))
+                         note=(("; ".join(problems) if problems else "cited, listed once")
+                               + f"; as printed: {entry}")))
     for n in sorted(set(where) - set(nums)):
         rows.append(dict(quantity=f"citation [{n}]", unit="", paper_text=f"[{n}]", reproduced="no such entry",
                          basis="parts", agrees=False,

@@ -78,6 +78,21 @@ _TEX_ACCENTS = {"\u0304": "bar", "\u0302": "hat", "\u0307": "dot", "\u0308": "dd
 TEX_CJK_FONT = "gbsn"
 """The font of Chinese text in a ``.tex`` export (AR PL SungtiL GB, through ``CJKutf8``)."""
 
+TEX_CJK_FALLBACK = "bsmi"
+"""The font of a Chinese character that the GB 2312 font lacks (a traditional form such as 銜):
+AR PL Mingti2L Big5, through ``CJKutf8``."""
+
+
+def _cjk_font(ch: str) -> str:
+    """:data:`TEX_CJK_FONT` for a character of GB 2312, else :data:`TEX_CJK_FALLBACK` where Big5 has it."""
+    for font, codec in ((TEX_CJK_FONT, "gb2312"), (TEX_CJK_FALLBACK, "big5")):
+        try:
+            ch.encode(codec)
+            return font
+        except UnicodeEncodeError:
+            pass
+    return TEX_CJK_FONT
+
 
 TEX_EXTRA_PACKAGES = {"≲": "amssymb", "≳": "amssymb"}
 """Characters whose macro needs a package beyond :data:`TEX_PACKAGES` (Chinese needs ``CJKutf8``)."""
@@ -112,7 +127,7 @@ def _tex_escape(s: str) -> str:
     kept apart (:data:`_TEX_LIGATURES`), Greek letters and mathematical signs as macros
     (:data:`_TEX_UNICODE`), accented letters composed, a combining accent over the preceding
     symbol, and each run of Chinese in a ``CJK`` environment of ``CJKutf8`` (font
-    :data:`TEX_CJK_FONT`), left as UTF-8.
+    :data:`TEX_CJK_FONT`, or :data:`TEX_CJK_FALLBACK` for a character it lacks), left as UTF-8.
 
     Raises
     ------
@@ -124,10 +139,10 @@ def _tex_escape(s: str) -> str:
     while i < len(s):
         ch = s[i]
         if _is_cjk(ch):
-            j = i
-            while j < len(s) and _is_cjk(s[j]):
+            font, j = _cjk_font(ch), i
+            while j < len(s) and _is_cjk(s[j]) and _cjk_font(s[j]) == font:
                 j += 1
-            out.append(rf"\begin{{CJK}}{{UTF8}}{{{TEX_CJK_FONT}}}{s[i:j]}\end{{CJK}}")
+            out.append(rf"\begin{{CJK}}{{UTF8}}{{{font}}}{s[i:j]}\end{{CJK}}")
             i = j
             continue
         if ch in _TEX_ACCENTS and out:

@@ -633,8 +633,26 @@ def _spaced(text):
     return re.sub(r"  +", " ", text)
 
 
+ENTRIES_SHOWN = 2
+"""How many differing terms a derivation row's note spells out (the rest are counted; the chapter's
+check lists every one)."""
+
+NOTE_CHARACTERS = 520
+"""The longest note of a derivation row: beyond it the note ends at a clause with "…" (every term is
+listed by the chapter's check; a longer note would not fit the page of the ``.tex`` export)."""
+
+
+def _short_note(note: str) -> str:
+    if len(note) <= NOTE_CHARACTERS:
+        return note
+    cut = note.rfind("; ", 0, NOTE_CHARACTERS)
+    return note[:cut if cut > 0 else NOTE_CHARACTERS] + "; … (every term: the chapter's check)"
+
+
 def _entries(c, label=("printed", "derived")) -> str:
-    return "; ".join(f"{w}: {label[0]} {p}, {label[1]} {d}" for w, p, d in c.differing)
+    shown = [f"{w}: {label[0]} {p}, {label[1]} {d}" for w, p, d in c.differing[:ENTRIES_SHOWN]]
+    rest = len(c.differing) - ENTRIES_SHOWN
+    return "; ".join(shown + ([f"{rest} more differing terms"] if rest > 0 else []))
 
 
 def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, notebook: str) -> list[dict]:
@@ -686,7 +704,8 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
             row["note"] = (f"{where}: every term derived ({'the identity holds' if c.kind == 'generic' else 'conventions: ' + dv.convention_text(c.conventions)})"
                            + (f"; reading: {reading}" if reading else ""))
         else:
-            row["reproduced"] = "; ".join(f"{w} = {d}" for w, _, d in c.differing)
+            derived = "; ".join(f"{w} = {d}" for w, _, d in c.differing)
+            row["reproduced"] = f"derived: {len(c.differing)} term(s) differ (note, corrected)"
             other = {"markov": "eq. (2-5) defines α as the gyro and β as the accelerometer correlation time",
                      "H-position": "Z rows 1-3 are printed in radians (L_SINS - L_GPS), which H = I maps; H scales them to metres"}
             why = other.get(spec.split(":")[0], "no sign convention of the 16 (errors computed/true, φ or ψ = -φ, sensor errors either sign) derives it")
@@ -695,9 +714,10 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
             remark = f"; {DERIVATION_REMARKS[name]}" if name in DERIVATION_REMARKS else ""
             row["note"] = f"{where}: {why}{sph}{remark}; {_entries(c)}" + (f"; reading: {reading}" if reading else "")
             if basis == "derivation":
-                row["corrected"] = DERIVATION_CORRECTED.get(name, row["reproduced"])
+                row["corrected"] = DERIVATION_CORRECTED.get(name, derived)
                 row["evidence"] = f"{notebook}; tests/test_derivations.py::" + DERIVATION_TESTS.get(
                     name, "test_printed_f_blocks_against_derivation")
+        row["note"] = _short_note(row["note"])
         rows.append(row)
     for a, b in DERIVATION_PAIRS.items():
         c = dv.check_item(f"{a} vs {b}", meta.at[a, "value"], f"pair:{b}", {b: meta.at[b, "value"]})
@@ -728,5 +748,7 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
                      reproduced=3 * per_axis, tolerance=0, basis="parts",
                      note=(f"F prints 0_(6x15) under the gravity states; AR({ar_order}) of (4-13) for three axes in companion form has "
                            f"{3 * per_axis} states; the text also says the size depends on the identified model")))
+    for r in rows:
+        r["note"] = _short_note(r.get("note", ""))
     return [{k: (_spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
             for r in rows]
