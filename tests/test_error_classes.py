@@ -522,3 +522,21 @@ def test_the_python_read_side_raises_a_registry_error_naming_the_file(case, call
     monkeypatch.setenv("REPLICATION_ROOT", str(root))
     with pytest.raises(rp.RegistryError, match=re.escape(names)):
         call()
+
+
+def test_a_turn_of_1e300_rad_is_refused_not_generated():
+    """An angle of 1e300 rad (a unit mistake) once made the trajectory builder run without end."""
+    from replication.nav import trajectory as tr_
+    for angle in (1e300, float("inf"), float("nan")):
+        with pytest.raises(ValueError, match="Turn"):
+            tr_.Turn(20.0, angle)
+    with pytest.raises(ValueError, match="duration"):
+        tr_.Turn(-5.0, 1.0)
+    assert tr_.Turn(20.0, np.pi / 2).angle == np.pi / 2
+
+
+def test_a_ship_of_negative_duration_is_refused():
+    from replication.papers.fang2020 import scenarios
+    for d in (-10.0, 0.0, float("nan")):
+        with pytest.raises(ValueError, match="duration"):
+            scenarios.fang2020_ship(d)

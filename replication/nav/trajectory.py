@@ -222,6 +222,17 @@ class Turn(_Flight):
     angle: float = 0.0
     speed_wave: float = 0.0
 
+    MAX_RATE = 2 * np.pi
+    """The largest peak turn rate 2·angle/duration accepted [rad/s]: one revolution per second,
+    beyond any vehicle the toolkit simulates (a larger angle is a unit mistake, e.g. degrees)."""
+
+    def __post_init__(self):
+        if not (np.isfinite(self.duration) and self.duration > 0):
+            raise ValueError(f"Turn: duration must be a positive number of seconds, got {self.duration!r}")
+        if not np.isfinite(self.angle) or 2 * abs(self.angle) / self.duration > self.MAX_RATE:
+            raise ValueError(f"Turn: angle {self.angle!r} rad over {self.duration} s exceeds a peak turn rate of "
+                             f"{self.MAX_RATE:.2f} rad/s: give the heading change in radians")
+
     def heading(self, tau):
         """Heading change, turn rate and its derivative over the turn.
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from replication.nav._validate import positive
 from replication.nav.trajectory import ShipRocking
 from replication.nav.units import DEG
 
@@ -30,6 +31,8 @@ def fang2020_ship(duration: float, rng=None, *, northward: bool = False):
     segments : list of replication.nav.trajectory.ShipRocking
         One rocking segment.
     """
+    duration = positive(duration, "duration", "fang2020_ship: duration must be a positive number of seconds, "
+                                              "got {value!r}")
     rng = np.random.default_rng(rng)
     ph = tuple(rng.uniform(0, 2 * np.pi, 3))
     head = 0.0 if northward else 90 * DEG
