@@ -177,19 +177,15 @@ def _closed_loop(**kw):
 
 
 def _cl_run(**kw):
-    """closedloop.run of one recorded run along _T1 (the inputs of kalman.closed_loop)."""
-    n = _T1.n
-    idx = np.asarray(_G1.index, np.int64)
-    spec = closedloop.build_spec(_M15, gnss=closedloop.GnssRows(R_pos=0.01 * I3, R_vel=1e-4 * I3))
-    state = closedloop.initial_batch_state(_T1.initial_state().vector()[None, :],
-                                           rotations.dcm_to_quat(_T1.initial_state().C_bn)[None, :], np.zeros(3))
-    m = len(idx)
-    inputs = kalman._single_run_inputs(_T1.t, _T1.dtheta, _T1.dv, (np.zeros(n + 1), np.zeros(n + 1)), idx, _G1,
-                                       (np.zeros((m, 6)), np.zeros((m, 4)), np.zeros((m, _M15.n - 9))))
-    args = dict(spec=spec, state=state, P0=_M15.P0(), ep_samples=idx, n_steps=n, inputs=inputs,
+    """The closed-loop filter (replication.nav.filter.run_filter) of one recorded run along _T1."""
+    from replication.nav import filter as NF
+    from replication.nav.measurements.gnss import GnssPosition, GnssVelocity
+    meas = (GnssPosition(0.01 * np.ones(3), _G1.position), GnssVelocity(1e-4 * np.ones(3), _G1.v_enu))
+    args = dict(model=_M15, measurements=meas, imu=NF.Imu(_T1.t, _T1.dtheta, _T1.dv),
+                initial=_T1.initial_state(), epochs=np.asarray(_G1.index, np.int64), P0=_M15.P0(),
                 options=closedloop.Options(workers=1))
     args.update(kw)
-    return closedloop.run(**args)
+    return NF.run_filter(**args)
 
 
 def _build_spec(R_pos=I3, R_vel=I3, lever_arm_b=(0.0, 0.0, 0.0), **kw):
@@ -337,12 +333,12 @@ PROBES += [
     ("closedloop.build_spec(gnss = dict)", "gnss", lambda: closedloop.build_spec(_M15, gnss={"R_pos": I3})),
     ("closedloop.counting_inputs(inputs = None)", "inputs", lambda: closedloop.counting_inputs(None, object())),
     ("closedloop.counting_inputs(bar without update)", "bar", lambda: closedloop.counting_inputs(print, object())),
-    ("closedloop.run(P0 = -I)", "P0", lambda: _cl_run(P0=-np.eye(15))),
+    ("filter.run_filter(P0 = -I)", "P0", lambda: _cl_run(P0=-np.eye(15))),
     ("closedloop.Options(record_every = 0)", "record_every", lambda: _cl_run(options=closedloop.Options(record_every=0))),
     ("closedloop.Smoother(form = 'ukf')", "form", lambda: closedloop.Smoother("ukf")),
     ("closedloop.Options(smoother = 'rts')", "smoother", lambda: closedloop.Options(smoother="rts")),
-    ("closedloop.run(options = 1)", "options", lambda: _cl_run(options=1)),
-    ("closedloop.run(ep_samples = [2.5])", "ep_samples", lambda: _cl_run(ep_samples=[2.5])),
+    ("filter.run_filter(options = 1)", "options", lambda: _cl_run(options=1)),
+    ("filter.run_filter(epochs = [2.5])", "epochs", lambda: _cl_run(epochs=[2.5])),
     ("inversion_test(segments = 2.5)", "segments", lambda: stationarity.inversion_test(_Y0, 2.5)),
     ("inversion_test(alpha = 1.5)", "alpha", lambda: stationarity.inversion_test(_Y0, 10, alpha=1.5)),
     ("inversion_test(y with NaN)", "y", lambda: stationarity.inversion_test(np.r_[_Y0[:50], np.nan, _Y0[51:]], 10)),
@@ -711,9 +707,8 @@ _CALLS = {
     "closedloop.initial_batch_state": (closedloop.initial_batch_state,
                                        dict(st=np.zeros((1, 6)), q=np.array([[1.0, 0, 0, 0]]), lever0=np.zeros(3)),
                                        {"st": "mat", "q": "mat", "lever0": "vec3"}),
-    "closedloop.run": (_cl_run, dict(),
-                       {"spec": "object", "state": "object", "P0": "cov15", "ep_samples": "epochs", "n_steps": "count",
-                        "inputs": "object", "options": "object"}),
+    "filter.run_filter": (_cl_run, dict(),
+                          {"P0": "cov15", "epochs": "epochs", "options": "object"}),
     "stationarity.inversion_count": (stationarity.inversion_count, dict(values=[1.0, 3.0, 2.0]), {"values": "series"}),
     "stationarity.inversion_moments": (stationarity.inversion_moments, dict(m=5), {"m": "count"}),
     "stationarity.inversion_distribution": (stationarity.inversion_distribution, dict(m=5), {"m": "count"}),

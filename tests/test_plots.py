@@ -94,7 +94,7 @@ def test_side_by_side_bars_put_the_printed_value_beside_the_reproduced_one():
 def test_the_analog_figures_draw_the_printed_values_over_their_curves():
     import pandas as pd
 
-    from replication.papers.duan2023 import airdata as ad
+    from replication.papers.duan2023 import montecarlo as ad
 
     t = np.arange(0.0, 600.0, 60.0)
     errors = {s: {"enu": np.full((2, t.size, 3), 100.0 * (k + 1))} for k, s in enumerate(ad.SYSTEMS)}

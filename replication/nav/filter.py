@@ -26,7 +26,7 @@ from typing import Callable
 import numpy as np
 
 from replication.nav import closedloop as CL
-from replication.nav._validate import finite_array, integer
+from replication.nav._validate import finite_array, integer, numeric
 from replication.nav.closedloop import FilterResult, Options, Smoother
 from replication.nav.measurements import Measurement
 from replication.nav.rotations import dcm_to_quat
@@ -184,7 +184,10 @@ def run_filter(model, measurements, imu, initial, epochs, *, P0=None, lever_arm=
     vertical = Vertical() if vertical is None else vertical
     if not isinstance(vertical, Vertical):
         raise TypeError(f"vertical must be a filter.Vertical, got {type(vertical).__name__}")
-    ep = np.asarray(epochs, np.int64)
+    e = numeric(epochs, "epochs")
+    if e.ndim != 1 or e.size == 0 or not np.all(np.isfinite(e)) or np.any(e != np.round(e)):
+        raise ValueError(f"epochs must be a non-empty 1-D array of whole IMU sample indices, got {epochs!r:.60}")
+    ep = e.astype(np.int64)
     st, q = _initial(initial)
     spec = CL.build_spec(model, gnss=CL.GnssRows(lever_arm_b=lever_arm), vmode=vertical.code, gains=vertical.gains,
                          ar=None if ar is None else ar[:2], nees=truth is not None, options=options,
