@@ -28,6 +28,7 @@ import json
 import math
 import os
 import platform
+import re
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -200,6 +201,23 @@ def keep_stored_images(nb: nbformat.NotebookNode, stored: nbformat.NotebookNode 
     return kept
 
 
+_STYLER_ID = re.compile(r"T_[0-9a-f]{5}(?=[_\"])")
+_STYLER_REPR = re.compile(r"(<pandas\.io\.formats\.style\.Styler at )0x[0-9a-f]+>")
+
+
+def stable_volatile(nb: nbformat.NotebookNode) -> None:
+    """Give pandas' Styler outputs the same text on every run: its random table id becomes one
+    named by the cell and output, its memory address 0x0 (strict nbval masks both anyway; this keeps
+    ``git status`` clean after ``make book``)."""
+    for i, cell in enumerate(nb.cells):
+        for j, out in enumerate(cell.get("outputs", []) if cell.cell_type == "code" else []):
+            data = out.get("data", {})
+            if isinstance(data.get("text/html"), str):
+                data["text/html"] = _STYLER_ID.sub(f"T_c{i}o{j}", data["text/html"])
+            if isinstance(data.get("text/plain"), str):
+                data["text/plain"] = _STYLER_REPR.sub(r"\g<1>0x0>", data["text/plain"])
+
+
 def execute(path: Path, timeout: int, rms: float = IMAGE_RMS) -> float:
     nb = nbformat.read(path, as_version=4)
     nb.metadata["kernelspec"] = {"display_name": "Python 3 (ipykernel)", "language": "python", "name": "python3"}
@@ -217,6 +235,7 @@ def execute(path: Path, timeout: int, rms: float = IMAGE_RMS) -> float:
     client.execute()
     elapsed = time.perf_counter() - t0
     clean(nb)
+    stable_volatile(nb)
     stored = nbformat.read(path, as_version=4) if path.exists() else None
     keep_stored_images(nb, stored, rms)
     nbformat.validate(nb)
