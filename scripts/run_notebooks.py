@@ -201,21 +201,21 @@ def keep_stored_images(nb: nbformat.NotebookNode, stored: nbformat.NotebookNode 
     return kept
 
 
-_STYLER_ID = re.compile(r"T_[0-9a-f]{5}(?=[_\"])")
-_STYLER_REPR = re.compile(r"(<pandas\.io\.formats\.style\.Styler at )0x[0-9a-f]+>")
+_STYLER_ID = re.compile(r"T_(?:[0-9a-f]{5}|c\d+o\d+)(?=[_\"])")
+_STYLER_REPR = re.compile(r"(<pandas\.io\.formats\.style\.Styler at )0x[0-9a-f]*>")
 
 
 def stable_volatile(nb: nbformat.NotebookNode) -> None:
-    """Give pandas' Styler outputs the same text on every run: its random table id becomes one
-    named by the cell and output, its memory address 0x0 (strict nbval masks both anyway; this keeps
-    ``git status`` clean after ``make book``)."""
+    """Give pandas' Styler outputs the same text on every run: its random table id becomes five hex
+    digits of the cell and output, its memory address 0x000000 (both still of the form that strict
+    nbval's sanitizers mask, book/sanitize.cfg; this keeps ``git status`` clean after ``make book``)."""
     for i, cell in enumerate(nb.cells):
         for j, out in enumerate(cell.get("outputs", []) if cell.cell_type == "code" else []):
             data = out.get("data", {})
             if isinstance(data.get("text/html"), str):
-                data["text/html"] = _STYLER_ID.sub(f"T_c{i}o{j}", data["text/html"])
+                data["text/html"] = _STYLER_ID.sub(f"T_{i:03x}{j:02x}", data["text/html"])
             if isinstance(data.get("text/plain"), str):
-                data["text/plain"] = _STYLER_REPR.sub(r"\g<1>0x0>", data["text/plain"])
+                data["text/plain"] = _STYLER_REPR.sub(r"\g<1>0x000000>", data["text/plain"])
 
 
 def execute(path: Path, timeout: int, rms: float = IMAGE_RMS) -> float:
