@@ -280,14 +280,14 @@ def degree_heatmap(printed, reproduced, *, status=None, printed_threshold=1e-5, 
     A degree at or below its verdict threshold (unobservable) is drawn grey, so that the round-off
     of an unobservable state (printed values down to 1e-30) is not plotted as a colour; each cell
     carries its value to two digits.  A cell whose row status (``status``) is one of
-    :data:`FLAG_STYLES` is outlined in both panels.
+    ``FLAG_STYLES`` is outlined in both panels.
 
     Parameters
     ----------
     printed, reproduced : pandas.DataFrame
         Degrees, states × maneuvers, the same index and columns (``printed`` from
         ``load_paper("chen2019-table-2-3")``, ``reproduced`` from
-        :func:`replication.papers.chen2019.observability.degrees_table`).
+        :func:`replication.papers.chen2019.observability_tables.degrees_table`).
     status : pandas.DataFrame or mapping, optional
         Row status of each cell: a table of the same shape, or the stored comparison's
         ``{quantity: status}`` with quantities ``"<label> | <maneuver>"`` (``chen2019-table-2-3``).
@@ -371,7 +371,7 @@ def degree_heatmap(printed, reproduced, *, status=None, printed_threshold=1e-5, 
 def side_by_side_bars(table, parts, *, intervals=None, ncols=3, log=None):
     """A comparison table as bars: for each panel (a printed component) and series (a printed
     column), the printed value (hatched) beside the reproduced one, with its 95 % interval where
-    given; a reproduced bar whose row status is one of :data:`FLAG_STYLES` is outlined in its style.
+    given; a reproduced bar whose row status is one of ``FLAG_STYLES`` is outlined in its style.
 
     Parameters
     ----------

@@ -214,12 +214,12 @@ def _how(notes: Sequence[str], most: int = 2, why: bool = False) -> str:
 def failing_part(tables: Sequence[pd.DataFrame]) -> str:
     """The failing part of an artifact: for each failing row status (:data:`FAILING_ORDER`) the
     rows' quantities (:func:`quantity_names`) and how they fail (their counts are in the status
-    label the line starts with, :func:`replication.registry.reproduction.status_label`).
+    label the line starts with, :func:`replication.registry.tallies.status_label`).
 
     Parameters
     ----------
     tables : sequence of pandas.DataFrame
-        The artifact's stored tables (:func:`replication.registry.reproduction.read_table`).
+        The artifact's stored tables (:func:`replication.registry.reading.read_table`).
 
     Returns
     -------
@@ -306,7 +306,7 @@ def findings_box(status: pd.DataFrame, notebook: str) -> str:
     Parameters
     ----------
     status : pandas.DataFrame
-        ``tables/status.csv`` as text (:func:`replication.registry.reproduction.build_index`).
+        ``tables/status.csv`` as text (:func:`replication.registry.index.build_index`).
     notebook : str
         The chapter (``book/<part>/<stem>.ipynb``).
 

@@ -63,7 +63,7 @@ def qualifier_rows(printed: pd.DataFrame, checks: Sequence[Mapping[str, Any]]) -
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`, named
+        Rows for :func:`replication.registry.exports.compare`, named
         ``"<caption> against <part>"``.
 
     Raises

@@ -12,7 +12,7 @@ Every disagreement is two printed parts that disagree (basis ``parts``), so ``in
 Criteria, fixed before comparing:
 
 * **the same work twice**: two entries whose normalized text (lower case, letters and digits
-  only) has a :class:`difflib.SequenceMatcher` ratio of at least :data:`SAME_WORK` = 0.85; the
+  only) has a ``difflib.SequenceMatcher`` ratio of at least :data:`SAME_WORK` = 0.85; the
   function reports the largest ratio among the other pairs, so a reader sees the margin;
 * **a reversed page range**: the last ``a-b`` page range of an entry with ``b < a`` (a date such as
   ``2008-04-30`` is not a range);
@@ -156,7 +156,7 @@ def reference_rows(printed: pd.DataFrame) -> list[dict[str, Any]]:
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`, each entry's row named like
+        Rows for :func:`replication.registry.exports.compare`, each entry's row named like
         its paper quantity (``reference [n]``).
 
     Raises
@@ -274,7 +274,7 @@ def volume_rows(printed: pd.DataFrame, *, same_step: int = SAME_STEP) -> list[di
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`, named
+        Rows for :func:`replication.registry.exports.compare`, named
         ``"volume of [n] against <journal>"``.
 
     Raises
@@ -336,7 +336,7 @@ def doi_rows(printed: pd.DataFrame) -> list[dict[str, Any]]:
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`, named ``DOI of reference [n]``, the
+        Rows for :func:`replication.registry.exports.compare`, named ``DOI of reference [n]``, the
         DOI in the note (a long DOI does not fit a table column) and, for a row that disagrees, as its
         printed text (the register shows it), then one ``DOI suffix shared by ...`` per suffix that two entries print.
 

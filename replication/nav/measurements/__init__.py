@@ -13,7 +13,7 @@ functions, :data:`ROWS_SIGNATURE` and :data:`RESIDUAL_SIGNATURE`):
 
 ``par`` holds the measurement's constants (:meth:`Measurement.parameters`, e.g. variances and
 the error state of its own error), ``data`` its measured values of the epoch for the run
-(:attr:`Measurement.width` numbers), ``ctx`` the epoch context laid out by the ``CTX_*``
+(``Measurement.width`` numbers), ``ctx`` the epoch context laid out by the ``CTX_*``
 offsets below (navigation state, lever arm, body rate, window sums, accumulated estimates), ``c``
 the attitude matrix C_b^n and ``enc`` the model's block encoding (rows: target, kind, first
 state, size of each block; :meth:`replication.nav.errors.ErrorModel.kernel_encoding`).  The

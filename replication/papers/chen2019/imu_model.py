@@ -411,7 +411,7 @@ def paper_triads(load, temperature: int, *, missing_signs: Mapping[str, float] |
     Parameters
     ----------
     load : callable
-        :func:`replication.registry.reproduction.load_paper`.
+        :func:`replication.registry.paper.load_paper`.
     temperature : int
         A printed calibration temperature [°C] (:data:`TEMPERATURE_TABLES`).
     missing_signs : Mapping[str, float] or None

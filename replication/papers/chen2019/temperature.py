@@ -148,7 +148,7 @@ def accel_scale_header_ratio(load, table: int, reference: int = 6) -> np.ndarray
     Parameters
     ----------
     load : callable
-        :func:`replication.registry.reproduction.load_paper`.
+        :func:`replication.registry.paper.load_paper`.
     table : int
         The table number n of Table 4-n.
     reference : int

@@ -588,7 +588,7 @@ def label_rows(printed: pd.DataFrame, pairs) -> list[dict]:
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`, named ``"<label> against <symbols>"``.
+        Rows for :func:`replication.registry.exports.compare`, named ``"<label> against <symbols>"``.
 
     Raises
     ------
