@@ -159,7 +159,7 @@ IMAGE_RMS = 1.0
 """Largest RMS pixel difference (0-255) at which a stored figure is kept."""
 
 # the slowest notebooks first, so that two workers finish together
-COST = {"chen2019/04b": 135, "fang2020/01": 95, "chen2019/06": 200, "chen2019/07": 116, "duan2023/01": 55, "foundations/02": 32,
+COST = {"chen2019/04b": 12, "fang2020/01": 95, "chen2019/06": 200, "chen2019/07": 116, "duan2023/01": 55, "foundations/02": 32,
         "chen2019/02_": 28, "an2021/01": 26, "chen2019/05": 195, "chen2019/03b": 15, "chen2019/04_": 35}
 """Approximate execution time (s) of the slow notebooks on the 2-core reference machine, numba's
 cache cold (``make notebooks`` prints the measured ones); the others take a few seconds.  Used to start the slowest

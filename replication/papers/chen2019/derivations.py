@@ -382,7 +382,19 @@ class Check:
 
 
 def _short(x) -> str:
-    return sp.sstr(sp.simplify(x))
+    """The shortest of a few cheap, deterministic forms of ``x`` (as written, common factors
+    pulled out, one denominator, cancelled): a readable display of a printed or derived term.
+
+    ``sympy.simplify`` is not used: its heuristics took minutes on the largest Coriolis terms
+    and could return a longer form than the input.
+    """
+    def cancelled(e):
+        return e.applyfunc(lambda y: sp.factor_terms(sp.cancel(y))) if e.is_Matrix else sp.factor_terms(sp.cancel(e))
+
+    forms = [x]
+    for transform in (sp.factor_terms, sp.together, cancelled):
+        forms.append(transform(x))
+    return min((sp.sstr(f) for f in forms), key=lambda s: (len(s), s))
 
 
 def judge(name, printed, derived, *, row, groups, kind="block") -> Check:
