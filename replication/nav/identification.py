@@ -96,7 +96,10 @@ def pacf_printed(y, nlags: int) -> np.ndarray:
 def correlogram(y, nlags: int, *, alpha: float = 0.05) -> pd.DataFrame:
     """ACF (3-9) and PACF (3-10) with confidence bands, from statsmodels (chen2019 Fig. 4-23).
 
-    The series is demeaned.  ``acf_band``: Bartlett's half-width z sqrt((1 + 2 sum_{j<k} r_j²)/n)
+    The series is demeaned.  The PACF is statsmodels' Durbin-Levinson recursion on the
+    unadjusted autocovariance (``method="ldb"``), which solves the same Yule-Walker systems
+    (3-10) as ``method="ywm"`` (equal to ~1e-16) in one pass instead of one solve per lag.
+    ``acf_band``: Bartlett's half-width z sqrt((1 + 2 sum_{j<k} r_j²)/n)
     (the band under the hypothesis that the ACF is zero beyond lag k-1, i.e. MA(k-1));
     ``pacf_band``: z/sqrt(n) (the band under AR(k-1)).
 
@@ -122,7 +125,7 @@ def correlogram(y, nlags: int, *, alpha: float = 0.05) -> pd.DataFrame:
     if not 1 <= nlags < y.size // 2:
         raise ValueError(f"nlags must lie in [1, {y.size // 2 - 1}] for a series of {y.size} samples")
     r, rci = acf(y, nlags=nlags, alpha=alpha, adjusted=False, fft=True, result_object=False)
-    pc, pci = pacf(y, nlags=nlags, alpha=alpha, method="ywm", result_object=False)
+    pc, pci = pacf(y, nlags=nlags, alpha=alpha, method="ldb", result_object=False)
     lags = np.arange(nlags + 1)
     df = pd.DataFrame({
         "lag": lags, "acf": r, "acf_band": rci[:, 1] - r, "pacf": pc, "pacf_band": pci[:, 1] - pc,
