@@ -94,6 +94,13 @@ def _cjk_font(ch: str) -> str:
     return TEX_CJK_FONT
 
 
+def _fallback_source(text: str) -> str:
+    """The header's word on :data:`TEX_CJK_FALLBACK` when ``text`` holds a character only it has."""
+    if any(_is_cjk(ch) and _cjk_font(ch) == TEX_CJK_FALLBACK for ch in text):
+        return f", and {TEX_CJK_FALLBACK} for characters GB 2312 lacks: latex-cjk-chinese-arphic-bsmi00lp"
+    return ""
+
+
 TEX_EXTRA_PACKAGES = {"≲": "amssymb", "≳": "amssymb"}
 """Characters whose macro needs a package beyond :data:`TEX_PACKAGES` (Chinese needs ``CJKutf8``)."""
 
@@ -241,11 +248,12 @@ def _latex(df: pd.DataFrame, title: str, table_id: str) -> str:
     lines = [
         f"% tables/{table_id}.tex: {_tex_escape(title)}",
         "% Written by replication.registry.reproduction from tables/" + table_id + ".csv (which keeps every stored",
-        "% digit); regenerate with `python -m replication index`.  UTF-8; compiles with pdflatex.",
+        "% digit); regenerate with replication.registry.exports.refresh_exports().  UTF-8; compiles with pdflatex.",
         "% Include with \\input{" + table_id + "} in a document whose preamble has",
         "%   \\usepackage{" + ",".join(packages) + "}",
         "% (array and longtable: LaTeX's tools bundle, Debian's texlive-latex-base"
-        + "".join(f"; {_TEX_PACKAGE_SOURCES[p]}" for p in packages if p in _TEX_PACKAGE_SOURCES) + ");",
+        + "".join(f"; {_TEX_PACKAGE_SOURCES[p]}" for p in packages if p in _TEX_PACKAGE_SOURCES)
+        + _fallback_source(" ".join([title, *(cell for row in rows for cell in row)])) + ");",
         "% the table fits the text width of a plain article, breaks across pages and repeats its header.",
         r"\begingroup",
         r"\footnotesize",
