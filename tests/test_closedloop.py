@@ -13,6 +13,7 @@ from replication.nav import earth
 from replication.nav import errors as er
 from replication.nav import kalman as kf
 from replication.nav import trajectory as tr
+from replication.nav.closedloop.update import _lead_gains
 from replication.nav.rotations import rotvec_to_dcm
 from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MICRO_G
 from replication.papers.chen2019 import simulation as sim
@@ -30,7 +31,7 @@ def test_sequential_gains_equal_the_joseph_update():
     z = rng.normal(size=m)
     gK, gs = np.empty((9, n)), np.empty(9)
     Pseq = P.copy()
-    cl._lead_gains(Pseq, np.vstack([H, np.zeros((9 - m, n))]), m, np.r_[Rd, np.ones(9 - m)], gK, gs, np.empty(n),
+    _lead_gains(Pseq, np.vstack([H, np.zeros((9 - m, n))]), m, np.r_[Rd, np.ones(9 - m)], gK, gs, np.empty(n),
                    np.empty(n, np.int64))
     x = np.zeros(n)
     for a in range(m):
