@@ -44,7 +44,7 @@ numba-compatible bundles :class:`Spec`, :class:`ChunkInputs`, :class:`BatchState
 initial state), ``inputs`` (a chunk's inputs), ``timeupdate`` (the compiled IMU steps and time
 update), ``update`` (the compiled measurement pass and sequential update), ``forward`` (the
 compiled chunk, :func:`filter_chunk`), ``smoother`` (:func:`mbf_chunk`, :func:`rts_chunk`),
-``records`` (:class:`FilterResult`) and ``driver`` (:func:`run`).  Every name is importable from
+``records`` (:class:`FilterResult`, :func:`innovation_covariance`) and ``driver`` (:func:`run`).  Every name is importable from
 ``replication.nav.closedloop``.
 """
 
@@ -55,11 +55,12 @@ from replication.nav.closedloop.driver import run
 from replication.nav.closedloop.forward import filter_chunk
 from replication.nav.closedloop.inputs import array_inputs, chunk_inputs, counting_inputs
 from replication.nav.closedloop.options import Options, Smoother, resolve_options
-from replication.nav.closedloop.records import FilterResult
+from replication.nav.closedloop.records import FilterResult, innovation_covariance
 from replication.nav.closedloop.smoother import mbf_chunk, rts_chunk
 from replication.nav.closedloop.spec import MAX_MEASUREMENTS, GnssRows, build_spec, initial_batch_state
 
 # the public entry point is replication.nav.filter.run_filter; the engine's bundles and builders stay here
 __all__ = ["Options", "Smoother", "GnssRows", "FilterResult", "resolve_options", "MAX_MEASUREMENTS", "Spec",
            "build_spec", "ChunkInputs", "BatchState", "LeadState", "Gains", "ChunkOut", "initial_batch_state", "run",
-           "filter_chunk", "rts_chunk", "mbf_chunk", "chunk_inputs", "array_inputs", "counting_inputs"]
+           "filter_chunk", "rts_chunk", "mbf_chunk", "chunk_inputs", "array_inputs", "counting_inputs",
+           "innovation_covariance"]

@@ -187,7 +187,7 @@ def _forward_pass(plan: _ChunkPlan, state: BatchState, lead: LeadState, res: Fil
             if pending is not None:
                 for t in pending[0]:
                     t.join()
-                _collect(res, pending[1], pending[2], pending[3], plan.rec_pos, plan.spec, pending[4])
+                _collect(res, pending[1], pending[2], pending[3], plan.rec_pos, plan.spec, pending[4], pending[5])
                 if smoother and not rts:
                     # every run's innovations, for the smoother (the rows in use)
                     innov[ci - 1] = np.ascontiguousarray(pending[3].innov[:, :, :int(pending[5].m.max())])
@@ -231,8 +231,9 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     options : Options, optional
         Records (``record_every``, ``store_nav``, ``store_P``), chunking (``chunk_epochs``), the
         smoother pass (``smoother``: a :class:`Smoother`, replaying the forward pass chunk by
-        chunk) and threads (``workers``); unset fields take run's defaults (every epoch recorded,
-        2000 epochs per chunk, no smoother, no IMU-rate solution, P kept, 2 threads).
+        chunk), threads (``workers``) and the innovation covariances (``innovations``); unset fields
+        take run's defaults (every epoch recorded, 2000 epochs per chunk, no smoother, no IMU-rate
+        solution, P kept, 2 threads, no innovation covariances).
 
     Returns
     -------
@@ -249,7 +250,7 @@ def run(spec: Spec, state: BatchState, P0, ep_samples, n_steps: int,
     state = _with_phat(state, n - 9)
     R = state.st.shape[0]
     rec_ep, rec_pos = _record_positions(len(ep), opt.record_every)
-    res = _new_records(spec, rec_ep, R, n, len(ep), n_steps, opt.store_P, opt.store_nav)
+    res = _new_records(spec, rec_ep, R, n, len(ep), n_steps, opt.store_P, opt.store_nav, opt.innovations)
     lead = LeadState(P0.copy(), P0.copy(), np.zeros(3), np.zeros((6, n)))
     plan = _ChunkPlan(spec, ep, n_steps, rec_pos, R, inputs, lead_inputs, opt)
     smoother = opt.smoother is not None

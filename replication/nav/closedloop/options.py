@@ -70,6 +70,10 @@ class Options:
         Order of the Van Loan series for (Φ, Q_d); default 4.
     prior_covariance : bool or None
         Also propagate the covariance without measurements; default False.
+    innovations : bool or None
+        Also record, at the recorded epochs, the innovation covariance S = H P⁻ Hᵀ + R of the
+        lead's rows and their number (``FilterResult.innovation_cov``, ``FilterResult.innovation_rows``;
+        the innovations themselves are ``FilterResult.innov``); default False (no extra memory).
     """
 
     record_every: int | None = None
@@ -80,6 +84,7 @@ class Options:
     workers: int | None = None
     series_order: int | None = None
     prior_covariance: bool | None = None
+    innovations: bool | None = None
 
     def __post_init__(self):
         sm = self.smoother
@@ -93,7 +98,7 @@ class Options:
             v = getattr(self, name)
             if v is not None:
                 integer(v, f"Options.{name}", low)
-        for name in ("store_nav", "store_P", "prior_covariance"):
+        for name in ("store_nav", "store_P", "prior_covariance", "innovations"):
             v = getattr(self, name)
             if v is not None and not isinstance(v, (bool, np.bool_)):
                 raise TypeError(f"Options.{name} must be True or False, got {v!r}")
@@ -120,7 +125,7 @@ class Options:
 
 
 _RUN_DEFAULTS = dict(record_every=1, chunk_epochs=2000, store_nav=False, store_P=True, workers=2, series_order=4,
-                     prior_covariance=False)
+                     prior_covariance=False, innovations=False)
 
 
 def resolve_options(value, defaults: dict | None = None, name: str = "options") -> Options:
