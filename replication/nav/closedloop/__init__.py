@@ -50,6 +50,7 @@ compiled chunk, :func:`filter_chunk`), ``smoother`` (:func:`mbf_chunk`, :func:`r
 
 from __future__ import annotations
 
+from replication.nav.closedloop import spec as _spec
 from replication.nav.closedloop.bundles import BatchState, ChunkInputs, ChunkOut, Gains, LeadState, Spec
 from replication.nav.closedloop.driver import run
 from replication.nav.closedloop.forward import filter_chunk
@@ -57,7 +58,11 @@ from replication.nav.closedloop.inputs import array_inputs, chunk_inputs, counti
 from replication.nav.closedloop.options import Options, Smoother, resolve_options
 from replication.nav.closedloop.records import FilterResult, innovation_covariance
 from replication.nav.closedloop.smoother import mbf_chunk, rts_chunk
-from replication.nav.closedloop.spec import MAX_MEASUREMENTS, GnssRows, build_spec, initial_batch_state
+from replication.nav.closedloop.spec import GnssRows, build_spec, initial_batch_state
+
+#: The most measurements of one filter (defined in ``spec``): the kernel tuples of :class:`Spec` are
+#: padded to this length with kernels that write no row, so one compiled loop serves every set of aids.
+MAX_MEASUREMENTS = _spec.MAX_MEASUREMENTS
 
 # the public entry point is replication.nav.filter.run_filter; the engine's bundles and builders stay here
 __all__ = ["Options", "Smoother", "GnssRows", "FilterResult", "resolve_options", "MAX_MEASUREMENTS", "Spec",

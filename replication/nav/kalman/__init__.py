@@ -18,9 +18,9 @@ importable from ``replication.nav.kalman``.
 
 from __future__ import annotations
 
+from replication.nav.kalman import montecarlo as _montecarlo
 from replication.nav.kalman.linear import chi2_band, discretize_series, nees, nis, predict, rts_smoother, update, van_loan
 from replication.nav.kalman.montecarlo import (
-    GNSS_ROWS,
     ClosedLoopResult,
     MonteCarloResult,
     closed_loop,
@@ -28,6 +28,9 @@ from replication.nav.kalman.montecarlo import (
     perturb_state,
     true_parameter_vector,
 )
+
+#: The GNSS rows :func:`closed_loop` can use (defined in ``montecarlo``).
+GNSS_ROWS = _montecarlo.GNSS_ROWS
 
 __all__ = ["van_loan", "discretize_series", "predict", "update", "rts_smoother", "nees", "nis", "chi2_band",
            "ClosedLoopResult", "GNSS_ROWS", "closed_loop", "perturb_state", "MonteCarloResult", "monte_carlo",
