@@ -13,6 +13,7 @@ from replication.nav import earth
 from replication.nav import errors as er
 from replication.nav import kalman as kf
 from replication.nav import trajectory as tr
+from replication.nav.closedloop.update import _lead_gains
 from replication.nav.rotations import rotvec_to_dcm
 from replication.nav.units import ARCMIN, ARCSEC, DEG, DEG_PER_H, MICRO_G
 from replication.papers.chen2019 import simulation as sim
@@ -30,7 +31,7 @@ def test_sequential_gains_equal_the_joseph_update():
     z = rng.normal(size=m)
     gK, gs = np.empty((9, n)), np.empty(9)
     Pseq = P.copy()
-    cl._lead_gains(Pseq, np.vstack([H, np.zeros((9 - m, n))]), m, np.r_[Rd, np.ones(9 - m)], gK, gs, np.empty(n),
+    _lead_gains(Pseq, np.vstack([H, np.zeros((9 - m, n))]), m, np.r_[Rd, np.ones(9 - m)], gK, gs, np.empty(n),
                    np.empty(n, np.int64))
     x = np.zeros(n)
     for a in range(m):
@@ -205,3 +206,94 @@ def test_smoother_does_not_depend_on_the_thread_count(short_flight):
     a = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, options=cl.Options(record_every=5, chunk_epochs=300, smoother=True, workers=1))
     b = sim.run_batch(short_flight, s, m, n_runs=5, seed=4, options=cl.Options(record_every=5, chunk_epochs=300, smoother=True, workers=3))
     assert np.array_equal(a.ds, b.ds) and np.array_equal(a.P_s, b.P_s)
+
+
+# ----------------------------------------------------------------------------- innovations
+
+
+def test_innovations_and_their_covariance_equal_a_dense_kalman_filter():
+    """``Options(innovations=True)``: over five epochs of a still IMU with a zero-velocity update
+    and a biased barometric height (4 rows, correlated through P⁻), the recorded innovations and
+    S = H P⁻ Hᵀ + R against a dense textbook filter (Gelb 1974, table 4.2-1: P⁻ = Φ P⁺ Φᵀ + Q_d,
+    ν = z − H x̂⁻ with x̂⁻ = 0 after the feedback, S, K = P⁻ Hᵀ S⁻¹, Joseph P⁺) written here in
+    numpy.  The dense filter takes the linearization the engine uses: Φ_k from the compiled chunk
+    (:func:`replication.nav.closedloop.filter_chunk` recording it), Q_d,k from the covariance
+    propagated without measurements (P̄_k − Φ_k P̄_{k−1} Φ_kᵀ), H and R as the aids define them.
+    Tolerances: S to 1e-9 σ_i σ_j (σ_i² its diagonal), P⁺ to 1e-9 of its largest variance, the NIS
+    νᵀ S⁻¹ ν to 1e-9 relative: the sequential scalar updates equal the batch update in exact
+    arithmetic and agree here to 1e-12 σ_i σ_j, 4e-16 and 3e-14; the option changes no other output."""
+    from replication.nav import filter as nf
+    from replication.nav.measurements.baro import BaroHeight
+    from replication.nav.measurements.zupt import ZeroVelocity
+    from replication.nav.rotations import dcm_to_quat
+
+    traj = tr.generate([tr.Dwell(1.0)], 45 * DEG, 110 * DEG, 300.0, dt=0.01)
+    baro = er.StateBlock("baro", ("b",), "none", dynamics=np.zeros((1, 1)), noise_psd=np.zeros((1, 1)),
+                         sd=np.array([20.0]))
+    m = er.model_15(lat=traj.lat[0], h=traj.h[0], velocity_sd=0.5).extend(baro)
+    n, col = m.n, m.slices["baro"].start
+    ep = np.arange(10, 60, 10)
+    E = len(ep)
+    p = 101325.0 * (1 - 0.0065 * (traj.h[ep] - 10.0) / 288.15) ** (9.80665 / (287.05287 * 0.0065))
+    r_v, r_h = np.array([1e-4, 1e-4, 4e-4]), 4.0
+    aids = (ZeroVelocity(r_v), BaroHeight(r_h, col, p))
+    init = traj.initial_state()
+    st0 = init.vector() + np.array([0, 0, 0, 0.3, -0.2, 0.1])
+    q0 = dcm_to_quat(init.C_bn)
+    imu = nf.Imu(traj.t[:ep[-1] + 1], traj.dtheta[:ep[-1]], traj.dv[:ep[-1]])
+    opt = nf.Options(store_P=True, prior_covariance=True, workers=1)
+    # the runs advance their initial state in place: each gets its own copy
+    rec = nf.run_filter(m, aids, imu, (st0[None].copy(), q0[None].copy()), ep, options=replace(opt, innovations=True))
+    plain = nf.run_filter(m, aids, imu, (st0[None].copy(), q0[None].copy()), ep, options=opt)
+    assert plain.innovation_cov is None and plain.innovation_rows is None
+    for f in ("st", "q", "p_hat", "nis", "innov", "P", "P_bar"):
+        assert np.array_equal(getattr(rec, f), getattr(plain, f)), f
+
+    # Φ_k of the same linearization: the compiled chunk over the same inputs, recording it
+    spec = cl.build_spec(m, vmode=0, options=opt, measurements=aids)
+    obs = nf._observations(aids, 1, E)
+    inp = cl.chunk_inputs(np.diff(imu.t), imu.dtheta, imu.dv, ep - 1, n_aug=n - 9, obs=obs)
+    state = cl.initial_batch_state(st0[None].copy(), q0[None].copy(), np.zeros(3))._replace(p_hat=np.zeros((1, n - 9)))
+    P0 = m.P0()
+    lead = cl.LeadState(P0.copy(), P0.copy(), np.zeros(3), np.zeros((6, n)))
+    mm = spec.m_max
+    gains = cl.Gains(np.zeros(E, np.int64), np.zeros((E, mm, n)), np.zeros((E, mm, n)), np.ones((E, mm)),
+                     np.zeros((E, len(spec.dyn_rows), n - 9)), np.empty((0, n)), np.empty((0, n, n)))
+    e3 = np.empty((E, n, n))
+    out = cl.ChunkOut(np.empty((1, E, 6)), np.empty((1, E, 4)), np.empty((1, E, n - 9)), np.empty((1, E)),
+                      np.zeros((1, E, mm)), np.empty((1, 0)), np.empty((1, 0, 6)), np.empty((1, 0, 4)),
+                      np.empty((E, n)), np.arange(E, dtype=np.int64), np.empty((E, n, n)), np.empty((E, n, n)),
+                      e3.copy(), e3.copy(), e3.copy(), np.empty((1, 0, n)))
+    cl.filter_chunk(spec, inp, state, lead, gains, out, True)
+    assert np.array_equal(out.P, rec.P) and np.array_equal(out.Pbar, rec.P_bar)
+
+    H = np.zeros((4, n))
+    H[0:3, 3:6] = np.eye(3)
+    H[3, 2], H[3, col] = 1.0, -1.0
+    Rm = np.diag(np.r_[r_v, r_h])
+    P, Pbar_prev = P0.copy(), P0.copy()
+    for k in range(E):
+        Phi = out.rec_Phi[k]
+        Qd = rec.P_bar[k] - Phi @ Pbar_prev @ Phi.T
+        Pbar_prev = rec.P_bar[k]
+        P = Phi @ P @ Phi.T + Qd
+        nu = rec.innov[0, k, :4] - H @ np.zeros(n)
+        S = H @ P @ H.T + Rm
+        Kg = np.linalg.solve(S, H @ P).T
+        A = np.eye(n) - Kg @ H
+        P = A @ P @ A.T + Kg @ Rm @ Kg.T
+        assert rec.innovation_rows[k] == 4
+        sd = np.sqrt(np.diag(S))
+        assert np.all(np.abs(rec.innovation_cov[k, :4, :4] - S) <= 1e-9 * np.outer(sd, sd))
+        assert np.all(rec.innovation_cov[k, 4:] == 0) and np.all(rec.innovation_cov[k, :, 4:] == 0)
+        assert np.max(np.abs(rec.P[k] - P)) < 1e-9 * np.max(np.diag(P))
+        assert np.isclose(rec.nis[0, k], nu @ np.linalg.solve(S, nu), rtol=1e-9, atol=0)
+
+
+def test_innovation_covariance_refuses_bad_shapes():
+    with pytest.raises(ValueError, match="m_max"):
+        cl.innovation_covariance(np.zeros((2, 3, 4)), np.zeros((2, 3, 4)), np.ones((2, 2)), [1, 1])
+    with pytest.raises(ValueError, match="count rows"):
+        cl.innovation_covariance(np.zeros((2, 3, 4)), np.zeros((2, 3, 4)), np.ones((2, 3)), [1, 4])
+    with pytest.raises(TypeError, match="innovations"):
+        cl.Options(innovations=1)

@@ -15,7 +15,8 @@ by the Van Loan series; sequential Joseph updates; feedback) for one run or a ba
 * ``epochs`` — the IMU sample index of each filter epoch.
 
 It returns a :class:`replication.nav.closedloop.FilterResult`: states, attitude, accumulated estimates, covariances,
-residuals, NIS/NEES and, with ``Options(smoother=...)``, the smoothed errors and covariances.
+residuals, NIS/NEES, with ``Options(smoother=...)`` the smoothed errors and covariances, and with
+``Options(innovations=True)`` the covariance S = H P⁻ Hᵀ + R of the innovations (the residuals).
 """
 
 from __future__ import annotations

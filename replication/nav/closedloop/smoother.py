@@ -1,0 +1,394 @@
+"""The fixed-interval smoother of the closed-loop filter: the backward passes over one chunk in the
+modified Bryson-Frazier form (:func:`mbf_chunk`) and the Rauch-Tung-Striebel form
+(:func:`rts_chunk`), and the pass over the chunks that drives them on the forward pass's replays.
+"""
+
+from __future__ import annotations
+
+import math
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+from numba import njit
+
+from replication.nav import _kernels as K
+from replication.nav.closedloop.bundles import _NJ
+from replication.nav.closedloop.records import FilterResult
+
+
+@njit(**_NJ)
+def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, out_ds, out_Ps, out_psdiag, with_cov):
+    """Backward Rauch-Tung-Striebel pass over one chunk of the closed-loop filter.
+
+    The filter feeds its estimate back, so its error state after each update is zero and the
+    smoothed error is d_k = C_k (d_{k+1} + x̂_{k+1}) with C_k = P_k⁺ Φ_kᵀ (P_{k+1}⁻)⁻¹ (x̂ the
+    update's estimate before feedback), P^s_k = P_k⁺ + C_k (P^s_{k+1} − P_{k+1}⁻) C_kᵀ.  Without
+    ``with_cov`` only the state recursion runs (C_k needs P_k⁺, P_{k+1}⁻ and Φ_k, not P^s).
+
+    A compiled kernel: it takes the chunk's arrays one by one, not a bundle (numba takes a
+    reference to each array of a bundle it receives; see CONTRIBUTING, "Library").
+
+    Parameters
+    ----------
+    Pf, Pp, Phi : (E, n, n) ndarray
+        P⁺, P⁻ and the transition into each epoch of the chunk (the lead's replay).
+    xrec : (R, E, n) ndarray
+        Every run's estimate x̂ before the feedback, per epoch.
+    has_next : bool
+        A chunk follows: ``Pp_n``, ``Phi_n``, ``x_n`` are its first epoch's P⁻, Φ and x̂.
+    Pp_n, Phi_n : (n, n) ndarray
+        P⁻ and Φ of the epoch after the chunk.
+    x_n : (R, n) ndarray
+        x̂ of the epoch after the chunk.
+    ds : (R, n) ndarray
+        Smoothed error at the epoch after the chunk on entry, at its first epoch on return.
+    Ps : (n, n) ndarray
+        The same for P^s.
+    out_flag : (E,) ndarray of int
+        Index of each epoch among the recorded ones (−1: not recorded).
+    out_ds, out_Ps : (R, recorded, n), (recorded, n, n) ndarray
+        Smoothed errors and covariances at the recorded epochs (written).
+    out_psdiag : (E, n) ndarray
+        diag P^s per epoch (written).
+    with_cov : bool
+        Also run the covariance recursion.
+    """
+    E_ = Pf.shape[0]
+    R = ds.shape[0]
+    n = Pf.shape[1]
+    d = np.empty(n)
+    Rc = np.empty((n, n))
+    rhs = np.empty((n, n))
+    tmp = np.empty(n)
+    for jj in range(E_ - 1, -1, -1):
+        if jj == E_ - 1 and not has_next:
+            for r in range(R):
+                for i in range(n):
+                    ds[r, i] = 0.0
+            for i in range(n):
+                for k in range(n):
+                    Ps[i, k] = Pf[jj, i, k]
+        else:
+            if jj == E_ - 1:
+                Pp1 = Pp_n
+                Ph1 = Phi_n
+                x1 = x_n
+            else:
+                Pp1 = Pp[jj + 1]
+                Ph1 = Phi[jj + 1]
+                x1 = xrec[:, jj + 1, :]
+            for i in range(n):
+                # a state with zero prior variance (no prior, no noise) decouples: unit scale,
+                # its row of Φ P⁺ is zero, so its column of C_k is zero
+                d[i] = math.sqrt(Pp1[i, i]) if Pp1[i, i] > 0.0 else 1.0
+            for i in range(n):
+                for k in range(n):
+                    Rc[i, k] = Pp1[i, k] / (d[i] * d[k])
+                if Pp1[i, i] <= 0.0:
+                    Rc[i, i] = 1.0
+            A = Ph1 @ Pf[jj]
+            for i in range(n):
+                for k in range(n):
+                    rhs[i, k] = A[i, k] / d[i]
+            Y = np.linalg.solve(Rc, rhs)
+            Cm = np.empty((n, n))
+            for i in range(n):
+                for k in range(n):
+                    Cm[k, i] = Y[i, k] / d[i]
+            for r in range(R):
+                for i in range(n):
+                    tmp[i] = ds[r, i] + x1[r, i]
+                for i in range(n):
+                    s_ = 0.0
+                    for k in range(n):
+                        s_ += Cm[i, k] * tmp[k]
+                    ds[r, i] = s_
+            if with_cov:
+                D = Ps - Pp1
+                G = Cm @ D @ Cm.T
+                for i in range(n):
+                    for k in range(i, n):
+                        v = Pf[jj, i, k] + 0.5 * (G[i, k] + G[k, i])
+                        Ps[i, k] = v
+                        Ps[k, i] = v
+        for i in range(n):
+            out_psdiag[jj, i] = Ps[i, i]
+        f = out_flag[jj]
+        if f >= 0:
+            for r in range(R):
+                for i in range(n):
+                    out_ds[r, f, i] = ds[r, i]
+            if with_cov:
+                for i in range(n):
+                    for k in range(n):
+                        out_Ps[f, i, k] = Ps[i, k]
+
+
+@njit(**_NJ)
+def _nonzeros(Phi, nzc, nzv, cnt, rzc, rzv, rcnt):
+    """The non-zeros of Φ by column (row indices ``nzc[i, :cnt[i]]``, values ``nzv``) and by row
+    (column indices ``rzc[k, :rcnt[k]]``, values ``rzv``)."""
+    n = Phi.shape[0]
+    K.row_nonzeros(Phi, rzc, rzv, rcnt)
+    for i in range(n):
+        cnt[i] = 0
+    for k in range(n):
+        for t in range(rcnt[k]):
+            i = rzc[k, t]
+            ci = cnt[i]
+            nzc[i, ci] = k
+            nzv[i, ci] = rzv[k, t]
+            cnt[i] = ci + 1
+
+
+@njit(**_NJ)
+def _congruence_transposed(Phi, L, W, row, nzc, nzv, cnt, rzc, rzv, rcnt):
+    """L ← Φᵀ L Φ for a symmetric L, from the non-zeros of Φ (``_nonzeros``; Φ of an INS error
+    model is sparse: dense navigation rows, sensor rows with one non-zero or two): W = Φᵀ L row by
+    row (row i: Σ_k Φ_ki L[k, :]), then row i of W Φ as Σ_k W[i, k] Φ[k, :] (a dense row of Φ
+    whole, a sparse one by its non-zeros); the upper triangle is kept and mirrored."""
+    n = L.shape[0]
+    K.sparse_times(nzc, nzv, cnt, L, W)
+    dense = n // 4
+    for i in range(n):
+        for j in range(n):
+            row[j] = 0.0
+        for k in range(n):
+            w = W[i, k]
+            if w == 0.0:
+                continue
+            if rcnt[k] > dense:
+                for j in range(n):
+                    row[j] += w * Phi[k, j]
+            else:
+                for t in range(rcnt[k]):
+                    row[rzc[k, t]] += w * rzv[k, t]
+        for j in range(i, n):
+            L[i, j] = row[j]
+            L[j, i] = row[j]
+
+
+@njit(**_NJ)
+def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov, transition_first):
+    """Backward pass over one chunk of the closed-loop filter in the modified Bryson-Frazier form
+    of the fixed-interval smoother (Bierman 1977, ch. X): the same smoothed error and covariance as
+    the Rauch-Tung-Striebel recursion of :func:`rts_chunk`, without inverting P⁻ and with the
+    O(n³) products only at the epochs kept.
+
+    With the adjoint λ_k (and its covariance Λ_k) of the epoch after its update, the smoothed error
+    of the solution after feedback is d_k = −P_k⁺ λ_k and P^s_k = P_k⁺ − P_k⁺ Λ_k P_k⁺.  Going back
+    through the scalar updates a = m−1 … 0 of epoch k (rows h_a, gains K_a, innovation variances
+    s_a, innovations ν_a of the sequential update):
+
+        λ ← λ − h_a (K_aᵀ λ + ν_a / s_a),
+        Λ ← (I − K_a h_aᵀ)ᵀ Λ (I − K_a h_aᵀ) + h_a h_aᵀ / s_a,
+
+    then λ_{k−1} = Φ_kᵀ λ, Λ_{k−1} = Φ_kᵀ Λ Φ_k; λ = 0, Λ = 0 after the last epoch.  The innovations
+    are recomputed from the raw ones ``z`` (runs × epochs × rows, INS − GNSS) as the filter formed
+    them (the same numbers).  Without ``with_cov`` only λ is propagated.  The runs are processed
+    side by side (λ as n × runs).
+
+    A compiled kernel: it takes the chunk's arrays one by one, not a bundle (numba takes a
+    reference to each array of a bundle it receives; see CONTRIBUTING, "Library").
+
+    Parameters
+    ----------
+    Phi : (E, n, n) ndarray
+        Transition into each epoch of the chunk (the lead's pass).
+    m : (E,) ndarray of int
+        Number of rows per epoch.
+    H, Kg : (E, m_max, n) ndarray
+        Rows and gains of the sequential update.
+    s : (E, m_max) ndarray
+        Innovation variances.
+    z : (R, E, m_max) ndarray
+        Every run's residuals (INS − aid).
+    Pf : (recorded, n, n) ndarray
+        P⁺ at the recorded epochs.
+    flag : (E,) ndarray of int
+        Index of each epoch among the recorded ones (−1: not recorded).
+    lam : (R, n) ndarray
+        λ of the last epoch of the chunk on entry, of the epoch before the chunk on return.
+    Lam : (n, n) ndarray
+        The same for Λ.
+    out_ds, out_Ps : (R, recorded, n), (recorded, n, n) ndarray
+        Smoothed errors and covariances at the recorded epochs (written).
+    with_cov : bool
+        Also propagate Λ and form P^s.
+    transition_first : bool
+        Apply the transition of the chunk's first epoch (False for the first chunk).
+    """
+    E_ = Phi.shape[0]
+    R = lam.shape[0]
+    n = Phi.shape[1]
+    L = np.ascontiguousarray(lam.T)
+    L2 = np.empty((n, R))
+    X = np.zeros((n, R))
+    m_max = H.shape[1]
+    Nu = np.empty((m_max, R))
+    acc = np.empty(R)
+    u = np.empty(n)
+    row = np.empty(n)
+    hz = np.empty((m_max, n), np.int64)
+    nh = np.empty(m_max, np.int64)
+    used = np.empty(n, np.int64)
+    W = np.empty((n, n))
+    nzc = np.empty((n, n), np.int64)
+    nzv = np.empty((n, n))
+    cnt = np.empty(n, np.int64)
+    rzc = np.empty((n, n), np.int64)
+    rzv = np.empty((n, n))
+    rcnt = np.empty(n, np.int64)
+    for jj in range(E_ - 1, -1, -1):
+        f = flag[jj]
+        if f >= 0:
+            P = Pf[f]
+            for i in range(n):
+                for r in range(R):
+                    acc[r] = 0.0
+                for k in range(n):
+                    p = P[i, k]
+                    for r in range(R):
+                        acc[r] += p * L[k, r]
+                for r in range(R):
+                    out_ds[r, f, i] = -acc[r]
+            if with_cov:
+                G = P @ (Lam @ P)
+                for i in range(n):
+                    for k in range(i, n):
+                        v = P[i, k] - 0.5 * (G[i, k] + G[k, i])
+                        out_Ps[f, i, k] = v
+                        out_Ps[f, k, i] = v
+        mj = m[jj]
+        # the non-zeros of the epoch's rows, and the columns any row uses
+        for k in range(n):
+            used[k] = 0
+        for a in range(mj):
+            c = 0
+            for k in range(n):
+                if H[jj, a, k] != 0.0:
+                    hz[a, c] = k
+                    used[k] = 1
+                    c += 1
+            nh[a] = c
+        # ---------------- the innovations of the sequential update (H's zero entries skipped: the
+        # filter's sums), then back through the scalar updates, last first
+        for k in range(n):
+            if used[k]:
+                for r in range(R):
+                    X[k, r] = 0.0
+        for a in range(mj):
+            for r in range(R):
+                acc[r] = z[r, jj, a]
+            for t in range(nh[a]):
+                k = hz[a, t]
+                h = H[jj, a, k]
+                for r in range(R):
+                    acc[r] -= h * X[k, r]
+            for k in range(n):
+                if used[k]:
+                    g = Kg[jj, a, k]
+                    for r in range(R):
+                        X[k, r] += g * acc[r]
+            for r in range(R):
+                Nu[a, r] = acc[r]
+        for a in range(mj - 1, -1, -1):
+            sa = s[jj, a]
+            for r in range(R):
+                acc[r] = Nu[a, r] / sa
+            for k in range(n):
+                g = Kg[jj, a, k]
+                for r in range(R):
+                    acc[r] += g * L[k, r]
+            for t in range(nh[a]):
+                k = hz[a, t]
+                h = H[jj, a, k]
+                for r in range(R):
+                    L[k, r] -= h * acc[r]
+        if with_cov:
+            for a in range(mj - 1, -1, -1):
+                for i in range(n):
+                    u[i] = 0.0
+                for k in range(n):
+                    g = Kg[jj, a, k]
+                    if g != 0.0:
+                        for i in range(n):
+                            u[i] += Lam[k, i] * g
+                c = 1.0 / s[jj, a]
+                for i in range(n):
+                    c += Kg[jj, a, i] * u[i]
+                # Λ + c h hᵀ − (h uᵀ + u hᵀ): only the rows and columns of h's non-zeros change; each
+                # pair (i, k) once, the increment symmetric in (i, k) to the last bit
+                for t in range(nh[a]):
+                    i = hz[a, t]
+                    hi = H[jj, a, i]
+                    for k in range(n):
+                        hk = H[jj, a, k]
+                        if hk != 0.0 and k < i:
+                            continue
+                        v = Lam[i, k] + (c * (hi * hk) - (hi * u[k] + u[i] * hk))
+                        Lam[i, k] = v
+                        Lam[k, i] = v
+        # ---------------- back through the transition into the previous epoch
+        if jj > 0 or transition_first:
+            Ph = Phi[jj]
+            _nonzeros(Ph, nzc, nzv, cnt, rzc, rzv, rcnt)
+            for i in range(n):
+                for r in range(R):
+                    acc[r] = 0.0
+                for t in range(cnt[i]):
+                    v = nzv[i, t]
+                    k = nzc[i, t]
+                    for r in range(R):
+                        acc[r] += v * L[k, r]
+                for r in range(R):
+                    L2[i, r] = acc[r]
+            L, L2 = L2, L
+            if with_cov:
+                _congruence_transposed(Ph, Lam, W, row, nzc, nzv, cnt, rzc, rzv, rcnt)
+    for r in range(R):
+        for i in range(n):
+            lam[r, i] = L[i, r]
+
+
+def _smooth(res: FilterResult, chunks, replay, innov, rec_pos, R, n, m_rec, with_cov, rts):
+    """Smoother pass: chunks replayed (``replay(chunk)``, newest first) ahead on other threads
+    while the backward recursion runs over the chunk replayed before: :func:`mbf_chunk` on the
+    lead's records and the forward pass's innovations ``innov`` (per chunk; the lead's replays
+    start from independent checkpoints, two run at once), or :func:`rts_chunk` when ``rts`` (one
+    replay of the whole batch at a time)."""
+    res.ds = np.empty((R, m_rec, n))
+    res.P_s = np.empty((m_rec, n, n)) if with_cov else None
+    ds = np.zeros((R, n))
+    Ps = np.zeros((n, n))
+    nxt = None
+    ahead = 1 if rts else 2
+    with ThreadPoolExecutor(max_workers=ahead) as ex:
+        futs = {c: ex.submit(replay, c) for c in range(len(chunks) - 1, max(len(chunks) - 1 - ahead, -1), -1)}
+        for ci in range(len(chunks) - 1, -1, -1):
+            j0, j1, o, g = futs.pop(ci).result()
+            if ci - ahead >= 0:
+                futs[ci - ahead] = ex.submit(replay, ci - ahead)
+            E_ = j1 - j0
+            n_f = int(np.sum(o.flag >= 0))
+            o_ds = np.empty((R, n_f, n))
+            o_Ps = np.empty((n_f if with_cov else 0, n, n))
+            o_pd = np.empty((E_, n))
+            if not rts:
+                # ds, Ps: the adjoint λ (runs × n) and its covariance Λ
+                mbf_chunk(o.rec_Phi, g.m, g.H, g.Kg, g.s, innov[ci], o.P, o.flag, ds, Ps, o_ds, o_Ps, with_cov,
+                          ci > 0)
+                innov[ci] = None
+            elif nxt is None:
+                rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, False, o.rec_Pp[0], o.rec_Phi[0],
+                          np.ascontiguousarray(o.rec_x[:, 0, :]), ds, Ps, o.flag, o_ds, o_Ps, o_pd, with_cov)
+            else:
+                rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, True, nxt[0], nxt[1], nxt[2], ds, Ps, o.flag,
+                          o_ds, o_Ps, o_pd, with_cov)
+            if rts:
+                nxt = (o.rec_Pp[0].copy(), o.rec_Phi[0].copy(), np.ascontiguousarray(o.rec_x[:, 0, :]))
+            pos = rec_pos[j0:j1][o.flag >= 0]
+            res.ds[:, pos] = o_ds
+            if with_cov:
+                res.P_s[pos] = o_Ps
+

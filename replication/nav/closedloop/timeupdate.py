@@ -1,0 +1,120 @@
+"""The compiled time update between two epochs: every run's IMU steps (corrections, strapdown,
+window sums; the lead's interval sums of the inputs of F), and the lead's (Φ, Q_d) by the Van Loan
+series at the interval mean of F with P⁻ = Φ P Φᵀ + Q_d on the sparsity of Φ.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from replication.nav import _kernels as K
+from replication.nav.closedloop.bundles import _NJ
+
+
+@njit(inline="always", **_NJ)
+def _propagate_sparse(Phi, P, Qd, W, Wt, U, nzc, nzv, cnt):
+    """P ← Φ P Φᵀ + Q_d using the non-zeros of Φ's rows (``nzc``, ``nzv``, ``cnt`` of
+    ``replication.nav._kernels.row_nonzeros``; Φ of an INS error model is sparse): W = Φ P, then
+    U = Φ Wᵀ, whose element (j, i) sums the products W[i, k] Φ[j, k] over Φ's non-zeros in
+    ascending k, and P[i, j] = U[j, i] + Q_d (symmetrized)."""
+    n = P.shape[0]
+    K.sparse_times(nzc, nzv, cnt, P, W)
+    for i in range(n):
+        for j in range(n):
+            Wt[j, i] = W[i, j]
+    K.sparse_times(nzc, nzv, cnt, Wt, U)
+    for i in range(n):
+        for j in range(i, n):
+            v = U[j, i] + 0.5 * (Qd[i, j] + Qd[j, i])
+            P[i, j] = v
+            P[j, i] = v
+
+
+@njit(inline="always", **_NJ)
+def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd, w1,
+                      w2, w3, nzc, nzv, cnt, P, Pbar, use_pbar):
+    """F as the interval mean (``build_F_core`` at the mean inputs plus the mean couplings ``Cpl``),
+    (Φ, Q_d) by the Van Loan series with the navigation white noise at the mean C_b^n, then
+    P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements).
+
+    The arguments are arrays, one by one, not a bundle (the configuration's ``fconst``, ``qc``, PSDs and series
+    order; the interval sums ``navsum``, ``fsum``, ``Csum``, ``Cpl`` over ``nsum`` steps and
+    ``tsum`` seconds; the work arrays of the series; the lead's ``P`` and ``Pbar``): a compiled
+    helper that receives a bundle takes a reference to each of its arrays once per epoch."""
+    n = F.shape[0]
+    inv = 1.0 / nsum
+    K.build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
+                   fsum[0] * inv, fsum[1] * inv, fsum[2] * inv, fconst, F)
+    for i in range(3):
+        for jj in range(9, n):
+            F[3 + i, jj] += Cpl[i, jj] * inv
+            F[6 + i, jj] -= Cpl[3 + i, jj] * inv
+    for i in range(3):
+        for jj in range(3):
+            Csum[i, jj] *= inv
+    K.interval_discretize(F, qc, Csum, q_accel, q_gyro, tsum, order, Qc, Phi, Qd, w1, w2, nzc, nzv, cnt)
+    K.row_nonzeros(Phi, nzc, nzv, cnt)
+    _propagate_sparse(Phi, P, Qd, w1, w2, w3, nzc, nzv, cnt)
+    if use_pbar:
+        _propagate_sparse(Phi, Pbar, Qd, w1, w2, w3, nzc, nzv, cnt)
+
+
+@njit(inline="always", **_NJ)
+def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_cp, trig, vacc, damp, first,
+               lead_acc, lead, sums, fsum, Csum, navsum, Cpl, nav_st, nav_q, nav_last, w):
+    """IMU steps k0..k1-1 of run ``r`` (views of its state taken once per interval): corrections,
+    strapdown, window sums; the lead's interval sums of the inputs of F when ``lead_acc``; the
+    IMU-rate solution for steps before ``nav_last``.  Returns the damping-loop integrator.
+
+    Called once per run and GNSS interval: the run's state arrays (``st`` … ``damp``), the lead's
+    interval sums (``sums``, ``fsum``, ``Csum``, ``navsum``, ``Cpl``), the run's IMU-rate records
+    and the per-step work arrays ``w`` are passed one by one (arrays, not a bundle), as views taken
+    once per interval (a bundle would cost a reference per array at every call)."""
+    u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en = w
+    store_nav = nav_st.shape[0] > 0
+    for k in range(k0, k1):
+        T = inp.dt[k]
+        for i in range(3):
+            u[i] = inp.dth[r, k, i]
+        K.apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 1, dth_c, B)
+        for i in range(3):
+            u[i] = inp.dvv[r, k, i]
+        K.apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 0, dv_c, B)
+        if first and k == 0:
+            for i in range(3):
+                dth_cp[i] = dth_c[i]
+                dv_cp[i] = dv_c[i]
+        w_sf = inp.sf_w[k]
+        in_win = inp.sf_win[k] >= 0
+        if lead_acc:
+            # inputs of F at the start of the step, summed over the GNSS interval
+            K.q2c(q, c)
+            for i in range(3):
+                fb[i] = dv_c[i] / T
+                wb[i] = dth_c[i] / T
+            K.accumulate_interval(c, fb, st, fsum, Csum, navsum)
+            K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, 1.0, Cpl, B)
+            if in_win:
+                for i in range(3):
+                    lead.facc[i] += w_sf * (c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2])
+                K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, w_sf, lead.Cw, B)
+            sums[0] += 1.0
+            sums[1] += T
+        v0, v1, v2 = st[3], st[4], st[5]
+        href = inp.h_ref[k + 1] if spec.vmode == 1 else inp.h_ref[k]
+        damp = K.sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, spec.vmode,
+                         href, inp.vu_ref[k + 1], spec.gains, damp, g_extra, trig)
+        if in_win:
+            vacc[0] += w_sf * (st[3] - v0) / T
+            vacc[1] += w_sf * (st[4] - v1) / T
+            vacc[2] += w_sf * (st[5] - v2) / T
+        for i in range(3):
+            dth_cp[i] = dth_c[i]
+            dv_cp[i] = dv_c[i]
+        if store_nav and k < nav_last:
+            for i in range(6):
+                nav_st[k + 1, i] = st[i]
+            for i in range(4):
+                nav_q[k + 1, i] = q[i]
+    return damp
+

@@ -1,0 +1,111 @@
+"""The compiled measurement pass of one epoch: the epoch context the measurement kernels read, the
+lead's rows of H (each measurement's ``rows`` kernel in turn), every run's residuals (each
+``residual`` kernel), ω_eb^b for the lever-arm rows, and the lead's sequential Joseph update
+(:func:`replication.nav.kalman.update`, one scalar row at a time: gains and innovation variances).
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from replication.nav import _kernels as K
+from replication.nav.closedloop.bundles import _NJ
+from replication.nav.measurements import CTX_LEVER, CTX_N, CTX_RATE, CTX_ST
+
+
+@njit(inline="always", **_NJ)
+def _fill_context(ctx, st, lever, wx, wy, wz, n):
+    """The epoch context's navigation part (:mod:`replication.nav.measurements`, ``CTX_*``): state,
+    lever arm in use, ω_eb^b and the number of error states."""
+    for i in range(6):
+        ctx[CTX_ST + i] = st[i]
+    for i in range(3):
+        ctx[CTX_LEVER + i] = lever[i]
+    ctx[CTX_RATE] = wx
+    ctx[CTX_RATE + 1] = wy
+    ctx[CTX_RATE + 2] = wz
+    ctx[CTX_N] = n
+
+
+@njit(inline="always", **_NJ)
+def _measurement_rows(kernels, n_meas, par, off, width, obs, ctx, c, enc, H, Rd, data):
+    """The lead's rows of one epoch: each measurement's ``rows`` kernel in turn (its constants
+    ``par[i]``, its values ``obs[off[i]:off[i] + width[i]]`` copied to ``data``); returns the
+    number of rows written into ``H`` (zero on entry) and ``Rd``.  Twelve arguments: the kernels,
+    their configuration (four arrays of :class:`Spec`), the run's values, the context and the
+    outputs — arrays, not a bundle (see :func:`_lead_time_update`)."""
+    r = 0
+    for i in range(n_meas):
+        o = off[i]
+        for k in range(width[i]):
+            data[k] = obs[o + k]
+        r += kernels[i](par[i], data, ctx, c, enc, H, Rd, r)
+    return r
+
+
+@njit(inline="always", **_NJ)
+def _measurement_residuals(kernels, n_meas, par, off, width, obs, ctx, c, z, data):
+    """One run's residuals of one epoch, each measurement's ``residual`` kernel in turn, the rows of
+    :func:`_measurement_rows` in the same order; returns the number written."""
+    m = 0
+    for i in range(n_meas):
+        o = off[i]
+        for k in range(width[i]):
+            data[k] = obs[o + k]
+        m += kernels[i](par[i], data, ctx, c, z, m)
+    return m
+
+
+@njit(inline="always", **_NJ)
+def _body_rate(dth, T, c, st, w_ie, w_en):
+    """ω_eb^b ≈ corrected gyro rate of the last step − C_b^nᵀ ω_ie^n (for the lever-arm rows)."""
+    K.rates_s(st[0], st[2], st[3], st[4], w_ie, w_en)
+    wx = dth[0] / T - (c[0, 0] * w_ie[0] + c[1, 0] * w_ie[1] + c[2, 0] * w_ie[2])
+    wy = dth[1] / T - (c[0, 1] * w_ie[0] + c[1, 1] * w_ie[1] + c[2, 1] * w_ie[2])
+    wz = dth[2] / T - (c[0, 2] * w_ie[0] + c[1, 2] * w_ie[1] + c[2, 2] * w_ie[2])
+    return wx, wy, wz
+
+
+@njit(**_NJ)
+def _lead_gains(P, H, m, Rd, gK, gs, bvec, hz):
+    """Sequential Joseph update of P for rows 0..m-1 of H (variances ``Rd``): gains ``gK[a]`` and
+    innovation variances ``gs[a]`` (see the Joseph form of :func:`replication.nav.kalman.update`).
+
+    The updates write P's upper triangle (contiguous rows) and mirror it once at the end; the
+    rows after the first read P from the upper triangle, which is what the lower one would hold.
+    ``hz`` (n ints) receives the non-zero columns of each row of H."""
+    n = P.shape[0]
+    for a in range(m):
+        c = 0
+        for k in range(n):
+            if H[a, k] != 0.0:
+                hz[c] = k
+                c += 1
+        for i in range(n):
+            acc = 0.0
+            for t in range(c):
+                k = hz[t]
+                if a == 0 or i <= k:
+                    acc += P[i, k] * H[a, k]
+                else:
+                    acc += P[k, i] * H[a, k]
+            gK[a, i] = acc
+        sv = Rd[a]
+        for k in range(n):
+            sv += H[a, k] * gK[a, k]
+        for i in range(n):
+            bvec[i] = gK[a, i]
+        for i in range(n):
+            gK[a, i] = bvec[i] / sv
+        gs[a] = sv
+        for i in range(n):
+            ki = gK[a, i]
+            bi = bvec[i]
+            ski = sv * ki
+            for j in range(i, n):
+                P[i, j] = P[i, j] - ki * bvec[j] - bi * gK[a, j] + ski * gK[a, j]
+    if m > 0:
+        for i in range(n):
+            for j in range(i + 1, n):
+                P[j, i] = P[i, j]
+
