@@ -18,6 +18,7 @@ import sympy as sp
 
 from replication.nav import units
 from replication.papers.an2021 import frequency, symbolic, transfer
+from replication.registry.paper import readable
 
 SYM = symbolic.SYMBOLS
 
@@ -76,6 +77,7 @@ def print_parts_rows(parts, eq5, eq7, lat=np.radians(30.0), v_north=10.0):
     """
     pp = parts.set_index("quantity")
     txt = lambda q: str(pp.loc[q, "value"])  # noqa: E731
+    show = lambda q: readable(txt(q))  # noqa: E731  (the printed text without its LaTeX markup)
 
     def at(*qs):
         lines = sorted({int(pp.loc[q, "line"]) for q in qs})
@@ -100,7 +102,7 @@ def print_parts_rows(parts, eq5, eq7, lat=np.radians(30.0), v_north=10.0):
     rows.append(dict(
         quantity="unit of the gain 1/10 of eqs. (11)-(12)",
         unit="",
-        paper_text=f"{txt('eq. (11)')}; {txt('eq. (12)')}",
+        paper_text=f"{show('eq. (11)')}; {show('eq. (12)')}",
         reproduced="; ".join(f"{v:.3g} {u}" for u, v in per_unit.items()),
         basis="parts",
         agrees=reach == ["rad/(m/s²)"],
@@ -119,7 +121,7 @@ def print_parts_rows(parts, eq5, eq7, lat=np.radians(30.0), v_north=10.0):
     rows.append(dict(
         quantity="matrix C_1 of eq. (10)",
         unit="",
-        paper_text=txt("eq. (10)"),
+        paper_text=show("eq. (10)"),
         reproduced=f"eq. (8) defines {', '.join(sorted(defined))}; C_1 {'defined' if 'C_1' in defined else 'not defined'}",
         basis="unstated",
         note=(
@@ -145,7 +147,10 @@ def print_parts_rows(parts, eq5, eq7, lat=np.radians(30.0), v_north=10.0):
     rows.append(dict(
         quantity=f"coefficients {', '.join(twice)} defined for eqs. (4)-(5) and again for eqs. (6)-(7)",
         unit="",
-        paper_text="; ".join(f"{q} = {eq5.value(q)} | {eq7.value(q)}" for q in twice[:2]) + "; …",
+        paper_text=(
+            f"after eq. (5): {', '.join(eq5.data.quantity)}; after eq. (7):"
+            f" {', '.join(eq7.data.quantity)} (the closed forms: an2021-eq-5, an2021-eq-7)"
+        ),
         reproduced="; ".join(f"{q}: m^{a} and m^{b}" for q, (a, b) in power.items()),
         basis="parts",
         agrees=all(p == -1 for p in tf_power.values()),
@@ -197,7 +202,7 @@ def print_parts_rows(parts, eq5, eq7, lat=np.radians(30.0), v_north=10.0):
     rows.append(dict(
         quantity="pole labels p_i of §1.1 and §1.2",
         unit="",
-        paper_text=f"{txt('poles and zeros of eqs. (4)-(5)')[:40]}… | {txt('poles and zeros of eqs. (6)-(7)')[:40]}…",
+        paper_text=f"{show('poles and zeros of eqs. (4)-(5)')} | {show('poles and zeros of eqs. (6)-(7)')}",
         reproduced=f"p_1…p_{n45} for eqs. (4)-(5), p_1…p_{n67} for eqs. (6)-(7); §2 names p_{named[0]}, p_{named[-1]} of eq. ({eq_named})",
         basis="parts",
         agrees=bool(resolves),
@@ -225,7 +230,7 @@ def print_parts_rows(parts, eq5, eq7, lat=np.radians(30.0), v_north=10.0):
     rows.append(dict(
         quantity="−40 dB/dec band 7e-4 to 5e-2 rad/s and the natural frequencies near ω_s",
         unit="",
-        paper_text=f"{txt('middle band')}; {txt('natural frequencies')}",
+        paper_text=f"{show('middle band')}; {show('natural frequencies')}",
         reproduced=(
             f"ω_s = {ws:.3g} rad/s; natural frequencies {', '.join(f'{w:.4g}' for w in natural)} rad/s"
             f" {'inside' if inside else 'outside'} the band; gain {g_lo:.3g} at {lo:.0e},"

@@ -19,6 +19,7 @@ import numpy as np
 from replication.nav import earth, units
 from replication.papers.fang2020 import damping, frames, two_point
 from replication.papers.fang2020.error_equations import OMEGA, input_u, m_matrix, transition_t
+from replication.registry.paper import readable
 
 SPHERE_RADII = {"polar semi-axis b": earth.B, "mean radius 6371 km": 6.371e6, "semi-major axis a": earth.A}
 """Radii a sphere model of the Earth may take (the print names the sphere, not its radius) [m]."""
@@ -94,6 +95,17 @@ def _wrap(a):
 
 def heading_readings(lat0, lon0, track, speed, duration):
     """The heading of a printed track under each reading of "heading" (deg).
+
+    Parameters
+    ----------
+    lat0, lon0 : float
+        Start of the track [rad].
+    track : {"north", "east"}
+        Along the meridian through the pole (after the pole on λ0 ± 180°), or along the parallel.
+    speed : float
+        Speed over ground [m/s].
+    duration : float
+        Length of the run [s].
 
     Returns
     -------
@@ -178,6 +190,7 @@ def print_parts_rows(parts, setup, table_1):
     """
     pp = parts.set_index("quantity")
     txt = lambda q: str(pp.loc[q, "value"])  # noqa: E731
+    show = lambda q: readable(txt(q))  # noqa: E731  (the printed text without its LaTeX markup)
     def at(*qs):
         lines = sorted({int(pp.loc[q, "line"]) for q in qs})
         return f"seed line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))}"
@@ -190,8 +203,11 @@ def print_parts_rows(parts, setup, table_1):
     rows.append(dict(
         quantity="matrix B of eqs. (25)-(27)",
         unit="",
-        paper_text=txt("eq. (25)"),
-        reproduced=f"defined after eq. (25): {', '.join(syms)}; B {'defined' if 'B' in syms else 'not defined'}",
+        paper_text=show("eq. (25)"),
+        reproduced=(
+            f"eq. (25) uses {', '.join(used)}; the sentence after it defines {', '.join(syms)}:"
+            f" B {'defined' if 'B' in syms else 'not defined'}"
+        ),
         basis="unstated",
         note=(
             "the print lacks B: eqs. (25)-(27) use it and no sentence defines it (the sentence after"
@@ -204,7 +220,7 @@ def print_parts_rows(parts, setup, table_1):
     rows.append(dict(
         quantity="time at which C_G^b of eqs. (25)-(27) is taken",
         unit="",
-        paper_text=txt("eq. (27)"),
+        paper_text=show("eq. (27)"),
         reproduced="not given (eq. (28): the ship rocks by 3°, 5° and 4° with 7-12 s periods)",
         basis="unstated",
         note=(
@@ -232,7 +248,7 @@ def print_parts_rows(parts, setup, table_1):
     rows.append(dict(
         quantity="horizontal attitude error neglected in eq. (3) (φ_x ≈ φ_y ≈ 0)",
         unit="deg/h",
-        paper_text=txt("horizontal attitude error neglected in eq. (3)"),
+        paper_text=show("horizontal attitude error neglected in eq. (3)"),
         reproduced=(
             f"tilt {tilt:.1e} rad from {bias:.0e} g; drift error through eq. (27) "
             + "; ".join(f"{k}: {lo / dh:.2g}-{hi / dh:.2g}" for k, (lo, hi) in err.items())
@@ -265,7 +281,7 @@ def print_parts_rows(parts, setup, table_1):
     rows.append(dict(
         quantity="distance to the pole at the printed latitude of the second fix",
         unit="m",
-        paper_text=f"{txt('latitude at t = 3.5 h')}, {txt('distance to the pole at t = 3.5 h')}",
+        paper_text=f"{show('latitude at t = 3.5 h')}, {show('distance to the pole at t = 3.5 h')}",
         reproduced=(
             f"{d['exact'][0] * 100:.2f}-{d['exact'][1] * 100:.2f} cm at {d['latitude']:.7f}° as"
             f" exact digits; {d['rounded'][0] * 100:.2f}-{d['rounded'][1] * 100:.2f} cm over the"
@@ -294,7 +310,7 @@ def print_parts_rows(parts, setup, table_1):
     rows.append(dict(
         quantity="case 2: heading 0° constant on a track along the meridian across the pole",
         unit="deg",
-        paper_text=f"{txt('case 2 heading')}; {txt('case 2 track')}; {txt('case 2 pole crossing')}",
+        paper_text=f"{show('case 2 heading')}; {show('case 2 track')}; {show('case 2 pole crossing')}",
         reproduced="; ".join(f"{k}: {_say(v)}" for k, v in h2.items()),
         basis="parts",
         agrees=any(fits.values()),
@@ -315,7 +331,7 @@ def print_parts_rows(parts, setup, table_1):
     rows.append(dict(
         quantity="case 1: mean yaw 90° of eq. (28) on a track along the 85°N parallel",
         unit="deg",
-        paper_text=f"{txt('case 1 yaw (eq. (28))')}; {txt('case 1 track')}",
+        paper_text=f"{show('case 1 yaw (eq. (28))')}; {show('case 1 track')}",
         reproduced="; ".join(f"{k}: {_say(v)}" for k, v in h1.items()),
         basis="parts",
         agrees=any(fits1.values()),
@@ -338,7 +354,7 @@ def print_parts_rows(parts, setup, table_1):
     rows.append(dict(
         quantity="M of eq. (17) at the printed second fix and at the pole",
         unit="",
-        paper_text=f"{txt('P equation in the polar region')}; M = {txt('M of eq. (17)')[:60]}…",
+        paper_text=f"{show('P equation in the polar region')}; M = {show('M of eq. (17)')}",
         reproduced=(
             f"finite at {lat_fix:.7f}°N 168°E (condition number"
             f" {cond:.3g}, rows 1-2 in units of R); at the pole the elements of rows 1-2 differ by {gap:.2g} R between"
