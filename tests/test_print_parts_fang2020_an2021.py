@@ -49,7 +49,7 @@ def test_length_power_of_printed_closed_forms():
 
 
 def test_readable_drops_the_markup_and_keeps_the_words():
-    from replication.registry.paper import readable
+    from replication.papers import readable
 
     assert readable(r"$\boldsymbol{\varepsilon}_b = C_G^b B \Omega U^{-1}(t_{n+1}, t_n)$") == (
         "ε_b = C_G^b B Ω U⁻¹(t_{n+1}, t_n)")

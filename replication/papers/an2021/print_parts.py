@@ -17,8 +17,8 @@ import numpy as np
 import sympy as sp
 
 from replication.nav import units
+from replication.papers import readable
 from replication.papers.an2021 import frequency, symbolic, transfer
-from replication.registry.paper import readable
 
 SYM = symbolic.SYMBOLS
 

@@ -17,9 +17,9 @@ import re
 import numpy as np
 
 from replication.nav import earth, units
+from replication.papers import readable
 from replication.papers.fang2020 import damping, frames, two_point
 from replication.papers.fang2020.error_equations import OMEGA, input_u, m_matrix, transition_t
-from replication.registry.paper import readable
 
 SPHERE_RADII = {"polar semi-axis b": earth.B, "mean radius 6371 km": 6.371e6, "semi-major axis a": earth.A}
 """Radii a sphere model of the Earth may take (the print names the sphere, not its radius) [m]."""
