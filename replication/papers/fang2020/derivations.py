@@ -425,7 +425,10 @@ def _display(v):
 
 
 def _identity(name, P, D):
-    match = {sgn: all(is_zero(v) for v in (P.subs(_sigma_sub(sgn)) - D)) for sgn in (1, -1)}
+    """``D`` is the derived form, or a function of the σ sign giving it (for a printed sin σ)."""
+    Dof = D if callable(D) else (lambda sgn: D)
+    D = Dof(1)
+    match = {sgn: all(is_zero(v) for v in (P.subs(_sigma_sub(sgn)) - Dof(sgn))) for sgn in (1, -1)}
     chk = Check(name, "identity", conventions=_over_conventions(lambda c: match[c["sigma"]]), derived=D, printed=P)
     if not chk.conventions:
         Ps = P.subs(_sigma_sub(1))
@@ -552,7 +555,7 @@ def check_item(name, reading, spec, readings=None) -> Check:
     if kind == "identity":
         g = geometry()
         D = {"C_gG": lambda: g["C_eG"] * g["C_eg"].T, "C_OG": lambda: g["C_OG"],
-             "sigma": lambda: sp.Matrix([g["sin_sigma"], g["cos_sigma"]]),
+             "sigma": lambda: (lambda sgn: sp.Matrix([sgn * g["sin_sigma"], g["cos_sigma"]])),
              "sphere": lambda: sp.Matrix([sp.sin(lam), sp.cos(lam), sp.sin(L), sp.cos(L)]),
              "Omega_O": lambda: g["Omega_O"], "T": lambda: psi_model()["T"], "U": lambda: psi_model()["U"]}
         if rest not in D:
