@@ -658,6 +658,18 @@ MODEL_GROUPS = {
 """Printed parts of one model that must hold under one sign convention (name -> the parts)."""
 
 
+def _corrected_product(n_check, c_reading, m_printed) -> bool:
+    """Whether the printed N with its non-derivable entries replaced by the derived ones (base
+    convention), times the printed C_OEPQ^G, equals the printed M."""
+    n = n_check.printed.copy()
+    for i in range(n.rows):
+        for j in range(n.cols):
+            if not is_zero(n[i, j] - n_check.derived[i, j]):
+                n[i, j] = n_check.derived[i, j]
+    sub = _sigma_sub(1)
+    return all(is_zero(v) for v in (n * parse(c_reading) - m_printed).subs(sub))
+
+
 def derivation_rows(checks: dict, printed, *, notebook: str) -> list[dict]:
     """The rows of fang2020-check-derivations: every printed part against its derivation, the printed
     M against the printed N C_OEPQ^G, and the parts of one model against a common convention.
@@ -685,9 +697,12 @@ def derivation_rows(checks: dict, printed, *, notebook: str) -> list[dict]:
         row = dict(quantity=name, unit="", paper_text=meta.at[name, "value"], agrees=c.agrees)
         if c.kind == "pair":
             a, b = meta.at[name, "spec"].split(":")[1:]
+            fixed = _corrected_product(checks[a], meta.at[b, "value"], c.printed)
             row.update(basis="parts", reproduced="equal" if c.agrees else f"{len(c.differing)} entries differ",
                        note=f"{where}: the printed M against the product of the printed {a} and {b}: "
-                       + ("equal" if c.agrees else "; ".join(f"{w}: M {p}, N C {q}" for w, p, q in c.differing)))
+                       + ("equal" if c.agrees else "; ".join(f"{w}: M {p}, N C {q}" for w, p, q in c.differing))
+                       + ("" if c.agrees else f"; with the derived entries of {a} the product "
+                          + ("equals" if fixed else "still differs from") + " the printed M"))
         elif c.agrees:
             row.update(basis="derivation", reproduced="derivable: " + convention_text(c.conventions),
                        note=f"{where}: every term derived; conventions: {convention_text(c.conventions)}{reading}")
