@@ -1,6 +1,6 @@
 """Exact zero tests and short displays for the symbolic derivations of the printed error models.
 
-Shared by :mod:`replication.papers.chen2019.derivations` and
+Shared by ``replication.papers.chen2019.derivations`` and
 :mod:`replication.papers.fang2020.derivations`: a printed term equals a derived one when their
 difference vanishes identically, which :func:`vanishes` decides exactly (no numbers): sines and
 cosines of the named angles become polynomial unknowns, the difference is brought over one
@@ -28,7 +28,7 @@ def _trig_symbols(angle):
 
 
 def _to_polynomial_unknowns(expr, angles):
-    """``expr`` with tan, sec, sin, cos of each angle written through the unknowns of :func:`_trig_symbols`."""
+    """``expr`` with tan, sec, sin, cos of each angle written through the polynomial unknowns standing for them."""
     e = sp.sympify(expr)
     for a in angles:
         s, c = _trig_symbols(a)

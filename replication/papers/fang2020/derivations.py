@@ -312,7 +312,7 @@ def namespace() -> dict:
     Returns
     -------
     dict
-        The scalars of :func:`symbols`; ``sqrt`` (on the sphere, :func:`_sphere_sqrt`); the
+        The scalars of :func:`symbols`; ``sqrt`` (on the sphere: R cos L, R Q, Q or R when the radicand is their square); the
         ψ-equation vectors ``psi``, ``dpsi`` (dψ/dt|_c, ψ̇_G), ``w_ic``, ``w_ip``, ``w_cp`` (the
         rate of p relative to c), ``eps`` (ε), ``eps_G``, ``Om`` (the Earth rate Ω as a vector,
         grid components); the OEPQ components ``psi_E`` … ``dpsi_E`` … ``eps_E`` …; for (25)-(27)
@@ -337,7 +337,7 @@ def namespace() -> dict:
 def parse(text: str, overrides=None) -> sp.Matrix:
     """A printed reading (sympy syntax) as a sympy Matrix in the names of :func:`namespace`.
 
-    x, y, z are put on the sphere (x = R cos L cos λ, …) and radicals resolved (:func:`_sphere_sqrt`).
+    x, y, z are put on the sphere (x = R cos L cos λ, …) and radicals resolved (R cos L, R Q, Q or R).
 
     Parameters
     ----------
@@ -538,7 +538,7 @@ def check_item(name, reading, spec, readings=None) -> Check:
     Returns
     -------
     Check
-        The result (chen2019's :class:`~replication.papers.chen2019.derivations.Check`).
+        The result (the ``Check`` record of ``replication.papers.chen2019.derivations``).
 
     Raises
     ------
