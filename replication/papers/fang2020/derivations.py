@@ -655,6 +655,8 @@ MODEL_GROUPS = {
     "ψ equation and calibration ((18)-(27)) under one convention": ("(18)", "(19)", "(20)", "(21)", "(22)", "(23)",
                                                                      "(24)", "(25)", "(26)", "(27)"),
 }
+MODEL_GROUPS["P and ψ equations together under one convention"] = tuple(
+    p for parts in list(MODEL_GROUPS.values()) for p in parts)
 """Printed parts of one model that must hold under one sign convention (name -> the parts)."""
 
 
@@ -718,7 +720,7 @@ def derivation_rows(checks: dict, printed, *, notebook: str) -> list[dict]:
         common = common_conventions([checks[p] for p in parts])
         rows.append(dict(quantity=label, unit="", paper_text=" | ".join(parts),
                          reproduced="common conventions: " + convention_text(common), basis="parts",
-                         agrees=bool(common), note="each part holds under: "
-                         + "; ".join(f"{p}: {convention_text(checks[p].conventions)}" for p in parts)
+                         agrees=bool(common), note=f"the conventions of the {len(parts)} parts (each in its own "
+                         "row) intersect in: " + convention_text(common)
                          + ("" if common else "; no convention holds for all, so the printed model mixes two")))
     return rows
