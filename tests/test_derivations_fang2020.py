@@ -109,7 +109,7 @@ PLANTED = [
     ("θ^g (display before (2))", "[0, cos(L), 0]", "[0, sin(L), 0]"),      # cos L for sin L
     ("(24)", "dpsi_Q - Omega*psi_E", "dpsi_Q + Omega*psi_E"),             # sign of the Earth-rate coupling
     ("(25) U", "[1 - cos(a_n), 0, sin(a_n)]", "[cos(a_n) - 1, 0, sin(a_n)]"),
-    ("(25)", "(psi1 - T*psi0)", "(psi1 + T*psi0)"),
+    ("(25)", "(psi1 - T * psi0)", "(psi1 + T * psi0)"),
     ("(12)", "sin(L)/(1 -", "cos(L)/(1 -"),
 ]
 

@@ -12,10 +12,11 @@ of a few cheap deterministic forms.
 from __future__ import annotations
 
 import functools
+import re
 
 import sympy as sp
 
-__all__ = ["vanishes", "normal_form", "short", "skew", "vee"]
+__all__ = ["vanishes", "normal_form", "short", "spaced", "skew", "vee"]
 
 _TRIG = {}
 
@@ -145,3 +146,21 @@ def skew(v) -> sp.Matrix:
 def vee(m) -> sp.Matrix:
     """The 3-vector v of a skew matrix [v×] (the inverse of :func:`skew` on skew matrices)."""
     return sp.Matrix([m[2, 1], m[0, 2], m[1, 0]])
+
+
+def spaced(text):
+    """A formula in sympy syntax with spaces around * and / (not **), so that a table cell can wrap.
+
+    Parameters
+    ----------
+    text : str or object
+        The formula; anything else is returned unchanged.
+
+    Returns
+    -------
+    str or object
+    """
+    if not isinstance(text, str):
+        return text
+    text = re.sub(r"(?<!\*)([*/])(?!\*)", r" \1 ", text).replace("Matrix(", "Matrix( ")
+    return re.sub(r"  +", " ", text)

@@ -41,7 +41,7 @@ import itertools
 import sympy as sp
 
 from replication.papers.chen2019.derivations import Check, rotation_from_quaternion
-from replication.papers.symbolic import normal_form, short, skew, vanishes, vee
+from replication.papers.symbolic import normal_form, short, skew, spaced, vanishes, vee
 
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "symbols", "geometry", "geometry_lemma", "error_relations",
            "psi_model", "namespace", "parse", "is_zero", "check_item", "check_all", "common_conventions",
@@ -723,4 +723,5 @@ def derivation_rows(checks: dict, printed, *, notebook: str) -> list[dict]:
                          agrees=bool(common), note=f"the conventions of the {len(parts)} parts (each in its own "
                          "row) intersect in: " + convention_text(common)
                          + ("" if common else "; no convention holds for all, so the printed model mixes two")))
-    return rows
+    return [{k: (spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
+            for r in rows]
