@@ -43,6 +43,8 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from replication.papers.symbolic import short, skew, vanishes, vee
+
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rotation_from_quaternion",
            "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
            "common_conventions", "companion_check", "convention_text", "check_all"]
@@ -100,12 +102,7 @@ def symbols() -> dict:
                 fz=fz, wx=wx, wy=wy, wz=wz, alpha=alpha, beta=beta)
 
 
-def _skew(v):
-    return sp.Matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-
-
-def _vee(m):
-    return sp.Matrix([m[2, 1], m[0, 2], m[1, 0]])
+_skew, _vee = skew, vee
 
 
 def _cross(a, b):
@@ -302,15 +299,12 @@ def parse(text: str, generic: bool = False) -> sp.Matrix:
     return out if isinstance(out, sp.MatrixBase) else sp.Matrix([out])
 
 
-_S, _K = sp.symbols("_sinL _cosL")
-
-
 def is_zero(expr) -> bool:
     """Whether a scalar expression vanishes identically (exact, not numerical).
 
     tan L and sec L are written through sin L and cos L, the expression is brought over one
-    denominator (``cancel``), and the
-    numerator is reduced modulo sin²L + cos²L − 1.
+    denominator (``cancel``), and the numerator is reduced modulo sin²L + cos²L − 1
+    (:func:`replication.papers.symbolic.vanishes` with the one angle L).
 
     Parameters
     ----------
@@ -322,18 +316,7 @@ def is_zero(expr) -> bool:
     bool
         True when the expression is identically zero.
     """
-    e = sp.sympify(expr)
-    if e == 0:
-        return True
-    e = e.subs({sp.sec(L): 1 / sp.cos(L), sp.tan(L): sp.sin(L) / sp.cos(L)}).subs({sp.sin(L): _S, sp.cos(L): _K})
-    num, _ = sp.fraction(sp.cancel(sp.together(e)))
-    num = sp.expand(num)
-    if num == 0:
-        return True
-    if not num.has(_S) and not num.has(_K):
-        return False
-    _, r = sp.reduced(num, [_S**2 + _K**2 - 1], _S, _K)
-    return sp.expand(r) == 0
+    return vanishes(expr, (L,))
 
 
 # ----------------------------------------------------------------------------- judging
@@ -381,20 +364,8 @@ class Check:
         return bool(self.conventions)
 
 
-def _short(x) -> str:
-    """The shortest of a few cheap, deterministic forms of ``x`` (as written, common factors
-    pulled out, one denominator, cancelled): a readable display of a printed or derived term.
-
-    ``sympy.simplify`` is not used: its heuristics took minutes on the largest Coriolis terms
-    and could return a longer form than the input.
-    """
-    def cancelled(e):
-        return e.applyfunc(lambda y: sp.factor_terms(sp.cancel(y))) if e.is_Matrix else sp.factor_terms(sp.cancel(e))
-
-    forms = [x]
-    for transform in (sp.factor_terms, sp.together, cancelled):
-        forms.append(transform(x))
-    return min((sp.sstr(f) for f in forms), key=lambda s: (len(s), s))
+_short = short
+"""The display of a term (:func:`replication.papers.symbolic.short`)."""
 
 
 def judge(name, printed, derived, *, row, groups, kind="block") -> Check:

@@ -18,8 +18,6 @@ the tests do.
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pandas as pd
 
@@ -28,6 +26,7 @@ from replication.papers.chen2019.observability import LEVEL_COMBINATIONS, verdic
 from replication.papers.chen2019.observability_tables import _table, verdict_under
 from replication.papers.chen2019.simulation import figure_4_14_estimates
 from replication.papers.chen2019.turntable import QUANTITIES
+from replication.papers.symbolic import spaced
 
 __all__ = ["closed_form_rows", "compare_verdicts", "column_groups", "EXACT_READING", "figure_4_14_ledger",
            "figure_4_14_range_text", "ordering_rows", "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims",
@@ -625,12 +624,8 @@ DERIVATION_GROUPS = {
 _PARTS_SPECS = ("markov", "H-position")
 
 
-def _spaced(text):
-    """A formula in sympy syntax with spaces around * and / (not **), so that a table cell can wrap."""
-    if not isinstance(text, str):
-        return text
-    text = re.sub(r"(?<!\*)([*/])(?!\*)", r" \1 ", text).replace("Matrix(", "Matrix( ")
-    return re.sub(r"  +", " ", text)
+_spaced = spaced
+"""A formula with spaces for a table cell to wrap (:func:`replication.papers.symbolic.spaced`)."""
 
 
 ENTRIES_SHOWN = 2
