@@ -12,11 +12,12 @@ of a few cheap deterministic forms.
 from __future__ import annotations
 
 import functools
+import itertools
 import re
 
 import sympy as sp
 
-__all__ = ["vanishes", "normal_form", "short", "spaced", "skew", "vee"]
+__all__ = ["vanishes", "normal_form", "short", "spaced", "skew", "vee", "common_conventions", "convention_text"]
 
 _TRIG = {}
 
@@ -164,3 +165,61 @@ def spaced(text):
         return text
     text = re.sub(r"(?<!\*)([*/])(?!\*)", r" \1 ", text).replace("Matrix(", "Matrix( ")
     return re.sub(r"  +", " ", text)
+
+
+def common_conventions(checks, conventions) -> list:
+    """The conventions under which every one of ``checks`` holds (empty: the parts exclude each other).
+
+    Parameters
+    ----------
+    checks : sequence
+        Checks with a ``conventions`` attribute (the conventions each holds under).
+    conventions : sequence of dict
+        Every convention the text leaves open, each a dict name -> ±1.
+
+    Returns
+    -------
+    list of dict
+        The shared conventions, in the order of ``conventions``.
+    """
+    out = list(conventions)
+    for c in checks:
+        out = [s for s in out if s in c.conventions]
+    return out
+
+
+def convention_text(convs, conventions, words) -> str:
+    """The signs a list of conventions fixes, in words: each sign they share, then each product of
+    two or three of the others that they share; ``'any'`` or ``'none'``.
+
+    Parameters
+    ----------
+    convs : sequence of dict
+        A subset of ``conventions``.
+    conventions : sequence of dict
+        Every convention the text leaves open, each a dict name -> ±1 (the same names in each).
+    words : dict
+        (name, sign) -> the convention in words.
+
+    Returns
+    -------
+    str
+        E.g. ``'errors computed − true; sign products a·gyro = -1'``.
+    """
+    convs = list(convs)
+    if not convs:
+        return "none"
+    if len(convs) == len(conventions):
+        return "any"
+    names = list(conventions[0])
+    fixed = [k for k in names if len({s[k] for s in convs}) == 1]
+    text = "; ".join(words[(k, convs[0][k])] for k in fixed)
+    free = [k for k in names if k not in fixed]
+    combos = []
+    for n in (2, 3):
+        for combo in itertools.combinations(free, n):
+            if len({sp.prod([s[k] for k in combo]) for s in convs}) == 1 and not any(
+                    set(c).issubset(combo) for c in combos):
+                combos.append(combo)
+    pairs = [f"{'·'.join(c)} = {sp.prod([convs[0][k] for k in c]):+d}" for c in combos]
+    return "; ".join(t for t in (text, "sign products " + ", ".join(pairs) if pairs else "") if t)

@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from replication.papers import symbolic
 from replication.papers.symbolic import short, skew, vanishes, vee
 
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rotation_from_quaternion",
@@ -434,7 +435,8 @@ def judge(name, printed, derived, *, row, groups, kind="block") -> Check:
 
 
 def common_conventions(checks) -> list:
-    """The conventions under which every one of ``checks`` holds.
+    """The conventions of :data:`CONVENTIONS` under which every one of ``checks`` holds
+    (:func:`replication.papers.symbolic.common_conventions`).
 
     Parameters
     ----------
@@ -446,14 +448,12 @@ def common_conventions(checks) -> list:
     list of dict
         The shared conventions; empty when the printed parts contradict each other.
     """
-    out = list(CONVENTIONS)
-    for c in checks:
-        out = [s for s in out if s in c.conventions]
-    return out
+    return symbolic.common_conventions(checks, CONVENTIONS)
 
 
 def convention_text(convs) -> str:
-    """The conventions of a list in words: the signs they all share, or ``'none'``.
+    """A list of conventions of :data:`CONVENTIONS` in words
+    (:func:`replication.papers.symbolic.convention_text` with :data:`CONVENTION_WORDS`).
 
     Parameters
     ----------
@@ -463,21 +463,9 @@ def convention_text(convs) -> str:
     Returns
     -------
     str
-        E.g. ``'errors computed − true; attitude error ψ = −φ (Ĉ = (I + ψ×)C)'``; ``'any'`` when
-        every convention holds.
+        The signs they all share, and the products of the others they share; ``'any'`` or ``'none'``.
     """
-    convs = list(convs)
-    if not convs:
-        return "none"
-    if len(convs) == len(CONVENTIONS):
-        return "any"
-    fixed = [k for k in ("e", "a", "acc", "gyro") if len({s[k] for s in convs}) == 1]
-    text = "; ".join(CONVENTION_WORDS[(k, convs[0][k])] for k in fixed)
-    if not fixed:
-        pairs = [f"{a}·{b} = {convs[0][a] * convs[0][b]:+d}" for a, b in itertools.combinations(("e", "a", "acc", "gyro"), 2)
-                 if len({s[a] * s[b] for s in convs}) == 1]
-        text = "sign products " + ", ".join(pairs)
-    return text
+    return symbolic.convention_text(convs, CONVENTIONS, CONVENTION_WORDS)
 
 
 # ----------------------------------------------------------------------------- the items

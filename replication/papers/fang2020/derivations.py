@@ -40,6 +40,7 @@ import itertools
 
 import sympy as sp
 
+from replication.papers import symbolic
 from replication.papers.chen2019.derivations import Check, rotation_from_quaternion
 from replication.papers.symbolic import normal_form, short, skew, spaced, vanishes, vee
 
@@ -598,49 +599,37 @@ def check_all(items) -> dict:
 
 
 def common_conventions(checks) -> list:
-    """The conventions under which every one of ``checks`` holds (empty: the parts exclude each other).
+    """The conventions of :data:`CONVENTIONS` under which every one of ``checks`` holds
+    (:func:`replication.papers.symbolic.common_conventions`).
 
     Parameters
     ----------
     checks : sequence of Check
+        Printed parts of one model.
 
     Returns
     -------
     list of dict
+        The shared conventions; empty when the printed parts contradict each other.
     """
-    out = list(CONVENTIONS)
-    for c in checks:
-        out = [s for s in out if s in c.conventions]
-    return out
+    return symbolic.common_conventions(checks, CONVENTIONS)
 
 
 def convention_text(convs) -> str:
-    """The signs a list of conventions fixes, in words; ``'any'`` or ``'none'``.
+    """A list of conventions of :data:`CONVENTIONS` in words
+    (:func:`replication.papers.symbolic.convention_text` with :data:`CONVENTION_WORDS`).
 
     Parameters
     ----------
     convs : sequence of dict
+        Conventions of :data:`CONVENTIONS`.
 
     Returns
     -------
     str
+        The signs they all share, and the products of the others they share; ``'any'`` or ``'none'``.
     """
-    convs = list(convs)
-    if not convs:
-        return "none"
-    if len(convs) == len(CONVENTIONS):
-        return "any"
-    fixed = [k_ for k_ in ("e", "a", "sigma", "gyro") if len({s[k_] for s in convs}) == 1]
-    text = "; ".join(CONVENTION_WORDS[(k_, convs[0][k_])] for k_ in fixed)
-    free = [k_ for k_ in ("e", "a", "sigma", "gyro") if k_ not in fixed]
-    pairs = []
-    for n in (2, 3):
-        for combo in itertools.combinations(free, n):
-            prod = {sp.prod([s[k_] for k_ in combo]) for s in convs}
-            if len(prod) == 1 and not any(set(p_).issubset(combo) for p_ in pairs):
-                pairs.append(combo)
-    pairs = [f"{'·'.join(c_)} = {sp.prod([convs[0][k_] for k_ in c_]):+d}" for c_ in pairs]
-    return "; ".join([t for t in (text, "sign products " + ", ".join(pairs) if pairs else "") if t])
+    return symbolic.convention_text(convs, CONVENTIONS, CONVENTION_WORDS)
 
 
 # ----------------------------------------------------------------------------- table rows
