@@ -233,3 +233,58 @@ def test_input_validation():
         xc.combination_sd_ratio("U-turn", {"∇_z": 0.0})
     with pytest.raises(ValueError, match="shape"):
         xc.error_model(np.eye(2), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3))
+
+
+def _common_rotation(alpha):
+    """The state offsets of a common small rotation α of both sensor triads (Table 2-2 coupling):
+    δA = δG = −α× (row i, column j: M_ij), zero navigation errors; φ is added per epoch."""
+    ax, ay, az = alpha
+    mis = {"xy": az, "xz": -ay, "yx": -az, "yz": ax, "zx": ay, "zy": -ax}
+    x = np.zeros(len(xc._ALL))
+    for k, v in mis.items():
+        x[xc._IDX["δA_" + k]] = v
+        x[xc._IDX["δG_" + k]] = v
+    return x
+
+
+@pytest.mark.parametrize("axis", range(3))
+def test_a_common_rotation_of_both_triads_is_unobservable_in_the_continuous_model(axis):
+    """With φ(t) = −C_b^n(t) α and δA = δG = −α× the navigation solution is unchanged: the direction
+    solves ẋ = F(t) x exactly (velocity rows 0, attitude rows −Ċ α = −C (ω_nb^b × α)) on any flight,
+    so no misalignment state is observable on its own in the continuous-time model; the 1-s
+    piecewise-constant transition of the second computation leaves it at ~1e-4-1e-2 of a
+    misalignment column (the module's 'Limits')."""
+    alpha = np.zeros(3)
+    alpha[axis] = 1e-5
+    prof = xc.flight_profile("figure-8")
+    p = [xc._IDX[n] for n in ("φ_E", "φ_N", "φ_U")]
+    v = [xc._IDX[n] for n in ("δV_E", "δV_N", "δV_U")]
+    w_ie = np.array([0.0, xc._OMEGA * xc._COS_L, xc._OMEGA * xc._SIN_L])
+    worst = 0.0
+    for k in range(0, prof["t"].size, 7):
+        c, vn = prof["C_bn"][k], prof["v_n"][k]
+        w_en = np.array([-vn[1] / (xc._RM + xc._HEIGHT), vn[0] / (xc._RN + xc._HEIGHT),
+                         vn[0] * np.tan(xc._LAT) / (xc._RN + xc._HEIGHT)])
+        w_nb = prof["w_ib"][k] - c.T @ (w_ie + w_en)
+        x = _common_rotation(alpha)
+        x[p] = -c @ alpha
+        f = xc.error_model(c, vn, prof["f_n"][k], prof["f_b"][k], prof["w_ib"][k], "table-2-2")
+        dx = f @ x
+        scale = np.abs(f[:, 15:33]).max() * 1e-5
+        worst = max(worst, np.abs(dx[v]).max() / scale,
+                    np.abs(dx[p] + c @ np.cross(w_nb, alpha)).max() / scale)
+    assert worst < 1e-9
+
+    # the discretized information matrix of the second computation does not see the symmetry
+    a = xc._measurement_matrix()
+    fdt = np.stack([xc.error_model(c, vn, fn, fb, w, "table-2-2") * xc._DT for c, vn, fn, fb, w in
+                    zip(prof["C_bn"], prof["v_n"], prof["f_n"], prof["f_b"], prof["w_ib"])])
+    phi, rows = np.eye(len(xc._ALL)), []
+    for step in xc._transition(fdt):
+        phi = step @ phi
+        rows.append(a @ phi)
+    m = np.vstack(rows)
+    x0 = _common_rotation(alpha)
+    x0[p] = -prof["C_bn"][0] @ alpha
+    column = np.linalg.norm(m[:, xc._IDX["δG_xz"]]) * 1e-5
+    assert np.linalg.norm(m @ x0) > 1e-5 * column

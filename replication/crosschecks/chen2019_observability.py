@@ -61,6 +61,20 @@ The noise-free limit is the notion of Table 2-3 (a printed degree of 1e-4 counts
 how well a state is estimated is a question of noise and duration, available here with
 ``noise_scale=1`` (the GNSS noise of Table 4-41).
 
+Limits
+------
+A common small rotation α of both sensor triads (δA = δG = −α× under Table 2-2's coupling, with
+φ(t) = −C_b^n(t) α) leaves the navigation solution unchanged: it solves the continuous error
+equations exactly on every flight (tests/test_crosscheck_chen2019_observability.py::
+test_a_common_rotation_of_both_triads_is_unobservable_in_the_continuous_model), so in the
+continuous-time model no misalignment angle is observable on its own, on any segment, and the
+attitude errors only in combination with them.  The transition here holds F constant over each 1-s
+step; in turns that leaves the three directions at about 1e-4 to 1e-2 of a misalignment column,
+far above the noise-free null-space cut, so the verdicts of this module on the twelve misalignment
+angles (and on the attitude errors they couple to) in turning segments are artefacts of the
+discretization, not properties of the model.  An independent recomputation from the paper alone
+found the same.  The verdicts of the other states are not affected by the symmetry.
+
 Only numpy and scipy are used; nothing is shared with the chapter's PWCS/SVD computation.
 """
 from __future__ import annotations

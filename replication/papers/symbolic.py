@@ -92,7 +92,12 @@ def normal_form(expr, angles, relations=(), unknowns=()):
     Parameters
     ----------
     expr : sympy expression
-    angles, relations, unknowns
+        The expression.
+    angles : sequence of sympy.Symbol
+        As for :func:`vanishes`.
+    relations : sequence of sympy expression, optional
+        As for :func:`vanishes`.
+    unknowns : sequence of sympy.Symbol, optional
         As for :func:`vanishes`.
 
     Returns
@@ -140,12 +145,34 @@ def short(x) -> str:
 
 
 def skew(v) -> sp.Matrix:
-    """The cross-product matrix [v×] of a 3-vector (``skew(a) * b == a.cross(b)``)."""
+    """The cross-product matrix [v×] of a 3-vector (``skew(a) * b == a.cross(b)``).
+
+    Parameters
+    ----------
+    v : sequence of 3 sympy expressions
+        The vector.
+
+    Returns
+    -------
+    sympy.Matrix
+        3 × 3, skew-symmetric.
+    """
     return sp.Matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
 
 
 def vee(m) -> sp.Matrix:
-    """The 3-vector v of a skew matrix [v×] (the inverse of :func:`skew` on skew matrices)."""
+    """The 3-vector v of a skew matrix [v×] (the inverse of :func:`skew` on skew matrices).
+
+    Parameters
+    ----------
+    m : sympy.Matrix
+        3 × 3, skew-symmetric.
+
+    Returns
+    -------
+    sympy.Matrix
+        3 × 1.
+    """
     return sp.Matrix([m[2, 1], m[0, 2], m[1, 0]])
 
 
