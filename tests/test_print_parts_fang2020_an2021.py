@@ -57,3 +57,59 @@ def test_readable_drops_the_markup_and_keeps_the_words():
         "(φ_E(s))/(g_{dN}(s)) ≈ 1/10")
     assert readable(r"$\bar{\mathbf{A}}$ 为 12×12 状态矩阵") == "A\u0304 为 12×12 状态矩阵"
     assert readable(r"纬度为 $89.999\ 999\ 8^\circ$ 处") == "纬度为 89.999 999 8° 处"
+
+
+def test_oepq_turn_cost_matches_the_closed_form_of_u():
+    tau, lat = 1.5 * units.HOUR, np.radians(85.0)
+    lam_dot = 0.247 * OMEGA
+    c = fang_pp.oepq_turn_cost(lat, lam_dot, tau, np.full(3, 1e-7), np.pi / 2)
+    a, a_t = OMEGA * tau, (OMEGA + lam_dot) * tau
+    # U acts on the E-Q plane as 2 sin(a/2) times a turn by a/2: the ratio turns by (a_t - a)/2
+    assert np.isclose(c["angle"], (a_t - a) / 2, rtol=1e-12)
+    assert np.isclose(c["gain"], OMEGA / (OMEGA + lam_dot) * np.sin(a_t / 2) / np.sin(a / 2), rtol=1e-12)
+    assert abs(c["oepq"][1]) < 1e-12  # the polar component: U_PP = a, exact for any rate
+    # no turn, no cost (round-off only)
+    assert np.all(np.abs(fang_pp.oepq_turn_cost(lat, 0.0, tau, np.full(3, 1e-7), 0.3)["body"]) < 1e-12)
+
+
+def test_longitude_rate_on_the_printed_tracks():
+    hour = units.HOUR
+    # the meridian track short of the pole: λ constant; the parallel: V / (a cos L)
+    assert fang_pp.longitude_rate(np.radians(88.868), np.radians(168.0), "north", 10.0, 2 * hour, 3.5 * hour) == 0.0
+    rate = fang_pp.longitude_rate(np.radians(85.0), np.radians(18.0), "east", 10.0, 2 * hour, 3.5 * hour)
+    assert np.isclose(rate, 10.0 / (fang_pp.earth.A * np.cos(np.radians(85.0))), rtol=1e-9)
+
+
+def test_phi_u_coefficients_earth_term_and_heading_sine_term():
+    t = np.array([0.0])
+    e, v = fang_pp.phi_u_coefficients(np.radians(85.0), np.radians(18.0), "east", 10.0, t)
+    sigma = np.arctan2(np.sin(np.radians(85.0)) * np.sin(np.radians(18.0)), np.cos(np.radians(18.0)))
+    assert np.isclose(e[0], OMEGA * np.cos(np.radians(85.0)) * np.cos(sigma), rtol=1e-12)
+    # heading east, grid heading 90° - σ: V sin(90° - σ) / R within the ellipsoid's few per mille
+    assert np.isclose(v[0], 10.0 * np.cos(sigma) / fang_pp.earth.A, rtol=1e-2)
+
+
+def test_euler_order_gap_is_second_order_in_pitch_and_roll():
+    p, r = np.radians(3.0), np.radians(5.0)
+    assert np.isclose(fang_pp.euler_order_gap(p, r), p * r, rtol=0.01)
+    assert fang_pp.euler_order_gap(p, 0.0) < 1e-12
+
+
+def test_eq_27_is_invariant_to_the_oepq_axes_at_a_fix_near_the_pole():
+    from replication.papers.fang2020 import frames, two_point
+
+    lat, lon, tau = np.radians(89.9999998), np.radians(168.0), 1.5 * units.HOUR
+    r = fang_pp.earth.geodetic_to_ecef(lat, lon, 0.0)
+    c = frames.attitude_from_euler(-frames.grid_azimuth(lat, lon), 0.0, 0.0)
+    p = np.array([30.0, -20.0, 1e-4])
+    e0 = two_point.two_point_drift(p, r, c, tau)
+    # a 5 m move swings λ through any value; the estimate moves by ~5 m / R only
+    e1 = two_point.two_point_drift(p, r + np.array([0.0, 5.0, 0.0]), c, tau)
+    assert np.max(np.abs(e1 - e0)) < 1e-5 * np.max(np.abs(e0))
+
+
+def test_natural_frequencies_split_by_about_twice_the_vertical_earth_rate():
+    assert an_pp.natural_split(0.0, 0.0) < an_pp.DISTINCT * 1.24e-3  # a double one at the equator at rest
+    lat = np.radians(30.0)
+    assert np.isclose(an_pp.natural_split(lat, 10.0), 2 * OMEGA * np.sin(lat), rtol=0.01)
+    assert len(an_pp.natural_frequencies(lat, 10.0)) == 2
