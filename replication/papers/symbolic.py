@@ -14,10 +14,11 @@ from __future__ import annotations
 import functools
 import itertools
 import re
+from dataclasses import dataclass, field
 
 import sympy as sp
 
-__all__ = ["vanishes", "normal_form", "short", "spaced", "skew", "vee", "common_conventions", "convention_text"]
+__all__ = ["Check", "rotation_from_quaternion", "vanishes", "normal_form", "short", "spaced", "skew", "vee", "common_conventions", "convention_text"]
 
 _TRIG = {}
 
@@ -250,3 +251,65 @@ def convention_text(convs, conventions, words) -> str:
                 combos.append(combo)
     pairs = [f"{'·'.join(c)} = {sp.prod([convs[0][k] for k in c]):+d}" for c in combos]
     return "; ".join(t for t in (text, "sign products " + ", ".join(pairs) if pairs else "") if t)
+
+
+def rotation_from_quaternion():
+    """C_b^n as the rotation of an unnormalised quaternion (q0, q1, q2, q3): R(q)/|q|².
+
+    Every entry is rational in q, and C Cᵀ = I and C (ω×) Cᵀ = ((Cω)×) hold as rational identities,
+    so orthogonality is applied exactly by :func:`vanishes` (``cancel``); the quaternion's symbols are q0, q1, q2, q3 (real).
+
+    Returns
+    -------
+    C : sympy.Matrix, shape (3, 3)
+        The direction cosine matrix, same layout as :func:`replication.nav.rotations.quat_to_dcm`.
+    """
+    a, b, c, d = sp.symbols("q0:4", real=True)
+    n = a**2 + b**2 + c**2 + d**2
+    R = sp.Matrix([[a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)],
+                   [2 * (b * c + a * d), a * a - b * b + c * c - d * d, 2 * (c * d - a * b)],
+                   [2 * (b * d - a * c), 2 * (c * d + a * b), a * a - b * b - c * c + d * d]])
+    return R / n
+
+
+@dataclass
+class Check:
+    """One printed part against its derivation.
+
+    Attributes
+    ----------
+    name : str
+        The printed part (the quantity of a ``-check-derivations`` table).
+    kind : str
+        ``equation`` (a row group of F as a linear form), ``block`` (a block of F or H),
+        ``generic`` (a perturbation identity, no convention), ``vector`` or ``pair`` (two
+        printed parts compared with each other).
+    matches : dict
+        State group -> set of signs s (±1) with printed = s × derived for that group's terms.
+    conventions : list of dict
+        The conventions (of the deriving module's ``CONVENTIONS``) that reproduce every compared term.
+    differing : list of tuple of str
+        The entries no sign reproduces: (entry, printed, derived) in plain text; for a ``pair``,
+        (entry, this print, the other print).
+    spherical : bool or None
+        Whether the print is derivable when R_n is set equal to R_m (a spherical Earth), for a
+        block or equation that is not derivable otherwise; None when not tried.
+    derived : sympy.Matrix or None
+        The derived form in the base convention (or the derived expression of a generic check).
+    printed : sympy.Matrix or None
+        The printed reading.
+    """
+
+    name: str
+    kind: str
+    matches: dict = field(default_factory=dict)
+    conventions: list = field(default_factory=list)
+    differing: list = field(default_factory=list)
+    derived: object = None
+    printed: object = None
+    spherical: object = None
+
+    @property
+    def agrees(self) -> bool:
+        """Whether some convention (or, for a generic check, the identity) reproduces the print."""
+        return bool(self.conventions)

@@ -68,6 +68,18 @@ def natural_frequencies(lat, v_north):
 
     One per conjugate pole pair of the pure-inertial transfer function, the pair at ω_ie (the
     pair p_5, p_6 that cancels) left out.
+
+    Parameters
+    ----------
+    lat : float
+        Latitude [rad].
+    v_north : float
+        North speed [m/s].
+
+    Returns
+    -------
+    numpy.ndarray
+        The frequencies [rad/s], ascending.
     """
     p = np.asarray(transfer.transfer_function(lat, 0.0, v_north, "phiE/gdN").poles())
     w = np.sort(np.abs(p[p.imag > 0]))
@@ -75,7 +87,20 @@ def natural_frequencies(lat, v_north):
 
 
 def natural_split(lat, v_north):
-    """Difference of the two natural frequencies near ω_s [rad/s] (0 for a double one)."""
+    """Difference of the two natural frequencies near ω_s [rad/s] (0 for a double one).
+
+    Parameters
+    ----------
+    lat : float
+        Latitude [rad].
+    v_north : float
+        North speed [m/s].
+
+    Returns
+    -------
+    float
+        The largest minus the smallest of :func:`natural_frequencies` [rad/s].
+    """
     w = natural_frequencies(lat, v_north)
     return float(w.max() - w.min())
 

@@ -39,12 +39,12 @@ chapter passes them in.  The findings module turns the results into table rows.
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import sympy as sp
 
 from replication.papers import symbolic
-from replication.papers.symbolic import short, skew, vanishes, vee
+from replication.papers.symbolic import Check, rotation_from_quaternion, short, skew, vanishes, vee
 
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rotation_from_quaternion",
            "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
@@ -108,25 +108,6 @@ _skew, _vee = skew, vee
 
 def _cross(a, b):
     return sp.Matrix(a).cross(sp.Matrix(b))
-
-
-def rotation_from_quaternion():
-    """C_b^n as the rotation of an unnormalised quaternion (q0, q1, q2, q3): R(q)/|q|².
-
-    Every entry is rational in q, and C Cᵀ = I and C (ω×) Cᵀ = ((Cω)×) hold as rational identities,
-    so orthogonality is applied exactly by :func:`is_zero` (``cancel``).
-
-    Returns
-    -------
-    C : sympy.Matrix, shape (3, 3)
-        The direction cosine matrix, same layout as :func:`replication.nav.rotations.quat_to_dcm`.
-    """
-    a, b, c, d = q0, q1, q2, q3
-    n = a**2 + b**2 + c**2 + d**2
-    R = sp.Matrix([[a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)],
-                   [2 * (b * c + a * d), a * a - b * b + c * c - d * d, 2 * (c * d - a * b)],
-                   [2 * (b * d - a * c), 2 * (c * d + a * b), a * a - b * b - c * c + d * d]])
-    return R / n
 
 
 C = sp.Matrix(3, 3, lambda i, j: sp.Symbol(f"C_{i + 1}{j + 1}", real=True))
@@ -321,49 +302,6 @@ def is_zero(expr) -> bool:
 
 
 # ----------------------------------------------------------------------------- judging
-
-@dataclass
-class Check:
-    """One printed part against its derivation.
-
-    Attributes
-    ----------
-    name : str
-        The printed part (the quantity of chen2019-check-derivations).
-    kind : str
-        ``equation`` (a row group of F as a linear form), ``block`` (a block of F or H),
-        ``generic`` (a perturbation identity, no convention), ``vector`` or ``pair`` (two
-        printed parts compared with each other).
-    matches : dict
-        State group -> set of signs s (±1) with printed = s × derived for that group's terms.
-    conventions : list of dict
-        The conventions of :data:`CONVENTIONS` that reproduce every compared term.
-    differing : list of tuple of str
-        The entries no sign reproduces: (entry, printed, derived) in plain text; for a ``pair``,
-        (entry, this print, the other print).
-    spherical : bool or None
-        Whether the print is derivable when R_n is set equal to R_m (a spherical Earth), for a
-        block or equation that is not derivable otherwise; None when not tried.
-    derived : sympy.Matrix or None
-        The derived form in the base convention (or the derived expression of a generic check).
-    printed : sympy.Matrix or None
-        The printed reading.
-    """
-
-    name: str
-    kind: str
-    matches: dict = field(default_factory=dict)
-    conventions: list = field(default_factory=list)
-    differing: list = field(default_factory=list)
-    derived: object = None
-    printed: object = None
-    spherical: object = None
-
-    @property
-    def agrees(self) -> bool:
-        """Whether some convention (or, for a generic check, the identity) reproduces the print."""
-        return bool(self.conventions)
-
 
 _short = short
 """The display of a term (:func:`replication.papers.symbolic.short`)."""

@@ -41,8 +41,7 @@ import itertools
 import sympy as sp
 
 from replication.papers import symbolic
-from replication.papers.chen2019.derivations import Check, rotation_from_quaternion
-from replication.papers.symbolic import normal_form, short, skew, spaced, vanishes, vee
+from replication.papers.symbolic import Check, normal_form, rotation_from_quaternion, short, skew, spaced, vanishes, vee
 
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "symbols", "geometry", "geometry_lemma", "error_relations",
            "psi_model", "namespace", "parse", "is_zero", "check_item", "check_all", "common_conventions",
@@ -539,7 +538,7 @@ def check_item(name, reading, spec, readings=None) -> Check:
     Returns
     -------
     Check
-        The result (the ``Check`` record of ``replication.papers.chen2019.derivations``).
+        The result (:class:`replication.papers.symbolic.Check`).
 
     Raises
     ------
