@@ -1,8 +1,9 @@
 """The methods of the four source documents, one sub-package per paper, built on
 :mod:`replication.nav` and never on each other (the chapters' figures in :mod:`.plots`).
 
-One helper is shared by the papers' comparison rows: :func:`readable`, a formula transcribed in
-LaTeX (``data/paper/``) written in plain characters for a table cell.
+Two helpers are shared by the papers' comparison rows: :func:`readable`, a formula transcribed in
+LaTeX (``data/paper/``) written in plain characters for a table cell, and :func:`transcription`,
+the printed text and seed lines of a print-parts transcription by quantity.
 """
 
 from __future__ import annotations
@@ -52,3 +53,33 @@ def readable(latex: str) -> str:
                    lambda m: "/".join(p if re.fullmatch(r"[\w.]+", p) else f"({p})" for p in m.groups()) + " ", s)
     s = re.sub(r"\\([A-Za-z]+)", lambda m: _GREEK.get(m.group(1), m.group(1)), s)
     return re.sub(r"\s+", " ", s).strip()
+
+
+def transcription(parts):
+    """Accessors of a print-parts transcription (``data/paper/<key>/<key>-print-parts.csv``).
+
+    Parameters
+    ----------
+    parts : pandas.DataFrame
+        The transcription: columns ``quantity``, ``value`` (the printed text) and ``line`` (its
+        line in the extracted seed).
+
+    Returns
+    -------
+    text, show, at : callable
+        ``text(q)`` the printed text of quantity ``q`` as transcribed; ``show(q)`` the same
+        without LaTeX markup (:func:`readable`); ``at(*qs)`` ``"seed line(s) n, m"`` of the quantities.
+    """
+    pp = parts.set_index("quantity") if "quantity" in parts.columns else parts
+
+    def text(q):
+        return str(pp.loc[q, "value"])
+
+    def show(q):
+        return readable(text(q))
+
+    def at(*qs):
+        lines = sorted({int(pp.loc[q, "line"]) for q in qs})
+        return f"seed line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))}"
+
+    return text, show, at

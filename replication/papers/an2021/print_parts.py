@@ -18,7 +18,7 @@ import sympy as sp
 
 from replication.nav import units
 from replication.nav.earth import OMEGA_IE
-from replication.papers import readable
+from replication.papers import transcription
 from replication.papers.an2021 import frequency, symbolic, transfer
 
 SYM = symbolic.SYMBOLS
@@ -129,12 +129,7 @@ def print_parts_rows(parts, eq5, eq7, lat=np.radians(30.0), v_north=10.0):
         Rows for :func:`~replication.registry.reproduction.compare`.
     """
     pp = parts.set_index("quantity")
-    txt = lambda q: str(pp.loc[q, "value"])  # noqa: E731
-    show = lambda q: readable(txt(q))  # noqa: E731  (the printed text without its LaTeX markup)
-
-    def at(*qs):
-        lines = sorted({int(pp.loc[q, "line"]) for q in qs})
-        return f"seed line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))}"
+    txt, show, at = transcription(pp)
 
     rows = []
     sys_ns = transfer.transfer_function(lat, 0.0, v_north, "phiE/gdN")

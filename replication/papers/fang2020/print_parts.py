@@ -17,7 +17,7 @@ import re
 import numpy as np
 
 from replication.nav import earth, rotations, units
-from replication.papers import readable
+from replication.papers import transcription
 from replication.papers.fang2020 import damping, frames, two_point
 from replication.papers.fang2020.error_equations import OMEGA, m_matrix, propagate_psi
 from replication.papers.fang2020.print_numbers import (  # noqa: F401  (public names kept here for callers)
@@ -58,11 +58,7 @@ def print_parts_rows(parts, setup, table_1, table_2, x_means):
         Rows for :func:`~replication.registry.reproduction.compare`.
     """
     pp = parts.set_index("quantity")
-    txt = lambda q: str(pp.loc[q, "value"])  # noqa: E731
-    show = lambda q: readable(txt(q))  # noqa: E731  (the printed text without its LaTeX markup)
-    def at(*qs):
-        lines = sorted({int(pp.loc[q, "line"]) for q in qs})
-        return f"seed line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))}"
+    txt, show, at = transcription(pp)
 
     rows = []
 
@@ -313,12 +309,7 @@ def second_reading_rows(pp, setup, table_1, table_2, x_means):
     list of dict
         Rows for :func:`replication.registry.exports.compare`.
     """
-    txt = lambda q: str(pp.loc[q, "value"])  # noqa: E731
-    show = lambda q: readable(txt(q))  # noqa: E731
-
-    def at(*qs):
-        lines = sorted({int(pp.loc[q, "line"]) for q in qs})
-        return f"seed line{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))}"
+    txt, show, at = transcription(pp)
 
     dh = units.DEG_PER_H
     rows = []
