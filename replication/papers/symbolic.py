@@ -178,7 +178,7 @@ def vee(m) -> sp.Matrix:
 
 
 def spaced(text):
-    """A formula in sympy syntax with spaces around * and / (not **), so that a table cell can wrap.
+    """A formula in sympy syntax with spaces around ``*`` and ``/`` (not ``**``), so that a table cell can wrap.
 
     Parameters
     ----------

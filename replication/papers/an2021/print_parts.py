@@ -2,7 +2,7 @@
 
 :func:`print_parts_rows` turns the transcription ``data/paper/an2021/an2021-print-parts.csv`` (and
 the printed coefficients of ``an2021-eq-5.csv`` and ``an2021-eq-7.csv``) into comparison rows for
-:func:`replication.registry.reproduction.compare`: the unit of the "1/10" of eqs. (11)-(12), the
+:func:`replication.registry.exports.compare`: the unit of the "1/10" of eqs. (11)-(12), the
 matrix :math:`C_1` of eq. (10), the symbols the print defines twice (the coefficients
 :math:`n_{ij}`, :math:`d_i`, the input matrix :math:`B`, the pole labels :math:`p_i`), the
 −40 dB/dec band against the Schuler resonance, and the matrices, constants and assumption the print
@@ -30,7 +30,7 @@ def length_power(expr):
     Parameters
     ----------
     expr : sympy.Expr
-        A closed form in the symbols of :data:`~replication.papers.an2021.symbolic.SYMBOLS`
+        A closed form in the symbols of ``replication.papers.an2021.symbolic.SYMBOLS``
         (ω_s written as sqrt(g/R), as :func:`~replication.papers.an2021.symbolic.parse_printed`
         gives it).
 
@@ -126,7 +126,7 @@ def print_parts_rows(parts, eq5, eq7, lat=np.radians(30.0), v_north=10.0):
     Returns
     -------
     list of dict
-        Rows for :func:`~replication.registry.reproduction.compare`.
+        Rows for :func:`~replication.registry.exports.compare`.
     """
     pp = parts.set_index("quantity")
     txt, show, at = transcription(pp)

@@ -20,11 +20,11 @@ relates; :func:`check_item` compares one printed part (its reading in sympy synt
 of ``data/paper/fang2020/fang2020-check-derivations.csv``) with the derivation.  The text leaves four
 signs open, and every part is checked under all sixteen combinations (:data:`CONVENTIONS`):
 
-``e``      position and azimuth errors computed − true (+1) or true − computed (−1);
-``a``      the angle of frame A relative to B (θ, φ, ψ) turns B into A (+1) or A into B (−1);
-``sigma``  the grid azimuth σ ("格网北向与地理北向夹角") measured from geographic north towards
-           east (+1) or towards west (−1);
-``gyro``   the gyro drift ε counted measured − true (+1) or true − measured (−1).
+* ``e``: position and azimuth errors computed − true (+1) or true − computed (−1);
+* ``a``: the angle of frame A relative to B (θ, φ, ψ) turns B into A (+1) or A into B (−1);
+* ``sigma``: the grid azimuth σ ("格网北向与地理北向夹角") measured from geographic north towards
+  east (+1) or towards west (−1);
+* ``gyro``: the gyro drift ε counted measured − true (+1) or true − measured (−1).
 
 A convention multiplies each printed error symbol by the sign of its class (δσ by e·sigma) and
 flips sin σ with ``sigma``; a printed part is derivable when one convention reproduces all its

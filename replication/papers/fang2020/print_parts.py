@@ -2,7 +2,7 @@
 
 :func:`print_parts_rows` turns the transcription ``data/paper/fang2020/fang2020-print-parts.csv``
 (with the §3 settings of ``fang2020-claim-simulation-setup.csv``) into comparison rows for
-:func:`replication.registry.reproduction.compare`: the matrix :math:`B` and the epoch of
+:func:`replication.registry.exports.compare`: the matrix :math:`B` and the epoch of
 :math:`C_G^b` of eqs. (25)-(27); the size of the horizontal attitude error that eq. (3) sets to
 zero, carried through eq. (27); the distance to the pole at the printed latitude of the second fix;
 the heading of case 2 across the pole and the yaw of eq. (28) in case 1; :math:`M` of eq. (17)
@@ -55,7 +55,7 @@ def print_parts_rows(parts, setup, table_1, table_2, x_means):
     Returns
     -------
     list of dict
-        Rows for :func:`~replication.registry.reproduction.compare`.
+        Rows for :func:`~replication.registry.exports.compare`.
     """
     pp = parts.set_index("quantity")
     txt, show, at = transcription(pp)
