@@ -2,16 +2,21 @@
 runs' IMU steps, then at each epoch the lead's time update and gains and every run's residuals,
 correction, feedback and records (the NEES against a truth included).
 
-The epoch is a sequence of compiled helpers, one concept each (the sensor-error estimates carried
-by Φ, the discrete AR step, the lead's records, context, rows and gains, one run's context,
-correction, records and NEES, the lead's end-of-epoch records).  They take arrays and scalars,
-never a bundle: a compiled helper that receives a bundle takes a reference to each of its arrays
-at every call, and helpers carrying ``spec``, ``inp``, ``batch``, ``gains``, ``out`` and a scratch
-bundle made the 15-state hour about a quarter slower (0.61 s against 0.41 s of CPU).  The work
-arrays are allocated once per chunk in :func:`filter_chunk` itself: made by a helper and returned as
-a tuple, they made the same hour about 4 % slower.
+The epoch is a sequence of compiled helpers, one concept each: the sensor-error estimates carried
+by Φ (:func:`_propagate_estimates`), the discrete AR step (:func:`_ar_step`), the lead's records
+for the smoother, its context and gains (:func:`_lead_context`, :func:`_lead_epoch_gains`), one
+run's context, correction, records and NEES (:func:`_run_context`, :func:`_run_correction`,
+:func:`_innovation_records`, :func:`_run_records`, :func:`_run_nees`), the lead's end-of-epoch
+records (:func:`_lead_records`).  They are compiled inline and take arrays and scalars, never a
+bundle: an inlined helper that receives a bundle still takes a reference to each of its arrays at
+every call.  Measured on the 15-state hour (CPU seconds, alternated processes), against the epoch
+written out in one function: helpers carrying ``spec``, ``inp``, ``batch``, ``gains``, ``out`` and
+a scratch bundle, a quarter slower (0.61 s against 0.41 s); every run's update as one helper
+receiving ``spec``, ``inp``, ``batch``, ``gains`` and ``out``, 9 % slower; the work arrays made by a
+helper and returned as a tuple, 4 % slower; the lead's rows of H cleared by a helper around
+:func:`_measurement_rows`, 4 % slower.  So the work arrays are allocated in :func:`filter_chunk`
+itself, H is cleared there, and the epoch's sequence of calls stays in its loop.
 """
-
 from __future__ import annotations
 
 import numpy as np
@@ -100,10 +105,9 @@ def _transition_records(rec_Phi, rec_Pp, j, Phi, ar_T, ar_tick, P):
 
 
 @njit(inline="always", **_NJ)
-def _lead_context(ctx, c, q, dth_cp, st, lever, T, facc, Cw, w_ie, w_en, window_end):
+def _lead_context(ctx, c, q, dth_cp, st, lever, T, facc, Cw, w_ie, w_en):
     """The lead's epoch context for the rows of H: C_b^n (into ``c``), the navigation part, and the
-    window sums of f^n (``facc``) and of the sensor blocks' couplings (``Cw``, 6 × n), which restart
-    from zero when a specific-force window ends here (``window_end``)."""
+    window sums of f^n (``facc``) and of the sensor blocks' couplings (``Cw``, 6 × n)."""
     n = Cw.shape[1]
     K.q2c(q, c)
     wx, wy, wz = _body_rate(dth_cp, T, c, st, w_ie, w_en)
@@ -114,19 +118,6 @@ def _lead_context(ctx, c, q, dth_cp, st, lever, T, facc, Cw, w_ie, w_en, window_
     for i in range(6):
         for jj in range(n):
             ctx[cw + i * n + jj] = Cw[i, jj]
-    if window_end:
-        facc[:] = 0.0
-        Cw[:, :] = 0.0
-
-
-@njit(inline="always", **_NJ)
-def _lead_rows(kernels, n_meas, par, off, width, obs, ctx, c, enc, H, Rd, data):
-    """The lead's rows of H and their variances ``Rd`` at one epoch, H cleared first, then each
-    measurement's ``rows`` kernel (``_measurement_rows``); returns the number of rows."""
-    for i in range(H.shape[0]):
-        for jj in range(H.shape[1]):
-            H[i, jj] = 0.0
-    return _measurement_rows(kernels, n_meas, par, off, width, obs, ctx, c, enc, H, Rd, data)
 
 
 @njit(inline="always", **_NJ)
@@ -142,20 +133,14 @@ def _lead_epoch_gains(P, H, m, Rd, gK, gs, gH, tmp, hz, nees_sd, nees_L, j):
 
 
 @njit(inline="always", **_NJ)
-def _run_context(ctx, c, q, dth_cp, st, lever, T, vacc, p_hat, w_ie, w_en, window_end):
-    """One run's epoch context for its residuals: C_b^n (into ``c``), the navigation part, the window
-    sum of the INS acceleration ``vacc``, which restarts from zero when a specific-force window ends
-    here (``window_end``: the residuals read the context), and the accumulated sensor-error
-    estimates ``p_hat`` (n − 9 of them)."""
-    n = p_hat.shape[0] + 9
+def _run_context(ctx, c, q, dth_cp, st, lever, T, vacc, p_hat, w_ie, w_en, n):
+    """One run's epoch context for its residuals (``n`` states): C_b^n (into ``c``), the navigation
+    part, the window sum of the INS acceleration and the accumulated sensor-error estimates."""
     K.q2c(q, c)
     wx, wy, wz = _body_rate(dth_cp, T, c, st, w_ie, w_en)
     _fill_context(ctx, st, lever, wx, wy, wz, n)
     for i in range(3):
         ctx[CTX_VACC + i] = vacc[i]
-    if window_end:
-        for i in range(3):
-            vacc[i] = 0.0
     for i in range(n - 9):
         ctx[CTX_PHAT + i] = p_hat[i]
 
@@ -230,26 +215,14 @@ def _lead_records(j, P, Pbar, use_pbar, record, pdiag, rec_Pf, flag, out_P, out_
             out_Pbar[f] = Pbar
 
 
-@njit(inline="always", **_NJ)
-def _reset_interval(Cpl, fsum, Csum, navsum, sums):
-    """The lead's interval sums of the inputs of F restart from zero (with the step count and
-    length ``sums``) after an epoch."""
-    K.reset_interval(Cpl, fsum, Csum, navsum)
-    sums[0] = 0.0
-    sums[1] = 0.0
-
-
 @njit(**_NJ)
 def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
     """One chunk of the closed-loop filter for the runs of a batch (see the module docstring).
 
     The runs advance one GNSS interval at a time (``_run_steps``); at each epoch the lead's time
-    update (``_lead_time_update``), the sensor-error estimates carried by Φ
-    (``_propagate_estimates``), the discrete AR step (``_ar_step``), the lead's records, measurement
-    rows (``_lead_context``, ``_measurement_rows``: each measurement's kernel) and its sequential
-    Joseph update (``_lead_epoch_gains``), then every run's residuals (``_run_context``,
-    ``_measurement_residuals``), correction (``_run_correction``), feedback and records; the lead's
-    end-of-epoch records last (``_lead_records``).
+    update (``_lead_time_update``), the estimates carried by Φ, the AR step, the lead's rows of H
+    (``_measurement_rows``: each measurement's kernel) and gains, then every run's residuals
+    (``_measurement_residuals``), correction, feedback and records.
 
     Parameters
     ----------
@@ -321,18 +294,28 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
             _transition_records(out.rec_Phi, out.rec_Pp, j, Phi, spec.ar_T, inp.ar_tick[j], lead.P)
         if is_lead:
             _lead_context(ctx, c, batch.q[0], batch.dth_cp[0], batch.st[0], batch.lever[0], T, lead.facc, lead.Cw,
-                          w_ie, w_en, sf >= 0)
-            gains.m[j] = _lead_rows(spec.meas_rows, spec.n_meas, spec.meas_par, spec.meas_off, spec.meas_width,
-                                    inp.obs[0, j], ctx, c, spec.enc, H, Rd, dbuf)
+                          w_ie, w_en)
+            for i in range(spec.m_max):
+                for jj in range(n):
+                    H[i, jj] = 0.0
+            gains.m[j] = _measurement_rows(spec.meas_rows, spec.n_meas, spec.meas_par, spec.meas_off,
+                                           spec.meas_width, inp.obs[0, j], ctx, c, spec.enc, H, Rd, dbuf)
             _lead_epoch_gains(lead.P, H, gains.m[j], Rd, gains.Kg[j], gains.s[j], gains.H[j], tmp, hz,
                               gains.nees_sd, gains.nees_L, j)
+            if sf >= 0:
+                lead.facc[:] = 0.0
+                lead.Cw[:, :] = 0.0
         # ---------------- per run: innovation, correction, feedback, records
         m, gH, gK, gS = gains.m[j], gains.H[j], gains.Kg[j], gains.s[j]
         for r in range(R):
             st_r, q_r, ph_r, lev_r = batch.st[r], batch.q[r], batch.p_hat[r], batch.lever[r]
-            _run_context(ctx, c, q_r, batch.dth_cp[r], st_r, lev_r, T, batch.vacc[r], ph_r, w_ie, w_en, sf >= 0)
+            _run_context(ctx, c, q_r, batch.dth_cp[r], st_r, lev_r, T, batch.vacc[r], ph_r, w_ie, w_en, n)
             _measurement_residuals(spec.meas_residual, spec.n_meas, spec.meas_par, spec.meas_off,
                                    spec.meas_width, inp.obs[r, j], ctx, c, z, dbuf)
+            if sf >= 0:
+                # the window ending here is used: the next one starts from zero
+                for i in range(3):
+                    batch.vacc[r, i] = 0.0
             out.nis[r, j] = _run_correction(z, m, gH, gK, gS, xk)
             _innovation_records(out.innov, out.rec_x, r, j, z, m, xk)
             K.feedback_nav(xk, st_r, batch.st_prev[r], q_r, ph_r, qtmp, e)
@@ -344,7 +327,9 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
         if is_lead:
             _lead_records(j, lead.P, lead.Pbar, spec.use_pbar, record, out.pdiag, out.rec_Pf, out.flag, out.P,
                           out.Pbar)
-        _reset_interval(Cpl, fsum, Csum, navsum, sums)
+        K.reset_interval(Cpl, fsum, Csum, navsum)
+        sums[0] = 0.0
+        sums[1] = 0.0
         j += 1
         if store_nav:
             _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, k_end)
