@@ -16,6 +16,88 @@ from replication.nav.closedloop.bundles import _NJ
 from replication.nav.closedloop.records import FilterResult
 
 
+@njit(inline="always", **_NJ)
+def _rts_last_epoch(Pf_last, ds, Ps):
+    """The smoothed error and covariance of the last epoch of the data: d = 0, P^s = P⁺."""
+    n = Ps.shape[0]
+    for r in range(ds.shape[0]):
+        for i in range(n):
+            ds[r, i] = 0.0
+    for i in range(n):
+        for k in range(n):
+            Ps[i, k] = Pf_last[i, k]
+
+
+@njit(inline="always", **_NJ)
+def _rts_gain(Pp1, Ph1, Pf_k, d, Rc, rhs):
+    """C_k = P_k⁺ Φ_{k+1}ᵀ (P_{k+1}⁻)⁻¹, solved with P_{k+1}⁻ scaled to a correlation matrix (scales
+    ``d``, the scaled matrix ``Rc`` and right-hand side ``rhs`` as work arrays)."""
+    n = Pp1.shape[0]
+    for i in range(n):
+        # a state with zero prior variance (no prior, no noise) decouples: unit scale,
+        # its row of Φ P⁺ is zero, so its column of C_k is zero
+        d[i] = math.sqrt(Pp1[i, i]) if Pp1[i, i] > 0.0 else 1.0
+    for i in range(n):
+        for k in range(n):
+            Rc[i, k] = Pp1[i, k] / (d[i] * d[k])
+        if Pp1[i, i] <= 0.0:
+            Rc[i, i] = 1.0
+    A = Ph1 @ Pf_k
+    for i in range(n):
+        for k in range(n):
+            rhs[i, k] = A[i, k] / d[i]
+    Y = np.linalg.solve(Rc, rhs)
+    Cm = np.empty((n, n))
+    for i in range(n):
+        for k in range(n):
+            Cm[k, i] = Y[i, k] / d[i]
+    return Cm
+
+
+@njit(inline="always", **_NJ)
+def _rts_errors(Cm, ds, x1, tmp):
+    """Every run's smoothed error back one epoch: d_k = C_k (d_{k+1} + x̂_{k+1})."""
+    n = Cm.shape[0]
+    for r in range(ds.shape[0]):
+        for i in range(n):
+            tmp[i] = ds[r, i] + x1[r, i]
+        for i in range(n):
+            s_ = 0.0
+            for k in range(n):
+                s_ += Cm[i, k] * tmp[k]
+            ds[r, i] = s_
+
+
+@njit(inline="always", **_NJ)
+def _rts_covariance(Cm, Ps, Pp1, Pf_k):
+    """P^s back one epoch: P^s_k = P_k⁺ + C_k (P^s_{k+1} − P_{k+1}⁻) C_kᵀ (symmetrized)."""
+    n = Ps.shape[0]
+    D = Ps - Pp1
+    G = Cm @ D @ Cm.T
+    for i in range(n):
+        for k in range(i, n):
+            v = Pf_k[i, k] + 0.5 * (G[i, k] + G[k, i])
+            Ps[i, k] = v
+            Ps[k, i] = v
+
+
+@njit(inline="always", **_NJ)
+def _rts_records(jj, ds, Ps, out_flag, out_ds, out_Ps, out_psdiag, with_cov):
+    """diag P^s at epoch ``jj``, and the smoothed errors (and P^s) when the epoch is recorded."""
+    n = Ps.shape[0]
+    for i in range(n):
+        out_psdiag[jj, i] = Ps[i, i]
+    f = out_flag[jj]
+    if f >= 0:
+        for r in range(ds.shape[0]):
+            for i in range(n):
+                out_ds[r, f, i] = ds[r, i]
+        if with_cov:
+            for i in range(n):
+                for k in range(n):
+                    out_Ps[f, i, k] = Ps[i, k]
+
+
 @njit(**_NJ)
 def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, out_ds, out_Ps, out_psdiag, with_cov):
     """Backward Rauch-Tung-Striebel pass over one chunk of the closed-loop filter.
@@ -53,21 +135,12 @@ def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, o
     with_cov : bool
         Also run the covariance recursion.
     """
-    E_ = Pf.shape[0]
-    R = ds.shape[0]
     n = Pf.shape[1]
-    d = np.empty(n)
-    Rc = np.empty((n, n))
-    rhs = np.empty((n, n))
-    tmp = np.empty(n)
+    d, Rc, rhs, tmp = np.empty(n), np.empty((n, n)), np.empty((n, n)), np.empty(n)
+    E_ = Pf.shape[0]
     for jj in range(E_ - 1, -1, -1):
         if jj == E_ - 1 and not has_next:
-            for r in range(R):
-                for i in range(n):
-                    ds[r, i] = 0.0
-            for i in range(n):
-                for k in range(n):
-                    Ps[i, k] = Pf[jj, i, k]
+            _rts_last_epoch(Pf[jj], ds, Ps)
         else:
             if jj == E_ - 1:
                 Pp1 = Pp_n
@@ -77,51 +150,11 @@ def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, o
                 Pp1 = Pp[jj + 1]
                 Ph1 = Phi[jj + 1]
                 x1 = xrec[:, jj + 1, :]
-            for i in range(n):
-                # a state with zero prior variance (no prior, no noise) decouples: unit scale,
-                # its row of Φ P⁺ is zero, so its column of C_k is zero
-                d[i] = math.sqrt(Pp1[i, i]) if Pp1[i, i] > 0.0 else 1.0
-            for i in range(n):
-                for k in range(n):
-                    Rc[i, k] = Pp1[i, k] / (d[i] * d[k])
-                if Pp1[i, i] <= 0.0:
-                    Rc[i, i] = 1.0
-            A = Ph1 @ Pf[jj]
-            for i in range(n):
-                for k in range(n):
-                    rhs[i, k] = A[i, k] / d[i]
-            Y = np.linalg.solve(Rc, rhs)
-            Cm = np.empty((n, n))
-            for i in range(n):
-                for k in range(n):
-                    Cm[k, i] = Y[i, k] / d[i]
-            for r in range(R):
-                for i in range(n):
-                    tmp[i] = ds[r, i] + x1[r, i]
-                for i in range(n):
-                    s_ = 0.0
-                    for k in range(n):
-                        s_ += Cm[i, k] * tmp[k]
-                    ds[r, i] = s_
+            Cm = _rts_gain(Pp1, Ph1, Pf[jj], d, Rc, rhs)
+            _rts_errors(Cm, ds, x1, tmp)
             if with_cov:
-                D = Ps - Pp1
-                G = Cm @ D @ Cm.T
-                for i in range(n):
-                    for k in range(i, n):
-                        v = Pf[jj, i, k] + 0.5 * (G[i, k] + G[k, i])
-                        Ps[i, k] = v
-                        Ps[k, i] = v
-        for i in range(n):
-            out_psdiag[jj, i] = Ps[i, i]
-        f = out_flag[jj]
-        if f >= 0:
-            for r in range(R):
-                for i in range(n):
-                    out_ds[r, f, i] = ds[r, i]
-            if with_cov:
-                for i in range(n):
-                    for k in range(n):
-                        out_Ps[f, i, k] = Ps[i, k]
+                _rts_covariance(Cm, Ps, Pp1, Pf[jj])
+        _rts_records(jj, ds, Ps, out_flag, out_ds, out_Ps, out_psdiag, with_cov)
 
 
 @njit(**_NJ)
@@ -166,6 +199,143 @@ def _congruence_transposed(Phi, L, W, row, nzc, nzv, cnt, rzc, rzv, rcnt):
         for j in range(i, n):
             L[i, j] = row[j]
             L[j, i] = row[j]
+
+
+@njit(inline="always", **_NJ)
+def _mbf_smoothed(P, L, Lam, f, out_ds, out_Ps, acc, with_cov):
+    """The smoothed errors and covariance at a recorded epoch (index ``f``) from its P⁺ and the adjoint
+    (λ as n × runs ``L``, Λ): d = −P⁺ λ for every run and P^s = P⁺ − P⁺ Λ P⁺ (symmetrized)."""
+    n = P.shape[0]
+    R = L.shape[1]
+    for i in range(n):
+        for r in range(R):
+            acc[r] = 0.0
+        for k in range(n):
+            p = P[i, k]
+            for r in range(R):
+                acc[r] += p * L[k, r]
+        for r in range(R):
+            out_ds[r, f, i] = -acc[r]
+    if with_cov:
+        G = P @ (Lam @ P)
+        for i in range(n):
+            for k in range(i, n):
+                v = P[i, k] - 0.5 * (G[i, k] + G[k, i])
+                out_Ps[f, i, k] = v
+                out_Ps[f, k, i] = v
+
+
+@njit(inline="always", **_NJ)
+def _rows_nonzeros(H, jj, mj, hz, nh, used):
+    """The non-zeros of epoch ``jj``'s ``mj`` rows of H (row a's columns ``hz[a, :nh[a]]``) and the
+    columns any row uses (``used``)."""
+    n = H.shape[2]
+    for k in range(n):
+        used[k] = 0
+    for a in range(mj):
+        c = 0
+        for k in range(n):
+            if H[jj, a, k] != 0.0:
+                hz[a, c] = k
+                used[k] = 1
+                c += 1
+        nh[a] = c
+
+
+@njit(inline="always", **_NJ)
+def _mbf_innovations(z, H, Kg, jj, mj, hz, nh, used, X, Nu, acc):
+    """Every run's innovations ν_a of epoch ``jj``'s sequential update (into ``Nu``, rows × runs),
+    recomputed from the residuals ``z`` as the filter formed them: ν_a = z_a − h_aᵀ x̂ over h_a's
+    non-zeros, x̂ ← x̂ + K_a ν_a from x̂ = 0 on the columns in use (``X``, n × runs)."""
+    R = X.shape[1]
+    n = X.shape[0]
+    for k in range(n):
+        if used[k]:
+            for r in range(R):
+                X[k, r] = 0.0
+    for a in range(mj):
+        for r in range(R):
+            acc[r] = z[r, jj, a]
+        for t in range(nh[a]):
+            k = hz[a, t]
+            h = H[jj, a, k]
+            for r in range(R):
+                acc[r] -= h * X[k, r]
+        for k in range(n):
+            if used[k]:
+                g = Kg[jj, a, k]
+                for r in range(R):
+                    X[k, r] += g * acc[r]
+        for r in range(R):
+            Nu[a, r] = acc[r]
+
+
+@njit(inline="always", **_NJ)
+def _adjoint_updates(L, H, Kg, s, jj, mj, hz, nh, Nu, acc):
+    """λ (n × runs ``L``) back through epoch ``jj``'s scalar updates, last first:
+    λ ← λ − h_a (K_aᵀ λ + ν_a / s_a)."""
+    R = L.shape[1]
+    n = L.shape[0]
+    for a in range(mj - 1, -1, -1):
+        sa = s[jj, a]
+        for r in range(R):
+            acc[r] = Nu[a, r] / sa
+        for k in range(n):
+            g = Kg[jj, a, k]
+            for r in range(R):
+                acc[r] += g * L[k, r]
+        for t in range(nh[a]):
+            k = hz[a, t]
+            h = H[jj, a, k]
+            for r in range(R):
+                L[k, r] -= h * acc[r]
+
+
+@njit(inline="always", **_NJ)
+def _adjoint_covariance_updates(Lam, H, Kg, s, jj, mj, hz, nh, u):
+    """Λ back through epoch ``jj``'s scalar updates, last first:
+    Λ ← (I − K_a h_aᵀ)ᵀ Λ (I − K_a h_aᵀ) + h_a h_aᵀ / s_a, as Λ + c h hᵀ − (h uᵀ + u hᵀ) with
+    u = Λ K_a and c = 1 / s_a + K_aᵀ u."""
+    n = Lam.shape[0]
+    for a in range(mj - 1, -1, -1):
+        for i in range(n):
+            u[i] = 0.0
+        for k in range(n):
+            g = Kg[jj, a, k]
+            if g != 0.0:
+                for i in range(n):
+                    u[i] += Lam[k, i] * g
+        c = 1.0 / s[jj, a]
+        for i in range(n):
+            c += Kg[jj, a, i] * u[i]
+        # only the rows and columns of h's non-zeros change; each pair (i, k) once, the increment
+        # symmetric in (i, k) to the last bit
+        for t in range(nh[a]):
+            i = hz[a, t]
+            hi = H[jj, a, i]
+            for k in range(n):
+                hk = H[jj, a, k]
+                if hk != 0.0 and k < i:
+                    continue
+                v = Lam[i, k] + (c * (hi * hk) - (hi * u[k] + u[i] * hk))
+                Lam[i, k] = v
+                Lam[k, i] = v
+
+
+@njit(inline="always", **_NJ)
+def _adjoint_transition(L, L2, acc, nzc, nzv, cnt):
+    """λ_{k−1} = Φ_kᵀ λ (into ``L2``, n × runs) from the non-zeros of Φ_k by column (``_nonzeros``)."""
+    R = L.shape[1]
+    for i in range(L.shape[0]):
+        for r in range(R):
+            acc[r] = 0.0
+        for t in range(cnt[i]):
+            v = nzv[i, t]
+            k = nzc[i, t]
+            for r in range(R):
+                acc[r] += v * L[k, r]
+        for r in range(R):
+            L2[i, r] = acc[r]
 
 
 @njit(**_NJ)
@@ -218,131 +388,28 @@ def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov,
     transition_first : bool
         Apply the transition of the chunk's first epoch (False for the first chunk).
     """
-    E_ = Phi.shape[0]
-    R = lam.shape[0]
-    n = Phi.shape[1]
+    E_, n, R, m_max = Phi.shape[0], Phi.shape[1], lam.shape[0], H.shape[1]
     L = np.ascontiguousarray(lam.T)
-    L2 = np.empty((n, R))
-    X = np.zeros((n, R))
-    m_max = H.shape[1]
-    Nu = np.empty((m_max, R))
-    acc = np.empty(R)
-    u = np.empty(n)
-    row = np.empty(n)
-    hz = np.empty((m_max, n), np.int64)
-    nh = np.empty(m_max, np.int64)
-    used = np.empty(n, np.int64)
-    W = np.empty((n, n))
-    nzc = np.empty((n, n), np.int64)
-    nzv = np.empty((n, n))
-    cnt = np.empty(n, np.int64)
-    rzc = np.empty((n, n), np.int64)
-    rzv = np.empty((n, n))
-    rcnt = np.empty(n, np.int64)
+    L2, X, Nu, acc, u, row = np.empty((n, R)), np.zeros((n, R)), np.empty((m_max, R)), np.empty(R), np.empty(n), np.empty(n)
+    hz, nh, used = np.empty((m_max, n), np.int64), np.empty(m_max, np.int64), np.empty(n, np.int64)
+    W, nzc, nzv, cnt = np.empty((n, n)), np.empty((n, n), np.int64), np.empty((n, n)), np.empty(n, np.int64)
+    rzc, rzv, rcnt = np.empty((n, n), np.int64), np.empty((n, n)), np.empty(n, np.int64)
     for jj in range(E_ - 1, -1, -1):
         f = flag[jj]
         if f >= 0:
-            P = Pf[f]
-            for i in range(n):
-                for r in range(R):
-                    acc[r] = 0.0
-                for k in range(n):
-                    p = P[i, k]
-                    for r in range(R):
-                        acc[r] += p * L[k, r]
-                for r in range(R):
-                    out_ds[r, f, i] = -acc[r]
-            if with_cov:
-                G = P @ (Lam @ P)
-                for i in range(n):
-                    for k in range(i, n):
-                        v = P[i, k] - 0.5 * (G[i, k] + G[k, i])
-                        out_Ps[f, i, k] = v
-                        out_Ps[f, k, i] = v
+            _mbf_smoothed(Pf[f], L, Lam, f, out_ds, out_Ps, acc, with_cov)
         mj = m[jj]
-        # the non-zeros of the epoch's rows, and the columns any row uses
-        for k in range(n):
-            used[k] = 0
-        for a in range(mj):
-            c = 0
-            for k in range(n):
-                if H[jj, a, k] != 0.0:
-                    hz[a, c] = k
-                    used[k] = 1
-                    c += 1
-            nh[a] = c
-        # ---------------- the innovations of the sequential update (H's zero entries skipped: the
-        # filter's sums), then back through the scalar updates, last first
-        for k in range(n):
-            if used[k]:
-                for r in range(R):
-                    X[k, r] = 0.0
-        for a in range(mj):
-            for r in range(R):
-                acc[r] = z[r, jj, a]
-            for t in range(nh[a]):
-                k = hz[a, t]
-                h = H[jj, a, k]
-                for r in range(R):
-                    acc[r] -= h * X[k, r]
-            for k in range(n):
-                if used[k]:
-                    g = Kg[jj, a, k]
-                    for r in range(R):
-                        X[k, r] += g * acc[r]
-            for r in range(R):
-                Nu[a, r] = acc[r]
-        for a in range(mj - 1, -1, -1):
-            sa = s[jj, a]
-            for r in range(R):
-                acc[r] = Nu[a, r] / sa
-            for k in range(n):
-                g = Kg[jj, a, k]
-                for r in range(R):
-                    acc[r] += g * L[k, r]
-            for t in range(nh[a]):
-                k = hz[a, t]
-                h = H[jj, a, k]
-                for r in range(R):
-                    L[k, r] -= h * acc[r]
+        _rows_nonzeros(H, jj, mj, hz, nh, used)
+        # the innovations of the sequential update, then back through the scalar updates, last first
+        _mbf_innovations(z, H, Kg, jj, mj, hz, nh, used, X, Nu, acc)
+        _adjoint_updates(L, H, Kg, s, jj, mj, hz, nh, Nu, acc)
         if with_cov:
-            for a in range(mj - 1, -1, -1):
-                for i in range(n):
-                    u[i] = 0.0
-                for k in range(n):
-                    g = Kg[jj, a, k]
-                    if g != 0.0:
-                        for i in range(n):
-                            u[i] += Lam[k, i] * g
-                c = 1.0 / s[jj, a]
-                for i in range(n):
-                    c += Kg[jj, a, i] * u[i]
-                # Λ + c h hᵀ − (h uᵀ + u hᵀ): only the rows and columns of h's non-zeros change; each
-                # pair (i, k) once, the increment symmetric in (i, k) to the last bit
-                for t in range(nh[a]):
-                    i = hz[a, t]
-                    hi = H[jj, a, i]
-                    for k in range(n):
-                        hk = H[jj, a, k]
-                        if hk != 0.0 and k < i:
-                            continue
-                        v = Lam[i, k] + (c * (hi * hk) - (hi * u[k] + u[i] * hk))
-                        Lam[i, k] = v
-                        Lam[k, i] = v
-        # ---------------- back through the transition into the previous epoch
+            _adjoint_covariance_updates(Lam, H, Kg, s, jj, mj, hz, nh, u)
+        # back through the transition into the previous epoch
         if jj > 0 or transition_first:
             Ph = Phi[jj]
             _nonzeros(Ph, nzc, nzv, cnt, rzc, rzv, rcnt)
-            for i in range(n):
-                for r in range(R):
-                    acc[r] = 0.0
-                for t in range(cnt[i]):
-                    v = nzv[i, t]
-                    k = nzc[i, t]
-                    for r in range(R):
-                        acc[r] += v * L[k, r]
-                for r in range(R):
-                    L2[i, r] = acc[r]
+            _adjoint_transition(L, L2, acc, nzc, nzv, cnt)
             L, L2 = L2, L
             if with_cov:
                 _congruence_transposed(Ph, Lam, W, row, nzc, nzv, cnt, rzc, rzv, rcnt)
