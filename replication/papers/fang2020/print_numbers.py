@@ -64,15 +64,10 @@ def _headings_along(lat0, lon0, track, speed, duration, n=721):
     "east": along the parallel.
     """
     t = np.linspace(0.0, duration, n)
-    s = speed * t / earth.A
-    if track == "north":
-        colat = np.pi / 2 - lat0 - s
-        lat = np.pi / 2 - np.abs(colat)
-        lon = np.where(colat >= 0, lon0, lon0 + np.pi)
-        true = np.where(colat >= 0, 0.0, 180.0)
+    lat, lon, _, _ = track_states(lat0, lon0, track, speed, t)
+    if track == "north":  # north before the pole, south after it
+        true = np.where(np.pi / 2 - lat0 - speed * t / earth.A >= 0, 0.0, 180.0)
     else:
-        lat = np.full_like(t, lat0)
-        lon = lon0 + s / np.cos(lat0)
         true = np.full_like(t, 90.0)
     keep = np.abs(lat) < np.radians(90 - 1e-6)  # σ has no value at the pole itself
     sigma = np.degrees(frames.grid_azimuth(lat[keep], lon[keep]))
