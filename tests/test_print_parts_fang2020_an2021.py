@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import sympy as sp
 
 from replication.nav import units
@@ -113,3 +114,23 @@ def test_natural_frequencies_split_by_about_twice_the_vertical_earth_rate():
     lat = np.radians(30.0)
     assert np.isclose(an_pp.natural_split(lat, 10.0), 2 * OMEGA * np.sin(lat), rtol=0.01)
     assert len(an_pp.natural_frequencies(lat, 10.0)) == 2
+
+
+@pytest.mark.parametrize("call, word", [
+    (lambda: fang_pp.heading_readings(np.nan, 0.0, "north", 10.0, 3600.0), "lat0"),
+    (lambda: fang_pp.heading_readings(2.0, 0.0, "north", 10.0, 3600.0), "lat0"),
+    (lambda: fang_pp.heading_readings(1.5, 0.0, "west", 10.0, 3600.0), "track"),
+    (lambda: fang_pp.heading_readings(1.5, 0.0, "north", -1.0, 3600.0), "speed"),
+    (lambda: fang_pp.heading_readings(1.5, 0.0, "north", 10.0, "1 h"), "duration"),
+    (lambda: fang_pp.track_states(1.5, 0.0, "east", 10.0, [0.0, np.inf]), "times"),
+    (lambda: fang_pp.longitude_rate(1.5, 0.0, "east", 10.0, 10.0, 5.0), "t1"),
+    (lambda: fang_pp.tilt_drift_error(1e-4, 1.5, 0.3, 0.0), "tau"),
+    (lambda: fang_pp.oepq_turn_cost(1.5, 1e-5, 5400.0, [1e-8, 1e-8], 0.0), "eps_b"),
+    (lambda: fang_pp.euler_order_gap("3", 0.1), "pitch"),
+    (lambda: fang_pp.pole_distance_readings("at the pole"), "lat_text"),
+    (lambda: an_pp.natural_frequencies(np.pi / 2, 10.0), "lat"),
+    (lambda: an_pp.natural_frequencies(0.5, np.nan), "v_north"),
+])
+def test_the_print_numbers_refuse_bad_input_naming_the_argument(call, word):
+    with pytest.raises((ValueError, TypeError), match=word):
+        call()

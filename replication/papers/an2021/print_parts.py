@@ -17,6 +17,7 @@ import numpy as np
 import sympy as sp
 
 from replication.nav import units
+from replication.nav._validate import finite
 from replication.nav.earth import OMEGA_IE
 from replication.papers import transcription
 from replication.papers.an2021 import frequency, symbolic, transfer
@@ -81,6 +82,9 @@ def natural_frequencies(lat, v_north):
     numpy.ndarray
         The frequencies [rad/s], ascending.
     """
+    lat, v_north = finite(lat, "lat"), finite(v_north, "v_north")
+    if abs(lat) >= np.pi / 2:
+        raise ValueError(f"lat must be a latitude in radians strictly within ±π/2, got {lat!r}")
     p = np.asarray(transfer.transfer_function(lat, 0.0, v_north, "phiE/gdN").poles())
     w = np.sort(np.abs(p[p.imag > 0]))
     return w[w > 10 * OMEGA_IE]

@@ -14,6 +14,7 @@ import re
 import numpy as np
 
 from replication.nav import earth, rotations
+from replication.nav._validate import choice, finite, finite_array, positive, vector3
 from replication.papers.fang2020 import frames
 from replication.papers.fang2020.error_equations import OMEGA, input_u, m_matrix, transition_t
 
@@ -21,9 +22,26 @@ SPHERE_RADII = {"polar semi-axis b": earth.B, "mean radius 6371 km": 6.371e6, "s
 """Radii a sphere model of the Earth may take (the print names the sphere, not its radius) [m]."""
 
 
+def _latitude(value, name):
+    lat = finite(value, name)
+    if abs(lat) > np.pi / 2:
+        raise ValueError(f"{name} must be a latitude in radians within ±π/2, got {value!r}")
+    return lat
+
+
+def _track(lat0, lon0, track, speed):
+    """The validated start, track and speed of a printed track."""
+    return (_latitude(lat0, "lat0"), finite(lon0, "lon0"), choice(track, ["north", "east"], "track"),
+            positive(speed, "speed"))
+
+
 def _deg(text):
     """The first number of a printed angle, thin spaces between digit groups removed."""
+    if not isinstance(text, str):
+        raise TypeError(f"lat_text must be the printed clause as a string, got {type(text).__name__}")
     m = re.search(r"(\d+(?:\.[\d\\ ]+)?)\s*(?:\^\\circ|°)", text)
+    if m is None:
+        raise ValueError(f"lat_text holds no angle in degrees (a number followed by ° or ^\\circ): {text!r}")
     return m.group(1).replace("\\", "").replace(" ", "")
 
 
@@ -106,6 +124,8 @@ def heading_readings(lat0, lon0, track, speed, duration):
         ``true`` (geographic), ``grid (true - σ)`` and ``grid (true + σ)`` (the print defines σ
         as the angle between grid and geographic north without a sign).
     """
+    lat0, lon0, track, speed = _track(lat0, lon0, track, speed)
+    duration = positive(duration, "duration")
     true, sigma = _headings_along(lat0, lon0, track, speed, duration)
     out = {}
     for name, h in (
@@ -142,6 +162,8 @@ def tilt_drift_error(tilt, lat, lon, tau):
         reading → (min, max) of |Δε| [rad/s] over the direction of the tilt in the grid
         horizontal plane.
     """
+    tilt, lat, lon = finite(tilt, "tilt"), _latitude(lat, "lat"), finite(lon, "lon")
+    tau = positive(tau, "tau")
     a = OMEGA * tau
     u, t = input_u(a), transition_t(a)
     c = frames.oepq_to_grid(lat, frames.grid_azimuth(lat, lon))
@@ -188,6 +210,8 @@ def track_states(lat0, lon0, track, speed, times):
     r, v : numpy.ndarray, shape times.shape + (3,)
         ECEF position on the ellipsoid [m] and velocity [m/s].
     """
+    lat0, lon0, track, speed = _track(lat0, lon0, track, speed)
+    times = finite_array(times, "times")
     s = speed * np.asarray(times, dtype=float) / earth.A
     if track == "north":
         colat = np.pi / 2 - lat0 - s
@@ -226,6 +250,8 @@ def longitude_rate(lat0, lon0, track, speed, t0, t1, n=601):
     float
         max |Δλ/Δt| over the samples [rad/s].
     """
+    if not finite(t1, "t1") > finite(t0, "t0"):
+        raise ValueError(f"t1 must be later than t0, got t0={t0!r}, t1={t1!r}")
     t = np.linspace(t0, t1, n)
     _, lon, _, _ = track_states(lat0, lon0, track, speed, t)
     return float(np.max(np.abs(np.diff(lon)) / np.diff(t)))
@@ -258,6 +284,8 @@ def oepq_turn_cost(lat, turn_rate, tau, eps_b, heading):
         ``angle`` (rotation of the E-Q estimate [rad]), ``gain`` (its scale), ``oepq`` and ``body``
         (estimate / true - 1 per component, OEPQ and body axes).
     """
+    lat, turn_rate = _latitude(lat, "lat"), finite(turn_rate, "turn_rate")
+    tau, eps_b, heading = positive(tau, "tau"), vector3(eps_b, "eps_b"), finite(heading, "heading")
     a, a_t = OMEGA * tau, (OMEGA + turn_rate) * tau
     k = OMEGA / (OMEGA + turn_rate) * np.linalg.solve(input_u(a), input_u(a_t))
     c_b_oepq = frames.oepq_to_grid(lat, 0.0).T @ rotations.euler_to_dcm(heading, 0.0, 0.0)
@@ -321,6 +349,7 @@ def euler_order_gap(pitch, roll, heading=0.0):
     float
         The rotation angle between the two matrices [rad].
     """
+    pitch, roll, heading = finite(pitch, "pitch"), finite(roll, "roll"), finite(heading, "heading")
     def rx(a):
         return np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]])
 
