@@ -31,7 +31,7 @@ z up), the attitude C_b^n = R_z(-ψ) R_y(γ) (heading ψ clockwise from north, r
 Flights
 -------
 The initial state of the chapter's simulation (47° N, 6000 m, heading 45°, 100 m/s, level;
-Table 4-41 prose), constant speed and height.  Turns are coordinated (tan γ = V ψ̇ / g), at a turn
+Table 4-41 prose), constant height, constant speed or a speed wave during the maneuver (below).  Turns are coordinated (tan γ = V ψ̇ / g), at a turn
 rate of 3 °/s, entered and left with a 4-s linear ramp of the turn rate (bank 28°).  Segments
 (:data:`SEGMENTS`): straight and level for 300 s ("before maneuver"); 60 s straight, a 180° right
 turn, 60 s straight ("U-turn"); 60 s straight, a 360° right turn, a 360° left turn, 60 s straight
@@ -52,28 +52,39 @@ the projection of e_i onto the null space of M: r_i = 0 when no unobservable dir
 state, r_i = 1 when the state is unobservable outright, and in between when only a combination with
 other states is observable (then r_i measures how much of the state the combination leaves unknown,
 in units of its prior, and so depends on the priors).  A state is called *observable* when
-r_i < :data:`THRESHOLD` = 0.01 in the noise-free limit, i.e. when no unobservable direction has a
-component on it.  Over the four segments the noise-free ratios are either below 1e-9 (round-off) or
-above 0.06, so any threshold between 1e-8 and 0.06 gives the same verdicts.  A threshold such as
-0.5 would instead cut through the members of the unobservable combinations of level flight
-(ratios 0.17 to 0.98 for φ_E, φ_N, φ_U, ∇_z, δK_az, ε_x, ε_y), whose split depends on the priors.
+r_i < :data:`THRESHOLD` = 1e-5 in the noise-free limit, i.e. when no unobservable direction has a
+component on it.  Over the four segments, at constant speed and with a speed wave, the noise-free
+ratios are either below 1e-8 (round-off of the singular vectors) or above 2.4e-3, so any threshold
+between about 1e-7 and 2e-3 gives the same verdicts.  The smallest ratios above round-off are those
+of the attitude errors on the common rotation of the triads (below): φ_U 2.5e-3 and φ_E, φ_N 1.25e-2
+of their priors — members of an unobservable combination, so unobservable alone, by an amount the
+priors set.  A threshold such as 0.5 would instead cut through the members of the unobservable
+combinations (ratios 0.17 to 0.98 for φ_E, φ_N, φ_U, ∇_z, δK_az, ε_x, ε_y in level flight, 0.5 for
+each misalignment angle in the turns), whose split depends on the priors.
 The noise-free limit is the notion of Table 2-3 (a printed degree of 1e-4 counts as observable);
 how well a state is estimated is a question of noise and duration, available here with
 ``noise_scale=1`` (the GNSS noise of Table 4-41).
 
-Limits
-------
-A common small rotation α of both sensor triads (δA = δG = −α× under Table 2-2's coupling, with
-φ(t) = −C_b^n(t) α) leaves the navigation solution unchanged: it solves the continuous error
-equations exactly on every flight (tests/test_crosscheck_chen2019_observability.py::
-test_a_common_rotation_of_both_triads_is_unobservable_in_the_continuous_model), so in the
-continuous-time model no misalignment angle is observable on its own, on any segment, and the
-attitude errors only in combination with them.  The transition here holds F constant over each 1-s
-step; in turns that leaves the three directions at about 1e-4 to 1e-2 of a misalignment column,
-far above the noise-free null-space cut, so the verdicts of this module on the twelve misalignment
-angles (and on the attitude errors they couple to) in turning segments are artefacts of the
-discretization, not properties of the model.  An independent recomputation from the paper alone
-found the same.  The verdicts of the other states are not affected by the symmetry.
+Speed
+-----
+``speed_wave`` flies the maneuver (between the first and the last straight leg) with a speed that
+rises by the given amount and returns, V + A (1 − cos 2πτ/T)/2, turns coordinated at the current
+speed: a forward specific force f_y up to π A / T, which constant-speed turns never give.  The
+report states neither the speed profile nor the turn-rate profile of its maneuvers.
+
+The common rotation of the triads
+---------------------------------
+A common small rotation α of both sensor triads (δA = δG = −α×, with φ(t) = −C_b^n(t) α) leaves
+the navigation solution unchanged: it solves the continuous error equations exactly on every
+flight (tests/test_crosscheck_chen2019_observability.py::
+test_a_common_rotation_of_both_triads_is_unobservable_in_the_continuous_model).  In the
+continuous-time model no misalignment angle is therefore observable on its own, on any segment,
+and the attitude errors only in combination with them.  The transition here holds F constant over
+each 1-s step, which leaves these three directions at about 1e-4 to 1e-2 of a misalignment column
+— information the model does not have.  The information matrix is therefore taken on the
+complement of the three directions (:func:`_common_rotation`); with them removed, the null space
+of every maneuver is exactly the rotation (plus δK_ay at constant speed), and the verdicts are those
+of the continuous model.  An independent recomputation from the paper alone found the symmetry.
 
 Only numpy and scipy are used; nothing is shared with the chapter's PWCS/SVD computation.
 """
@@ -138,8 +149,9 @@ SEGMENTS: dict[str, tuple[tuple[float, float], ...]] = {
 }
 
 #: Posterior over prior standard deviation below which a state is called observable (noise-free
-#: limit: the length of the state's projection on the unobservable subspace).
-THRESHOLD = 0.01
+#: limit: the length of the state's projection on the unobservable subspace; round-off <= 1e-8,
+#: the smallest genuine projection 2.5e-3: the module docstring, "Criterion").
+THRESHOLD = 1e-5
 
 _ARCSEC = np.radians(1.0 / 3600.0)
 _UG = 9.78e-6
@@ -186,13 +198,29 @@ def _check_noise_scale(noise_scale: float) -> float:
     return kappa
 
 
-def flight_profile(segment: str) -> dict[str, np.ndarray]:
+def _check_speed_wave(speed_wave: float) -> float:
+    try:
+        wave = float(speed_wave)
+    except (TypeError, ValueError):
+        wave = float("nan")
+    if not np.isfinite(wave) or _SPEED + min(wave, 0.0) <= 0:
+        raise ValueError(f"speed_wave must be a finite number of m/s above -{_SPEED:g} (the speed change during "
+                         f"the maneuver; 0 = constant speed), got {speed_wave!r}")
+    return wave
+
+
+def flight_profile(segment: str, speed_wave: float = 0.0) -> dict[str, np.ndarray]:
     """Kinematics of a flight segment at the mid-point of each 1-s propagation step.
 
     Parameters
     ----------
     segment : str
         A key of :data:`SEGMENTS` ("before maneuver", "U-turn", "figure-8", "S-turn").
+    speed_wave : float, default 0
+        Speed change during the maneuver, m/s: between the first and the last straight leg the
+        speed is V + speed_wave (1 - cos 2πτ/T)/2 (rises and returns; forward specific force up to
+        π·speed_wave/T), the turns stay coordinated at the current speed.  0 flies the maneuver at
+        constant speed (f_y = 0); the segment "before maneuver" is always flown at constant speed.
 
     Returns
     -------
@@ -206,9 +234,11 @@ def flight_profile(segment: str) -> dict[str, np.ndarray]:
     Raises
     ------
     ValueError
-        If ``segment`` is not one of :data:`SEGMENTS`.
+        If ``segment`` is not one of :data:`SEGMENTS`, or ``speed_wave`` is not a finite number
+        that keeps the speed positive.
     """
     legs = _check_segment(segment)
+    wave = _check_speed_wave(speed_wave)
     durations = np.array([d for d, _ in legs])
     rates = np.radians([w for _, w in legs])
     total = float(durations.sum())
@@ -230,9 +260,16 @@ def flight_profile(segment: str) -> dict[str, np.ndarray]:
     psid = np.interp(t, knots_t, knots_w)
     seg = np.clip(np.searchsorted(knots_t, t) - 1, 0, len(knots_t) - 2)
     psidd = (knots_w[seg + 1] - knots_w[seg]) / (knots_t[seg + 1] - knots_t[seg])
-    tan_g = _SPEED * psid / _G
+    speed, speedd = np.full(t.size, _SPEED), np.zeros(t.size)
+    if wave and len(legs) > 2:  # a maneuver between two straight legs
+        t0, t1 = durations[0], total - durations[-1]
+        inside = (t > t0) & (t < t1)
+        ph = 2 * np.pi * (t[inside] - t0) / (t1 - t0)
+        speed[inside] += 0.5 * wave * (1 - np.cos(ph))
+        speedd[inside] = 0.5 * wave * np.sin(ph) * 2 * np.pi / (t1 - t0)
+    tan_g = speed * psid / _G
     gamma = np.arctan(tan_g)
-    gammad = (_SPEED * psidd / _G) / (1 + tan_g**2)
+    gammad = ((speedd * psid + speed * psidd) / _G) / (1 + tan_g**2)
 
     k = t.size
     cp, sp, cg, sg = np.cos(psi), np.sin(psi), np.cos(gamma), np.sin(gamma)
@@ -241,8 +278,9 @@ def flight_profile(segment: str) -> dict[str, np.ndarray]:
     ry = np.zeros((k, 3, 3))
     ry[:, 0, 0], ry[:, 0, 2], ry[:, 1, 1], ry[:, 2, 0], ry[:, 2, 2] = cg, sg, 1.0, -sg, cg  # R_y(γ)
     c_bn = rz @ ry
-    v_n = _SPEED * np.stack([sp, cp, np.zeros(k)], axis=1)
-    a_n = (_SPEED * psid)[:, None] * np.stack([cp, -sp, np.zeros(k)], axis=1)
+    forward, right = np.stack([sp, cp, np.zeros(k)], axis=1), np.stack([cp, -sp, np.zeros(k)], axis=1)
+    v_n = speed[:, None] * forward
+    a_n = (speed * psid)[:, None] * right + speedd[:, None] * forward
     w_ie = np.array([0.0, _OMEGA * _COS_L, _OMEGA * _SIN_L])
     w_en = np.stack([-v_n[:, 1] / (_RM + _HEIGHT), v_n[:, 0] / (_RN + _HEIGHT),
                      v_n[:, 0] * np.tan(_LAT) / (_RN + _HEIGHT)], axis=1)
@@ -358,14 +396,42 @@ def _transition(fdt: np.ndarray, order: int = 12) -> np.ndarray:
     return total
 
 
-_CACHE: dict[tuple[str, str], tuple[np.ndarray, np.ndarray]] = {}
+_CACHE: dict[tuple[str, str, float], tuple[np.ndarray, np.ndarray]] = {}
 
 
-def _scaled_information(segment: str, coupling: str) -> tuple[np.ndarray, np.ndarray]:
-    """Singular values and right singular vectors of M = stack(R^{-1/2} H Φ(t_k, 0) D)."""
-    key = (segment, coupling)
+def _common_rotation(coupling: str) -> np.ndarray:
+    """The three directions of a common small rotation α of both sensor triads, state units.
+
+    Column j is the state offset of α = e_j: misalignment angles with δM u = −α × u for every u
+    (δA = δG = −α×, in the parameters of ``coupling``), φ = −C_b^n(0) α at the start (level,
+    heading ψ_0), zero navigation errors and other sensor errors.  The direction solves the
+    continuous error equations exactly on any flight (the sensed specific force and rate are
+    those of a body frame turned by α, which the GNSS cannot tell apart), so it is unobservable.
+    """
+    jac = np.stack([_misalignment_jacobian(u, coupling) for u in np.eye(3)])  # (3 inputs, 3, 6)
+    cp, sp = np.cos(_HEADING0), np.sin(_HEADING0)
+    c0 = np.array([[cp, sp, 0.0], [-sp, cp, 0.0], [0.0, 0.0, 1.0]])  # R_z(-ψ0), level
+    out = np.zeros((_N, 3))
+    for j, alpha in enumerate(np.eye(3)):
+        target = np.concatenate([-np.cross(alpha, u) for u in np.eye(3)])  # δM e_k for k = x, y, z
+        mis, *_ = np.linalg.lstsq(jac.reshape(9, 6), target, rcond=None)
+        out[15:21, j] = out[27:33, j] = mis
+        out[6:9, j] = -c0 @ alpha
+    return out
+
+
+def _scaled_information(segment: str, coupling: str, speed_wave: float = 0.0,
+                        keep_rotation: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Singular values and right singular vectors of M = stack(R^{-1/2} H Φ(t_k, 0) D) P⊥.
+
+    P⊥ projects out the common rotation of the sensor triads (:func:`_common_rotation`, scaled by
+    D): exactly unobservable in the continuous model, it keeps 1e-4 to 1e-2 of a misalignment
+    column in the 1-s piece-wise constant Φ, information the model does not have
+    (``keep_rotation=True`` keeps it, for the tests that show the artefact).
+    """
+    key = (segment, coupling, float(speed_wave), bool(keep_rotation))
     if key not in _CACHE:
-        prof = flight_profile(segment)
+        prof = flight_profile(segment, speed_wave)
         d = np.array([PRIOR_SD[n] for n in _ALL])
         a = _measurement_matrix() / _GNSS_SD[:, None]
         fdt = np.stack([error_model(c, vn, fn, fb, w, coupling) * _DT for c, vn, fn, fb, w in
@@ -376,19 +442,24 @@ def _scaled_information(segment: str, coupling: str) -> tuple[np.ndarray, np.nda
         for step in steps:
             phi = step @ phi
             rows.append(a @ phi * d[None, :])
-        _, s, vt = np.linalg.svd(np.vstack(rows), full_matrices=False)
+        m = np.vstack(rows)
+        if not keep_rotation:
+            q, _ = np.linalg.qr(_common_rotation(coupling) / d[:, None])
+            m = m - (m @ q) @ q.T
+        _, s, vt = np.linalg.svd(m, full_matrices=False)
         _CACHE[key] = (s, vt.T)
     return _CACHE[key]
 
 
-def _posterior(segment: str, noise_scale: float, coupling: str) -> np.ndarray:
+def _posterior(segment: str, noise_scale: float, coupling: str, speed_wave: float = 0.0,
+               keep_rotation: bool = False) -> np.ndarray:
     """Scaled posterior covariance P_z (prior I) after the segment's GNSS updates."""
-    s, v = _scaled_information(segment, coupling)
+    s, v = _scaled_information(segment, coupling, speed_wave, keep_rotation)
     s2 = np.zeros(_N)
     s2[: s.size] = s**2
     if noise_scale == 0.0:
         # noise-free limit: projector onto the numerical null space (σ_j below 1e-12 σ_max; on the
-        # four segments the smallest nonzero σ_j is >= 9e-10 σ_max and round-off <= 1.4e-16 σ_max,
+        # segments the smallest nonzero σ_j is >= 9e-10 σ_max and round-off <= 1e-15 σ_max,
         # so any cut between 1e-10 and 1e-14 gives the same null space)
         w = (s2 <= (1e-12 * s[0]) ** 2).astype(float)
     else:
@@ -396,7 +467,8 @@ def _posterior(segment: str, noise_scale: float, coupling: str) -> np.ndarray:
     return (v * w[None, :]) @ v.T
 
 
-def posterior_sd_ratio(segment: str, noise_scale: float = 0.0, coupling: str = "eq-2-8") -> dict[str, float]:
+def posterior_sd_ratio(segment: str, noise_scale: float = 0.0, coupling: str = "eq-2-8",
+                       speed_wave: float = 0.0) -> dict[str, float]:
     """Posterior over prior standard deviation of each Table 2-3 state after a flight segment.
 
     Parameters
@@ -408,6 +480,8 @@ def posterior_sd_ratio(segment: str, noise_scale: float = 0.0, coupling: str = "
         noise-free limit (the projection of each state on the unobservable subspace).
     coupling : {"eq-2-8", "table-2-2"}
         Misalignment coupling of the error model (see :func:`error_model`).
+    speed_wave : float, default 0
+        Speed change during the maneuver, m/s (:func:`flight_profile`).
 
     Returns
     -------
@@ -422,12 +496,13 @@ def posterior_sd_ratio(segment: str, noise_scale: float = 0.0, coupling: str = "
     _check_segment(segment)
     _check_coupling(coupling)
     kappa = _check_noise_scale(noise_scale)
-    diag = np.clip(np.diag(_posterior(segment, kappa, coupling)), 0.0, None)
+    wave = _check_speed_wave(speed_wave)
+    diag = np.clip(np.diag(_posterior(segment, kappa, coupling, wave)), 0.0, None)
     return {name: float(np.sqrt(diag[_IDX[name]])) for name in STATES}
 
 
 def combination_sd_ratio(segment: str, weights: Mapping[str, float], noise_scale: float = 0.0,
-                         coupling: str = "eq-2-8") -> float:
+                         coupling: str = "eq-2-8", speed_wave: float = 0.0) -> float:
     """Posterior over prior standard deviation of a linear combination Σ w_i x_i of states.
 
     Parameters
@@ -437,7 +512,7 @@ def combination_sd_ratio(segment: str, weights: Mapping[str, float], noise_scale
     weights : mapping of str to float
         Coefficients on states in physical units, e.g. ``{"∇_z": 1.0, "δK_az": 9.8}`` for
         ∇_z + g δK_az (m/s²).  Names from :data:`STATES`.
-    noise_scale, coupling : float, str
+    noise_scale, coupling, speed_wave : float, str, float
         As in :func:`posterior_sd_ratio`.
 
     Returns
@@ -462,12 +537,12 @@ def combination_sd_ratio(segment: str, weights: Mapping[str, float], noise_scale
         a[_IDX[name]] = float(w) * PRIOR_SD[name]  # weights on the scaled state z = x / s
     if not np.any(a):
         raise ValueError("the combination has all-zero weights")
-    p = _posterior(segment, kappa, coupling)
+    p = _posterior(segment, kappa, coupling, _check_speed_wave(speed_wave))
     return float(np.sqrt(max(a @ p @ a, 0.0) / (a @ a)))
 
 
 def observable_states(segment: str, threshold: float = THRESHOLD, noise_scale: float = 0.0,
-                      coupling: str = "eq-2-8") -> dict[str, bool]:
+                      coupling: str = "eq-2-8", speed_wave: float = 0.0) -> dict[str, bool]:
     """Observable / unobservable verdict of each Table 2-3 state over a flight segment.
 
     A state is observable when the Kalman posterior standard deviation falls below ``threshold``
@@ -478,13 +553,15 @@ def observable_states(segment: str, threshold: float = THRESHOLD, noise_scale: f
     ----------
     segment : str
         A key of :data:`SEGMENTS`: "before maneuver", "U-turn", "figure-8", "S-turn".
-    threshold : float, default :data:`THRESHOLD` (0.01)
+    threshold : float, default :data:`THRESHOLD` (1e-5)
         Ratio threshold, strictly between 0 and 1.  In the noise-free limit any value between
-        1e-8 and 0.06 gives the same verdicts on the four segments.
+        1e-7 and 2e-3 gives the same verdicts on the four segments.
     noise_scale : float, default 0
         GNSS noise-variance factor (0 = noise-free limit, 1 = Table 4-41).
     coupling : {"eq-2-8", "table-2-2"}
         Misalignment coupling of the error model.
+    speed_wave : float, default 0
+        Speed change during the maneuver, m/s (:func:`flight_profile`).
 
     Returns
     -------
@@ -498,17 +575,17 @@ def observable_states(segment: str, threshold: float = THRESHOLD, noise_scale: f
     """
     if not isinstance(threshold, (int, float)) or not 0.0 < float(threshold) < 1.0:
         raise ValueError(f"threshold must be a number strictly between 0 and 1, got {threshold!r}")
-    ratios = posterior_sd_ratio(segment, noise_scale, coupling)
+    ratios = posterior_sd_ratio(segment, noise_scale, coupling, speed_wave)
     return {name: r < threshold for name, r in ratios.items()}
 
 
 def verdict_table(noise_scale: float = 0.0, coupling: str = "eq-2-8",
-                  threshold: float = THRESHOLD) -> list[dict[str, object]]:
+                  threshold: float = THRESHOLD, speed_wave: float = 0.0) -> list[dict[str, object]]:
     """All verdicts as rows (state, segment, ratio, observable), in the order of Table 2-3.
 
     Parameters
     ----------
-    noise_scale, coupling : float, str
+    noise_scale, coupling, speed_wave : float, str, float
         As in :func:`posterior_sd_ratio`.
     threshold : float, default :data:`THRESHOLD`
         As in :func:`observable_states`.
@@ -522,7 +599,7 @@ def verdict_table(noise_scale: float = 0.0, coupling: str = "eq-2-8",
     if not isinstance(threshold, (int, float)) or not 0.0 < float(threshold) < 1.0:
         raise ValueError(f"threshold must be a number strictly between 0 and 1, got {threshold!r}")
     rows = []
-    ratios = {seg: posterior_sd_ratio(seg, noise_scale, coupling) for seg in SEGMENTS}
+    ratios = {seg: posterior_sd_ratio(seg, noise_scale, coupling, speed_wave) for seg in SEGMENTS}
     for name in STATES:
         for seg in SEGMENTS:
             r = ratios[seg][name]

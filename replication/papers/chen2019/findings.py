@@ -101,7 +101,10 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
         The main reading, a key of ``readings``.
     exact : dict
         ``(state, scenario)`` → bool: the second computation's verdict (exact null-space
-        criterion); a reading of the ledger named ``exact_name``.
+        criterion), a reading of the ledger named ``exact_name``; or reading name → such a dict,
+        several readings of the second computation (e.g. its flights at constant speed and with
+        a speed change), the first of which also decides the level-flight combinations and the
+        note on agreeing values.
     explain : dict
         State → the physical reason a verdict differs (one line).
     symbols : dict, optional
@@ -142,17 +145,24 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
         if not all(c in t.attrs.get("rank_tol", {}) and c in t.attrs.get("ambiguity", {}) for c in printed.columns):
             raise ValueError(f"readings[{r!r}] needs attrs['rank_tol'] and attrs['ambiguity'] for every scenario "
                              "(observability.degrees_table)")
-    if not isinstance(exact, dict):
-        raise TypeError(f"exact must be a dict {{(state, scenario): observable}}, got {type(exact).__name__}")
-    missing = [(s, c) for s in printed.index for c in printed.columns if (s, c) not in exact]
-    if missing:
-        raise ValueError(f"exact has no verdict of the second computation for {missing[:3]} (one per state and "
-                         "scenario of printed)")
-    if exact_name in readings:
-        raise ValueError(f"exact_name {exact_name!r} is already a reading")
+    if not isinstance(exact, dict) or not exact:
+        raise TypeError(f"exact must be a non-empty dict {{(state, scenario): observable}} or {{reading: such a "
+                        f"dict}}, got {type(exact).__name__}")
+    exacts = {exact_name: exact} if all(isinstance(k, tuple) for k in exact) else dict(exact)
+    for name, ex in exacts.items():
+        if not isinstance(ex, dict):
+            raise TypeError(f"exact[{name!r}] must be a dict {{(state, scenario): observable}}, got "
+                            f"{type(ex).__name__}")
+        missing = [(s, c) for s in printed.index for c in printed.columns if (s, c) not in ex]
+        if missing:
+            raise ValueError(f"exact reading {name!r} has no verdict of the second computation for {missing[:3]} "
+                             "(one per state and scenario of printed)")
+        if name in readings:
+            raise ValueError(f"exact reading name {name!r} is already a reading")
+    exact = next(iter(exacts.values()))
     sym = symbols or {s: s for s in printed.index}
     ruled = tuple(ruled_out)
-    excluded = {r for r in list(readings) + [exact_name] if any(r.startswith(k) for k in ruled)}
+    excluded = {r for r in list(readings) + list(exacts) if any(r.startswith(k) for k in ruled)}
     if main in excluded:
         raise ValueError(f"the main reading {main!r} is itself ruled out")
     pv = {(s, c): float(printed.loc[s, c]) > printed_threshold for s in printed.index for c in printed.columns}
@@ -167,7 +177,8 @@ def compare_verdicts(printed, readings: dict, main: str, *, exact: dict, explain
                                                t.attrs["ambiguity"][c][s], printed_threshold=printed_threshold)
                 v[(s, c)] = (vo if decided else None, _stored_degree(t, s, c) if decided else None)
         verdicts[r] = v
-    verdicts[exact_name] = {k: (bool(exact[k]), None) for k in pv}
+    for name, ex in exacts.items():
+        verdicts[name] = {k: (bool(ex[k]), None) for k in pv}
     others = [r for r in verdicts if r != main]
 
     def agrees(r, k):
