@@ -168,9 +168,9 @@ def test_in_turns_only_the_rotation_of_the_triads_and_the_forward_scale_factor_s
         assert unobservable == set(_ROTATION_STATES) | {"δK_ay"}
         waved = {k for k, v in xc.observable_states(seg, coupling=coupling, speed_wave=2.0).items() if not v}
         assert waved == set(_ROTATION_STATES)
-        for wave, dim in ((0.0, 4), (2.0, 3)):
-            s, _ = xc._scaled_information(seg, coupling, wave)
-            assert int(np.sum(s <= 1e-12 * s[0])) + (xc._N - s.size) == dim
+        # the rotation (3) and, at constant speed, δK_ay and the two misalignments f_y drives (3)
+        for wave, dim in ((0.0, 6), (2.0, 3)):
+            assert xc._null_basis(seg, coupling, wave).shape[1] == dim
 
 
 def test_a_speed_wave_changes_only_the_forward_scale_factor():
@@ -231,7 +231,9 @@ def test_each_segment_is_computed_once(monkeypatch):
             xc.observable_states(seg)
             xc.observable_states(seg, threshold=0.05, noise_scale=1.0)
             xc.posterior_sd_ratio(seg, noise_scale=0.5)
-    assert len(series) == len(svds) == len(xc.SEGMENTS)
+    # one series per segment; per segment one SVD of the information as propagated, one of it with the
+    # rotation projected out (the noisy posterior) and one of the null basis joined with the rotation
+    assert len(series) == len(xc.SEGMENTS) and len(svds) == 3 * len(xc.SEGMENTS)
     assert all(len(shape) == 3 and shape[0] > 1 for shape in series), series
     xc._CACHE.clear()
 
@@ -331,3 +333,5 @@ def test_a_common_rotation_of_both_triads_is_unobservable_in_the_continuous_mode
     z = basis / d
     seen = (v[:, : s.size] * s[None, :]).T @ z  # the singular components of the kept information on z
     assert np.linalg.norm(seen) < 1e-12 * s[0] * np.linalg.norm(z)
+    null = xc._null_basis("figure-8", "table-2-2")
+    assert np.linalg.norm(z - null @ (null.T @ z)) < 1e-12 * np.linalg.norm(z)  # and it lies in the null space

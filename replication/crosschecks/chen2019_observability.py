@@ -54,10 +54,10 @@ other states is observable (then r_i measures how much of the state the combinat
 in units of its prior, and so depends on the priors).  A state is called *observable* when
 r_i < :data:`THRESHOLD` = 1e-5 in the noise-free limit, i.e. when no unobservable direction has a
 component on it.  Over the four segments, at constant speed and with a speed wave, the noise-free
-ratios are either below 1e-8 (round-off of the singular vectors) or above 2.4e-3, so any threshold
-between about 1e-7 and 2e-3 gives the same verdicts.  The smallest ratios above round-off are those
-of the attitude errors on the common rotation of the triads (below): φ_U 2.5e-3 and φ_E, φ_N 1.25e-2
-of their priors — members of an unobservable combination, so unobservable alone, by an amount the
+ratios are either below 1e-9 (round-off of the singular vectors) or above 2.4e-3, so any threshold
+between about 1e-8 and 2e-3 gives the same verdicts.  The smallest ratios above round-off are those
+of the attitude errors on the common rotation of the triads (below): φ_U 2.5e-3 to 2.9e-3 and φ_E,
+φ_N 1.25e-2 to 1.35e-2 of their priors — members of an unobservable combination, so unobservable alone, by an amount the
 priors set.  A threshold such as 0.5 would instead cut through the members of the unobservable
 combinations (ratios 0.17 to 0.98 for φ_E, φ_N, φ_U, ∇_z, δK_az, ε_x, ε_y in level flight, 0.5 for
 each misalignment angle in the turns), whose split depends on the priors.
@@ -82,9 +82,11 @@ continuous-time model no misalignment angle is therefore observable on its own, 
 and the attitude errors only in combination with them.  The transition here holds F constant over
 each 1-s step, which leaves these three directions at about 1e-4 to 1e-2 of a misalignment column
 — information the model does not have.  The information matrix is therefore taken on the
-complement of the three directions (:func:`_common_rotation`); with them removed, the null space
-of every maneuver is exactly the rotation (plus δK_ay at constant speed), and the verdicts are those
-of the continuous model.  An independent recomputation from the paper alone found the symmetry.
+complement of the three directions (:func:`_common_rotation`), and its noise-free null space is the
+numerical null space joined with them (:func:`_null_basis`): in every maneuver that is exactly the
+rotation, plus, at constant speed (f_y = 0), the forward-force terms δK_ay and the misalignments
+f_y drives (δA_xy, δA_zy under Table 2-2's coupling); the verdicts are those of the continuous
+model.  An independent recomputation from the paper alone found the symmetry.
 
 Only numpy and scipy are used; nothing is shared with the chapter's PWCS/SVD computation.
 """
@@ -149,7 +151,7 @@ SEGMENTS: dict[str, tuple[tuple[float, float], ...]] = {
 }
 
 #: Posterior over prior standard deviation below which a state is called observable (noise-free
-#: limit: the length of the state's projection on the unobservable subspace; round-off <= 1e-8,
+#: limit: the length of the state's projection on the unobservable subspace; round-off <= 1e-9,
 #: the smallest genuine projection 2.5e-3: the module docstring, "Criterion").
 THRESHOLD = 1e-5
 
@@ -396,7 +398,7 @@ def _transition(fdt: np.ndarray, order: int = 12) -> np.ndarray:
     return total
 
 
-_CACHE: dict[tuple[str, str, float], tuple[np.ndarray, np.ndarray]] = {}
+_CACHE: dict[tuple, object] = {}
 
 
 def _common_rotation(coupling: str) -> np.ndarray:
@@ -420,16 +422,9 @@ def _common_rotation(coupling: str) -> np.ndarray:
     return out
 
 
-def _scaled_information(segment: str, coupling: str, speed_wave: float = 0.0,
-                        keep_rotation: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Singular values and right singular vectors of M = stack(R^{-1/2} H Φ(t_k, 0) D) P⊥.
-
-    P⊥ projects out the common rotation of the sensor triads (:func:`_common_rotation`, scaled by
-    D): exactly unobservable in the continuous model, it keeps 1e-4 to 1e-2 of a misalignment
-    column in the 1-s piece-wise constant Φ, information the model does not have
-    (``keep_rotation=True`` keeps it, for the tests that show the artefact).
-    """
-    key = (segment, coupling, float(speed_wave), bool(keep_rotation))
+def _information(segment: str, coupling: str, speed_wave: float = 0.0) -> np.ndarray:
+    """M = stack(R^{-1/2} H Φ(t_k, 0) D) over the GNSS epochs of the segment, as propagated."""
+    key = ("M", segment, coupling, float(speed_wave))
     if key not in _CACHE:
         prof = flight_profile(segment, speed_wave)
         d = np.array([PRIOR_SD[n] for n in _ALL])
@@ -442,8 +437,25 @@ def _scaled_information(segment: str, coupling: str, speed_wave: float = 0.0,
         for step in steps:
             phi = step @ phi
             rows.append(a @ phi * d[None, :])
-        m = np.vstack(rows)
+        _CACHE[key] = np.vstack(rows)
+    return _CACHE[key]
+
+
+def _scaled_information(segment: str, coupling: str, speed_wave: float = 0.0,
+                        keep_rotation: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Singular values and right singular vectors of M P⊥ (:func:`_information`).
+
+    P⊥ projects out the common rotation of the sensor triads (:func:`_common_rotation`, scaled by
+    D): exactly unobservable in the continuous model, it keeps 1e-4 to 1e-2 of a misalignment
+    column in the 1-s piece-wise constant Φ, information the model does not have
+    (``keep_rotation=True`` keeps it: the information as propagated, whose null space
+    :func:`_null_basis` joins with the rotation).
+    """
+    key = ("svd", segment, coupling, float(speed_wave), bool(keep_rotation))
+    if key not in _CACHE:
+        m = _information(segment, coupling, speed_wave)
         if not keep_rotation:
+            d = np.array([PRIOR_SD[n] for n in _ALL])
             q, _ = np.linalg.qr(_common_rotation(coupling) / d[:, None])
             m = m - (m @ q) @ q.T
         _, s, vt = np.linalg.svd(m, full_matrices=False)
@@ -451,19 +463,41 @@ def _scaled_information(segment: str, coupling: str, speed_wave: float = 0.0,
     return _CACHE[key]
 
 
+def _null_basis(segment: str, coupling: str, speed_wave: float = 0.0, keep_rotation: bool = False) -> np.ndarray:
+    """Orthonormal basis (scaled coordinates) of the unobservable subspace of the segment, noise free.
+
+    The numerical null space of M as propagated (σ_j below 1e-12 σ_max; on the segments the
+    smallest nonzero σ_j is >= 9e-11 σ_max and round-off <= 1e-15 σ_max, so any cut between 1e-11
+    and 1e-14 gives the same null space), joined with the common rotation of the triads, which the
+    continuous model leaves unobservable and the 1-s steps do not (``keep_rotation=False``).
+    """
+    key = ("null", segment, coupling, float(speed_wave), bool(keep_rotation))
+    if key not in _CACHE:
+        s, v = _scaled_information(segment, coupling, speed_wave, keep_rotation=True)
+        basis = v[:, s <= 1e-12 * s[0]]
+        if not keep_rotation:
+            d = np.array([PRIOR_SD[n] for n in _ALL])
+            basis = np.hstack([basis, _common_rotation(coupling) / d[:, None]])
+            u, sv, _ = np.linalg.svd(basis, full_matrices=False)
+            basis = u[:, sv > 1e-9 * sv[0]]
+        _CACHE[key] = basis
+    return _CACHE[key]
+
+
 def _posterior(segment: str, noise_scale: float, coupling: str, speed_wave: float = 0.0,
                keep_rotation: bool = False) -> np.ndarray:
-    """Scaled posterior covariance P_z (prior I) after the segment's GNSS updates."""
+    """Scaled posterior covariance P_z (prior I) after the segment's GNSS updates.
+
+    Noise free: the projector onto :func:`_null_basis`.  With noise: the posterior of the
+    information with the rotation of the triads projected out (unless ``keep_rotation``).
+    """
+    if noise_scale == 0.0:
+        basis = _null_basis(segment, coupling, speed_wave, keep_rotation)
+        return basis @ basis.T
     s, v = _scaled_information(segment, coupling, speed_wave, keep_rotation)
     s2 = np.zeros(_N)
     s2[: s.size] = s**2
-    if noise_scale == 0.0:
-        # noise-free limit: projector onto the numerical null space (σ_j below 1e-12 σ_max; on the
-        # segments the smallest nonzero σ_j is >= 9e-10 σ_max and round-off <= 1e-15 σ_max,
-        # so any cut between 1e-10 and 1e-14 gives the same null space)
-        w = (s2 <= (1e-12 * s[0]) ** 2).astype(float)
-    else:
-        w = noise_scale / (noise_scale + s2)
+    w = noise_scale / (noise_scale + s2)
     return (v * w[None, :]) @ v.T
 
 
@@ -555,7 +589,7 @@ def observable_states(segment: str, threshold: float = THRESHOLD, noise_scale: f
         A key of :data:`SEGMENTS`: "before maneuver", "U-turn", "figure-8", "S-turn".
     threshold : float, default :data:`THRESHOLD` (1e-5)
         Ratio threshold, strictly between 0 and 1.  In the noise-free limit any value between
-        1e-7 and 2e-3 gives the same verdicts on the four segments.
+        1e-8 and 2e-3 gives the same verdicts on the four segments.
     noise_scale : float, default 0
         GNSS noise-variance factor (0 = noise-free limit, 1 = Table 4-41).
     coupling : {"eq-2-8", "table-2-2"}
