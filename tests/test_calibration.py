@@ -225,17 +225,26 @@ def test_printed_closed_forms_against_the_derivation(triads):
     checks = closed_forms.printed_form_checks(triads[-10]["gyro"], triads[-10]["accel"], RATE, LAT)
     by = {(c.equation, c.finding.split()[0]): c for c in checks}
     assert [c.agrees for c in checks] == [False, False, False, False, False, False, True, True, True, True, False,
-                                          False, False]
+                                          True, False]
     # (4-3): the printed row 4 repeats run 3 (axis down, +ω) instead of run 4 (axis down, -ω)
     assert checks[0].derived.endswith("(rows 4 differ)") and checks[0].printed_value < 0
     # (4-3): Ω_e sin φ with φ turning with the table averages to zero; the vertical Earth rate does not
     assert abs(checks[2].printed_value) < 1e-12 and checks[2].derived_value == pytest.approx(1.0, rel=1e-12)
     # (4-5): the missing index can only be 8
     assert checks[6].derived.endswith("[8]")
-    # (4-7) is 12 times the bias, (4-8) 4g times K_ax
+    # (4-7) is 12 times the bias; each of the nine bare sums of (4-8) is 4g times the unknown beside it, so the
+    # one factor lost with its '=' is 1/(4g), and the read form returns K_ax
     assert checks[10].printed_value == pytest.approx(12.0, rel=1e-9)
     g = earth.normal_gravity(LAT)
-    assert checks[11].printed_value == pytest.approx(4 * g, rel=1e-9)
+    y = calibration.simulate_rate_table(triads[-10]["gyro"], triads[-10]["accel"], calibration.six_position_runs(RATE),
+                                        lat=LAT)["accel"].noise_free
+    ratios = closed_forms.eq_4_8_factors(y, triads[-10]["accel"].matrix)
+    assert np.allclose(ratios, 4 * g, rtol=1e-9, atol=0)
+    assert checks[11].printed_value == pytest.approx(1.0, rel=1e-9)
+    # a wrong factor would not return the unknowns: 1/(2g) misses by a factor 2
+    assert not np.allclose(ratios, 2 * g, rtol=1e-3, atol=0)
+    with pytest.raises(ValueError, match="zero"):
+        closed_forms.eq_4_8_factors(y, np.zeros((3, 3)))
     # (4-9)-(4-12): i = 1 asks for T_0
     assert "[1]" in checks[12].derived
     assert by[("(4-5)", "captioned")].basis == "parts" and by[("(4-3)", "the")].basis == "parts"

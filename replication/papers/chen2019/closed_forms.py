@@ -288,6 +288,15 @@ PRINTED_4_8 = "ax1 + ax2 - ax3 - ax4"
 """The printed (4-8), the entry printed beside K_ax (no '=' and no factor between them)."""
 
 
+PRINTED_4_8_ENTRIES = {
+    (i, j): f"a{c}{4 * j + 1} + a{c}{4 * j + 2} - a{c}{4 * j + 3} - a{c}{4 * j + 4}"
+    for i, c in enumerate("xyz") for j in range(3)
+}
+"""The nine sums of the printed (4-8), keyed by the (row, column) of the unknown matrix
+[[K_ax, M_xy, M_xz], [M_yx, K_ay, M_yz], [M_zx, M_zy, K_az]] printed beside them: row i sums the
+channel-i outputs, column j the four runs of axis j (runs 4j+1 … 4j+4, up/up/down/down)."""
+
+
 PRINTED_4_8_TEXT = "K_{ax}  M_{xy}  M_{xz}  a_{x1} + a_{x2} - a_{x3} - a_{x4}  …"
 
 
@@ -364,6 +373,42 @@ def _eval_printed(expr: str, outputs, rate: float, bias) -> np.longdouble:
         else:
             vals.append(y[int(name[2:]) - 1, "xyz".index(name[1])])
     return sp.lambdify(syms, e, modules="numpy")(*vals)
+
+
+def eq_4_8_factors(outputs, matrix) -> np.ndarray:
+    """The nine sums of the printed chen2019 eq. (4-8) (:data:`PRINTED_4_8_ENTRIES`) divided by the
+    unknowns printed beside them.
+
+    Under (4-4) each sum is 4g times its unknown, so every ratio is the one factor the print
+    lost between the two halves of (4-8) (its inverse, 1/(4g), is the derived factor).
+
+    Parameters
+    ----------
+    outputs : array_like, shape (12, 3)
+        Mean accelerometer outputs of the 12 runs of (4-4) (run r in row r-1, channels x, y, z).
+    matrix : array_like, shape (3, 3)
+        The true [[K_ax, M_xy, M_xz], …] of (4-2) behind the outputs.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3)
+        Printed sum over unknown, entry by entry.
+
+    Raises
+    ------
+    ValueError
+        When the shapes are not (12, 3) and (3, 3), or an unknown is zero (no ratio).
+    """
+    y = np.asarray(outputs, dtype=np.longdouble)
+    m = np.asarray(matrix, dtype=np.longdouble)
+    if y.shape != (12, 3) or m.shape != (3, 3):
+        raise ValueError(f"outputs must be (12, 3) run means and matrix (3, 3); got {y.shape} and {m.shape}")
+    if np.any(m == 0):
+        raise ValueError("an unknown of the matrix is zero: the ratio of its printed sum is undefined")
+    out = np.empty((3, 3))
+    for (i, j), expr in PRINTED_4_8_ENTRIES.items():
+        out[i, j] = float(_eval_printed(expr.replace("a", "w"), y, 0.0, 0.0) / m[i, j])
+    return out
 
 
 def printed_form_checks(gyro: SensorTriad, accel: SensorTriad, rate: float, lat: float) -> list[FormCheck]:
@@ -503,11 +548,20 @@ def printed_form_checks(gyro: SensorTriad, accel: SensorTriad, rate: float, lat:
                          PRINTED_4_7_TEXT, "a_{x0} = (1/12) Σ_r ā_{x r}", float(a47 / accel.null_output[0]),
                          float(ca["null_output"][0] / accel.null_output[0]),
                          t + "test_printed_closed_forms_against_the_derivation"))
+    # (4-8): the display lost its '=' together with the brackets of its two matrices (one bare matrix of 18
+    # entries); read as 'unknowns = c × sums', the one scalar c that returns every unknown is the lost factor
+    g = float(exp["accel"].gravity)
+    ratios = eq_4_8_factors(ya, accel.matrix)
+    common = bool(np.all(np.abs(ratios / ratios[0, 0] - 1) <= AGREE_REL))
     a48 = _eval_printed(PRINTED_4_8.replace("a", "w"), ya, rate, 0.0)
-    out.append(FormCheck("(4-8)", "the left-hand matrix and the right-hand side are printed side by side without '=' "
-                         "and without the factor 1/(4g)", "derivation", same(a48, ca["matrix"][0, 0]),
-                         PRINTED_4_8_TEXT, "K_{ax} = (ā_{x1} + ā_{x2} - ā_{x3} - ā_{x4}) / (4g)",
-                         float(a48 / accel.matrix[0, 0]), float(ca["matrix"][0, 0] / accel.matrix[0, 0]),
+    out.append(FormCheck("(4-8)", "the display is printed as one bare matrix (no '=', no brackets between the unknowns "
+                         "and the sums; possibly lost in the extraction together with the factor); the only consistent "
+                         "reading is one scalar factor between the two halves, and the one factor that returns all "
+                         "nine unknowns is 1/(4g)", "derivation", common and same(ratios[0, 0], 4 * g),
+                         PRINTED_4_8_TEXT,
+                         "K_{ax} = (ā_{x1} + ā_{x2} - ā_{x3} - ā_{x4}) / (4g); the nine printed sums divided by their "
+                         f"unknowns: {ratios.min():.12g} … {ratios.max():.12g} (4g = {4 * g:.12g})",
+                         float(a48 / (4 * g) / accel.matrix[0, 0]), float(ca["matrix"][0, 0] / accel.matrix[0, 0]),
                          t + "test_printed_closed_forms_against_the_derivation"))
     n_nodes = len(TEMPERATURE_TABLES)
     first = PRINTED_4_9_RANGE[0]
