@@ -460,6 +460,12 @@ _ERRATA = {
                                  "test_erratum_eq6_half_and_eq12_cos", "S_y/(S^2+h^2)"),
     "eq. (6) phi_N^c per dh^c": ("factor 1/2 too many (as for phi_E^c)", "test_erratum_eq6_half_and_eq12_cos",
                                  "-S_x/(S^2+h^2)"),
+    "eq. (12) dV_U^c per phi^c": ("cos(theta_2) missing: turning V by phi^c about the horizontal u of eq. (5) changes its "
+                                  "up component by phi^c V cos(theta_2), and eq. (13), which the text obtains by putting "
+                                  "eq. (4) into eq. (12), keeps that cos(theta_2) = S/sqrt(S^2+h^2); the factor multiplies "
+                                  "the first-order coefficient, and no printed assumption makes theta_2 small (assumption 5 "
+                                  "names the errors and corrections; eqs. (4) and (13) keep h^2 beside S^2)",
+                                  "test_erratum_eq6_half_and_eq12_cos", "V cos(theta_2) = S V/sqrt(S^2+h^2)"),
     "text below (19) dL-dot^c per dV_N^c": ("metric factors exchanged: the latitude rate is dV_N/R_Mh",
                                             "test_reading_b_is_the_economical_one", "1/R_Mh"),
     "text below (19) dlambda-dot^c per dV_E^c": ("metric factors exchanged: the longitude rate is dV_E/(R_Nh cos L)",
@@ -484,15 +490,13 @@ _INCONSISTENT = {
 }
 
 
-#: Printed elements that the exact re-derivation does not match but that agree with it at the
-#: paper's first order (assumption 5: the flight-path angle small), checked by
+#: Printed elements that the exact re-derivation does not match but that agree with it at first
+#: order in the flight-path angle, checked by
 #: :func:`replication.papers.duan2023.printed.agree_to_first_order`: a ``derivation`` row without
-#: a tolerance, ``agrees`` computed (``qualitative`` when they agree at that order).
-_FIRST_ORDER = {
-    "eq. (12) dV_U^c per phi^c": "eq. (12) writes phi^c V where turning V by phi^c changes its up component by phi^c V "
-                                 "cos(theta_2); eq. (13) keeps that cos(theta_2) = S/sqrt(S^2+h^2). The two differ at "
-                                 "relative O(h^2/S^2), beyond the paper's first order (assumption 5)",
-}
+#: a tolerance, ``agrees`` computed.  None: the print states no small flight-path angle (its
+#: assumption 5 names the errors and corrections, and eqs. (4) and (13) keep h^2 beside S^2), so a
+#: missing cos(theta_2) is an erratum (eq. (12), in ``_ERRATA``), not an approximation of the print.
+_FIRST_ORDER: dict[str, str] = {}
 
 
 #: Printed elements that match the re-derivation, with a remark on another printed part at the
@@ -502,8 +506,10 @@ _REMARKS = {
     "eq. (4) phi^c per dh^c": lambda st: (
         "the first-order expansion of tan(theta_1 - theta_2) with S^c = S, as printed; assumption 1 and eq. (18) "
         "(SINS/ADS and SINS displacements of equal length) give dh^c/S instead, which differs by cos^2(theta_2) = "
-        f"S^2/(S^2+h^2), a relative O(h^2/S^2) ({st['h'] ** 2 / (st['Sx'] ** 2 + st['Sy'] ** 2):.1e} at this state): "
-        "the two printed forms agree at the paper's first order (assumption 5)"),
+        "S^2/(S^2+h^2) on the first-order coefficient, not by a higher order in dh^c (relative "
+        f"{st['h'] ** 2 / (st['Sx'] ** 2 + st['Sy'] ** 2 + st['h'] ** 2):.1e} at this state), and no printed "
+        "assumption makes theta_2 small: the two printed parts disagree (duan2023-print-parts, eq. (4) against "
+        "assumption 1 and eq. (18))"),
 }
 
 
