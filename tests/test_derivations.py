@@ -220,11 +220,11 @@ def test_noise_input_of_3_3_enters_where_the_biases_enter(checks, readings):
     np.testing.assert_allclose(_numeric(D[6:9, 3:6], p), F[sl["attitude"], sl["gyro_bias"]], rtol=0, atol=1e-12)
     assert D[:3, :] == sp.zeros(3, 6) and D[9:, :] == sp.zeros(6, 6)
     v, s = readings[G1]
-    swapped = v.replace("Matrix.hstack(C, zeros(3, 3)), Matrix.hstack(zeros(3, 3), C)",
-                        "Matrix.hstack(zeros(3, 3), C), Matrix.hstack(C, zeros(3, 3))")
+    swapped = v.replace("Matrix.hstack( C, zeros(3, 3)), Matrix.hstack( zeros(3, 3), C)",
+                        "Matrix.hstack( zeros(3, 3), C), Matrix.hstack( C, zeros(3, 3))")
     assert swapped != v and not dv.check_item("G swapped", swapped, s).agrees
     # one block negated: a convention absorbs it, but not the convention of F2
-    neg = dv.check_item("G negated", v.replace("Matrix.hstack(C, zeros(3, 3))", "Matrix.hstack(-C, zeros(3, 3))"), s)
+    neg = dv.check_item("G negated", v.replace("Matrix.hstack( C, zeros(3, 3))", "Matrix.hstack( -C, zeros(3, 3))"), s)
     assert neg.agrees and dv.common_conventions([neg, *f2]) == []
     with pytest.raises(ValueError, match="15, 6"):
         dv.check_item("G short", "zeros(9, 6)", s)
