@@ -467,7 +467,7 @@ def _at(expr, vals) -> float:
     return float(sp.sympify(expr).xreplace(vals).evalf(30))
 
 
-def _numeric(kind, arg, printed, other):
+def _numeric(kind, arg, printed):
     """The second, independent computation: the printed reading evaluated with the exact finite turn of
     :func:`replication.papers.duan2023.geometry.exact_correction` (numpy) at :func:`motion_states`."""
     states = motion_states()
@@ -625,7 +625,6 @@ def check_part(name: str, reading: str, spec: str, readings: dict | None = None)
         factor = sp.cancel(derived / printed)
         ok = factor.is_number and factor != 0
         facts["no term of order zero"] = sp.expand(series.coeff_monomial(1)) == 0
-        holds_under = None
         derived = (derived, factor, series.coeff_monomial(k**2))
     elif kind == "displacement":
         derived = (s + n["dS"]) ** 2 + (h + n["dh"]) ** 2 - (s**2 + h**2)
@@ -640,7 +639,7 @@ def check_part(name: str, reading: str, spec: str, readings: dict | None = None)
     chk = Check(name, kind, conventions=[{}] if ok else [], derived=derived, printed=printed)
     if not ok:
         chk.differing.append(("the part", str(printed), str(derived)))
-    return PrintedCheck(chk, spec, holds_under, facts, _numeric(kind, arg, printed, other))
+    return PrintedCheck(chk, spec, holds_under, facts, _numeric(kind, arg, printed))
 
 
 def check_printed(items) -> dict:
