@@ -188,3 +188,50 @@ def test_companion_form_and_bad_input():
         dv.judge("x", sp.eye(3), sp.eye(3), row=None, groups=["nonsense"])
     with pytest.raises(ValueError, match="unknown spec"):
         dv.check_item("x", "eye(3)", "nonsense")
+
+
+G1 = "§3.3 G_1 (noise input of the augmented model)"
+
+
+def test_random_constant_scale_factors_of_2_6(checks, readings):
+    assert checks["(2-6)"].agrees and checks["(2-6)"].conventions == list(dv.CONVENTIONS)
+    rates, limit = dv.random_constant_rates(["gyro scale", "accel scale"])
+    assert rates == sp.zeros(6, 1) and limit == sp.zeros(6, 1)
+    v, s = readings["(2-6)"]
+    # a scale factor drifting like the Gauss-Markov of (2-5), or one state short, is seen
+    assert not dv.check_item("(2-6) drifting", "Matrix([0, 0, 0, 0, 0, -dK_az/beta])", s).agrees
+    assert not dv.check_item("(2-6) short", "zeros(5, 1)", s).agrees
+    with pytest.raises(ValueError, match="unknown state groups"):
+        dv.random_constant_rates(["scale"])
+
+
+def test_noise_input_of_3_3_enters_where_the_biases_enter(checks, readings):
+    c = checks[G1]
+    assert c.agrees
+    f2 = [checks[p] for p in findings.NOISE_INPUT_PARTS]
+    assert c.conventions == dv.common_conventions(f2)
+    D, zero_blocks = dv.noise_input()
+    assert zero_blocks == {1: True, 2: True, 3: True}
+    # the derived non-zero blocks equal the package's bias columns (ErrorModel.F) at a flight state
+    p = _point(4)
+    m = E.model_15(accel_bias_sd=1e-3, gyro_bias_sd=1e-7)
+    F, sl = m.F(p), m.slices
+    np.testing.assert_allclose(_numeric(D[3:6, 0:3], p), F[sl["velocity"], sl["accel_bias"]], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(_numeric(D[6:9, 3:6], p), F[sl["attitude"], sl["gyro_bias"]], rtol=0, atol=1e-12)
+    assert D[:3, :] == sp.zeros(3, 6) and D[9:, :] == sp.zeros(6, 6)
+    v, s = readings[G1]
+    swapped = v.replace("Matrix.hstack( C, zeros(3, 3)), Matrix.hstack( zeros(3, 3), C)",
+                        "Matrix.hstack( zeros(3, 3), C), Matrix.hstack( C, zeros(3, 3))")
+    assert swapped != v and not dv.check_item("G swapped", swapped, s).agrees
+    # one block negated: a convention absorbs it, but not the convention of F2
+    neg = dv.check_item("G negated", v.replace("Matrix.hstack( C, zeros(3, 3))", "Matrix.hstack( -C, zeros(3, 3))"), s)
+    assert neg.agrees and dv.common_conventions([neg, *f2]) == []
+    with pytest.raises(ValueError, match="15, 6"):
+        dv.check_item("G short", "zeros(9, 6)", s)
+
+
+def test_the_two_new_rows_are_derivations(checks, printed):
+    rows = {r["quantity"]: r for r in findings.derivation_rows(checks, printed, ar_order=3, notebook="nb")}
+    for q in ("(2-6)", G1):
+        assert rows[q]["basis"] == "derivation" and rows[q]["agrees"], q
+    assert "the noise enters where the bias enters" in rows[G1]["note"]

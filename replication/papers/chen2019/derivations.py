@@ -48,7 +48,8 @@ from replication.papers.symbolic import Check, rotation_from_quaternion, short, 
 
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rotation_from_quaternion",
            "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
-           "common_conventions", "companion_check", "convention_text", "check_all"]
+           "common_conventions", "companion_check", "convention_text", "check_all", "random_constant_rates",
+           "NOISE_ROWS", "NOISE_COLUMNS", "noise_input"]
 
 # ----------------------------------------------------------------------------- symbols
 
@@ -444,7 +445,9 @@ def check_item(name, reading, spec, readings=None) -> Check:
         ENU); ``H-position`` (Z position rows in radians); ``generic:<item>`` (a perturbation
         identity, see :func:`check_all`); ``pair:<other name>`` (two printed parts, compared
         with each other); ``substitute:<generic item>:<name of (3-4)>`` ((3-8): the perturbation
-        of (3-7) with the printed (3-4) substituted).
+        of (3-7) with the printed (3-4) substituted); ``constant:<groups, comma-separated>`` (the rates
+        of random-constant states, eq. (2-6), :func:`random_constant_rates`); ``noise-input`` (the G_1
+        of the augmented model of §3.3, :func:`noise_input`).
     readings : dict, optional
         Name -> reading of every printed part (needed by ``pair`` and ``substitute``).
 
@@ -497,6 +500,10 @@ def check_item(name, reading, spec, readings=None) -> Check:
         return Check(name, "generic", conventions=list(CONVENTIONS) if ok else [],
                      differing=[] if ok else [("diagonal", _short(P[0, 0]), _short(D[0, 0]))],
                      derived=D, printed=P)
+    if kind == "constant":
+        return _random_constant(name, P, rest.split(","))
+    if kind == "noise-input":
+        return _noise_input(name, P)
     if kind == "gravity":
         # ENU: the third axis points up, gravity down
         D = sp.Matrix([0, 0, -gam])
@@ -513,6 +520,129 @@ def check_item(name, reading, spec, readings=None) -> Check:
                               for i in range(P.rows) for j in range(P.cols) if not is_zero(P[i, j] - Q[i, j])]
         return Check(name, "pair", conventions=list(CONVENTIONS) if ok else [], differing=diff, derived=Q, printed=P)
     raise ValueError(f"unknown spec {spec!r} for {name!r}")
+
+
+def random_constant_rates(groups) -> tuple:
+    """The rates of random-constant error states, derived twice (chen2019 eq. (2-6)).
+
+    A random constant keeps the value it draws: x(t) = x(t_0) for every t, so ẋ = 0 and no noise
+    drives it.  Independently, it is the first-order Gauss-Markov process of eq. (2-5),
+    ẋ = −x/τ + w, with an infinite correlation time and no driving noise: −x/τ → 0 as τ → ∞.
+
+    Parameters
+    ----------
+    groups : sequence of str
+        State groups of :data:`GROUPS` (e.g. ``["gyro scale", "accel scale"]``).
+
+    Returns
+    -------
+    rates : sympy.Matrix
+        d/dt of the states of ``groups`` stacked (from x(t) = x(t_0)).
+    markov_limit : sympy.Matrix
+        The Gauss-Markov rate −x/τ in the limit τ → ∞, same shape.
+
+    Raises
+    ------
+    ValueError
+        For an unknown group.
+    """
+    unknown = set(groups) - set(GROUPS)
+    if unknown or not groups:
+        raise ValueError(f"unknown state groups {sorted(unknown)}; known: {sorted(GROUPS)}")
+    t, tau = sp.Symbol("t", real=True), sp.Symbol("tau", positive=True)
+    states = sp.Matrix.vstack(*(GROUPS[g] for g in groups))
+    rates = states.diff(t)              # x(t) = x(t_0): the value drawn at t_0, free of t
+    markov_limit = (-states / tau).applyfunc(lambda e: sp.limit(e, tau, sp.oo))
+    return rates, markov_limit
+
+
+def _random_constant(name, printed, groups):
+    rates, limit = random_constant_rates(groups)
+    ok = printed.shape == rates.shape and all(is_zero(x) for x in (printed - rates)) and \
+        all(is_zero(x) for x in (rates - limit))
+    diff = [] if ok else [(f"row {i + 1}", _short(printed[i]), _short(rates[i])) for i in range(min(printed.rows, rates.rows))
+                          if not is_zero(printed[i] - rates[i])] or [("shape", str(printed.shape), str(rates.shape))]
+    return Check(name, "generic", conventions=list(CONVENTIONS) if ok else [], differing=diff, derived=rates,
+                 printed=printed)
+
+
+NOISE_ROWS = ("position", "velocity", "attitude", "accel", "gyro")
+"""The state groups of the 15 rows of G_1 in §3.3 (δp, δV, ψ, ∇_b, ε_b), in order."""
+
+NOISE_COLUMNS = ("accel", "gyro")
+"""The sign classes of the two noise columns of G_1: ω_a enters with the accelerometer error, ω_g with the gyro error."""
+
+
+def noise_input(ar_orders=(1, 2, 3)):
+    """The noise-input matrix G of the augmented Kalman model of chen2019 §3.3, derived.
+
+    The 15 error states (δp, δV, attitude, ∇_b, ε_b) follow :func:`base_model` with the sensor errors
+    of the text after (3-16), ∇ = ∇_b + ω_a and ε = ε_b + ω_g (white noises; no scale factor in
+    §3.3), and ∇̇_b = ε̇_b = 0 (random constants, eq. (2-5)); the gravity disturbance is the first
+    state of an AR(p) companion realisation per axis (eq. (3-11)), δd' = A δd + (ω_d, 0, …, 0),
+    δg = (first state of each axis).  G = ∂(rates)/∂(ω_a, ω_g, ω_d).
+
+    Parameters
+    ----------
+    ar_orders : sequence of int, default (1, 2, 3)
+        The AR orders for which the off-diagonal zero blocks are derived.
+
+    Returns
+    -------
+    G1 : sympy.Matrix, shape (15, 6)
+        The block of the navigation and bias rows under (ω_a, ω_g), base convention.
+    zero_blocks : dict of int to bool
+        AR order -> whether G's blocks 15 × 3 (navigation rows, ω_d) and 3p × 6 (gravity rows,
+        ω_a, ω_g) vanish.
+    """
+    base = base_model().rows
+    wa, wg = sp.Matrix(sp.symbols("omega_a1:4", real=True)), sp.Matrix(sp.symbols("omega_g1:4", real=True))
+    nb, eb = sp.Matrix(sp.symbols("nabla_b1:4", real=True)), sp.Matrix(sp.symbols("epsilon_b1:4", real=True))
+    scale0 = {x: 0 for g in ("accel scale", "gyro scale") for x in GROUPS[g]}
+    sensors = dict(zip(GROUPS["accel"], nb + wa)) | dict(zip(GROUPS["gyro"], eb + wg))
+    nav = sp.Matrix.vstack(*(base[g] for g in ("position", "velocity", "attitude"))).subs(scale0).subs(sensors)
+    noise = sp.Matrix.vstack(wa, wg)
+    G1 = sp.Matrix.vstack(nav.jacobian(noise), sp.zeros(6, 6))      # ∇̇_b = ε̇_b = 0: no noise
+    zero_blocks = {}
+    for p in ar_orders:
+        d = sp.Matrix(sp.symbols(f"d1:{3 * p + 1}", real=True))
+        wd = sp.Matrix(sp.symbols("omega_d1:4", real=True))
+        A = sp.zeros(p)
+        A[0, :] = sp.Matrix([sp.symbols(f"phi1:{p + 1}")])
+        for i in range(1, p):
+            A[i, i - 1] = 1
+        grav = sp.Matrix.vstack(*(A * d[p * i:p * (i + 1), 0] + sp.Matrix([wd[i]] + [0] * (p - 1)) for i in range(3)))
+        nav_d = nav.subs(dict(zip(GROUPS["gravity"], [d[p * i] for i in range(3)])))
+        rates = sp.Matrix.vstack(nav_d, sp.zeros(6, 1), grav)
+        full = rates.jacobian(sp.Matrix.vstack(noise, wd))
+        zero_blocks[p] = all(x == 0 for x in full[:15, 6:]) and all(x == 0 for x in full[15:, :6]) and \
+            all(sp.expand(x) == 0 for x in (full[:15, :6] - G1))
+    return G1, zero_blocks
+
+
+def _noise_input(name, printed):
+    D, zero_blocks = noise_input()
+    if printed.shape != D.shape:
+        raise ValueError(f"{name}: the printed G_1 is {printed.shape}, the derived one {D.shape}")
+    chk = Check(name, "block", derived=D, printed=printed)
+    rows = [g for g in NOISE_ROWS for _ in range(3)]
+    cols = [g for g in NOISE_COLUMNS for _ in range(3)]
+    sign = lambda c, g: c[_SIGN_OF[g]]
+
+    def wrong(c):
+        return [(i, j) for i in range(15) for j in range(6)
+                if not is_zero(printed[i, j] - sign(c, rows[i]) * sign(c, cols[j]) * D[i, j])]
+    per = {i: wrong(c) for i, c in enumerate(CONVENTIONS)}
+    chk.conventions = [c for i, c in enumerate(CONVENTIONS) if not per[i]] if all(zero_blocks.values()) else []
+    if not all(zero_blocks.values()):
+        chk.differing.append(("blocks 0_(15x*), 0_(*x6)", "0", "non-zero for AR orders "
+                              + ", ".join(str(p) for p, ok in zero_blocks.items() if not ok)))
+    if not any(not v for v in per.values()):
+        best = min(per, key=lambda i: len(per[i]))
+        c = CONVENTIONS[best]
+        chk.differing = [(f"({i + 1},{j + 1})", _short(printed[i, j]), _short(sign(c, rows[i]) * sign(c, cols[j]) * D[i, j]))
+                         for i, j in per[best]]
+    return chk
 
 
 def companion_check(order: int):

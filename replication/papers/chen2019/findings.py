@@ -661,6 +661,28 @@ def _entries(c, label=("printed", "derived")) -> str:
     return "; ".join(shown + ([f"{rest} more differing terms"] if rest > 0 else []))
 
 
+NOISE_INPUT_PARTS = ("(3-17) F2, velocity rows", "(3-17) F2, attitude rows")
+"""The printed bias columns of F whose conventions the noise input G_1 of §3.3 is compared with."""
+
+
+def _derived_remark(spec: str, c, checks: dict) -> str:
+    """What a derivable part's row adds to "every term derived": how (2-6) and G_1 of §3.3 were derived."""
+    from replication.papers.chen2019 import derivations as dv
+
+    kind = spec.split(":")[0]
+    if kind == "constant":
+        return ("; derived twice: x(t) = x(t_0) gives dx/dt = 0, and the Gauss-Markov rate -x/τ of (2-5) tends to 0 "
+                "as τ → ∞ (no driving noise)")
+    if kind == "noise-input":
+        f2 = [checks[p] for p in NOISE_INPUT_PARTS if p in checks]
+        same = bool(f2) and dv.convention_text(dv.common_conventions(f2)) == dv.convention_text(c.conventions)
+        return ("; G_1 = ∂(rates)/∂(ω_a, ω_g), constant biases; the two zero blocks of G derived for AR(1)-AR(3) "
+                "gravity states; " + ("the conventions of the F2 bias columns (the noise enters where the bias enters)"
+                                      if same else "conventions other than those of the F2 bias columns")
+                + "; a G column's sign leaves G Q G^T unchanged")
+    return ""
+
+
 def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, notebook: str) -> list[dict]:
     """The rows of chen2019-check-derivations: every printed part against its derivation, the
     blocks printed twice against each other, and the parts of one model against a common convention.
@@ -708,7 +730,7 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
         if c.agrees:
             row["reproduced"] = "derivable: " + dv.convention_text(c.conventions)
             row["note"] = (f"{where}: every term derived ({'the identity holds' if c.kind == 'generic' else 'conventions: ' + dv.convention_text(c.conventions)})"
-                           + (f"; reading: {reading}" if reading else ""))
+                           + _derived_remark(spec, c, checks) + (f"; reading: {reading}" if reading else ""))
         else:
             derived = "; ".join(f"{w} = {d}" for w, _, d in c.differing)
             row["reproduced"] = f"derived: {len(c.differing)} term(s) differ (note, corrected)"

@@ -10,6 +10,14 @@ under each reading of the printed angle β (``READINGS``), at the kinematic stat
 Eq. (1), the SINS error equation the paper cites without printing, is rebuilt from the navigation
 core's 15-state model: :func:`sins_error_matrix`, :func:`eq1_checks`.
 
+The printed equations that define the geometry or state an assumption — (2), (3), the chain of
+ratios (8), (9), (10) and (17) — are checked by :func:`check_part` against Fig. 1 rebuilt from the
+same pieces as :func:`derived_coefficients` (the axis u and the turn D of eq. (5), the first-order
+turn φ^c (u × V)): each printed reading (``data/paper/duan2023/duan2023-check-derivations.csv``)
+exactly in sympy (:func:`replication.papers.symbolic.vanishes`), each link of (8) under the classes
+of motion of :data:`MOTIONS`, and beside it numerically with the finite turn of
+:func:`replication.papers.duan2023.geometry.exact_correction`.
+
 Units: SI and radians.
 """
 
@@ -22,7 +30,9 @@ import numpy as np
 from replication.nav import earth
 from replication.nav.errors import NavPoint, model_15
 
-__all__ = ["STATE_NAMES", "reference_state", "derived_coefficients", "sins_error_matrix", "eq1_checks"]
+__all__ = ["STATE_NAMES", "reference_state", "derived_coefficients", "sins_error_matrix", "eq1_checks",
+           "MOTIONS", "SPECS", "NUMERIC_DH", "LINK_TOLERANCE", "TRACK_TURN_DEG", "reading_names", "parse_reading",
+           "motion_states", "PrintedCheck", "check_part", "check_printed"]
 
 
 STATE_NAMES = ("phi_E", "phi_N", "dV_E", "dV_N", "dV_U", "dL", "dlambda", "dh")
@@ -53,6 +63,26 @@ def _ddt(expr):
     sp, k = _symbols()
     pairs = [("Sx", "VE"), ("Sy", "VN"), ("h", "VU"), ("VE", "AE"), ("VN", "AN"), ("VU", "AU")]
     return sum(sp.diff(expr, k[a]) * k[b] for a, b in pairs)
+
+
+def _axis(sx, sy, s):
+    """The axis u = [S_y/S, -S_x/S, 0] of eq. (5) (u = e_S × e_U: a positive turn raises a vector), S given."""
+    sp, _ = _symbols()
+    return sp.Matrix([sy / s, -sx / s, 0])
+
+
+def _first_order_turn(phi, u, vec):
+    """The change of ``vec`` turned by the small angle φ about u, to first order: φ (u × vec) (eqs. (5), (8))."""
+    return phi * u.cross(vec)
+
+
+def _turn(phi, u):
+    """Rodrigues' D = I + sin φ (u×) + (1 - cos φ)(u×)² of eq. (5), exact (u a unit vector)."""
+    sp, _ = _symbols()
+    from replication.papers.symbolic import skew
+
+    k = skew(u)
+    return sp.eye(3) + sp.sin(phi) * k + (1 - sp.cos(phi)) * k * k
 
 
 @lru_cache(maxsize=None)
@@ -98,9 +128,9 @@ def derived_coefficients(reading: str = "B"):
     v = sp.sqrt(k["VE"] ** 2 + k["VN"] ** 2 + k["VU"] ** 2)
     e = sp.Symbol("epsilon")
     phi = sp.series(sp.atan((h + e) / s) - sp.atan(h / s), e, 0, 2).removeO().coeff(e, 1)   # eq. (4)
-    u = sp.Matrix([sy / s, -sx / s, 0])
+    u = _axis(sx, sy, s)
     vel = v / r * sp.Matrix([sx, sy, h])                                                     # eq. (8)
-    dvel = phi * u.cross(vel)
+    dvel = _first_order_turn(phi, u, vel)
     ds = sp.series(sp.sqrt(s**2 + h**2 - (h + e) ** 2) - s, e, 0, 2).removeO().coeff(e, 1)   # eq. (17)
     dsx, dsy = sx / s * ds, sy / s * ds
     lat_c, lon_c = dsy / k["RMh"], dsx / (k["RNh"] * sp.cos(k["L"]))
@@ -239,3 +269,391 @@ def eq1_checks(point):
             "position forcing largest element": float(max(np.max(np.abs(m["G_gyro"][6:9])),
                                                           np.max(np.abs(m["G_accel"][6:9])))),
             "F vs numerical Jacobian (max column-relative difference)": float(np.max(np.abs(Fa - Fn) / col))}
+
+
+# ----------------------------------------------------------------------------- eqs. (2), (3), (8)-(10), (17)
+
+MOTIONS = ("any motion", "straight ground track", "straight line")
+"""The kinematics over one interval under which a link of eq. (8) is tried, each class inside the one
+before: ``any motion`` (displacement d, velocity V and acceleration V̇ independent); ``straight ground
+track`` (the horizontal velocity and acceleration along the horizontal displacement S, the vertical
+free: a straight ground track through the origin o); ``straight line`` (d, V and V̇ along one line
+through o: straight flight).  Assumption 2 makes the SINS/ADS and SINS horizontal directions agree;
+it does not put the velocity along the displacement, so the two narrower classes are assumptions
+beyond the printed five."""
+
+SPECS = ("elevation", "link", "speed", "first-order", "displacement", "expansion")
+"""What a printed part of ``duan2023-check-derivations`` is (the ``spec`` column, ``<kind>:<argument>``):
+``elevation:SINS`` or ``elevation:SINS/ADS`` (the tangent of the elevation of a displacement, eqs. (3),
+(2)); ``link:<n>`` (the n-th equality of the chain (8), printed as the pair of its two ratios);
+``speed`` (assumption 4 as an equation, (9)); ``first-order:<part>`` (the first-order form of another
+printed part, (10)); ``displacement`` (assumption 1 as an equation, the first line of (17));
+``expansion:<part>`` (another printed part multiplied out, the second line of (17))."""
+
+NUMERIC_DH = (1.0, 10.0)
+"""The height corrections δh^c [m] of the numeric second computation (:func:`check_printed`)."""
+
+LINK_TOLERANCE = 10.0
+"""A link of eq. (8) holds numerically, with the finite turn of :func:`replication.papers.duan2023.geometry.exact_correction`,
+when its two ratios differ by at most this many times φ^c (relative): a first-order relation misses the
+exact turn by O(φ^c) ≈ δh^c/S, ≈ 2e-4 for δh^c = 1 m over a 30-s interval at 180 m/s."""
+
+TRACK_TURN_DEG = 10.0
+"""The angle [deg] by which the velocity and acceleration of the ``any motion`` state are turned about
+the vertical away from the displacement (:func:`motion_states`)."""
+
+
+@lru_cache(maxsize=None)
+def _fig1_symbols():
+    sp, k = _symbols()
+    names = dict(k)
+    names.update({n: sp.Symbol(n, real=True) for n in ("dh", "dS", "dVE", "dVN", "dVU")})
+    names.update({n: sp.Symbol(n, positive=True) for n in ("S", "Sc", "V")})
+    return sp, names
+
+
+def reading_names() -> dict:
+    """The names a printed reading of eqs. (2), (3), (8)-(10), (17) may use (column ``value`` of
+    ``data/paper/duan2023/duan2023-check-derivations.csv``).
+
+    Returns
+    -------
+    dict of str to sympy.Symbol
+        ``Sx``, ``Sy``, ``h`` (SINS displacement east, north, up over the interval [m]), ``S``
+        (√(S_x² + S_y²)), ``Sc`` (S^c, the SINS/ADS horizontal displacement), ``VE``, ``VN``, ``VU``
+        (SINS velocity [m/s]), ``V`` (its norm), ``AE``, ``AN``, ``AU`` (V̇_E, V̇_N, V̇_U [m/s²]),
+        ``dh`` (δh^c), ``dS`` (δS^C = S^C − S), ``dVE``, ``dVN``, ``dVU`` (δV^C = V^C − V), and the
+        kinematic symbols of :func:`derived_coefficients`.
+    """
+    return dict(_fig1_symbols()[1])
+
+
+def parse_reading(text: str):
+    """A printed reading as sympy: one expression, or a tuple (the two ratios of a link of eq. (8)).
+
+    Parameters
+    ----------
+    text : str
+        The reading in sympy syntax, in the names of :func:`reading_names`, e.g. ``"(dh + h)/Sc"``.
+
+    Returns
+    -------
+    sympy.Expr or tuple of sympy.Expr
+
+    Raises
+    ------
+    ValueError
+        When the text is empty, does not parse, or names something :func:`reading_names` lacks.
+    """
+    sp, names = _fig1_symbols()
+    if not isinstance(text, str) or not text.strip():
+        raise ValueError("a printed reading must be non-empty sympy text, e.g. '(dh + h)/Sc'")
+    try:
+        out = sp.sympify(text, locals=dict(names))
+    except (sp.SympifyError, TypeError, SyntaxError) as exc:
+        raise ValueError(f"cannot read {text!r} as sympy: {exc}") from exc
+    parts = out if isinstance(out, tuple) else (out,)
+    unknown = set().union(*(sp.sympify(p).free_symbols for p in parts)) - set(names.values())
+    if unknown:
+        raise ValueError(f"{text!r} names {sorted(map(str, unknown))}, which derivation.reading_names() lacks")
+    return out
+
+
+@lru_cache(maxsize=None)
+def _fig1_geometry():
+    """Fig. 1 rebuilt: the SINS displacement d, the axis u and the turn D(φ) of eq. (5), the SINS/ADS
+    displacement d^c = D d (assumptions 1-2: as long as d, in its vertical plane) and its parts."""
+    sp, n = _fig1_symbols()
+    phi = sp.Symbol("phi", real=True)
+    sx, sy, h, s = n["Sx"], n["Sy"], n["h"], n["S"]
+    u = _axis(sx, sy, s)
+    turn = _turn(phi, u)
+    d = sp.Matrix([sx, sy, h])
+    dc = turn * d
+    return dict(phi=phi, u=u, D=turn, d=d, dc=dc, up=dc[2],
+                horizontal=(dc[0] * sx + dc[1] * sy) / s,        # the horizontal length of d^c (along S)
+                across=dc[0] * sy - dc[1] * sx,                  # its horizontal part across S
+                relations=(s**2 - sx**2 - sy**2,))
+
+
+def _zero(expr, angles=(), geometry=True) -> bool:
+    """Whether ``expr`` vanishes identically, S² = S_x² + S_y² and sin² + cos² = 1 of the angles applied."""
+    from replication.papers.symbolic import vanishes
+
+    sp, n = _fig1_symbols()
+    if not geometry:
+        return vanishes(expr, tuple(angles))
+    return vanishes(expr, tuple(angles), relations=_fig1_geometry()["relations"], unknowns=(n["S"],))
+
+
+def _motion(kind: str):
+    """The substitution that puts the kinematics in a class of :data:`MOTIONS`, with its angles."""
+    sp, n = _fig1_symbols()
+    psi, gam = sp.symbols("psi gamma", real=True)            # heading from north, flight-path angle
+    if kind == "any motion":
+        return {}, (), True
+    if kind == "straight ground track":
+        w, ah = sp.symbols("w_h a_h", real=True)
+        e = (sp.sin(psi), sp.cos(psi))
+        sub = {n["Sx"]: n["S"] * e[0], n["Sy"]: n["S"] * e[1], n["VE"]: w * e[0], n["VN"]: w * e[1],
+               n["AE"]: ah * e[0], n["AN"]: ah * e[1]}
+        return sub, (psi,), False
+    s, w, a = sp.Symbol("s", positive=True), sp.Symbol("w", real=True), sp.Symbol("a", real=True)
+    e = (sp.cos(gam) * sp.sin(psi), sp.cos(gam) * sp.cos(psi), sp.sin(gam))
+    sub = {n["Sx"]: s * e[0], n["Sy"]: s * e[1], n["h"]: s * e[2], n["S"]: s * sp.cos(gam)}
+    sub.update({n[f"V{c}"]: w * x for c, x in zip("ENU", e)})
+    sub.update({n[f"A{c}"]: a * x for c, x in zip("ENU", e)})
+    return sub, (psi, gam), False
+
+
+def _derived_velocity_change():
+    """δV^C = φ^c (u × V), the first-order turn of V about u (eqs. (5), (8); φ^c left as a symbol)."""
+    sp, n = _fig1_symbols()
+    g = _fig1_geometry()
+    dv = _first_order_turn(g["phi"], g["u"], sp.Matrix([n["VE"], n["VN"], n["VU"]]))
+    return {n["dVE"]: dv[0], n["dVN"]: dv[1], n["dVU"]: dv[2]}
+
+
+def _link_holds(pair, kind) -> bool:
+    sp, n = _fig1_symbols()
+    sub, angles, geometry = _motion(kind)
+    lhs, rhs = (sp.sympify(x).xreplace(_derived_velocity_change()) for x in pair)
+    diff = (lhs - rhs).xreplace(sub)
+    num = sp.fraction(sp.together(diff))[0]
+    return _zero(num, angles, geometry)
+
+
+def motion_states() -> dict:
+    """The kinematic states of the numeric second computation, one per class of :data:`MOTIONS`.
+
+    ``straight line``: :func:`reference_state` ``"climb"`` (d, V, V̇ along one line);
+    ``straight ground track``: the same with the up velocity and acceleration doubled (the ground track
+    still along S, the climb off the chord); ``any motion``: the climb state with V turned by
+    :data:`TRACK_TURN_DEG` about the vertical one way and V̇ the other way.
+
+    Returns
+    -------
+    dict of str to dict
+        Class -> state (keys of :func:`reference_state`).
+    """
+    base = reference_state("climb")
+    track = dict(base, VU=2 * base["VU"], AU=2 * base["AU"])
+    turned = dict(base)
+    for (a, b), sign in ((("VE", "VN"), 1.0), (("AE", "AN"), -1.0)):
+        t = np.radians(sign * TRACK_TURN_DEG)
+        turned[a] = np.cos(t) * base[a] + np.sin(t) * base[b]
+        turned[b] = -np.sin(t) * base[a] + np.cos(t) * base[b]
+    return {"any motion": turned, "straight ground track": track, "straight line": base}
+
+
+def _numeric_values(state, dh):
+    """Every reading name at ``state`` with the exact finite turn of geometry.exact_correction for ``dh``."""
+    from replication.papers.duan2023 import geometry
+
+    _, n = _fig1_symbols()
+    v = np.array([state["VE"], state["VN"], state["VU"]])
+    ex = geometry.exact_correction(state["Sx"], state["Sy"], state["h"], v, dh)
+    s = float(np.hypot(state["Sx"], state["Sy"]))
+    vals = {n[k]: float(state[k]) for k in _KIN}
+    vals.update({n["S"]: s, n["Sc"]: float(np.hypot(*ex["d_new"][:2])), n["V"]: float(np.linalg.norm(v)),
+                 n["dh"]: float(dh), n["dS"]: float(ex["dS"])})
+    vals.update({n[f"dV{c}"]: float(x) for c, x in zip("ENU", ex["dv"])})
+    return vals, ex
+
+
+def _at(expr, vals) -> float:
+    import sympy as sp
+
+    return float(sp.sympify(expr).xreplace(vals).evalf(30))
+
+
+def _numeric(kind, arg, printed):
+    """The second, independent computation: the printed reading evaluated with the exact finite turn of
+    :func:`replication.papers.duan2023.geometry.exact_correction` (numpy) at :func:`motion_states`."""
+    states = motion_states()
+    line = states["straight line"]
+    out = {}
+    if kind == "link":
+        for cls, st in states.items():
+            vals, ex = _numeric_values(st, NUMERIC_DH[0])
+            lhs, rhs = (_at(x, vals) for x in printed)
+            out[cls] = abs(lhs - rhs) / abs(rhs)
+            out["phi^c"] = float(ex["angle"])          # the same displacement in every state
+        return out
+    dh = NUMERIC_DH[-1]
+    vals, ex = _numeric_values(line, dh)
+    r2 = line["Sx"] ** 2 + line["Sy"] ** 2 + line["h"] ** 2
+    v2 = line["VE"] ** 2 + line["VN"] ** 2 + line["VU"] ** 2
+    if kind == "elevation":
+        d = ex["d_new"] if arg == "SINS/ADS" else np.array([line["Sx"], line["Sy"], line["h"]])
+        theta = float(np.arctan2(d[2], np.hypot(d[0], d[1])))              # elevation of the vector
+        out["relative difference"] = abs(_at(printed, vals) - np.tan(theta)) / abs(np.tan(theta))
+        if arg == "SINS/ADS":
+            theta2 = float(np.arctan2(line["h"], np.hypot(line["Sx"], line["Sy"])))
+            out["theta_1 - theta_2 - phi^c"] = theta - theta2 - float(ex["angle"])
+    elif kind == "speed":
+        out["residual / V^2"] = _at(printed, vals) / v2
+    elif kind in ("displacement", "expansion"):
+        out["residual / |d|^2"] = _at(printed, vals) / r2
+    elif kind == "first-order":
+        for dhi in NUMERIC_DH:
+            vi, exi = _numeric_values(line, dhi)
+            out[f"residual / (V |dV|), dh = {dhi:g} m"] = _at(printed, vi) / (np.sqrt(v2) * np.linalg.norm(exi["dv"]))
+    return out
+
+
+class PrintedCheck:
+    """One printed part of eqs. (2), (3), (8)-(10), (17) against its derivation.
+
+    Attributes
+    ----------
+    check : replication.papers.symbolic.Check
+        The symbolic comparison (``agrees``, ``derived``, ``printed``, ``differing``).
+    spec : str
+        What the part is (:data:`SPECS`).
+    holds_under : str or None
+        For a link of eq. (8): the widest class of :data:`MOTIONS` under which it holds (None: under
+        none); for the other parts, ``"any motion"`` when it holds.
+    facts : dict of str to bool
+        The further identities the derivation establishes for the part (e.g. that the turned
+        displacement stays in the vertical plane of d), each decided exactly.
+    numeric : dict of str to float
+        The second computation: the printed reading evaluated with the finite turn of
+        :func:`replication.papers.duan2023.geometry.exact_correction` at :func:`motion_states`
+        (relative differences or residuals, and φ^c).
+    """
+
+    def __init__(self, check, spec, holds_under, facts, numeric):
+        self.check, self.spec, self.holds_under, self.facts, self.numeric = check, spec, holds_under, facts, numeric
+
+    @property
+    def agrees(self) -> bool:
+        """Whether the derivation gives the print (for a link: under some class of motion) and every fact holds."""
+        return self.check.agrees and all(self.facts.values())
+
+
+def check_part(name: str, reading: str, spec: str, readings: dict | None = None) -> PrintedCheck:
+    """Check one printed part of eqs. (2), (3), (8)-(10), (17) against its derivation from Fig. 1.
+
+    The geometry of Fig. 1: the SINS displacement d = [S_x, S_y, h], the SINS/ADS one
+    d^c = D d with D the turn of eq. (5) by φ^c about u = [S_y/S, −S_x/S, 0] (assumptions 1-2), whose up
+    component is h + δh^c and horizontal length S^c = S + δS^C; the velocity turned with it,
+    V^c = D V = V + δV^C (assumption 4), to first order δV^C = φ^c (u × V).
+
+    * ``elevation``: the elevation angle θ of a displacement (sin θ = up/|d|, cos θ = horizontal/|d|),
+      tan θ = up/horizontal, against the printed tangent; for SINS/ADS also that d^c stays in the
+      vertical plane of d and that θ_1 = θ_2 + φ^c (the angle eq. (4) takes as θ_1 − θ_2);
+    * ``link``: the two printed ratios, with δV^C = φ^c (u × V), cross-multiplied and reduced under each
+      class of :data:`MOTIONS`;
+    * ``speed``: |V + δV^C|² − |V|² (assumption 4), and the printed form with V^c = D V (exact turn);
+    * ``first-order``: the term of the other printed part linear in the small quantities (δV^C), which
+      must be the printed form times a non-zero number (an equation = 0), the rest of second order;
+    * ``displacement``: |d^c|² − |d|² with horizontal length S + δS^C and up h + δh^c (assumption 1), and
+      the printed form with d^c = D d (exact turn);
+    * ``expansion``: the other printed part multiplied out.
+
+    Parameters
+    ----------
+    name : str
+        The printed part.
+    reading : str
+        Its reading (:func:`parse_reading`).
+    spec : str
+        What it is (:data:`SPECS`).
+    readings : dict, optional
+        Name -> reading of every printed part (``first-order`` and ``expansion`` name another).
+
+    Returns
+    -------
+    PrintedCheck
+
+    Raises
+    ------
+    ValueError
+        For an unknown spec, a missing other part or a reading that does not parse.
+    """
+    from replication.papers.symbolic import Check
+
+    sp, n = _fig1_symbols()
+    kind, _, arg = str(spec).partition(":")
+    if kind not in SPECS:
+        raise ValueError(f"{name}: unknown spec {spec!r}; known kinds: {', '.join(SPECS)}")
+    printed = parse_reading(reading)
+    other = None
+    if kind in ("first-order", "expansion"):
+        if not readings or arg not in readings:
+            raise ValueError(f"{name}: spec {spec!r} needs the reading of {arg!r} (pass readings=)")
+        other = parse_reading(readings[arg])
+    if kind == "link" and not (isinstance(printed, tuple) and len(printed) == 2):
+        raise ValueError(f"{name}: a link of eq. (8) is read as the pair of its two ratios, '(lhs, rhs)'")
+    g = _fig1_geometry()
+    phi, s, h = g["phi"], n["S"], n["h"]
+    facts, holds_under, derived = {}, None, None
+    if kind == "elevation":
+        if arg == "SINS/ADS":
+            derived = g["up"] / g["horizontal"]
+            at = sp.sympify(printed).xreplace({n["dh"]: g["up"] - h, n["Sc"]: g["horizontal"]})
+            ok = _zero(at - derived, (phi,))
+            facts["the turned displacement stays in the vertical plane of d"] = _zero(g["across"], (phi,))
+            facts["theta_1 = theta_2 + phi^c"] = _zero(derived - (h / s + sp.tan(phi)) / (1 - h / s * sp.tan(phi)),
+                                                       (phi,))
+        elif arg == "SINS":
+            derived = g["d"][2] / s
+            ok = _zero(sp.sympify(printed) - derived)
+        else:
+            raise ValueError(f"{name}: elevation of 'SINS' or 'SINS/ADS', not {arg!r}")
+    elif kind == "link":
+        holds = {m: _link_holds(printed, m) for m in MOTIONS}
+        holds_under = next((m for m in MOTIONS if holds[m]), None)
+        facts["a narrower class of motion keeps the link"] = all(
+            holds[m] for m in MOTIONS[MOTIONS.index(holds_under):]) if holds_under else True
+        ok = holds_under is not None
+        derived = tuple(sp.sympify(x).xreplace(_derived_velocity_change()) for x in printed)
+    elif kind == "speed":
+        v = sp.Matrix([n["VE"], n["VN"], n["VU"]])
+        dv = sp.Matrix([n["dVE"], n["dVN"], n["dVU"]])
+        derived = (v + dv).dot(v + dv) - v.dot(v)
+        ok = _zero(sp.expand(printed - derived), geometry=False)
+        turned = (g["D"] - sp.eye(3)) * v
+        facts["holds with V^c = D V (exact turn)"] = _zero(
+            sp.sympify(printed).xreplace(dict(zip(dv, turned))), (phi,))
+    elif kind == "first-order":
+        k = sp.Symbol("k")
+        small = {n[c]: k * n[c] for c in ("dVE", "dVN", "dVU")}
+        series = sp.Poly(sp.expand(sp.sympify(other).xreplace(small)), k)
+        derived = series.coeff_monomial(k)
+        factor = sp.cancel(derived / printed)
+        ok = factor.is_number and factor != 0
+        facts["no term of order zero"] = sp.expand(series.coeff_monomial(1)) == 0
+        derived = (derived, factor, series.coeff_monomial(k**2))
+    elif kind == "displacement":
+        derived = (s + n["dS"]) ** 2 + (h + n["dh"]) ** 2 - (s**2 + h**2)
+        ok = _zero(sp.expand(printed - derived), geometry=False)
+        facts["holds with d^c = D d (exact turn)"] = _zero(
+            sp.sympify(printed).xreplace({n["dS"]: g["horizontal"] - s, n["dh"]: g["up"] - h}), (phi,))
+    else:                                                    # expansion
+        derived = sp.expand(other)
+        ok = _zero(sp.expand(printed - derived), geometry=False)
+    if kind != "link":
+        holds_under = "any motion" if ok else None
+    chk = Check(name, kind, conventions=[{}] if ok else [], derived=derived, printed=printed)
+    if not ok:
+        chk.differing.append(("the part", str(printed), str(derived)))
+    return PrintedCheck(chk, spec, holds_under, facts, _numeric(kind, arg, printed))
+
+
+def check_printed(items) -> dict:
+    """Check every printed part of ``duan2023-check-derivations`` (:func:`check_part`).
+
+    Parameters
+    ----------
+    items : sequence of (name, reading, spec)
+        The rows of the paper file: quantity, ``value`` (the reading) and ``spec``.
+
+    Returns
+    -------
+    dict of str to PrintedCheck
+        Name -> result, in the order given.
+    """
+    readings = {nm: r for nm, r, _ in items}
+    return {nm: check_part(nm, r, s, readings) for nm, r, s in items}

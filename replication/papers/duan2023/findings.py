@@ -14,7 +14,8 @@ imports it; the notebooks and the tests do.
   reads the exported ledger back, reading by reading;
 * :func:`startup_tilt_rows` — the printed proposed-method values against the start-up bound of
   eq. (6) (:func:`startup_tilt_bound`), under both readings of eq. (6);
-* :func:`eq22_rows`, :func:`eq22_readings_rows` — the printed elements of eqs. (4)-(21).
+* :func:`eq22_rows`, :func:`eq22_readings_rows` — the printed elements of eqs. (4)-(21);
+* :func:`derivation_rows` — eqs. (2), (3), (8)-(10), (17) against their derivation from Fig. 1.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from replication.papers.duan2023.sweeps import attitude_readings
 __all__ = ["PROPOSED_REASON", "table1_comparison", "LEDGER_ID", "LEDGER_TOLERANCE", "LEDGER_QUANTITIES",
            "readings_ledger_rows", "diagnostic_ledger_rows", "attitude_ledger_rows", "attitude_verdicts",
            "startup_tilt_bound", "STARTUP_READINGS", "STARTUP_GROUP",
-           "startup_tilt_rows", "eq22_rows", "eq22_readings_rows"]
+           "startup_tilt_rows", "eq22_rows", "eq22_readings_rows", "DERIVATIONS_TEST", "derivation_rows"]
 
 
 PROPOSED_REASON = (
@@ -615,3 +616,129 @@ def eq22_readings_rows(paper, state: str = "climb"):
                                  ("reproduced under reading A: a convention, recorded as an inconsistency"
                                   if da.loc[q, "match"] else "")})
     return rows
+
+
+# ----------------------------------------------------------------------------- eqs. (2), (3), (8)-(10), (17)
+
+DERIVATIONS_TEST = "tests/test_derivations_duan2023.py::test_every_printed_part_holds_under_its_assumptions"
+"""The test that holds the derivation rows of ``duan2023-check-derivations``."""
+
+_WHAT = {
+    "elevation:SINS/ADS": ("definition: θ_1 is the elevation (tan = up/horizontal) of the SINS/ADS displacement "
+                           "d^c = D d, d turned by φ^c about u (eq. (5), assumptions 1-2): up h + δh^c, horizontal S^c"),
+    "elevation:SINS": "definition: θ_2 is the elevation of the SINS displacement d = [S_x, S_y, h] from o (tan = up/horizontal)",
+    "link": "δV^C = φ^c (u × V) (first-order turn of eq. (5)), the two ratios cross-multiplied",
+    "speed": "assumption 4 (|V^c| = |V|, V^c = V + δV^C) written out: |V + δV^C|² − |V|²",
+    "first-order": "(9) expanded in δV^C (assumption 5)",
+    "displacement": ("assumption 1 (|d^c| = |d|) with d^c in the vertical plane of d (assumption 2), horizontal "
+                     "S + δS^C, up h + δh^C"),
+    "expansion": "the first line multiplied out (exact, nothing dropped)",
+}
+
+_FACT_WORDS = {
+    "the turned displacement stays in the vertical plane of d": "d^c stays in the vertical plane of d",
+    "theta_1 = theta_2 + phi^c": "θ_1 = θ_2 + φ^c, the angle eq. (4) takes as θ_1 − θ_2",
+    "holds with V^c = D V (exact turn)": "with V^c = D V (a turn keeps the length) it holds exactly",
+    "holds with d^c = D d (exact turn)": "with d^c = D d it holds exactly",
+    "no term of order zero": "no term of order zero",
+}
+
+_MOTION_WORDS = {
+    "any motion": "holds for any motion (a turn about the horizontal u across S moves V_h along S only; V_U ≠ 0)",
+    "straight ground track": ("holds only on a straight ground track through o (horizontal V and V̇ along S); "
+                              "assumption 2 aligns the SINS/ADS and SINS horizontal directions, not V and S: an "
+                              "assumption beyond the printed five"),
+    "straight line": ("holds only when d, V and V̇ lie along one line through o (straight flight), an assumption "
+                      "beyond the printed five; in level flight (h = V_U = 0) its ratios are 0/0"),
+}
+
+
+def _numeric_words(kind, num) -> str:
+    from replication.papers.duan2023.derivation import LINK_TOLERANCE, MOTIONS, NUMERIC_DH
+
+    if kind == "link":
+        each = ", ".join(f"{num[m]:.0e} ({m})" for m in reversed(MOTIONS))
+        return (f"numeric (finite turn, δh^c = {NUMERIC_DH[0]:g} m, φ^c = {num['phi^c']:.1e}, holds within "
+                f"{LINK_TOLERANCE:g} φ^c): the ratios differ by {each}")
+    if kind == "elevation":
+        out = f"numeric (finite turn, climb, δh^c = {NUMERIC_DH[-1]:g} m): relative difference {num['relative difference']:.0e}"
+        if "theta_1 - theta_2 - phi^c" in num:
+            out += f", θ_1 − θ_2 − φ^c = {num['theta_1 - theta_2 - phi^c']:.0e} rad"
+        return out
+    if kind == "first-order":
+        vals = [v for k, v in num.items()]
+        dh = ", ".join(f"{v:.1e} at δh^c = {d:g} m" for v, d in zip(vals, NUMERIC_DH))
+        return f"numeric (finite turn): the printed left side / (V |δV^C|) = {dh} (grows with δh^c: second order)"
+    (label, value), = num.items()
+    return f"numeric (finite turn, δh^c = {NUMERIC_DH[-1]:g} m): {label} = {value:.0e}"
+
+
+def derivation_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]:
+    """The rows of ``duan2023-check-derivations``: eqs. (2), (3), (8) link by link, (9), (10) and (17)
+    against their derivation from Fig. 1 (:func:`replication.papers.duan2023.derivation.check_printed`).
+
+    Each row has basis ``derivation``; a part holds when the derivation gives it exactly — a link of
+    eq. (8) under the widest class of motion that keeps it, named in the row (an assumption beyond
+    the printed five is recorded, not blamed).  A part no class of motion derives would be an erratum
+    with the derived form as its correction and this module's test as evidence.
+
+    Parameters
+    ----------
+    printed : pandas.DataFrame
+        The paper file ``duan2023-check-derivations`` (columns quantity, value, spec, location, printed, note).
+    notebook : str
+        The chapter, quoted in the evidence.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.reproduction.compare`.
+
+    Raises
+    ------
+    ValueError
+        When ``printed`` lacks a column the rows need.
+    """
+    from replication.papers.duan2023.derivation import check_printed
+    from replication.papers.symbolic import spaced
+
+    missing = {"quantity", "value", "spec", "location", "note"} - set(printed.columns)
+    if missing:
+        raise ValueError(f"the paper file lacks the columns {sorted(missing)}")
+    checks = check_printed([(r.quantity, r.value, r.spec) for r in printed.itertuples()])
+    meta = printed.set_index("quantity")
+    rows = []
+    for name, c in checks.items():
+        kind = c.spec.split(":")[0]
+        what = _WHAT.get(c.spec, _WHAT.get(kind, ""))
+        facts = [_FACT_WORDS.get(f, f) for f, ok in c.facts.items() if ok and f in _FACT_WORDS]
+        if kind == "link":
+            verdict = _MOTION_WORDS[c.holds_under] if c.agrees else "holds under no class of motion tried"
+            if c.holds_under == "straight line" and "VU" not in meta.at[name, "value"]:
+                verdict = verdict.split("; in level flight")[0]
+        elif kind == "first-order":
+            factor, second = c.check.derived[1], c.check.derived[2]
+            verdict = (f"its first-order term is {factor} × the printed left side (an equation = 0: the factor is "
+                       f"immaterial), the dropped term {second} of second order")
+        else:
+            verdict = "identical" if c.agrees else "differs"
+        reading = meta.at[name, "note"]
+        note = "; ".join(p for p in (f"{meta.at[name, 'location']}: {what}", verdict, *facts,
+                                     _numeric_words(kind, c.numeric),
+                                     f"reading: {reading}" if isinstance(reading, str) and reading else "") if p)
+        if c.agrees:
+            if kind == "link":
+                shown = f"derived: holds for {'a ' * (c.holds_under != 'any motion')}{c.holds_under}"
+            elif kind == "first-order":
+                shown = f"derived: the first-order term of {c.spec.partition(':')[2]} / {c.check.derived[1]}"
+            else:
+                shown = "derived: identical"
+            row = dict(reproduced=shown)
+        else:
+            row = dict(reproduced="derived: differs", corrected=str(c.check.derived),
+                       evidence=f"{notebook}; {DERIVATIONS_TEST}")
+        row.update(quantity=name, unit="", paper_text=meta.at[name, "value"], basis="derivation", agrees=c.agrees,
+                   note=note)
+        rows.append(row)
+    return [{k: (spaced(v) if k in ("paper_text", "reproduced", "corrected") else v) for k, v in r.items()}
+            for r in rows]
