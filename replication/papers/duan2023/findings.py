@@ -653,24 +653,35 @@ _MOTION_WORDS = {
 }
 
 
+#: Differences and residuals of the numeric substitution below this are round-off (double precision,
+#: amplified by the ratios: at most 1e-11 on these checks) and are shown as the bound, not as digits
+#: that change with the machine's floating-point code path; the genuine ones are 1e-5 and above.
+ROUND_OFF = 1e-10
+
+
+def _shown(v: float) -> str:
+    return f"< {ROUND_OFF:.0e}" if abs(v) < ROUND_OFF else f"{v:.0e}"
+
+
 def _numeric_words(kind, num) -> str:
     from replication.papers.duan2023.derivation import LINK_TOLERANCE, MOTIONS, NUMERIC_DH
 
     if kind == "link":
-        each = ", ".join(f"{num[m]:.0e} ({m})" for m in reversed(MOTIONS))
+        each = ", ".join(f"{_shown(num[m])} ({m})" for m in reversed(MOTIONS))
         return (f"numeric (finite turn, δh^c = {NUMERIC_DH[0]:g} m, φ^c = {num['phi^c']:.1e}, holds within "
                 f"{LINK_TOLERANCE:g} φ^c): the ratios differ by {each}")
     if kind == "elevation":
-        out = f"numeric (finite turn, climb, δh^c = {NUMERIC_DH[-1]:g} m): relative difference {num['relative difference']:.0e}"
+        out = (f"numeric (finite turn, climb, δh^c = {NUMERIC_DH[-1]:g} m): relative difference "
+               f"{_shown(num['relative difference'])}")
         if "theta_1 - theta_2 - phi^c" in num:
-            out += f", θ_1 − θ_2 − φ^c = {num['theta_1 - theta_2 - phi^c']:.0e} rad"
+            out += f", |θ_1 − θ_2 − φ^c| {_shown(num['theta_1 - theta_2 - phi^c'])} rad"
         return out
     if kind == "first-order":
         vals = [v for k, v in num.items()]
         dh = ", ".join(f"{v:.1e} at δh^c = {d:g} m" for v, d in zip(vals, NUMERIC_DH))
         return f"numeric (finite turn): the printed left side / (V |δV^C|) = {dh} (grows with δh^c: second order)"
     (label, value), = num.items()
-    return f"numeric (finite turn, δh^c = {NUMERIC_DH[-1]:g} m): {label} = {value:.0e}"
+    return f"numeric (finite turn, δh^c = {NUMERIC_DH[-1]:g} m): |{label}| {_shown(value)}"
 
 
 def derivation_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]:
