@@ -161,7 +161,7 @@ def _turntable_rows(inputs, at) -> list[dict]:
     total = {e: float(traj[e].t[-1]) / 60.0 for e in traj}
     rows.append(dict(
         quantity="turntable navigation duration against the procedure", unit="min", paper=dur_p,
-        reproduced_text=f"{collected:g} min of collection ({dwell_p:g} min × (1 + 2 × {rep_p:g}))",
+        reproduced=f"{collected:g} min of collection ({dwell_p:g} min × (1 + 2 × {rep_p:g}))",
         basis="parts", agrees=bool(math.isclose(collected, dur_p)),
         note=("the printed navigation time equals the printed collection time of the procedure; the rotations add"
               f" {min(total.values()) - collected:.1f}-{max(total.values()) - collected:.1f} min in the analog"
@@ -212,7 +212,7 @@ def _spec_rows(t443, t446, setup, traj, inputs, at) -> list[dict]:
         agrees = v43 <= v46 * (1 + _CONVERSION) if bound else math.isclose(v43, v46, rel_tol=_CONVERSION)
         rows.append(dict(
             quantity=f"Table 4-43 against Table 4-46: {q43}", unit=b443.loc[q43, "unit"],
-            paper=float(b443.loc[q43, "value"]), reproduced_text=f"Table 4-46: {text46} {b446.loc[q46, 'unit']}",
+            paper=float(b443.loc[q43, "value"]), reproduced=f"Table 4-46: {text46} {b446.loc[q46, 'unit']}",
             basis="parts", agrees=bool(agrees),
             note=("one TX-L20-A2 in §4.2 and §4.3; " + ("a value v and a bound <b agree when v ≤ b" if bound
                                                          else "the same number in both tables")
@@ -238,7 +238,7 @@ def _spec_rows(t443, t446, setup, traj, inputs, at) -> list[dict]:
                    paper=printed, reproduced=r)
         if same:
             row.update(tolerance=_CONVERSION, tolerance_kind="rel", basis="value",
-                       note=f"{field} of simulation.table_4_41_setup(Table 4-41), converted to {unit}")
+                       note=f"simulation.table_4_41_setup(Table 4-41): {field}, converted to {unit}")
         else:
             extra = (f"; up {setup.sigma_pos[2]:g} m"
                      if q == "GNSS position accuracy" else "")
@@ -251,7 +251,7 @@ def _spec_rows(t443, t446, setup, traj, inputs, at) -> list[dict]:
     d42, d43 = inputs.value("flight duration (§4.2)"), inputs.value("flight duration (§4.3)")
     rows.append(dict(
         quantity="flight duration: §4.2 against §4.3", unit="h", paper=d42,
-        reproduced_text=f"§4.3: {d43:g} h", basis="parts", agrees=bool(math.isclose(d42, d43)),
+        reproduced=f"§4.3: {d43:g} h", basis="parts", agrees=bool(math.isclose(d42, d43)),
         note=("the same TX-L20-A2 on the same A2C aircraft in both sections, with the same duration; the"
               " 15-state row of Table 4-44 and the normal-gravity column of Table 4-50 are also the same three"
               f" numbers (chen2019-print-parts); {at('flight duration (§4.2)', 'flight duration (§4.3)')}")))
@@ -274,17 +274,17 @@ def _temperature_rows(inputs, at, printed: list[int]) -> list[dict]:
     return [
         dict(quantity="calibration temperatures: procedure against results sentence", unit="°C",
              paper_text=inputs.value("calibration temperatures (procedure)"),
-             reproduced_text=f"results sentence: {inputs.value('calibration temperatures (results)')}",
+             reproduced=f"results sentence: {inputs.value('calibration temperatures (results)')}",
              basis="parts", agrees=proc == res,
              note=f"the same six points in the same order; {at('calibration temperatures (procedure)', 'calibration temperatures (results)')}"),
         dict(quantity="calibration temperatures within the oven range", unit="°C",
              paper_text=f"{inputs.value('calibration temperatures (procedure)')} in [{lo:g}, {hi:g}]",
-             reproduced_text=f"{min(proc):g} to {max(proc):g}", basis="parts",
+             reproduced=f"{min(proc):g} to {max(proc):g}", basis="parts",
              agrees=all(lo <= t <= hi for t in proc),
              note=f"every point of the procedure lies in the oven's range; {at('calibration temperatures (procedure)', 'calibration oven range')}"),
         dict(quantity="calibration temperatures with printed results", unit="°C",
              paper_text=inputs.value("calibration temperatures (procedure)"),
-             reproduced_text=(f"Tables 4-1 ... 4-32: {fmt(f'{t:g}' for t in printed)}; read by the package"
+             reproduced=(f"Tables 4-1 ... 4-32: {fmt(f'{t:g}' for t in printed)}; read by the package"
                               f" (imu_model.TEMPERATURE_TABLES): {fmt(f'{t:g}' for t in code)}"),
              basis="parts", agrees=set(printed) <= set(proc) and code == printed,
              note=("every temperature with printed results is one of the six, and the package reads exactly those;"
