@@ -285,7 +285,7 @@ def _temperature_rows(inputs, at, printed: list[int]) -> list[dict]:
         dict(quantity="calibration temperatures with printed results", unit="°C",
              paper_text=inputs.value("calibration temperatures (procedure)"),
              reproduced=(f"Tables 4-1 ... 4-32: {fmt(f'{t:g}' for t in printed)}; read by the package"
-                              f" (imu_model.TEMPERATURE_TABLES): {fmt(f'{t:g}' for t in code)}"),
+                         f" (imu_model): {fmt(f'{t:g}' for t in code)}"),
              basis="parts", agrees=set(printed) <= set(proc) and code == printed,
              note=("every temperature with printed results is one of the six, and the package reads exactly those;"
                    f" {fmt(f'{t:g}' for t in sorted(set(proc) - set(printed), reverse=True))} °C have no printed"
