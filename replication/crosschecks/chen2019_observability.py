@@ -82,8 +82,8 @@ continuous-time model no misalignment angle is therefore observable on its own, 
 and the attitude errors only in combination with them.  The transition here holds F constant over
 each 1-s step, which leaves these three directions at about 1e-4 to 1e-2 of a misalignment column
 — information the model does not have.  The information matrix is therefore taken on the
-complement of the three directions (:func:`_common_rotation`), and its noise-free null space is the
-numerical null space joined with them (:func:`_null_basis`): in every maneuver that is exactly the
+complement of the three directions (``_common_rotation``), and its noise-free null space is the
+numerical null space joined with them (``_null_basis``): in every maneuver that is exactly the
 rotation, plus, at constant speed (f_y = 0), the forward-force terms δK_ay and the misalignments
 f_y drives (δA_xy, δA_zy under Table 2-2's coupling); the verdicts are those of the continuous
 model.  An independent recomputation from the paper alone found the symmetry.
@@ -445,11 +445,11 @@ def _scaled_information(segment: str, coupling: str, speed_wave: float = 0.0,
                         keep_rotation: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Singular values and right singular vectors of M P⊥ (:func:`_information`).
 
-    P⊥ projects out the common rotation of the sensor triads (:func:`_common_rotation`, scaled by
+    P⊥ projects out the common rotation of the sensor triads (``_common_rotation``, scaled by
     D): exactly unobservable in the continuous model, it keeps 1e-4 to 1e-2 of a misalignment
     column in the 1-s piece-wise constant Φ, information the model does not have
     (``keep_rotation=True`` keeps it: the information as propagated, whose null space
-    :func:`_null_basis` joins with the rotation).
+    ``_null_basis`` joins with the rotation).
     """
     key = ("svd", segment, coupling, float(speed_wave), bool(keep_rotation))
     if key not in _CACHE:
@@ -488,7 +488,7 @@ def _posterior(segment: str, noise_scale: float, coupling: str, speed_wave: floa
                keep_rotation: bool = False) -> np.ndarray:
     """Scaled posterior covariance P_z (prior I) after the segment's GNSS updates.
 
-    Noise free: the projector onto :func:`_null_basis`.  With noise: the posterior of the
+    Noise free: the projector onto ``_null_basis``.  With noise: the posterior of the
     information with the rotation of the triads projected out (unless ``keep_rotation``).
     """
     if noise_scale == 0.0:

@@ -71,7 +71,7 @@ def printed_temperatures(load: Callable, tables=range(1, 33)) -> list[int]:
     Parameters
     ----------
     load : callable
-        :func:`replication.registry.reproduction.load_paper`.
+        :func:`replication.registry.paper.load_paper`.
     tables : iterable of int
         The numbers n of the tables ``chen2019-table-4-n`` to read (column ``temperature_C``).
 
@@ -302,7 +302,7 @@ def analog_input_rows(inputs, load: Callable) -> list[dict]:
     inputs : PaperTable
         ``rp.load_paper("chen2019-check-analog-inputs")`` (quantity, unit, value, line).
     load : callable
-        :func:`replication.registry.reproduction.load_paper`, for Tables 4-41, 4-43, 4-46 and the
+        :func:`replication.registry.paper.load_paper`, for Tables 4-41, 4-43, 4-46 and the
         calibration tables 4-1 ... 4-32.
 
     Returns

@@ -703,7 +703,7 @@ def derivation_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]:
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`.
+        Rows for :func:`replication.registry.exports.compare`.
 
     Raises
     ------

@@ -62,7 +62,7 @@ def print_parts_rows(parts: pd.DataFrame, setup=None, figure_2=None) -> list[dic
     ----------
     parts : pandas.DataFrame
         ``data/paper/duan2023/duan2023-print-parts.csv`` (quantity, unit, value, line), as
-        :func:`replication.registry.reproduction.load_paper` returns it in ``.data``.
+        :func:`replication.registry.paper.load_paper` returns it in ``.data``.
     setup, figure_2 : PaperTable, optional
         ``duan2023-claim-simulation-setup`` (correction interval, ADS error) and
         ``duan2023-figure-2`` (range, flight duration).  With both, the rows of the derivation
