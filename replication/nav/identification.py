@@ -16,6 +16,7 @@ Monte Carlo with Wilson intervals (:func:`simulate_arma` draws the series).
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass
@@ -176,17 +177,31 @@ def cutoff_lag(values, band, *, max_lag: int, alpha: float = 0.05) -> int | None
         raise ValueError(f"max_lag must lie in [0, {c.size - 1}] for {c.size} lags")
     probability(alpha, "alpha", "{name} must lie in (0, 1), got {value!r}")
     K = c.size
-    z = stats.norm.ppf(1 - alpha / 2)
+    z = _normal_quantile(1 - alpha / 2)
     ratio = np.abs(c) / b
     for q in range(0, max_lag + 1):
         if q > 0 and not ratio[q - 1] > 1:
             continue
         rest = ratio[q:]
-        allowed = stats.binom.ppf(0.99, K - q, alpha)
-        zb = stats.norm.ppf(1 - alpha / (2 * (K - q)))
+        allowed, zb = _tail_thresholds(K - q, alpha)
         if np.sum(rest > 1) <= allowed and np.all(rest <= zb / z):
             return q
     return None
+
+
+@functools.lru_cache(maxsize=256)
+def _normal_quantile(p: float) -> float:
+    """z_p of the standard normal, ``scipy.stats.norm.ppf(p)``, computed once per p (:func:`cutoff_lag` asks
+    for the same few quantiles for every series of a Monte Carlo)."""
+    return stats.norm.ppf(p)
+
+
+@functools.lru_cache(maxsize=1024)
+def _tail_thresholds(m: int, alpha: float) -> tuple[float, float]:
+    """The two thresholds of :func:`cutoff_lag` for the m = K - q lags after a candidate cut-off: the
+    99 % quantile of Binomial(m, alpha) (rule ii) and the Bonferroni quantile z_{1 - alpha/(2m)}
+    (rule iii); computed once per (m, alpha)."""
+    return stats.binom.ppf(0.99, m, alpha), _normal_quantile(1 - alpha / (2 * m))
 
 
 @dataclass(frozen=True)
@@ -279,7 +294,8 @@ def cutoff_aic(y, ar_order: int, ma_order: int) -> dict:
     if q:
         def innovations(th):
             with np.errstate(over="ignore", invalid="ignore"):  # a non-invertible trial point
-                return np.nan_to_num(signal.lfilter([1.0], np.r_[1.0, th], y)[s:], nan=1e150, posinf=1e150, neginf=-1e150)
+                w = signal.lfilter([1.0], np.concatenate(([1.0], th)), y)[s:]
+            return w if np.isfinite(w).all() else np.nan_to_num(w, nan=1e150, posinf=1e150, neginf=-1e150)
 
         # an invertible MA(q) polynomial has |theta_k| <= C(q, k)
         bound = np.array([math.comb(q, k) for k in range(1, q + 1)], dtype=float)
@@ -432,10 +448,23 @@ def identify_model(y, *, method: str = "printed", nlags: int | None = None, max_
     if method != "printed":
         return _from_orders(order_criteria(y, max_ar=max_ar, max_ma=max_ma), method)
     y = _series(y, min_length=4 * max_order + 10)
+    qa, qp = _printed_cutoffs(y, nlags, max_order, alpha)
+    return _printed_identification(y, qa, qp, rule, margin)
+
+
+def _printed_cutoffs(y: np.ndarray, nlags: int | None, max_order: int, alpha: float) -> tuple[int | None, int | None]:
+    """The cut-off lags (q_a, q_p) of the ACF and PACF of a checked series, the first step of the printed
+    route of :func:`identify_model` (shared by its rules)."""
     nlags = nlags or int(min(4 * max_order, y.size // 4))
     cg = correlogram(y, nlags, alpha=alpha)
     qa = cutoff_lag(cg["acf"], cg["acf_band"], max_lag=max_order, alpha=alpha)
     qp = cutoff_lag(cg["pacf"], cg["pacf_band"], max_lag=max_order, alpha=alpha)
+    return qa, qp
+
+
+def _printed_identification(y: np.ndarray, qa: int | None, qp: int | None, rule: str, margin: float) -> Identification:
+    """Table 3-1 read from the cut-off lags of :func:`_printed_cutoffs`, a double cut-off resolved by
+    ``rule`` (the second step of the printed route of :func:`identify_model`)."""
     acf_cuts = qa is not None and (qp is None or qa <= qp)
     pacf_cuts = qp is not None and (qa is None or qp <= qa)
     extra = ""
@@ -555,12 +584,15 @@ def identification_rate(phi, theta, n: int, *, n_series: int, seed: int, rules=(
         raise ValueError("give at least one AR (phi) or MA (theta) coefficient")
     expect = ("ARMA", None) if ph.size and th.size else ("AR", ph.size) if ph.size else ("MA", th.size)
     Y = simulate_arma(ph, th, n, n_series, np.random.default_rng(seed))
+    count = dict.fromkeys(rules, 0)
+    for y in Y:  # as identify_model(y, max_order=max_order, rule=rule); the cut-offs serve every rule
+        y = _series(y, min_length=4 * max_order + 10)
+        qa, qp = _printed_cutoffs(y, None, max_order, 0.05)
+        for rule in count:
+            idf = _printed_identification(y, qa, qp, rule, 4.0)
+            count[rule] += (idf.model, idf.order) == expect
     rows = {}
-    for rule in rules:
-        hits = 0
-        for y in Y:
-            idf = identify_model(y, max_order=max_order, rule=rule)
-            hits += (idf.model, idf.order) == expect
+    for rule, hits in count.items():
         lo, hi = proportion_confint(hits, n_series, alpha=0.05, method="wilson")
         rows[rule] = dict(rate=hits / n_series, low=lo, high=hi, hits=hits, n_series=n_series)
     return pd.DataFrame(rows).T.astype({"hits": int, "n_series": int})

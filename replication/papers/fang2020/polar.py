@@ -24,6 +24,8 @@ the true rate (strapdown convention); fang2020's ψ equation (18)-(24) is writte
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 from collections import namedtuple
 from dataclasses import dataclass, field, replace
 from functools import partial
@@ -435,13 +437,67 @@ def _run_grid(k0, k1, dt, traj, sens, state, coef, damping, pos_damped, rec, rec
     :func:`_polar_kernels.truth_table` (bit-identical to each run computing it)."""
     shared = traj.shape[0] > 1 and bool(np.all(traj == traj[0]))
     if shared:
-        tin = np.empty((k1 - k0 + 1, _k.TRUTH_STEP_FIELDS))
-        trec = np.empty((rec.shape[1], _k.TRUTH_RECORD_FIELDS))
-        _k.truth_table(k0, k1, dt, np.ascontiguousarray(traj[0]), rec_every, tin, trec)
+        tin, trec = _shared_truth(k0, k1, dt, np.ascontiguousarray(traj[0]), rec_every, rec.shape[1])
     else:
         tin, trec = np.empty((0, _k.TRUTH_STEP_FIELDS)), np.empty((0, _k.TRUTH_RECORD_FIELDS))
     _k.run_grid(k0, k1, dt, traj, sens, tuple(state), (coef, damping, pos_damped), rec, rec_every, acc_every, tin,
                 trec)
+
+
+_TRUTH_MEMO: contextvars.ContextVar = contextvars.ContextVar("fang2020_truth_memo", default=None)
+"""The truth tables kept by :func:`sharing_truths` in this context (``None``: none are kept)."""
+
+TRUTH_MEMO_BYTES = 128 * 2**20
+"""The most memory the truth tables kept by :func:`sharing_truths` may take: the two segments of one
+trajectory to the second fix of fang2020 §3 at 100 Hz (2 h and 1.5 h: 46 MB and 35 MB)."""
+
+
+def _shared_truth(k0, k1, dt, p, rec_every, n_rec):
+    """The truth of the trajectory ``p`` over steps k0..k1 (:func:`_polar_kernels.truth_table`), as
+    ``(tin, trec)``; taken from the tables of :func:`sharing_truths` when a variant before computed
+    it from the same arguments (the kernel is deterministic: the same numbers).  The tables are read,
+    never written, by :func:`_polar_kernels.run_grid`."""
+    memo = _TRUTH_MEMO.get()
+    key = (int(k0), int(k1), float(dt), p.dtype.str, p.tobytes(), int(rec_every), int(n_rec))
+    if memo is not None and key in memo:
+        entry = memo[key]
+        entry[2] += 1
+        return entry[0], entry[1]
+    tin = np.empty((k1 - k0 + 1, _k.TRUTH_STEP_FIELDS))
+    trec = np.empty((n_rec, _k.TRUTH_RECORD_FIELDS))
+    _k.truth_table(k0, k1, dt, p, rec_every, tin, trec)
+    if memo is not None:
+        # room for the new table by dropping tables never read again (the oldest first); a table
+        # read again is kept, and when it leaves no room the new one is not kept
+        size = tin.nbytes + trec.nbytes
+        unused = [k for k, e in memo.items() if e[2] == 0]
+        while unused and sum(e[0].nbytes + e[1].nbytes for e in memo.values()) + size > TRUTH_MEMO_BYTES:
+            del memo[unused.pop(0)]
+        if sum(e[0].nbytes + e[1].nbytes for e in memo.values()) + size <= TRUTH_MEMO_BYTES:
+            memo[key] = [tin, trec, 0]
+    return tin, trec
+
+
+@contextlib.contextmanager
+def sharing_truths():
+    """Within the block, runs in this thread that share one trajectory reuse its truth across calls of
+    :func:`simulate`: the truth tables of the grid INS simulation are kept, up to
+    :data:`TRUTH_MEMO_BYTES`, and a later segment of the same trajectory, step range and record
+    interval reads them instead of computing them again (the same numbers: the computation is
+    deterministic).  The variants of :func:`~replication.papers.fang2020.sensitivity.sensitivity`
+    that differ only in the sensors, the estimator or the position integration fly the same truth.
+    The tables are released on exit.
+
+    Yields
+    ------
+    None
+        The block runs with the tables kept.
+    """
+    token = _TRUTH_MEMO.set({})
+    try:
+        yield
+    finally:
+        _TRUTH_MEMO.reset(token)
 
 
 def run_segment(sc, k0, k1, traj, sens, state):

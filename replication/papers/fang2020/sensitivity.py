@@ -16,7 +16,14 @@ import pandas as pd
 
 from replication.nav import parallel as PAR
 from replication.nav import units
-from replication.papers.fang2020.polar import ESTIMATORS, FANG2020_READING, FANG2020_SEEDS, fang2020_scenario, simulate
+from replication.papers.fang2020.polar import (
+    ESTIMATORS,
+    FANG2020_READING,
+    FANG2020_SEEDS,
+    fang2020_scenario,
+    sharing_truths,
+    simulate,
+)
 
 
 def drift_summary(result, estimator="printed"):
@@ -82,8 +89,9 @@ def sensitivity(case, variants, *, n_runs=4, seed=None, executor=None, chunk_run
     items = list(variants.items())
     if executor is None and chunk_runs is None:
         chunk_runs = 1                  # one variant at a time in this process (the progress bar counts them)
-    parts = PAR.run_chunks(partial(_sensitivity_rows, case, items, n_runs, seed), len(items), executor=executor,
-                           chunk_runs=chunk_runs, progress=progress, desc="fang2020 variants")
+    with sharing_truths():              # variants in this process that fly one trajectory compute its truth once
+        parts = PAR.run_chunks(partial(_sensitivity_rows, case, items, n_runs, seed), len(items), executor=executor,
+                               chunk_runs=chunk_runs, progress=progress, desc="fang2020 variants")
     return pd.DataFrame([row for part in parts for row in part])
 
 
