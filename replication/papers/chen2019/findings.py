@@ -464,7 +464,9 @@ def maneuver_claims(degrees: pd.DataFrame, *, before: str = "before maneuver", m
     makes two claims: every state's degree rises after the maneuvers, and the S-turn raises them
     most.  Readings computed here: *rises* — each state's degree under each maneuver exceeds its
     degree before the maneuvers; *most* — by the degree summed over the states (the overall raise
-    the sentence describes), and by the number of states whose largest degree a maneuver gives.
+    the sentence describes), by the number of states whose largest degree a maneuver gives, by the
+    median and by the geometric mean over the states (the last two, like the count, are not carried
+    by a few large degrees; the count and the geometric mean do not depend on the states' units).
 
     Parameters
     ----------
@@ -481,8 +483,9 @@ def maneuver_claims(degrees: pd.DataFrame, *, before: str = "before maneuver", m
     -------
     dict
         ``summed`` (Series: degree summed over the states, per maneuver), ``largest`` (Series:
-        states whose largest degree the maneuver gives), ``best_by_sum``, ``best_by_count`` (the
-        maneuver), ``not_risen`` (list of (state, maneuver) whose degree does not exceed the one
+        states whose largest degree the maneuver gives), ``median``, ``geomean`` (Series over the
+        states with a positive degree), ``best_by_sum``, ``best_by_count``, ``best_by_median``,
+        ``best_by_geomean`` (the maneuver), ``not_risen`` (list of (state, maneuver) whose degree does not exceed the one
         before), ``round_off_states`` (maneuver → states at or below ``round_off``) and
         ``zero_under_all`` (states at or below ``round_off`` under every maneuver).
 
@@ -500,11 +503,14 @@ def maneuver_claims(degrees: pd.DataFrame, *, before: str = "before maneuver", m
         raise ValueError("observability degrees are non-negative")
     m = d[list(maneuvers)]
     summed = m.sum()
+    median = m.median()
+    geomean = np.exp(np.log(m.where(m > 0)).mean())
     largest = m.idxmax(axis=1).value_counts().reindex(list(maneuvers), fill_value=0)
     not_risen = [(s, c) for s in d.index for c in maneuvers if not d.loc[s, c] > d.loc[s, before]]
     low = {c: [s for s in d.index if d.loc[s, c] <= round_off] for c in maneuvers}
-    return {"summed": summed, "largest": largest, "best_by_sum": str(summed.idxmax()),
-            "best_by_count": str(largest.idxmax()), "not_risen": not_risen, "round_off_states": low,
+    return {"summed": summed, "largest": largest, "median": median, "geomean": geomean,
+            "best_by_sum": str(summed.idxmax()), "best_by_count": str(largest.idxmax()),
+            "best_by_median": str(median.idxmax()), "best_by_geomean": str(geomean.idxmax()), "not_risen": not_risen, "round_off_states": low,
             "zero_under_all": [s for s in d.index if all(s in low[c] for c in maneuvers)]}
 
 
