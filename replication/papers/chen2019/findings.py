@@ -866,7 +866,7 @@ def chapter2_rows(parts, sync_text: str, *, notebook: str) -> list[dict]:
                  "not a misprint" if fig_ok else "no reading of (2-7) keeps them on their axes")
               + "; read as acting on the outputs, ω_s = (I + δC_m^s) ω_m, the axes would carry " + axes("outputs")),
     ), dict(
-        quantity="(2-9) and (2-3) against (2-1), (2-7) and Fig. 2-2: layout of the misalignment error", unit="",
+        quantity="(2-9)/(2-3) against (2-1)/(2-7)/Fig. 2-2: layout of the misalignment error", unit="",
         paper_text="(2-9): δG = [0 -G_yz G_zy; G_xz 0 -G_zx; -G_xy G_yx 0]; (2-3): δω = ε + (δK_g + δG) ω_ib^b",
         reproduced="readings of (2-7) that keep both: " + (", ".join(both) or "none"),
         basis="parts", agrees=bool(both),
