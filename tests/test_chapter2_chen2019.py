@@ -51,7 +51,7 @@ def test_printed_matrix_refuses_other_text():
 
 def test_sync_error_example():
     text = rp.load_paper("chen2019-claim-conclusions").value(
-        "time-synchronisation error: position error at a given speed")
+        "time sync error: position error at a given speed")
     s = c2.sync_error_example(text)
     # two computations of the distance travelled in the offset: closed form and generated trajectory
     assert s["closed_form_m"] == pytest.approx(s["speed_kmh"] / 3.6 * s["offset_ms"] / 1000.0, rel=1e-12)

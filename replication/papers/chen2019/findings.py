@@ -884,7 +884,7 @@ def chapter2_rows(parts, sync_text: str, *, notebook: str) -> list[dict]:
     tol = 0.5 * 10.0 ** (-decimals)
     gap = abs(s["integrated_m"] - s["closed_form_m"])
     rows.append(dict(
-        quantity=(f"§3 time-synchronisation example: position error of {s['offset_ms']:g} ms at "
+        quantity=(f"§3 time sync example: position error of {s['offset_ms']:g} ms at "
                   f"{s['speed_kmh']:g} km/h"), unit="m", paper=s["printed_m"], reproduced=s["closed_form_m"],
         tolerance=tol, basis="derivation", evidence=ev + "test_sync_error_example",
         corrected=(f"{s['closed_form_m']:.2f} m ({s['printed_m']:g} m needs {s['offset_for_printed_ms']:.1f} ms at "
