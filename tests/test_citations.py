@@ -83,6 +83,21 @@ def test_volumes_out_of_step_with_their_journal_are_found():
         C.volume_rows(printed, same_step=1)
 
 
+def test_locators_shared_by_two_works_are_found():
+    printed = _printed([(1, "A. X[J]. Jour, 2010, 25(6): 714-719"), (2, "B. Y[J]. Other, 1999, 25(6): 714 -719"),
+                        (3, "C. Z[J]. Jour, 2005, 25(6): 714-720"), (4, "D. W[M]. Press, 2001.")], [])
+    rows = C.locator_rows(printed)
+    assert [r["quantity"] for r in rows] == ["locator of [1] against [2]"]
+    assert rows[0]["agrees"] is False and "25(6): 714-719" in rows[0]["paper_text"]
+    with pytest.raises(ValueError, match="columns"):
+        C.locator_rows(printed.drop(columns="line"))
+
+
+def test_chen2019_shared_locator():
+    rows = C.locator_rows(rp.load_paper("chen2019-print-references").data)
+    assert [r["quantity"] for r in rows] == ["locator of [35] against [66]"]
+
+
 def test_entry_year_and_journal_volume_read_the_printed_form():
     assert C.entry_year("Moritz H. Report, 1978, No.277") == 1978
     assert C.entry_year("no year") is None

@@ -19,6 +19,9 @@ def test_maneuver_claims_on_the_printed_table_2_3():
     assert c["best_by_sum"] == "S-turn" and c["summed"]["S-turn"] > c["summed"]["figure-8"]
     assert c["best_by_count"] == "figure-8" and (c["largest"]["figure-8"], c["largest"]["S-turn"]) == (14, 13)
     assert c["largest"].sum() == 27
+    # the measures a few large degrees do not carry: the median and the geometric mean give the figure-8
+    assert c["best_by_median"] == "figure-8" and c["best_by_geomean"] == "figure-8"
+    assert c["geomean"]["figure-8"] > c["geomean"]["S-turn"] and c["median"]["figure-8"] > c["median"]["S-turn"]
     # every printed degree under every maneuver exceeds the one before; nine stay at round-off under the U-turn
     assert c["not_risen"] == [] and len(c["round_off_states"]["U-turn"]) == 9 and c["zero_under_all"] == []
 

@@ -32,7 +32,7 @@ from typing import Any
 import pandas as pd
 
 __all__ = ["SAME_WORK", "SAME_STEP", "cited_numbers", "duplicate_pairs", "entry_year", "journal_volume",
-           "reversed_pages", "reference_rows", "volume_rows", "doi_rows"]
+           "reversed_pages", "reference_rows", "volume_rows", "locator_rows", "doi_rows"]
 
 SAME_WORK = 0.85
 """The similarity ratio from which two entries of a list are the same work (see the module docstring)."""
@@ -309,6 +309,62 @@ def volume_rows(printed: pd.DataFrame, *, same_step: int = SAME_STEP) -> list[di
                              note=(f"year minus volume {y - v}, as {others}: one volume a year" if ok else
                                    f"year minus volume {y - v}; {others} give {step}: by them the volume of {y} "
                                    f"is {y - step}, not {v}")))
+    return rows
+
+
+_LOCATOR = re.compile(r"(?P<volume>\d+)\s*\((?P<issue>\d+)\)\s*[:：]\s*(?P<first>\d+)\s*[-–]\s*(?P<last>\d+)\s*\.?\s*$")
+
+
+def locator_rows(printed: pd.DataFrame) -> list[dict[str, Any]]:
+    """Comparison rows (``basis="parts"``): journal articles of one list that print the same locator.
+
+    The locator is the closing ``volume(issue): first-last`` of a journal article.  Two entries of
+    different works — different journals or years — that print the same volume, issue, first and
+    last page disagree: one entry's locator is a copy of the other's (two printed parts of the
+    list, so ``inconsistent``).  The list alone does not say which is the original, so the row
+    names both.  Entries whose locators are all different give no row.
+
+    Parameters
+    ----------
+    printed : pandas.DataFrame
+        The transcription (the module docstring): ``quantity``, ``value``, ``kind``, ``number``, ``line``.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.exports.compare`, named ``"locator of [a] against [b]"``.
+
+    Raises
+    ------
+    ValueError
+        When a column is missing.
+    """
+    need = {"quantity", "value", "kind", "number", "line"}
+    if not need <= set(printed.columns):
+        raise ValueError(f"the transcription needs the columns {sorted(need)}; it has {list(printed.columns)}")
+    refs = printed[printed["kind"] == "entry"]
+    by_locator: dict[tuple[int, ...], list[tuple[int, str, int | None, int]]] = {}
+    for n, entry, line in zip(refs["number"], refs["value"], refs["line"]):
+        m = _LOCATOR.search(str(entry))
+        jv = journal_volume(entry)
+        if m and jv is not None:
+            key = tuple(int(m[k]) for k in ("volume", "issue", "first", "last"))
+            by_locator.setdefault(key, []).append((int(n), jv[0], jv[1], int(line)))
+    rows = []
+    for (vol, issue, first, last), items in sorted(by_locator.items()):
+        for i, (a, ja, ya, la) in enumerate(items):
+            for b, jb, yb, lb in items[i + 1:]:
+                if (ja, ya) == (jb, yb):
+                    continue
+                loc = f"{vol}({issue}): {first}-{last}"
+                rows.append(dict(quantity=f"locator of [{a}] against [{b}]", unit="",
+                                 paper_text=f"[{a}] {ja}, {ya}, {loc} (seed line {la})",
+                                 reproduced=f"[{b}] {jb}, {yb}, {loc} (seed line {lb})", basis="parts",
+                                 agrees=False,
+                                 note=(f"two works in {'different journals' if ja != jb else 'one journal'}"
+                                       f"{' and years' if ya != yb else ''} print the same volume, issue and "
+                                       "page range: one entry's locator is a copy of the other's; the list alone "
+                                       "does not say which")))
     return rows
 
 

@@ -18,6 +18,8 @@ the tests do.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 
@@ -30,7 +32,7 @@ from replication.papers.symbolic import spaced
 
 __all__ = ["closed_form_rows", "compare_verdicts", "column_groups", "EXACT_READING", "figure_4_14_ledger",
            "figure_4_14_range_text", "ordering_rows", "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims",
-           "model_claims", "compensation_claims"]
+           "model_claims", "compensation_claims", "chapter2_rows"]
 
 
 def _stored_degree(table, state, scenario) -> float:
@@ -462,7 +464,9 @@ def maneuver_claims(degrees: pd.DataFrame, *, before: str = "before maneuver", m
     makes two claims: every state's degree rises after the maneuvers, and the S-turn raises them
     most.  Readings computed here: *rises* — each state's degree under each maneuver exceeds its
     degree before the maneuvers; *most* — by the degree summed over the states (the overall raise
-    the sentence describes), and by the number of states whose largest degree a maneuver gives.
+    the sentence describes), by the number of states whose largest degree a maneuver gives, by the
+    median and by the geometric mean over the states (the last two, like the count, are not carried
+    by a few large degrees; the count and the geometric mean do not depend on the states' units).
 
     Parameters
     ----------
@@ -479,8 +483,9 @@ def maneuver_claims(degrees: pd.DataFrame, *, before: str = "before maneuver", m
     -------
     dict
         ``summed`` (Series: degree summed over the states, per maneuver), ``largest`` (Series:
-        states whose largest degree the maneuver gives), ``best_by_sum``, ``best_by_count`` (the
-        maneuver), ``not_risen`` (list of (state, maneuver) whose degree does not exceed the one
+        states whose largest degree the maneuver gives), ``median``, ``geomean`` (Series over the
+        states with a positive degree), ``best_by_sum``, ``best_by_count``, ``best_by_median``,
+        ``best_by_geomean`` (the maneuver), ``not_risen`` (list of (state, maneuver) whose degree does not exceed the one
         before), ``round_off_states`` (maneuver → states at or below ``round_off``) and
         ``zero_under_all`` (states at or below ``round_off`` under every maneuver).
 
@@ -498,11 +503,14 @@ def maneuver_claims(degrees: pd.DataFrame, *, before: str = "before maneuver", m
         raise ValueError("observability degrees are non-negative")
     m = d[list(maneuvers)]
     summed = m.sum()
+    median = m.median()
+    geomean = np.exp(np.log(m.where(m > 0)).mean())
     largest = m.idxmax(axis=1).value_counts().reindex(list(maneuvers), fill_value=0)
     not_risen = [(s, c) for s in d.index for c in maneuvers if not d.loc[s, c] > d.loc[s, before]]
     low = {c: [s for s in d.index if d.loc[s, c] <= round_off] for c in maneuvers}
-    return {"summed": summed, "largest": largest, "best_by_sum": str(summed.idxmax()),
-            "best_by_count": str(largest.idxmax()), "not_risen": not_risen, "round_off_states": low,
+    return {"summed": summed, "largest": largest, "median": median, "geomean": geomean,
+            "best_by_sum": str(summed.idxmax()), "best_by_count": str(largest.idxmax()),
+            "best_by_median": str(median.idxmax()), "best_by_geomean": str(geomean.idxmax()), "not_risen": not_risen, "round_off_states": low,
             "zero_under_all": [s for s in d.index if all(s in low[c] for c in maneuvers)]}
 
 
@@ -631,6 +639,16 @@ DERIVATION_GROUPS = {
     "(3-4) against (3-18) H2 and its bias block": ("(3-4)", "(3-18) H2", "(3-18) H bias block"),
 }
 """Printed parts of one model that must hold under one sign convention (name -> the parts)."""
+
+SENSOR_SIGN_GROUPS = {
+    "(2-3) against the (2-15) attitude line and Table 2-2: one sign for both sensor errors":
+        ("(2-15) attitude line", "Table 2-2 attitude rows, drift columns", "Table 2-2 velocity rows, bias columns"),
+    "(3-16) against (3-17) F2: one sign for both sensor errors": ("(3-16)", "(3-17) F2, velocity rows"),
+}
+"""Printed parts of one model whose gyro and accelerometer errors the print defines alike: eq. (2-3)
+writes δω and δf by one formula as "陀螺和加速度计的误差", and ch. 3 defines ∇ and ε in one sentence
+after (3-16) as the accelerometer's and the gyro's 误差; so the two sensor signs of
+:data:`replication.papers.chen2019.derivations.CONVENTIONS` are one (name -> the parts)."""
 
 _PARTS_SPECS = ("markov", "H-position")
 
@@ -767,6 +785,16 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
                          reproduced="common conventions: " + dv.convention_text(common), basis="parts",
                          agrees=bool(common), note=f"each part holds under: {each}"
                          + ("" if common else "; no convention holds for all, so the printed model mixes two")))
+    for label, parts in SENSOR_SIGN_GROUPS.items():
+        common = dv.common_conventions([checks[p] for p in parts])
+        alike = [c for c in common if c["acc"] == c["gyro"]]
+        each = "; ".join(f"{p}: {dv.convention_text(checks[p].conventions)}" for p in parts)
+        rows.append(dict(quantity=label, unit="", paper_text=" | ".join(meta.at[p, "value"] for p in parts),
+                         reproduced="common conventions with one sensor-error sign: " + dv.convention_text(alike),
+                         basis="parts", agrees=bool(alike),
+                         note=f"the print defines the gyro and the accelerometer error alike; each part holds under: {each}"
+                         + ("" if alike else "; together only with the gyro error counted opposite to the "
+                            "accelerometer error, which the print does not say: the printed model mixes two")))
     ok, per_axis = dv.companion_check(ar_order)
     n = int(meta.at["(3-17) rows of the lower-left zero block", "value"])
     rows.append(dict(quantity="AR(p) of (3-11) in companion form: characteristic polynomial", unit="",
@@ -776,6 +804,97 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
                      reproduced=3 * per_axis, tolerance=0, basis="parts",
                      note=(f"F prints 0_(6x15) under the gravity states; AR({ar_order}) of (4-13) for three axes in companion form has "
                            f"{3 * per_axis} states; the text also says the size depends on the identified model")))
+    for r in rows:
+        r["note"] = _short_note(r.get("note", ""))
+    return [{k: (_spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
+            for r in rows]
+
+
+def chapter2_rows(parts, sync_text: str, *, notebook: str) -> list[dict]:
+    """Rows of chen2019-check-derivations for three printed parts of ch. 2 (:mod:`.chapter2`).
+
+    * eq. (2-7) against eq. (2-1) and Fig. 2-2 (the direction of the misalignment map): a
+      ``derivation`` row, qualitative when one reading of (2-7) keeps Fig. 2-2's angles on their
+      axes (a convention), else an erratum;
+    * eqs. (2-9)/(2-3) against eqs. (2-1), (2-7) and Fig. 2-2: ``parts``, inconsistent when no
+      reading of (2-7) keeps both the angles of Fig. 2-2 and the layout of δG;
+    * the time-synchronisation example of §3: ``derivation``, the printed error against v Δt, computed
+      in closed form and along a generated trajectory, within half a unit of the printed last digit.
+
+    Parameters
+    ----------
+    parts : PaperTable
+        ``rp.load_paper("chen2019-print-chapter-2")``.
+    sync_text : str
+        The printed sentence of the time-synchronisation example.
+    notebook : str
+        The chapter, quoted in the evidence.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.reproduction.compare`.
+    """
+    from replication.papers.chen2019 import chapter2 as c2
+
+    angles = c2.figure_2_2_angles(parts.value("Fig. 2-2 angles"))
+    c_ms = c2.printed_matrix(parts.value("(2-7)"), "theta")
+    d_g = c2.printed_matrix(parts.value("(2-9)"), "G")
+    res = c2.misalignment_map_readings(c_ms, d_g, angles)
+    fig_ok = [r for r, v in res.items() if v["figure"]]
+    both = [r for r, v in res.items() if v["figure"] and v["error_model"]]
+    err_ok = [r for r, v in res.items() if v["error_model"]]
+
+    def axes(r):
+        return ", ".join(f"{a}: " + "/".join(f"θ_{n}" for n in res[r]["axis_angles"][a]) for a in "xyz")
+
+    def row1(m):
+        return "(" + ", ".join(str(e).replace("theta_", "θ_") for e in m[0, :]) + ")"
+
+    fig = ", ".join(f"{a}: " + "/".join(f"θ_{n}" for n in angles[a]) for a in "xyz")
+    ev = f"{notebook}; tests/test_chapter2_chen2019.py::"
+    rows = [dict(
+        quantity="(2-7) against (2-1) and Fig. 2-2: direction of the misalignment map", unit="",
+        paper_text="(2-1): rows of direction cosines of the sensor axes | (2-7): [X_s Y_s Z_s]^T = C_m^s [X_m Y_m Z_m]^T",
+        reproduced="derivable: " + ("; ".join(c2.MISALIGNMENT_READINGS[r] for r in fig_ok) or "none"),
+        basis="derivation", agrees=bool(fig_ok),
+        evidence=ev + "test_misalignment_map_readings",
+        corrected="" if fig_ok else "C_m^s with the angles of each axis in its column",
+        note=("Fig. 2-2 gives each axis two angles (" + fig + "); "
+              + ("with the columns of C_m^s the measurement axes, they carry exactly those angles, and (2-1) gives "
+                 "the outputs ω_m = (C_m^s)^T ω_s, compensated by ω_s ≈ (I − (δC_m^s)^T) ω_m: a convention, "
+                 "not a misprint" if fig_ok else "no reading of (2-7) keeps them on their axes")
+              + "; read as acting on the outputs, ω_s = (I + δC_m^s) ω_m, the axes would carry " + axes("outputs")),
+    ), dict(
+        quantity="(2-9)/(2-3) against (2-1)/(2-7)/Fig. 2-2: layout of the misalignment error", unit="",
+        paper_text="(2-9): δG = [0 -G_yz G_zy; G_xz 0 -G_zx; -G_xy G_yx 0]; (2-3): δω = ε + (δK_g + δG) ω_ib^b",
+        reproduced="readings of (2-7) that keep both: " + (", ".join(both) or "none"),
+        basis="parts", agrees=bool(both),
+        note=("under the reading that keeps Fig. 2-2's angles on their axes ("
+              + ", ".join(fig_ok) + f"), (2-1) makes the sensor error {row1(res[fig_ok[0]]['error'])}… ω (row x), "
+              f"while (2-9) lays δG out as δC_m^s, row x {row1(d_g)}, which (2-3) multiplies into δω; "
+              f"(2-9) follows under the readings {', '.join(err_ok)} (δω counted true − measured), where the axes carry "
+              + axes(err_ok[0]) + ": the two layouts differ by relabelling the six angles, so the labels of (2-9) "
+              "are not those of Fig. 2-2") if fig_ok and err_ok and not both else
+             "the layouts of (2-9) and of (2-1), (2-7), Fig. 2-2 compared under every reading of (2-7)",
+    )]
+    s = c2.sync_error_example(sync_text)
+    printed_txt = re.search(r"(\d+(?:\.(\d+))?)\s*m\s*$", sync_text.strip("。 "))
+    decimals = len(printed_txt.group(2) or "") if printed_txt else 1
+    tol = 0.5 * 10.0 ** (-decimals)
+    gap = abs(s["integrated_m"] - s["closed_form_m"])
+    rows.append(dict(
+        quantity=(f"§3 time sync example: position error of {s['offset_ms']:g} ms at "
+                  f"{s['speed_kmh']:g} km/h"), unit="m", paper=s["printed_m"], reproduced=s["closed_form_m"],
+        tolerance=tol, basis="derivation", evidence=ev + "test_sync_error_example",
+        corrected=(f"{s['closed_form_m']:.2f} m ({s['printed_m']:g} m needs {s['offset_for_printed_ms']:.1f} ms at "
+                   f"{s['speed_kmh']:g} km/h, or {s['speed_for_printed_kmh']:.0f} km/h with {s['offset_ms']:g} ms)"),
+        note=(f"reading: one time offset of {s['offset_ms']:g} ms between the SINS and GNSS data, as printed (no ±); "
+              "the error is the distance travelled in it, v Δt, and equally the distance along a generated "
+              f"straight {s['speed_kmh']:g} km/h trajectory (the two agree to "
+              + ("< 1e-9 m" if gap < 1e-9 else f"{gap:.1e} m") + f"); tolerance {tol:g} m, half a unit of the printed "
+              f"last digit; the printed value is {s['printed_m'] / s['closed_form_m']:.2f} times the derived one"),
+    ))
     for r in rows:
         r["note"] = _short_note(r.get("note", ""))
     return [{k: (_spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
