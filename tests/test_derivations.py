@@ -26,7 +26,7 @@ def printed():
 
 @pytest.fixture(scope="module")
 def readings(printed):
-    return {r.quantity: (r.value, r.spec) for r in printed.itertuples() if r.spec != "ar-states"}
+    return {r.quantity: (r.value, r.spec) for r in printed.itertuples() if r.spec not in ("ar-states", "text")}
 
 
 @pytest.fixture(scope="module")
@@ -268,3 +268,16 @@ def test_specific_force_rows_share_the_accelerometer_noise_with_the_process_nois
     assert n["accel_noise_in_z"] and n["accel_noise_in_w"]
     assert n["cross_velocity"] == pytest.approx(2 ** -0.5, abs=1e-12)
     assert n["lag1"] == pytest.approx(-0.5, abs=1e-12)
+
+
+def test_chapter3_reading_rows_quote_the_transcription_and_judge_as_derived(printed):
+    rows = {r["quantity"]: r for r in findings.chapter3_reading_rows(printed, notebook="nb")}
+    basis = {q: r["basis"] for q, r in rows.items()}
+    assert sorted(basis.values()) == ["claim", "claim", "derivation", "parts", "unstated"]
+    agrees = {r["basis"] + (" gravimetry" if "gravimetry" in q else ""): r.get("agrees") for q, r in rows.items()}
+    assert agrees["derivation"] is True            # §3.2 equivalence holds as derived
+    assert agrees["parts"] is False                # v of (3-18) shares ω_a with w
+    assert agrees["claim gravimetry"] is False     # |g| does not give δg_E, δg_N
+    assert all("line" in r["paper_text"] for r in rows.values())
+    with pytest.raises(ValueError, match="lacks"):
+        findings.chapter3_reading_rows(printed[~printed["quantity"].str.startswith("text: height")], notebook="nb")
