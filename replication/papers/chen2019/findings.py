@@ -880,7 +880,7 @@ def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]
              paper_text=text["text: step 3 yields a more accurate disturbance"],
              reproduced="rests on the AR state-space model and noises, which are not printed",
              basis="claim", agrees=bool(sep["rank"] >= sep["columns"] - 1),
-             rests_on=f"chen2019-check-derivations#{equiv}; {parts}",
+             rests_on=parts,
              note=("the print gives no separability argument: step 1's filter has no gravity state and "
                    "corrects f^n with its ∇_b estimate (line 673), which takes up the slow part of δg before "
                    "step 2 models it; in step 3 ∇_bz and δg_U stay one combination in level flight (row "
@@ -905,7 +905,7 @@ def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]
              note=("Z_7..9 holds the SINS specific force f^n, whose white noise ω_a (∇ = ∇_b + ω_a) G_1 also "
                    "puts into the process noise w; the text calls v the GNSS noise and white: the noise of the "
                    "specific-force rows is correlated with w, which the filter of (3-17)-(3-18) does not "
-                   "handle; how V̇_GPS is formed is not printed (" + parts.split("#", 1)[1] + "): a "
+                   "handle; how V̇_GPS is formed is not printed (" + parts.replace("#", ", row ", 1) + "): a "
                    "differenced GNSS velocity would also correlate v with its velocity rows and colour it")),
     ]
     return [{k: (_spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
