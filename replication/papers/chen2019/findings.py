@@ -784,7 +784,7 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
     for r in rows:
         r["note"] = _short_note(r.get("note", ""))
         if gravity_gradient is not None and r["quantity"] in GRADIENT_ROWS:
-            r["note"] += gradient_remark(gravity_gradient)
+            r["note"] += _gradient_remark(gravity_gradient)
     return [{k: (_spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
             for r in rows]
 
@@ -793,22 +793,8 @@ GRADIENT_ROWS = ("(3-17) F21", "Table 2-2 F21")
 """The rows whose (3,3) entry, ∂δV̇_U/∂δh, the frozen-γ derivation leaves without the gravity gradient."""
 
 
-def gradient_remark(g: dict) -> str:
-    """The clause an F21 row adds: the normal-gravity gradient that the frozen-γ derivation (the
-    approximation level of the printed F, a stated convention of
-    :mod:`replication.papers.chen2019.derivations`) leaves out of ∂δV̇_U/∂δh.
-
-    Parameters
-    ----------
-    g : dict
-        :func:`replication.papers.chen2019.derivations.height_gradient_entry` plus ``lat_deg`` and
-        ``speed``.
-
-    Returns
-    -------
-    str
-        The clause, starting with "; ".
-    """
+def _gradient_remark(g: dict) -> str:
+    """The clause an F21 row adds: the normal-gravity gradient the frozen-γ derivation leaves out of ∂δV̇_U/∂δh."""
     need = {"gradient", "two_g_over_r", "ratio", "lat_deg", "speed"}
     if not need <= set(g):
         raise ValueError(f"the gradient record lacks {sorted(need - set(g))}")
