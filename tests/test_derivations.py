@@ -26,7 +26,7 @@ def printed():
 
 @pytest.fixture(scope="module")
 def readings(printed):
-    return {r.quantity: (r.value, r.spec) for r in printed.itertuples() if r.spec != "ar-states"}
+    return {r.quantity: (r.value, r.spec) for r in printed.itertuples() if r.spec not in ("ar-states", "text")}
 
 
 @pytest.fixture(scope="module")
@@ -235,3 +235,49 @@ def test_the_two_new_rows_are_derivations(checks, printed):
     for q in ("(2-6)", G1):
         assert rows[q]["basis"] == "derivation" and rows[q]["agrees"], q
     assert "the noise enters where the bias enters" in rows[G1]["note"]
+
+
+def test_frozen_gamma_leaves_out_a_gradient_four_orders_above_the_kinematic_term():
+    # -dγ/dh of the WGS-84 closed form against the printed (3-1) coefficient 3.0877e-6 - 0.0044e-6 sin²L
+    # (the series agrees with the closed form to ~1e-9 s^-2 per metre at sea level: 0.1 %)
+    g = dv.height_gradient_entry(lat_deg=30.0, speed=100.0)
+    assert g["gradient"] == pytest.approx((3.0877 - 0.0044 * 0.25) * 1e-6, rel=1e-3)
+    assert g["gradient"] == pytest.approx(g["two_g_over_r"], rel=0.01)  # 2γ/R up to flattening terms
+    assert g["ratio"] > 1e4
+    assert g["mgal_per_m"] == pytest.approx(0.3086, abs=1e-3)
+
+
+def test_bias_and_vertical_disturbance_stay_one_combination_in_level_flight():
+    r = dv.bias_disturbance_rank((0.0, 90.0, 180.0, 270.0))
+    assert r["same_combination"]
+    assert (r["rank"], r["columns"]) == (5, 6)
+    np.testing.assert_allclose(np.abs(r["null"]), [0, 0, 2 ** -0.5, 0, 0, 2 ** -0.5], atol=1e-6)
+    assert dv.bias_disturbance_rank((0.0,))["rank"] == 3  # one heading: the three components only
+
+
+def test_absolute_gravimetry_sees_the_vertical_disturbance_only_to_first_order():
+    m = dv.magnitude_sensitivity(30.0)
+    np.testing.assert_allclose(m["gradient"], [0.0, 0.0, -1.0], atol=1e-15)
+    # second order: δg_h²/(2γ) = (3e-4)²/(2·9.79) m/s² ≈ 4.6e-4 mGal; the exact norm agrees to 1e-9 relative
+    assert m["exact_mgal"] == pytest.approx(m["second_order_mgal"], rel=1e-6)
+    assert 4e-4 < m["exact_mgal"] < 5e-4
+
+
+def test_specific_force_rows_share_the_accelerometer_noise_with_the_process_noise():
+    n = dv.acceleration_noise_correlation()
+    assert n["accel_noise_in_z"] and n["accel_noise_in_w"]
+    assert n["cross_velocity"] == pytest.approx(2 ** -0.5, abs=1e-12)
+    assert n["lag1"] == pytest.approx(-0.5, abs=1e-12)
+
+
+def test_chapter3_reading_rows_quote_the_transcription_and_judge_as_derived(printed):
+    rows = {r["quantity"]: r for r in findings.chapter3_reading_rows(printed, notebook="nb")}
+    basis = {q: r["basis"] for q, r in rows.items()}
+    assert sorted(basis.values()) == ["claim", "claim", "derivation", "parts", "unstated"]
+    agrees = {r["basis"] + (" gravimetry" if "gravimetry" in q else ""): r.get("agrees") for q, r in rows.items()}
+    assert agrees["derivation"] is True            # §3.2 equivalence holds as derived
+    assert agrees["parts"] is False                # v of (3-18) shares ω_a with w
+    assert agrees["claim gravimetry"] is False     # |g| does not give δg_E, δg_N
+    assert all("line" in r["paper_text"] for r in rows.values())
+    with pytest.raises(ValueError, match="lacks"):
+        findings.chapter3_reading_rows(printed[~printed["quantity"].str.startswith("text: height")], notebook="nb")

@@ -479,3 +479,44 @@ def test_identification_rates_score_arma_by_class_on_the_printed_route():
     got = idn.identify_model(y, method="bic")
     assert (got.model, got.orders) == ("ARMA", (1, 1))
     assert idn.identify_model(y).orders is None
+
+
+def test_log10_aic_penalty_is_2_ln10_by_sympy_and_by_statsmodels_fits():
+    # exact by construction up to double rounding: 1e-12
+    assert ts.log10_aic_penalty() == pytest.approx(2 * math.log(10), abs=1e-12)
+    # second computation: statsmodels likelihoods of nested AR fits; ln(10) times the printed
+    # (3-13) minus Akaike's -2 ln L + 2p is (2 ln 10 - 2) p for every order (round-off: 1e-8)
+    rng = np.random.default_rng(3)
+    y = ts.simulate_ar([0.6, -0.3], 1.0, 2000, 1, rng)[0]
+    table = ts.aic_by_order(y, 8)
+    p = table.index.to_numpy(float)
+    diff = math.log(10) * ts.aic_log10_form(table) - table["aic_printed_form"]
+    np.testing.assert_allclose(diff, (2 * math.log(10) - 2) * p, atol=1e-8)
+
+
+def test_printed_aic_selects_a_lower_order_when_the_fit_gain_lies_between_the_penalties():
+    # -2 ln L falls by 3 per order up to order 6: Akaike (penalty 2) keeps adding orders,
+    # the printed lg form (penalty 4.61 in ln units) stops at order 0
+    orders = np.arange(0, 7)
+    table = pd.DataFrame({"llf": 1.5 * orders}, index=pd.Index(orders, name="order"))
+    akaike = -2 * table["llf"] + 2 * orders
+    assert int(akaike.idxmin()) == 6
+    assert int(ts.aic_log10_form(table).idxmin()) == 0
+    back = ts.aic_change_of_logarithm(ts.aic_log10_form(table), orders, to="natural")
+    np.testing.assert_allclose(back, akaike, atol=1e-12)
+    with pytest.raises(ValueError, match="natural"):
+        ts.aic_change_of_logarithm([1.0], [1], to="ln")
+    with pytest.raises(ValueError, match="llf"):
+        ts.aic_log10_form(pd.DataFrame({"aic": [1.0]}))
+
+
+def test_pacf_read_without_the_inverse_is_no_partial_correlation():
+    # AR(1) with rho_1 = 0.9: the Yule-Walker phi_22 is 0; the literal product is
+    # rho_1^2 + rho_2 = 1.62, outside [-1, 1]
+    rho = 0.9 ** np.arange(4)
+    assert idn.pacf_as_extracted(rho, 2) == pytest.approx(1.62, abs=1e-12)
+    from scipy import linalg
+
+    assert linalg.solve_toeplitz(rho[:2], rho[1:3])[-1] == pytest.approx(0.0, abs=1e-12)
+    with pytest.raises(ValueError, match="rho_0"):
+        idn.pacf_as_extracted([0.5, 0.2, 0.1], 2)

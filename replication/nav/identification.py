@@ -31,7 +31,7 @@ from replication.nav.stationarity import _series
 from replication.nav.timeseries import _require_stationary
 
 __all__ = [
-    "METHODS", "acf_printed", "pacf_printed", "correlogram", "cutoff_lag", "Identification", "cutoff_aic",
+    "METHODS", "acf_printed", "pacf_printed", "pacf_as_extracted", "correlogram", "cutoff_lag", "Identification", "cutoff_aic",
     "order_criteria", "identify_model", "simulate_arma", "identification_rate", "BENCHMARK_MODELS", "identification_rates",
 ]
 
@@ -92,6 +92,40 @@ def pacf_printed(y, nlags: int) -> np.ndarray:
     for k in range(1, nlags + 1):
         out.append(linalg.solve_toeplitz(rho[:k], rho[1 : k + 1])[-1])
     return np.array(out)
+
+
+def pacf_as_extracted(rho, k: int) -> float:
+    """phi_kk of chen2019 eq. (3-10) read literally from the extracted text, without the inverse.
+
+    The extracted display gives (phi_k1 .. phi_kk)^T = R_k (rho_1 .. rho_k)^T with the Toeplitz
+    matrix R_k of rho_0..rho_{k-1}; the Yule-Walker solution (:func:`pacf_printed`) is
+    R_k^{-1} (rho_1 .. rho_k)^T.  Used to show that the literal reading is no partial
+    correlation (it can leave [-1, 1]).
+
+    Parameters
+    ----------
+    rho : array_like
+        Autocorrelations rho_0 (= 1), rho_1, ..., at least k + 1 of them.
+    k : int
+        The lag, k >= 1.
+
+    Returns
+    -------
+    float
+        The last element of R_k (rho_1 .. rho_k)^T.
+
+    Raises
+    ------
+    ValueError
+        When ``rho`` is shorter than k + 1 or rho_0 is not 1.
+    """
+    r = np.ravel(finite_array(rho, "rho"))
+    integer(k, "k")
+    if k < 1 or r.size < k + 1:
+        raise ValueError(f"need k >= 1 and at least k + 1 autocorrelations, got k = {k}, {r.size} values")
+    if abs(r[0] - 1.0) > 1e-12:
+        raise ValueError(f"rho_0 must be 1, got {r[0]}")
+    return float((linalg.toeplitz(r[:k]) @ r[1 : k + 1])[-1])
 
 
 def correlogram(y, nlags: int, *, alpha: float = 0.05) -> pd.DataFrame:

@@ -31,7 +31,8 @@ from replication.nav.stationarity import NonStationaryError, _series, require_st
 __all__ = [
     "ar_coefficients", "ar_design", "ar_least_squares", "fit_ar", "order_cap", "aic_by_order", "select_order",
     "select_order_checked", "aic_increment_bound", "ar_poles", "is_stationary", "ar_autocorrelation", "ar_variance",
-    "check_ar_model", "simulate_ar", "gauss_markov", "aic_batch", "order_recovery",
+    "check_ar_model", "simulate_ar", "gauss_markov", "aic_batch", "order_recovery", "log10_aic_penalty",
+    "aic_log10_form", "aic_change_of_logarithm",
 ]
 
 
@@ -244,6 +245,90 @@ def aic_by_order(y, max_order: int | None = None, *, demean: bool = True) -> pd.
                          aic_printed_form=-2 * r.llf + 2 * p, aic_per_obs=r.aic / N,
                          aic_log_sigma2=math.log(r.sigma2) + 2 * p / N))
     return pd.DataFrame(rows).set_index("order")
+
+
+def log10_aic_penalty() -> float:
+    """Penalty per parameter, in units of -2 ln L, of chen2019 eq. (3-13) read with lg = log10.
+
+    (3-13) prints AIC(p) = -2 lg L + 2p.  Multiplied by ln 10 (which moves no minimum) it is
+    -2 ln L + 2 ln(10) p: the printed criterion charges 2 ln 10 = 4.61 per parameter where
+    Akaike's charges 2.  Derived with sympy (the logarithm rewritten, the coefficient of p read off).
+
+    Returns
+    -------
+    float
+        2 ln 10.
+    """
+    import sympy as sp
+
+    lik, p = sp.symbols("L p", positive=True)
+    printed = -2 * sp.log(lik, 10) + 2 * p
+    in_ln = sp.expand(sp.simplify(printed * sp.log(10)))
+    if sp.simplify(in_ln.coeff(sp.log(lik)) + 2) != 0:
+        raise ArithmeticError("the rescaled criterion lost its -2 ln L term")
+    return float(in_ln.coeff(p))
+
+
+def aic_log10_form(table: pd.DataFrame) -> pd.Series:
+    """chen2019 eq. (3-13) as printed, -2 lg L + 2p with lg = log10, from the fits of :func:`aic_by_order`.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The output of :func:`aic_by_order` (index ``order``, column ``llf``).
+
+    Returns
+    -------
+    pandas.Series
+        The printed criterion per order.
+
+    Raises
+    ------
+    ValueError
+        When ``table`` has no ``llf`` column.
+    """
+    if "llf" not in getattr(table, "columns", ()):
+        raise ValueError("table must be the output of aic_by_order (a column 'llf')")
+    p = np.asarray(table.index, float)
+    return -2.0 * table["llf"] / math.log(10.0) + 2.0 * p
+
+
+def aic_change_of_logarithm(values, orders, *, to: str) -> np.ndarray:
+    """Values of -2 log L + 2p re-expressed with the other logarithm (chen2019 eq. (3-13)).
+
+    ``to="natural"`` reads ``values`` as -2 lg L + 2p (the printed (3-13)) and returns
+    -2 ln L + 2p = ln(10) (v - 2p) + 2p; ``to="log10"`` reads them as -2 ln L + 2p and returns
+    -2 lg L + 2p = (v - 2p)/ln(10) + 2p.  Both assume the values are the raw criterion (not
+    divided by the number of observations).
+
+    Parameters
+    ----------
+    values : array_like
+        Criterion values, one per order.
+    orders : array_like
+        The order p of each value.
+    to : {"natural", "log10"}
+        The logarithm of the result.
+
+    Returns
+    -------
+    numpy.ndarray
+        The re-expressed values.
+
+    Raises
+    ------
+    ValueError
+        On an unknown ``to`` or arrays of different lengths.
+    """
+    v = np.ravel(finite_array(values, "values"))
+    p = np.ravel(finite_array(orders, "orders"))
+    if v.size != p.size:
+        raise ValueError(f"values ({v.size}) and orders ({p.size}) must have the same length")
+    if to == "natural":
+        return math.log(10.0) * (v - 2.0 * p) + 2.0 * p
+    if to == "log10":
+        return (v - 2.0 * p) / math.log(10.0) + 2.0 * p
+    raise ValueError(f"to must be 'natural' or 'log10', got {to!r}")
 
 
 def select_order(y, max_order: int | None = None, *, demean: bool = True, check: bool = True,

@@ -39,17 +39,22 @@ chapter passes them in.  The findings module turns the results into table rows.
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 
+import numpy as np
 import sympy as sp
 
+from replication.nav import earth
+from replication.nav._validate import finite_array, positive
 from replication.papers import symbolic
 from replication.papers.symbolic import Check, rotation_from_quaternion, short, skew, vanishes, vee
 
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rotation_from_quaternion",
            "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
            "common_conventions", "companion_check", "convention_text", "check_all", "random_constant_rates",
-           "NOISE_ROWS", "NOISE_COLUMNS", "noise_input"]
+           "NOISE_ROWS", "NOISE_COLUMNS", "noise_input", "height_gradient_entry", "bias_disturbance_rank",
+           "magnitude_sensitivity", "acceleration_noise_correlation"]
 
 # ----------------------------------------------------------------------------- symbols
 
@@ -698,3 +703,164 @@ def check_all(items) -> dict:
     """
     readings = {n: r for n, r, _ in items}
     return {n: check_item(n, r, s, readings) for n, r, s in items}
+
+
+# ----------------------------------------------------------------------------- the chapter-3 reading
+
+def height_gradient_entry(lat_deg: float = 30.0, speed: float = 100.0, h: float = 0.0) -> dict:
+    """What the frozen-γ entry F21(3,3) of chen2019 eq. (3-17) leaves out: the normal-gravity gradient.
+
+    :func:`base_model` freezes γ, as the printed F of §3.3 and Table 2-2 do (no printed entry
+    carries a gravity term).  With γ(h) of eq. (3-1), δV̇_U = ... − γ(h + δh) + γ(h) adds
+    −∂γ/∂h to ∂δV̇_U/∂δh (errors computed − true, ENU).  The gradient is taken from the WGS-84
+    closed form (:func:`replication.nav.earth.normal_gravity_closed_form`, central difference,
+    step 10 m: truncation ~1e-14 s⁻²) and set against 2γ/√(R_M R_N) and the kinematic term
+    V²/(R_N + h)² of the same entry at ``speed``.
+
+    Parameters
+    ----------
+    lat_deg : float, default 30
+        Latitude, degrees.
+    speed : float, default 100
+        Horizontal speed, m/s (> 0).
+    h : float, default 0
+        Height, m.
+
+    Returns
+    -------
+    dict
+        ``gradient`` (−∂γ/∂h, s⁻²), ``two_g_over_r`` (s⁻²), ``kinematic`` (V²/(R_N+h)², s⁻²),
+        ``ratio`` (gradient / kinematic), ``mgal_per_m`` (the gradient in mGal per metre).
+    """
+    earth.check_latitude(np.radians(lat_deg), name="lat_deg")
+    earth.check_height(h)
+    positive(speed, "speed")
+    lat, step = math.radians(lat_deg), 10.0
+    up = float(earth.normal_gravity_closed_form(lat, h + step))
+    down = float(earth.normal_gravity_closed_form(lat, h - step))
+    grad = -(up - down) / (2 * step)
+    rm, rn = (float(r) for r in earth.radii(lat))
+    g0 = float(earth.normal_gravity_closed_form(lat, h))
+    kin = speed ** 2 / (rn + h) ** 2
+    return dict(gradient=grad, two_g_over_r=2 * g0 / math.sqrt(rm * rn), kinematic=kin, ratio=grad / kin,
+                mgal_per_m=grad / earth.MGAL)
+
+
+def _rz(heading_deg: float) -> np.ndarray:
+    c, s = math.cos(math.radians(heading_deg)), math.sin(math.radians(heading_deg))
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def bias_disturbance_rank(headings_deg=(0.0, 90.0, 180.0, 270.0)) -> dict:
+    """How far the accelerometer bias ∇_b and a constant disturbance δg^n separate (chen2019 §3.2, §3.3).
+
+    Both enter the velocity rows of :func:`base_model` (eq. (3-5)) and the specific-force rows of
+    the Z of eq. (3-18) through one combination, C_b^n ∇_b and δg^n (the statement of §3.2 that
+    the two are 等效).  In level flight C_b^n is a rotation about the vertical, so over any set of
+    headings the stacked map (∇_b, δg) → C_b^n ∇_b ∓ δg has rank 5 of 6: body-z bias and δg_U
+    stay one combination; only the disturbance's own dynamics can tell them apart.
+
+    Parameters
+    ----------
+    headings_deg : sequence of float
+        Headings of the level-flight legs, degrees (at least one).
+
+    Returns
+    -------
+    dict
+        ``same_combination`` (∂/∂∇_b = C_b^n and ∂/∂δg = ±I in both the velocity rows and the
+        specific-force rows), ``rank`` of the stacked map, ``columns`` (6), ``null`` (the
+        unit null vector over (∇_b, δg), rounded to 6 decimals).
+    """
+    heads = np.ravel(finite_array(headings_deg, "headings_deg"))
+    if heads.size < 1:
+        raise ValueError("headings_deg needs at least one heading")
+    base = base_model()
+    vel, sf = base.rows["velocity"], base.specific_force
+    jv_a, jv_g = vel.jacobian(GROUPS["accel"]), vel.jacobian(GROUPS["gravity"])
+    z_g = -sp.eye(3)                                   # Z_7..9 = Ĉf̂ − C f − δg (true kinematics)
+    js_a = sf.jacobian(GROUPS["accel"])
+    scale0 = {x: 0 for g in ("accel scale",) for x in GROUPS[g]}
+    jv_a, js_a = jv_a.subs(scale0), js_a.subs(scale0)
+    Cm = _c_matrix()
+    same = all(sp.expand(x) == 0 for x in (jv_a - Cm)) and all(sp.expand(x) == 0 for x in (js_a - Cm)) and \
+        (jv_g == sp.eye(3) or jv_g == -sp.eye(3)) and z_g == -sp.eye(3)
+    blocks = []
+    for hd in heads:
+        R = sp.Matrix(_rz(float(hd)))
+        sub = {Cm[i, j]: R[i, j] for i in range(3) for j in range(3)}
+        blocks.append(np.array(sp.Matrix.hstack(js_a.subs(sub), z_g), dtype=float))
+    M = np.vstack(blocks)
+    _, sv, vt = np.linalg.svd(M)
+    rank = int(np.sum(sv > 1e-9 * sv[0]))
+    null = vt[-1] * np.sign(vt[-1][np.argmax(np.abs(vt[-1]))])
+    return dict(same_combination=bool(same), rank=rank, columns=M.shape[1], null=np.round(null, 6))
+
+
+def _c_matrix():
+    return C
+
+
+def magnitude_sensitivity(horizontal_mgal: float = 30.0, lat_deg: float = 30.0) -> dict:
+    """What an absolute gravimeter, which measures |g|, sees of the vector δg^n of chen2019 eq. (3-6).
+
+    g = g_m + δg with g_m = (0, 0, −γ) (ENU).  The gradient of |g| with respect to δg at δg = 0
+    is (0, 0, −1) (sympy): to first order |g| carries δg_U alone; a horizontal component
+    δg_h enters at second order, δg_h²/(2γ).
+
+    Parameters
+    ----------
+    horizontal_mgal : float, default 30
+        Size of a horizontal component, mGal (> 0).
+    lat_deg : float, default 30
+        Latitude for γ, degrees.
+
+    Returns
+    -------
+    dict
+        ``gradient`` (∂|g|/∂(δg_E, δg_N, δg_U) at δg = 0), ``second_order_mgal`` (δg_h²/(2γ) in
+        mGal), ``exact_mgal`` (|g_m + (δg_h, 0, 0)| − γ in mGal, by sympy at 50 digits).
+    """
+    positive(horizontal_mgal, "horizontal_mgal")
+    earth.check_latitude(np.radians(lat_deg), name="lat_deg")
+    gE, gN, gU = sp.symbols("dg_E dg_N dg_U", real=True)
+    g0 = float(earth.normal_gravity_closed_form(math.radians(lat_deg)))
+    norm = sp.sqrt(gE ** 2 + gN ** 2 + (gU - sp.Float(g0, 30)) ** 2)
+    grad = [float(sp.diff(norm, v).subs({gE: 0, gN: 0, gU: 0})) for v in (gE, gN, gU)]
+    dh = horizontal_mgal * earth.MGAL
+    exact = sp.N(norm.subs({gE: sp.Float(dh, 30), gN: 0, gU: 0}) - sp.Float(g0, 30), 50)
+    return dict(gradient=np.array(grad), second_order_mgal=dh ** 2 / (2 * g0) / earth.MGAL,
+                exact_mgal=float(exact) / earth.MGAL)
+
+
+def acceleration_noise_correlation() -> dict:
+    """Correlations of the noise of the specific-force rows Z_7..9 of chen2019 eq. (3-18).
+
+    Z_7..9 = f^n + g_m^n − (2ω_ie^n + ω_en^n) × V_GPS^n − V̇_GPS^n holds the SINS specific force,
+    whose white noise ω_a (∇ = ∇_b + ω_a, text after (3-16)) also drives the velocity rows through
+    G_1 of (3-17): from :func:`base_model` and :func:`noise_input`, ∂Z_7..9/∂ω_a = C_b^n and the
+    velocity rows of G_1 are C_b^n, so E[w vᵀ] ⊃ C_b^n q_a C_b^nᵀ ≠ 0.  If V̇_GPS is the difference
+    of consecutive GNSS velocities (the print does not say), v_acc,k = −(n_k − n_{k−1})/Δt with n
+    the velocity noise of rows 4-6: its correlation with the velocity row is 1/√2 and its lag-1
+    autocorrelation −1/2 (exact, from the covariance of the difference operator).
+
+    Returns
+    -------
+    dict
+        ``accel_noise_in_z`` and ``accel_noise_in_w`` (both the Jacobian equals C_b^n, as bool),
+        ``cross_velocity`` (correlation of v_acc with the velocity-row noise), ``lag1`` (lag-1
+        autocorrelation of v_acc).
+    """
+    base = base_model()
+    Cm = _c_matrix()
+    scale0 = {x: 0 for x in GROUPS["accel scale"]}
+    in_z = all(sp.expand(x) == 0 for x in (base.specific_force.jacobian(GROUPS["accel"]).subs(scale0) - Cm))
+    G1, _ = noise_input(ar_orders=(1,))
+    in_w = all(sp.expand(x) == 0 for x in (G1[3:6, 0:3] - Cm))
+    # velocity noise n_0, n_1, n_2 (unit variance, unit interval): v_vel,k = −n_k,
+    # v_acc,k = −(n_k − n_{k−1}), v_acc,k−1 = −(n_{k−1} − n_{k−2})
+    D = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, -1.0], [1.0, -1.0, 0.0]])  # rows: v_vel,2, v_acc,2, v_acc,1
+    S = D @ D.T
+    corr = S / np.sqrt(np.outer(np.diag(S), np.diag(S)))
+    return dict(accel_noise_in_z=bool(in_z), accel_noise_in_w=bool(in_w), cross_velocity=float(corr[0, 1]),
+                lag1=float(corr[1, 2]))

@@ -701,7 +701,8 @@ def _derived_remark(spec: str, c, checks: dict) -> str:
     return ""
 
 
-def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, notebook: str) -> list[dict]:
+def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, notebook: str,
+                    gravity_gradient: dict | None = None) -> list[dict]:
     """The rows of chen2019-check-derivations: every printed part against its derivation, the
     blocks printed twice against each other, and the parts of one model against a common convention.
 
@@ -721,6 +722,10 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
         The AR order of the disturbance model used (eq. (4-13)), for the size of F's lower block.
     notebook : str
         The chapter, quoted in the evidence.
+    gravity_gradient : dict, optional
+        :func:`replication.papers.chen2019.derivations.height_gradient_entry` with the latitude and
+        speed it was computed at (keys ``lat_deg``, ``speed``): the F21 rows then say what the
+        frozen-γ derivation leaves out of their (3,3) entry.
 
     Returns
     -------
@@ -806,6 +811,117 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
                            f"{3 * per_axis} states; the text also says the size depends on the identified model")))
     for r in rows:
         r["note"] = _short_note(r.get("note", ""))
+        if gravity_gradient is not None and r["quantity"] in GRADIENT_ROWS:
+            r["note"] += _gradient_remark(gravity_gradient)
+    return [{k: (_spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
+            for r in rows]
+
+
+GRADIENT_ROWS = ("(3-17) F21", "Table 2-2 F21")
+"""The rows whose (3,3) entry, ∂δV̇_U/∂δh, the frozen-γ derivation leaves without the gravity gradient."""
+
+
+def _gradient_remark(g: dict) -> str:
+    """The clause an F21 row adds: the normal-gravity gradient the frozen-γ derivation leaves out of ∂δV̇_U/∂δh."""
+    need = {"gradient", "two_g_over_r", "ratio", "lat_deg", "speed"}
+    if not need <= set(g):
+        raise ValueError(f"the gradient record lacks {sorted(need - set(g))}")
+    return (f"; (3,3) derived with γ frozen, the stated convention of the derivation and the level of the printed "
+            f"F (no printed entry carries a gravity term), so not a slip: with γ(h) of (3-1) it gains "
+            f"-∂γ/∂h = +{g['gradient']:.3g} s^-2 (2γ/R = {g['two_g_over_r']:.3g}; L = {g['lat_deg']:g}°), "
+            f"{g['ratio']:.2g} times the kinematic term at {g['speed']:g} m/s")
+
+
+def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]:
+    """Rows of chen2019-check-derivations on sentences of ch. 3: the height of (3-1), the equivalence of
+    δg^n and ∇_b (§3.2) and what step 3 can separate, absolute gravimetry (§3.1), the noise of (3-18).
+
+    Parameters
+    ----------
+    printed : pandas.DataFrame
+        The paper file chen2019-check-derivations (its ``text:`` rows transcribe the sentences).
+    notebook : str
+        The chapter, quoted in the evidence.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.reproduction.compare`.
+
+    Raises
+    ------
+    ValueError
+        When the paper file lacks a ``text:`` row these rows quote.
+    """
+    from replication.papers.chen2019 import derivations as dv
+
+    meta = printed.set_index("quantity")
+    need = ["text: height of (3-1)", "text: absolute gravimetry", "text: disturbance equivalent to bias",
+            "text: step 3 yields a more accurate disturbance", "text: measurement noise of (3-18)"]
+    missing = [q for q in need if q not in meta.index]
+    if missing:
+        raise ValueError(f"the paper file lacks {missing}; add them to chen2019-check-derivations.csv")
+    text = {q: f"{meta.at[q, 'value']} ({meta.at[q, 'location']})" for q in need}
+    grad = dv.height_gradient_entry(30.0)
+    heads = (0.0, 90.0, 180.0, 270.0)
+    sep = dv.bias_disturbance_rank(heads)
+    mag = dv.magnitude_sensitivity(30.0)
+    noise = dv.acceleration_noise_correlation()
+    equiv = "§3.2 δg^n and ∇_b equivalent in the velocity error and in Z_7..9"
+    parts = ("chen2019-print-parts#sampling interval and units of the gravity-disturbance series, AR(3) "
+             "state-space form, GNSS acceleration and its noise (§4.3)")
+    null = ", ".join(f"{v:.3f}" for v in sep["null"] + 0.0)
+    rows = [
+        dict(quantity="(3-1) height h: 海拔高度, and the undefined Δh", unit="mGal/m",
+             paper_text=text["text: height of (3-1)"], reproduced=round(grad["mgal_per_m"], 4), digits=4,
+             basis="unstated",
+             note=("the text calls h 海拔高度 (height above sea level) and writes γ(Δh), Δh defined nowhere; the "
+                   "series is normal gravity above the ellipsoid, whose height gradient is the reproduced "
+                   "value (WGS-84 closed form, L = 30°): with a sea-level height, g - g_m of (3-6) is off by "
+                   "that much per metre of geoid undulation, which is not printed for the flight area, nor is "
+                   "which height the h of (3-14) and of Z is")),
+        dict(quantity=equiv, unit="", paper_text=text["text: disturbance equivalent to bias"],
+             reproduced=(f"one combination, C_b^n ∇_b and δg^n, in both; level flight at headings "
+                         f"{', '.join(f'{h:g}°' for h in heads)}: rank {sep['rank']} of {sep['columns']}, null "
+                         f"direction (∇_b, δg) = ({null})"),
+             basis="derivation", agrees=bool(sep["same_combination"] and sep["rank"] < sep["columns"]),
+             note=("derived: ∂/∂∇_b = C_b^n and ∂/∂δg^n = -I in the velocity rows of the base model (3-5) and in "
+                   "the specific-force rows of Z (3-18), so the two are equivalent as printed; heading changes "
+                   "separate the horizontal components, but in level flight C_b^n keeps body z up and ∇_bz, δg_U "
+                   "stay one combination at every heading: only the disturbance's own dynamics can tell them "
+                   "apart")),
+        dict(quantity="§3.1 step 3 separates δg^n from ∇_b (更加精确的重力扰动值)", unit="",
+             paper_text=text["text: step 3 yields a more accurate disturbance"],
+             reproduced="rests on the AR state-space model and noises, which are not printed",
+             basis="claim", agrees=bool(sep["rank"] >= sep["columns"] - 1),
+             rests_on=parts,
+             note=("the print gives no separability argument: step 1's filter has no gravity state and "
+                   "corrects f^n with its ∇_b estimate (line 673), which takes up the slow part of δg before "
+                   "step 2 models it; in step 3 ∇_bz and δg_U stay one combination in level flight (row "
+                   f"'{equiv}'), so how much of δg_U is separated rests on the AR model's state-space form and "
+                   "noises (not printed)")),
+        dict(quantity="§3.1 absolute gravimetry measures the gravity disturbance (method 1)", unit="",
+             paper_text=text["text: absolute gravimetry"],
+             reproduced=(f"∂|g|/∂(δg_E, δg_N, δg_U) = ({', '.join(f'{v:g}' for v in mag['gradient'] + 0.0)}); "
+                         f"a horizontal component of 30 mGal changes |g| by {mag['exact_mgal']:.1e} mGal"),
+             basis="claim", agrees=bool(np.count_nonzero(mag["gradient"]) == 3),
+             rests_on="chen2019-check-derivations#(3-7)",
+             note=("(3-6), (3-7) and the filter's δd make δg^n a vector; an absolute gravimeter measures |g|, "
+                   "whose first-order sensitivity to δg^n is the reproduced gradient (sympy): it gives δg_U, and "
+                   "δg_E, δg_N (the deflection of the vertical) only at second order, δg_h²/(2γ); the "
+                   "claim holds for the magnitude, not for the vector the chapter needs")),
+        dict(quantity="(3-18) v, GNSS white noise, against f^n in Z_7..9 and ω_a in G_1 w", unit="",
+             paper_text=text["text: measurement noise of (3-18)"],
+             reproduced=(f"∂Z_7..9/∂ω_a = C_b^n = velocity rows of G_1, so E[w v^T] ≠ 0; with V̇_GPS differenced, "
+                         f"correlation with the velocity rows {noise['cross_velocity']:.3f}, lag-1 "
+                         f"{noise['lag1']:.2f}"),
+             basis="parts", agrees=not (noise["accel_noise_in_z"] and noise["accel_noise_in_w"]),
+             note=("Z_7..9 holds the SINS specific force f^n, whose white noise ω_a (∇ = ∇_b + ω_a) G_1 also "
+                   "puts into the process noise w; the text calls v the GNSS noise and white: the noise of the "
+                   "specific-force rows is correlated with w, which the filter of (3-17)-(3-18) does not "
+                   "handle; how V̇_GPS is formed is not printed (" + parts.replace("#", ", row ", 1) + "): a "
+                   "differenced GNSS velocity would also correlate v with its velocity rows and colour it")),
+    ]
     return [{k: (_spaced(v) if k in ("paper_text", "reproduced", "corrected", "note") else v) for k, v in r.items()}
             for r in rows]
 
