@@ -14,8 +14,8 @@ import sympy as sp
 from replication.nav import earth
 from replication.nav import errors as E
 from replication.nav.rotations import euler_to_dcm
+from replication.papers.chen2019 import derivation_rows, table_2_2
 from replication.papers.chen2019 import derivations as dv
-from replication.papers.chen2019 import findings, table_2_2
 from replication.registry import reproduction as rp
 
 
@@ -165,7 +165,7 @@ def test_gravity_vector_of_3_1_points_up_in_enu(checks):
 
 
 def test_chapter_3_parts_need_conventions_that_exclude_each_other(checks):
-    for label, parts in findings.DERIVATION_GROUPS.items():
+    for label, parts in derivation_rows.DERIVATION_GROUPS.items():
         assert all(checks[p].agrees for p in parts), label
         assert dv.common_conventions([checks[p] for p in parts]) == [], label
     assert {(x["e"], x["a"], x["acc"]) for x in checks["(3-5)"].conventions} == {(-1, 1, -1)}
@@ -208,7 +208,7 @@ def test_random_constant_scale_factors_of_2_6(checks, readings):
 def test_noise_input_of_3_3_enters_where_the_biases_enter(checks, readings):
     c = checks[G1]
     assert c.agrees
-    f2 = [checks[p] for p in findings.NOISE_INPUT_PARTS]
+    f2 = [checks[p] for p in derivation_rows.NOISE_INPUT_PARTS]
     assert c.conventions == dv.common_conventions(f2)
     D, zero_blocks = dv.noise_input()
     assert zero_blocks == {1: True, 2: True, 3: True}
@@ -231,7 +231,7 @@ def test_noise_input_of_3_3_enters_where_the_biases_enter(checks, readings):
 
 
 def test_the_two_new_rows_are_derivations(checks, printed):
-    rows = {r["quantity"]: r for r in findings.derivation_rows(checks, printed, ar_order=3, notebook="nb")}
+    rows = {r["quantity"]: r for r in derivation_rows.derivation_rows(checks, printed, ar_order=3, notebook="nb")}
     for q in ("(2-6)", G1):
         assert rows[q]["basis"] == "derivation" and rows[q]["agrees"], q
     assert "the noise enters where the bias enters" in rows[G1]["note"]
@@ -271,7 +271,7 @@ def test_specific_force_rows_share_the_accelerometer_noise_with_the_process_nois
 
 
 def test_chapter3_reading_rows_quote_the_transcription_and_judge_as_derived(printed):
-    rows = {r["quantity"]: r for r in findings.chapter3_reading_rows(printed, notebook="nb")}
+    rows = {r["quantity"]: r for r in derivation_rows.chapter3_reading_rows(printed, notebook="nb")}
     basis = {q: r["basis"] for q, r in rows.items()}
     assert sorted(basis.values()) == ["claim", "claim", "derivation", "parts", "unstated"]
     agrees = {r["basis"] + (" gravimetry" if "gravimetry" in q else ""): r.get("agrees") for q, r in rows.items()}
@@ -280,4 +280,4 @@ def test_chapter3_reading_rows_quote_the_transcription_and_judge_as_derived(prin
     assert agrees["claim gravimetry"] is False     # |g| does not give δg_E, δg_N
     assert all("line" in r["paper_text"] for r in rows.values())
     with pytest.raises(ValueError, match="lacks"):
-        findings.chapter3_reading_rows(printed[~printed["quantity"].str.startswith("text: height")], notebook="nb")
+        derivation_rows.chapter3_reading_rows(printed[~printed["quantity"].str.startswith("text: height")], notebook="nb")
