@@ -74,7 +74,7 @@ SENSOR_SIGN_GROUPS = {
 """Printed parts of one model whose gyro and accelerometer errors the print defines alike: eq. (2-3)
 writes δω and δf by one formula as "陀螺和加速度计的误差", and ch. 3 defines ∇ and ε in one sentence
 after (3-16) as the accelerometer's and the gyro's 误差; so the two sensor signs of
-:data:`replication.papers.chen2019.derivations.CONVENTIONS` are one (name -> the parts)."""
+``replication.papers.chen2019.derivations.CONVENTIONS`` are one (name -> the parts)."""
 
 _PARTS_SPECS = ("markov", "H-position")
 
@@ -141,7 +141,7 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
     Parameters
     ----------
     checks : dict of str to Check
-        :func:`replication.papers.chen2019.derivations.check_all` of the paper file.
+        ``replication.papers.chen2019.derivations.check_all`` of the paper file.
     printed : pandas.DataFrame
         The paper file (columns quantity, value, spec, location, printed, note).
     ar_order : int
@@ -149,14 +149,14 @@ def derivation_rows(checks: dict, printed: pd.DataFrame, *, ar_order: int, noteb
     notebook : str
         The chapter, quoted in the evidence.
     gravity_gradient : dict, optional
-        :func:`replication.papers.chen2019.derivations.height_gradient_entry` with the latitude and
+        ``replication.papers.chen2019.derivations.height_gradient_entry`` with the latitude and
         speed it was computed at (keys ``lat_deg``, ``speed``): the F21 rows then say what the
         frozen-γ derivation leaves out of their (3,3) entry.
 
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`.
+        Rows for :func:`replication.registry.exports.compare`.
 
     Raises
     ------
@@ -272,7 +272,7 @@ def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`.
+        Rows for :func:`replication.registry.exports.compare`.
 
     Raises
     ------
@@ -353,7 +353,7 @@ def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]
 
 
 def chapter2_rows(parts, sync_text: str, *, notebook: str) -> list[dict]:
-    """Rows of chen2019-check-derivations for three printed parts of ch. 2 (:mod:`.chapter2`).
+    """Rows of chen2019-check-derivations for three printed parts of ch. 2 (``replication.papers.chen2019.chapter2``).
 
     * eq. (2-7) against eq. (2-1) and Fig. 2-2 (the direction of the misalignment map): a
       ``derivation`` row, qualitative when one reading of (2-7) keeps Fig. 2-2's angles on their
@@ -375,7 +375,7 @@ def chapter2_rows(parts, sync_text: str, *, notebook: str) -> list[dict]:
     Returns
     -------
     list of dict
-        Rows for :func:`replication.registry.reproduction.compare`.
+        Rows for :func:`replication.registry.exports.compare`.
     """
     from replication.papers.chen2019 import chapter2 as c2
 
