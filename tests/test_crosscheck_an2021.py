@@ -47,6 +47,11 @@ CHANNELS = ("phiE/gdN", "phiN/gdE")
 TOL_EDGE_REL = 3e-3
 TOL_WAVELENGTH_REL = 7e-3
 TOL_SLOPE_DB = 0.1
+TOL_BAND_DB = 0.35
+"""The slope fitted over the printed band 7e-4..5e-2 rad/s, which holds the undamped Schuler pair:
+the fit moves with the point density (51 to 20001 log-uniform points: -44.4 to -44.6 dB/dec), the
+stored value is rounded to half a dB/dec (±0.25), and the 201-point fit of the closed forms lies
+within 0.1 of the 200-point fit of the state-space model: 0.35 dB/dec."""
 TOL_RATIO_CONSTANTS = 1e-4
 
 
@@ -69,7 +74,7 @@ def test_edge_and_slopes_agree_with_stored(features, motion, channel):
     mid = float(df.loc[f"pure-mode slope between the edges ({channel})", "reproduced"])
     high = float(df.loc[f"pure-mode slope above 0.05 rad/s ({channel})", "reproduced"])
     assert mine["edge_rad_s"] == pytest.approx(edge, rel=TOL_EDGE_REL)
-    assert mine["slope_mid_db_per_decade"] == pytest.approx(mid, abs=TOL_SLOPE_DB)
+    assert mine["slope_band_db_per_decade"] == pytest.approx(mid, abs=TOL_BAND_DB)
     assert mine["slope_high_db_per_decade"] == pytest.approx(high, abs=TOL_SLOPE_DB)
 
 
@@ -102,7 +107,7 @@ def test_second_computation_gives_the_same_verdicts_against_the_print(features):
             c = features[motion]["channels"][ch]
             rows += [
                 (df.loc[f"proportional-band upper edge, pure ({ch})"], c["edge_rad_s"]),
-                (df.loc[f"pure-mode slope between the edges ({ch})"], c["slope_mid_db_per_decade"]),
+                (df.loc[f"pure-mode slope between the edges ({ch})"], c["slope_band_db_per_decade"]),
                 (df.loc[f"pure-mode slope above 0.05 rad/s ({ch})"], c["slope_high_db_per_decade"]),
             ]
     t1 = _table("an2021-table-1.csv")

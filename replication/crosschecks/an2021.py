@@ -64,6 +64,7 @@ R_MEAN = 6371000.0  # m
 MOTIONS = ("north-south", "east-west")
 _EQS = {"north-south": ("(4)", "(5)"), "east-west": ("(6)", "(7)")}
 _MID = (5e-3, 5e-2)
+_BAND = (7e-4, 5e-2)  # the printed middle band of §4 and Table 1, the Schuler pair inside it
 _HIGH = (5e-2, 5e-1)
 
 
@@ -211,7 +212,8 @@ def pure_mode_features(
 
     Evaluates the printed closed forms, eqs. (4)-(5) (north-south) or (6)-(7) (east-west), on
     ``s = jω`` and measures the DC gain, the proportional-band upper edge (3 dB departure from
-    the DC gain), the slopes over ``5e-3..5e-2`` and ``0.05..0.5 rad/s``, the natural frequencies
+    the DC gain), the slopes over ``5e-3..5e-2`` (above the Schuler pair), over the printed band ``7e-4..5e-2``
+    (``slope_band_db_per_decade``, the pair inside it) and over ``0.05..0.5 rad/s``, the natural frequencies
     relative to ``ω_s = sqrt(g/R)``, and the long-wave boundary ``λ_g = 2π v/ω_edge`` of
     eq. (13) / Table 1.
 
@@ -267,6 +269,7 @@ def pure_mode_features(
             "edge_rad_s": float(edge),
             "earth_rate_band_deviation_db": blip,
             "slope_mid_db_per_decade": _slope(G, _MID),
+            "slope_band_db_per_decade": _slope(G, _BAND),
             "slope_high_db_per_decade": _slope(G, _HIGH),
             "long_wave_boundary_m": {v: 2.0 * np.pi * v / edge for v in speeds},
         }
