@@ -293,7 +293,6 @@ def print_parts_rows(parts, eq5, eq7, lat=np.radians(30.0), v_north=10.0, table1
     from_w = float(w[np.nonzero(~in_class)[0].max() + 1]) if not in_class.all() else lo
     asym_lo = 0.0 if lo < natural[0] else -20.0 * order_gap  # straight-line Bode: flat below the first break
     fitted = frequency.loglog_slope(sys_ns, lo, hi)
-    rises = bool(g_nat > g_lo)
     readings = {
         "pointwise (local slope in −40 ± 5 dB/dec across the band)": bool(in_class.all()),
         "straight-line Bode asymptote (−40 dB/dec from 7e-4)": bool(asym_lo == said),
