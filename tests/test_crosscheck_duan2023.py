@@ -210,10 +210,10 @@ def test_up_bias_band_against_the_closed_form():
     from replication.papers.duan2023.findings import up_bias_band
 
     k = xc.vertical_channel_closed_form(accel_bias_ug=1.0)["dv_from"]["accel_bias"]
-    lo, hi = up_bias_band(45.97, 46.39, "velocity error")
+    lo, hi = up_bias_band(45.97, 46.39, k)
     # rounded outwards: the band is covered, and the bias at each end lands within 0.1 ug of it
     assert lo * k <= 0.95 * 45.97 - 46.39 < (lo + 0.1) * k
     assert (hi - 0.1) * k < 1.05 * 45.97 - 46.39 <= hi * k
     assert max(-lo, hi) < 2.0  # a hundredth of the printed 100 ug, or less
-    with pytest.raises(ValueError, match="quantity must be"):
-        up_bias_band(45.97, 46.39, "misalignment")
+    with pytest.raises(ValueError, match="gain must be"):
+        up_bias_band(45.97, 46.39, -k)
