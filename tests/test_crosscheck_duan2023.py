@@ -71,7 +71,7 @@ def test_pure_sins_agrees_with_stored(sins, stored):
         row = df.loc[f"SINS / {q}"]
         assert row["status"] == "inconsistent"
         assert sins["initial_only"]["final"][key] == pytest.approx(stored["SINS"][key], rel=0.15), key
-        full = float(re.search(r"up-bias\) ([0-9.]+) \(", row["note"]).group(1))
+        full = float(re.search(r"names no axis\): ([0-9.]+) \(", row["note"]).group(1))
         assert sins["all"]["final"][key] == pytest.approx(full, rel=0.15), key
 
 
@@ -204,3 +204,16 @@ def test_proposed_linear_propagation_refuses_a_wrong_bundle():
 def test_pure_sins_sources_rejects_unknown_argument():
     with pytest.raises(TypeError, match="allowed"):
         xc.pure_sins_sources(gyro=1)
+
+
+def test_up_bias_band_against_the_closed_form():
+    from replication.papers.duan2023.findings import up_bias_band
+
+    k = xc.vertical_channel_closed_form(accel_bias_ug=1.0)["dv_from"]["accel_bias"]
+    lo, hi = up_bias_band(45.97, 46.39, k)
+    # rounded outwards: the band is covered, and the bias at each end lands within 0.1 ug of it
+    assert lo * k <= 0.95 * 45.97 - 46.39 < (lo + 0.1) * k
+    assert (hi - 0.1) * k < 1.05 * 45.97 - 46.39 <= hi * k
+    assert max(-lo, hi) < 2.0  # a hundredth of the printed 100 ug, or less
+    with pytest.raises(ValueError, match="gain must be"):
+        up_bias_band(45.97, 46.39, -k)

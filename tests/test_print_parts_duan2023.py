@@ -50,7 +50,7 @@ from replication.registry import reproduction as rp  # noqa: E402
 def rows():
     parts = rp.load_paper("duan2023-print-parts").data
     got = print_parts_rows(parts, setup=rp.load_paper("duan2023-claim-simulation-setup"),
-                           figure_2=rp.load_paper("duan2023-figure-2"))
+                           figure_2=rp.load_paper("duan2023-figure-2"), table_1=rp.load_paper("duan2023-table-1"))
     return {r["quantity"]: r for r in got}
 
 
@@ -112,3 +112,35 @@ def test_a_missing_transcription_is_named():
     with pytest.raises(ValueError, match=r"lacks \['eq. \(18\)'\]"):
         print_parts_rows(short, setup=rp.load_paper("duan2023-claim-simulation-setup"),
                          figure_2=rp.load_paper("duan2023-figure-2"))
+
+
+def test_tilt_link_row_is_unstated_and_a_tilt_barely_turns_the_inclination(rows):
+    r = rows["eqs. (2)-(4): change of the displacement's inclination taken as the platform tilt"]
+    assert r["basis"] == "unstated" and r["note"].startswith("unstated: ") and "F25" in r["note"]
+    assert "俯仰角" in r["paper_text"] and "失准角修正量" in r["paper_text"]
+
+
+def test_inclination_after_tilt_against_the_second_order_closed_form():
+    from replication.papers.duan2023.print_parts import inclination_after_tilt
+
+    st = dict(derivation.reference_state("level"), AE=0.0, AN=0.0, AU=0.0)
+    g, phi, T = 9.8, 1e-3, 30.0
+    th, th_t = inclination_after_tilt(st, phi, g)
+    assert th == 0.0
+    # unaccelerated level flight: f vertical, the tilt leaves g(cos phi - 1) up: -g phi^2 T^2/4 over S = V T
+    assert th_t == pytest.approx(-g * phi**2 * T / (4 * 180.0), rel=1e-3)
+    # an along-track acceleration turned by the tilt: first order in phi, size A T/(2V)
+    th0, th_a = inclination_after_tilt(derivation.reference_state("level"), phi, g)
+    assert abs(th_a - th0) / phi == pytest.approx(0.5 * 30.0 / (2 * 180.0), rel=0.02)
+    with pytest.raises(ValueError, match="small non-zero angle"):
+        inclination_after_tilt(st, 0.5, g)
+
+
+def test_speed_premise_row(rows):
+    r = rows["speed premise of the introduction against the SINS velocity error of Table 1"]
+    assert r["basis"] == "parts" and r["agrees"] is True
+    v = 729e3 / (1.05 * 3600.0)
+    assert f"speed +{math.hypot(v, 45.97) - v:.1f} m/s" in r["reproduced"]
+    assert f"turned {math.degrees(math.atan(45.97 / v)):.1f} deg" in r["reproduced"]
+    with pytest.raises(ValueError, match="needs setup"):
+        print_parts_rows(rp.load_paper("duan2023-print-parts").data, table_1=rp.load_paper("duan2023-table-1"))

@@ -8,7 +8,9 @@ eq. (5) in the misalignment convention that the forcing of eq. (1) fixes; the le
 against assumption 4 and the vector V; eq. (4) against assumption 1 and eq. (18); the height
 correction δh^c as a measured quantity and as a state of eqs. (13) and (20); the origin reset of §2
 against the §3 and §4 accounts of where the approximate terms grow; and the quantities the print
-leaves out (the start of eq. (21) in each interval, the statistic of Table 1, the ADS error model).
+leaves out (the start of eq. (21) in each interval, the statistic of Table 1, the ADS error model,
+the argument that makes the change of the flight path's inclination in eqs. (2)-(4) a platform tilt);
+and the introduction's premise of an unchanged speed against the SINS velocity error of Table 1.
 Each row names its basis; every ``agrees`` is computed here from the transcribed text.
 """
 
@@ -40,7 +42,8 @@ DERIVATION_PARTS = (
     "assumption 1", "assumption 4", "assumption 5", "known quantities", "sought quantities", "V symbols",
     "eq. (4)", "eq. (12)", "legend of eq. (12)", "eq. (13)", "eq. (18)", "eq. (20)",
     "origin reset at each interval", "occasion of large approximate terms", "start-up errors (results)",
-    "start-up errors (conclusions)", "Table 1 title", "Table 1 row label misalignment",
+    "start-up errors (conclusions)", "eq. (2)", "eq. (3)", "legend of eqs. (2)-(3)", "lead of eq. (4)",
+    "legend of eq. (4)", "Table 1 title", "Table 1 row label misalignment",
     "Table 1 row label velocity error", "Table 1 row label position error", "ADS error source", "ADS error",
 )
 
@@ -55,7 +58,7 @@ def _unit_of(sym: str) -> str:
     return UNIT[sym]
 
 
-def print_parts_rows(parts: pd.DataFrame, setup=None, figure_2=None) -> list[dict]:
+def print_parts_rows(parts: pd.DataFrame, setup=None, figure_2=None, table_1=None) -> list[dict]:
     """The comparison rows of ``duan2023-print-parts``.
 
     Parameters
@@ -68,6 +71,9 @@ def print_parts_rows(parts: pd.DataFrame, setup=None, figure_2=None) -> list[dic
         ``duan2023-figure-2`` (range, flight duration).  With both, the rows of the derivation
         (eqs. (4), (12), (13), (20)), of the interval starts and of the unstated quantities follow
         the vector-label, §3-condition and eq. (22) rows; without them only those three kinds.
+    table_1 : PaperTable, optional
+        ``duan2023-table-1`` (with ``setup`` and ``figure_2``): adds the row of the introduction's
+        premise of an unchanged speed against the SINS velocity error of Table 1.
 
     Returns
     -------
@@ -125,6 +131,11 @@ def print_parts_rows(parts: pd.DataFrame, setup=None, figure_2=None) -> list[dic
     if setup is not None:
         rows += derivation_part_rows(parts)
         rows += interval_rows(parts, setup, figure_2)
+        rows.append(tilt_link_row(parts))
+    if table_1 is not None:
+        if setup is None:
+            raise ValueError("table_1 needs setup and figure_2 too (the printed mean speed comes from figure_2)")
+        rows.append(speed_premise_row(parts, table_1, figure_2))
     return rows
 
 
@@ -516,3 +527,151 @@ def interval_rows(parts: pd.DataFrame, setup, figure_2) -> list[dict]:
         ),
     ))
     return rows
+
+
+#: a platform tilt for the eq. (4) row [rad]: small (assumption 5), large beside the round-off of
+#: the inclination of a displacement of kilometres (~1e-16 rad)
+TILT = 1e-3
+
+
+def inclination_after_tilt(state: dict, tilt: float, g: float) -> tuple[float, float]:
+    """The inclination of the SINS displacement of eqs. (2)-(3) over one interval, without and with a platform tilt.
+
+    duan2023 eqs. (2)-(3) define θ by ``tan θ = h/S``, the displacement's up part over its horizontal
+    part.  A platform tilted by ``tilt`` about the horizontal axis ``u = [S_y/S, -S_x/S, 0]`` of
+    eq. (5) computes the specific force as ``exp(-tilt u×) f`` (the convention ``Ĉ = exp(-φ×) C`` of
+    eq. (1)); over the interval ``T = S/V`` this shifts the displacement by ``½ (exp(-tilt u×) f - f) T²``.
+
+    Parameters
+    ----------
+    state : dict
+        A straight-flight state of :func:`~replication.papers.duan2023.derivation.reference_state`
+        (``Sx``, ``Sy``, ``h``, ``VE``, ``VN``, ``VU``, ``AE``, ``AN``, ``AU``).
+    tilt : float
+        The platform tilt [rad], small (assumption 5).
+    g : float
+        Gravity [m/s²], the up part of the specific force in unaccelerated flight.
+
+    Returns
+    -------
+    theta, theta_tilted : float
+        The inclination [rad] without and with the tilt.
+    """
+    if not (math.isfinite(tilt) and 0 < abs(tilt) < 0.1):
+        raise ValueError(f"tilt must be a small non-zero angle in rad (|tilt| < 0.1), got {tilt!r}")
+    if not (math.isfinite(g) and g > 0):
+        raise ValueError(f"g must be a positive gravity in m/s^2, got {g!r}")
+    d = np.array([state["Sx"], state["Sy"], state["h"]], dtype=float)
+    s = math.hypot(d[0], d[1])
+    if not s > 0:
+        raise ValueError("the state's horizontal displacement must be positive")
+    T = float(np.linalg.norm(d) / np.linalg.norm([state["VE"], state["VN"], state["VU"]]))
+    f = np.array([state["AE"], state["AN"], state["AU"] + g])
+    u = np.array([d[1] / s, -d[0] / s, 0.0])
+    dt = d + 0.5 * (rotations.rotvec_to_dcm(-tilt * u) @ f - f) * T**2
+    return math.atan2(d[2], s), math.atan2(dt[2], math.hypot(dt[0], dt[1]))
+
+
+def tilt_link_row(parts: pd.DataFrame) -> dict:
+    """eqs. (2)-(4): the change of the displacement's inclination taken as the platform tilt (``unstated``).
+
+    eqs. (2)-(3) define θ1, θ2 as the inclinations of the SINS/ADS and the SINS displacements, the
+    legend calls them pitch angles (俯仰角), and eq. (4) with its legend sets their difference equal
+    to the misalignment correction φ^c, which eqs. (5)-(6) split into φ_E^c, φ_N^c.  The print
+    gives no argument that a platform tilt changes the inclination by itself; the row computes
+    what a tilt does to the inclination along the package's reference flight
+    (:func:`inclination_after_tilt`).
+    """
+    txt, show, at = transcription(parts)
+    if "俯仰角" not in txt("legend of eqs. (2)-(3)") or "失准角" not in txt("legend of eq. (4)"):
+        raise ValueError("the transcribed legends of eqs. (2)-(4) name no pitch angle (俯仰角) or misalignment (失准角)")
+    if not (r"\theta_1" in txt("eq. (2)") and r"\theta_2" in txt("eq. (3)")):
+        raise ValueError("eqs. (2)-(3) as transcribed do not define theta_1, theta_2")
+    from replication.nav import earth
+
+    cases = {
+        "unaccelerated level flight": dict(derivation.reference_state("level"), AE=0.0, AN=0.0, AU=0.0),
+        "level flight accelerating at 0.5 m/s^2": derivation.reference_state("level"),
+        "the 3 deg climb accelerating at 0.5 m/s^2": derivation.reference_state("climb"),
+    }
+    ratios = {}
+    for label, st in cases.items():
+        g = float(earth.somigliana(math.sin(st["L"]) ** 2))
+        th, th_t = inclination_after_tilt(st, TILT, g)
+        ratios[label] = (th_t - th) / TILT
+    T = math.hypot(st["Sx"], st["Sy"], st["h"]) / math.hypot(st["VE"], st["VN"], st["VU"])
+    # what eq. (4) needs: the inclination turned with the platform, ratio 1
+    return dict(
+        quantity="eqs. (2)-(4): change of the displacement's inclination taken as the platform tilt",
+        unit="",
+        paper_text=(f"{show('eq. (2)')}; {show('eq. (3)')}; {show('legend of eqs. (2)-(3)')}; "
+                    f"{show('lead of eq. (4)')} {show('eq. (4)')}; {show('legend of eq. (4)')}"),
+        reproduced=(
+            f"a platform tilt of {TILT:g} rad about u (eq. (5)) over T = {T:.0f} s at 180 m/s (reference_state)"
+            " turns the inclination of the SINS displacement by "
+            + "; ".join(f"{r:.1e} times the tilt in {k}" for k, r in ratios.items())
+            + "; eqs. (4)-(6) take the two as equal (ratio 1)"
+        ),
+        basis="unstated",
+        note=(
+            "unstated: the argument that links the inclination of the displacement (tan θ = h/S, eqs. (2)-(3),"
+            " named pitch angles) to the platform misalignment φ_E, φ_N that eq. (4) and its legend make of"
+            " their difference. A tilt φ turns the computed specific force f: in unaccelerated level flight f"
+            " is vertical and the error f × φ horizontal, so the inclination moves by -g T φ/(4V) times the"
+            " tilt (second order); an along-track acceleration A adds a part of size A T/(2V) and a climb one"
+            " of size g T sin(2θ)/(4V),"
+            " a few per cent at 30 s: a change of inclination read from the ADS height is no measure of the"
+            " tilt. Earlier"
+            " the same point stood only as reasoning: reading.md F25 (the horizontal corrections rest on"
+            " unverified assumptions) and the notes of the duan2023-table-1 proposed-method rows (a tilt leaves"
+            " no height signature in level flight: 1 mrad -> 3 mm over 30 s)"
+            f" ({at('eq. (2)', 'eq. (3)', 'legend of eqs. (2)-(3)', 'lead of eq. (4)', 'eq. (4)', 'legend of eq. (4)')})"
+        ),
+    )
+
+
+def speed_premise_row(parts: pd.DataFrame, table_1, figure_2) -> dict:
+    """The introduction's premise of an unchanged speed against the SINS velocity error of Table 1 (``parts``).
+
+    The introduction assumes that the speed's magnitude stays unchanged because the accelerometer
+    bias is small, only its direction changing (the premise behind assumption 4).  Table 1's SINS
+    velocity error is read as vertical, the free vertical channel that duan2023-table-1 "SINS /
+    velocity error" finds, on a level velocity of the printed mean speed (range over duration,
+    ``figure_2``).  Tolerance, stated before comparing: the premise is a first-order statement
+    (assumption 5: small errors), so it agrees with Table 1 when the change of the magnitude is of
+    second order, at most ``e²/|V|`` (twice the change ``e²/(2|V|)`` of an error ``e`` normal to ``V``).
+    """
+    txt, show, at = transcription(parts)
+    if "数值不发生变化" not in txt("speed premise (introduction)"):
+        raise ValueError("the transcribed premise does not state an unchanged speed (数值不发生变化)")
+    e = float(table_1.value("SINS / velocity error"))
+    e_prop = float(table_1.value("proposed SINS/ADS / velocity error"))
+    rng, dur = float(figure_2.value("range")), float(figure_2.value("flight duration"))
+    vbar = rng * 1e3 / (dur * 3600.0)
+    if not (e > 0 and e_prop > 0 and vbar > 0):
+        raise ValueError(f"the SINS velocity error and the mean speed must be positive, got {e!r}, {vbar!r}")
+    d_mag = math.hypot(vbar, e) - vbar
+    turn = math.degrees(math.atan2(e, vbar))
+    bound = e**2 / vbar
+    return dict(
+        quantity="speed premise of the introduction against the SINS velocity error of Table 1",
+        unit="m/s",
+        paper_text=f"{show('speed premise (introduction)')}; Table 1 SINS velocity error {e:g} m/s",
+        reproduced=(
+            f"the {e:g} m/s error vertical on a level velocity of {vbar:.1f} m/s ({rng:g} km over {dur:g} h): speed"
+            f" {d_mag:+.1f} m/s ({d_mag / vbar:.1%}), direction turned {turn:.1f} deg; second-order bound"
+            f" e^2/|V| = {bound:.1f} m/s; the same error along the track would change the speed by {e:g} m/s"
+        ),
+        basis="parts",
+        agrees=bool(d_mag <= bound),
+        note=(
+            "the introduction lets the speed keep its magnitude (the accelerometer bias being small) and"
+            " corrects only the direction; Table 1's SINS velocity error is the free vertical channel"
+            " (duan2023-table-1 SINS / velocity error), normal to a level velocity, so it changes the speed"
+            " only at second order, as the premise allows, and turns the velocity by an angle that is no"
+            " longer small (tan differs from the angle by"
+            f" {math.tan(math.radians(turn)) / math.radians(turn) - 1:.1%}); the speed change is"
+            f" {d_mag / e_prop:.0f} times the {e_prop:g} m/s of the proposed column, which the method never corrects"
+            f" ({at('speed premise (introduction)')})"
+        ),
+    )
