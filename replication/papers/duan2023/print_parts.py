@@ -581,6 +581,22 @@ def tilt_link_row(parts: pd.DataFrame) -> dict:
     gives no argument that a platform tilt changes the inclination by itself; the row computes
     what a tilt does to the inclination along the package's reference flight
     (:func:`inclination_after_tilt`).
+
+    Parameters
+    ----------
+    parts : pandas.DataFrame
+        The transcription ``duan2023-print-parts`` (``.data`` of its paper table), with the
+        legends of eqs. (2)-(4) and the equations themselves.
+
+    Returns
+    -------
+    dict
+        One row for :func:`replication.registry.exports.compare`, basis ``unstated``.
+
+    Raises
+    ------
+    ValueError
+        When the transcribed legends or equations do not name what the row compares.
     """
     txt, show, at = transcription(parts)
     if "俯仰角" not in txt("legend of eqs. (2)-(3)") or "失准角" not in txt("legend of eq. (4)"):
@@ -640,6 +656,25 @@ def speed_premise_row(parts: pd.DataFrame, table_1, figure_2) -> dict:
     ``figure_2``).  Tolerance, stated before comparing: the premise is a first-order statement
     (assumption 5: small errors), so it agrees with Table 1 when the change of the magnitude is of
     second order, at most ``e²/|V|`` (twice the change ``e²/(2|V|)`` of an error ``e`` normal to ``V``).
+
+    Parameters
+    ----------
+    parts : pandas.DataFrame
+        The transcription ``duan2023-print-parts`` (``.data``), with the premise of the introduction.
+    table_1 : PaperTable
+        The printed Table 1 (``duan2023-table-1``): the SINS and the proposed velocity errors, m/s.
+    figure_2 : PaperTable
+        The printed flight of Fig. 2 (``duan2023-figure-2``): its range (km) and duration (h).
+
+    Returns
+    -------
+    dict
+        One row for :func:`replication.registry.exports.compare`, basis ``parts``.
+
+    Raises
+    ------
+    ValueError
+        When the premise is not in the transcription, or an error or the mean speed is not positive.
     """
     txt, show, at = transcription(parts)
     if "数值不发生变化" not in txt("speed premise (introduction)"):
