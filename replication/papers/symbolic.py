@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-__all__ = ["Check", "rotation_from_quaternion", "vanishes", "normal_form", "short", "spaced", "skew", "vee", "common_conventions", "convention_text"]
+__all__ = ["Check", "rotation_from_quaternion", "vanishes", "normal_form", "short", "spaced", "skew", "vee", "common_conventions", "convention_text",
+           "check_each"]
 
 _TRIG = {}
 
@@ -193,6 +194,26 @@ def spaced(text):
         return text
     text = re.sub(r"(?<!\*)([*/])(?!\*)", r" \1 ", text).replace("Matrix(", "Matrix( ")
     return re.sub(r"  +", " ", text)
+
+
+def check_each(items, check) -> dict:
+    """Every printed part of a paper file checked by ``check``, each seeing the readings of all.
+
+    Parameters
+    ----------
+    items : sequence of (name, reading, spec)
+        The rows of the paper file: quantity, ``value`` (the reading) and ``spec``.
+    check : callable
+        ``check(name, reading, spec, readings)`` -> the part's result (``readings``: name -> reading,
+        for a part defined through another).
+
+    Returns
+    -------
+    dict
+        Name -> result, in the order given.
+    """
+    readings = {n: r for n, r, _ in items}
+    return {n: check(n, r, s, readings) for n, r, s in items}
 
 
 def common_conventions(checks, conventions) -> list:

@@ -46,7 +46,7 @@ import numpy as np
 import sympy as sp
 
 from replication.nav import earth
-from replication.nav._validate import finite_array, positive
+from replication.nav._validate import finite, finite_array, positive
 from replication.papers import symbolic
 from replication.papers.symbolic import Check, rotation_from_quaternion, short, skew, vanishes, vee
 
@@ -701,8 +701,7 @@ def check_all(items) -> dict:
     dict of str to Check
         Name -> result, in the order given.
     """
-    readings = {n: r for n, r, _ in items}
-    return {n: check_item(n, r, s, readings) for n, r, s in items}
+    return symbolic.check_each(items, check_item)
 
 
 # ----------------------------------------------------------------------------- the chapter-3 reading
@@ -732,7 +731,9 @@ def height_gradient_entry(lat_deg: float = 30.0, speed: float = 100.0, h: float 
         ``gradient`` (−∂γ/∂h, s⁻²), ``two_g_over_r`` (s⁻²), ``kinematic`` (V²/(R_N+h)², s⁻²),
         ``ratio`` (gradient / kinematic), ``mgal_per_m`` (the gradient in mGal per metre).
     """
-    earth.check_latitude(np.radians(lat_deg), name="lat_deg")
+    lat_deg = finite(lat_deg, "lat_deg")
+    if abs(lat_deg) > 90.0:
+        raise ValueError(f"lat_deg must be a latitude in degrees within ±90°, got {lat_deg!r}")
     earth.check_height(h)
     positive(speed, "speed")
     lat, step = math.radians(lat_deg), 10.0

@@ -593,8 +593,7 @@ def check_all(items) -> dict:
     dict of str to Check
         Name -> result, in the order given.
     """
-    readings = {n: r for n, r, _ in items}
-    return {n: check_item(n, r, s, readings) for n, r, s in items}
+    return symbolic.check_each(items, check_item)
 
 
 def common_conventions(checks) -> list:
