@@ -45,12 +45,18 @@ def _cmd_status(args) -> int:
 
 def _cmd_show(args) -> int:
     tables = rp.resolve_table_ids(args.id)
-    for table_id in tables:                      # every table readable (CSV and sidecar) before any is printed
+    texts = {}
+    for table_id in tables:                      # every table readable (CSV, sidecar, export) before any is printed
         rp.load_table(table_id)
         export = rp.tables_dir() / f"{table_id}.{args.format}"
+        fix = "rebuild the exports with replication.registry.reproduction.refresh_exports(), or restore it (git checkout)"
         if args.format != "csv" and not export.is_file():
-            raise rp.RegistryError(f"{export} does not exist: rebuild the exports with "
-                                   "replication.registry.reproduction.refresh_exports(), or restore it (git checkout)")
+            raise rp.RegistryError(f"{export} does not exist: {fix}")
+        if args.format != "csv":
+            try:
+                texts[table_id] = export.read_text(encoding="utf-8")
+            except UnicodeDecodeError as exc:
+                raise rp.RegistryError(f"{export} is not UTF-8 ({exc.reason} at byte {exc.start}): {fix}") from None
     for i, table_id in enumerate(tables):
         if len(tables) > 1:                      # an artifact covered by several tables: each in turn
             heading = f"{table_id} ({i + 1} of {len(tables)} tables covering {args.id})"
@@ -59,7 +65,7 @@ def _cmd_show(args) -> int:
         if args.format == "csv":
             sys.stdout.write(rp.read_table(table_id).to_csv(index=False, lineterminator="\n"))
         else:
-            sys.stdout.write((rp.tables_dir() / f"{table_id}.{args.format}").read_text(encoding="utf-8"))
+            sys.stdout.write(texts[table_id])
     return 0
 
 

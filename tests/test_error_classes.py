@@ -8,13 +8,17 @@ collinear series given to the AR least squares); negative durations of trajector
 "nearest rotation" that would be a reflection.  A call either returns a finite, correct result or
 raises ``ValueError``/``TypeError`` naming the argument; it never returns inf/NaN, never lets a
 numpy/scipy error (``LinAlgError``, ``ZeroDivisionError``) through.  The command line answers a
-user's mistake (a corrupt sidecar, an empty or malformed CSV, a malformed ``artifacts.csv``, a
-missing or wrong ``REPLICATION_ROOT``, an unknown id) with one line on stderr naming the file or
-value and what to do, exit code 2, and no traceback.
+user's mistake (a sidecar that is corrupt, missing or of the wrong shape, an empty, malformed or
+hand-edited CSV, an export or ``sources.bib`` that is missing or not UTF-8, a malformed
+``artifacts.csv``, a missing ``tables/`` or ``status.csv``, a missing or wrong ``REPLICATION_ROOT``,
+an unknown id) with one line on stderr naming the file or value and what to do, exit code 2, and no
+traceback — never with a silent result (a NaN, a title or commit made up, a citation without its
+source).
 
 Hypothesis runs are small (``max_examples`` 40-60, derandomized) so the file runs in seconds.
 """
 
+import json
 import os
 import re
 import shutil
@@ -424,7 +428,34 @@ def _corrupt(root: Path, case: str) -> None:
         "missing artifacts.csv": lambda: (d / "artifacts.csv").unlink(),
         "corrupt status.csv": lambda: (t / "status.csv").write_text('"x\n1,2,3\n', encoding="utf-8"),
         "missing export": lambda: (t / f"{TID}.md").unlink(),
+        "md export not UTF-8": lambda: (t / f"{TID}.md").write_bytes(b"\xff\xfe\x00abc"),
+        "tex export not UTF-8": lambda: (t / f"{TID}.tex").write_bytes(b"\xff\xfe\x00abc"),
+        "sources.bib not UTF-8": lambda: (d / "sources.bib").write_bytes(b"\xff\xfe\x00abc"),
+        "missing sources.bib": lambda: (d / "sources.bib").unlink(),
+        "sources.bib without the entry": lambda: (d / "sources.bib").write_text("@misc{other,\n}\n", encoding="utf-8"),
+        "missing sidecar": lambda: (t / f"{TID}.json").unlink(),
+        "empty sidecar": lambda: (t / f"{TID}.json").write_text("{}", encoding="utf-8"),
+        "sidecar of a title only": lambda: (t / f"{TID}.json").write_text('{"title": 5}', encoding="utf-8"),
+        "sidecar title a number": lambda: _edit_sidecar(t / f"{TID}.json", title=5),
+        "sidecar of another table": lambda: _edit_sidecar(t / f"{TID}.json", id="chen2019-eq-3-13"),
+        "CSV cell edited by hand": lambda: _edit_cell(t / f"{TID}.csv", "paper", "ten"),
+        "missing tables": lambda: shutil.rmtree(t),
+        "missing status.csv": lambda: (t / "status.csv").unlink(),
     }[case]()
+
+
+def _edit_sidecar(path: Path, **fields) -> None:
+    """Set ``fields`` in a sidecar, every other key kept."""
+    meta = json.loads(path.read_text(encoding="utf-8"))
+    path.write_text(json.dumps({**meta, **fields}), encoding="utf-8")
+
+
+def _edit_cell(path: Path, column: str, value: str) -> None:
+    """Put ``value`` in ``column`` of the first row, as a hand edit would (the digest left as it was)."""
+    lines = path.read_text(encoding="utf-8").splitlines(keepends=True)
+    header, first = lines[0].rstrip("\n").split(","), lines[1].split(",")
+    first[header.index(column)] = value
+    path.write_text(lines[0] + ",".join(first) + "".join(lines[2:]), encoding="utf-8")
 
 
 # (case, command, what the one line must name)
@@ -445,6 +476,25 @@ CLI_CASES = [
     ("missing artifacts.csv", ["status"], "artifacts.csv"),
     ("corrupt status.csv", ["show", ARTIFACT], "status.csv"),
     ("missing export", ["show", TID], f"{TID}.md"),
+    ("md export not UTF-8", ["show", TID], f"{TID}.md"),
+    ("tex export not UTF-8", ["show", TID, "--format", "tex"], f"{TID}.tex"),
+    ("sources.bib not UTF-8", ["cite", TID], "sources.bib"),
+    ("missing sources.bib", ["cite", TID], "sources.bib"),
+    ("sources.bib without the entry", ["cite", TID], "sources.bib"),
+    ("missing sidecar", ["cite", TID], f"{TID}.json"),
+    ("missing sidecar", ["show", TID], f"{TID}.json"),
+    ("empty sidecar", ["show", TID], f"{TID}.json"),
+    ("empty sidecar", ["cite", TID], f"{TID}.json"),
+    ("empty sidecar", ["status"], f"{TID}.json"),
+    ("sidecar of a title only", ["cite", TID], f"{TID}.json"),
+    ("sidecar of a title only", ["show", TID], f"{TID}.json"),
+    ("sidecar title a number", ["cite", TID], f"{TID}.json"),
+    ("sidecar of another table", ["show", TID], f"{TID}.json"),
+    ("CSV cell edited by hand", ["show", TID], f"{TID}.csv"),
+    ("CSV cell edited by hand", ["show", TID, "--format", "csv"], f"{TID}.csv"),
+    ("CSV cell edited by hand", ["cite", TID], f"{TID}.csv"),
+    ("missing tables", ["status"], "tables does not exist"),
+    ("missing status.csv", ["show", ARTIFACT], "status.csv"),
 ]
 
 
@@ -511,6 +561,14 @@ def test_the_real_command_line_prints_no_traceback(tables_copy, tmp_path):
     ("empty CSV", lambda: rp.read_table(TID), f"{TID}.csv"),
     ("malformed artifacts.csv", rp.load_artifacts, "artifacts.csv"),
     ("corrupt status.csv", lambda: rp.resolve_table_ids(ARTIFACT), "status.csv"),
+    ("missing status.csv", lambda: rp.resolve_table_ids(ARTIFACT), "status.csv"),
+    ("missing sidecar", lambda: rp.load_table(TID), f"{TID}.json"),
+    ("empty sidecar", lambda: rp.load_tables(TID), f"{TID}.json"),
+    ("sidecar title a number", lambda: rp.load_table(TID), f"{TID}.json"),
+    ("empty sidecar", lambda: rp.build_index(write=False), f"{TID}.json"),
+    ("CSV cell edited by hand", lambda: rp.load_table(TID), "table_digest"),
+    ("missing sources.bib", lambda: rp.source_bibtex("chen2019"), "sources.bib"),
+    ("missing tables", lambda: rp.build_index(write=False), "tables does not exist"),
 ])
 def test_the_python_read_side_raises_a_registry_error_naming_the_file(case, call, names, tables_copy, tmp_path,
                                                                       monkeypatch):

@@ -384,11 +384,10 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
     csv = d / f"{tid}.csv"
     if not csv.exists():
         return [Problem(tid, "", "its sidecar has no CSV")]
-    digest = hashlib.sha256(csv.read_bytes()).hexdigest()
     out = []
-    if meta.get("table_digest") != digest:
-        out.append(Problem(tid, "", "the CSV differs from the table its notebook computed (its content does not match "
-                                    "the sidecar's table_digest): rerun the notebook, never edit a table by hand"))
+    changed = rp._digest_problem(tid, meta)
+    if changed:
+        out.append(Problem(tid, "", changed))
     df = rp.read_table(tid)
     records = _records(tid)
     by_q = {r["quantity"]: r for r in records}

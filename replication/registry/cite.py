@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import re
 
-from replication._meta import __version__, repository_url
+from replication._meta import repository_url
 from replication.registry.locations import data_root
-from replication.registry.reading import _sidecar, read_table, resolve_table_ids
+from replication.registry.reading import load_table, resolve_table_ids
 from replication.registry.schema import SOURCE_KEYS, STATUSES, RegistryError
 from replication.registry.tallies import summarize_status
 
@@ -40,22 +40,21 @@ def bibtex_for(ident: str) -> str:
         entries.append(entry)
         if source in SOURCE_KEYS and source not in sources:
             sources.append(source)
-    originals = [b for b in (source_bibtex(s) for s in sources) if b]
-    return "\n".join(entries) + "".join("\n" + b for b in originals)
+    return "\n".join(entries) + "".join("\n" + source_bibtex(s) for s in sources)
 
 
 def _table_bibtex(table_id: str) -> tuple[str, str]:
     """The ``@misc`` entry of one exported table, and the source key it reproduces."""
-    df = read_table(table_id)
-    meta = _sidecar(table_id)
-    source = meta.get("source", table_id.split("-")[0])
-    commit = meta.get("git_commit") or "unknown"
-    version = meta.get("library_version", __version__)
+    df = load_table(table_id)           # the sidecar checked, and the CSV the one its notebook computed
+    meta = df.attrs
+    source = meta["source"]
+    commit = meta["git_commit"] or "unknown"        # null: computed outside a git checkout
+    version = meta["library_version"]
     counts = df["status"].value_counts()
     split = ", ".join(f"{int(counts[s])} {s}" for s in STATUSES if int(counts.get(s, 0)))
     overall = summarize_status(df["status"])
     is_paper = source in SOURCE_KEYS
-    title = meta.get("title", table_id)
+    title = meta["title"]
     lines = [f"@misc{{repro-{table_id},",
              f"  title        = {{{{{title}}}}},",
              "  author       = {{SINS/GNSS reproduction package contributors}},",
@@ -82,15 +81,25 @@ def source_bibtex(key: str) -> str:
     Returns
     -------
     str
-        The entry with a trailing newline; empty when ``data/sources.bib`` lacks it.
+        The entry with a trailing newline.
+
+    Raises
+    ------
+    RegistryError
+        ``data/sources.bib`` missing, not UTF-8, or without the entry (a citation of a reproduction
+        that asks to cite the original as well must carry it).
     """
     path = data_root() / "data" / "sources.bib"
-    if not path.exists():
-        return ""
-    text = path.read_text(encoding="utf-8")
+    fix = "restore it: git checkout -- data/sources.bib"
+    if not path.is_file():
+        raise RegistryError(f"{path} does not exist (it holds the entries of the source documents): {fix}")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise RegistryError(f"{path} is not UTF-8 ({exc.reason} at byte {exc.start}): {fix}") from None
     m = re.search(r"@\w+\{" + re.escape(key) + r",", text)
     if not m:
-        return ""
+        raise RegistryError(f"{path} has no entry {key}: {fix}")
     depth, i = 0, m.start()
     for j in range(text.index("{", m.start()), len(text)):
         depth += {"{": 1, "}": -1}.get(text[j], 0)

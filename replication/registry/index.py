@@ -15,10 +15,17 @@ from replication.registry.datapackage import write_datapackage
 from replication.registry.links import _chapter_link, _table_links
 from replication.registry.locations import _write_if_changed, project_root, tables_dir
 from replication.registry.markdown import _md_table
-from replication.registry.reading import _sidecar, artifact_tables, list_tables, load_artifacts, read_table
+from replication.registry.reading import (
+    _no_tables_dir,
+    _sidecar,
+    artifact_tables,
+    list_tables,
+    load_artifacts,
+    read_table,
+)
 from replication.registry.readings import check_verdicts
 from replication.registry.register import _register_markdown, build_register
-from replication.registry.schema import SOURCE_KEYS, STATUSES
+from replication.registry.schema import SOURCE_KEYS, STATUSES, RegistryError
 from replication.registry.tallies import ARTIFACT_STATUSES, status_bar_html, status_label, status_tally, summarize_status
 
 
@@ -44,6 +51,8 @@ def build_index(write: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
         ``(status, register)``.
     """
     arts = load_artifacts()
+    if not tables_dir().is_dir():       # not "every table missing": one line naming the folder
+        raise RegistryError(_no_tables_dir())
     exported = {tid: _sidecar(tid) for tid in list_tables()}
     rows = []
     covered: set[str] = set()

@@ -6,6 +6,7 @@ with near-miss suggestions, and the typed loaders :func:`load_table` and :func:`
 from __future__ import annotations
 
 import difflib
+import hashlib
 import json
 import os
 from pathlib import Path
@@ -68,32 +69,39 @@ def _read_csv(path: Path, fix: str, **kw) -> pd.DataFrame:
 
 def _known_ids() -> list[str]:
     """Every id the read side answers to: the exported tables and the artifacts of ``data/artifacts.csv``."""
-    ids = set(list_tables())
+    return sorted(set(list_tables()) | _artifact_ids())
+
+
+def _artifact_ids() -> set[str]:
+    """The ids of ``data/artifacts.csv`` (none when it cannot be read: its own reader names the problem)."""
     try:
-        ids.update(load_artifacts()["id"])
+        return set(load_artifacts()["id"])
     except RegistryError:
-        pass
-    return sorted(ids)
+        return set()
 
 
 def _near_ids(ident: str) -> list[str]:
     """The known ids nearest to ``ident`` (at most five, by ``difflib``; case and spaces ignored)."""
-    known = _known_ids()
+    known = [k for k in _known_ids() if k != ident]         # never the id typed (a table without its CSV)
     return (difflib.get_close_matches(ident, known, n=5, cutoff=0.6)
             or difflib.get_close_matches(ident.strip().lower(), known, n=5, cutoff=0.6))
 
 
 def _unknown_id(ident: str) -> str:
     """The message for an id that names no table: the nearest known ids (at most five), or where to find them."""
-    d = tables_dir()
-    if not d.is_dir():
-        env = os.environ.get("REPLICATION_ROOT")
-        where = f" (REPLICATION_ROOT={env})" if env else ""
-        return (f"no exported table {ident!r}: {d} does not exist{where}; run inside a clone of the repository or "
-                "set REPLICATION_ROOT to its root")
+    if not tables_dir().is_dir():
+        return f"no exported table {ident!r}: {_no_tables_dir()}"
     near = _near_ids(ident)
     hint = f"did you mean {', '.join(near)}?" if near else "no known id is close to it;"
     return f"no exported table {ident!r}: {hint} (python -m replication status lists every id)"
+
+
+def _no_tables_dir() -> str:
+    """The message for a missing ``tables/``: where it was looked for and what to do."""
+    env = os.environ.get("REPLICATION_ROOT")
+    where = f" (REPLICATION_ROOT={env})" if env else ""
+    return (f"{tables_dir()} does not exist{where}: restore it (git checkout -- tables), run inside a clone of the "
+            "repository, or set REPLICATION_ROOT to its root")
 
 
 def list_tables() -> list[str]:
@@ -163,13 +171,24 @@ def load_table(table_id: str) -> pd.DataFrame:
     pandas.DataFrame
         The table, numeric columns as floats (each in its row's ``unit``; ``rel_error`` and a
         relative tolerance dimensionless), ``attrs`` the sidecar.
+
+    Raises
+    ------
+    RegistryError
+        An unknown id; a CSV or sidecar that is missing or damaged; a CSV that is not the table its
+        notebook computed (its digest differs from the sidecar's ``table_digest``: a cell edited by
+        hand is refused, never read as NaN).
     """
     table_id = resolve_table_id(table_id)
     df = read_table(table_id)
+    meta = _sidecar(table_id)
+    changed = _digest_problem(table_id, meta)
+    if changed:                         # a cell edited by hand would be read as NaN, or as another number
+        raise RegistryError(f"{tables_dir() / f'{table_id}.csv'}: {changed}")
     for c in NUMERIC_COLUMNS:
         if c in df.columns:
             df[c] = pd.to_numeric(df[c].replace("", np.nan), errors="coerce")
-    df.attrs.update(_sidecar(table_id))
+    df.attrs.update(meta)
     return df
 
 
@@ -213,21 +232,61 @@ def artifact_tables(artifact: Mapping[str, Any]) -> list[str]:
     return extra or [artifact["id"]]
 
 
+SIDECAR_KEYS = {
+    "id": (str,), "title": (str,), "source": (str,), "notebook": (str,), "table_digest": (str,),
+    "library_version": (str,), "git_commit": (str, type(None)), "status_counts": (dict,),
+}
+"""The keys every sidecar ``tables/<id>.json`` carries (written by
+:func:`~replication.registry.exports.compare`) with their JSON types; ``git_commit`` is null when the
+table was computed outside a git checkout."""
+
+SIDECAR_OPTIONAL = {
+    "description": (str,), "seeds": (dict,), "packages": (dict,), "summary": (str,), "main_reading": (str,),
+    "main_reading_evidence": (str,), "readings": (list,), "ruled_out": (dict,), "groups": (dict,),
+}
+"""The keys a sidecar may carry, with the JSON types the readers rely on."""
+
+
 def _sidecar(table_id: str) -> dict:
-    """The sidecar ``tables/<id>.json`` of a table as a dict (empty when there is none); a sidecar that is
-    not a JSON object raises :class:`~replication.registry.schema.RegistryError` naming the file."""
+    """The sidecar ``tables/<id>.json`` of a table as a dict, checked by every reader: a sidecar that is
+    missing, not a JSON object, or lacks a key of :data:`SIDECAR_KEYS` (or holds a key of
+    :data:`SIDECAR_KEYS` or :data:`SIDECAR_OPTIONAL` of another type, or another table's id) raises
+    :class:`~replication.registry.schema.RegistryError` naming the file."""
     path = tables_dir() / f"{table_id}.json"
+    fix = "re-run the notebook that exports the table, or restore it from the repository (git checkout)"
     if not path.exists():
-        return {}
+        raise RegistryError(f"{path} does not exist: tables/{table_id}.csv has no sidecar (its title, commit and "
+                            f"digest); {fix}")
     try:
         meta = json.loads(path.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise RegistryError(f"{path} is not valid JSON ({str(exc).splitlines()[0][:100]}): re-run the notebook that "
-                            "exports the table, or restore it from the repository (git checkout)") from None
+        raise RegistryError(f"{path} is not valid JSON ({str(exc).splitlines()[0][:100]}): {fix}") from None
     if not isinstance(meta, dict):
-        raise RegistryError(f"{path} holds a {type(meta).__name__}, not a table's sidecar (a JSON object): re-run "
-                            "the notebook that exports the table, or restore it from the repository (git checkout)")
+        raise RegistryError(f"{path} holds a {type(meta).__name__}, not a table's sidecar (a JSON object): {fix}")
+    missing = [k for k in SIDECAR_KEYS if k not in meta]
+    if missing:
+        raise RegistryError(f"{path} is not a table's sidecar: it lacks {', '.join(missing)}; {fix}")
+    for key, kinds in {**SIDECAR_OPTIONAL, **SIDECAR_KEYS}.items():
+        if key in meta and not isinstance(meta[key], kinds):
+            want = " or ".join("null" if k is type(None) else {str: "a string", dict: "an object",
+                                                                 list: "a list"}[k] for k in kinds)
+            raise RegistryError(f"{path}: {key} is {json.dumps(meta[key])[:40]}, not {want}; {fix}")
+    if meta["id"] != table_id or not meta["title"].strip():
+        what = f"the id {meta['id']!r}" if meta["id"] != table_id else "an empty title"
+        raise RegistryError(f"{path}: the sidecar of {table_id} holds {what}; {fix}")
     return meta
+
+
+def _digest_problem(table_id: str, meta: Mapping[str, Any]) -> str:
+    """Why ``tables/<id>.csv`` is not the table its notebook computed (its SHA-256 differs from the
+    sidecar's ``table_digest``: the CSV was edited by hand), or ``""`` when it is.  The one digest
+    check, run by the audit of ``python -m replication index`` and ``status``
+    (:func:`~replication.registry.audit.audit_table`) and by :func:`load_table`."""
+    digest = hashlib.sha256((tables_dir() / f"{table_id}.csv").read_bytes()).hexdigest()
+    if meta.get("table_digest") == digest:
+        return ""
+    return ("the CSV differs from the table its notebook computed (its content does not match the sidecar's "
+            "table_digest): re-run the notebook, or restore it (git checkout); never edit a table by hand")
 
 
 def resolve_table_ids(ident: str) -> list[str]:
@@ -267,6 +326,10 @@ def resolve_table_ids(ident: str) -> list[str]:
             if not tables:
                 raise RegistryError(f"{ident!r} is {hit.iloc[0]['status']}: no table has been exported for it yet")
             return tables
+    elif ident in _artifact_ids():
+        raise RegistryError(f"{status_path} does not exist: it lists the tables covering the artifact {ident!r}; "
+                            "rebuild it with python -m replication index (in a clone), or restore it "
+                            "(git checkout -- tables/status.csv)")
     read_table(ident)                   # not a table either: raises, naming the tables of that source
     return [ident]
 

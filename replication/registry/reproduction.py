@@ -152,8 +152,13 @@ from replication.registry.paper import (
 )
 from replication.registry.reading import (
     READ_COLUMNS,
+    SIDECAR_KEYS,
+    SIDECAR_OPTIONAL,
+    _artifact_ids,
+    _digest_problem,
     _known_ids,
     _near_ids,
+    _no_tables_dir,
     _read_csv,
     _sidecar,
     _unknown_id,
