@@ -98,6 +98,31 @@ def test_chen2019_shared_locator():
     assert [r["quantity"] for r in rows] == ["locator of [35] against [66]"]
 
 
+def test_year_step_rows_judge_what_volume_rows_cannot():
+    printed = _printed([(1, "A. X[J]. Jour, 2006, 32(2): 1-2"), (2, "B. Y[J]. Jour, 2010, 35(1): 3-4"),
+                        (3, "C. Z[J]. Fixed, 2004, 12(1): 5-6"), (4, "D. W[J]. Fixed, 2007, 15(3): 7-8"),
+                        (5, "E. V[J]. Fixed, 1991, 2: 50 -55"), (6, "F. U[J]. Fixed, 1999, 4: 1-9"),
+                        (7, "G. T[J]. Other, 2010, 5(1): 1-2"), (8, "H. S[J]. Other, 2011, 6(1): 1-2")], [])
+    rows = {r["quantity"]: r for r in C.year_step_rows(printed)}
+    # Jour: 1974 against 1975, no step shared: the pair disagrees; Other agrees, no pair row
+    assert set(rows) == {"volume of [1] against [2]", "year of [5] against Fixed", "year of [6] against Fixed"}
+    assert rows["volume of [1] against [2]"]["agrees"] is False
+    assert "2 journals" in rows["volume of [1] against [2]"]["note"]
+    # Fixed: step 1992, so 1991 would be volume -1 and 1999 volume 7
+    assert rows["year of [5] against Fixed"]["reproduced"] == -1 and not rows["year of [5] against Fixed"]["agrees"]
+    assert rows["year of [6] against Fixed"]["reproduced"] == 7 and rows["year of [6] against Fixed"]["agrees"]
+    with pytest.raises(ValueError):
+        C.year_step_rows(printed, same_step=1)
+    with pytest.raises(ValueError, match="columns"):
+        C.year_step_rows(printed.drop(columns="line"))
+
+
+def test_chen2019_year_steps():
+    rows = {r["quantity"]: r for r in C.year_step_rows(rp.load_paper("chen2019-print-references").data)}
+    assert set(rows) == {"volume of [63] against [65]", "year of [60] against 中国惯性技术学报"}
+    assert not any(r["agrees"] for r in rows.values())
+
+
 def test_entry_year_and_journal_volume_read_the_printed_form():
     assert C.entry_year("Moritz H. Report, 1978, No.277") == 1978
     assert C.entry_year("no year") is None

@@ -20,6 +20,13 @@ Criteria, fixed before comparing:
   printed as ``[J]. <journal>, <year>, <volume>(<issue>)``, grouped by journal; a journal with one
   volume a year has one value of year minus volume, so where at least :data:`SAME_STEP` = 2 entries
   of a journal share that value, an entry of the same journal with another value disagrees with them;
+* **two entries of one journal out of step with each other** (:func:`year_step_rows`): a journal
+  whose entries share no year minus volume (so :func:`volume_rows` fixes no step) is held to the
+  rhythm every journal whose step the list fixes follows, one volume a year: two of its entries
+  with different values cannot both hold, and the list alone does not say which;
+* **a year before the first volume** (:func:`year_step_rows`): an entry of a journal whose step the
+  list fixes that prints no volume (``[J]. <journal>, <year>, <issue>: pages``) is placed by that
+  step; a year whose volume would be below 1 precedes the journal's first volume;
 * **the year of an entry**: the first four-digit year 19xx or 20xx that it prints (:func:`entry_year`).
 """
 
@@ -32,7 +39,8 @@ from typing import Any
 import pandas as pd
 
 __all__ = ["SAME_WORK", "SAME_STEP", "cited_numbers", "duplicate_pairs", "entry_year", "journal_volume",
-           "reversed_pages", "reference_rows", "volume_rows", "locator_rows", "doi_rows"]
+           "reversed_pages", "reference_rows", "volume_rows", "year_step_rows", "locator_rows",
+           "doi_rows"]
 
 SAME_WORK = 0.85
 """The similarity ratio from which two entries of a list are the same work (see the module docstring)."""
@@ -41,6 +49,7 @@ SAME_STEP = 2
 """How many entries of one journal must share one year minus volume before another entry is judged by it."""
 
 _JOURNAL = re.compile(r"\[J\]\.?\s*(?P<journal>[^,，\[\]]+?)\s*[,，]\s*(?P<year>(?:19|20)\d{2})\s*[,，]\s*(?P<volume>\d+)\s*\(")
+_JOURNAL_YEAR = re.compile(r"\[J\]\.?\s*(?P<journal>[^,，\[\]]+?)\s*[,，]\s*(?P<year>(?:19|20)\d{2})\s*[,，]")
 _YEAR = re.compile(r"(?<!\d)((?:19|20)\d{2})(?!\d)")
 _RANGE = re.compile(r"(\d+)\s*[-–]\s*(\d+)")
 _PAGES = re.compile(r"(?<![\d.\-–])(\d{1,5})\s*[-–]\s*(\d{1,5})(?![\d.\-–])")
@@ -309,6 +318,98 @@ def volume_rows(printed: pd.DataFrame, *, same_step: int = SAME_STEP) -> list[di
                              note=(f"year minus volume {y - v}, as {others}: one volume a year" if ok else
                                    f"year minus volume {y - v}; {others} give {step}: by them the volume of {y} "
                                    f"is {y - step}, not {v}")))
+    return rows
+
+
+def _journal_steps(printed: pd.DataFrame) -> dict[str, list[tuple[int, int, int, int]]]:
+    """Journal articles with a printed volume, by journal: ``(number, year, volume, line)``."""
+    need = {"quantity", "value", "kind", "number", "line"}
+    if not need <= set(printed.columns):
+        raise ValueError(f"the transcription needs the columns {sorted(need)}; it has {list(printed.columns)}")
+    refs = printed[printed["kind"] == "entry"]
+    by_journal: dict[str, list[tuple[int, int, int, int]]] = {}
+    for n, entry, line in zip(refs["number"], refs["value"], refs["line"]):
+        if (jv := journal_volume(entry)) is not None:
+            by_journal.setdefault(jv[0], []).append((int(n), jv[1], jv[2], int(line)))
+    return by_journal
+
+
+def year_step_rows(printed: pd.DataFrame, *, same_step: int = SAME_STEP) -> list[dict[str, Any]]:
+    """Comparison rows (``basis="parts"``): the entries :func:`volume_rows` cannot judge.
+
+    Two cases (the module docstring):
+
+    * a journal with at least two articles that share no year minus volume: each pair with
+      different values is compared, under the one-volume-a-year rhythm of every journal whose step
+      the list fixes (at least ``same_step`` entries sharing it); such a pair disagrees, and the
+      list alone does not say which entry is wrong;
+    * an article of a journal whose step the list fixes that prints a year and no volume: the
+      volume its year takes by that step, ``year - step``; below 1, the year precedes the journal's
+      first volume by the list's own entries (disagrees), otherwise it agrees.
+
+    Parameters
+    ----------
+    printed : pandas.DataFrame
+        The transcription (the module docstring): ``quantity``, ``value``, ``kind``, ``number``, ``line``.
+    same_step : int, optional
+        The entries that must share one year minus volume to fix a journal's step, at least 2.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`replication.registry.exports.compare`, named ``"volume of [a] against [b]"``
+        and ``"year of [n] against <journal>"``.
+
+    Raises
+    ------
+    ValueError
+        When a column is missing or ``same_step`` is below 2.
+    """
+    if int(same_step) < 2:
+        raise ValueError(f"same_step must be at least 2 entries (one entry fixes no step); got {same_step}")
+    by_journal = _journal_steps(printed)
+    fixed: dict[str, tuple[int, list[str]]] = {}
+    unfixed: dict[str, list[tuple[int, int, int, int]]] = {}
+    for journal, items in by_journal.items():
+        counts = pd.Series([y - v for _, y, v, _ in items]).value_counts()
+        if counts.iloc[0] >= same_step and not (len(counts) > 1 and counts.iloc[1] == counts.iloc[0]):
+            step = int(counts.index[0])
+            fixed[journal] = (step, [f"[{n}] {y}, vol. {v}" for n, y, v, _ in items if y - v == step])
+        elif len(items) >= 2 and counts.iloc[0] == 1:
+            unfixed[journal] = items
+    rhythm = f"one volume a year, the rhythm of the {len(fixed)} journals whose step the list fixes"
+    rows = []
+    for journal, items in unfixed.items():
+        for i, (a, ya, va, la) in enumerate(items):
+            for b, yb, vb, lb in items[i + 1:]:
+                rows.append(dict(quantity=f"volume of [{a}] against [{b}]", unit="",
+                                 paper_text=f"[{a}] {journal}, {ya}, vol. {va} (seed line {la})",
+                                 reproduced=f"[{b}] {journal}, {yb}, vol. {vb} (seed line {lb})",
+                                 basis="parts", agrees=False,
+                                 note=(f"two entries of one journal, year minus volume {ya - va} and {yb - vb}: "
+                                       f"under {rhythm}, they cannot both hold ({yb - ya} years apart, "
+                                       f"{vb - va} volumes); "
+                                       + ("the list has no third entry of the journal and alone"
+                                          if len(items) == 2 else "the list's entries of the journal share no "
+                                          "value, and the list")
+                                       + " does not say which is wrong")))
+    refs = printed[printed["kind"] == "entry"]
+    for n, entry, line in zip(refs["number"], refs["value"], refs["line"]):
+        m = _JOURNAL_YEAR.search(str(entry))
+        if m is None or journal_volume(entry) is not None:
+            continue
+        journal, year = re.sub(r"\s+", " ", m["journal"]).strip(), int(m["year"])
+        if journal not in fixed:
+            continue
+        step, by = fixed[journal]
+        vol = year - step
+        rows.append(dict(quantity=f"year of [{int(n)}] against {journal}", unit="", paper=year,
+                         paper_text=f"[{int(n)}] {journal}, {year}, no volume printed (seed line {int(line)})",
+                         reproduced=vol, basis="parts", agrees=vol >= 1,
+                         note=(f"{', '.join(by)} give year minus volume {step}: by them the volume of {year} is "
+                               f"{vol}" + (", a volume the journal has" if vol >= 1 else
+                                           f", before the journal's volume 1 ({step + 1}); the list alone "
+                                           "does not say whether the year or the journal is wrong"))))
     return rows
 
 
