@@ -258,3 +258,17 @@ def test_the_pdf_stays_small(reader):
     page; a structure tree (about 58 kB a page) or rasterised shadows (37) would exceed 30."""
     per_page = PDF.stat().st_size / len(reader.pages)
     assert per_page < 30_000, f"{per_page / 1e3:.0f} kB a page ({PDF.stat().st_size / 1e6:.1f} MB)"
+
+
+def test_the_readme_states_the_pdf_a_reader_gets(reader):
+    """The README's page count and size describe the printed PDF: within a tenth in pages and a
+    fifth in bytes (chapters grow by a row or a paragraph between releases; a larger change means
+    the README must be updated)."""
+    text = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    m = re.search(r"`make pdf` prints the book for readers from the stored outputs, offline: (\d+) pages, "
+                  r"([\d.]+) MB", text)
+    assert m, "README.md no longer states the PDF's page count and size after 'make pdf prints the book'"
+    pages, mb = int(m.group(1)), float(m.group(2))
+    n, size = len(reader.pages), PDF.stat().st_size / 1e6
+    assert abs(n - pages) <= 0.1 * pages, f"README says {pages} pages, the PDF has {n}: update README.md"
+    assert abs(size - mb) <= 0.2 * mb, f"README says {mb} MB, the PDF holds {size:.1f} MB: update README.md"
