@@ -134,3 +134,33 @@ def test_natural_frequencies_split_by_about_twice_the_vertical_earth_rate():
 def test_the_print_numbers_refuse_bad_input_naming_the_argument(call, word):
     with pytest.raises((ValueError, TypeError), match=word):
         call()
+
+
+def _fang_rows():
+    from replication.registry import reproduction as rp
+
+    rows = fang_pp.print_parts_rows(
+        rp.load_paper("fang2020-print-parts").data,
+        rp.load_paper("fang2020-claim-simulation-setup"),
+        rp.load_paper("fang2020-table-1"),
+        rp.load_paper("fang2020-table-2"),
+        x_means={"linear model": (0.00853, 0.00854)},
+    )
+    return {r["quantity"]: r for r in rows}
+
+
+def test_drift_constant_in_oepq_between_the_fixes_on_the_printed_tracks():
+    row = next(r for q, r in _fang_rows().items() if q.startswith("eqs. (24)-(27): drift constant"))
+    assert row["basis"] == "parts" and row["agrees"] is True
+    # case 1 (a parallel) does not turn the body in OEPQ; case 2 (a meridian) turns it by the
+    # latitude sailed, 10 m/s over 1.5 h on the sphere a: 0.0085 rad, printed to two digits
+    assert "case 1: C_b^OEPQ turns by < 1e-06 rad" in row["reproduced"]
+    sailed = 10.0 * 1.5 * units.HOUR / fang_pp.earth.A
+    assert f"case 2: C_b^OEPQ turns by {sailed:.2g} rad" in row["reproduced"]
+
+
+def test_case_2_conclusion_on_the_e_axis_is_read_as_a_rate_in_time():
+    row = _fang_rows()["case 2: Table 2 supports 'the faster turn of the E axis near the pole matters little'"]
+    # λ̇ = 0 on the meridian between the fixes: the scenario does not exercise the rate it concludes on
+    assert row["basis"] == "parts" and row["agrees"] is False
+    assert "case 2 0 Ω" in row["reproduced"]
