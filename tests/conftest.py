@@ -18,6 +18,7 @@ STORED = frozenset({
     "test_installed.py",         # a wheel of the clone, answering from its stored tables
     "test_inventory.py",         # the inventory of each print against the stored tables
     "test_print_edition.py",     # the landing page's link to the PDF
+    "test_reproduction.py",      # the registry: comparisons, statuses, displays, exports and the command line
     "test_tex_exports.py",       # the stored .tex exports through pdflatex, against the stored CSVs
     "test_words.py",             # the counts the book's words state, recomputed from the stored tables
 })
