@@ -735,17 +735,29 @@ PLANTED = {
 one wider than a phone."""
 
 
+RAW_PLANTS = {
+    "a dict or a set printed as Python writes it": "{'reproduced': 13}",
+    "a numpy scalar's repr": "np.float64(0.25)",
+    "a bare True/False": "True",
+    "a Python power (**) outside code and maths": "x**2 + 1",
+    "a truncation marker (...)": "[0.1, 0.2, ..., 0.9]",
+    "a negative zero": "-0.0",
+}
+"""One stored output of each kind of :data:`RAW_OUTPUT`, in the planted notebook."""
+
+
 def _planted_notebook():
-    """A notebook page whose stored output is a printed dict and whose code has a line of 100
-    characters."""
+    """A notebook page whose stored outputs are one of each kind of raw Python output
+    (:data:`RAW_PLANTS`) and whose code has a line of 100 characters."""
     import nbformat
 
     nb = nbformat.v4.new_notebook()
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
-    nb.cells = [nbformat.v4.new_markdown_cell("# A raw dict"),
-                nbformat.v4.new_code_cell("counts = {'reproduced': 13}  # " + "x" * 70 + "\nprint(counts)",
-                                          outputs=[nbformat.v4.new_output("stream", name="stdout",
-                                                                          text="{'reproduced': 13}\n")])]
+    nb.cells = [nbformat.v4.new_markdown_cell("# Raw outputs")]
+    for i, text in enumerate(RAW_PLANTS.values()):
+        code = (f"counts = {{'reproduced': 13}}  # {'x' * 70}\n" if i == 0 else "") + f"print(value_{i})"
+        nb.cells.append(nbformat.v4.new_code_cell(code, outputs=[
+            nbformat.v4.new_output("stream", name="stdout", text=text + "\n")]))
     return nb
 
 
@@ -776,8 +788,8 @@ def build_planted_book(tmp: Path) -> Path:
 def test_the_reader_checks_catch_what_they_look_for(tmp_path, browser):
     """:func:`reader_problems` on a synthetic book (:func:`build_planted_book`): the clean page
     passes (numbers, a status word and ids in a wide table, a range, an ellipsis and -0.05 in
-    prose); a number broken mid-token, a page wider than a phone, a printed dict and a code line
-    of 100 characters are each found."""
+    prose); a number broken mid-token, a page wider than a phone, each kind of raw output
+    (:data:`RAW_PLANTS`) and a code line of 100 characters are each found."""
     html = build_planted_book(tmp_path)
     statuses = _statuses()
     found = {}
@@ -792,5 +804,6 @@ def test_the_reader_checks_catch_what_they_look_for(tmp_path, browser):
     assert found["clean"] == [], found["clean"]
     assert any("broken across lines" in p and "0.00011051871234" in p for p in found["broken"]), found["broken"]
     assert any(f"at {PHONE} px the page scrolls sideways" in p for p in found["wide"]), found["wide"]
-    assert any("a dict" in p for p in found["raw"]), found["raw"]
+    for what in RAW_PLANTS:
+        assert any(f"raw output, {what}" in p for p in found["raw"]), (what, found["raw"])
     assert any(f"over {MAX_CODE} characters" in p for p in found["raw"]), found["raw"]

@@ -593,6 +593,24 @@ def test_a_turn_of_1e300_rad_is_refused_not_generated():
     assert tr_.Turn(20.0, np.pi / 2).angle == np.pi / 2
 
 
+@SMALL
+@given(st.floats(0.1, 1e4), st.floats(-1e300, 1e300), st.booleans())
+def test_a_turn_beyond_one_revolution_a_second_is_refused_and_any_other_is_built(duration, angle, degrees):
+    """Any heading change over any duration: a peak rate 2·angle/duration above one revolution a
+    second (``Turn.MAX_RATE``, a unit mistake such as degrees or 1e300 rad) is refused naming the
+    angle; any other turn is built and its heading change is the angle given."""
+    from replication.nav import trajectory as tr_
+    if degrees:  # the same turn given in degrees by mistake
+        angle = np.degrees(angle) if abs(angle) < 1e300 else angle
+    if 2 * abs(angle) / duration > tr_.Turn.MAX_RATE:
+        with pytest.raises(ValueError, match="Turn: angle"):
+            tr_.Turn(duration, angle)
+    else:
+        dpsi, rate, _ = tr_.Turn(duration, angle).heading(np.array([0.0, duration]))
+        assert dpsi[0] == 0.0 and dpsi[1] == pytest.approx(angle, rel=1e-12, abs=1e-300)
+        assert np.all(np.abs(rate) <= tr_.Turn.MAX_RATE)
+
+
 def test_a_ship_of_negative_duration_is_refused():
     from replication.papers.fang2020 import scenarios
     for d in (-10.0, 0.0, float("nan")):
