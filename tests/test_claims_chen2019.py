@@ -54,3 +54,28 @@ def test_compensation_claims_on_the_printed_table_4_50():
     assert c["level_gain"] == pytest.approx(27.907, abs=1e-3)          # roll vs direct difference, as printed
     assert not c["decisive"] and c["changed_markedly"] == ["pitch", "roll"]
     assert c["position_spread"] == pytest.approx(0.0055) and np.isfinite(c["change"]["height"])
+
+
+def _terms(**kw):
+    base = dict(attitude_error=np.radians(0.003), specific_force=9.80665, accel_bias=50 * 9.80665e-6,
+                velocity_error=0.03, position_error=0.03, height_error=0.1, speed=100.0, lat=np.radians(47.0))
+    return F.gravity_error_terms(**{**base, **kw})
+
+
+def test_gravity_error_terms_size_eq_3_8_with_the_printed_values():
+    r = _terms()
+    t = r["terms"]
+    # ψ f and ∇ are each about 50 mGal (1 mGal = 1e-5 m/s²); the velocity coupling is (2Ω + v/R) δV
+    assert t["attitude error ψ × f"] == pytest.approx(np.radians(0.003) * 9.80665)
+    assert t["accelerometer bias C ∇"] == pytest.approx(50 * 9.80665e-6)
+    assert t["velocity error (2ω_ie + ω_en) × δV"] == pytest.approx((2 * 7.292115e-5 + 100 / 6.37e6) * 0.03, rel=2e-3)
+    # the free-air gradient 2γ/R ≈ 3.08e-6 s⁻² on a 0.1 m height error
+    assert t["normal-gravity error δg_m"] == pytest.approx(3.08e-7, rel=0.02)
+    assert r["dominant"] and 90 < r["margin"] < 120
+
+
+def test_gravity_error_terms_turn_when_the_velocity_error_grows():
+    # a velocity error of 5 m/s makes the Coriolis coupling exceed the 50 μg bias: not dominant
+    assert not _terms(velocity_error=5.0)["dominant"]
+    with pytest.raises(ValueError, match="velocity_error"):
+        _terms(velocity_error=-1.0)

@@ -53,6 +53,8 @@ _TEX_UNICODE = {
     **{ch: rf"\ensuremath{{\{name}}}" for ch, name in _MATH_SIGNS.items()},
     "°": r"\textdegree{}", "§": r"\S{}", "¶": r"\P{}", "†": r"\dag{}", "‡": r"\ddag{}", "©": r"\copyright{}",
     "¹": r"\ensuremath{^1}", "²": r"\ensuremath{^2}", "³": r"\ensuremath{^3}", "⁻": r"\ensuremath{^-}",
+    "⁰": r"\ensuremath{^0}", "⁴": r"\ensuremath{^4}", "⁵": r"\ensuremath{^5}", "⁶": r"\ensuremath{^6}",
+    "⁷": r"\ensuremath{^7}", "⁸": r"\ensuremath{^8}", "⁹": r"\ensuremath{^9}",
     "″": r"\ensuremath{''}", "‴": r"\ensuremath{'''}", "−": r"\ensuremath{-}", "–": "--", "—": "---",
     "…": r"\ldots{}", "‘": "`", "’": "'", "“": "``", "”": "''", "\u00a0": "~", "\u2009": r"\,",
     "ß": r"\ss{}", "æ": r"\ae{}", "Æ": r"\AE{}", "œ": r"\oe{}", "Œ": r"\OE{}", "ø": r"\o{}", "Ø": r"\O{}",

@@ -2,7 +2,8 @@
 printed parts that describe one setting twice (``chen2019-check-analog-inputs``).
 
 :func:`analog_input_rows` builds the rows from the transcription
-``data/paper/chen2019/chen2019-check-analog-inputs.csv`` (the procedures of §4.1, the initial
+``data/paper/chen2019/chen2019-check-analog-inputs.csv`` (the procedures of §4.1 and the length of
+its static runs, the initial
 conditions of §4.2 一.1, the flight durations of §4.2 二 and §4.3 一), Tables 4-41, 4-43 and 4-46,
 and the calibration tables of §4.1 (their ``temperature_C``).  Every reproduced value is read from
 the objects the analogs run on, never typed:
@@ -15,7 +16,9 @@ the objects the analogs run on, never typed:
 * the sensor setup of that simulation (:func:`replication.papers.chen2019.simulation.table_4_41_setup`),
   which stands in for the TX-L20-A2 of Table 4-43 in the analog of Table 4-44;
 * the printed calibration temperatures the package reads
-  (:data:`replication.papers.chen2019.imu_model.TEMPERATURE_TABLES`).
+  (:data:`replication.papers.chen2019.imu_model.TEMPERATURE_TABLES`);
+* the length of the static analog runs of chapter 03
+  (:data:`replication.papers.chen2019.static_tests.RUN_DURATION_S`).
 
 Rows of basis ``value`` compare a printed setting with the code's value (tolerance 0, or 1e-9
 relative where a unit conversion in floating point stands between them); ``stand-in`` rows name a
@@ -37,7 +40,7 @@ import numpy as np
 
 from replication.nav.units import DEG, DEG_PER_H, MICRO_G
 from replication.papers import transcription
-from replication.papers.chen2019 import imu_model, simulation, turntable
+from replication.papers.chen2019 import imu_model, simulation, static_tests, turntable
 from replication.papers.chen2019.scenarios import turntable_chen2019
 
 __all__ = ["TABLE", "SPEC_PAIRS", "analog_input_rows", "printed_temperatures"]
@@ -325,6 +328,7 @@ def analog_input_rows(inputs, load: Callable) -> list[dict]:
         "simulation initial pitch and roll": "°", "simulation speed": "m/s",
         "calibration temperatures (procedure)": "°C", "calibration temperatures (results)": "°C",
         "calibration oven range": "°C", "flight duration (§4.2)": "h", "flight duration (§4.3)": "h",
+        "static test duration": "h",
     }
     data = inputs.data.set_index("quantity")
     for q, unit in need.items():
@@ -340,4 +344,10 @@ def analog_input_rows(inputs, load: Callable) -> list[dict]:
     rows += flight
     rows += _spec_rows(load("chen2019-table-4-43"), load("chen2019-table-4-46"), setup, traj, inputs, at)
     rows += _temperature_rows(inputs, at, printed_temperatures(load))
+    rows.append(dict(
+        quantity="static test duration", unit="h", paper=inputs.value("static test duration"),
+        reproduced=static_tests.RUN_DURATION_S / 3600.0, tolerance=_CONVERSION, tolerance_kind="rel",
+        basis="value",
+        note=("static_tests.RUN_DURATION_S, the length of each run of the static analog of chapter 03"
+              f" (chen2019-check-calibration-allan), s → h; {at('static test duration')}")))
     return rows

@@ -12,6 +12,7 @@ the tests do.
 * :func:`ordering_rows` — the orderings between two turntable experiments (Tables 4-37..4-39);
 * :func:`maneuver_claims`, :func:`model_claims`, :func:`compensation_claims` — the report's claims
   about Tables 2-3, 4-44 and 4-50, each judged on the printed numbers under a stated reading;
+* :func:`gravity_error_terms` — the terms of the gravity-disturbance error (3-8) sized with printed values;
 * :func:`closed_form_rows` — the printed six-position and temperature formulas against their derivation;
 * :data:`TABLE_2_2_CORRECTED_TEXT` — the corrected blocks of Table 2-2.
 """
@@ -21,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from replication.nav import earth
 from replication.nav._validate import nonnegative
 from replication.papers.chen2019.observability import LEVEL_COMBINATIONS, verdict_threshold
 from replication.papers.chen2019.observability_tables import _table, verdict_under
@@ -29,7 +31,7 @@ from replication.papers.chen2019.turntable import QUANTITIES
 
 __all__ = ["closed_form_rows", "compare_verdicts", "column_groups", "EXACT_READING", "figure_4_14_ledger",
            "figure_4_14_range_text", "ordering_rows", "TABLE_2_2_CORRECTED_TEXT", "MANEUVERS", "maneuver_claims",
-           "model_claims", "compensation_claims"]
+           "model_claims", "compensation_claims", "gravity_error_terms"]
 
 
 def _stored_degree(table, state, scenario) -> float:
@@ -596,3 +598,75 @@ def compensation_claims(t50, *, position_bound: float, methods=("normal", "direc
             "decisive": all(c >= level_gain for c in change.values()),
             "changed_markedly": [q for q, c in change.items() if c >= level_gain],
             "better_than_direct": all(v[q][2] < v[q][1] for q in ("pitch", "roll"))}
+
+
+GRAVITY_TERMS = ("attitude error ψ × f", "accelerometer bias C ∇", "velocity error (2ω_ie + ω_en) × δV",
+                 "rate error (2δω_ie + δω_en) × V", "normal-gravity error δg_m")
+"""The terms of chen2019 eq. (3-8) that printed values size, in the order of the equation (δV̇, the
+error of the GNSS acceleration, is the one the print does not size)."""
+
+
+def gravity_error_terms(*, attitude_error: float, specific_force: float, accel_bias: float, velocity_error: float,
+                        position_error: float, height_error: float, speed: float, lat: float) -> dict:
+    """Upper bounds on the terms of the gravity-disturbance error, chen2019 eq. (3-8)::
+
+        δ(δg^n) = δV̇^n − ψ^n × f^n − C_b^n ∇_b + (2δω_ie^n + δω_en^n) × V^n
+                  + (2ω_ie^n + ω_en^n) × δV^n − δg_m^n
+
+    each sized from the magnitudes given (|a × b| ≤ |a||b|): |ψ × f| ≤ ψ f; |C ∇| = ∇;
+    |(2ω_ie + ω_en) × δV| ≤ (2Ω + v/R) δV; |(2δω_ie + δω_en) × V| ≤ (2Ω δp/R + δV/R + v δp/R²) v
+    (δω_ie from the latitude error δp/R, δω_en from the velocity and position errors);
+    |δg_m| ≤ (2γ/R) δh + |∂γ/∂L| δp/R (the free-air gradient and the latitude gradient of
+    :func:`replication.nav.earth.normal_gravity`). R is the mean of the meridian and prime-vertical
+    radii at ``lat``. δV̇ is not sized: it is the error of the GNSS acceleration.
+
+    Parameters
+    ----------
+    attitude_error : float
+        ψ, the level attitude error [rad].
+    specific_force : float
+        |f|, the specific force [m/s²] (g in level unaccelerated flight).
+    accel_bias : float
+        ∇, the accelerometer bias [m/s²].
+    velocity_error, position_error, height_error : float
+        δV [m/s], the horizontal position error δp [m] and the height error δh [m].
+    speed : float
+        v, the speed [m/s].
+    lat : float
+        Latitude [rad].
+
+    Returns
+    -------
+    dict
+        ``terms`` ({name of :data:`GRAVITY_TERMS`: bound, m/s²}), ``dominant`` (the attitude and
+        bias terms each exceed every other sized term), ``margin`` (the smaller of the two over the
+        largest other term).
+
+    Raises
+    ------
+    ValueError
+        When a magnitude is negative or not finite, or ``lat`` is not a latitude.
+    """
+    mags = dict(attitude_error=attitude_error, specific_force=specific_force, accel_bias=accel_bias,
+                velocity_error=velocity_error, position_error=position_error, height_error=height_error,
+                speed=speed)
+    m = {k: nonnegative(v, k) for k, v in mags.items()}
+    lat = float(earth.check_latitude(lat, name="lat"))
+    r_m, r_n = (float(r) for r in earth.radii(lat))
+    radius = 0.5 * (r_m + r_n)
+    gamma = float(earth.normal_gravity(lat, 0.0))
+    step = 1e-6
+    d_gamma = abs(float(earth.normal_gravity(lat + step, 0.0)) - float(earth.normal_gravity(lat - step, 0.0))) / (
+        2 * step)
+    omega, v, dv, dp = earth.OMEGA_IE, m["speed"], m["velocity_error"], m["position_error"]
+    bounds = (
+        m["attitude_error"] * m["specific_force"],
+        m["accel_bias"],
+        (2 * omega + v / radius) * dv,
+        (2 * omega * dp / radius + dv / radius + v * dp / radius**2) * v,
+        2 * gamma / radius * m["height_error"] + d_gamma * dp / radius,
+    )
+    terms = dict(zip(GRAVITY_TERMS, (float(b) for b in bounds)))
+    others = max(terms[k] for k in GRAVITY_TERMS[2:])
+    lead = min(terms[k] for k in GRAVITY_TERMS[:2])
+    return {"terms": terms, "dominant": bool(lead > others), "margin": float(lead / others) if others else np.inf}

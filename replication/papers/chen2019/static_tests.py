@@ -6,7 +6,8 @@
   :func:`reconstruct_missing_pair`);
 * static-data simulation — random constant + first-order Gauss-Markov + white noise, (2-4)-(2-5)
   (:func:`simulate_static_sensor`) — with the Allan deviation through ``allantools``
-  (:func:`allan_deviation`) and the bias stability (:func:`bias_stability`).
+  (:func:`allan_deviation`) and the bias stability (:func:`bias_stability`); the analog runs last
+  :data:`RUN_DURATION_S`, the printed length of one static test.
 
 Units: SI inside (rad, rad/s, m/s^2); the papers' units through :mod:`replication.nav.units`.
 """
@@ -22,6 +23,11 @@ import numpy as np
 
 from replication.nav._validate import finite, finite_array, nonnegative, positive
 from replication.nav.timeseries import gauss_markov
+
+RUN_DURATION_S = 5400.0
+"""Length of one analog static run [s]: chen2019 §4.1 二, step 3) of the static-test procedure
+(试验时间达 1.5 小时), the runs of Tables 4-33 and 4-34; read against the print in
+``chen2019-check-analog-inputs``."""
 
 
 # Summary rows of the static tests (Tables 4-33..4-36): arithmetic with rounding bounds
