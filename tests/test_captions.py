@@ -67,7 +67,10 @@ def test_chen2019_print_parts_hold_what_an_independent_reading_found():
              "unit of the Table 4-2 scale factor against K_i of (4-1)",
              "unit of the Table 4-6 scale factor against K_{ai} of (4-2)",
              "roll run 1: middle-frame travel of the coordinated turn of step (4)",
-             "roll run 2: middle-frame travel of the coordinated turn of step (4)"]
+             "roll run 2: middle-frame travel of the coordinated turn of step (4)",
+             # the independent readings of chs. 1, 5 and 4 §2-§3 (reading.md)
+             "volume of [63] against [65]", "year of [60] against 中国惯性技术学报",
+             "POS AV/610 specification of Table 4-44 against its accuracy after offline processing in ch. 1"]
     assert (t.loc[found, "status"] == "inconsistent").all()
     assert (t.status == "inconsistent").sum() == len(found) + 2  # Tables 4-13 and 4-21 as 4-5 and 4-29
     # B23: the static g self-checks against the 10 μg of conclusion 2 turn on an unprinted quantity
