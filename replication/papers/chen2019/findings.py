@@ -638,7 +638,7 @@ def gravity_error_terms(*, attitude_error: float, specific_force: float, accel_b
     Returns
     -------
     dict
-        ``terms`` ({name of :data:`GRAVITY_TERMS`: bound, m/s²}), ``dominant`` (the attitude and
+        ``terms`` ({name of ``GRAVITY_TERMS``: bound, m/s²}), ``dominant`` (the attitude and
         bias terms each exceed every other sized term), ``margin`` (the smaller of the two over the
         largest other term).
 
