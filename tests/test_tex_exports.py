@@ -298,3 +298,24 @@ def test_export_header_names_the_packages_and_keeps_the_reason():
 def test_overfull_boxes_are_read_from_the_log():
     log = "x\nOverfull \\hbox (12.5pt too wide) in alignment at lines 10--12\nOverfull \\vbox (3.0pt too high) has occurred\n"
     assert overfull_boxes(log) == [("hbox", 12.5, "in alignment at lines 10--12"), ("vbox", 3.0, "has occurred")]
+
+
+def test_a_planted_less_than_sign_is_caught_in_the_compiled_pdf(tmp_path):
+    """End to end: an export whose ``\\textless`` is written back as a bare ``<`` (what OT1 sets as
+    ¡) is compiled and extracted like every export, and the comparison names the cell; the export
+    as stored passes."""
+    exe, text_exe = _tool("pdflatex", "texlive-latex-base"), _tool("pdftotext", "poppler-utils")
+    tid = next(f.stem for f in sorted(rp.tables_dir().glob("*.tex"))
+               if "\\textless" in f.read_text(encoding="utf-8") and "CJK" not in f.read_text(encoding="utf-8"))
+    good = (rp.tables_dir() / f"{tid}.tex").read_text(encoding="utf-8")
+    found = {}
+    for name, text in (("stored", good), ("planted", good.replace("\\textless{}", "<").replace("\\textless", "<"))):
+        (tmp_path / f"{tid}.tex").write_text(text, encoding="utf-8")
+        ok, log = _compile(exe, tmp_path, name, header_packages(text), [tid])
+        assert ok, log
+        raw = subprocess.run([text_exe, "-raw", "-enc", "UTF-8", f"{name}.pdf", "-"], cwd=tmp_path, capture_output=True,
+                             text=True, encoding="utf-8", check=True, timeout=120).stdout
+        chunk = re.split(rf"^{MARK} \S+\n", raw.replace("\f", "\n"), flags=re.M)[1]
+        found[name] = mismatch(pdf_text(chunk), 1, tid)
+    assert found["stored"] is None, found["stored"]
+    assert found["planted"] is not None and "<" in found["planted"], found["planted"]
