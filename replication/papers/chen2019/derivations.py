@@ -53,7 +53,7 @@ from replication.papers.symbolic import Check, rotation_from_quaternion, short, 
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rotation_from_quaternion",
            "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
            "common_conventions", "companion_check", "convention_text", "check_all", "random_constant_rates",
-           "NOISE_ROWS", "NOISE_COLUMNS", "noise_input", "height_gradient_entry", "bias_disturbance_rank",
+           "NOISE_ROWS", "NOISE_COLUMNS", "noise_input", "NOISE_ROWS_2_4", "NOISE_COLUMNS_2_4", "noise_input_2_4", "height_gradient_entry", "bias_disturbance_rank",
            "magnitude_sensitivity", "acceleration_noise_correlation"]
 
 # ----------------------------------------------------------------------------- symbols
@@ -452,7 +452,8 @@ def check_item(name, reading, spec, readings=None) -> Check:
         with each other); ``substitute:<generic item>:<name of (3-4)>`` ((3-8): the perturbation
         of (3-7) with the printed (3-4) substituted); ``constant:<groups, comma-separated>`` (the rates
         of random-constant states, eq. (2-6), :func:`random_constant_rates`); ``noise-input`` (the G_1
-        of the augmented model of §3.3, :func:`noise_input`).
+        of the augmented model of §3.3, :func:`noise_input`); ``noise-input:2.4`` (the G of the
+        39-state model of §2.4, :func:`noise_input_2_4`).
     readings : dict, optional
         Name -> reading of every printed part (needed by ``pair`` and ``substitute``).
 
@@ -508,7 +509,7 @@ def check_item(name, reading, spec, readings=None) -> Check:
     if kind == "constant":
         return _random_constant(name, P, rest.split(","))
     if kind == "noise-input":
-        return _noise_input(name, P)
+        return _noise_input_2_4(name, P) if rest == "2.4" else _noise_input(name, P)
     if kind == "gravity":
         # ENU: the third axis points up, gravity down
         D = sp.Matrix([0, 0, -gam])
@@ -625,17 +626,69 @@ def noise_input(ar_orders=(1, 2, 3)):
     return G1, zero_blocks
 
 
+NOISE_ROWS_2_4 = (("position", 3), ("velocity", 3), ("attitude", 3), ("accel", 3), ("accel", 3), ("accel", 9),
+                  ("gyro", 3), ("gyro", 3), ("gyro", 9))
+"""The 39 rows of G in §2.4 (the row order of the F of Table 2-2), as (sign class, rows): δp, δV, φ, ∇_b,
+∇_m, δK_a and δA, ε_b, ε_m, δK_g and δG."""
+
+NOISE_COLUMNS_2_4 = ("accel", "gyro", "accel", "gyro")
+"""The sign classes of the four noise columns of G in §2.4: w = (ω_a, ω_g, ω_am, ω_gm), eq. (2-10) and (2-5)."""
+
+
+def noise_input_2_4():
+    """The noise-input matrix G of the 39-state model of chen2019 §2.4 (after Table 2-2), derived.
+
+    The navigation rows follow :func:`base_model` with the sensor errors of eq. (2-10),
+    ∇ = ∇_b + ∇_m + ω_a and ε = ε_b + ε_m + ω_g (the scale-factor and misalignment errors multiply
+    f^b and ω^b and carry no noise); the Markov parts follow eq. (2-5), ∇̇_m = −∇_m/β + ω_am and
+    ε̇_m = −ε_m/α + ω_gm; the random constants ∇_b, ε_b (eq. (2-5)), δK_a, δK_g (eq. (2-6)) and the
+    misalignments δA, δG (eq. (2-9)) have zero rates.  G = ∂(rates)/∂(ω_a, ω_g, ω_am, ω_gm), base
+    convention (all signs +1), rows in the order of :data:`NOISE_ROWS_2_4`.
+
+    Returns
+    -------
+    sympy.Matrix, shape (39, 12)
+        The derived G.
+    """
+    base = base_model().rows
+    wa, wg = sp.Matrix(sp.symbols("omega_a1:4", real=True)), sp.Matrix(sp.symbols("omega_g1:4", real=True))
+    wam, wgm = sp.Matrix(sp.symbols("omega_am1:4", real=True)), sp.Matrix(sp.symbols("omega_gm1:4", real=True))
+    nb, nm = sp.Matrix(sp.symbols("nabla_b1:4", real=True)), sp.Matrix(sp.symbols("nabla_m1:4", real=True))
+    eb, em = sp.Matrix(sp.symbols("epsilon_b1:4", real=True)), sp.Matrix(sp.symbols("epsilon_m1:4", real=True))
+    sensors = dict(zip(GROUPS["accel"], nb + nm + wa)) | dict(zip(GROUPS["gyro"], eb + em + wg))   # eq. (2-10)
+    nav = sp.Matrix.vstack(*(base[g] for g in ("position", "velocity", "attitude"))).subs(sensors)
+    rates = sp.Matrix.vstack(nav, sp.zeros(3, 1), -nm / beta + wam,            # ∇_b, ∇_m (eq. (2-5))
+                             sp.zeros(9, 1), sp.zeros(3, 1), -em / alpha + wgm,  # δK_a, δA; ε_b, ε_m
+                             sp.zeros(9, 1))                                     # δK_g, δG
+    return rates.jacobian(sp.Matrix.vstack(wa, wg, wam, wgm))
+
+
 def _noise_input(name, printed):
     D, zero_blocks = noise_input()
     if printed.shape != D.shape:
         raise ValueError(f"{name}: the printed G_1 is {printed.shape}, the derived one {D.shape}")
-    chk = Check(name, "block", derived=D, printed=printed)
     rows = [g for g in NOISE_ROWS for _ in range(3)]
     cols = [g for g in NOISE_COLUMNS for _ in range(3)]
+    return _noise_check(name, printed, D, rows, cols, zero_blocks)
+
+
+def _noise_input_2_4(name, printed):
+    D = noise_input_2_4()
+    if printed.shape != D.shape:
+        raise ValueError(f"{name}: the printed G of §2.4 is {printed.shape}, the derived one {D.shape}")
+    rows = [g for g, n in NOISE_ROWS_2_4 for _ in range(n)]
+    cols = [g for g in NOISE_COLUMNS_2_4 for _ in range(3)]
+    return _noise_check(name, printed, D, rows, cols, {})
+
+
+def _noise_check(name, printed, D, rows, cols, zero_blocks):
+    """A printed noise input against the derived ``D`` under every convention: entry (i, j) carries the
+    signs of its row state ``rows[i]`` and its noise ``cols[j]``."""
+    chk = Check(name, "block", derived=D, printed=printed)
     sign = lambda c, g: c[_SIGN_OF[g]]
 
     def wrong(c):
-        return [(i, j) for i in range(15) for j in range(6)
+        return [(i, j) for i in range(D.rows) for j in range(D.cols)
                 if not is_zero(printed[i, j] - sign(c, rows[i]) * sign(c, cols[j]) * D[i, j])]
     per = {i: wrong(c) for i, c in enumerate(CONVENTIONS)}
     chk.conventions = [c for i, c in enumerate(CONVENTIONS) if not per[i]] if all(zero_blocks.values()) else []
