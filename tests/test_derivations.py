@@ -313,3 +313,14 @@ def test_chapter3_reading_rows_quote_the_transcription_and_judge_as_derived(prin
     assert all("line" in r["paper_text"] for r in rows.values())
     with pytest.raises(ValueError, match="lacks"):
         derivation_rows.chapter3_reading_rows(printed[~printed["quantity"].str.startswith("text: height")], notebook="nb")
+
+
+def test_velocity_equation_3_2_follows_from_newtons_law(checks, readings):
+    c = checks["(3-2)"]
+    assert c.agrees and c.kind == "generic"
+    v, s = readings["(3-2)"]
+    # the Coriolis factor 2 dropped, the rotation terms or gravity with the opposite sign: each seen
+    for bad in (v.replace("2*wie", "wie"), v.replace("- cross(", "+ cross("), v.replace("+ gn", "- gn")):
+        assert bad != v and not dv.check_item("(3-2) planted", bad, s).agrees
+    # the centrifugal term is absorbed in g: no Earth-frame position is left in the derived rate
+    assert not any(str(x).startswith("r") for x in dv.newton_velocity_rate().free_symbols)

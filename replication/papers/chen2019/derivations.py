@@ -54,7 +54,7 @@ __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rot
            "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
            "common_conventions", "companion_check", "convention_text", "check_all", "random_constant_rates",
            "NOISE_ROWS", "NOISE_COLUMNS", "noise_input", "NOISE_ROWS_2_4", "NOISE_COLUMNS_2_4", "noise_input_2_4", "height_gradient_entry", "bias_disturbance_rank",
-           "magnitude_sensitivity", "acceleration_noise_correlation"]
+           "magnitude_sensitivity", "acceleration_noise_correlation", "newton_velocity_rate"]
 
 # ----------------------------------------------------------------------------- symbols
 
@@ -227,7 +227,7 @@ def namespace(generic: bool = False) -> dict:
     generic : bool
         For the perturbation equations (3-3), (3-7), (3-8): adds independent perturbations
         ``df`` (δf^n), ``Dwie``, ``Dwen`` (δω_ie^n, δω_en^n), ``Dg`` (δg^n), ``Vdot``, ``dVdot``,
-        ``gm``, ``dgm`` (g_m^n and its perturbation).
+        ``gm``, ``dgm`` (g_m^n and its perturbation), ``gn`` (g^n).
 
     Returns
     -------
@@ -254,7 +254,7 @@ def namespace(generic: bool = False) -> dict:
     if generic:
         vec = lambda name: sp.Matrix(sp.symbols(f"{name}1:4", real=True))
         ns.update(df=vec("df"), Dwie=vec("Dwie"), Dwen=vec("Dwen"), Dg=vec("Dg"), Vdot=vec("Vdot"),
-                  dVdot=vec("dVdot"), gm=vec("gm"), dgm=vec("dgm"))
+                  dVdot=vec("dVdot"), gm=vec("gm"), dgm=vec("dgm"), gn=vec("gn"))
     return ns
 
 
@@ -414,10 +414,55 @@ def convention_text(convs) -> str:
 
 # ----------------------------------------------------------------------------- the items
 
+def _c_en(lat, lon):
+    """C_e^n of the ENU frame at latitude ``lat`` and longitude ``lon`` (rows E, N, U in Earth-frame components)."""
+    return sp.Matrix([[-sp.sin(lon), sp.cos(lon), 0],
+                      [-sp.sin(lat) * sp.cos(lon), -sp.sin(lat) * sp.sin(lon), sp.cos(lat)],
+                      [sp.cos(lat) * sp.cos(lon), sp.cos(lat) * sp.sin(lon), sp.sin(lat)]])
+
+
+def newton_velocity_rate():
+    """V̇^n from Newton's second law in the inertial frame, chen2019 eq. (3-2) derived.
+
+    r^i = C_e^i(t) r^e(t) with C_e^i a rotation by ω_ie t about the polar axis (the inertial frame
+    taken along the Earth frame at the instant considered, t = 0); d²r^i/dt² = f^i + G^i (specific
+    force plus gravitation); V^n = C_e^n(L(t), λ(t)) ṙ^e, the ground velocity in ENU; gravity is
+    gravitation plus the centrifugal term, g = G − ω_ie × (ω_ie × r); L̇ and λ̇ from the position
+    rates of eq. (3-14).  Differentiation by sympy; no transport theorem is assumed.
+
+    Returns
+    -------
+    sympy.Matrix, shape (3, 1)
+        V̇^n in the symbols of :func:`namespace` (``f``, ``V``) and ``gn`` (g^n), with the
+        longitude ``lambda`` (which must drop out; :func:`check_item` tests it exactly).
+    """
+    t, lam = sp.Symbol("t", real=True), sp.Symbol("lambda", real=True)
+    lat_t, lon_t = sp.Function("L")(t), sp.Function("lambda")(t)
+    r = sp.Matrix([sp.Function(f"r{i}")(t) for i in range(1, 4)])
+    Cen = _c_en(lat_t, lon_t)
+    Cei = sp.Matrix([[sp.cos(w * t), -sp.sin(w * t), 0], [sp.sin(w * t), sp.cos(w * t), 0], [0, 0, 1]])
+    fn, gravitation = sp.Matrix([fE, fN, fU]), sp.Matrix(sp.symbols("G1:4", real=True))
+    gn = sp.Matrix(sp.symbols("gn1:4", real=True))
+    # Newton: d²(C_e^i r^e)/dt² = C_e^i C_n^e (f^n + G^n), solved for r̈^e
+    acc_i = (Cei * r).diff(t, 2)
+    rdd = Cei.T * (Cei * Cen.T * (fn + gravitation) - (acc_i - Cei * r.diff(t, 2)))
+    vdot = Cen.diff(t) * r.diff(t) + Cen * rdd
+    we = sp.Matrix([0, 0, w])
+    vdot = vdot.subs(dict(zip(gravitation, gn + Cen * _cross(we, _cross(we, r)))))   # G = g + ω × (ω × r)
+    vd = sp.Matrix(sp.symbols("vd1:4", real=True))
+    vdot = vdot.subs({r[i].diff(t): vd[i] for i in range(3)})
+    vdot = vdot.subs({lat_t.diff(t): VN / (Rm + h), lon_t.diff(t): VE / ((Rn + h) * sp.cos(lat_t))})
+    vdot = vdot.subs({lat_t: L, lon_t: lam}).subs(t, 0)
+    vdot = vdot.subs(dict(zip(vd, _c_en(L, lam).T * sp.Matrix([VE, VN, VU]))))   # ṙ^e = C_n^e V^n
+    return vdot.applyfunc(sp.expand)
+
+
 def _generic_derivation(item):
     ns = namespace(generic=True)
     e = sp.Symbol("e")
     cr = _cross
+    if item == "Newton's second law in the navigation frame":
+        return newton_velocity_rate()
     if item == "perturbation of (3-2)":
         rhs = lambda f_, wie_, wen_, v_, g_: f_ - cr(2 * wie_ + wen_, v_) + g_
         return sp.diff(rhs(ns["f"] + e * ns["df"], ns["wie"] + e * ns["Dwie"], ns["wen"] + e * ns["Dwen"],
@@ -475,9 +520,10 @@ def check_item(name, reading, spec, readings=None) -> Check:
         if kind == "substitute":
             ns = namespace(generic=True)
             D = D.subs(dict(zip(ns["df"], parse(readings[other], generic=True))))
-        ok = all(is_zero(x) for x in (P - D))
+        zero = (lambda x: vanishes(x, (L, sp.Symbol("lambda", real=True)))) if item.startswith("Newton") else is_zero
+        ok = all(zero(x) for x in (P - D))
         diff = [] if ok else [(f"row {i + 1}", _short(P[i]), _short(D[i])) for i in range(P.rows)
-                              if not is_zero(P[i] - D[i])]
+                              if not zero(P[i] - D[i])]
         return Check(name, "generic", conventions=list(CONVENTIONS) if ok else [], differing=diff, derived=D, printed=P)
     P = parse(reading)
     if kind in ("equation", "block"):
