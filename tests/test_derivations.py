@@ -324,3 +324,11 @@ def test_velocity_equation_3_2_follows_from_newtons_law(checks, readings):
         assert bad != v and not dv.check_item("(3-2) planted", bad, s).agrees
     # the centrifugal term is absorbed in g: no Earth-frame position is left in the derived rate
     assert not any(str(x).startswith("r") for x in dv.newton_velocity_rate().free_symbols)
+
+
+def test_imu_error_model_2_10_is_2_4_substituted_into_2_3(checks, readings):
+    assert checks["(2-10)"].agrees
+    v, s = readings["(2-10)"]
+    # the white noises of the two sensors exchanged, or a misalignment term with the wrong sign: each seen
+    for bad in (v.replace("+ w_g +", "+ w_a +", 1), v.replace("(dKa + dA)", "(dKa - dA)")):
+        assert bad != v and not dv.check_item("(2-10) planted", bad, s).agrees

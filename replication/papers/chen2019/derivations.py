@@ -227,7 +227,9 @@ def namespace(generic: bool = False) -> dict:
     generic : bool
         For the perturbation equations (3-3), (3-7), (3-8): adds independent perturbations
         ``df`` (δf^n), ``Dwie``, ``Dwen`` (δω_ie^n, δω_en^n), ``Dg`` (δg^n), ``Vdot``, ``dVdot``,
-        ``gm``, ``dgm`` (g_m^n and its perturbation), ``gn`` (g^n).
+        ``gm``, ``dgm`` (g_m^n and its perturbation), ``gn`` (g^n); the sensor-error parts of
+        (2-4) ``eps_b``, ``eps_m``, ``w_g``, ``nabla_b``, ``nabla_m``, ``w_a`` and the misalignment
+        matrices ``dG``, ``dA``.
 
     Returns
     -------
@@ -254,7 +256,10 @@ def namespace(generic: bool = False) -> dict:
     if generic:
         vec = lambda name: sp.Matrix(sp.symbols(f"{name}1:4", real=True))
         ns.update(df=vec("df"), Dwie=vec("Dwie"), Dwen=vec("Dwen"), Dg=vec("Dg"), Vdot=vec("Vdot"),
-                  dVdot=vec("dVdot"), gm=vec("gm"), dgm=vec("dgm"), gn=vec("gn"))
+                  dVdot=vec("dVdot"), gm=vec("gm"), dgm=vec("dgm"), gn=vec("gn"), eps_b=vec("eps_b"),
+                  eps_m=vec("eps_m"), w_g=vec("w_g"), nabla_b=vec("nabla_b"), nabla_m=vec("nabla_m"),
+                  w_a=vec("w_a"), dG=sp.Matrix(3, 3, lambda i, j: sp.Symbol(f"dG{i}{j}", real=True)),
+                  dA=sp.Matrix(3, 3, lambda i, j: sp.Symbol(f"dA{i}{j}", real=True)))
     return ns
 
 
@@ -463,6 +468,12 @@ def _generic_derivation(item):
     cr = _cross
     if item == "Newton's second law in the navigation frame":
         return newton_velocity_rate()
+    if item == "(2-4) substituted into (2-3)":
+        # (2-3): δω = ε + (δK_g + δG) ω_ib^b, δf = ∇ + (δK_a + δA) f^b; (2-4): ε = ε_b + ε_m + ω_g, ∇ = ∇_b + ∇_m + ω_a
+        eps, nab = sp.Matrix(sp.symbols("eps1:4", real=True)), sp.Matrix(sp.symbols("nab1:4", real=True))
+        model = sp.Matrix.vstack(eps + (ns["dKg"] + ns["dG"]) * ns["wb"], nab + (ns["dKa"] + ns["dA"]) * ns["fb"])
+        return model.subs(dict(zip(eps, ns["eps_b"] + ns["eps_m"] + ns["w_g"]))
+                          | dict(zip(nab, ns["nabla_b"] + ns["nabla_m"] + ns["w_a"])))
     if item == "perturbation of (3-2)":
         rhs = lambda f_, wie_, wen_, v_, g_: f_ - cr(2 * wie_ + wen_, v_) + g_
         return sp.diff(rhs(ns["f"] + e * ns["df"], ns["wie"] + e * ns["Dwie"], ns["wen"] + e * ns["Dwen"],
