@@ -230,6 +230,38 @@ def test_noise_input_of_3_3_enters_where_the_biases_enter(checks, readings):
         dv.check_item("G short", "zeros(9, 6)", s)
 
 
+G24 = "§2.4 G (noise input of the 39-state model)"
+
+
+def test_noise_input_of_2_4_enters_where_the_biases_enter(checks, readings, printed):
+    c = checks[G24]
+    assert c.agrees
+    assert c.conventions == dv.common_conventions([checks[p] for p in derivation_rows.NOISE_INPUT_PARTS_2_4])
+    D = dv.noise_input_2_4()
+    assert D.shape == (39, 12)
+    # the white noises enter where the §3.3 derivation puts them, the Markov noises with unit gain
+    assert D[3:9, :6] == dv.noise_input()[0][3:9, :]
+    assert D[12:15, 6:9] == sp.eye(3) and D[27:30, 9:12] == sp.eye(3)
+    assert sum(1 for x in D if x != 0) == 9 + 9 + 3 + 3
+    v, s = readings[G24]
+    # a Markov noise entering with -I, a factor 2 on C_b^n, the two white-noise blocks swapped: each seen
+    planted = [v.replace("eye(3), zeros(3, 3))", "-eye(3), zeros(3, 3))"),
+               v.replace("Matrix.hstack( C, zeros(3, 9))", "Matrix.hstack( 2*C, zeros(3, 9))"),
+               v.replace("Matrix.hstack( C, zeros(3, 9)), Matrix.hstack( zeros(3, 3), C, zeros(3, 6))",
+                         "Matrix.hstack( zeros(3, 3), C, zeros(3, 6)), Matrix.hstack( C, zeros(3, 9))")]
+    for bad in planted:
+        assert bad != v and not dv.check_item("G planted", bad, s).agrees
+    # the attitude block negated: a convention absorbs it, but not the one of the Table 2-2 bias columns
+    neg = dv.check_item("G negated", v.replace("zeros(3, 3), C, zeros(3, 6)", "zeros(3, 3), -C, zeros(3, 6)"), s)
+    assert neg.agrees
+    assert dv.common_conventions([neg, *(checks[p] for p in derivation_rows.NOISE_INPUT_PARTS_2_4)]) == []
+    with pytest.raises(ValueError, match="39, 12"):
+        dv.check_item("G short", "zeros(36, 12)", s)
+    rows = {r["quantity"]: r for r in derivation_rows.derivation_rows(checks, printed, ar_order=3, notebook="nb")}
+    assert rows[G24]["basis"] == "derivation" and rows[G24]["agrees"]
+    assert "the noise enters where the bias enters" in rows[G24]["note"]
+
+
 def test_the_two_new_rows_are_derivations(checks, printed):
     rows = {r["quantity"]: r for r in derivation_rows.derivation_rows(checks, printed, ar_order=3, notebook="nb")}
     for q in ("(2-6)", G1):
@@ -281,3 +313,22 @@ def test_chapter3_reading_rows_quote_the_transcription_and_judge_as_derived(prin
     assert all("line" in r["paper_text"] for r in rows.values())
     with pytest.raises(ValueError, match="lacks"):
         derivation_rows.chapter3_reading_rows(printed[~printed["quantity"].str.startswith("text: height")], notebook="nb")
+
+
+def test_velocity_equation_3_2_follows_from_newtons_law(checks, readings):
+    c = checks["(3-2)"]
+    assert c.agrees and c.kind == "generic"
+    v, s = readings["(3-2)"]
+    # the Coriolis factor 2 dropped, the rotation terms or gravity with the opposite sign: each seen
+    for bad in (v.replace("2*wie", "wie"), v.replace("- cross(", "+ cross("), v.replace("+ gn", "- gn")):
+        assert bad != v and not dv.check_item("(3-2) planted", bad, s).agrees
+    # the centrifugal term is absorbed in g: no Earth-frame position is left in the derived rate
+    assert not any(str(x).startswith("r") for x in dv.newton_velocity_rate().free_symbols)
+
+
+def test_imu_error_model_2_10_is_2_4_substituted_into_2_3(checks, readings):
+    assert checks["(2-10)"].agrees
+    v, s = readings["(2-10)"]
+    # the white noises of the two sensors exchanged, or a misalignment term with the wrong sign: each seen
+    for bad in (v.replace("+ w_g +", "+ w_a +", 1), v.replace("(dKa + dA)", "(dKa - dA)")):
+        assert bad != v and not dv.check_item("(2-10) planted", bad, s).agrees

@@ -38,7 +38,7 @@ from replication.papers.an2021.transfer import (
 __all__ = ["SYMBOLS", "symbolic_system_matrix", "symbolic_error_model_from_vectors",
            "symbolic_transfer_functions", "coefficient", "printed_namespace", "parse_printed", "evaluate_at",
            "evaluate", "is_identity", "coefficient_location", "derived_coefficient",
-           "printed_in_derived_normalization", "coefficient_checks"]
+           "printed_in_derived_normalization", "coefficient_checks", "low_frequency_gain"]
 
 
 # --------------------------------------------------------------------------- symbolic
@@ -201,6 +201,39 @@ def symbolic_transfer_functions(motion):
         pd = sp.Poly([sp.factor(sp.trigsimp(k)) for k in pd.all_coeffs()], s)
         out[pair] = (pn, pd, common)
     return out
+
+
+def low_frequency_gain(motion, pair):
+    """The s → 0 limit of ϕ_E/g_dN or ϕ_N/g_dE, the low-frequency gains of an2021 eqs. (11)-(12).
+
+    The ratio of the constant coefficients of the numerator and denominator of
+    :func:`symbolic_transfer_functions` (the pure SINS of eq. (1)): 1/g and −R/(Rg + 2V_N²) for
+    north-south motion; for east-west motion ϕ_N/g_dE = −1/g and ϕ_E/g_dN = 1/g up to terms in
+    V_E ω_ie and V_E²/R.
+
+    Parameters
+    ----------
+    motion : {"north-south", "east-west"}
+        The motion of :func:`symbolic_transfer_functions`.
+    pair : {"phiE/gdN", "phiN/gdE"}
+        The transfer function.
+
+    Returns
+    -------
+    sympy.Expr
+        The gain [rad/(m/s²)] in the symbols of :data:`SYMBOLS`.
+
+    Raises
+    ------
+    ValueError
+        If ``motion`` or ``pair`` is not one of those named, or the closed form has a pole at s = 0.
+    """
+    choice(pair, PAIRS, "pair", _NOT_ONE_OF)
+    num, den, _ = symbolic_transfer_functions(motion)[pair]
+    d0 = coefficient(den, 0)
+    if sp.simplify(d0) == 0:
+        raise ValueError(f"{pair} for {motion} motion has a pole at s = 0: no finite low-frequency gain")
+    return sp.factor(sp.simplify(coefficient(num, 0) / d0))
 
 
 def coefficient(poly, power):

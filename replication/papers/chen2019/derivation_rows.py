@@ -24,7 +24,7 @@ import pandas as pd
 from replication.papers.symbolic import spaced
 
 __all__ = ["derivation_rows", "chapter3_reading_rows", "chapter2_rows", "DERIVATION_GROUPS",
-           "SENSOR_SIGN_GROUPS", "NOISE_INPUT_PARTS"]
+           "SENSOR_SIGN_GROUPS", "NOISE_INPUT_PARTS", "NOISE_INPUT_PARTS_2_4"]
 
 
 # --------------------------------------------------------------------------- the printed model, derived
@@ -108,15 +108,25 @@ def _entries(c, label=("printed", "derived")) -> str:
 NOISE_INPUT_PARTS = ("(3-17) F2, velocity rows", "(3-17) F2, attitude rows")
 """The printed bias columns of F whose conventions the noise input G_1 of §3.3 is compared with."""
 
+NOISE_INPUT_PARTS_2_4 = ("Table 2-2 velocity rows, bias columns", "Table 2-2 attitude rows, drift columns")
+"""The printed bias columns of F whose conventions the noise input G of §2.4 is compared with."""
+
 
 def _derived_remark(spec: str, c, checks: dict) -> str:
-    """What a derivable part's row adds to "every term derived": how (2-6) and G_1 of §3.3 were derived."""
+    """What a derivable part's row adds to "every term derived": how (2-6), G of §2.4 and G_1 of §3.3 were derived."""
     from replication.papers.chen2019 import derivations as dv
 
     kind = spec.split(":")[0]
     if kind == "constant":
         return ("; derived twice: x(t) = x(t_0) gives dx/dt = 0, and the Gauss-Markov rate -x/τ of (2-5) tends to 0 "
                 "as τ → ∞ (no driving noise)")
+    if kind == "noise-input" and spec == "noise-input:2.4":
+        f = [checks[p] for p in NOISE_INPUT_PARTS_2_4 if p in checks]
+        same = bool(f) and dv.convention_text(dv.common_conventions(f)) == dv.convention_text(c.conventions)
+        return ("; G = ∂(rates)/∂(ω_a, ω_g, ω_am, ω_gm) with the sensor errors of (2-10) and the Markov rates of (2-5); "
+                + ("the conventions of the Table 2-2 bias columns (the noise enters where the bias enters)"
+                   if same else "conventions other than those of the Table 2-2 bias columns")
+                + "; a G column's sign leaves G Q G^T unchanged")
     if kind == "noise-input":
         f2 = [checks[p] for p in NOISE_INPUT_PARTS if p in checks]
         same = bool(f2) and dv.convention_text(dv.common_conventions(f2)) == dv.convention_text(c.conventions)

@@ -53,8 +53,8 @@ from replication.papers.symbolic import Check, rotation_from_quaternion, short, 
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rotation_from_quaternion",
            "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
            "common_conventions", "companion_check", "convention_text", "check_all", "random_constant_rates",
-           "NOISE_ROWS", "NOISE_COLUMNS", "noise_input", "height_gradient_entry", "bias_disturbance_rank",
-           "magnitude_sensitivity", "acceleration_noise_correlation"]
+           "NOISE_ROWS", "NOISE_COLUMNS", "noise_input", "NOISE_ROWS_2_4", "NOISE_COLUMNS_2_4", "noise_input_2_4", "height_gradient_entry", "bias_disturbance_rank",
+           "magnitude_sensitivity", "acceleration_noise_correlation", "newton_velocity_rate"]
 
 # ----------------------------------------------------------------------------- symbols
 
@@ -227,7 +227,9 @@ def namespace(generic: bool = False) -> dict:
     generic : bool
         For the perturbation equations (3-3), (3-7), (3-8): adds independent perturbations
         ``df`` (δf^n), ``Dwie``, ``Dwen`` (δω_ie^n, δω_en^n), ``Dg`` (δg^n), ``Vdot``, ``dVdot``,
-        ``gm``, ``dgm`` (g_m^n and its perturbation).
+        ``gm``, ``dgm`` (g_m^n and its perturbation), ``gn`` (g^n); the sensor-error parts of
+        (2-4) ``eps_b``, ``eps_m``, ``w_g``, ``nabla_b``, ``nabla_m``, ``w_a`` and the misalignment
+        matrices ``dG``, ``dA``.
 
     Returns
     -------
@@ -254,7 +256,10 @@ def namespace(generic: bool = False) -> dict:
     if generic:
         vec = lambda name: sp.Matrix(sp.symbols(f"{name}1:4", real=True))
         ns.update(df=vec("df"), Dwie=vec("Dwie"), Dwen=vec("Dwen"), Dg=vec("Dg"), Vdot=vec("Vdot"),
-                  dVdot=vec("dVdot"), gm=vec("gm"), dgm=vec("dgm"))
+                  dVdot=vec("dVdot"), gm=vec("gm"), dgm=vec("dgm"), gn=vec("gn"), eps_b=vec("eps_b"),
+                  eps_m=vec("eps_m"), w_g=vec("w_g"), nabla_b=vec("nabla_b"), nabla_m=vec("nabla_m"),
+                  w_a=vec("w_a"), dG=sp.Matrix(3, 3, lambda i, j: sp.Symbol(f"dG{i}{j}", real=True)),
+                  dA=sp.Matrix(3, 3, lambda i, j: sp.Symbol(f"dA{i}{j}", real=True)))
     return ns
 
 
@@ -414,10 +419,61 @@ def convention_text(convs) -> str:
 
 # ----------------------------------------------------------------------------- the items
 
+def _c_en(lat, lon):
+    """C_e^n of the ENU frame at latitude ``lat`` and longitude ``lon`` (rows E, N, U in Earth-frame components)."""
+    return sp.Matrix([[-sp.sin(lon), sp.cos(lon), 0],
+                      [-sp.sin(lat) * sp.cos(lon), -sp.sin(lat) * sp.sin(lon), sp.cos(lat)],
+                      [sp.cos(lat) * sp.cos(lon), sp.cos(lat) * sp.sin(lon), sp.sin(lat)]])
+
+
+def newton_velocity_rate():
+    """V̇^n from Newton's second law in the inertial frame, chen2019 eq. (3-2) derived.
+
+    r^i = C_e^i(t) r^e(t) with C_e^i a rotation by ω_ie t about the polar axis (the inertial frame
+    taken along the Earth frame at the instant considered, t = 0); d²r^i/dt² = f^i + G^i (specific
+    force plus gravitation); V^n = C_e^n(L(t), λ(t)) ṙ^e, the ground velocity in ENU; gravity is
+    gravitation plus the centrifugal term, g = G − ω_ie × (ω_ie × r); L̇ and λ̇ from the position
+    rates of eq. (3-14).  Differentiation by sympy; no transport theorem is assumed.
+
+    Returns
+    -------
+    sympy.Matrix, shape (3, 1)
+        V̇^n in the symbols of :func:`namespace` (``f``, ``V``) and ``gn`` (g^n), with the
+        longitude ``lambda`` (which must drop out; :func:`check_item` tests it exactly).
+    """
+    t, lam = sp.Symbol("t", real=True), sp.Symbol("lambda", real=True)
+    lat_t, lon_t = sp.Function("L")(t), sp.Function("lambda")(t)
+    r = sp.Matrix([sp.Function(f"r{i}")(t) for i in range(1, 4)])
+    Cen = _c_en(lat_t, lon_t)
+    Cei = sp.Matrix([[sp.cos(w * t), -sp.sin(w * t), 0], [sp.sin(w * t), sp.cos(w * t), 0], [0, 0, 1]])
+    fn, gravitation = sp.Matrix([fE, fN, fU]), sp.Matrix(sp.symbols("G1:4", real=True))
+    gn = sp.Matrix(sp.symbols("gn1:4", real=True))
+    # Newton: d²(C_e^i r^e)/dt² = C_e^i C_n^e (f^n + G^n), solved for r̈^e
+    acc_i = (Cei * r).diff(t, 2)
+    rdd = Cei.T * (Cei * Cen.T * (fn + gravitation) - (acc_i - Cei * r.diff(t, 2)))
+    vdot = Cen.diff(t) * r.diff(t) + Cen * rdd
+    we = sp.Matrix([0, 0, w])
+    vdot = vdot.subs(dict(zip(gravitation, gn + Cen * _cross(we, _cross(we, r)))))   # G = g + ω × (ω × r)
+    vd = sp.Matrix(sp.symbols("vd1:4", real=True))
+    vdot = vdot.subs({r[i].diff(t): vd[i] for i in range(3)})
+    vdot = vdot.subs({lat_t.diff(t): VN / (Rm + h), lon_t.diff(t): VE / ((Rn + h) * sp.cos(lat_t))})
+    vdot = vdot.subs({lat_t: L, lon_t: lam}).subs(t, 0)
+    vdot = vdot.subs(dict(zip(vd, _c_en(L, lam).T * sp.Matrix([VE, VN, VU]))))   # ṙ^e = C_n^e V^n
+    return vdot.applyfunc(sp.expand)
+
+
 def _generic_derivation(item):
     ns = namespace(generic=True)
     e = sp.Symbol("e")
     cr = _cross
+    if item == "Newton's second law in the navigation frame":
+        return newton_velocity_rate()
+    if item == "(2-4) substituted into (2-3)":
+        # (2-3): δω = ε + (δK_g + δG) ω_ib^b, δf = ∇ + (δK_a + δA) f^b; (2-4): ε = ε_b + ε_m + ω_g, ∇ = ∇_b + ∇_m + ω_a
+        eps, nab = sp.Matrix(sp.symbols("eps1:4", real=True)), sp.Matrix(sp.symbols("nab1:4", real=True))
+        model = sp.Matrix.vstack(eps + (ns["dKg"] + ns["dG"]) * ns["wb"], nab + (ns["dKa"] + ns["dA"]) * ns["fb"])
+        return model.subs(dict(zip(eps, ns["eps_b"] + ns["eps_m"] + ns["w_g"]))
+                          | dict(zip(nab, ns["nabla_b"] + ns["nabla_m"] + ns["w_a"])))
     if item == "perturbation of (3-2)":
         rhs = lambda f_, wie_, wen_, v_, g_: f_ - cr(2 * wie_ + wen_, v_) + g_
         return sp.diff(rhs(ns["f"] + e * ns["df"], ns["wie"] + e * ns["Dwie"], ns["wen"] + e * ns["Dwen"],
@@ -452,7 +508,8 @@ def check_item(name, reading, spec, readings=None) -> Check:
         with each other); ``substitute:<generic item>:<name of (3-4)>`` ((3-8): the perturbation
         of (3-7) with the printed (3-4) substituted); ``constant:<groups, comma-separated>`` (the rates
         of random-constant states, eq. (2-6), :func:`random_constant_rates`); ``noise-input`` (the G_1
-        of the augmented model of §3.3, :func:`noise_input`).
+        of the augmented model of §3.3, :func:`noise_input`); ``noise-input:2.4`` (the G of the
+        39-state model of §2.4, :func:`noise_input_2_4`).
     readings : dict, optional
         Name -> reading of every printed part (needed by ``pair`` and ``substitute``).
 
@@ -474,9 +531,10 @@ def check_item(name, reading, spec, readings=None) -> Check:
         if kind == "substitute":
             ns = namespace(generic=True)
             D = D.subs(dict(zip(ns["df"], parse(readings[other], generic=True))))
-        ok = all(is_zero(x) for x in (P - D))
+        zero = (lambda x: vanishes(x, (L, sp.Symbol("lambda", real=True)))) if item.startswith("Newton") else is_zero
+        ok = all(zero(x) for x in (P - D))
         diff = [] if ok else [(f"row {i + 1}", _short(P[i]), _short(D[i])) for i in range(P.rows)
-                              if not is_zero(P[i] - D[i])]
+                              if not zero(P[i] - D[i])]
         return Check(name, "generic", conventions=list(CONVENTIONS) if ok else [], differing=diff, derived=D, printed=P)
     P = parse(reading)
     if kind in ("equation", "block"):
@@ -508,7 +566,7 @@ def check_item(name, reading, spec, readings=None) -> Check:
     if kind == "constant":
         return _random_constant(name, P, rest.split(","))
     if kind == "noise-input":
-        return _noise_input(name, P)
+        return _noise_input_2_4(name, P) if rest == "2.4" else _noise_input(name, P)
     if kind == "gravity":
         # ENU: the third axis points up, gravity down
         D = sp.Matrix([0, 0, -gam])
@@ -625,17 +683,69 @@ def noise_input(ar_orders=(1, 2, 3)):
     return G1, zero_blocks
 
 
+NOISE_ROWS_2_4 = (("position", 3), ("velocity", 3), ("attitude", 3), ("accel", 3), ("accel", 3), ("accel", 9),
+                  ("gyro", 3), ("gyro", 3), ("gyro", 9))
+"""The 39 rows of G in §2.4 (the row order of the F of Table 2-2), as (sign class, rows): δp, δV, φ, ∇_b,
+∇_m, δK_a and δA, ε_b, ε_m, δK_g and δG."""
+
+NOISE_COLUMNS_2_4 = ("accel", "gyro", "accel", "gyro")
+"""The sign classes of the four noise columns of G in §2.4: w = (ω_a, ω_g, ω_am, ω_gm), eq. (2-10) and (2-5)."""
+
+
+def noise_input_2_4():
+    """The noise-input matrix G of the 39-state model of chen2019 §2.4 (after Table 2-2), derived.
+
+    The navigation rows follow :func:`base_model` with the sensor errors of eq. (2-10),
+    ∇ = ∇_b + ∇_m + ω_a and ε = ε_b + ε_m + ω_g (the scale-factor and misalignment errors multiply
+    f^b and ω^b and carry no noise); the Markov parts follow eq. (2-5), ∇̇_m = −∇_m/β + ω_am and
+    ε̇_m = −ε_m/α + ω_gm; the random constants ∇_b, ε_b (eq. (2-5)), δK_a, δK_g (eq. (2-6)) and the
+    misalignments δA, δG (eq. (2-9)) have zero rates.  G = ∂(rates)/∂(ω_a, ω_g, ω_am, ω_gm), base
+    convention (all signs +1), rows in the order of :data:`NOISE_ROWS_2_4`.
+
+    Returns
+    -------
+    sympy.Matrix, shape (39, 12)
+        The derived G.
+    """
+    base = base_model().rows
+    wa, wg = sp.Matrix(sp.symbols("omega_a1:4", real=True)), sp.Matrix(sp.symbols("omega_g1:4", real=True))
+    wam, wgm = sp.Matrix(sp.symbols("omega_am1:4", real=True)), sp.Matrix(sp.symbols("omega_gm1:4", real=True))
+    nb, nm = sp.Matrix(sp.symbols("nabla_b1:4", real=True)), sp.Matrix(sp.symbols("nabla_m1:4", real=True))
+    eb, em = sp.Matrix(sp.symbols("epsilon_b1:4", real=True)), sp.Matrix(sp.symbols("epsilon_m1:4", real=True))
+    sensors = dict(zip(GROUPS["accel"], nb + nm + wa)) | dict(zip(GROUPS["gyro"], eb + em + wg))   # eq. (2-10)
+    nav = sp.Matrix.vstack(*(base[g] for g in ("position", "velocity", "attitude"))).subs(sensors)
+    rates = sp.Matrix.vstack(nav, sp.zeros(3, 1), -nm / beta + wam,            # ∇_b, ∇_m (eq. (2-5))
+                             sp.zeros(9, 1), sp.zeros(3, 1), -em / alpha + wgm,  # δK_a, δA; ε_b, ε_m
+                             sp.zeros(9, 1))                                     # δK_g, δG
+    return rates.jacobian(sp.Matrix.vstack(wa, wg, wam, wgm))
+
+
 def _noise_input(name, printed):
     D, zero_blocks = noise_input()
     if printed.shape != D.shape:
         raise ValueError(f"{name}: the printed G_1 is {printed.shape}, the derived one {D.shape}")
-    chk = Check(name, "block", derived=D, printed=printed)
     rows = [g for g in NOISE_ROWS for _ in range(3)]
     cols = [g for g in NOISE_COLUMNS for _ in range(3)]
+    return _noise_check(name, printed, D, rows, cols, zero_blocks)
+
+
+def _noise_input_2_4(name, printed):
+    D = noise_input_2_4()
+    if printed.shape != D.shape:
+        raise ValueError(f"{name}: the printed G of §2.4 is {printed.shape}, the derived one {D.shape}")
+    rows = [g for g, n in NOISE_ROWS_2_4 for _ in range(n)]
+    cols = [g for g in NOISE_COLUMNS_2_4 for _ in range(3)]
+    return _noise_check(name, printed, D, rows, cols, {})
+
+
+def _noise_check(name, printed, D, rows, cols, zero_blocks):
+    """A printed noise input against the derived ``D`` under every convention: entry (i, j) carries the
+    signs of its row state ``rows[i]`` and its noise ``cols[j]``."""
+    chk = Check(name, "block", derived=D, printed=printed)
     sign = lambda c, g: c[_SIGN_OF[g]]
 
     def wrong(c):
-        return [(i, j) for i in range(15) for j in range(6)
+        return [(i, j) for i in range(D.rows) for j in range(D.cols)
                 if not is_zero(printed[i, j] - sign(c, rows[i]) * sign(c, cols[j]) * D[i, j])]
     per = {i: wrong(c) for i, c in enumerate(CONVENTIONS)}
     chk.conventions = [c for i, c in enumerate(CONVENTIONS) if not per[i]] if all(zero_blocks.values()) else []
