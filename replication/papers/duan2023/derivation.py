@@ -8,8 +8,7 @@ under each reading of the printed angle β (``READINGS``), at the kinematic stat
 :mod:`replication.papers.duan2023.printed`.
 
 Eq. (1), the SINS error equation the paper cites without printing, is rebuilt from the navigation
-core's 15-state model: :func:`sins_error_matrix`, :func:`eq1_checks`; its printed structure is derived
-symbolically from first principles by :func:`eq1_symbolic`.
+core's 15-state model: :func:`sins_error_matrix`, :func:`eq1_checks`.
 
 The printed equations that define the geometry or state an assumption — (2), (3), the chain of
 ratios (8), (9), (10) and (17) — are checked by :func:`check_part` against Fig. 1 rebuilt from the
@@ -31,7 +30,7 @@ import numpy as np
 from replication.nav import earth
 from replication.nav.errors import NavPoint, model_15
 
-__all__ = ["STATE_NAMES", "reference_state", "derived_coefficients", "sins_error_matrix", "eq1_checks", "eq1_symbolic",
+__all__ = ["STATE_NAMES", "reference_state", "derived_coefficients", "sins_error_matrix", "eq1_checks",
            "MOTIONS", "SPECS", "NUMERIC_DH", "LINK_TOLERANCE", "TRACK_TURN_DEG", "reading_names", "parse_reading",
            "motion_states", "PrintedCheck", "check_part", "check_printed"]
 
@@ -270,45 +269,6 @@ def eq1_checks(point):
             "position forcing largest element": float(max(np.max(np.abs(m["G_gyro"][6:9])),
                                                           np.max(np.abs(m["G_accel"][6:9])))),
             "F vs numerical Jacobian (max column-relative difference)": float(np.max(np.abs(Fa - Fn) / col))}
-
-
-def eq1_symbolic():
-    """The printed structure of duan2023 eq. (1) derived symbolically (sympy), from first principles.
-
-    The ENU error rates are those of :func:`replication.papers.chen2019.derivations.base_model`:
-    the mechanization L̇ = V_N/(R_M+h), λ̇ = V_E sec L/(R_N+h), ḣ = V_U,
-    V̇ = C_b^n f^b − (2ω_ie^n + ω_en^n) × V + g, Ċ_b^n = C_b^n(ω_ib^b×) − (ω_in^n×)C_b^n, perturbed
-    with the errors computed − true, Ĉ_b^n = (I − φ×)C_b^n and the sensor errors measured − true
-    (δf^b, δω_ib^b), and linearised.  Read off: the attitude-error column of the position rows
-    (M_pφ of eq. (1)), the gyro forcing of the attitude rows and the accelerometer forcing of the
-    velocity rows (each a multiple k of C_b^n), and the forcing of the position rows.
-
-    Returns
-    -------
-    dict of str to float
-        The keys of :func:`eq1_checks`: ``block (p; phi) largest element`` (0 when the derived
-        block vanishes identically, else ``inf``), ``gyro forcing coefficient of C_b^n`` and
-        ``accelerometer forcing coefficient of C_b^n`` (k, or ``nan`` when the derived block is
-        not a multiple of C_b^n), ``position forcing largest element`` (0 or ``inf``).
-    """
-    import sympy as sp
-
-    from replication.papers.chen2019 import derivations as dv
-
-    rows, groups, C = dv.base_model().rows, dv.GROUPS, dv.C
-
-    def zero(m):
-        return 0.0 if all(sp.simplify(x) == 0 for x in m) else float("inf")
-
-    def multiple_of_c(m):
-        k = sp.simplify(m[0, 0] / C[0, 0])
-        return float(k) if k.is_number and all(sp.expand(x) == 0 for x in (m - k * C)) else float("nan")
-
-    pos = rows["position"]
-    return {"block (p; phi) largest element": zero(pos.jacobian(groups["attitude"])),
-            "gyro forcing coefficient of C_b^n": multiple_of_c(rows["attitude"].jacobian(groups["gyro"])),
-            "accelerometer forcing coefficient of C_b^n": multiple_of_c(rows["velocity"].jacobian(groups["accel"])),
-            "position forcing largest element": zero(pos.jacobian(sp.Matrix.vstack(groups["gyro"], groups["accel"])))}
 
 
 # ----------------------------------------------------------------------------- eqs. (2), (3), (8)-(10), (17)
