@@ -221,7 +221,7 @@ def low_frequency_gain(motion, pair):
     Returns
     -------
     sympy.Expr
-        The gain [rad/(m/s²)] in the symbols of :data:`SYMBOLS`.
+        The gain [rad/(m/s²)] in the symbols of ``SYMBOLS``.
 
     Raises
     ------

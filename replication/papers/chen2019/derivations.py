@@ -34,6 +34,13 @@ two printed parts of one model contradict each other when no convention reproduc
 The printed forms are read from ``data/paper/chen2019/chen2019-check-derivations.csv`` (column
 ``value``: each printed block or equation in sympy syntax, names in :func:`namespace`); the
 chapter passes them in.  The findings module turns the results into table rows.
+
+Why this module is long: it is one derivation, the report's error model from one mechanization
+written once, and every function reads the same symbols, state groups and sixteen conventions:
+the rows of F (:func:`base_model`), the printed readings parsed into them, the judge of a block
+under the conventions, the noise inputs G of §2.4 and §3.3, Newton's law behind (3-2), the AR
+companion blocks and the numerical side checks of chapter 3.  Split, each part would import the
+symbols of the others and the convention logic would be written twice.
 """
 
 from __future__ import annotations
