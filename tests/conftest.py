@@ -28,7 +28,18 @@ carry the ``stored`` marker, and ``scripts/portability.py`` runs them once, nati
 a perturbed numerical configuration, where they would repeat the same work to the same verdict."""
 
 
+SCHEDULING = frozenset({
+    "test_parallel.py",          # the same batch on threads, processes, Dask and in chunks, compared bit for bit
+})
+"""Test modules that run one computation on several executors or chunkings and compare the results
+bit for bit within one configuration: a numerical configuration changes both sides alike, so the
+verdict does not depend on it.  They carry the ``scheduling`` marker and run once, natively (the
+kernels they schedule run under the perturbed configurations in the other tests and notebooks)."""
+
+
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.path.name in STORED:
             item.add_marker(pytest.mark.stored)
+        if item.path.name in SCHEDULING:
+            item.add_marker(pytest.mark.scheduling)

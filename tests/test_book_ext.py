@@ -73,6 +73,11 @@ def test_numbers_status_words_and_ids_of_a_table_cell_are_kept_whole():
     assert "".join(p for p, _ in pieces) == text
     assert [p for p, keep in pieces if keep] == ["0.00011051871,", "not-reproduced:", "chen2019-table-4-33"]
     assert split_text("plain prose only", statuses) == [("plain prose only", False)]
+    # a Chinese sentence breaks between its characters: only its non-Chinese runs with a digit stay whole
+    cjk = "文献[15-17]利用大气数据信息,建立一阶马尔可夫过程"
+    pieces = split_text(cjk, statuses)
+    assert "".join(p for p, _ in pieces) == cjk
+    assert [p for p, keep in pieces if keep] == ["[15-17]"]
 
 
 def test_a_token_that_is_not_a_string_is_refused():

@@ -18,8 +18,11 @@ import re
 
 from docutils import nodes
 
-TOKEN = re.compile(r"\S+")
-"""A token: a run of characters between spaces."""
+_CJK = "\u3000-\u303f\u3400-\u4dbf\u4e00-\u9fff\uf900-\ufaff\uff00-\uffef"
+TOKEN = re.compile(rf"[{_CJK}]+|[^\s{_CJK}]+")
+"""A token: a run of characters between spaces, cut where Chinese begins or ends (a line breaks
+between Chinese characters, so a Chinese sentence with a number in it is not one word: only
+its non-Chinese runs holding a digit stay whole)."""
 
 SKIP = ("execution-report",)
 """Tables that mark their own tokens (``_ext/execution_report.py``)."""
