@@ -291,16 +291,9 @@ def volume_rows(printed: pd.DataFrame, *, same_step: int = SAME_STEP) -> list[di
     ValueError
         When a column is missing or ``same_step`` is below 2.
     """
-    need = {"quantity", "value", "kind", "number", "line"}
-    if not need <= set(printed.columns):
-        raise ValueError(f"the transcription needs the columns {sorted(need)}; it has {list(printed.columns)}")
+    by_journal = _journal_steps(printed)
     if int(same_step) < 2:
         raise ValueError(f"same_step must be at least 2 entries (one entry fixes no step); got {same_step}")
-    refs = printed[printed["kind"] == "entry"]
-    by_journal: dict[str, list[tuple[int, int, int, int]]] = {}
-    for n, entry, line in zip(refs["number"], refs["value"], refs["line"]):
-        if (jv := journal_volume(entry)) is not None:
-            by_journal.setdefault(jv[0], []).append((int(n), jv[1], jv[2], int(line)))
     rows = []
     for journal, items in by_journal.items():
         steps = pd.Series([y - v for _, y, v, _ in items])
