@@ -293,7 +293,8 @@ def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]
 
     meta = printed.set_index("quantity")
     need = ["text: height of (3-1)", "text: absolute gravimetry", "text: disturbance equivalent to bias",
-            "text: step 3 yields a more accurate disturbance", "text: measurement noise of (3-18)"]
+            "text: step 3 yields a more accurate disturbance", "text: measurement noise of (3-18)",
+            "text: differencing for stationarity"]
     missing = [q for q in need if q not in meta.index]
     if missing:
         raise ValueError(f"the paper file lacks {missing}; add them to chen2019-check-derivations.csv")
@@ -321,11 +322,14 @@ def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]
                          f"{', '.join(f'{h:g}°' for h in heads)}: rank {sep['rank']} of {sep['columns']}, null "
                          f"direction (∇_b, δg) = ({null})"),
              basis="derivation", agrees=bool(sep["same_combination"] and sep["rank"] < sep["columns"]),
-             note=("derived: ∂/∂∇_b = C_b^n and ∂/∂δg^n = -I in the velocity rows of the base model (3-5) and in "
-                   "the specific-force rows of Z (3-18), so the two are equivalent as printed; heading changes "
-                   "separate the horizontal components, but in level flight C_b^n keeps body z up and ∇_bz, δg_U "
-                   "stay one combination at every heading: only the disturbance's own dynamics can tell them "
-                   "apart")),
+             note=("derived (errors counted computed − true): ∂/∂∇_b = C_b^n and ∂/∂δg^n = -I in the velocity "
+                   "rows of the linearised model and in the specific-force rows of Z; the print's signs differ "
+                   "((3-5) carries +δg^n, row '(3-5) gravity term against Z = SINS - GNSS of (3-18)'; its H "
+                   "carries -C_b^n for the bias, row '(3-17) F2 against the bias block of (3-18) H'), but in "
+                   "every row group, derived or printed, the two enter as one combination, so the text's "
+                   "equivalence holds either way; heading changes separate the horizontal components, but in "
+                   "level flight C_b^n keeps body z up and ∇_bz, δg_U stay one combination at every heading: "
+                   "only the disturbance's own dynamics can tell them apart")),
         dict(quantity="§3.1 step 3 separates δg^n from ∇_b (更加精确的重力扰动值)", unit="",
              paper_text=text["text: step 3 yields a more accurate disturbance"],
              reproduced="rests on the AR state-space model and noises, which are not printed",
@@ -336,6 +340,15 @@ def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]
                    "step 2 models it; in step 3 ∇_bz and δg_U stay one combination in level flight (row "
                    f"'{equiv}'), so how much of δg_U is separated rests on the AR model's state-space form and "
                    "noises (not printed)")),
+        dict(quantity="§3.1 step 2: the model of a differenced series as the state δd of (3-17)", unit="",
+             paper_text=text["text: differencing for stationarity"],
+             reproduced=("not printed: an ARMA model identified on the differenced series describes Δδg, and "
+                         "δd of (3-17) then needs an integrating state the chapter does not give"),
+             basis="unstated",
+             note=("step 2 differences a series the inversion test finds non-stationary and identifies the "
+                   "model of the differenced series (lines 703, 707); (3-17) augments the filter with the AR "
+                   "model of δg itself (line 782): how a differenced model enters F and G, and whether the "
+                   "flight series of §4.3 was differenced, is not printed")),
         dict(quantity="§3.1 absolute gravimetry measures the gravity disturbance (method 1)", unit="",
              paper_text=text["text: absolute gravimetry"],
              reproduced=(f"∂|g|/∂(δg_E, δg_N, δg_U) = ({', '.join(f'{v:g}' for v in mag['gradient'] + 0.0)}); "
