@@ -61,7 +61,8 @@ __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rot
            "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
            "common_conventions", "companion_check", "convention_text", "check_all", "random_constant_rates",
            "NOISE_ROWS", "NOISE_COLUMNS", "noise_input", "NOISE_ROWS_2_4", "NOISE_COLUMNS_2_4", "noise_input_2_4", "height_gradient_entry", "bias_disturbance_rank",
-           "magnitude_sensitivity", "acceleration_noise_correlation", "newton_velocity_rate"]
+           "magnitude_sensitivity", "acceleration_noise_correlation", "newton_velocity_rate",
+           "CALIBRATION_ITEM", "compensated_sensor_error"]
 
 # ----------------------------------------------------------------------------- symbols
 
@@ -469,12 +470,80 @@ def newton_velocity_rate():
     return vdot.applyfunc(sp.expand)
 
 
+CALIBRATION_ITEM = "(2-2) compensated with its calibrated coefficients, first order in the residuals"
+"""The generic item of chen2019-check-derivations that derives eq. (2-3) (:func:`compensated_sensor_error`)."""
+
+
+def compensated_sensor_error(sensor: str = "gyro"):
+    """The error of a sensor triad compensated with the calibration model of chen2019 eq. (2-2), derived.
+
+    §2.2 sets the cross-coupling and second-order coefficients of (2-2) to zero, so each axis i
+    reads u_i = K_i x_i + c_0i + c_1i x_j + c_2i x_k (x the true input, j, k the other two axes
+    in the order of (2-2)): u = M x + c_0 with M = diag(K) + the off-diagonal c_1, c_2.  The
+    output is compensated with the calibrated coefficients, x̂ = M̂⁻¹(u − ĉ_0), and the text
+    names the calibration residuals (true − calibrated) of c_0, K, c_1, c_2 the drift (bias),
+    scale-factor and misalignment errors.  The misalignment coefficients are small (the
+    installation angles are 小量, before (2-7)), as are the residuals: each is ``e`` times a
+    finite symbol, and δx = x̂ − x is differentiated once in ``e`` at 0.
+
+    Parameters
+    ----------
+    sensor : {"gyro", "accel"}
+        The gyros of (2-2) (K_g, G_0 … G_2, input ω) or the accelerometers (K_a, A_0 … A_2, input f).
+
+    Returns
+    -------
+    first_order : sympy.Matrix, shape (3, 1)
+        δx to first order, in the residuals ``d<c>0_i``, ``dK_i``, ``d<c>1_i``, ``d<c>2_i``
+        (c = G or A, i = x, y, z), the calibrated scale factors ``K_i`` and the input
+        (``wb`` or ``fb`` of :func:`namespace`).
+    identification : dict
+        The printed error parameters of eq. (2-3) in the places of the residuals, as the text
+        of §2.2 names them: residual of c_0i = K_i × (ε or ∇)_i, of K_i = K_i × δK_i, of c_1i and
+        c_2i = K_i × the δG (δA) element in the row of axis i and the column of the axis they
+        multiply.
+    """
+    if sensor not in ("gyro", "accel"):
+        raise ValueError(f"sensor must be 'gyro' or 'accel', got {sensor!r}")
+    ns = namespace(generic=True)
+    c, x = ("G", ns["wb"]) if sensor == "gyro" else ("A", ns["fb"])
+    bias, scale, mis = (ns["eps"], ns["dKg"], ns["dG"]) if sensor == "gyro" else (ns["nabla"], ns["dKa"], ns["dA"])
+    e = sp.Symbol("e")
+    axes = "xyz"
+    others = {0: (1, 2), 1: (0, 2), 2: (0, 1)}         # the columns c_1i, c_2i multiply in (2-2)
+    K = [sp.Symbol(f"K_{a}", positive=True) for a in axes]
+    c1, c2 = ([sp.Symbol(f"{c}{n}_{a}", real=True) for a in axes] for n in (1, 2))
+    d0, dK, d1, d2 = ([sp.Symbol(f"d{n}_{a}", real=True) for a in axes] for n in (f"{c}0", "K", f"{c}1", f"{c}2"))
+    c0 = sp.Matrix(sp.symbols(f"{c}0_x:z", real=True))
+
+    def matrix(k, m1, m2):
+        m = sp.diag(*k)
+        for i, (j1, j2) in others.items():
+            m[i, j1], m[i, j2] = m1[i], m2[i]
+        return m
+    M_hat = matrix(K, [e * v for v in c1], [e * v for v in c2])
+    M_true = matrix([K[i] + e * dK[i] for i in range(3)], [e * (c1[i] + d1[i]) for i in range(3)],
+                    [e * (c2[i] + d2[i]) for i in range(3)])
+    u = M_true * x + c0 + e * sp.Matrix(d0)                          # (2-2), true coefficients
+    x_hat = M_hat.inv() * (u - c0)                                   # compensated with the calibrated ones
+    first = sp.diff(x_hat - x, e).subs(e, 0).applyfunc(sp.simplify)
+    ident = {}
+    for i, (j1, j2) in others.items():
+        ident |= {d0[i]: K[i] * bias[i], dK[i]: K[i] * scale[i, i], d1[i]: K[i] * mis[i, j1],
+                  d2[i]: K[i] * mis[i, j2]}
+    return first, ident
+
+
 def _generic_derivation(item):
     ns = namespace(generic=True)
     e = sp.Symbol("e")
     cr = _cross
     if item == "Newton's second law in the navigation frame":
         return newton_velocity_rate()
+    if item == CALIBRATION_ITEM:
+        # (2-3) as the first-order error of the output compensated with (2-2), in its printed parameters
+        parts = [d.subs(ident).applyfunc(sp.expand) for d, ident in map(compensated_sensor_error, ("gyro", "accel"))]
+        return sp.Matrix.vstack(*parts)
     if item == "(2-4) substituted into (2-3)":
         # (2-3): δω = ε + (δK_g + δG) ω_ib^b, δf = ∇ + (δK_a + δA) f^b; (2-4): ε = ε_b + ε_m + ω_g, ∇ = ∇_b + ∇_m + ω_a
         eps, nab = sp.Matrix(sp.symbols("eps1:4", real=True)), sp.Matrix(sp.symbols("nab1:4", real=True))
@@ -535,6 +604,9 @@ def check_item(name, reading, spec, readings=None) -> Check:
         item, _, other = rest.partition(":")
         P = parse(reading, generic=True)
         D = _generic_derivation(item)
+        if item == CALIBRATION_ITEM:
+            ns = namespace(generic=True)          # (2-9): δG and δA have no diagonal
+            P = P.subs({ns[m][i, i]: 0 for m in ("dG", "dA") for i in range(3)})
         if kind == "substitute":
             ns = namespace(generic=True)
             D = D.subs(dict(zip(ns["df"], parse(readings[other], generic=True))))
