@@ -56,7 +56,7 @@ def _part(module: str) -> str:
     parts = module.split(".")
     if len(parts) < 2:
         return "top"
-    if parts[1] == "papers" and len(parts) > 2 and parts[2] not in ("plots", "symbolic"):
+    if parts[1] == "papers" and len(parts) > 2 and parts[2] not in ("plots", "symbolic", "sins_error_rates"):
         return f"papers.{parts[2]}"
     return ".".join(parts[:2])
 

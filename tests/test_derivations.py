@@ -335,3 +335,45 @@ def test_imu_error_model_2_10_is_2_4_substituted_into_2_3(checks, readings):
     # the white noises of the two sensors exchanged, or a misalignment term with the wrong sign: each seen
     for bad in (v.replace("+ w_g +", "+ w_a +", 1), v.replace("(dKa + dA)", "(dKa - dA)")):
         assert bad != v and not dv.check_item("(2-10) planted", bad, s).agrees
+
+
+def test_sensor_error_model_2_3_is_the_first_order_error_of_2_2_compensated(checks, readings):
+    assert checks["(2-3)"].agrees
+    v, s = readings["(2-3)"]
+    # a term with the wrong sign, the misalignment transposed, or the input of the other sensor: each seen
+    for bad in (v.replace("eps +", "-eps +", 1), v.replace("(dKg + dG)", "(dKg - dG)"),
+                v.replace("dG)*wb", "dG.T)*wb"), v.replace("(dKa + dA)*fb", "(dKa + dA)*wb"),
+                v.replace("(dKg + dG)", "2*(dKg + dG)")):
+        assert bad != v and not dv.check_item("(2-3) planted", bad, s).agrees
+    with pytest.raises(ValueError, match="sensor"):
+        dv.compensated_sensor_error("magnetometer")
+
+
+@pytest.mark.parametrize("sensor", ["gyro", "accel"])
+def test_first_order_compensation_error_matches_the_exact_one_numerically(sensor):
+    """A second computation: (2-2) inverted in floating point, the residuals and the calibrated
+    misalignment coefficients of size e; the gap to the first-order form is of order e² (relative:
+    e), so halving e halves the relative gap, and a sign error in any term would leave a gap of order 1."""
+    first, _ = dv.compensated_sensor_error(sensor)
+    rng = np.random.default_rng(7)
+    k = rng.uniform(0.5, 2.0, 3)
+    mis0, d0, x = rng.normal(0, 1.0, (3, 2)), rng.normal(0, 1.0, (4, 3)), rng.normal(0, 1.0, 3)
+    others = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
+    c = "G" if sensor == "gyro" else "A"
+    ns = dv.namespace(generic=True)
+    inp = ns["wb"] if sensor == "gyro" else ns["fb"]
+    gap = []
+    for e in (1e-4, 5e-5):
+        mis, d = mis0 * e, d0 * e                            # misalignments; residuals of c_0, K, c_1, c_2
+        M_hat, M_true = np.diag(k), np.diag(k + d[1])
+        for i, (j1, j2) in others.items():
+            M_hat[i, j1], M_hat[i, j2] = mis[i]
+            M_true[i, j1], M_true[i, j2] = mis[i] + d[2:, i]
+        exact = np.linalg.solve(M_hat, M_true @ x + d[0]) - x
+        vals = {sp.Symbol(f"K_{a}", positive=True): k[i] for i, a in enumerate("xyz")}
+        for n, name in enumerate((f"{c}0", "K", f"{c}1", f"{c}2")):
+            vals |= {sp.Symbol(f"d{name}_{a}", real=True): d[n, i] for i, a in enumerate("xyz")}
+        vals |= {inp[i]: x[i] for i in range(3)}
+        approx = np.array(first.subs(vals).evalf(), dtype=float).ravel()
+        gap.append(np.max(np.abs(exact - approx)) / np.max(np.abs(approx)))
+    assert gap[0] < 1e-3 and 1.8 < gap[0] / gap[1] < 2.2

@@ -52,3 +52,56 @@ def test_planted_sign_and_factor_errors_are_caught(printed):
             assert abs(paper - derived) <= TOLERANCE * abs(derived)
             for planted in (-paper, 10 * paper, paper / 2):
                 assert abs(planted - derived) > TOLERANCE * abs(derived), (pair, planted)
+
+
+# --------------------------------------------------------------------------- eq. (8), derived
+
+@pytest.fixture(scope="module")
+def printed8():
+    eq10 = rp.load_paper("an2021-eq-10")
+    return {q: eq10.value(q) for q in eq10.quantities if "," in q}
+
+
+def test_eq8_derived_from_eq1_reproduces_every_printed_element_and_zero(printed8):
+    checks = symbolic.integrated_model_checks(printed8)
+    assert checks["identical"].all(), checks[~checks["identical"]]
+    assert len(checks) == len(printed8) + 4          # + the zeros of Ā, B, C and Ā_1:7,1:7 = A
+    m = symbolic.symbolic_integrated_model()
+    assert all(x == 0 for x in m["Ā"][7:, :])        # constant biases: zero rates
+    # the bias columns of Ā are the drift/bias columns of eq. (1) (−I_3 on ϕ̇, +I_2 on δV̇), B its −g_d part
+    assert m["Ā"][:7, 7:] == sp.Matrix(7, 5, lambda i, j: -1 if i == j < 3 else (1 if i == j else 0))
+    assert m["B"][:7, :] == -m["Ā"][:7, 10:]
+
+
+def test_eq8_derived_agrees_with_the_numerical_model_the_filter_uses():
+    from replication.papers.an2021 import integrated
+
+    lat, ve, vn = np.radians(30.0), 10.0, -7.0
+    a, b, c, _ = integrated.integrated_model(lat, ve, vn)
+    r, g = transfer.earth_parameters(lat)
+    m = symbolic.symbolic_integrated_model()
+    for name, numeric in (("Ā", a), ("B", b), ("C", c)):
+        derived = np.array([[float(symbolic.evaluate_at(x, lat, ve, vn, radius=r, gravity=g)) for x in row]
+                            for row in m[name].tolist()])
+        assert np.allclose(derived, numeric, rtol=1e-12, atol=1e-15), name
+
+
+@pytest.mark.parametrize("element", ["Ā_1,8", "Ā_4,11", "B_5,2", "C_2,7"])
+def test_a_planted_sign_error_in_eq8_fails_its_row(printed8, element):
+    planted = dict(printed8) | {element: -printed8[element]}
+    checks = symbolic.integrated_model_checks(planted).set_index("quantity")
+    assert not checks.at[element, "identical"]
+    row = dict(quantity=element, unit="1", paper=planted[element], reproduced=float(checks.at[element, "derived"]),
+               tolerance=0.0, basis="derivation", note="planted")
+    assert rp.comparison_frame([row]).loc[0, "status"] != "reproduced"
+
+
+def test_a_planted_extra_element_breaks_the_zero_structure(printed8):
+    dropped = {q: v for q, v in printed8.items() if q != "C_2,7"}
+    checks = symbolic.integrated_model_checks(dropped).set_index("quantity")
+    assert not checks.at["C: elements not printed", "identical"]
+    assert checks.at["C: elements not printed", "derived"] == [(2, 7, 1)]
+    with pytest.raises(ValueError, match="outside"):
+        symbolic.integrated_model_checks({"B_13,1": -1})
+    with pytest.raises(ValueError, match="element name"):
+        symbolic.integrated_model_checks({"D_1,1": 1})

@@ -69,6 +69,12 @@ def test_the_second_computation_agrees_with_the_symbolic_verdict(checks):
     ("(10)", "VE*dVE", "-VE*dVE"),
     ("(17) first line", "(h + dh)**2", "(h - dh)**2"),
     ("(17) second line", "2*h*dh", "h*dh"),
+    ("(1) M_pφ", "zeros(3, 3)", "eye(3)"),
+    ("(1) attitude forcing", "-C", "C"),
+    ("(1) velocity forcing", "C", "-C"),
+    ("(1) velocity forcing", "C", "2*C"),
+    ("(1) velocity forcing", "C", "C.T"),
+    ("(1) position forcing", "zeros(3, 6)", "Matrix.hstack(zeros(3, 3), C)"),
 ])
 def test_a_planted_error_is_seen(items, name, old, new):
     readings = {n: v for n, v, _ in items}
@@ -121,3 +127,27 @@ def test_bad_input_is_refused(items):
         dv.check_part("x", "VE*dVE", "first-order:(9)")
     with pytest.raises(ValueError, match="columns"):
         findings.derivation_rows(rp.load_paper("duan2023-check-derivations").data.drop(columns="spec"), notebook="x")
+
+
+def test_eq1_blocks_derive_from_the_shared_mechanization_and_a_planted_sign_is_seen_twice(items):
+    """The printed blocks of eq. (1) hold exactly; a forcing with the wrong sign fails the exact check
+    and, independently, the numeric one against the navigation core (|difference| = 2 max|C_b^n|)."""
+    parts = [i for i in items if i[2].startswith("error-model:")]
+    assert len(parts) == 4
+    for name, reading, spec in parts:
+        c = dv.check_part(name, reading, spec)
+        assert c.agrees and c.numeric["|printed − navigation core|"] < 1e-12, name
+    name, reading, spec = next(i for i in parts if i[0] == "(1) velocity forcing")
+    bad = dv.check_part(name, "-" + reading, spec)
+    assert not bad.agrees and bad.numeric["|printed − navigation core|"] > 0.5
+    assert dv.error_model_block("attitude", "gyro") == -dv.error_model_block("velocity", "accel")
+    with pytest.raises(ValueError, match="non-empty"):
+        dv.parse_error_model(" ")
+    with pytest.raises(ValueError, match="not a matrix"):
+        dv.parse_error_model("C11 + x")
+    with pytest.raises(ValueError, match="row group"):
+        dv.error_model_block("heading", "gyro")
+    with pytest.raises(ValueError, match="state groups"):
+        dv.error_model_block("attitude", "magnetometer")
+    with pytest.raises(ValueError, match="error-model:<rows>:<columns>"):
+        dv.check_part(name, reading, "error-model:velocity")

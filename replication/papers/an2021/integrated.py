@@ -130,7 +130,9 @@ def integrated_model(lat, v_east=0.0, v_north=0.0, *, radius=None, gravity=None)
     """The matrices of the integrated-navigation model, an2021 eqs. (8)-(9).
 
     Ā_{1:7,1:7} = A, Ā_{1,8} = Ā_{2,9} = Ā_{3,10} = -1, Ā_{4,11} = Ā_{5,12} = 1;
-    B_{4,1} = B_{5,2} = -1; C_{1,6} = C_{2,7} = 1; H̄_{1,1} = H̄_{2,2} = 1.
+    B_{4,1} = B_{5,2} = -1; C_{1,6} = C_{2,7} = 1; H̄_{1,1} = H̄_{2,2} = 1.  The same Ā, B and C
+    are derived symbolically from the vector error equations of eq. (1) by
+    :func:`replication.papers.an2021.symbolic.symbolic_integrated_model`.
 
     Parameters
     ----------

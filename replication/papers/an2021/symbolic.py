@@ -36,6 +36,7 @@ from replication.papers.an2021.transfer import (
 )
 
 __all__ = ["SYMBOLS", "symbolic_system_matrix", "symbolic_error_model_from_vectors",
+           "symbolic_integrated_model", "integrated_model_checks",
            "symbolic_transfer_functions", "coefficient", "printed_namespace", "parse_printed", "evaluate_at",
            "evaluate", "is_identity", "coefficient_location", "derived_coefficient",
            "printed_in_derived_normalization", "coefficient_checks", "low_frequency_gain"]
@@ -96,19 +97,12 @@ def symbolic_system_matrix(motion="general"):
     return a
 
 
-def symbolic_error_model_from_vectors():
-    """An independent derivation of the 7×7 A from the vector error equations (spherical Earth).
+def _vector_error_rates(eps, nabla, g_d):
+    """The right-hand sides of the vector error equations of an2021 eq. (1), spherical Earth.
 
-    ϕ̇ = -ω_in^n × ϕ + δω_in^n - ε, δV̇ = f^n × ϕ - (2ω_ie^n + ω_en^n) × δV - (2δω_ie^n + δω_en^n) × V
-    + ∇ - g_d, δL̇ = δV_N/R, δλ̇ = δV_E sec L / R + V_E tan L sec L δL / R, with level
-    unaccelerated motion (f^n = (0, 0, g), V_U = 0, δV_U = 0, height fixed).  Used to check
-    every printed element of an2021 eq. (1).
-
-    Returns
-    -------
-    a : sympy.Matrix, shape (7, 7)
-        The Jacobian of the right-hand sides at zero error, in the symbols of ``SYMBOLS``,
-        states :data:`~replication.papers.an2021.transfer.STATES`.
+    ``eps`` (ε_E, ε_N, ε_U), ``nabla`` (∇_E, ∇_N) and ``g_d`` (g_dE, g_dN) are the sensor errors
+    and the disturbance, n-frame components, as sympy expressions; returns the seven rates and the
+    seven error-state symbols of :data:`~replication.papers.an2021.transfer.STATES`.
     """
     R, g, w, L = (SYMBOLS[k] for k in ("R", "g", "omega_ie", "L"))
     ve, vn = SYMBOLS["V_E"], SYMBOLS["V_N"]
@@ -123,20 +117,139 @@ def symbolic_error_model_from_vectors():
     d_wie = (wie_p - wie)
     d_wen = (wen_p - wen)
     win = wie + wen
-    phidot = -win.cross(phi) + d_wie + d_wen
+    phidot = -win.cross(phi) + d_wie + d_wen - sp.Matrix(eps)
     f = sp.Matrix([0, 0, g])
     v = sp.Matrix([ve, vn, 0])
     dv = sp.Matrix([dve, dvn, 0])
-    dvdot = f.cross(phi) - (2 * wie + wen).cross(dv) - (2 * d_wie + d_wen).cross(v)
+    forcing = sp.Matrix([nabla[0] - g_d[0], nabla[1] - g_d[1], 0])
+    dvdot = f.cross(phi) - (2 * wie + wen).cross(dv) - (2 * d_wie + d_wen).cross(v) + forcing
     dldot = dvn / R
     dlamdot = (ve + dve) / (R * sp.cos(lat)) - ve / (R * sp.cos(L))
-    rhs = list(phidot) + [dvdot[0], dvdot[1], dldot, dlamdot]
-    zero = {xi: 0 for xi in x}
-    a = sp.zeros(7, 7)
-    for i, e in enumerate(rhs):
-        for j, xj in enumerate(x):
-            a[i, j] = sp.simplify(sp.diff(e, xj).subs(zero))
-    return a
+    return list(phidot) + [dvdot[0], dvdot[1], dldot, dlamdot], x
+
+
+def _jacobian_at_zero(rhs, variables, zero):
+    return sp.Matrix(len(rhs), len(variables),
+                     lambda i, j: sp.simplify(sp.diff(rhs[i], variables[j]).subs(zero)))
+
+
+def symbolic_error_model_from_vectors():
+    """An independent derivation of the 7×7 A from the vector error equations (spherical Earth).
+
+    ϕ̇ = -ω_in^n × ϕ + δω_in^n - ε, δV̇ = f^n × ϕ - (2ω_ie^n + ω_en^n) × δV - (2δω_ie^n + δω_en^n) × V
+    + ∇ - g_d, δL̇ = δV_N/R, δλ̇ = δV_E sec L / R + V_E tan L sec L δL / R, with level
+    unaccelerated motion (f^n = (0, 0, g), V_U = 0, δV_U = 0, height fixed).  Used to check
+    every printed element of an2021 eq. (1).
+
+    Returns
+    -------
+    a : sympy.Matrix, shape (7, 7)
+        The Jacobian of the right-hand sides at zero error, in the symbols of ``SYMBOLS``,
+        states :data:`~replication.papers.an2021.transfer.STATES`.
+    """
+    rhs, x = _vector_error_rates((0, 0, 0), (0, 0), (0, 0))
+    return _jacobian_at_zero(rhs, x, {xi: 0 for xi in x})
+
+
+def symbolic_integrated_model():
+    """The matrices Ā, B, C of an2021 eq. (8), derived from the vector error equations of eq. (1).
+
+    The text of §3 models each gyro drift and accelerometer bias as a constant term plus a
+    random term (常值项与随机项之和), ε = ε^c + ε^r and ∇ = ∇^c + ∇^r, and observes the position
+    (用位置作为观测量, z = (δL, δλ)).  So:
+
+    * the 7 error rates are those of :func:`symbolic_error_model_from_vectors` with these sensor
+      errors (the random terms ε^r, ∇^r go to the noise w);
+    * the constant terms are states whose value does not change, ε^c(t) = ε^c(t_0): their rates
+      are d/dt of a quantity free of t, zero (rows 8-12 of Ā);
+    * Ā = ∂(rates)/∂x and B = ∂(rates)/∂(g_dE, g_dN) at zero error, x the 12 states of
+      ``replication.papers.an2021.integrated.STATES_12``;
+    * z is the SINS position minus the GNSS position, L̂ − L_GNSS with L̂ = L + δL and
+      L_GNSS = L + v_L (and the same for λ), so C = ∂z/∂x and the GNSS errors are v.
+
+    Returns
+    -------
+    dict
+        ``Ā`` (12 × 12), ``B`` (12 × 2), ``C`` (2 × 12) as sympy matrices in the symbols of
+        ``SYMBOLS``; ``noise`` (12 × 5, ∂(rates)/∂(ε^r, ∇^r)) and ``measurement noise``
+        (2 × 2, ∂z/∂(v_L, v_λ)).
+    """
+    t = sp.Symbol("t", real=True)
+    eps_c = sp.Matrix(sp.symbols("eps_E_c eps_N_c eps_U_c", real=True))
+    nab_c = sp.Matrix(sp.symbols("nabla_E_c nabla_N_c", real=True))
+    eps_r = sp.Matrix(sp.symbols("eps_E_r eps_N_r eps_U_r", real=True))
+    nab_r = sp.Matrix(sp.symbols("nabla_E_r nabla_N_r", real=True))
+    g_d = sp.Matrix(sp.symbols("g_dE g_dN", real=True))
+    rhs, x = _vector_error_rates(eps_c + eps_r, nab_c + nab_r, g_d)
+    biases = list(eps_c) + list(nab_c)
+    rhs = rhs + [sp.diff(b, t) for b in biases]          # ε^c(t) = ε^c(t_0): free of t
+    states = x + biases
+    zero = {s: 0 for s in states + list(eps_r) + list(nab_r) + list(g_d)}
+    lat, lon = SYMBOLS["L"], sp.Symbol("lambda", real=True)
+    v_l, v_lam = sp.symbols("v_L v_lambda", real=True)
+    z = [(lat + x[5]) - (lat + v_l), (lon + x[6]) - (lon + v_lam)]   # SINS − GNSS position
+    zero_z = {s: 0 for s in states + [v_l, v_lam]}
+    return {"Ā": _jacobian_at_zero(rhs, states, zero),
+            "B": _jacobian_at_zero(rhs, list(g_d), zero),
+            "C": _jacobian_at_zero(z, states, zero_z),
+            "noise": _jacobian_at_zero(rhs, list(eps_r) + list(nab_r), zero),
+            "measurement noise": _jacobian_at_zero(z, [v_l, v_lam], zero_z)}
+
+
+def integrated_model_checks(printed):
+    """The printed elements of an2021 eq. (8) against :func:`symbolic_integrated_model`.
+
+    Every printed non-zero element is compared with the derived one (exact: their difference
+    simplifies to 0), and each matrix's block structure with the print: the print lists the
+    non-zero elements of Ā outside Ā_{1:7,1:7} = A, and of B and C, so every other element must
+    derive to 0; Ā_{1:7,1:7} must derive to the A of :func:`symbolic_error_model_from_vectors`.
+
+    Parameters
+    ----------
+    printed : dict of str to str or number
+        The printed elements, ``"Ā_i,j"``, ``"B_i,j"``, ``"C_i,j"`` (1-based, as printed) ->
+        value, e.g. the elements of the paper file ``an2021-eq-10``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per printed element (``quantity``, ``printed``, ``derived``, ``identical``),
+        then one per matrix (``quantity`` ``"<M>: elements not printed"``, ``printed`` 0,
+        ``derived`` the derived non-zero elements the print does not list, ``identical`` when
+        there are none; for Ā the block 1:7 × 1:7 is compared with A instead).
+
+    Raises
+    ------
+    ValueError
+        If an element is not named ``<Ā|B|C>_i,j`` or lies outside its matrix.
+    """
+    derived = symbolic_integrated_model()
+    listed = {m: set() for m in ("Ā", "B", "C")}
+    rows = []
+    for q, value in printed.items():
+        m = re.fullmatch(r"(Ā|B|C)_(\d+),(\d+)", str(q))
+        if m is None:
+            raise ValueError(f"{q!r} is not an element name of the form Ā_i,j, B_i,j or C_i,j")
+        name, i, j = m.group(1), int(m.group(2)) - 1, int(m.group(3)) - 1
+        mat = derived[name]
+        if not (0 <= i < mat.rows and 0 <= j < mat.cols):
+            raise ValueError(f"{q!r} lies outside {name}, which is {mat.rows}×{mat.cols}")
+        listed[name].add((i, j))
+        p = sp.nsimplify(sp.sympify(value))
+        rows.append(dict(quantity=q, printed=p, derived=mat[i, j],
+                         identical=sp.simplify(p - mat[i, j]) == 0))
+    a7 = symbolic_error_model_from_vectors()
+    for name, mat in derived.items():
+        if name not in listed:
+            continue
+        in_a = (lambda i, j: i < 7 and j < 7) if name == "Ā" else (lambda i, j: False)
+        extra = [(i + 1, j + 1, mat[i, j]) for i in range(mat.rows) for j in range(mat.cols)
+                 if not in_a(i, j) and (i, j) not in listed[name] and sp.simplify(mat[i, j]) != 0]
+        rows.append(dict(quantity=f"{name}: elements not printed", printed=sp.Integer(0),
+                         derived=extra, identical=not extra))
+    rows.append(dict(quantity="Ā_1:7,1:7 = A", printed="A of eq. (1)", derived="the A derived for eq. (1)",
+                     identical=all(sp.simplify(x) == 0 for x in (derived["Ā"][:7, :7] - a7))))
+    return pd.DataFrame(rows)
 
 
 def _trig_to_cos(expr, c):

@@ -1,6 +1,7 @@
 """chen2019's printed error equations derived symbolically, term by term, under every sign convention.
 
-The derivation starts from the mechanization written here once, in the ENU navigation frame the
+The derivation starts from the mechanization written once, in the shared module
+``replication.papers.sins_error_rates`` (which duan2023's eq. (1) reads too), in the ENU navigation frame the
 report states (V^n = [V_E, V_N, V_U], ψ_U "天向失准角"), at the report's approximation level
 (Earth radii R_m, R_n and normal gravity γ frozen, as in Table 2-2 and the F of §3.3):
 
@@ -13,9 +14,9 @@ report states (V^n = [V_E, V_N, V_U], ψ_U "天向失准角"), at the report's a
 * the first-order Gauss-Markov processes of eq. (2-5) and the AR(p) disturbance model of
   eq. (3-11) in companion form.
 
-:func:`base_model` linearises the computed-minus-true rates (δx = x̂ − x, Ĉ = (I − φ×)C) with
+``base_model`` (of the shared module) linearises the computed-minus-true rates (δx = x̂ − x, Ĉ = (I − φ×)C) with
 sympy and returns each row of F as a linear form in the states (C_b^n kept as nine symbols; its
-orthogonality enters only through :func:`rotation_lemma`, proved with a quaternion).  The print leaves four signs open,
+orthogonality enters only through ``rotation_lemma``, proved with a quaternion).  The print leaves four signs open,
 and every check is made under all sixteen combinations (:data:`CONVENTIONS`):
 
 ``e``    the navigation errors computed − true (+1) or true − computed (−1);
@@ -29,7 +30,7 @@ a block of H (whose Z is printed as SINS − GNSS) by the sign of its column; so
 block and each state group the derivation gives the printed form, its negative or neither
 (:func:`judge`).  A printed part is derivable when one convention reproduces all its terms;
 two printed parts of one model contradict each other when no convention reproduces both
-(:func:`common_conventions`).  Trigonometric identities are applied exactly by :func:`is_zero`.
+(:func:`common_conventions`).  Trigonometric identities are applied exactly by ``is_zero``.
 
 The printed forms are read from ``data/paper/chen2019/chen2019-check-derivations.csv`` (column
 ``value``: each printed block or equation in sympy syntax, names in :func:`namespace`); the
@@ -37,7 +38,7 @@ chapter passes them in.  The findings module turns the results into table rows.
 
 Why this module is long: it is one derivation, the report's error model from one mechanization
 written once, and every function reads the same symbols, state groups and sixteen conventions:
-the rows of F (:func:`base_model`), the printed readings parsed into them, the judge of a block
+the printed readings parsed into the rows of F (``base_model``, shared with duan2023), the judge of a block
 under the conventions, the noise inputs G of §2.4 and §3.3, Newton's law behind (3-2), the AR
 companion blocks and the numerical side checks of chapter 3.  Split, each part would import the
 symbols of the others and the convention logic would be written twice.
@@ -47,46 +48,51 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
 
 from replication.nav import earth
 from replication.nav._validate import finite, finite_array, positive
+from replication.papers import sins_error_rates as _rates
 from replication.papers import symbolic
+from replication.papers.sins_error_rates import (
+    GROUPS,
+    VE,
+    VN,
+    VU,
+    C,
+    L,
+    Rm,
+    Rn,
+    base_model,
+    fE,
+    fN,
+    fU,
+    fx,
+    fy,
+    fz,
+    gam,
+    h,
+    is_zero,
+    rotation_lemma,
+    w,
+    wx,
+    wy,
+    wz,
+)
 from replication.papers.symbolic import Check, rotation_from_quaternion, short, skew, vanishes, vee
 
 __all__ = ["CONVENTIONS", "CONVENTION_WORDS", "GROUPS", "Check", "symbols", "rotation_from_quaternion",
            "rotation_lemma", "base_model", "namespace", "parse", "is_zero", "judge", "check_item",
            "common_conventions", "companion_check", "convention_text", "check_all", "random_constant_rates",
            "NOISE_ROWS", "NOISE_COLUMNS", "noise_input", "NOISE_ROWS_2_4", "NOISE_COLUMNS_2_4", "noise_input_2_4", "height_gradient_entry", "bias_disturbance_rank",
-           "magnitude_sensitivity", "acceleration_noise_correlation", "newton_velocity_rate"]
+           "magnitude_sensitivity", "acceleration_noise_correlation", "newton_velocity_rate",
+           "CALIBRATION_ITEM", "compensated_sensor_error"]
 
 # ----------------------------------------------------------------------------- symbols
 
-_POS = dict(positive=True)
-L, h, Rm, Rn, w, gam = sp.symbols("L h R_m R_n omega_ie gamma", real=True)
-VE, VN, VU = sp.symbols("V_E V_N V_U", real=True)
-fE, fN, fU = sp.symbols("f_E f_N f_U", real=True)
-fx, fy, fz = sp.symbols("f_x f_y f_z", real=True)
-wx, wy, wz = sp.symbols("omega_x omega_y omega_z", real=True)
-alpha, beta = sp.symbols("alpha beta", **_POS)
-q0, q1, q2, q3 = sp.symbols("q0:4", real=True)
-
-_STATE_NAMES = {
-    "position": ("dL", "dlambda", "dh"),
-    "velocity": ("dV_E", "dV_N", "dV_U"),
-    "attitude": ("a_E", "a_N", "a_U"),
-    "accel": ("nabla_x", "nabla_y", "nabla_z"),
-    "accel scale": ("dK_ax", "dK_ay", "dK_az"),
-    "gyro": ("epsilon_x", "epsilon_y", "epsilon_z"),
-    "gyro scale": ("dK_gx", "dK_gy", "dK_gz"),
-    "gravity": ("dg_E", "dg_N", "dg_U"),
-}
-GROUPS = {g: sp.Matrix(sp.symbols(" ".join(n), real=True)) for g, n in _STATE_NAMES.items()}
-"""The error states by group (position, velocity, attitude, accelerometer bias and scale factor,
-gyro drift and scale factor, gravity disturbance), each a 3-vector of sympy symbols."""
+alpha, beta = sp.symbols("alpha beta", positive=True)
 
 _SIGN_OF = {"position": "e", "velocity": "e", "attitude": "a", "accel": "acc", "accel scale": "acc",
             "gyro": "gyro", "gyro scale": "gyro", "gravity": None}
@@ -109,119 +115,15 @@ def symbols() -> dict:
     Returns
     -------
     dict of str to sympy.Symbol
+        Those of the shared mechanization (``replication.papers.sins_error_rates.symbols``):
         L, h, Rm, Rn (R_m, R_n), w (ω_ie), gam (γ), VE, VN, VU, fE, fN, fU (f^n), fx, fy, fz
-        (f^b), wx, wy, wz (ω_ib^b), alpha, beta (the correlation times of eq. (2-5)).
+        (f^b), wx, wy, wz (ω_ib^b); and alpha, beta (the correlation times of eq. (2-5)).
     """
-    return dict(L=L, h=h, Rm=Rm, Rn=Rn, w=w, gam=gam, VE=VE, VN=VN, VU=VU, fE=fE, fN=fN, fU=fU, fx=fx, fy=fy,
-                fz=fz, wx=wx, wy=wy, wz=wz, alpha=alpha, beta=beta)
+    return _rates.symbols() | dict(alpha=alpha, beta=beta)
 
 
 _skew, _vee = skew, vee
-
-
-def _cross(a, b):
-    return sp.Matrix(a).cross(sp.Matrix(b))
-
-
-C = sp.Matrix(3, 3, lambda i, j: sp.Symbol(f"C_{i + 1}{j + 1}", real=True))
-"""C_b^n as nine symbols; its orthogonality enters the derivation only through :func:`rotation_lemma`."""
-
-
-def rotation_lemma() -> bool:
-    """Whether C Cᵀ = I and C (ω×) Cᵀ = ((C ω)×) hold identically for :func:`rotation_from_quaternion`.
-
-    The two identities that turn the perturbed attitude update into φ̇ = −ω_in × φ + δω_in − C δω.
-
-    Returns
-    -------
-    bool
-        True when both differences cancel to zero.
-    """
-    u = sp.Matrix(sp.symbols("u1:4", real=True))
-    Q = rotation_from_quaternion()
-    ok1 = all(sp.cancel(x) == 0 for x in (Q * Q.T - sp.eye(3)))
-    ok2 = all(sp.cancel(x) == 0 for x in (Q * _skew(u) * Q.T - _skew(Q * u)))
-    return ok1 and ok2
-
-
-def _w_ie(lat):
-    return sp.Matrix([0, w * sp.cos(lat), w * sp.sin(lat)])
-
-
-def _w_en(lat, hh, v):
-    return sp.Matrix([-v[1] / (Rm + hh), v[0] / (Rn + hh), v[0] * sp.tan(lat) / (Rn + hh)])
-
-
-@dataclass(frozen=True)
-class _Base:
-    rows: dict
-    specific_force: sp.Matrix
-
-
-_BASE = None
-
-
-def base_model():
-    """The linearised error rates in the base convention (all signs +1), from first principles.
-
-    Perturbs the mechanization of the module docstring with δL, δh, δV (additive), Ĉ = (I − φ×)C,
-    f̂^b = (I + δK_a) f^b + ∇, ω̂^b = (I + δK_g) ω^b + ε and the disturbance δg of eq. (3-6)
-    (true gravity g_m + δg, the SINS using g_m), and differentiates the computed-minus-true rates
-    with respect to the perturbation at zero.  The attitude rate is read off
-    Φ̇ = [−ΦĊ − ∂(ĈΩ̂_ib − Ω̂_in Ĉ)] Cᵀ (Φ = φ×), which :func:`rotation_lemma` makes skew.
-
-    Returns
-    -------
-    rows : dict of str to sympy.Matrix
-        ``position``, ``velocity``, ``attitude``: 3-vectors linear in the states of
-        :data:`GROUPS`; ``specific force``: δf^n = Ĉ f̂^b − C f^b to first order (f^n = C f^b
-        written with its own symbols f_E, f_N, f_U).
-    """
-    global _BASE
-    if _BASE is not None:
-        return _BASE
-    e = sp.Symbol("e")
-    G = GROUPS
-    dp, dv, phi = G["position"], G["velocity"], G["attitude"]
-    V = sp.Matrix([VE, VN, VU])
-    fn = sp.Matrix([fE, fN, fU])
-    fb = sp.Matrix([fx, fy, fz])
-    wb = sp.Matrix([wx, wy, wz])
-    Lh, hh, Vh = L + e * dp[0], h + e * dp[2], V + e * dv
-    Phi = _skew(phi)
-    # position rates
-    prate = lambda lat, hgt, v: sp.Matrix([v[1] / (Rm + hgt), v[0] / ((Rn + hgt) * sp.cos(lat)), v[2]])
-    pos = sp.diff(prate(Lh, hh, Vh), e).subs(e, 0)
-    # specific force in n: Ĉ f̂^b = (I - eΦ) C ((I + e dKa) f^b + e ∇), with C f^b = f^n
-    dKa, dKg = sp.diag(*G["accel scale"]), sp.diag(*G["gyro scale"])
-    sf_hat = (sp.eye(3) - e * Phi) * (fn + e * C * (dKa * fb + G["accel"]))
-    sf = sp.diff(sf_hat, e).subs(e, 0)
-    g_m = sp.Matrix([0, 0, -gam])
-    vel_hat = sf_hat - _cross(2 * _w_ie(Lh) + _w_en(Lh, hh, Vh), Vh) + g_m
-    vel_true = fn - _cross(2 * _w_ie(L) + _w_en(L, h, V), V) + g_m + e * G["gravity"]
-    vel = sp.diff(vel_hat - vel_true, e).subs(e, 0)
-    # attitude: Ĉ = (I - eΦ) C, mechanization Ĉ' = Ĉ Ω̂_ib - Ω̂_in Ĉ, so that
-    # Φ̇ C = -ΦĊ - ∂_e(Ĉ Ω̂_ib - Ω̂_in Ĉ) =: M and Φ̇ = M Cᵀ (C orthogonal)
-    w_in = _w_ie(L) + _w_en(L, h, V)
-    Cdot = C * _skew(wb) - _skew(w_in) * C
-    Chat = (sp.eye(3) - e * Phi) * C
-    dw = dKg * wb + G["gyro"]
-    w_in_hat = _w_ie(Lh) + _w_en(Lh, hh, Vh)
-    M = (-Phi * Cdot - sp.diff(Chat * _skew(wb + e * dw) - _skew(w_in_hat) * Chat, e).subs(e, 0)).expand()
-    gyro0 = {s: 0 for s in list(G["gyro"]) + list(G["gyro scale"])}
-    # the gyro-free part of M is X C with X free of C, so Φ̇ = X C Cᵀ = X
-    X = M.subs(gyro0).subs({C[i, j]: int(i == j) for i in range(3) for j in range(3)})
-    if any(sp.expand(x) != 0 for x in (M.subs(gyro0) - X * C)):
-        raise ArithmeticError("the gyro-free part of the attitude rate is not X C")
-    # the gyro part of M is -C (δω×), so Φ̇ = -C (δω×) Cᵀ = -((C δω)×) (rotation_lemma)
-    if any(sp.expand(x) != 0 for x in (M - M.subs(gyro0) + C * _skew(dw))):
-        raise ArithmeticError("the gyro part of the attitude rate is not -C (δω×)")
-    Phidot = X - _skew(C * dw)
-    if not all(is_zero(x) for x in (Phidot + Phidot.T)):
-        raise ArithmeticError("the attitude-error rate is not skew")
-    att = _vee(Phidot)
-    _BASE = _Base(rows={"position": pos, "velocity": vel, "attitude": att}, specific_force=sf)
-    return _BASE
+_w_ie, _w_en, _cross = _rates.w_ie, _rates.w_en, _rates.cross
 
 
 # ----------------------------------------------------------------------------- printed readings
@@ -297,26 +199,6 @@ def parse(text: str, generic: bool = False) -> sp.Matrix:
     except (sp.SympifyError, TypeError, NameError) as exc:
         raise ValueError(f"cannot read {text!r} in the names of derivations.namespace(): {exc}") from exc
     return out if isinstance(out, sp.MatrixBase) else sp.Matrix([out])
-
-
-def is_zero(expr) -> bool:
-    """Whether a scalar expression vanishes identically (exact, not numerical).
-
-    tan L and sec L are written through sin L and cos L, the expression is brought over one
-    denominator (``cancel``), and the numerator is reduced modulo sin²L + cos²L − 1
-    (:func:`replication.papers.symbolic.vanishes` with the one angle L).
-
-    Parameters
-    ----------
-    expr : sympy expression
-        The difference to test.
-
-    Returns
-    -------
-    bool
-        True when the expression is identically zero.
-    """
-    return vanishes(expr, (L,))
 
 
 # ----------------------------------------------------------------------------- judging
@@ -469,12 +351,80 @@ def newton_velocity_rate():
     return vdot.applyfunc(sp.expand)
 
 
+CALIBRATION_ITEM = "(2-2) compensated with its calibrated coefficients, first order in the residuals"
+"""The generic item of chen2019-check-derivations that derives eq. (2-3) (:func:`compensated_sensor_error`)."""
+
+
+def compensated_sensor_error(sensor: str = "gyro"):
+    """The error of a sensor triad compensated with the calibration model of chen2019 eq. (2-2), derived.
+
+    §2.2 sets the cross-coupling and second-order coefficients of (2-2) to zero, so each axis i
+    reads u_i = K_i x_i + c_0i + c_1i x_j + c_2i x_k (x the true input, j, k the other two axes
+    in the order of (2-2)): u = M x + c_0 with M = diag(K) + the off-diagonal c_1, c_2.  The
+    output is compensated with the calibrated coefficients, x̂ = M̂⁻¹(u − ĉ_0), and the text
+    names the calibration residuals (true − calibrated) of c_0, K, c_1, c_2 the drift (bias),
+    scale-factor and misalignment errors.  The misalignment coefficients are small (the
+    installation angles are 小量, before (2-7)), as are the residuals: each is ``e`` times a
+    finite symbol, and δx = x̂ − x is differentiated once in ``e`` at 0.
+
+    Parameters
+    ----------
+    sensor : {"gyro", "accel"}
+        The gyros of (2-2) (K_g, G_0 … G_2, input ω) or the accelerometers (K_a, A_0 … A_2, input f).
+
+    Returns
+    -------
+    first_order : sympy.Matrix, shape (3, 1)
+        δx to first order, in the residuals ``d<c>0_i``, ``dK_i``, ``d<c>1_i``, ``d<c>2_i``
+        (c = G or A, i = x, y, z), the calibrated scale factors ``K_i`` and the input
+        (``wb`` or ``fb`` of :func:`namespace`).
+    identification : dict
+        The printed error parameters of eq. (2-3) in the places of the residuals, as the text
+        of §2.2 names them: residual of c_0i = K_i × (ε or ∇)_i, of K_i = K_i × δK_i, of c_1i and
+        c_2i = K_i × the δG (δA) element in the row of axis i and the column of the axis they
+        multiply.
+    """
+    if sensor not in ("gyro", "accel"):
+        raise ValueError(f"sensor must be 'gyro' or 'accel', got {sensor!r}")
+    ns = namespace(generic=True)
+    c, x = ("G", ns["wb"]) if sensor == "gyro" else ("A", ns["fb"])
+    bias, scale, mis = (ns["eps"], ns["dKg"], ns["dG"]) if sensor == "gyro" else (ns["nabla"], ns["dKa"], ns["dA"])
+    e = sp.Symbol("e")
+    axes = "xyz"
+    others = {0: (1, 2), 1: (0, 2), 2: (0, 1)}         # the columns c_1i, c_2i multiply in (2-2)
+    K = [sp.Symbol(f"K_{a}", positive=True) for a in axes]
+    c1, c2 = ([sp.Symbol(f"{c}{n}_{a}", real=True) for a in axes] for n in (1, 2))
+    d0, dK, d1, d2 = ([sp.Symbol(f"d{n}_{a}", real=True) for a in axes] for n in (f"{c}0", "K", f"{c}1", f"{c}2"))
+    c0 = sp.Matrix(sp.symbols(f"{c}0_x:z", real=True))
+
+    def matrix(k, m1, m2):
+        m = sp.diag(*k)
+        for i, (j1, j2) in others.items():
+            m[i, j1], m[i, j2] = m1[i], m2[i]
+        return m
+    M_hat = matrix(K, [e * v for v in c1], [e * v for v in c2])
+    M_true = matrix([K[i] + e * dK[i] for i in range(3)], [e * (c1[i] + d1[i]) for i in range(3)],
+                    [e * (c2[i] + d2[i]) for i in range(3)])
+    u = M_true * x + c0 + e * sp.Matrix(d0)                          # (2-2), true coefficients
+    x_hat = M_hat.inv() * (u - c0)                                   # compensated with the calibrated ones
+    first = sp.diff(x_hat - x, e).subs(e, 0).applyfunc(sp.simplify)
+    ident = {}
+    for i, (j1, j2) in others.items():
+        ident |= {d0[i]: K[i] * bias[i], dK[i]: K[i] * scale[i, i], d1[i]: K[i] * mis[i, j1],
+                  d2[i]: K[i] * mis[i, j2]}
+    return first, ident
+
+
 def _generic_derivation(item):
     ns = namespace(generic=True)
     e = sp.Symbol("e")
     cr = _cross
     if item == "Newton's second law in the navigation frame":
         return newton_velocity_rate()
+    if item == CALIBRATION_ITEM:
+        # (2-3) as the first-order error of the output compensated with (2-2), in its printed parameters
+        parts = [d.subs(ident).applyfunc(sp.expand) for d, ident in map(compensated_sensor_error, ("gyro", "accel"))]
+        return sp.Matrix.vstack(*parts)
     if item == "(2-4) substituted into (2-3)":
         # (2-3): δω = ε + (δK_g + δG) ω_ib^b, δf = ∇ + (δK_a + δA) f^b; (2-4): ε = ε_b + ε_m + ω_g, ∇ = ∇_b + ∇_m + ω_a
         eps, nab = sp.Matrix(sp.symbols("eps1:4", real=True)), sp.Matrix(sp.symbols("nab1:4", real=True))
@@ -535,6 +485,9 @@ def check_item(name, reading, spec, readings=None) -> Check:
         item, _, other = rest.partition(":")
         P = parse(reading, generic=True)
         D = _generic_derivation(item)
+        if item == CALIBRATION_ITEM:
+            ns = namespace(generic=True)          # (2-9): δG and δA have no diagonal
+            P = P.subs({ns[m][i, i]: 0 for m in ("dG", "dA") for i in range(3)})
         if kind == "substitute":
             ns = namespace(generic=True)
             D = D.subs(dict(zip(ns["df"], parse(readings[other], generic=True))))

@@ -8,7 +8,10 @@ under each reading of the printed angle β (``READINGS``), at the kinematic stat
 :mod:`replication.papers.duan2023.printed`.
 
 Eq. (1), the SINS error equation the paper cites without printing, is rebuilt from the navigation
-core's 15-state model: :func:`sins_error_matrix`, :func:`eq1_checks`.
+core's 15-state model: :func:`sins_error_matrix`, :func:`eq1_checks`.  The blocks it does print (the
+zero block M_pφ and the three forcing terms) are derived symbolically by :func:`check_part` (spec
+``error-model``) from the linearised ENU mechanization of :mod:`replication.papers.sins_error_rates`,
+with the navigation core's model as the numeric second computation.
 
 The printed equations that define the geometry or state an assumption — (2), (3), the chain of
 ratios (8), (9), (10) and (17) — are checked by :func:`check_part` against Fig. 1 rebuilt from the
@@ -31,6 +34,7 @@ from replication.nav import earth
 from replication.nav.errors import NavPoint, model_15
 
 __all__ = ["STATE_NAMES", "reference_state", "derived_coefficients", "sins_error_matrix", "eq1_checks",
+           "ERROR_MODEL_TIME", "parse_error_model", "error_model_block",
            "MOTIONS", "SPECS", "NUMERIC_DH", "LINK_TOLERANCE", "TRACK_TURN_DEG", "reading_names", "parse_reading",
            "motion_states", "PrintedCheck", "check_part", "check_printed"]
 
@@ -282,13 +286,24 @@ through o: straight flight).  Assumption 2 makes the SINS/ADS and SINS horizonta
 it does not put the velocity along the displacement, so the two narrower classes are assumptions
 beyond the printed five."""
 
-SPECS = ("elevation", "link", "speed", "first-order", "displacement", "expansion")
+SPECS = ("elevation", "link", "speed", "first-order", "displacement", "expansion", "error-model")
 """What a printed part of ``duan2023-check-derivations`` is (the ``spec`` column, ``<kind>:<argument>``):
 ``elevation:SINS`` or ``elevation:SINS/ADS`` (the tangent of the elevation of a displacement, eqs. (3),
 (2)); ``link:<n>`` (the n-th equality of the chain (8), printed as the pair of its two ratios);
 ``speed`` (assumption 4 as an equation, (9)); ``first-order:<part>`` (the first-order form of another
 printed part, (10)); ``displacement`` (assumption 1 as an equation, the first line of (17));
-``expansion:<part>`` (another printed part multiplied out, the second line of (17))."""
+``expansion:<part>`` (another printed part multiplied out, the second line of (17));
+``error-model:<rows>:<columns>`` (a printed block of eq. (1): the Jacobian of the ``position``,
+``velocity`` or ``attitude`` error rates with respect to the state groups named, comma-separated, of
+:data:`replication.papers.sins_error_rates.GROUPS`: ``attitude``, ``gyro``, ``accel`` …)."""
+
+ERROR_MODEL_TIME = 1500.0
+"""The time [s] of the flight (``flight.duan2023_flight``) at which the printed blocks of eq. (1) are
+compared numerically with the navigation core's model (:func:`sins_error_matrix`)."""
+
+_CORE_ROWS = {"attitude": slice(0, 3), "velocity": slice(3, 6), "position": slice(6, 9)}
+_CORE_COLUMNS = {"attitude": ("F", slice(0, 3)), "velocity": ("F", slice(3, 6)), "position": ("F", slice(6, 9)),
+                 "gyro": ("G_gyro", slice(0, 3)), "accel": ("G_accel", slice(0, 3))}
 
 NUMERIC_DH = (1.0, 10.0)
 """The height corrections δh^c [m] of the numeric second computation (:func:`check_printed`)."""
@@ -532,6 +547,110 @@ class PrintedCheck:
         return self.check.agrees and all(self.facts.values())
 
 
+def parse_error_model(text: str):
+    """A printed block of duan2023 eq. (1) read into sympy: the names ``C`` (C_b^n, nine symbols of
+    :data:`replication.papers.sins_error_rates.C`), ``zeros``, ``eye`` and ``Matrix``.
+
+    Parameters
+    ----------
+    text : str
+        The reading, e.g. ``"-C"`` or ``"zeros(3, 3)"``.
+
+    Returns
+    -------
+    sympy.Matrix
+
+    Raises
+    ------
+    ValueError
+        When the text is empty, does not parse, names something else or is not a matrix.
+    """
+    import sympy as sp
+
+    from replication.papers import sins_error_rates as rates
+
+    if not isinstance(text, str) or not text.strip():
+        raise ValueError("a printed block of eq. (1) must be non-empty sympy text")
+    ns = {"C": rates.C, "zeros": sp.zeros, "eye": sp.eye, "Matrix": sp.Matrix}
+    try:
+        out = sp.sympify(text, locals=ns)
+    except (sp.SympifyError, TypeError, NameError) as exc:
+        raise ValueError(f"cannot read {text!r} in the names {sorted(ns)}: {exc}") from exc
+    known = set(rates.C)
+    if not isinstance(out, sp.MatrixBase) or not out.free_symbols <= known:
+        raise ValueError(f"{text!r} is not a matrix in the names {sorted(ns)}")
+    return out
+
+
+def error_model_block(rows: str, columns: str):
+    """A block of the linearised ENU error model, duan2023 eq. (1), derived from first principles.
+
+    The Jacobian of the ``rows`` error rates of :func:`replication.papers.sins_error_rates.base_model`
+    with respect to the state groups ``columns`` (comma-separated, stacked in order).
+
+    Parameters
+    ----------
+    rows : {"position", "velocity", "attitude"}
+        The row group.
+    columns : str
+        State groups of :data:`replication.papers.sins_error_rates.GROUPS`, comma-separated.
+
+    Returns
+    -------
+    sympy.Matrix
+
+    Raises
+    ------
+    ValueError
+        For an unknown row or column group.
+    """
+    import sympy as sp
+
+    from replication.papers import sins_error_rates as rates
+
+    model = rates.base_model().rows
+    if rows not in model:
+        raise ValueError(f"unknown row group {rows!r}; known: {sorted(model)}")
+    groups = [g.strip() for g in columns.split(",")]
+    unknown = [g for g in groups if g not in rates.GROUPS]
+    if unknown or not groups:
+        raise ValueError(f"unknown state groups {unknown}; known: {sorted(rates.GROUPS)}")
+    return model[rows].jacobian(sp.Matrix.vstack(*(rates.GROUPS[g] for g in groups)))
+
+
+@lru_cache(maxsize=1)
+def _core_model():
+    from replication.papers.duan2023 import flight
+
+    traj = flight.duan2023_flight()
+    point = NavPoint.from_trajectory(traj, int(np.searchsorted(traj.t, ERROR_MODEL_TIME)))
+    return point, sins_error_matrix(point)
+
+
+def _check_error_model(name, reading, spec):
+    """A printed block of eq. (1) against :func:`error_model_block` (exact) and the core's model (numeric)."""
+    from replication.papers import sins_error_rates as rates
+    from replication.papers.symbolic import Check
+
+    parts = str(spec).split(":")
+    if len(parts) != 3:
+        raise ValueError(f"{name}: spec {spec!r} must read 'error-model:<rows>:<columns>'")
+    _, rows, columns = parts
+    printed = parse_error_model(reading)
+    derived = error_model_block(rows, columns)
+    ok = printed.shape == derived.shape and all(rates.is_zero(x) for x in (printed - derived))
+    chk = Check(name, "error-model", conventions=[{}] if ok else [], derived=derived, printed=printed)
+    if not ok:
+        chk.differing.append(("the block", str(printed), str(derived)))
+    point, m = _core_model()
+    groups = [g.strip() for g in columns.split(",")]
+    core = np.hstack([m[_CORE_COLUMNS[g][0]][_CORE_ROWS[rows], _CORE_COLUMNS[g][1]] for g in groups])
+    values = {rates.C[i, j]: float(point.C_bn[i, j]) for i in range(3) for j in range(3)}
+    at = np.array(printed.subs(values).evalf(), dtype=float) if printed.shape == core.shape else np.full(core.shape, np.inf)
+    numeric = {"|printed − navigation core|": float(np.max(np.abs(at - core)))}
+    return PrintedCheck(chk, spec, "any motion" if ok else None, {}, numeric)
+
+
 def check_part(name: str, reading: str, spec: str, readings: dict | None = None) -> PrintedCheck:
     """Check one printed part of eqs. (2), (3), (8)-(10), (17) against its derivation from Fig. 1.
 
@@ -550,7 +669,11 @@ def check_part(name: str, reading: str, spec: str, readings: dict | None = None)
       must be the printed form times a non-zero number (an equation = 0), the rest of second order;
     * ``displacement``: |d^c|² − |d|² with horizontal length S + δS^C and up h + δh^c (assumption 1), and
       the printed form with d^c = D d (exact turn);
-    * ``expansion``: the other printed part multiplied out.
+    * ``expansion``: the other printed part multiplied out;
+    * ``error-model``: a printed block of eq. (1) against the block of the linearised ENU mechanization
+      (:func:`replication.papers.sins_error_rates.base_model`: errors computed − true,
+      Ĉ_b^n = (I − φ×)C_b^n, sensor errors measured − true), exactly; numerically against the navigation
+      core's model at :data:`ERROR_MODEL_TIME` of the flight.
 
     Parameters
     ----------
@@ -578,6 +701,8 @@ def check_part(name: str, reading: str, spec: str, readings: dict | None = None)
     kind, _, arg = str(spec).partition(":")
     if kind not in SPECS:
         raise ValueError(f"{name}: unknown spec {spec!r}; known kinds: {', '.join(SPECS)}")
+    if kind == "error-model":
+        return _check_error_model(name, reading, spec)
     printed = parse_reading(reading)
     other = None
     if kind in ("first-order", "expansion"):

@@ -686,6 +686,8 @@ _WHAT = {
     "displacement": ("assumption 1 (|d^c| = |d|) with d^c in the vertical plane of d (assumption 2), horizontal "
                      "S + δS^C, up h + δh^C"),
     "expansion": "the first line multiplied out (exact, nothing dropped)",
+    "error-model": ("the block of the linearised ENU mechanization (replication.papers.sins_error_rates: "
+                    "errors computed − true, Ĉ_b^n = (I − φ×)C_b^n, sensor errors measured − true)"),
 }
 
 _FACT_WORDS = {
@@ -734,6 +736,11 @@ def _numeric_words(kind, num) -> str:
         dh = ", ".join(f"{v:.1e} at δh^c = {d:g} m" for v, d in zip(vals, NUMERIC_DH))
         return f"numeric (finite turn): the printed left side / (V |δV^C|) = {dh} (grows with δh^c: second order)"
     (label, value), = num.items()
+    if kind == "error-model":
+        from replication.papers.duan2023.derivation import ERROR_MODEL_TIME
+
+        return (f"numeric (the navigation core's 15-state model at t = {ERROR_MODEL_TIME:g} s of the flight, "
+                f"C_b^n of that instant): {label} {_shown(value)}")
     return f"numeric (finite turn, δh^c = {NUMERIC_DH[-1]:g} m): |{label}| {_shown(value)}"
 
 
