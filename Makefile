@@ -130,7 +130,7 @@ browser: env
 # the book as one PDF for readers (book/_build/pdf/book.pdf): the single-page HTML build of the stored
 # outputs (execution off), printed on A4 by headless Chromium, offline, maths typeset by the local MathJax;
 # scripts/book_pdf.py leaves out the library reference's module pages, adds the title page and the
-# contents (a second print fills in their page numbers) and points every link at the repository
+# contents (the front matter printed again fills in their page numbers) and points every link at the repository
 pdf: env
 	$(VENV)/bin/jupyter-book build book --path-output book --builder singlehtml --quiet
 	$(PY) scripts/book_pdf.py

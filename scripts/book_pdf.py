@@ -18,11 +18,12 @@ decodes; then, before Chromium prints the page on A4:
   the commit and the repository address) and a numbered contents (parts, chapters and their
   sections) open the book.
 
-Chromium prints twice: the contents carry placeholder page numbers in the first print, the pages
-each entry's heading landed on are read from the first PDF's named destinations, and the second
-print carries them; the pages are read again from the second PDF and must agree (the numbers take
-the same room as the placeholders, so nothing moves).  The page numbers are the ones in the page
-footers.  ``book/_static/print.css`` hides the navigation and fits tables and figures to the page.
+Chromium prints the book once with placeholder page numbers in the contents; the pages each
+entry's heading landed on are read from that PDF's named destinations and written into the
+contents, and Chromium prints the front matter alone (the title page and the contents) again, in
+place of the first print's: the numbers take the same room as the placeholders and the book's
+first chapter starts on a new page, so the front matter keeps its page count (checked) and no page
+after it moves.  The page numbers are the ones in the page footers.  ``book/_static/print.css`` hides the navigation and fits tables and figures to the page.
 Chinese text needs a CJK font (Debian's fonts-wqy-zenhei, ``make sysdeps``).
 """
 
@@ -219,14 +220,11 @@ MARGIN_MM = 14
 """Left and right page margins."""
 
 PLACEHOLDER = "000"
-"""The page number of a contents entry in the first print: as wide as any number the second print writes."""
+"""The page number of a contents entry in the first print: as wide as any number the front matter's second print writes."""
 
 FOOTER = ('<div style="font-size:8px; width:100%; text-align:center; color:#555;">'
           '<span class="pageNumber"></span> / <span class="totalPages"></span></div>')
 
-PASSES = 3
-"""Prints at most: the first with placeholders, the second with the page numbers; a third only if
-the second moved a heading (it cannot, as the numbers fit the placeholders' room)."""
 
 
 class _Quiet(http.server.SimpleHTTPRequestHandler):
@@ -358,6 +356,48 @@ def destination_pages(pdf: Path, ids: list[str]) -> dict[str, int]:
     return out
 
 
+def _quiet_clone_counts() -> None:
+    """pypdf's writer logs "Object count ... exceeds defined trailer size" for a clone it adds
+    objects to: it counts the clone's own additions, not a defect."""
+    quiet = logging.Filter()
+    quiet.filter = lambda record: not record.getMessage().startswith("Object count")
+    logging.getLogger("pypdf._writer").addFilter(quiet)
+
+
+def splice_front(book: Path, front: Path, out: Path, n_front: int) -> None:
+    """Write ``out``: the printed ``book`` with its first ``n_front`` pages (the title page and the
+    contents with placeholder page numbers) replaced by the pages of ``front`` (the same front
+    matter printed again with the numbers).  Each replaced page keeps its place in the page tree,
+    so every named destination of ``book`` stays where it was; the links of the new contents name
+    those destinations.
+
+    Raises
+    ------
+    SystemExit
+        When ``front`` does not hold ``n_front`` pages: the numbers would have moved the pages after it.
+    """
+    from pypdf import PdfReader, PdfWriter
+    from pypdf.generic import NameObject
+
+    new = PdfReader(front)
+    if len(new.pages) != n_front:
+        raise SystemExit(f"book_pdf: the front matter with page numbers took {len(new.pages)} pages, not "
+                         f"{n_front}: the pages after it would move")
+    _quiet_clone_counts()
+    writer = PdfWriter(clone_from=str(book))
+    for i in range(n_front):
+        page = writer.pages[i]
+        fresh = writer.add_page(new.pages[i])       # the new page's objects copied into the writer
+        for key in ("/Contents", "/Resources", "/Annots"):
+            if key in fresh:
+                page[NameObject(key)] = fresh[key]
+            elif key in page:
+                del page[NameObject(key)]
+        writer.remove_page(len(writer.pages) - 1)
+    with open(out, "wb") as f:
+        writer.write(f)
+
+
 def add_outline(pdf: Path, rows: list[dict], pages: dict[str, int], front: dict) -> None:
     """Bookmark ``pdf`` as its contents read (parts, their chapters, the chapters' sections) and
     name its authors and version in its metadata; the viewer opens with the bookmarks shown.
@@ -382,9 +422,7 @@ def add_outline(pdf: Path, rows: list[dict], pages: dict[str, int], front: dict)
     contents = 1                         # the page after the title page
     if not (PdfReader(pdf).pages[contents].extract_text() or "").lstrip().startswith("Contents"):
         raise SystemExit("book_pdf: the title page ran over one page: the contents do not start on page 2")
-    quiet = logging.Filter()
-    quiet.filter = lambda record: not record.getMessage().startswith("Object count")   # counts the clone's own
-    logging.getLogger("pypdf._writer").addFilter(quiet)                                   # additions, not a defect
+    _quiet_clone_counts()
     writer = PdfWriter(clone_from=str(pdf))
     writer.add_outline_item(title="Contents", page_number=contents)
     parents: dict[int, object] = {}
@@ -429,6 +467,7 @@ def build_pdf(html: Path = HTML, out: Path = OUT, timeout_ms: int = 300_000) -> 
     external = []
     out.parent.mkdir(parents=True, exist_ok=True)
     first = out.with_name(out.stem + ".pass.pdf")
+    front_pdf = out.with_name(out.stem + ".front.pdf")
     try:
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=CHROMIUM, args=ARGS)
@@ -457,29 +496,29 @@ def build_pdf(html: Path = HTML, out: Path = OUT, timeout_ms: int = 300_000) -> 
                                  f"does not hold, which a PDF cannot carry: {prep['local'][:5]}")
             fit = page.evaluate(FIT_JS)
             targets = [r["target"] for r in prep["rows"]]
-            pages: dict[str, int] = {}
-            for n in range(1, PASSES + 1):
-                page.pdf(path=str(first if n == 1 else out), format="A4", print_background=True,
-                         display_header_footer=True, header_template="<span></span>", footer_template=FOOTER,
-                         outline=False, tagged=False,
-                         margin={"top": "14mm", "bottom": "16mm", "left": f"{MARGIN_MM}mm", "right": f"{MARGIN_MM}mm"})
-                found = destination_pages(first if n == 1 else out, targets)
-                if n > 1 and found == pages:
-                    break
-                pages = found
-                missing = page.evaluate(FILL_JS, pages)
-                if missing:
-                    raise SystemExit(f"book_pdf: no page found for contents entries {missing[:5]}")
-            else:
-                raise SystemExit(f"book_pdf: the contents' page numbers still moved after {PASSES} prints")
+            options = dict(format="A4", print_background=True, display_header_footer=True,
+                           header_template="<span></span>", footer_template=FOOTER, outline=False, tagged=False,
+                           margin={"top": "14mm", "bottom": "16mm", "left": f"{MARGIN_MM}mm",
+                                   "right": f"{MARGIN_MM}mm"})
+            page.pdf(path=str(first), **options)
+            pages = destination_pages(first, targets)
+            missing = page.evaluate(FILL_JS, pages)
+            if missing:
+                raise SystemExit(f"book_pdf: no page found for contents entries {missing[:5]}")
+            n_front = min(pages.values()) - 1          # the title page and the contents
+            page.pdf(path=str(front_pdf), page_ranges=f"1-{n_front}", **options)
             browser.close()
     finally:
         httpd.shutdown()
+    try:
+        splice_front(first, front_pdf, out, n_front)
+    finally:
         first.unlink(missing_ok=True)
+        front_pdf.unlink(missing_ok=True)
     add_outline(out, prep["rows"], pages, front)
     return dict(formulas=ready["math"], external_refused=len(external), seconds=time.perf_counter() - t0,
                 bytes=out.stat().st_size, shrunk=fit["shrunk"], strongest_zoom=fit["worst"], overrun=fit["left"],
-                prints=n, contents=len(targets), to_source=prep["to_source"], to_repository=prep["to_repository"],
+                prints=2, contents=len(targets), to_source=prep["to_source"], to_repository=prep["to_repository"],
                 unlinked=prep["unlinked"])
 
 

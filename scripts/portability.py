@@ -256,8 +256,8 @@ BOOK_JOB = ("strict book build, browser check and PDF", ["make", "--no-print-dir
 its time waiting for pages to go network-idle (one tab visits every page: about 30 s of CPU,
 Chromium's renderer included, in 45 s), so it runs beside the workers instead of occupying one.
 The PDF follows: the single-page build reuses the strict build's parsed sources and Chromium
-prints it twice, the second time with the contents' page numbers (about 50 s for the two prints
-of its 800 pages), then tests/test_book_pdf.py reads a sample of its pages and every page's
+prints it once (about 20 s of CPU for its 840 pages) and its front matter again with the contents'
+page numbers (about 5 s), then tests/test_book_pdf.py reads a sample of its pages and every page's
 links (a few seconds)."""
 
 
