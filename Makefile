@@ -90,10 +90,10 @@ units: env
 	$(PY) scripts/portability.py units
 
 # the unit tests once more on a perturbed numerical code path (scripts/portability.py says why), but for
-# those that run no numerical code path or compare executors within one configuration (the `stored` and
-# `scheduling` markers, tests/conftest.py)
+# those that run no numerical code path, compare executors within one configuration or are identities of
+# sympy's exact algebra (the `stored`, `scheduling` and `symbolic` markers, tests/conftest.py)
 unit-portable: env
-	$(PY) scripts/portability.py unit tests -m "not browser and not slow and not stored and not scheduling"
+	$(PY) scripts/portability.py unit tests -m "not browser and not slow and not stored and not scheduling and not symbolic"
 
 # the unit tests and the perturbed notebooks as one queue of jobs on every core this process may use, slowest first,
 # with the strict book build and the browser check beside them (what `make test` runs)

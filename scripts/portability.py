@@ -178,11 +178,12 @@ def units() -> int:
     return rc
 
 
-PERTURBED_UNITS = "not browser and not slow and not stored and not scheduling"
+PERTURBED_UNITS = "not browser and not slow and not stored and not scheduling and not symbolic"
 """The unit tests run again under the first perturbed configuration: all but the browser checks, the
-slow numerical ones, those that run no numerical code path (the ``stored`` marker) and those that
-compare one computation across executors within one configuration (the ``scheduling`` marker;
-tests/conftest.py): the same work to the same verdict on any configuration."""
+slow numerical ones, those that run no numerical code path (the ``stored`` marker), those that
+compare one computation across executors within one configuration (the ``scheduling`` marker) and
+those whose verdict is an identity of sympy's exact algebra (the ``symbolic`` marker; tests/conftest.py):
+the same work to the same verdict on any configuration."""
 
 SMALL_NOTEBOOK_S = 12.0
 """Notebooks estimated below this many seconds are run together, one job per configuration

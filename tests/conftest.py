@@ -34,7 +34,14 @@ SCHEDULING = frozenset({
 """Test modules that run one computation on several executors or chunkings and compare the results
 bit for bit within one configuration: a numerical configuration changes both sides alike, so the
 verdict does not depend on it.  They carry the ``scheduling`` marker and run once, natively (the
-kernels they schedule run under the perturbed configurations in the other tests and notebooks)."""
+kernels they schedule run under the perturbed configurations in the other tests and notebooks).
+
+Two markers are set test by test, not by module: ``symbolic`` on the tests of the derivation
+modules whose verdict is an identity of sympy's exact algebra (rationals and symbols, no floating
+point: no numpy loop, BLAS kernel or libm function can change it), while the numerical cross-checks
+beside them (finite differences, the navigation core, numeric substitution) stay unmarked and run
+under the perturbed configuration too; and ``stored`` on the command-line tests of
+test_error_classes.py, whose damaged files reach no numerical code path."""
 
 
 def pytest_collection_modifyitems(config, items):

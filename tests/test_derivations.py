@@ -87,6 +87,7 @@ def test_derived_sensor_columns_equal_the_package_error_model():
         np.testing.assert_allclose(D, F[blk], rtol=0, atol=1e-12 * max(1.0, np.abs(F[blk]).max()), err_msg=f"{row}/{col}")
 
 
+@pytest.mark.symbolic
 def test_rotation_identities_and_exact_zero_test():
     assert dv.rotation_lemma()
     L = dv.symbols()["L"]
@@ -95,6 +96,7 @@ def test_rotation_identities_and_exact_zero_test():
     assert not dv.is_zero(sp.sec(L) - 1)
 
 
+@pytest.mark.symbolic
 def test_printed_f_blocks_against_derivation(checks):
     bad = {n for n, c in checks.items() if not c.agrees}
     assert {"Table 2-2 F21", "Table 2-2 F22", "Table 2-2 F23", "Table 2-2 F43", "(3-17) F21", "(3-17) F22",
@@ -108,6 +110,7 @@ def test_printed_f_blocks_against_derivation(checks):
         assert checks[n].agrees, n
 
 
+@pytest.mark.symbolic
 def test_corrected_blocks_are_derivable(readings):
     v, s = readings["(3-17) F22"]
     fixed = v.replace("(VN*tan(L) - VU)/(Rm + h)", "(VN*tan(L) - VU)/(Rn + h)").replace(
@@ -117,6 +120,7 @@ def test_corrected_blocks_are_derivable(readings):
     assert dv.check_item("F33 corrected", v.replace("[-w*sin(L) - VE/(Rn + h)", "[-w*sin(L) - VE*tan(L)/(Rn + h)"), s).agrees
 
 
+@pytest.mark.symbolic
 @pytest.mark.parametrize("name, old, new", [
     ("(3-17) F12", "[sec(L)/(Rn + h), 0, 0]", "[-sec(L)/(Rn + h), 0, 0]"),
     ("(3-17) F23", "[[0, -fU, fN]", "[[0, fU, fN]"),
@@ -135,6 +139,7 @@ def test_a_planted_error_in_a_derivable_part_is_seen(readings, name, old, new):
     assert not dv.check_item(name, v.replace(old, new), s, {k: r for k, (r, _) in readings.items()}).agrees
 
 
+@pytest.mark.symbolic
 def test_a_whole_block_negated_is_seen_unless_a_convention_absorbs_it(readings):
     v, s = readings["(3-17) F12"]
     assert not dv.check_item("F12 negated", f"-({v})", s).agrees        # e² = 1: no convention
@@ -143,6 +148,7 @@ def test_a_whole_block_negated_is_seen_unless_a_convention_absorbs_it(readings):
     assert c.agrees and all(x["e"] * x["a"] == -1 for x in c.conventions)  # the ψ = -φ reading
 
 
+@pytest.mark.symbolic
 def test_coriolis_terms_of_2_15_and_3_15_are_not_derivable(checks, readings):
     assert not checks["(3-15)"].agrees and not checks["(2-15) velocity line"].agrees
     assert checks["(3-3)"].agrees and checks["(3-5)"].agrees
@@ -164,6 +170,7 @@ def test_gravity_vector_of_3_1_points_up_in_enu(checks):
     assert checks["(3-1) g_m^n"].derived == sp.Matrix([0, 0, -dv.symbols()["gam"]])
 
 
+@pytest.mark.symbolic
 def test_chapter_3_parts_need_conventions_that_exclude_each_other(checks):
     for label, parts in derivation_rows.DERIVATION_GROUPS.items():
         assert all(checks[p].agrees for p in parts), label
@@ -172,10 +179,12 @@ def test_chapter_3_parts_need_conventions_that_exclude_each_other(checks):
     assert checks["(3-18) H2"].matches == {"attitude": {-1}}
 
 
+@pytest.mark.symbolic
 def test_markov_constants_of_table_2_2_swap_alpha_and_beta(checks):
     assert not checks["Table 2-2 F6"].agrees and not checks["Table 2-2 F7"].agrees
 
 
+@pytest.mark.symbolic
 def test_companion_form_and_bad_input():
     assert dv.companion_check(3) == (True, 3)
     with pytest.raises(ValueError, match="AR order"):
@@ -193,6 +202,7 @@ def test_companion_form_and_bad_input():
 G1 = "§3.3 G_1 (noise input of the augmented model)"
 
 
+@pytest.mark.symbolic
 def test_random_constant_scale_factors_of_2_6(checks, readings):
     assert checks["(2-6)"].agrees and checks["(2-6)"].conventions == list(dv.CONVENTIONS)
     rates, limit = dv.random_constant_rates(["gyro scale", "accel scale"])
@@ -233,6 +243,7 @@ def test_noise_input_of_3_3_enters_where_the_biases_enter(checks, readings):
 G24 = "§2.4 G (noise input of the 39-state model)"
 
 
+@pytest.mark.symbolic
 def test_noise_input_of_2_4_enters_where_the_biases_enter(checks, readings, printed):
     c = checks[G24]
     assert c.agrees
@@ -262,6 +273,7 @@ def test_noise_input_of_2_4_enters_where_the_biases_enter(checks, readings, prin
     assert "the noise enters where the bias enters" in rows[G24]["note"]
 
 
+@pytest.mark.symbolic
 def test_the_two_new_rows_are_derivations(checks, printed):
     rows = {r["quantity"]: r for r in derivation_rows.derivation_rows(checks, printed, ar_order=3, notebook="nb")}
     for q in ("(2-6)", G1):
@@ -318,6 +330,7 @@ def test_chapter3_reading_rows_quote_the_transcription_and_judge_as_derived(prin
         derivation_rows.chapter3_reading_rows(printed[~printed["quantity"].str.startswith("text: height")], notebook="nb")
 
 
+@pytest.mark.symbolic
 def test_velocity_equation_3_2_follows_from_newtons_law(checks, readings):
     c = checks["(3-2)"]
     assert c.agrees and c.kind == "generic"
@@ -329,6 +342,7 @@ def test_velocity_equation_3_2_follows_from_newtons_law(checks, readings):
     assert not any(str(x).startswith("r") for x in dv.newton_velocity_rate().free_symbols)
 
 
+@pytest.mark.symbolic
 def test_imu_error_model_2_10_is_2_4_substituted_into_2_3(checks, readings):
     assert checks["(2-10)"].agrees
     v, s = readings["(2-10)"]
@@ -337,6 +351,7 @@ def test_imu_error_model_2_10_is_2_4_substituted_into_2_3(checks, readings):
         assert bad != v and not dv.check_item("(2-10) planted", bad, s).agrees
 
 
+@pytest.mark.symbolic
 def test_sensor_error_model_2_3_is_the_first_order_error_of_2_2_compensated(checks, readings):
     assert checks["(2-3)"].agrees
     v, s = readings["(2-3)"]

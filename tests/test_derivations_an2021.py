@@ -21,6 +21,7 @@ def printed():
     return rp.load_paper("an2021-eq-12")
 
 
+@pytest.mark.symbolic
 def test_gain_limits_are_the_level_tilt_of_the_apparent_vertical():
     g, r, vn = (symbolic.SYMBOLS[k] for k in ("g", "R", "V_N"))
     assert sp.simplify(symbolic.low_frequency_gain("north-south", "phiE/gdN") - 1 / g) == 0
@@ -62,6 +63,7 @@ def printed8():
     return {q: eq10.value(q) for q in eq10.quantities if "," in q}
 
 
+@pytest.mark.symbolic
 def test_eq8_derived_from_eq1_reproduces_every_printed_element_and_zero(printed8):
     checks = symbolic.integrated_model_checks(printed8)
     assert checks["identical"].all(), checks[~checks["identical"]]
@@ -86,6 +88,7 @@ def test_eq8_derived_agrees_with_the_numerical_model_the_filter_uses():
         assert np.allclose(derived, numeric, rtol=1e-12, atol=1e-15), name
 
 
+@pytest.mark.symbolic
 @pytest.mark.parametrize("element", ["Ā_1,8", "Ā_4,11", "B_5,2", "C_2,7"])
 def test_a_planted_sign_error_in_eq8_fails_its_row(printed8, element):
     planted = dict(printed8) | {element: -printed8[element]}
@@ -96,6 +99,7 @@ def test_a_planted_sign_error_in_eq8_fails_its_row(printed8, element):
     assert rp.comparison_frame([row]).loc[0, "status"] != "reproduced"
 
 
+@pytest.mark.symbolic
 def test_a_planted_extra_element_breaks_the_zero_structure(printed8):
     dropped = {q: v for q, v in printed8.items() if q != "C_2,7"}
     checks = symbolic.integrated_model_checks(dropped).set_index("quantity")

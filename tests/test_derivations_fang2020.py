@@ -47,10 +47,12 @@ def _at(expr, lat_deg, lon_deg, radius=6.371e6):
     return np.array(sp.Matrix(expr).subs(vals).evalf(), dtype=float)
 
 
+@pytest.mark.symbolic
 def test_geometry_is_consistent():
     assert dv.geometry_lemma()
 
 
+@pytest.mark.symbolic
 def test_printed_n22_is_not_derivable_under_any_convention(items, checks):
     for name in ERRATA:
         c = checks[name]
@@ -67,11 +69,13 @@ def test_printed_n22_is_not_derivable_under_any_convention(items, checks):
     assert [w for w, _, _ in checks[PAIR].differing] == ["(2,1)", "(2,2)", "(2,3)"]
 
 
+@pytest.mark.symbolic
 def test_every_other_printed_part_is_derivable(checks):
     bad = [n for n, c in checks.items() if n not in ERRATA | {PAIR} and not c.agrees]
     assert bad == []
 
 
+@pytest.mark.symbolic
 def test_one_convention_carries_the_whole_printed_model(checks):
     parts = [c for n, c in checks.items() if n not in ERRATA | {PAIR}]
     common = dv.common_conventions(parts)
@@ -114,6 +118,7 @@ PLANTED = [
 ]
 
 
+@pytest.mark.symbolic
 @pytest.mark.parametrize("name, old, new", PLANTED)
 def test_planted_errors_are_caught(items, checks, name, old, new):
     value, spec = _reading(items, name)
@@ -122,6 +127,7 @@ def test_planted_errors_are_caught(items, checks, name, old, new):
     assert not dv.check_item(name, value.replace(old, new, 1), spec).agrees
 
 
+@pytest.mark.symbolic
 def test_a_sign_a_convention_absorbs_is_caught_by_the_model(items, checks):
     # (18) with -ε holds on its own (gyro drift counted the other way) but not together with (21)
     value, spec = _reading(items, "(18)")

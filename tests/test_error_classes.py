@@ -504,6 +504,7 @@ def _run(argv, capsys):
     return code, err
 
 
+@pytest.mark.stored  # the command line and the read side on damaged files: no numerical code path
 @pytest.mark.parametrize("case, argv, names", CLI_CASES, ids=[f"{c} | {' '.join(a)}" for c, a, _ in CLI_CASES])
 def test_the_command_line_answers_a_damaged_file_in_one_line(case, argv, names, tables_copy, tmp_path, monkeypatch,
                                                              capsys):
@@ -518,6 +519,7 @@ def test_the_command_line_answers_a_damaged_file_in_one_line(case, argv, names, 
     assert re.search(r"restore|re-run|rebuild|set it|unset|git checkout", lines[0]), f"says nothing to do: {err}"
 
 
+@pytest.mark.stored  # the command line and the read side on damaged files: no numerical code path
 @pytest.mark.parametrize("where", ["missing", "not a clone"])
 def test_a_wrong_replication_root_is_named(where, tmp_path, monkeypatch, capsys):
     value = str(tmp_path / "nowhere") if where == "missing" else str(tmp_path)
@@ -528,6 +530,7 @@ def test_a_wrong_replication_root_is_named(where, tmp_path, monkeypatch, capsys)
         assert code == 2 and len(lines) == 1 and "REPLICATION_ROOT" in lines[0] and value in lines[0], err
 
 
+@pytest.mark.stored  # the command line and the read side on damaged files: no numerical code path
 @pytest.mark.parametrize("ident, expect", [
     ("chen2019-eq-3-99", "chen2019-eq-3-"), ("chen2019-table-9-9", "chen2019-table-"),
     ("chen2019-Eq-3-1", "chen2019-eq-3-1"), ("chen2019-eq3-1", "chen2019-eq-3-1"),
@@ -543,6 +546,7 @@ def test_an_unknown_id_suggests_at_most_five_near_ids(ident, expect, tables_copy
         assert 1 <= len(suggested) <= 5 and any(s.startswith(expect) for s in suggested), err
 
 
+@pytest.mark.stored  # the command line and the read side on damaged files: no numerical code path
 def test_the_real_command_line_prints_no_traceback(tables_copy, tmp_path):
     """End to end (a new interpreter): a corrupt sidecar and an unknown id, one line each, exit code 2."""
     root = tmp_path / "root"
@@ -555,6 +559,7 @@ def test_the_real_command_line_prints_no_traceback(tables_copy, tmp_path):
         assert p.returncode == 2 and "Traceback" not in p.stderr and len(p.stderr.strip().splitlines()) == 1, p.stderr
 
 
+@pytest.mark.stored  # the command line and the read side on damaged files: no numerical code path
 @pytest.mark.parametrize("case, call, names", [
     ("corrupt sidecar", lambda: rp.load_table(TID), f"{TID}.json"),
     ("malformed CSV", lambda: rp.load_tables(TID), f"{TID}.csv"),
