@@ -6,9 +6,10 @@ The epoch, in order:
 
 1. every run's IMU steps up to the epoch (``_run_steps``: corrections, strapdown, window sums; the
    lead's interval sums of the inputs of F);
-2. the lead's prior (``_lead_prior``): the time update (``_lead_time_update``: Φ, Q_d,
+2. the lead's prior: the time update (``_lead_time_update``: Φ, Q_d,
    P⁻ = Φ P Φᵀ + Q_d, the rows of Φ that carry the sensor-error estimates), the discrete AR step of
-   the gravity states at an AR epoch, and the transition and P⁻ recorded for the smoother;
+   the gravity states at an AR epoch and the transition and P⁻ recorded for the smoother
+   (``_ar_prior``);
 3. the lead's rows and gains: its epoch context (``_lead_context``, which consumes the window sums
    of a window ending here), the rows of H (``_measurement_rows``: each measurement's kernel), the
    sequential Joseph update (``_lead_epoch_gains``: gains, innovation variances, the rows kept for
@@ -92,20 +93,15 @@ def _store_nav(nav_st, nav_q, st, q, k):
 
 
 @njit(inline="always", **_NJ)
-def _lead_prior(model, acc, tw, P, Pbar, use_pbar, Phid, ar, tick, rec_Phi, rec_Pp, j):
-    """The lead's prior at epoch ``j``: the time update (``_lead_time_update``, with the rows of Φ
-    that carry the estimates into ``Phid``), the discrete AR step of the gravity states at an AR
-    epoch (``tick``; ``ar``: T and its noise), P ← T P Tᵀ + Q (and P̄), and the records for the
-    smoother (``_transition_records``).  ``model``: the configuration's F, Q_c, PSDs, series order
-    and rows with dynamics, as a tuple made once per chunk."""
-    fconst, qc, q_accel, q_gyro, order, dyn_rows = model
-    _lead_time_update(fconst, qc, q_accel, q_gyro, order, acc, tw, P, Pbar, use_pbar, dyn_rows, Phid)
-    ar_T, ar_Q = ar
+def _ar_prior(ar_T, ar_Q, tick, P, Pbar, use_pbar, Phi, rec_Phi, rec_Pp, j):
+    """The discrete AR step of the gravity states on the lead's prior at an AR epoch (``tick``):
+    P ← T P Tᵀ + Q (and P̄); then the records for the smoother at epoch ``j``
+    (``_transition_records``)."""
     if tick:
         P[:, :] = ar_T @ P @ ar_T.T + ar_Q
         if use_pbar:
             Pbar[:, :] = ar_T @ Pbar @ ar_T.T + ar_Q
-    _transition_records(rec_Phi, rec_Pp, j, tw[2], ar_T, tick, P)
+    _transition_records(rec_Phi, rec_Pp, j, Phi, ar_T, tick, P)
 
 
 @njit(inline="always", **_NJ)
@@ -286,7 +282,6 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
     R, n_steps, n_ep = inp.dth.shape[0], inp.dt.shape[0], inp.ep_step.shape[0]
     w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta) = _workspace(spec.fconst.shape[0], spec.m_max,
                                                                        spec.dyn_rows.shape[0], inp.obs.shape[2], spec.ar_T)
-    model, ar = (spec.fconst, spec.qc, spec.q_accel, spec.q_gyro, spec.order, spec.dyn_rows), (spec.ar_T, spec.ar_Q)
     c, qtmp, w_ie, w_en = w[6:]
     _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, 0)
     j, k = 0, 0
@@ -301,7 +296,9 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
             break
         T, sf, tick = inp.dt[k_end - 1], inp.sf_end[j], inp.ar_tick[j]
         if is_lead:
-            _lead_prior(model, acc, tw, lead.P, lead.Pbar, spec.use_pbar, gains.Phid[j], ar, tick, out.rec_Phi, out.rec_Pp, j)
+            _lead_time_update(spec.fconst, spec.qc, spec.q_accel, spec.q_gyro, spec.order, acc, tw, lead.P, lead.Pbar,
+                              spec.use_pbar, spec.dyn_rows, gains.Phid[j])
+            _ar_prior(spec.ar_T, spec.ar_Q, tick, lead.P, lead.Pbar, spec.use_pbar, tw[2], out.rec_Phi, out.rec_Pp, j)
             _lead_context(ctx, c, batch.q[0], batch.dth_cp[0], batch.st[0], batch.lever[0], T, lead.facc, lead.Cw, w_ie,
                           w_en, sf)
             gains.m[j] = _measurement_rows(spec.meas_rows, spec.n_meas, spec.meas_par, spec.meas_off, spec.meas_width,
