@@ -69,16 +69,17 @@ def _attitude_error(q, tq, e):
 
 @njit(inline="always", **_NJ)
 def _workspace(n, m_max, n_dyn, n_obs, ar_T):
-    """The chunk's work arrays, made once: the IMU steps' ``w`` (its last four, C_b^n, a quaternion,
-    ω_ie^n and ω_en^n, shared with the epoch), the interval sums ``acc``, the time update's ``tw``,
-    and the epoch's rows, residuals, estimate, error, scratch and ``Ta`` (T's augmented block)."""
+    """The chunk's work arrays, made once: the IMU steps' ``w``, the interval sums ``acc``, the time
+    update's ``tw``, and the epoch's rows, residuals, estimate, error, scratch, ``Ta`` (T's augmented
+    block) and the last four of ``w`` (C_b^n, a quaternion, ω_ie^n and ω_en^n) it shares."""
     c, qtmp, w_ie, w_en = np.empty((3, 3)), np.empty(4), np.empty(3), np.empty(3)
     w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en)
     acc = (np.zeros(2), np.zeros(3), np.zeros((3, 3)), np.zeros(5), np.zeros((6, n)))
     tw = (np.zeros((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)),
           np.empty((n, n)), np.empty((n, n), np.int64), np.empty((n, n)), np.empty(n, np.int64))
     ew = (np.zeros((m_max, n)), np.zeros(m_max), np.empty(m_max), np.zeros(ctx_size(n)), np.empty(n), np.empty(n),
-          np.empty(max(n_dyn, n)), np.empty(n, np.int64), np.zeros(max(n_obs, 1)), np.ascontiguousarray(ar_T[9:, 9:]))
+          np.empty(max(n_dyn, n)), np.empty(n, np.int64), np.zeros(max(n_obs, 1)), np.ascontiguousarray(ar_T[9:, 9:]),
+          c, qtmp, w_ie, w_en)
     return w, acc, tw, ew
 
 
@@ -244,21 +245,22 @@ def _run_records(out_st, out_q, out_phat, r, j, st, q, p_hat):
 
 
 @njit(inline="always", **_NJ)
-def _run_nees(st, q, p_hat, truth_st, truth_q, truth_p, nees_L, nees_sd, e):
-    """One run's NEES against the truth: e = (δst, φ, p_true − p̂) (into ``e``) through P⁺'s scaled
-    Cholesky factor."""
+def _run_nees(st, q, p_hat, truth_st, truth_q, truth_p, nees_L, nees_sd, e, r, j):
+    """Run ``r``'s NEES against the truth at epoch ``j``: e = (δst, φ, p_true − p̂) (into ``e``)
+    through P⁺'s scaled Cholesky factor (``nees_L[j]``, ``nees_sd[j]``)."""
+    tst, tp = truth_st[j], truth_p[r, j]
     for i in range(6):
-        e[i] = st[i] - truth_st[i]
-    _attitude_error(q, truth_q, e)
+        e[i] = st[i] - tst[i]
+    _attitude_error(q, truth_q[j], e)
     for i in range(e.shape[0] - 9):
-        e[9 + i] = truth_p[i] - p_hat[i]
-    return K.solve_scaled(nees_L, nees_sd, e)
+        e[9 + i] = tp[i] - p_hat[i]
+    return K.solve_scaled(nees_L[j], nees_sd[j], e)
 
 
 @njit(**_NJ)
 def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
-    """One chunk of the closed-loop filter for the runs of a batch: every run's IMU steps up to each
-    GNSS epoch, then the epoch (the module docstring lists its steps).
+    """One chunk of the closed-loop filter for the runs of ``batch``: their IMU steps up to each
+    GNSS epoch, then the epoch (its steps are listed in the module docstring).
 
     Parameters
     ----------
@@ -266,13 +268,10 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
         The configuration (:func:`build_spec`) and the chunk's inputs for the runs of ``batch``.
     batch, lead : BatchState, LeadState
         The runs' state (views), and the lead's covariance and window sums, advanced in place.
-    gains : Gains
-        Per epoch of the chunk: written by the lead's pass, read by the followers.
-    out : ChunkOut
-        The chunk's outputs for the runs of ``batch``, written in place.
+    gains, out : Gains, ChunkOut
+        Per epoch, the gains the lead's pass writes and the followers read; the chunk's outputs.
     is_lead : bool
-        Run 0 of ``batch`` is the lead: the covariance is propagated and updated from it and the gains
-        are written; otherwise the runs follow ``gains`` of the lead's pass over the same chunk.
+        Run 0 of ``batch`` is the lead: the covariance follows it and ``gains`` are written.
 
     Returns
     -------
@@ -280,12 +279,11 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
         The number of GNSS epochs processed.
     """
     R, n_steps, n_ep = inp.dth.shape[0], inp.dt.shape[0], inp.ep_step.shape[0]
-    w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta) = _workspace(spec.fconst.shape[0], spec.m_max,
-                                                                       spec.dyn_rows.shape[0], inp.obs.shape[2], spec.ar_T)
-    c, qtmp, w_ie, w_en = w[6:]
+    w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta, c, qtmp, w_ie, w_en) = _workspace(
+        spec.fconst.shape[0], spec.m_max, spec.dyn_rows.shape[0], inp.obs.shape[2], spec.ar_T)
     _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, 0)
-    j, k = 0, 0
-    while k < n_steps:
+    k = 0
+    for j in range(n_ep + 1):
         has_ep = j < n_ep
         k_end = inp.ep_step[j] + 1 if has_ep else n_steps
         for r in range(R):
@@ -317,8 +315,6 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
             K.feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, batch.g_extra[r])
             _run_records(out.st, out.q, out.phat, r, j, st_r, q_r, ph_r)
             if spec.nees:
-                out.nees[r, j] = _run_nees(st_r, q_r, ph_r, inp.truth_st[j], inp.truth_q[j], inp.truth_p[r, j],
-                                           gains.nees_L[j], gains.nees_sd[j], e)
-        j += 1
+                out.nees[r, j] = _run_nees(st_r, q_r, ph_r, inp.truth_st, inp.truth_q, inp.truth_p, gains.nees_L, gains.nees_sd, e, r, j)
         _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, k_end)
-    return j
+    return n_ep
