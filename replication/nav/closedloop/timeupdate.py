@@ -76,11 +76,10 @@ def _run_steps(spec, inp, batch, r, k0, k1, nav_last, lead_acc, lead, acc, nav_s
     corrections, strapdown, window sums; the lead's interval sums of the inputs of F into ``acc``
     when ``lead_acc``; the IMU-rate solution (``nav_st``, ``nav_q``) for steps before ``nav_last``.
 
-    Why these arguments (thirteen): it is called once per run and GNSS interval; the bundles it takes
-    (``spec``, ``inp``, ``batch``, ``lead``) are those whose arrays the steps read, ``acc`` and ``w``
-    are tuples of exactly the arrays used, and the run's IMU-rate records come as two views rather
-    than ``ChunkOut``, most of whose arrays the steps do not read (a compiled helper that receives a
-    bundle takes a reference to each of its arrays per call)."""
+    Why these arguments (thirteen): called once per run and GNSS interval, it takes the bundles whose
+    arrays the steps read (``spec``, ``inp``, ``batch``, ``lead``), ``acc`` and ``w`` as tuples of
+    exactly the arrays used, and the run's IMU-rate records as two views, not the ``ChunkOut``
+    bundle, most of whose arrays the steps do not read (see the package's ``forward`` module)."""
     u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en = w
     sums, fsum, Csum, navsum, Cpl = acc
     st, st_prev, q, p_hat, g_extra = batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r], batch.g_extra[r]
