@@ -146,6 +146,7 @@ MAX_ARGUMENTS = 12
 # closed-loop filter's hour 0.61 s of CPU against 0.41 s with arrays).  Such a kernel says so in
 # its docstring, with this phrase.
 ARGUED = "not a bundle"
+WHY_ARGUMENTS = "Why these arguments"
 SIGNATURES_PENDING: set[str] = set()
 
 
@@ -176,14 +177,16 @@ def _long_signatures():
         tree = ast.parse(path.read_text(encoding="utf-8"))
         for qual, node in _functions(tree, name):
             if _n_arguments(node) > MAX_ARGUMENTS:
-                argued = _compiled(node) and ARGUED in (ast.get_docstring(node) or "")
+                doc = ast.get_docstring(node) or ""
+                argued = _compiled(node) and (ARGUED in doc or WHY_ARGUMENTS in doc)
                 out[qual] = (_n_arguments(node), argued)
     return out
 
 
 def test_no_signature_over_twelve_arguments():
     """No function of the package takes more than twelve arguments, but a compiled kernel that
-    argues why (its docstring says the arrays come "not a bundle"); option bundles
+    argues why (its docstring says the arrays come "not a bundle", or has a "Why these arguments"
+    paragraph); option bundles
     (``closedloop.RunOptions``, ``kalman.VerticalChannel``, ...) carry the rest."""
     long = _long_signatures()
     over = {q: n for q, (n, argued) in long.items() if not argued and q not in SIGNATURES_PENDING}
@@ -199,6 +202,62 @@ def test_the_signature_rule_can_fail():
     src = "@njit\ndef g(self, " + ", ".join(f"a{i}" for i in range(12)) + "):\n    '''x, not a bundle'''\n"
     node = ast.parse(src).body[0]
     assert _n_arguments(node) == 12 and _compiled(node)
+
+
+# ------------------------------------------------------------------ the closed-loop filter's compiled functions
+# The compiled passes of the closed-loop filter (``replication/nav/closedloop/``) read as sequences of
+# concept-named helpers: no compiled function there is over COMPILED_LINES lines (the whole def, its
+# docstring included; a long explanation belongs in the module docstring) unless a paragraph of its
+# docstring starts with WHY_LONG_FUNCTION, and none takes over MAX_ARGUMENTS arguments unless a
+# paragraph starts with WHY_ARGUMENTS (numba takes a reference to each array of a bundle a compiled
+# helper receives, so a helper called per step or epoch may take its arrays one by one).
+COMPILED_LINES = 60
+WHY_LONG_FUNCTION = "Why this function is long"
+CLOSED_LOOP = PKG / "nav" / "closedloop"
+
+
+def _paragraph_starts(doc: str, words: str) -> bool:
+    return any(para.strip().startswith(words) for para in re.split(r"\n\s*\n", doc))
+
+
+def compiled_oversize(source: str) -> dict[str, str]:
+    """Each compiled function of ``source`` over COMPILED_LINES lines or MAX_ARGUMENTS arguments
+    without the paragraph that argues it, with what is over."""
+    out = {}
+    for qual, node in _functions(ast.parse(source), ""):
+        if not _compiled(node):
+            continue
+        doc, lines, n_args = ast.get_docstring(node) or "", node.end_lineno - node.lineno + 1, _n_arguments(node)
+        over = []
+        if lines > COMPILED_LINES and not _paragraph_starts(doc, WHY_LONG_FUNCTION):
+            over.append(f"{lines} lines")
+        if n_args > MAX_ARGUMENTS and not _paragraph_starts(doc, WHY_ARGUMENTS):
+            over.append(f"{n_args} arguments")
+        if over:
+            out[qual.lstrip(".")] = ", ".join(over)
+    return out
+
+
+def test_closed_loop_compiled_functions_are_short():
+    """Every compiled function of the closed-loop filter within 60 lines and 12 arguments, or argued."""
+    paths = sorted(CLOSED_LOOP.glob("*.py"))
+    assert any("def filter_chunk" in p.read_text(encoding="utf-8") for p in paths)
+    found = {f"{p.stem}.{q}": what for p in paths for q, what in compiled_oversize(p.read_text(encoding="utf-8")).items()}
+    assert not found, (f"compiled functions over {COMPILED_LINES} lines or {MAX_ARGUMENTS} arguments without a "
+                       f"{WHY_LONG_FUNCTION!r} / {WHY_ARGUMENTS!r} paragraph (split them into helpers): {found}")
+
+
+def test_the_compiled_size_rule_can_fail():
+    """A long compiled function and a wide one are caught; the arguing paragraph (not a mention in
+    passing) and an uncompiled function pass."""
+    args13 = ", ".join(f"a{i}" for i in range(13))
+    body = "    x = 1\n" * 60
+    src = (f'@njit(**_NJ)\ndef long_one(a):\n    """Doc."""\n{body}\n'
+           f'@njit(inline="always")\ndef wide({args13}):\n    """Doc, saying why these arguments."""\n\n'
+           f'@njit\ndef argued({args13}):\n    """Doc.\n\n    Why these arguments: one array each."""\n\n'
+           f'@njit\ndef argued_long(a):\n    """Doc.\n\n    Why this function is long: one loop."""\n{body}\n'
+           f"def plain({args13}):\n{body}")
+    assert compiled_oversize(src) == {"long_one": "62 lines", "wide": "13 arguments"}
 
 
 # ------------------------------------------------------------------ the toolkit knows no paper

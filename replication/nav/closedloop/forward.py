@@ -2,21 +2,41 @@
 runs' IMU steps, then at each epoch the lead's time update and gains and every run's residuals,
 correction, feedback and records (the NEES against a truth included).
 
-The epoch is a sequence of compiled helpers, one concept each: the sensor-error estimates carried
-by Φ (:func:`_propagate_estimates`), the discrete AR step (:func:`_ar_step`), the lead's records
-for the smoother, its context and gains (:func:`_lead_context`, :func:`_lead_epoch_gains`), one
-run's context, correction, records and NEES (:func:`_run_context`, :func:`_run_correction`,
-:func:`_innovation_records`, :func:`_run_records`, :func:`_run_nees`), the lead's end-of-epoch
-records (:func:`_lead_records`).  They are compiled inline and take arrays and scalars, never a
-bundle: an inlined helper that receives a bundle still takes a reference to each of its arrays at
-every call.  Measured on the 15-state hour (CPU seconds, alternated processes), against the epoch
-written out in one function: helpers carrying ``spec``, ``inp``, ``batch``, ``gains``, ``out`` and
-a scratch bundle, a quarter slower (0.61 s against 0.41 s); every run's update as one helper
-receiving ``spec``, ``inp``, ``batch``, ``gains`` and ``out``, 9 % slower; the work arrays made by a
-helper and returned as a tuple, 4 % slower; the lead's rows of H cleared by a helper around
-:func:`_measurement_rows`, 4 % slower.  So the work arrays are allocated in :func:`filter_chunk`
-itself, H is cleared there, and the epoch's sequence of calls stays in its loop.
+The epoch, in order:
+
+1. every run's IMU steps up to the epoch (``_run_steps``: corrections, strapdown, window sums; the
+   lead's interval sums of the inputs of F);
+2. the lead's prior: the time update (``_lead_time_update``: Φ, Q_d,
+   P⁻ = Φ P Φᵀ + Q_d, the rows of Φ that carry the sensor-error estimates), the discrete AR step of
+   the gravity states at an AR epoch and the transition and P⁻ recorded for the smoother
+   (``_ar_prior``);
+3. the lead's rows and gains: its epoch context (``_lead_context``, which consumes the window sums
+   of a window ending here), the rows of H (``_measurement_rows``: each measurement's kernel), the
+   sequential Joseph update (``_lead_epoch_gains``: gains, innovation variances, the rows kept for
+   the runs, P⁺'s scaled Cholesky factor for the NEES), and its records (``_lead_records``);
+4. every run's sensor-error estimates carried by Φ and the AR step (``_carry_estimates``);
+5. per run: its context (``_run_context``), residuals (``_measurement_residuals``), correction
+   with the lead's gains (``_run_correction``: NIS and residual records), feedback
+   (``replication.nav._kernels.feedback_nav`` and ``feedback_blocks``), records (``_run_records``)
+   and NEES (``_run_nees``).
+
+The lead's steps 2 and 3 come before step 4: they read neither the runs' estimates nor anything
+step 4 writes, so the order changes no number.  The followers (``is_lead`` false) skip 2 and 3 and
+read the lead's ``Gains``.
+
+The helpers are compiled inline and take arrays and scalars, not the configuration's bundles: an
+inlined helper that receives a bundle still takes a reference to each of its arrays at every call.
+Measured on the 15-state hour (CPU seconds, alternated processes), against the epoch written out in
+one function: helpers carrying ``spec``, ``inp``, ``batch``, ``gains``, ``out`` and a scratch bundle,
+a quarter slower (0.61 s against 0.41 s); every run's update as one helper receiving ``spec``,
+``inp``, ``batch``, ``gains`` and ``out``, 9 % slower.  The bundles that stay (``spec``, ``inp``,
+``batch`` and ``lead`` into ``_run_steps``) are the ones whose arrays the steps read.  The work
+arrays are made once per chunk by ``_workspace``, compiled inline into :func:`filter_chunk` (the
+allocations are its own, as when they were written out there), and the scratch tuples it returns
+(``acc``: the interval sums, ``tw``: the time update's arrays) are unpacked by the helpers that use
+them.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -48,26 +68,61 @@ def _attitude_error(q, tq, e):
 
 
 @njit(inline="always", **_NJ)
+def _workspace(n, m_max, n_dyn, n_obs, ar_T):
+    """The chunk's work arrays, made once: the IMU steps' ``w``, the interval sums ``acc``, the time
+    update's ``tw``, and the epoch's rows, residuals, estimate, error, scratch, ``Ta`` (T's augmented
+    block) and the last four of ``w`` (C_b^n, a quaternion, ω_ie^n and ω_en^n) it shares."""
+    c, qtmp, w_ie, w_en = np.empty((3, 3)), np.empty(4), np.empty(3), np.empty(3)
+    w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en)
+    acc = (np.zeros(2), np.zeros(3), np.zeros((3, 3)), np.zeros(5), np.zeros((6, n)))
+    tw = (np.zeros((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)),
+          np.empty((n, n)), np.empty((n, n), np.int64), np.empty((n, n)), np.empty(n, np.int64))
+    ew = (np.zeros((m_max, n)), np.zeros(m_max), np.empty(m_max), np.zeros(ctx_size(n)), np.empty(n), np.empty(n),
+          np.empty(max(n_dyn, n)), np.empty(n, np.int64), np.zeros(max(n_obs, 1)), np.ascontiguousarray(ar_T[9:, 9:]),
+          c, qtmp, w_ie, w_en)
+    return w, acc, tw, ew
+
+
+@njit(inline="always", **_NJ)
 def _store_nav(nav_st, nav_q, st, q, k):
-    """The IMU-rate solution of every run at step ``k`` (``nav_st``, ``nav_q``: runs × steps × ·)."""
-    for r in range(st.shape[0]):
-        nav_st[r, k, :] = st[r]
-        nav_q[r, k, :] = q[r]
+    """The IMU-rate solution of every run at step ``k`` when it is kept (``nav_st``, ``nav_q``:
+    runs × steps × ·, no steps when not kept)."""
+    if nav_st.shape[1] > 0:
+        for r in range(st.shape[0]):
+            nav_st[r, k, :] = st[r]
+            nav_q[r, k, :] = q[r]
 
 
 @njit(inline="always", **_NJ)
-def _dynamic_rows(Phi, dyn_rows, Phid):
-    """The rows of Φ of the augmented states with dynamics, their augmented columns, into ``Phid``."""
-    n_aug = Phi.shape[0] - 9
-    for t in range(dyn_rows.shape[0]):
-        for jj in range(n_aug):
-            Phid[t, jj] = Phi[9 + dyn_rows[t], 9 + jj]
+def _ar_prior(ar_T, ar_Q, tick, P, Pbar, use_pbar, Phi, rec_Phi, rec_Pp, j):
+    """The discrete AR step of the gravity states on the lead's prior at an AR epoch (``tick``):
+    P ← T P Tᵀ + Q (and P̄); then the records for the smoother at epoch ``j``
+    (``_transition_records``)."""
+    if tick:
+        P[:, :] = ar_T @ P @ ar_T.T + ar_Q
+        if use_pbar:
+            Pbar[:, :] = ar_T @ Pbar @ ar_T.T + ar_Q
+    _transition_records(rec_Phi, rec_Pp, j, Phi, ar_T, tick, P)
 
 
 @njit(inline="always", **_NJ)
-def _propagate_estimates(Phid, dyn_rows, p_hat, tmp):
+def _transition_records(rec_Phi, rec_Pp, j, Phi, ar_T, ar_tick, P):
+    """The lead's records for the smoother at epoch ``j``, when kept: the transition from the last
+    epoch's P⁺ to this epoch's P⁻ (T Φ at an AR epoch) and P⁻ (RTS only)."""
+    if rec_Phi.shape[0] > 0:
+        if ar_tick:
+            rec_Phi[j] = ar_T @ Phi
+        else:
+            rec_Phi[j] = Phi
+        if rec_Pp.shape[0] > 0:
+            rec_Pp[j] = P
+
+
+@njit(inline="always", **_NJ)
+def _carry_estimates(Phid, dyn_rows, p_hat, tmp, tick, Ta):
     """Every run's sensor-error estimates with dynamics (Markov, gravity) carried through Φ (its rows
-    ``Phid``): p̂[dyn_rows] ← Φ_d p̂."""
+    ``Phid``): p̂[dyn_rows] ← Φ_d p̂; then, at an AR epoch (``tick``), p̂ ← T_a p̂ (``Ta``: T's
+    augmented block)."""
     n_dyn = dyn_rows.shape[0]
     n_aug = Phid.shape[1]
     for r in range(p_hat.shape[0]):
@@ -78,36 +133,16 @@ def _propagate_estimates(Phid, dyn_rows, p_hat, tmp):
             tmp[t] = s_
         for t in range(n_dyn):
             p_hat[r, dyn_rows[t]] = tmp[t]
+    if tick:
+        for r in range(p_hat.shape[0]):
+            p_hat[r, :] = Ta @ p_hat[r]
 
 
 @njit(inline="always", **_NJ)
-def _ar_step(ar_T, ar_Q, Ta, P, Pbar, p_hat, is_lead, use_pbar):
-    """Discrete AR step of the gravity states (held between steps): x ← T x for every run's
-    estimates (``Ta``: T's augmented block), P ← T P Tᵀ + Q for the lead (and P̄)."""
-    if is_lead:
-        P[:, :] = ar_T @ P @ ar_T.T + ar_Q
-        if use_pbar:
-            Pbar[:, :] = ar_T @ Pbar @ ar_T.T + ar_Q
-    for r in range(p_hat.shape[0]):
-        p_hat[r, :] = Ta @ p_hat[r]
-
-
-@njit(inline="always", **_NJ)
-def _transition_records(rec_Phi, rec_Pp, j, Phi, ar_T, ar_tick, P):
-    """The lead's records for the smoother at epoch ``j``: the transition from the last epoch's P⁺
-    to this epoch's P⁻ (T Φ at an AR epoch) and P⁻."""
-    if ar_tick:
-        rec_Phi[j] = ar_T @ Phi
-    else:
-        rec_Phi[j] = Phi
-    if rec_Pp.shape[0] > 0:
-        rec_Pp[j] = P
-
-
-@njit(inline="always", **_NJ)
-def _lead_context(ctx, c, q, dth_cp, st, lever, T, facc, Cw, w_ie, w_en):
+def _lead_context(ctx, c, q, dth_cp, st, lever, T, facc, Cw, w_ie, w_en, sf):
     """The lead's epoch context for the rows of H: C_b^n (into ``c``), the navigation part, and the
-    window sums of f^n (``facc``) and of the sensor blocks' couplings (``Cw``, 6 × n)."""
+    window sums of f^n (``facc``) and of the sensor blocks' couplings (``Cw``, 6 × n), which are
+    zeroed when their window ends at this epoch (``sf`` ≥ 0): the next one starts from zero."""
     n = Cw.shape[1]
     K.q2c(q, c)
     wx, wy, wz = _body_rate(dth_cp, T, c, st, w_ie, w_en)
@@ -118,24 +153,47 @@ def _lead_context(ctx, c, q, dth_cp, st, lever, T, facc, Cw, w_ie, w_en):
     for i in range(6):
         for jj in range(n):
             ctx[cw + i * n + jj] = Cw[i, jj]
+    if sf >= 0:
+        facc[:] = 0.0
+        Cw[:, :] = 0.0
 
 
 @njit(inline="always", **_NJ)
 def _lead_epoch_gains(P, H, m, Rd, gK, gs, gH, tmp, hz, nees_sd, nees_L, j):
     """The lead's sequential Joseph update over the ``m`` rows of H (``_lead_gains``: gains ``gK``,
-    innovation variances ``gs``), the rows kept in ``gH`` for the runs, and P⁺'s scaled Cholesky
-    factor for the NEES at epoch ``j`` (when ``nees_L``, epochs × n × n, is not empty)."""
+    innovation variances ``gs``), the rows kept in ``gH`` for the runs (and H's rows zeroed for the
+    next epoch's kernels), and P⁺'s scaled Cholesky factor for the NEES at epoch ``j`` (when
+    ``nees_L``, epochs × n × n, is not empty)."""
     _lead_gains(P, H, m, Rd, gK, gs, tmp, hz)
     for a in range(m):
         gH[a, :] = H[a]
+        H[a, :] = 0.0
     if nees_L.shape[0] > 0:
         K.chol_scaled(P, nees_sd[j], nees_L[j])
 
 
 @njit(inline="always", **_NJ)
-def _run_context(ctx, c, q, dth_cp, st, lever, T, vacc, p_hat, w_ie, w_en, n):
-    """One run's epoch context for its residuals (``n`` states): C_b^n (into ``c``), the navigation
-    part, the window sum of the INS acceleration and the accumulated sensor-error estimates."""
+def _lead_records(j, P, Pbar, use_pbar, pdiag, rec_Pf, flag, out_P, out_Pbar):
+    """The lead's records of epoch ``j``: diag P⁺, P⁺ for the RTS smoother (when ``rec_Pf`` is not
+    empty), and P⁺ (and P̄) at a recorded epoch (``flag[j]`` ≥ 0)."""
+    n = P.shape[0]
+    for i in range(n):
+        pdiag[j, i] = P[i, i]
+    if rec_Pf.shape[0] > 0:
+        rec_Pf[j] = P
+    f = flag[j]
+    if f >= 0 and out_P.shape[0] > 0:
+        out_P[f] = P
+        if use_pbar and out_Pbar.shape[0] > 0:
+            out_Pbar[f] = Pbar
+
+
+@njit(inline="always", **_NJ)
+def _run_context(ctx, c, q, dth_cp, st, lever, T, vacc, p_hat, w_ie, w_en, sf):
+    """One run's epoch context for its residuals: C_b^n (into ``c``), the navigation part, the window
+    sum of the INS acceleration (zeroed when its window ends at this epoch, ``sf`` ≥ 0) and the
+    accumulated sensor-error estimates."""
+    n = p_hat.shape[0] + 9
     K.q2c(q, c)
     wx, wy, wz = _body_rate(dth_cp, T, c, st, w_ie, w_en)
     _fill_context(ctx, st, lever, wx, wy, wz, n)
@@ -143,32 +201,31 @@ def _run_context(ctx, c, q, dth_cp, st, lever, T, vacc, p_hat, w_ie, w_en, n):
         ctx[CTX_VACC + i] = vacc[i]
     for i in range(n - 9):
         ctx[CTX_PHAT + i] = p_hat[i]
+    if sf >= 0:
+        for i in range(3):
+            vacc[i] = 0.0
 
 
 @njit(inline="always", **_NJ)
-def _run_correction(z, m, gH, gK, gS, xk):
-    """One run's sequential update with the lead's rows ``gH``, gains ``gK`` and innovation
-    variances ``gS``: row a's innovation ν_a = z_a − h_aᵀ x̂, x̂ ← x̂ + K_a ν_a from x̂ = 0 (into
-    ``xk``); returns the NIS Σ ν_a² / s_a."""
+def _run_correction(z, j, gm, gH, gK, gS, xk, nis, innov, rec_x, r):
+    """Run ``r``'s sequential update at epoch ``j`` with the lead's rows ``gH``, gains ``gK`` and
+    innovation variances ``gS`` (``gm``: rows per epoch): row a's innovation ν_a = z_a − h_aᵀ x̂,
+    x̂ ← x̂ + K_a ν_a from x̂ = 0 (into ``xk``); its NIS Σ ν_a² / s_a into ``nis``, its residuals into
+    ``innov`` and, for the RTS smoother, x̂ before the feedback into ``rec_x`` (runs × epochs × n, no
+    epochs when not kept)."""
+    m, h, g, s = gm[j], gH[j], gK[j], gS[j]
     n = xk.shape[0]
     for i in range(n):
         xk[i] = 0.0
-    nis = 0.0
+    v = 0.0
     for a in range(m):
         nu = z[a]
         for kk in range(n):
-            nu -= gH[a, kk] * xk[kk]
+            nu -= h[a, kk] * xk[kk]
         for i in range(n):
-            xk[i] += gK[a, i] * nu
-        nis += nu * nu / gS[a]
-    return nis
-
-
-@njit(inline="always", **_NJ)
-def _innovation_records(innov, rec_x, r, j, z, m, xk):
-    """Run ``r``'s residuals at epoch ``j`` (``innov``: runs × epochs × m_max) and, for the RTS
-    smoother, its estimate before the feedback (``rec_x``, runs × epochs × n, no epochs when not
-    kept)."""
+            xk[i] += g[a, i] * nu
+        v += nu * nu / s[a]
+    nis[r, j] = v
     for a in range(m):
         innov[r, j, a] = z[a]
     if rec_x.shape[1] > 0:
@@ -188,149 +245,76 @@ def _run_records(out_st, out_q, out_phat, r, j, st, q, p_hat):
 
 
 @njit(inline="always", **_NJ)
-def _run_nees(st, q, p_hat, truth_st, truth_q, truth_p, nees_L, nees_sd, e):
-    """One run's NEES against the truth: e = (δst, φ, p_true − p̂) (into ``e``) through P⁺'s scaled
-    Cholesky factor."""
+def _run_nees(st, q, p_hat, truth_st, truth_q, truth_p, nees_L, nees_sd, e, r, j):
+    """Run ``r``'s NEES against the truth at epoch ``j``: e = (δst, φ, p_true − p̂) (into ``e``)
+    through P⁺'s scaled Cholesky factor (``nees_L[j]``, ``nees_sd[j]``)."""
+    tst, tp = truth_st[j], truth_p[r, j]
     for i in range(6):
-        e[i] = st[i] - truth_st[i]
-    _attitude_error(q, truth_q, e)
+        e[i] = st[i] - tst[i]
+    _attitude_error(q, truth_q[j], e)
     for i in range(e.shape[0] - 9):
-        e[9 + i] = truth_p[i] - p_hat[i]
-    return K.solve_scaled(nees_L, nees_sd, e)
-
-
-@njit(inline="always", **_NJ)
-def _lead_records(j, P, Pbar, use_pbar, record, pdiag, rec_Pf, flag, out_P, out_Pbar):
-    """The lead's end-of-epoch records: diag P⁺, P⁺ for the RTS smoother (``record``), and P⁺ (and
-    P̄) at a recorded epoch (``flag[j]`` ≥ 0)."""
-    n = P.shape[0]
-    for i in range(n):
-        pdiag[j, i] = P[i, i]
-    if record and rec_Pf.shape[0] > 0:
-        rec_Pf[j] = P
-    f = flag[j]
-    if f >= 0 and out_P.shape[0] > 0:
-        out_P[f] = P
-        if use_pbar and out_Pbar.shape[0] > 0:
-            out_Pbar[f] = Pbar
+        e[9 + i] = tp[i] - p_hat[i]
+    return K.solve_scaled(nees_L[j], nees_sd[j], e)
 
 
 @njit(**_NJ)
 def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
-    """One chunk of the closed-loop filter for the runs of a batch (see the module docstring).
-
-    The runs advance one GNSS interval at a time (``_run_steps``); at each epoch the lead's time
-    update (``_lead_time_update``), the estimates carried by Φ, the AR step, the lead's rows of H
-    (``_measurement_rows``: each measurement's kernel) and gains, then every run's residuals
-    (``_measurement_residuals``), correction, feedback and records.
+    """One chunk of the closed-loop filter for the runs of ``batch``: their IMU steps up to each
+    GNSS epoch, then the epoch (its steps are listed in the module docstring).
 
     Parameters
     ----------
-    spec : Spec
-        The configuration (:func:`build_spec`).
-    inp : ChunkInputs
-        The chunk's inputs for the runs of ``batch``.
-    batch : BatchState
-        The runs' state (views), advanced in place.
-    lead : LeadState
-        The lead's covariance and window sums, advanced in place when ``is_lead``.
-    gains : Gains
-        Per epoch of the chunk: written by the lead's pass, read by the followers.
-    out : ChunkOut
-        The chunk's outputs for the runs of ``batch``, written in place.
+    spec, inp : Spec, ChunkInputs
+        The configuration (:func:`build_spec`) and the chunk's inputs for the runs of ``batch``.
+    batch, lead : BatchState, LeadState
+        The runs' state (views), and the lead's covariance and window sums, advanced in place.
+    gains, out : Gains, ChunkOut
+        Per epoch, the gains the lead's pass writes and the followers read; the chunk's outputs.
     is_lead : bool
-        Run 0 of ``batch`` is the lead: the covariance is propagated and updated from it and the
-        gains are written for every epoch; otherwise the runs follow ``gains`` written by the
-        lead's pass over the same chunk.
+        Run 0 of ``batch`` is the lead: the covariance follows it and ``gains`` are written.
 
     Returns
     -------
     int
         The number of GNSS epochs processed.
     """
-    R, n_steps, n_ep, n = inp.dth.shape[0], inp.dt.shape[0], inp.ep_step.shape[0], spec.fconst.shape[0]
-    # the work arrays, allocated here (see the module docstring)
-    c, qtmp, w_ie, w_en = np.empty((3, 3)), np.empty(4), np.empty(3), np.empty(3)
-    w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en)
-    F, Phi, Qd, Qc, w1, w2, w3 = (np.zeros((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)),
-                                  np.empty((n, n)), np.empty((n, n)), np.empty((n, n)))
-    nzc, nzv, cnt = np.empty((n, n), np.int64), np.empty((n, n)), np.empty(n, np.int64)
-    Csum, Cpl, fsum, navsum, sums = np.zeros((3, 3)), np.zeros((6, n)), np.zeros(3), np.zeros(5), np.zeros(2)
-    H, Rd, z, ctx = np.zeros((spec.m_max, n)), np.zeros(spec.m_max), np.empty(spec.m_max), np.zeros(ctx_size(n))
-    xk, e, tmp, hz = np.empty(n), np.empty(n), np.empty(max(spec.dyn_rows.shape[0], n)), np.empty(n, np.int64)
-    dbuf = np.zeros(max(inp.obs.shape[2], 1))
-    Ta = np.ascontiguousarray(spec.ar_T[9:, 9:])
-    store_nav = out.nav_st.shape[1] > 0
-    record = out.rec_Phi.shape[0] > 0
-    if store_nav:
-        _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, 0)
-    first = batch.first[0] == 1
-    j = 0
+    R, n_steps, n_ep = inp.dth.shape[0], inp.dt.shape[0], inp.ep_step.shape[0]
+    w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta, c, qtmp, w_ie, w_en) = _workspace(
+        spec.fconst.shape[0], spec.m_max, spec.dyn_rows.shape[0], inp.obs.shape[2], spec.ar_T)
+    _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, 0)
     k = 0
-    while k < n_steps:
+    for j in range(n_ep + 1):
         has_ep = j < n_ep
         k_end = inp.ep_step[j] + 1 if has_ep else n_steps
         for r in range(R):
-            batch.damp[r] = _run_steps(spec, inp, r, k, k_end, batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r],
-                                     batch.g_extra[r], batch.dth_cp[r], batch.dv_cp[r], batch.trig[r], batch.vacc[r],
-                                     batch.damp[r], first, is_lead and r == 0, lead, sums, fsum, Csum, navsum, Cpl,
-                                     out.nav_st[r], out.nav_q[r], k_end - 1 if has_ep else k_end, w)
-        first = False
-        batch.first[0] = 0
-        k = k_end
+            _run_steps(spec, inp, batch, r, k, k_end, k_end - 1 if has_ep else k_end, is_lead and r == 0, lead, acc,
+                       out.nav_st[r], out.nav_q[r], w)
+        k, batch.first[0] = k_end, 0
         if not has_ep:
-            continue
-        # ---------------- one GNSS epoch: the lead's time update, records, rows and gains
-        T, sf = inp.dt[k_end - 1], inp.sf_end[j]
+            break
+        T, sf, tick = inp.dt[k_end - 1], inp.sf_end[j], inp.ar_tick[j]
         if is_lead:
-            _lead_time_update(spec.fconst, spec.qc, spec.q_accel, spec.q_gyro, spec.order, navsum, fsum, Csum, Cpl,
-                              int(sums[0]), sums[1], F, Qc, Phi, Qd, w1, w2, w3, nzc, nzv, cnt, lead.P, lead.Pbar,
-                              spec.use_pbar)
-            _dynamic_rows(Phi, spec.dyn_rows, gains.Phid[j])
-        _propagate_estimates(gains.Phid[j], spec.dyn_rows, batch.p_hat, tmp)
-        if inp.ar_tick[j]:
-            _ar_step(spec.ar_T, spec.ar_Q, Ta, lead.P, lead.Pbar, batch.p_hat, is_lead, spec.use_pbar)
-        if is_lead and record:
-            _transition_records(out.rec_Phi, out.rec_Pp, j, Phi, spec.ar_T, inp.ar_tick[j], lead.P)
-        if is_lead:
-            _lead_context(ctx, c, batch.q[0], batch.dth_cp[0], batch.st[0], batch.lever[0], T, lead.facc, lead.Cw,
-                          w_ie, w_en)
-            for i in range(spec.m_max):
-                for jj in range(n):
-                    H[i, jj] = 0.0
-            gains.m[j] = _measurement_rows(spec.meas_rows, spec.n_meas, spec.meas_par, spec.meas_off,
-                                           spec.meas_width, inp.obs[0, j], ctx, c, spec.enc, H, Rd, dbuf)
-            _lead_epoch_gains(lead.P, H, gains.m[j], Rd, gains.Kg[j], gains.s[j], gains.H[j], tmp, hz,
-                              gains.nees_sd, gains.nees_L, j)
-            if sf >= 0:
-                lead.facc[:] = 0.0
-                lead.Cw[:, :] = 0.0
-        # ---------------- per run: innovation, correction, feedback, records
-        m, gH, gK, gS = gains.m[j], gains.H[j], gains.Kg[j], gains.s[j]
+            _lead_time_update(spec.fconst, spec.qc, spec.q_accel, spec.q_gyro, spec.order, acc, tw, lead.P, lead.Pbar,
+                              spec.use_pbar, spec.dyn_rows, gains.Phid[j])
+            _ar_prior(spec.ar_T, spec.ar_Q, tick, lead.P, lead.Pbar, spec.use_pbar, tw[2], out.rec_Phi, out.rec_Pp, j)
+            _lead_context(ctx, c, batch.q[0], batch.dth_cp[0], batch.st[0], batch.lever[0], T, lead.facc, lead.Cw, w_ie,
+                          w_en, sf)
+            gains.m[j] = _measurement_rows(spec.meas_rows, spec.n_meas, spec.meas_par, spec.meas_off, spec.meas_width,
+                                           inp.obs[0, j], ctx, c, spec.enc, H, Rd, dbuf)
+            _lead_epoch_gains(lead.P, H, gains.m[j], Rd, gains.Kg[j], gains.s[j], gains.H[j], tmp, hz, gains.nees_sd,
+                              gains.nees_L, j)
+            _lead_records(j, lead.P, lead.Pbar, spec.use_pbar, out.pdiag, out.rec_Pf, out.flag, out.P, out.Pbar)
+        _carry_estimates(gains.Phid[j], spec.dyn_rows, batch.p_hat, tmp, tick, Ta)
         for r in range(R):
             st_r, q_r, ph_r, lev_r = batch.st[r], batch.q[r], batch.p_hat[r], batch.lever[r]
-            _run_context(ctx, c, q_r, batch.dth_cp[r], st_r, lev_r, T, batch.vacc[r], ph_r, w_ie, w_en, n)
-            _measurement_residuals(spec.meas_residual, spec.n_meas, spec.meas_par, spec.meas_off,
-                                   spec.meas_width, inp.obs[r, j], ctx, c, z, dbuf)
-            if sf >= 0:
-                # the window ending here is used: the next one starts from zero
-                for i in range(3):
-                    batch.vacc[r, i] = 0.0
-            out.nis[r, j] = _run_correction(z, m, gH, gK, gS, xk)
-            _innovation_records(out.innov, out.rec_x, r, j, z, m, xk)
+            _run_context(ctx, c, q_r, batch.dth_cp[r], st_r, lev_r, T, batch.vacc[r], ph_r, w_ie, w_en, sf)
+            _measurement_residuals(spec.meas_residual, spec.n_meas, spec.meas_par, spec.meas_off, spec.meas_width,
+                                   inp.obs[r, j], ctx, c, z, dbuf)
+            _run_correction(z, j, gains.m, gains.H, gains.Kg, gains.s, xk, out.nis, out.innov, out.rec_x, r)
             K.feedback_nav(xk, st_r, batch.st_prev[r], q_r, ph_r, qtmp, e)
             K.feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, batch.g_extra[r])
             _run_records(out.st, out.q, out.phat, r, j, st_r, q_r, ph_r)
             if spec.nees:
-                out.nees[r, j] = _run_nees(st_r, q_r, ph_r, inp.truth_st[j], inp.truth_q[j], inp.truth_p[r, j],
-                                           gains.nees_L[j], gains.nees_sd[j], e)
-        if is_lead:
-            _lead_records(j, lead.P, lead.Pbar, spec.use_pbar, record, out.pdiag, out.rec_Pf, out.flag, out.P,
-                          out.Pbar)
-        K.reset_interval(Cpl, fsum, Csum, navsum)
-        sums[0] = 0.0
-        sums[1] = 0.0
-        j += 1
-        if store_nav:
-            _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, k_end)
-    return j
+                out.nees[r, j] = _run_nees(st_r, q_r, ph_r, inp.truth_st, inp.truth_q, inp.truth_p, gains.nees_L, gains.nees_sd, e, r, j)
+        _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, k_end)
+    return n_ep

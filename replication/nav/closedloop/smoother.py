@@ -1,8 +1,30 @@
 """The fixed-interval smoother of the closed-loop filter: the backward passes over one chunk in the
 modified Bryson-Frazier form (:func:`mbf_chunk`) and the Rauch-Tung-Striebel form
 (:func:`rts_chunk`), and the pass over the chunks that drives them on the forward pass's replays.
-"""
 
+The modified Bryson-Frazier form (Bierman 1977, ch. X) gives the same smoothed error and covariance
+as the Rauch-Tung-Striebel recursion, without inverting P⁻ and with the O(n³) products only at the
+epochs kept.  With the adjoint λ_k (and its covariance Λ_k) of the epoch after its update, the
+smoothed error of the solution after feedback is d_k = −P_k⁺ λ_k and P^s_k = P_k⁺ − P_k⁺ Λ_k P_k⁺.
+Going back through the scalar updates a = m−1 … 0 of epoch k (rows h_a, gains K_a, innovation
+variances s_a, innovations ν_a of the sequential update):
+
+    λ ← λ − h_a (K_aᵀ λ + ν_a / s_a),
+    Λ ← (I − K_a h_aᵀ)ᵀ Λ (I − K_a h_aᵀ) + h_a h_aᵀ / s_a,
+
+then λ_{k−1} = Φ_kᵀ λ, Λ_{k−1} = Φ_kᵀ Λ Φ_k; λ = 0, Λ = 0 after the last epoch.  The innovations
+are recomputed from the raw ones (runs × epochs × rows, INS − aid) as the filter formed them (the
+same numbers).  Without the covariance only λ is propagated.  The runs are processed side by side
+(λ as n × runs).  Per epoch, last first, :func:`mbf_chunk` calls: the smoothed values at a recorded
+epoch (``_mbf_smoothed``), the non-zeros of the epoch's rows (``_rows_nonzeros``), the innovations
+(``_mbf_innovations``), λ and Λ back through the scalar updates (``_adjoint_updates``,
+``_adjoint_covariance_updates``), and back through the transition (``_nonzeros`` of Φ,
+``_adjoint_transition``, ``_congruence_transposed``), over the work arrays of ``_mbf_workspace``.
+
+The backward passes are called once per chunk; their helpers, called per epoch, are compiled inline
+and take arrays one by one (numba takes a reference to each array of a bundle it receives; see
+CONTRIBUTING, "Library").
+"""
 from __future__ import annotations
 
 import math
@@ -107,7 +129,8 @@ def rts_chunk(Pf, Pp, Phi, xrec, has_next, Pp_n, Phi_n, x_n, ds, Ps, out_flag, o
     update's estimate before feedback), P^s_k = P_k⁺ + C_k (P^s_{k+1} − P_{k+1}⁻) C_kᵀ.  Without
     ``with_cov`` only the state recursion runs (C_k needs P_k⁺, P_{k+1}⁻ and Φ_k, not P^s).
 
-    A compiled kernel: it takes the chunk's arrays one by one, not a bundle (numba takes a
+    Why these arguments (fifteen): the chunk's records, the first epoch of the chunk after it, the
+    carried smoothed values and the outputs, each an array of its own, not a bundle (numba takes a
     reference to each array of a bundle it receives; see CONTRIBUTING, "Library").
 
     Parameters
@@ -338,63 +361,47 @@ def _adjoint_transition(L, L2, acc, nzc, nzv, cnt):
             L2[i, r] = acc[r]
 
 
+@njit(inline="always", **_NJ)
+def _mbf_workspace(n, R, m_max):
+    """The backward pass's work arrays, made once per chunk: λ's second copy (n × runs), x̂ and ν of
+    the runs (``X``, ``Nu``), a sum per run, u and a row, the rows' non-zeros (``hz``, ``nh``,
+    ``used``), and the non-zeros of Φ by column and by row with a product's scratch ``W``."""
+    return ((np.empty((n, R)), np.zeros((n, R)), np.empty((m_max, R)), np.empty(R), np.empty(n), np.empty(n)),
+            (np.empty((m_max, n), np.int64), np.empty(m_max, np.int64), np.empty(n, np.int64)),
+            (np.empty((n, n)), np.empty((n, n), np.int64), np.empty((n, n)), np.empty(n, np.int64),
+             np.empty((n, n), np.int64), np.empty((n, n)), np.empty(n, np.int64)))
+
+
 @njit(**_NJ)
-def mbf_chunk(Phi, m, H, Kg, s, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov, transition_first):
-    """Backward pass over one chunk of the closed-loop filter in the modified Bryson-Frazier form
-    of the fixed-interval smoother (Bierman 1977, ch. X): the same smoothed error and covariance as
-    the Rauch-Tung-Striebel recursion of :func:`rts_chunk`, without inverting P⁻ and with the
-    O(n³) products only at the epochs kept.
-
-    With the adjoint λ_k (and its covariance Λ_k) of the epoch after its update, the smoothed error
-    of the solution after feedback is d_k = −P_k⁺ λ_k and P^s_k = P_k⁺ − P_k⁺ Λ_k P_k⁺.  Going back
-    through the scalar updates a = m−1 … 0 of epoch k (rows h_a, gains K_a, innovation variances
-    s_a, innovations ν_a of the sequential update):
-
-        λ ← λ − h_a (K_aᵀ λ + ν_a / s_a),
-        Λ ← (I − K_a h_aᵀ)ᵀ Λ (I − K_a h_aᵀ) + h_a h_aᵀ / s_a,
-
-    then λ_{k−1} = Φ_kᵀ λ, Λ_{k−1} = Φ_kᵀ Λ Φ_k; λ = 0, Λ = 0 after the last epoch.  The innovations
-    are recomputed from the raw ones ``z`` (runs × epochs × rows, INS − GNSS) as the filter formed
-    them (the same numbers).  Without ``with_cov`` only λ is propagated.  The runs are processed
-    side by side (λ as n × runs).
-
-    A compiled kernel: it takes the chunk's arrays one by one, not a bundle (numba takes a
-    reference to each array of a bundle it receives; see CONTRIBUTING, "Library").
+def mbf_chunk(Phi, gains, z, Pf, flag, lam, Lam, out_ds, out_Ps, with_cov, transition_first):
+    """Backward pass over one chunk of the closed-loop filter in the modified Bryson-Frazier form of
+    the fixed-interval smoother (Bierman 1977, ch. X; the recursion is in the module docstring): the
+    same smoothed error and covariance as :func:`rts_chunk`, without inverting P⁻.
 
     Parameters
     ----------
     Phi : (E, n, n) ndarray
         Transition into each epoch of the chunk (the lead's pass).
-    m : (E,) ndarray of int
-        Number of rows per epoch.
-    H, Kg : (E, m_max, n) ndarray
-        Rows and gains of the sequential update.
-    s : (E, m_max) ndarray
-        Innovation variances.
+    gains : Gains
+        The lead's sequential update per epoch: rows in use ``m``, rows ``H``, gains ``Kg`` and
+        innovation variances ``s``.
     z : (R, E, m_max) ndarray
         Every run's residuals (INS − aid).
-    Pf : (recorded, n, n) ndarray
-        P⁺ at the recorded epochs.
-    flag : (E,) ndarray of int
-        Index of each epoch among the recorded ones (−1: not recorded).
-    lam : (R, n) ndarray
-        λ of the last epoch of the chunk on entry, of the epoch before the chunk on return.
-    Lam : (n, n) ndarray
-        The same for Λ.
+    Pf, flag : (recorded, n, n), (E,) ndarray
+        P⁺ at the recorded epochs, and each epoch's index among them (−1: not recorded).
+    lam, Lam : (R, n), (n, n) ndarray
+        λ and Λ of the last epoch of the chunk on entry, of the epoch before the chunk on return.
     out_ds, out_Ps : (R, recorded, n), (recorded, n, n) ndarray
         Smoothed errors and covariances at the recorded epochs (written).
-    with_cov : bool
-        Also propagate Λ and form P^s.
-    transition_first : bool
-        Apply the transition of the chunk's first epoch (False for the first chunk).
+    with_cov, transition_first : bool
+        Also propagate Λ and form P^s; apply the transition of the chunk's first epoch (False for the
+        first chunk).
     """
-    E_, n, R, m_max = Phi.shape[0], Phi.shape[1], lam.shape[0], H.shape[1]
+    m, H, Kg, s = gains.m, gains.H, gains.Kg, gains.s
+    n, R = Phi.shape[1], lam.shape[0]
     L = np.ascontiguousarray(lam.T)
-    L2, X, Nu, acc, u, row = np.empty((n, R)), np.zeros((n, R)), np.empty((m_max, R)), np.empty(R), np.empty(n), np.empty(n)
-    hz, nh, used = np.empty((m_max, n), np.int64), np.empty(m_max, np.int64), np.empty(n, np.int64)
-    W, nzc, nzv, cnt = np.empty((n, n)), np.empty((n, n), np.int64), np.empty((n, n)), np.empty(n, np.int64)
-    rzc, rzv, rcnt = np.empty((n, n), np.int64), np.empty((n, n)), np.empty(n, np.int64)
-    for jj in range(E_ - 1, -1, -1):
+    (L2, X, Nu, acc, u, row), (hz, nh, used), (W, nzc, nzv, cnt, rzc, rzv, rcnt) = _mbf_workspace(n, R, H.shape[1])
+    for jj in range(Phi.shape[0] - 1, -1, -1):
         f = flag[jj]
         if f >= 0:
             _mbf_smoothed(Pf[f], L, Lam, f, out_ds, out_Ps, acc, with_cov)
@@ -443,8 +450,7 @@ def _smooth(res: FilterResult, chunks, replay, innov, rec_pos, R, n, m_rec, with
             o_pd = np.empty((E_, n))
             if not rts:
                 # ds, Ps: the adjoint λ (runs × n) and its covariance Λ
-                mbf_chunk(o.rec_Phi, g.m, g.H, g.Kg, g.s, innov[ci], o.P, o.flag, ds, Ps, o_ds, o_Ps, with_cov,
-                          ci > 0)
+                mbf_chunk(o.rec_Phi, g, innov[ci], o.P, o.flag, ds, Ps, o_ds, o_Ps, with_cov, ci > 0)
                 innov[ci] = None
             elif nxt is None:
                 rts_chunk(o.rec_Pf, o.rec_Pp, o.rec_Phi, o.rec_x, False, o.rec_Pp[0], o.rec_Phi[0],

@@ -31,16 +31,20 @@ def _propagate_sparse(Phi, P, Qd, W, Wt, U, nzc, nzv, cnt):
 
 
 @njit(inline="always", **_NJ)
-def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cpl, nsum, tsum, F, Qc, Phi, Qd, w1,
-                      w2, w3, nzc, nzv, cnt, P, Pbar, use_pbar):
+def _lead_time_update(fconst, qc, q_accel, q_gyro, order, acc, tw, P, Pbar, use_pbar, dyn_rows, Phid):
     """F as the interval mean (``build_F_core`` at the mean inputs plus the mean couplings ``Cpl``),
     (Φ, Q_d) by the Van Loan series with the navigation white noise at the mean C_b^n, then
-    P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements).
+    P⁻ = Φ P Φᵀ + Q_d (and the same for the covariance without measurements); the rows of Φ of
+    the augmented states with dynamics (``dyn_rows``), their augmented columns, into ``Phid``; the
+    interval sums zeroed for the next interval.
 
-    The arguments are arrays, one by one, not a bundle (the configuration's ``fconst``, ``qc``, PSDs and series
-    order; the interval sums ``navsum``, ``fsum``, ``Csum``, ``Cpl`` over ``nsum`` steps and
-    ``tsum`` seconds; the work arrays of the series; the lead's ``P`` and ``Pbar``): a compiled
-    helper that receives a bundle takes a reference to each of its arrays once per epoch."""
+    The configuration's arrays (``fconst``, ``qc``, PSDs, series order) come one by one, not as a
+    bundle; ``acc`` holds the interval sums (``sums``: steps and seconds; ``fsum``, ``Csum``,
+    ``navsum``, ``Cpl``) and ``tw`` the series' work arrays, each a tuple of exactly the arrays used
+    (a compiled helper that receives a bundle takes a reference to each of its arrays per call)."""
+    sums, fsum, Csum, navsum, Cpl = acc
+    F, Qc, Phi, Qd, w1, w2, w3, nzc, nzv, cnt = tw
+    nsum, tsum = int(sums[0]), sums[1]
     n = F.shape[0]
     inv = 1.0 / nsum
     K.build_F_core(navsum[0] * inv, navsum[1] * inv, navsum[2] * inv, navsum[3] * inv, navsum[4] * inv,
@@ -57,20 +61,30 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, navsum, fsum, Csum, Cp
     _propagate_sparse(Phi, P, Qd, w1, w2, w3, nzc, nzv, cnt)
     if use_pbar:
         _propagate_sparse(Phi, Pbar, Qd, w1, w2, w3, nzc, nzv, cnt)
+    n_aug = n - 9
+    for t in range(dyn_rows.shape[0]):
+        for jj in range(n_aug):
+            Phid[t, jj] = Phi[9 + dyn_rows[t], 9 + jj]
+    K.reset_interval(Cpl, fsum, Csum, navsum)
+    sums[0] = 0.0
+    sums[1] = 0.0
 
 
 @njit(inline="always", **_NJ)
-def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_cp, trig, vacc, damp, first,
-               lead_acc, lead, sums, fsum, Csum, navsum, Cpl, nav_st, nav_q, nav_last, w):
-    """IMU steps k0..k1-1 of run ``r`` (views of its state taken once per interval): corrections,
-    strapdown, window sums; the lead's interval sums of the inputs of F when ``lead_acc``; the
-    IMU-rate solution for steps before ``nav_last``.  Returns the damping-loop integrator.
+def _run_steps(spec, inp, batch, r, k0, k1, nav_last, lead_acc, lead, acc, nav_st, nav_q, w):
+    """IMU steps k0..k1-1 of run ``r`` of ``batch`` (views of its state taken once per interval):
+    corrections, strapdown, window sums; the lead's interval sums of the inputs of F into ``acc``
+    when ``lead_acc``; the IMU-rate solution (``nav_st``, ``nav_q``) for steps before ``nav_last``.
 
-    Called once per run and GNSS interval: the run's state arrays (``st`` … ``damp``), the lead's
-    interval sums (``sums``, ``fsum``, ``Csum``, ``navsum``, ``Cpl``), the run's IMU-rate records
-    and the per-step work arrays ``w`` are passed one by one (arrays, not a bundle), as views taken
-    once per interval (a bundle would cost a reference per array at every call)."""
+    Why these arguments (thirteen): called once per run and GNSS interval, it takes the bundles whose
+    arrays the steps read (``spec``, ``inp``, ``batch``, ``lead``), ``acc`` and ``w`` as tuples of
+    exactly the arrays used, and the run's IMU-rate records as two views, not the ``ChunkOut``
+    bundle, most of whose arrays the steps do not read (see the package's ``forward`` module)."""
     u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en = w
+    sums, fsum, Csum, navsum, Cpl = acc
+    st, st_prev, q, p_hat, g_extra = batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r], batch.g_extra[r]
+    dth_cp, dv_cp, trig, vacc = batch.dth_cp[r], batch.dv_cp[r], batch.trig[r], batch.vacc[r]
+    damp, first = batch.damp[r], batch.first[0] == 1
     store_nav = nav_st.shape[0] > 0
     for k in range(k0, k1):
         T = inp.dt[k]
@@ -116,5 +130,5 @@ def _run_steps(spec, inp, r, k0, k1, st, st_prev, q, p_hat, g_extra, dth_cp, dv_
                 nav_st[k + 1, i] = st[i]
             for i in range(4):
                 nav_q[k + 1, i] = q[i]
-    return damp
+    batch.damp[r] = damp
 

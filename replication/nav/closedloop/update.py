@@ -33,7 +33,7 @@ def _measurement_rows(kernels, n_meas, par, off, width, obs, ctx, c, enc, H, Rd,
     ``par[i]``, its values ``obs[off[i]:off[i] + width[i]]`` copied to ``data``); returns the
     number of rows written into ``H`` (zero on entry) and ``Rd``.  Twelve arguments: the kernels,
     their configuration (four arrays of :class:`Spec`), the run's values, the context and the
-    outputs — arrays, not a bundle (see :func:`_lead_time_update`)."""
+    outputs — arrays, not a bundle (see ``_lead_time_update``)."""
     r = 0
     for i in range(n_meas):
         o = off[i]
@@ -46,7 +46,7 @@ def _measurement_rows(kernels, n_meas, par, off, width, obs, ctx, c, enc, H, Rd,
 @njit(inline="always", **_NJ)
 def _measurement_residuals(kernels, n_meas, par, off, width, obs, ctx, c, z, data):
     """One run's residuals of one epoch, each measurement's ``residual`` kernel in turn, the rows of
-    :func:`_measurement_rows` in the same order; returns the number written."""
+    ``_measurement_rows`` in the same order; returns the number written."""
     m = 0
     for i in range(n_meas):
         o = off[i]
