@@ -57,9 +57,12 @@ def hour_workload():
     from replication.nav import errors as er
     from replication.nav import trajectory as tr
     from replication.nav.units import DEG, DEG_PER_H, DEG_PER_SQRT_H, MICRO_G
-    from replication.papers.chen2019 import scenarios
 
-    segs, init = scenarios.chen2019_flight()
+    try:
+        from replication.papers.chen2019.scenarios import chen2019_flight
+    except ImportError:                       # a tree from before the paper trajectories left nav/
+        chen2019_flight = tr.chen2019_flight
+    segs, init = chen2019_flight()
     traj = tr.generate(segs[:4] + [tr.Straight(900.0)], **init)
     model = er.model_15(position_sd=1.0, velocity_sd=0.05, attitude_sd=(1e-4, 1e-4, 1e-3), lat=47 * DEG, h=6000.0,
                         accel_bias_sd=100 * MICRO_G, gyro_bias_sd=0.05 * DEG_PER_H,
