@@ -286,7 +286,7 @@ def cutoff_aic(y, ar_order: int, ma_order: int) -> dict:
     squares of Box & Jenkins): AR(p) by the least squares of eq. (3-11)-(3-12), MA(q) by
     nonlinear least squares of w_t = y_t - theta_1 w_{t-1} - ... - theta_q w_{t-q} (pre-sample
     w = 0; ``scipy.optimize.least_squares`` from theta = 0 within |theta_k| <= C(q, k), the bound
-    of an invertible polynomial).  Then
+    of an invertible polynomial, with the exact Jacobian: the lagged innovations through the same filter).  Then
     AIC_k = N ln(RSS_k/N) + 2 (k + 1) (eq. (3-13) with the noise variance counted).
 
     Parameters
@@ -326,14 +326,26 @@ def cutoff_aic(y, ar_order: int, ma_order: int) -> dict:
     else:
         out["AR"] = out["white noise"]
     if q:
-        def innovations(th):
+        def finite(a):
+            return a if np.isfinite(a).all() else np.nan_to_num(a, nan=1e150, posinf=1e150, neginf=-1e150)
+
+        def whole(th):
             with np.errstate(over="ignore", invalid="ignore"):  # a non-invertible trial point
-                w = signal.lfilter([1.0], np.concatenate(([1.0], th)), y)[s:]
-            return w if np.isfinite(w).all() else np.nan_to_num(w, nan=1e150, posinf=1e150, neginf=-1e150)
+                return signal.lfilter([1.0], np.concatenate(([1.0], th)), y)
+
+        def innovations(th):
+            return finite(whole(th)[s:])
+
+        def jacobian(th):
+            # dw_t/dtheta_j = -w_{t-j} - sum_k theta_k dw_{t-k}/dtheta_j: the lagged innovations through the same filter
+            w, a = whole(th), np.concatenate(([1.0], th))
+            lagged = np.column_stack([np.concatenate((np.zeros(j), w[:n - j])) for j in range(1, q + 1)])
+            with np.errstate(over="ignore", invalid="ignore"):
+                return finite(-signal.lfilter([1.0], a, lagged, axis=0)[s:])
 
         # an invertible MA(q) polynomial has |theta_k| <= C(q, k)
         bound = np.array([math.comb(q, k) for k in range(1, q + 1)], dtype=float)
-        fit = least_squares(innovations, np.zeros(q), bounds=(-bound, bound))
+        fit = least_squares(innovations, np.zeros(q), jac=jacobian, bounds=(-bound, bound))
         out["MA"] = aic(float(fit.fun @ fit.fun), q)
     else:
         out["MA"] = out["white noise"]
