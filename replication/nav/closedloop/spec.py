@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import types
 from numba.experimental.function_type import _get_wrapper_address
+from numba.extending import typeof_impl
 
 from replication.nav._validate import choice, finite_array, integer, numeric
 from replication.nav.closedloop.bundles import BatchState, Spec
@@ -123,6 +124,27 @@ def _kernel(dispatcher, sig) -> _Kernel:
     if k is None or k.dispatcher is not dispatcher:
         k = _KERNELS[key] = _Kernel(dispatcher, sig)
     return k
+
+
+_SPEC_TYPES: dict = {}
+
+
+@typeof_impl.register(Spec)
+def _typeof_spec(val, c):
+    """The numba type of a :class:`Spec`, found once per configuration.
+
+    numba types a bundle of arrays and numbers from a fingerprint in compiled code; the kernels
+    of a :class:`Spec` have none, so every call of the compiled loop would type its every field in
+    Python (about 0.3 ms a chunk).  A configuration's fields are never replaced (a named tuple),
+    so its type is kept, by identity, for the last configurations seen."""
+    hit = _SPEC_TYPES.get(id(val))
+    if hit is not None and hit[0] is val:
+        return hit[1]
+    ty = types.BaseTuple.from_types([typeof_impl(v, c) for v in val], Spec)
+    if len(_SPEC_TYPES) >= 32:
+        _SPEC_TYPES.clear()
+    _SPEC_TYPES[id(val)] = (val, ty)
+    return ty
 
 
 #: Columns of ``ChunkInputs.obs`` when :func:`chunk_inputs` packs its ``gnss``, ``windows`` and ``aux``
