@@ -32,7 +32,8 @@ dyn_rows : (k,) ndarray of int
 meas_rows, meas_residual : tuple of compiled functions
     The ``rows`` and ``residual`` kernels of the measurements in use
     (:mod:`replication.nav.measurements`), in the order of their rows, padded to
-    :data:`MAX_MEASUREMENTS` (one compiled loop for any set of aids).
+    :data:`MAX_MEASUREMENTS` (one compiled loop for any set of aids); each wrapped with its numba
+    type and compiled address, found once (``spec._Kernel``).
 n_meas : int
     The number of measurements in use.
 meas_par : (MAX_MEASUREMENTS, p) ndarray

@@ -8,12 +8,21 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import types
+from numba.experimental.function_type import _get_wrapper_address
+from numba.extending import typeof_impl
 
 from replication.nav._validate import choice, finite_array, integer, numeric
 from replication.nav.closedloop.bundles import BatchState, Spec
 from replication.nav.closedloop.options import Options, resolve_options
 from replication.nav.errors import ErrorModel
-from replication.nav.measurements import Measurement, compile_residual, compile_rows
+from replication.nav.measurements import (
+    RESIDUAL_SIGNATURE,
+    ROWS_SIGNATURE,
+    Measurement,
+    compile_residual,
+    compile_rows,
+)
 from replication.nav.measurements.airdata import AirHeight, Airspeed
 from replication.nav.measurements.gnss import GnssPosition, GnssVelocity
 from replication.nav.measurements.specific_force import SpecificForce
@@ -74,6 +83,70 @@ def _no_residual(par, data, ctx, c, z, m):
     return 0
 
 
+class _Kernel:
+    """A measurement kernel as the compiled loop receives it: its numba type and the address of its
+    compiled code, found once.
+
+    A compiled function passed to a compiled one as a first-class function is typed and its address
+    looked up again at every call (about 50 µs a kernel, 0.8 ms for the sixteen kernels of
+    :class:`Spec` at every chunk); this object carries both (numba's ``_numba_type_`` and wrapper
+    address protocol), so passing it costs an attribute read.  The loop calls the kernel through
+    its C wrapper: the same compiled code, the same numbers."""
+
+    __slots__ = ("dispatcher", "_numba_type_", "_sig", "_addr")
+
+    def __init__(self, dispatcher, sig):
+        self.dispatcher = dispatcher
+        self._sig = sig
+        self._numba_type_ = types.FunctionType(sig)
+        self._addr = _get_wrapper_address(dispatcher, sig)
+
+    def signature(self):
+        """The kernel's signature (numba's wrapper address protocol)."""
+        return self._sig
+
+    def __reduce__(self):
+        # an address is valid in this process only: another one finds its own
+        return _kernel, (self.dispatcher, self._sig)
+
+    def __wrapper_address__(self):
+        """The address of the kernel's compiled C wrapper (numba's wrapper address protocol)."""
+        return self._addr
+
+
+_KERNELS: dict = {}
+
+
+def _kernel(dispatcher, sig) -> _Kernel:
+    """The :class:`_Kernel` of ``dispatcher`` (made once per compiled function)."""
+    key = (id(dispatcher), str(sig))
+    k = _KERNELS.get(key)
+    if k is None or k.dispatcher is not dispatcher:
+        k = _KERNELS[key] = _Kernel(dispatcher, sig)
+    return k
+
+
+_SPEC_TYPES: dict = {}
+
+
+@typeof_impl.register(Spec)
+def _typeof_spec(val, c):
+    """The numba type of a :class:`Spec`, found once per configuration.
+
+    numba types a bundle of arrays and numbers from a fingerprint in compiled code; the kernels
+    of a :class:`Spec` have none, so every call of the compiled loop would type its every field in
+    Python (about 0.3 ms a chunk).  A configuration's fields are never replaced (a named tuple),
+    so its type is kept, by identity, for the last configurations seen."""
+    hit = _SPEC_TYPES.get(id(val))
+    if hit is not None and hit[0] is val:
+        return hit[1]
+    ty = types.BaseTuple.from_types([typeof_impl(v, c) for v in val], Spec)
+    if len(_SPEC_TYPES) >= 32:
+        _SPEC_TYPES.clear()
+    _SPEC_TYPES[id(val)] = (val, ty)
+    return ty
+
+
 #: Columns of ``ChunkInputs.obs`` when :func:`chunk_inputs` packs its ``gnss``, ``windows`` and ``aux``
 #: arguments: GNSS position, GNSS velocity, the specific-force values, then the one-row aids of
 #: ``build_spec(rows=...)``.
@@ -132,9 +205,10 @@ def _measurement_spec(model, measurements, offsets):
     width = np.zeros(MAX_MEASUREMENTS, np.int64)
     width[:len(measurements)] = [mz.width for mz in measurements]
     # the kernels are class attributes (a compiled function read from an instance binds to it)
-    return (tuple(type(mz).rows_kernel for mz in measurements) + (_no_rows,) * pad,
-            tuple(type(mz).residual_kernel for mz in measurements) + (_no_residual,) * pad, len(measurements), par, off,
-            width, int(sum(mz.size for mz in measurements)))
+    rows = tuple(type(mz).rows_kernel for mz in measurements) + (_no_rows,) * pad
+    residuals = tuple(type(mz).residual_kernel for mz in measurements) + (_no_residual,) * pad
+    return (tuple(_kernel(f, ROWS_SIGNATURE) for f in rows), tuple(_kernel(f, RESIDUAL_SIGNATURE) for f in residuals),
+            len(measurements), par, off, width, int(sum(mz.size for mz in measurements)))
 
 
 def build_spec(model: ErrorModel, *, gnss: GnssRows | None = None, rows=(), vmode: int = 0, gains=(0.0, 0.0, 0.0),
