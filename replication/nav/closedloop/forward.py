@@ -45,14 +45,18 @@ from numba import njit
 from replication.nav import _kernels as K
 from replication.nav.closedloop.bundles import _NJ
 from replication.nav.closedloop.timeupdate import _lead_time_update, _run_steps
-from replication.nav.closedloop.update import (
-    _body_rate,
-    _fill_context,
-    _lead_gains,
-    _measurement_residuals,
-    _measurement_rows,
+from replication.nav.closedloop.update import _lead_gains, _measurement_residuals, _measurement_rows
+from replication.nav.measurements import (
+    CTX_FACC,
+    CTX_LEVER,
+    CTX_N,
+    CTX_PHAT,
+    CTX_RATE,
+    CTX_ST,
+    CTX_VACC,
+    ctx_size,
+    ctx_window,
 )
-from replication.nav.measurements import CTX_FACC, CTX_PHAT, CTX_VACC, ctx_size, ctx_window
 
 
 @njit(**_NJ)
@@ -85,32 +89,27 @@ def _workspace(n, m_max, n_dyn, n_obs, ar_T):
 
 @njit(inline="always", **_NJ)
 def _store_nav(nav_st, nav_q, st, q, k):
-    """The IMU-rate solution of every run at step ``k`` when it is kept (``nav_st``, ``nav_q``:
-    runs × steps × ·, no steps when not kept)."""
-    if nav_st.shape[1] > 0:
-        for r in range(st.shape[0]):
-            nav_st[r, k, :] = st[r]
-            nav_q[r, k, :] = q[r]
+    """The IMU-rate solution of every run at step ``k`` (``nav_st``, ``nav_q``: runs × steps × ·),
+    called only when it is kept: the arrays an inlined helper receives are reference-counted at
+    each call, kept or not."""
+    for r in range(st.shape[0]):
+        nav_st[r, k, :] = st[r]
+        nav_q[r, k, :] = q[r]
 
 
 @njit(inline="always", **_NJ)
 def _ar_prior(ar_T, ar_Q, tick, P, Pbar, use_pbar, Phi, rec_Phi, rec_Pp, j):
     """The discrete AR step of the gravity states on the lead's prior at an AR epoch (``tick``):
-    P ← T P Tᵀ + Q (and P̄); then the records for the smoother at epoch ``j``
-    (``_transition_records``)."""
+    P ← T P Tᵀ + Q (and P̄); then the lead's records for the smoother at epoch ``j``, when kept: the
+    transition from the last epoch's P⁺ to this epoch's P⁻ (T Φ at an AR epoch) and P⁻ (RTS only).
+    One level: each array an inlined helper receives is reference-counted at each call, and a helper
+    nested in it would count its arrays again."""
     if tick:
         P[:, :] = ar_T @ P @ ar_T.T + ar_Q
         if use_pbar:
             Pbar[:, :] = ar_T @ Pbar @ ar_T.T + ar_Q
-    _transition_records(rec_Phi, rec_Pp, j, Phi, ar_T, tick, P)
-
-
-@njit(inline="always", **_NJ)
-def _transition_records(rec_Phi, rec_Pp, j, Phi, ar_T, ar_tick, P):
-    """The lead's records for the smoother at epoch ``j``, when kept: the transition from the last
-    epoch's P⁺ to this epoch's P⁻ (T Φ at an AR epoch) and P⁻ (RTS only)."""
     if rec_Phi.shape[0] > 0:
-        if ar_tick:
+        if tick:
             rec_Phi[j] = ar_T @ Phi
         else:
             rec_Phi[j] = Phi
@@ -145,8 +144,13 @@ def _lead_context(ctx, c, q, dth_cp, st, lever, T, facc, Cw, w_ie, w_en, sf):
     zeroed when their window ends at this epoch (``sf`` ≥ 0): the next one starts from zero."""
     n = Cw.shape[1]
     K.q2c(q, c)
-    wx, wy, wz = _body_rate(dth_cp, T, c, st, w_ie, w_en)
-    _fill_context(ctx, st, lever, wx, wy, wz, n)
+    K.rates_s(st[0], st[2], st[3], st[4], w_ie, w_en)
+    for i in range(6):
+        ctx[CTX_ST + i] = st[i]
+    for i in range(3):
+        ctx[CTX_LEVER + i] = lever[i]
+        ctx[CTX_RATE + i] = dth_cp[i] / T - (c[0, i] * w_ie[0] + c[1, i] * w_ie[1] + c[2, i] * w_ie[2])
+    ctx[CTX_N] = n
     for i in range(3):
         ctx[CTX_FACC + i] = facc[i]
     cw = ctx_window(n)
@@ -195,8 +199,13 @@ def _run_context(ctx, c, q, dth_cp, st, lever, T, vacc, p_hat, w_ie, w_en, sf):
     accumulated sensor-error estimates."""
     n = p_hat.shape[0] + 9
     K.q2c(q, c)
-    wx, wy, wz = _body_rate(dth_cp, T, c, st, w_ie, w_en)
-    _fill_context(ctx, st, lever, wx, wy, wz, n)
+    K.rates_s(st[0], st[2], st[3], st[4], w_ie, w_en)
+    for i in range(6):
+        ctx[CTX_ST + i] = st[i]
+    for i in range(3):
+        ctx[CTX_LEVER + i] = lever[i]
+        ctx[CTX_RATE + i] = dth_cp[i] / T - (c[0, i] * w_ie[0] + c[1, i] * w_ie[1] + c[2, i] * w_ie[2])
+    ctx[CTX_N] = n
     for i in range(3):
         ctx[CTX_VACC + i] = vacc[i]
     for i in range(n - 9):
@@ -213,18 +222,17 @@ def _run_correction(z, j, gm, gH, gK, gS, xk, nis, innov, rec_x, r):
     x̂ ← x̂ + K_a ν_a from x̂ = 0 (into ``xk``); its NIS Σ ν_a² / s_a into ``nis``, its residuals into
     ``innov`` and, for the RTS smoother, x̂ before the feedback into ``rec_x`` (runs × epochs × n, no
     epochs when not kept)."""
-    m, h, g, s = gm[j], gH[j], gK[j], gS[j]
-    n = xk.shape[0]
+    m, n = gm[j], xk.shape[0]
     for i in range(n):
         xk[i] = 0.0
     v = 0.0
     for a in range(m):
         nu = z[a]
         for kk in range(n):
-            nu -= h[a, kk] * xk[kk]
+            nu -= gH[j, a, kk] * xk[kk]
         for i in range(n):
-            xk[i] += g[a, i] * nu
-        v += nu * nu / s[a]
+            xk[i] += gK[j, a, i] * nu
+        v += nu * nu / gS[j, a]
     nis[r, j] = v
     for a in range(m):
         innov[r, j, a] = z[a]
@@ -277,18 +285,26 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
     -------
     int
         The number of GNSS epochs processed.
+
+    Why this function is long: the helpers that an epoch may not need (the AR step and the
+    smoother's records, the IMU-rate solution) are called behind their conditions here, and the
+    runs' state is passed to ``_run_steps`` as views taken here, because each array an inlined
+    helper receives costs a reference count at each call whether it is used or not.
     """
     R, n_steps, n_ep = inp.dth.shape[0], inp.dt.shape[0], inp.ep_step.shape[0]
     w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta, c, qtmp, w_ie, w_en) = _workspace(
         spec.fconst.shape[0], spec.m_max, spec.dyn_rows.shape[0], inp.obs.shape[2], spec.ar_T)
-    _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, 0)
+    if out.nav_st.shape[1] > 0:
+        _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, 0)
     k = 0
     for j in range(n_ep + 1):
         has_ep = j < n_ep
         k_end = inp.ep_step[j] + 1 if has_ep else n_steps
         for r in range(R):
-            _run_steps(spec, inp, batch, r, k, k_end, k_end - 1 if has_ep else k_end, is_lead and r == 0, lead, acc,
-                       out.nav_st[r], out.nav_q[r], w)
+            batch.damp[r] = _run_steps(spec, inp, r, k, k_end, k_end - 1 if has_ep else k_end, is_lead and r == 0, lead,
+                                       acc, w, batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r],
+                                       batch.g_extra[r], batch.dth_cp[r], batch.dv_cp[r], batch.trig[r], batch.vacc[r],
+                                       batch.damp[r], batch.first[0] == 1, out.nav_st[r], out.nav_q[r])
         k, batch.first[0] = k_end, 0
         if not has_ep:
             break
@@ -296,7 +312,8 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
         if is_lead:
             _lead_time_update(spec.fconst, spec.qc, spec.q_accel, spec.q_gyro, spec.order, acc, tw, lead.P, lead.Pbar,
                               spec.use_pbar, spec.dyn_rows, gains.Phid[j])
-            _ar_prior(spec.ar_T, spec.ar_Q, tick, lead.P, lead.Pbar, spec.use_pbar, tw[2], out.rec_Phi, out.rec_Pp, j)
+            if tick or out.rec_Phi.shape[0] > 0:
+                _ar_prior(spec.ar_T, spec.ar_Q, tick, lead.P, lead.Pbar, spec.use_pbar, tw[2], out.rec_Phi, out.rec_Pp, j)
             _lead_context(ctx, c, batch.q[0], batch.dth_cp[0], batch.st[0], batch.lever[0], T, lead.facc, lead.Cw, w_ie,
                           w_en, sf)
             gains.m[j] = _measurement_rows(spec.meas_rows, spec.n_meas, spec.meas_par, spec.meas_off, spec.meas_width,
@@ -316,5 +333,6 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
             _run_records(out.st, out.q, out.phat, r, j, st_r, q_r, ph_r)
             if spec.nees:
                 out.nees[r, j] = _run_nees(st_r, q_r, ph_r, inp.truth_st, inp.truth_q, inp.truth_p, gains.nees_L, gains.nees_sd, e, r, j)
-        _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, k_end)
+        if out.nav_st.shape[1] > 0:
+            _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, k_end)
     return n_ep

@@ -71,20 +71,20 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, acc, tw, P, Pbar, use_
 
 
 @njit(inline="always", **_NJ)
-def _run_steps(spec, inp, batch, r, k0, k1, nav_last, lead_acc, lead, acc, nav_st, nav_q, w):
-    """IMU steps k0..k1-1 of run ``r`` of ``batch`` (views of its state taken once per interval):
-    corrections, strapdown, window sums; the lead's interval sums of the inputs of F into ``acc``
-    when ``lead_acc``; the IMU-rate solution (``nav_st``, ``nav_q``) for steps before ``nav_last``.
+def _run_steps(spec, inp, r, k0, k1, nav_last, lead_acc, lead, acc, w, st, st_prev, q, p_hat, g_extra, dth_cp, dv_cp,
+               trig, vacc, damp, first, nav_st, nav_q):
+    """IMU steps k0..k1-1 of run ``r``: corrections, strapdown, window sums; the lead's interval sums
+    of the inputs of F into ``acc`` when ``lead_acc``; the IMU-rate solution (``nav_st``, ``nav_q``)
+    for steps before ``nav_last``.  Returns the damping-loop integrator (``damp`` on entry).
 
-    Why these arguments (thirteen): called once per run and GNSS interval, it takes the bundles whose
-    arrays the steps read (``spec``, ``inp``, ``batch``, ``lead``), ``acc`` and ``w`` as tuples of
-    exactly the arrays used, and the run's IMU-rate records as two views, not the ``ChunkOut``
-    bundle, most of whose arrays the steps do not read (see the package's ``forward`` module)."""
+    Why these arguments (twenty-three): called once per run and GNSS interval, it takes the bundles
+    whose arrays the steps read (``spec``, ``inp``, ``lead``), ``acc`` and ``w`` as tuples of exactly
+    the arrays used, and the run's state (``st`` … ``vacc``), ``damp``, ``first`` and its IMU-rate
+    records as views the caller takes once per interval, not the ``BatchState`` and ``ChunkOut``
+    bundles: a view taken inside the helper, or a bundle most of whose arrays the steps do not read,
+    costs a reference count per array at every call (12 fewer an epoch in the 15-state hour)."""
     u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en = w
     sums, fsum, Csum, navsum, Cpl = acc
-    st, st_prev, q, p_hat, g_extra = batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r], batch.g_extra[r]
-    dth_cp, dv_cp, trig, vacc = batch.dth_cp[r], batch.dv_cp[r], batch.trig[r], batch.vacc[r]
-    damp, first = batch.damp[r], batch.first[0] == 1
     store_nav = nav_st.shape[0] > 0
     for k in range(k0, k1):
         T = inp.dt[k]
@@ -130,5 +130,5 @@ def _run_steps(spec, inp, batch, r, k0, k1, nav_last, lead_acc, lead, acc, nav_s
                 nav_st[k + 1, i] = st[i]
             for i in range(4):
                 nav_q[k + 1, i] = q[i]
-    batch.damp[r] = damp
+    return damp
 

@@ -1,6 +1,6 @@
-"""The compiled measurement pass of one epoch: the epoch context the measurement kernels read, the
-lead's rows of H (each measurement's ``rows`` kernel in turn), every run's residuals (each
-``residual`` kernel), ω_eb^b for the lever-arm rows, and the lead's sequential Joseph update
+"""The compiled measurement pass of one epoch: the lead's rows of H (each measurement's ``rows``
+kernel in turn, reading the epoch context that the package's ``forward`` module fills), every run's
+residuals (each ``residual`` kernel), and the lead's sequential Joseph update
 (:func:`replication.nav.kalman.update`, one scalar row at a time: gains and innovation variances).
 """
 
@@ -8,23 +8,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from replication.nav import _kernels as K
 from replication.nav.closedloop.bundles import _NJ
-from replication.nav.measurements import CTX_LEVER, CTX_N, CTX_RATE, CTX_ST
-
-
-@njit(inline="always", **_NJ)
-def _fill_context(ctx, st, lever, wx, wy, wz, n):
-    """The epoch context's navigation part (:mod:`replication.nav.measurements`, ``CTX_*``): state,
-    lever arm in use, ω_eb^b and the number of error states."""
-    for i in range(6):
-        ctx[CTX_ST + i] = st[i]
-    for i in range(3):
-        ctx[CTX_LEVER + i] = lever[i]
-    ctx[CTX_RATE] = wx
-    ctx[CTX_RATE + 1] = wy
-    ctx[CTX_RATE + 2] = wz
-    ctx[CTX_N] = n
 
 
 @njit(inline="always", **_NJ)
@@ -54,16 +38,6 @@ def _measurement_residuals(kernels, n_meas, par, off, width, obs, ctx, c, z, dat
             data[k] = obs[o + k]
         m += kernels[i](par[i], data, ctx, c, z, m)
     return m
-
-
-@njit(inline="always", **_NJ)
-def _body_rate(dth, T, c, st, w_ie, w_en):
-    """ω_eb^b ≈ corrected gyro rate of the last step − C_b^nᵀ ω_ie^n (for the lever-arm rows)."""
-    K.rates_s(st[0], st[2], st[3], st[4], w_ie, w_en)
-    wx = dth[0] / T - (c[0, 0] * w_ie[0] + c[1, 0] * w_ie[1] + c[2, 0] * w_ie[2])
-    wy = dth[1] / T - (c[0, 1] * w_ie[0] + c[1, 1] * w_ie[1] + c[2, 1] * w_ie[2])
-    wz = dth[2] / T - (c[0, 2] * w_ie[0] + c[1, 2] * w_ie[1] + c[2, 2] * w_ie[2])
-    return wx, wy, wz
 
 
 @njit(**_NJ)
