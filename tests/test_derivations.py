@@ -319,7 +319,7 @@ def test_chapter3_reading_rows_quote_the_transcription_and_judge_as_derived(prin
     basis = {q: r["basis"] for q, r in rows.items()}
     assert sorted(basis.values()) == ["claim", "claim", "derivation", "parts", "unstated", "unstated"]
     # the differenced series of step 2 has no state-space form in (3-17): named as unstated
-    differenced = rows["§3.1 step 2: the model of a differenced series as the state δd of (3-17)"]
+    differenced = rows["§3 第三节 step 2: the model of a differenced series as the state δd of (3-17)"]
     assert differenced["basis"] == "unstated" and "差分" in differenced["paper_text"]
     agrees = {r["basis"] + (" gravimetry" if "gravimetry" in q else ""): r.get("agrees") for q, r in rows.items()}
     assert agrees["derivation"] is True            # §3.2 equivalence holds as derived

@@ -325,9 +325,12 @@ def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]
              note=("derived (errors counted computed − true): ∂/∂∇_b = C_b^n and ∂/∂δg^n = -I in the velocity "
                    "rows of the linearised model and in the specific-force rows of Z; the print's signs differ "
                    "((3-5) carries +δg^n, row '(3-5) gravity term against Z = SINS - GNSS of (3-18)'; its H "
-                   "carries -C_b^n for the bias, row '(3-17) F2 against the bias block of (3-18) H'), but in "
-                   "every row group, derived or printed, the two enter as one combination, so the text's "
-                   "equivalence holds either way; heading changes separate the horizontal components, but in "
+                   "carries -C_b^n for the bias, row '(3-17) F2 against the bias block of (3-18) H'): within "
+                   "each block of rows, derived or printed, the two enter as one combination, so the text's "
+                   "equivalence in the velocity equation holds either way; for the velocity rows and Z "
+                   "together it holds on the derived signs, and on the printed ones it hinges on the sign of "
+                   "the δg block of H, which is not printed; heading changes separate the horizontal "
+                   "components, but in "
                    "level flight C_b^n keeps body z up and ∇_bz, δg_U stay one combination at every heading: "
                    "only the disturbance's own dynamics can tell them apart")),
         dict(quantity="§3.1 step 3 separates δg^n from ∇_b (更加精确的重力扰动值)", unit="",
@@ -340,15 +343,16 @@ def chapter3_reading_rows(printed: pd.DataFrame, *, notebook: str) -> list[dict]
                    "step 2 models it; in step 3 ∇_bz and δg_U stay one combination in level flight (row "
                    f"'{equiv}'), so how much of δg_U is separated rests on the AR model's state-space form and "
                    "noises (not printed)")),
-        dict(quantity="§3.1 step 2: the model of a differenced series as the state δd of (3-17)", unit="",
+        dict(quantity="§3 第三节 step 2: the model of a differenced series as the state δd of (3-17)", unit="",
              paper_text=text["text: differencing for stationarity"],
              reproduced=("not printed: an ARMA model identified on the differenced series describes Δδg, and "
                          "δd of (3-17) then needs an integrating state the chapter does not give"),
              basis="unstated",
              note=("step 2 differences a series the inversion test finds non-stationary and identifies the "
-                   "model of the differenced series (lines 703, 707); (3-17) augments the filter with the AR "
-                   "model of δg itself (line 782): how a differenced model enters F and G, and whether the "
-                   "flight series of §4.3 was differenced, is not printed")),
+                   "model of the differenced series (lines 703, 707); (3-17) augments the filter with a state "
+                   "describing the disturbance (line 782), and §4.3 adds the AR(3) of δg itself ((4-13), "
+                   "lines 1730 and 1734): how a differenced model enters F and G, and whether the flight "
+                   "series of §4.3 was differenced, is not printed")),
         dict(quantity="§3.1 absolute gravimetry measures the gravity disturbance (method 1)", unit="",
              paper_text=text["text: absolute gravimetry"],
              reproduced=(f"∂|g|/∂(δg_E, δg_N, δg_U) = ({', '.join(f'{v:g}' for v in mag['gradient'] + 0.0)}); "
