@@ -32,6 +32,7 @@ import pandas as pd
 
 from replication.registry import reproduction as rp
 from replication.registry import verdicts as vd
+from replication.registry.reading import csv_text_frame
 
 CRITERIA = {
     "reproduced": "numbers and a tolerance, the stored error within it",
@@ -187,16 +188,22 @@ def evidence_ok(root: Path, evidence: str, notebook: str = "") -> bool:
         any((root / f).exists() for f in files)
 
 
-@functools.lru_cache(maxsize=512)
-def _records_at(path: str, mtime_ns: int, size: int) -> tuple[dict, ...]:
-    return tuple(pd.read_csv(path, dtype=str, keep_default_na=False).to_dict("records"))
+@functools.lru_cache(maxsize=4096)
+def _evidence_ok_once(root: Path, evidence: str, notebook: str = "") -> bool:
+    """:func:`evidence_ok` once per cell and table within one :func:`audit_table` (a ledger repeats
+    the same evidence on thousands of rows); emptied when each table's audit starts, so a file
+    removed between two audits is seen."""
+    return evidence_ok(root, evidence, notebook)
+
+
+@functools.lru_cache(maxsize=1024)
+def _records_of(content: bytes) -> tuple[dict, ...]:
+    return tuple(csv_text_frame(content).to_dict("records"))
 
 
 def _records(table_id: str) -> tuple[dict, ...]:
-    """The rows of a stored table as dictionaries, read once per version of the file."""
-    path = rp.tables_dir() / f"{table_id}.csv"
-    st = path.stat()
-    return _records_at(str(path), st.st_mtime_ns, st.st_size)
+    """The rows of a stored table as dictionaries, made once per content of the file."""
+    return _records_of((rp.tables_dir() / f"{table_id}.csv").read_bytes())
 
 
 @functools.lru_cache(maxsize=256)
@@ -360,7 +367,7 @@ def _row_problems(tid: str, r: Mapping[str, Any], root: Path, ledger: bool, has_
     if s == "erratum":
         if within is True:
             out.append("an erratum whose printed value lies within the tolerance is not wrong")
-        if not evidence_ok(root, r["evidence"], notebook):
+        if not _evidence_ok_once(root, r["evidence"], notebook):
             out.append(f"an erratum needs evidence naming a notebook and a test that exist, not {r['evidence']!r}")
     return out
 
@@ -380,6 +387,7 @@ def audit_table(tid: str, meta: Mapping[str, Any] | None = None) -> list[Problem
     list of Problem
     """
     root, d = rp.data_root(), rp.tables_dir()
+    _evidence_ok_once.cache_clear()
     meta = rp._sidecar(tid) if meta is None else meta
     csv = d / f"{tid}.csv"
     if not csv.exists():
@@ -481,7 +489,7 @@ def _every_reading_problems(tid: str, df: pd.DataFrame, meta: Mapping[str, Any],
                                     "readings ledger backs it"))
     if _is_ledger(tid):
         return out
-    for r in df.to_dict("records"):
+    for r in _records(tid):
         backed = r["status"] == "not-reproduced" and (ledgers or r.get("basis", "") == "claim")
         if EVERY_READING.search(str(r["note"])) and not backed:
             out.append(Problem(tid, r["quantity"], f"its note speaks of every reading, but the row is {r['status']}"
@@ -506,7 +514,7 @@ def _paper_problems(tid: str, df: pd.DataFrame, meta: Mapping[str, Any]) -> list
     except rp.RegistryError:
         return out
     values = paper.numeric()
-    for r in df.to_dict("records"):
+    for r in _records(tid):
         q = r["quantity"]
         if q not in values.index or r["paper"] == "" or not math.isfinite(values[q]):
             continue
@@ -547,7 +555,7 @@ def _basis_problems(tid: str, r: Mapping[str, Any], df: pd.DataFrame, meta: Mapp
     within = _within(r)
     led = ledger_evidence(q, df, meta, readings, by_q) if readings else None
     ev = vd.Evidence(basis=r["basis"], agrees=agrees, within=within, ledger=led, rests_on=tuple(statuses),
-                     has_test=evidence_ok(root, r["evidence"], meta.get("notebook", "")))
+                     has_test=_evidence_ok_once(root, r["evidence"], meta.get("notebook", "")))
     try:
         derived = vd.derive_status(ev)
     except ValueError as exc:

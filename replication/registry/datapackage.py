@@ -11,6 +11,7 @@ import pandas as pd
 
 from replication._meta import __version__
 from replication.registry.locations import _write_if_changed, tables_dir
+from replication.registry.reading import csv_text_frame
 from replication.registry.schema import NUMERIC_COLUMNS, STATUSES
 
 FIELD_DESCRIPTIONS = {
@@ -133,7 +134,7 @@ def datapackage() -> dict:
     d = tables_dir()
     resources = []
     for path in sorted(d.glob("*.csv")):
-        df = pd.read_csv(path, dtype=str, keep_default_na=False)
+        df = csv_text_frame(path.read_bytes())
         side = d / f"{path.stem}.json"
         meta = json.loads(side.read_text(encoding="utf-8")) if side.exists() else {}
         res = {"name": path.stem, "path": path.name, "profile": "tabular-data-resource", "format": "csv",

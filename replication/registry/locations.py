@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -28,12 +29,18 @@ def _clone_root() -> Path | None:
     clone containing the current directory.  ``None`` outside any clone."""
     env = os.environ.get("REPLICATION_ROOT")
     if env:
-        return Path(env).resolve()
+        return _resolved(env)
     here = Path(__file__).resolve().parents[2]
     if _is_clone(here):
         return here
     cwd = Path.cwd().resolve()
     return next((p for p in (cwd, *cwd.parents) if _is_clone(p)), None)
+
+
+@functools.lru_cache(maxsize=64)
+def _resolved(path: str) -> Path:
+    """``Path(path).resolve()``, once per value of ``$REPLICATION_ROOT`` (every read of a table asks)."""
+    return Path(path).resolve()
 
 
 def project_root() -> Path:

@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import functools
 import io
 import os
 import re
@@ -131,42 +132,56 @@ def parse_paper_file(path: str | os.PathLike) -> PaperTable:
     except UnicodeDecodeError as exc:
         raise RegistryError(f"{path}: not UTF-8 text (byte {exc.start} is {exc.object[exc.start:exc.start + 1]!r}); "
                             "save the transcription as UTF-8") from None
+    try:
+        provenance, df = _parse_paper_text(text)
+    except _Unparsed as exc:
+        raise RegistryError(f"{path}{exc}") from exc.__cause__
+    return PaperTable(table_id=path.stem, path=path, provenance=dict(provenance), data=df.copy())
+
+
+class _Unparsed(ValueError):
+    """What :func:`_parse_paper_text` cannot accept, the file's name left for the caller to put first."""
+
+
+@functools.lru_cache(maxsize=512)
+def _parse_paper_text(text: str) -> tuple[dict, pd.DataFrame]:
+    """The provenance and the body of a paper-value file's ``text``, parsed once per content (the
+    audit of ``index`` reads each paper file for every table that quotes it); the callers copy them."""
     provenance: dict[str, str] = {}
     body_lines: list[str] = []
     for lineno, line in enumerate(text.splitlines(), 1):
         if line.startswith("#"):
             m = re.match(r"#\s*([A-Za-z_]+)\s*:\s*(.*)$", line)
             if not m:
-                raise RegistryError(f"{path}:{lineno}: provenance lines look like '# field: text'")
+                raise _Unparsed(f":{lineno}: provenance lines look like '# field: text'")
             key = m.group(1).lower()
             provenance[key] = (provenance[key] + " " + m.group(2).strip()).strip() if key in provenance else m.group(2).strip()
         elif line.strip():
             body_lines.append(line)
     missing = [k for k in REQUIRED_PROVENANCE if not provenance.get(k)]
     if missing:
-        raise RegistryError(
-            f"{path}: missing provenance {missing}; start the file with lines such as "
+        raise _Unparsed(
+            f": missing provenance {missing}; start the file with lines such as "
             "'# document: chen2019', '# location: Table 1-1', '# section: ch. 1 §1', "
             "'# notes: how it was transcribed'"
         )
     if provenance["document"] not in SOURCE_KEYS:
-        raise RegistryError(f"{path}: document {provenance['document']!r} is not one of {SOURCE_KEYS}")
+        raise _Unparsed(f": document {provenance['document']!r} is not one of {SOURCE_KEYS}")
     if not body_lines:
-        raise RegistryError(f"{path}: no CSV body after the provenance header")
+        raise _Unparsed(": no CSV body after the provenance header")
     try:
         df = pd.read_csv(io.StringIO("\n".join(body_lines)), dtype=str, keep_default_na=False)
     except Exception as exc:  # pandas raises several parser errors
-        raise RegistryError(f"{path}: CSV body cannot be parsed: {exc}") from exc
+        raise _Unparsed(f": CSV body cannot be parsed: {exc}") from exc
     for col in ("quantity", "unit", "value"):
         if col not in df.columns:
-            raise RegistryError(f"{path}: CSV body needs a column {col!r}; it has {list(df.columns)}")
+            raise _Unparsed(f": CSV body needs a column {col!r}; it has {list(df.columns)}")
     if (df["quantity"].str.strip() == "").any():
-        raise RegistryError(f"{path}: a row has an empty quantity")
+        raise _Unparsed(": a row has an empty quantity")
     dup = df["quantity"][df["quantity"].duplicated()].tolist()
     if dup:
-        raise RegistryError(f"{path}: duplicated quantities {dup[:5]}")
-    table_id = path.stem
-    return PaperTable(table_id=table_id, path=path, provenance=provenance, data=df)
+        raise _Unparsed(f": duplicated quantities {dup[:5]}")
+    return provenance, df
 
 
 def load_paper(table_id: str) -> PaperTable:

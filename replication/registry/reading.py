@@ -6,7 +6,9 @@ with near-miss suggestions, and the typed loaders :func:`load_table` and :func:`
 from __future__ import annotations
 
 import difflib
+import functools
 import hashlib
+import io
 import json
 import os
 from pathlib import Path
@@ -53,11 +55,12 @@ READ_COLUMNS = ("quantity", "unit", "paper", "reproduced", "status")
 """The columns of :data:`~replication.registry.schema.TABLE_COLUMNS` every reader relies on; :func:`read_table` refuses a CSV without them."""
 
 
-def _read_csv(path: Path, fix: str, **kw) -> pd.DataFrame:
+def _read_csv(path: Path, fix: str, comment: str | None = None) -> pd.DataFrame:
     """``path`` read as text columns; a file that is empty, not CSV or not UTF-8 raises :class:`~replication.registry.schema.RegistryError`
-    naming it and ``fix``."""
+    naming it and ``fix``.  The parse is kept per content (:func:`csv_text_frame`): the audit of
+    ``index`` reads most tables several times, and an unchanged file is parsed once."""
     try:
-        return pd.read_csv(path, dtype=str, keep_default_na=False, encoding="utf-8", **kw)
+        return csv_text_frame(Path(path).read_bytes(), comment).copy()
     except pd.errors.EmptyDataError:
         why = "is empty"
     except (pd.errors.ParserError, UnicodeDecodeError) as exc:
@@ -65,6 +68,27 @@ def _read_csv(path: Path, fix: str, **kw) -> pd.DataFrame:
     except OSError as exc:
         why = f"cannot be read ({exc.strerror or exc})"
     raise RegistryError(f"{path} {why}: {fix}")
+
+
+@functools.lru_cache(maxsize=1024)
+def csv_text_frame(content: bytes, comment: str | None = None) -> pd.DataFrame:
+    """The CSV ``content`` (UTF-8) as text columns, empty cells as ``""``: parsed once per content
+    (the key is the bytes themselves, so a copy of a file, or a file rewritten with the same bytes,
+    is not parsed again, and an edited one always is).  Callers copy the frame before changing it.
+
+    Parameters
+    ----------
+    content : bytes
+        The file's bytes.
+    comment : str or None
+        A character that starts a comment line (``pandas.read_csv``'s ``comment``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Shared between the callers with the same content: not to be changed in place.
+    """
+    return pd.read_csv(io.BytesIO(content), dtype=str, keep_default_na=False, encoding="utf-8", comment=comment)
 
 
 def _known_ids() -> list[str]:
