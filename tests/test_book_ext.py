@@ -1,5 +1,5 @@
 """The book's small Sphinx extensions (book/_ext): figure alt text, Chinese search terms, numpydoc scope,
-the tokens of table cells kept whole."""
+the tokens of table cells kept whole, the nodes of a page owned by its document."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "book" / "_ext"))
 
 from cjk_search import SearchEnglishCJK, cjk_terms  # noqa: E402
+from doctree_owner import own_nodes  # noqa: E402
 from figure_alt import MAX_CHARS, first_sentence  # noqa: E402
 from napoleon_scope import process_docstring  # noqa: E402
 from table_tokens import protect_html, protected, split_text, status_words  # noqa: E402
@@ -93,3 +94,43 @@ def test_the_text_cells_of_a_notebook_table_are_marked_too():
             '<td class="x"><span class="nowrap">not-reproduced</span></td><td><b>x 1</b></td>') in out
     with pytest.raises(TypeError, match="html must be a str"):
         protect_html(None)
+
+
+def test_nodes_of_another_document_are_pointed_at_the_page():
+    from docutils import nodes
+    from docutils.utils import new_document
+
+    page, other = new_document("page"), new_document("other")
+    para = nodes.paragraph("", "")
+    para += nodes.Text("docstring")
+    page += para
+    para.document = para[0].document = other   # as a nested parse leaves them
+    assert own_nodes(None, page) == 2
+    assert para.document is page and para[0].document is page and own_nodes(None, page) == 0
+
+
+def _foreign_documents(doctree) -> int:
+    return len({id(n.__dict__["_document"]) for n in doctree.findall()
+                if n.__dict__.get("_document", doctree) is not doctree})
+
+
+@pytest.mark.parametrize("with_extension", [False, True])
+def test_an_autodoc_page_in_myst_pickles_without_the_build_environment(tmp_path, with_extension):
+    """An ``eval-rst`` automodule in a MyST page: without the extension its nodes keep the
+    document autodoc parsed them into (and, pickled, the build environment its settings hold)."""
+    import pickle
+
+    from sphinx.application import Sphinx
+
+    src = tmp_path / "src"
+    src.mkdir()
+    ext = ', "doctree_owner"' if with_extension else ""
+    (src / "conf.py").write_text(f'extensions = ["myst_parser", "sphinx.ext.autodoc"{ext}]\n', encoding="utf-8")
+    (src / "index.md").write_text("# Page\n\n```{eval-rst}\n.. automodule:: json\n   :members: dumps\n```\n",
+                                  encoding="utf-8")
+    app = Sphinx(str(src), str(src), str(tmp_path / "out"), str(tmp_path / "doctrees"), "html", status=None,
+                 warning=None, freshenv=True)
+    app.build()
+    doctree = pickle.loads((tmp_path / "doctrees" / "index.doctree").read_bytes())
+    assert "dumps" in doctree.astext()
+    assert (_foreign_documents(doctree) == 0) is with_extension
