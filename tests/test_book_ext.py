@@ -121,6 +121,7 @@ def test_an_autodoc_page_in_myst_pickles_without_the_build_environment(tmp_path,
     import pickle
 
     from sphinx.application import Sphinx
+    from sphinx.util.docutils import docutils_namespace
 
     src = tmp_path / "src"
     src.mkdir()
@@ -128,9 +129,9 @@ def test_an_autodoc_page_in_myst_pickles_without_the_build_environment(tmp_path,
     (src / "conf.py").write_text(f'extensions = ["myst_parser", "sphinx.ext.autodoc"{ext}]\n', encoding="utf-8")
     (src / "index.md").write_text("# Page\n\n```{eval-rst}\n.. automodule:: json\n   :members: dumps\n```\n",
                                   encoding="utf-8")
-    app = Sphinx(str(src), str(src), str(tmp_path / "out"), str(tmp_path / "doctrees"), "html", status=None,
-                 warning=None, freshenv=True)
-    app.build()
+    with docutils_namespace():   # the directives myst_parser registers do not outlive the build
+        Sphinx(str(src), str(src), str(tmp_path / "out"), str(tmp_path / "doctrees"), "html", status=None,
+               warning=None, freshenv=True).build()
     doctree = pickle.loads((tmp_path / "doctrees" / "index.doctree").read_bytes())
     assert "dumps" in doctree.astext()
     assert (_foreign_documents(doctree) == 0) is with_extension
