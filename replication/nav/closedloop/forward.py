@@ -76,10 +76,12 @@ def _attitude_error(q, tq, e):
 
 
 @njit(inline="always", **_NJ)
-def _workspace(n, m_max, n_dyn, n_obs, ar_T):
+def _workspace(spec, inp):
     """The chunk's work arrays, made once: the IMU steps' ``w``, the interval sums ``acc``, the time
     update's ``tw``, and the epoch's rows, residuals, estimate, error, scratch, ``Ta`` (T's augmented
-    block) and the last four of ``w`` (C_b^n, a quaternion, ω_ie^n and ω_en^n) it shares."""
+    block) and the last four of ``w`` (C_b^n, a quaternion, ω_ie^n and ω_en^n) it shares.  It takes
+    the bundles: it is called once per chunk."""
+    n, m_max, n_dyn, n_obs, ar_T = spec.fconst.shape[0], spec.m_max, spec.dyn_rows.shape[0], inp.obs.shape[2], spec.ar_T
     c, qtmp, w_ie, w_en = np.empty((3, 3)), np.empty(4), np.empty(3), np.empty(3)
     w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en)
     acc = (np.zeros(2), np.zeros(3), np.zeros((3, 3)), np.zeros(5), np.zeros((6, n)))
@@ -271,17 +273,15 @@ def _run_nees(st, q, p_hat, truth_st, truth_q, truth_p, nees_L, nees_sd, e, r, j
 
 @njit(**_NJ)
 def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
-    """One chunk of the closed-loop filter for the runs of ``batch``: their IMU steps up to each
-    GNSS epoch, then the epoch (its steps are listed in the module docstring).
+    """One chunk of the closed-loop filter for the runs of ``batch``: their IMU steps up to each GNSS epoch,
+    then the epoch (the module docstring lists its steps, and says why helpers are called as they are).
 
     Parameters
     ----------
-    spec, inp : Spec, ChunkInputs
-        The configuration (:func:`build_spec`) and the chunk's inputs for the runs of ``batch``.
-    batch, lead : BatchState, LeadState
-        The runs' state (views), and the lead's covariance and window sums, advanced in place.
-    gains, out : Gains, ChunkOut
-        Per epoch, the gains the lead's pass writes and the followers read; the chunk's outputs.
+    spec, inp, batch, lead, gains, out : Spec, ChunkInputs, BatchState, LeadState, Gains, ChunkOut
+        The configuration (:func:`build_spec`), the chunk's inputs, the runs' state (views) and the lead's
+        covariance and window sums (advanced in place), the gains per epoch (the lead's pass writes them,
+        the followers read them) and the chunk's outputs.
     is_lead : bool
         Run 0 of ``batch`` is the lead: the covariance follows it and ``gains`` are written.
 
@@ -289,26 +289,20 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
     -------
     int
         The number of GNSS epochs processed.
-
-    Why this function is long: the helpers that an epoch may not need (the AR step and the
-    smoother's records, the IMU-rate solution) are called behind their conditions here, and the
-    runs' state is passed to ``_run_steps`` as views taken here, because each array an inlined
-    helper receives costs a reference count at each call whether it is used or not.
     """
     R, n_steps, n_ep = inp.dth.shape[0], inp.dt.shape[0], inp.ep_step.shape[0]
-    w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta, c, qtmp, w_ie, w_en) = _workspace(
-        spec.fconst.shape[0], spec.m_max, spec.dyn_rows.shape[0], inp.obs.shape[2], spec.ar_T)
-    if out.nav_st.shape[1] > 0:
-        _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, 0)
+    w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta, c, qtmp, w_ie, w_en) = _workspace(spec, inp)
     k = 0
     for j in range(n_ep + 1):
+        if out.nav_st.shape[1] > 0:      # the chunk's first step, then each epoch's state after the feedback
+            _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, k)
         has_ep = j < n_ep
         k_end = inp.ep_step[j] + 1 if has_ep else n_steps
         for r in range(R):
-            batch.damp[r] = _run_steps(spec, inp, r, k, k_end, k_end - 1 if has_ep else k_end, is_lead and r == 0, lead,
-                                       acc, w, batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r],
-                                       batch.g_extra[r], batch.dth_cp[r], batch.dv_cp[r], batch.trig[r], batch.vacc[r],
-                                       batch.damp[r], batch.first[0] == 1, out.nav_st[r], out.nav_q[r])
+            batch.damp[r] = _run_steps(spec, inp, r, k, k_end, k_end - 1 if has_ep else k_end, is_lead and r == 0, lead, acc,
+                                       w, batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r], batch.g_extra[r],
+                                       batch.dth_cp[r], batch.dv_cp[r], batch.trig[r], batch.vacc[r], batch.damp[r],
+                                       batch.first[0] == 1, out.nav_st[r], out.nav_q[r])
         k, batch.first[0] = k_end, 0
         if not has_ep:
             break
@@ -337,6 +331,4 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
             _run_records(out.st, out.q, out.phat, r, j, st_r, q_r, ph_r)
             if spec.nees:
                 out.nees[r, j] = _run_nees(st_r, q_r, ph_r, inp.truth_st, inp.truth_q, inp.truth_p, gains.nees_L, gains.nees_sd, e, r, j)
-        if out.nav_st.shape[1] > 0:
-            _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, k_end)
     return n_ep
