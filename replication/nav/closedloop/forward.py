@@ -29,16 +29,19 @@ inlined helper that receives a bundle still takes a reference to each of its arr
 Measured on the 15-state hour (CPU seconds, alternated processes), against the epoch written out in
 one function: helpers carrying ``spec``, ``inp``, ``batch``, ``gains``, ``out`` and a scratch bundle,
 a quarter slower (0.61 s against 0.41 s); every run's update as one helper receiving ``spec``,
-``inp``, ``batch``, ``gains`` and ``out``, 9 % slower.  The bundles that stay (``spec``, ``inp``
-and ``lead`` into ``_run_steps``) are the ones whose arrays the steps read; the run's state comes as
-views taken once per interval here.  An array an inlined helper receives is counted when it lives
-across a loop of the helper (numba's pruning of reference counts leaves those), so a helper an epoch
-may not need is called behind its condition here, and no helper nests another that takes arrays
-(201 reference increments a GNSS epoch in the 15-state hour before, 179 after).  The work
-arrays are made once per chunk by ``_workspace``, compiled inline into :func:`filter_chunk` (the
-allocations are its own, as when they were written out there), and the scratch tuples it returns
-(``acc``: the interval sums, ``tw``: the time update's arrays) are unpacked by the helpers that use
-them.
+``inp``, ``batch``, ``gains`` and ``out``, 9 % slower.  An array an inlined helper receives is
+counted when it lives across a loop of the helper (numba's pruning of reference counts leaves
+those), so a helper an epoch may not need is called behind its condition here, and no helper nests
+another that takes arrays (201 reference increments a GNSS epoch in the 15-state hour before, 179
+after).  No bundle reaches ``_run_steps`` either: a bundle counts every one of its arrays, read or
+not (``spec`` and ``inp`` were 31 an interval), and an array read from a bundle inside the steps'
+loop for a call is counted at every IMU step (the vertical channel's references and gains, 20 an
+epoch); it takes ``io``, the fifteen inputs, encodings and window sums the steps read, and the run's
+state as views taken once per interval here, and it stores the IMU-rate solution at the top of its
+interval (136 increments a GNSS epoch).  The work arrays are made once per chunk by ``_workspace``,
+compiled inline into :func:`filter_chunk` (the allocations are its own, as when they were written
+out there), and the scratch tuples it returns (``io``; ``acc``: the interval sums; ``tw``: the time
+update's arrays) are unpacked by the helpers that use them.
 """
 
 from __future__ import annotations
@@ -76,11 +79,11 @@ def _attitude_error(q, tq, e):
 
 
 @njit(inline="always", **_NJ)
-def _workspace(spec, inp):
+def _workspace(spec, inp, lead):
     """The chunk's work arrays, made once: the IMU steps' ``w``, the interval sums ``acc``, the time
     update's ``tw``, and the epoch's rows, residuals, estimate, error, scratch, ``Ta`` (T's augmented
-    block) and the last four of ``w`` (C_b^n, a quaternion, ω_ie^n and ω_en^n) it shares.  It takes
-    the bundles: it is called once per chunk."""
+    block) and the last four of ``w`` (C_b^n, a quaternion, ω_ie^n and ω_en^n) it shares; and ``io``,
+    the arrays of the bundles the IMU steps read.  It takes the bundles: it is called once per chunk."""
     n, m_max, n_dyn, n_obs, ar_T = spec.fconst.shape[0], spec.m_max, spec.dyn_rows.shape[0], inp.obs.shape[2], spec.ar_T
     c, qtmp, w_ie, w_en = np.empty((3, 3)), np.empty(4), np.empty(3), np.empty(3)
     w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en)
@@ -90,17 +93,9 @@ def _workspace(spec, inp):
     ew = (np.zeros((m_max, n)), np.zeros(m_max), np.empty(m_max), np.zeros(ctx_size(n)), np.empty(n), np.empty(n),
           np.empty(max(n_dyn, n)), np.empty(n, np.int64), np.zeros(max(n_obs, 1)), np.ascontiguousarray(ar_T[9:, 9:]),
           c, qtmp, w_ie, w_en)
-    return w, acc, tw, ew
-
-
-@njit(inline="always", **_NJ)
-def _store_nav(nav_st, nav_q, st, q, k):
-    """The IMU-rate solution of every run at step ``k`` (``nav_st``, ``nav_q``: runs × steps × ·),
-    called only when it is kept: the arrays an inlined helper receives are reference-counted at
-    each call, kept or not."""
-    for r in range(st.shape[0]):
-        nav_st[r, k, :] = st[r]
-        nav_q[r, k, :] = q[r]
+    io = (inp.dt, inp.dth, inp.dvv, inp.h_ref, inp.vu_ref, inp.sf_w, inp.sf_win, spec.tg, spec.kd, spec.bs, spec.bz,
+          spec.vmode, spec.gains, lead.facc, lead.Cw)
+    return io, w, acc, tw, ew
 
 
 @njit(inline="always", **_NJ)
@@ -176,7 +171,8 @@ def _lead_epoch_gains(P, H, m, Rd, gK, gs, gH, tmp, hz, nees_sd, nees_L, j):
     ``nees_L``, epochs × n × n, is not empty)."""
     _lead_gains(P, H, m, Rd, gK, gs, tmp, hz)
     for a in range(m):
-        gH[a, :] = H[a]
+        for kk in range(H.shape[1]):
+            gH[a, kk] = H[a, kk]
         H[a, :] = 0.0
     if nees_L.shape[0] > 0:
         K.chol_scaled(P, nees_sd[j], nees_L[j])
@@ -291,16 +287,14 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
         The number of GNSS epochs processed.
     """
     R, n_steps, n_ep = inp.dth.shape[0], inp.dt.shape[0], inp.ep_step.shape[0]
-    w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta, c, qtmp, w_ie, w_en) = _workspace(spec, inp)
+    io, w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta, c, qtmp, w_ie, w_en) = _workspace(spec, inp, lead)
     k = 0
     for j in range(n_ep + 1):
-        if out.nav_st.shape[1] > 0:      # the chunk's first step, then each epoch's state after the feedback
-            _store_nav(out.nav_st, out.nav_q, batch.st, batch.q, k)
         has_ep = j < n_ep
         k_end = inp.ep_step[j] + 1 if has_ep else n_steps
         for r in range(R):
-            batch.damp[r] = _run_steps(spec, inp, r, k, k_end, k_end - 1 if has_ep else k_end, is_lead and r == 0, lead, acc,
-                                       w, batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r], batch.g_extra[r],
+            batch.damp[r] = _run_steps(io, r, k, k_end, k_end - 1 if has_ep else k_end, is_lead and r == 0, acc, w,
+                                       batch.st[r], batch.st_prev[r], batch.q[r], batch.p_hat[r], batch.g_extra[r],
                                        batch.dth_cp[r], batch.dv_cp[r], batch.trig[r], batch.vacc[r], batch.damp[r],
                                        batch.first[0] == 1, out.nav_st[r], out.nav_q[r])
         k, batch.first[0] = k_end, 0

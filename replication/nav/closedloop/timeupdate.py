@@ -71,35 +71,36 @@ def _lead_time_update(fconst, qc, q_accel, q_gyro, order, acc, tw, P, Pbar, use_
 
 
 @njit(inline="always", **_NJ)
-def _run_steps(spec, inp, r, k0, k1, nav_last, lead_acc, lead, acc, w, st, st_prev, q, p_hat, g_extra, dth_cp, dv_cp,
-               trig, vacc, damp, first, nav_st, nav_q):
-    """IMU steps k0..k1-1 of run ``r``: corrections, strapdown, window sums; the lead's interval sums
-    of the inputs of F into ``acc`` when ``lead_acc``; the IMU-rate solution (``nav_st``, ``nav_q``)
-    for steps before ``nav_last``.  Returns the damping-loop integrator (``damp`` on entry).
+def _run_steps(io, r, k0, k1, nav_last, lead_acc, acc, w, st, st_prev, q, p_hat, g_extra, dth_cp, dv_cp, trig, vacc,
+               damp, first, nav_st, nav_q):
+    """IMU steps k0..k1-1 of run ``r`` (corrections, strapdown, window sums; the lead's sums of the
+    inputs of F into ``acc`` when ``lead_acc``; the IMU-rate solution at k0 and after the steps
+    before ``nav_last``); returns the damping-loop integrator (``damp`` on entry).
 
-    Why these arguments (twenty-three): called once per run and GNSS interval, it takes the bundles
-    whose arrays the steps read (``spec``, ``inp``, ``lead``), ``acc`` and ``w`` as tuples of exactly
-    the arrays used, and the run's state (``st`` … ``vacc``), ``damp``, ``first`` and its IMU-rate
-    records as views the caller takes once per interval, not the ``BatchState`` and ``ChunkOut``
-    bundles: a view taken inside the helper, or a bundle most of whose arrays the steps do not read,
-    costs a reference count per array at every call (12 fewer an epoch in the 15-state hour)."""
+    Why these arguments (twenty-one): the arrays the steps read, as tuples made once per chunk (``io``:
+    inputs, block encoding, vertical channel, the lead's window sums; ``acc``; ``w``), and the run's
+    state and records as views taken once per interval (see ``forward``: not bundles)."""
+    dt, dth, dvv, h_ref, vu_ref, sf_w, sf_win, tg, kd, bs, bz, vmode, gains, facc, Cw = io
     u, dth_c, dv_c, fb, wb, B, c, qtmp, w_ie, w_en = w
     sums, fsum, Csum, navsum, Cpl = acc
     store_nav = nav_st.shape[0] > 0
+    if store_nav:                   # the chunk's first step, or the state after the last epoch's feedback
+        nav_st[k0, :] = st
+        nav_q[k0, :] = q
     for k in range(k0, k1):
-        T = inp.dt[k]
+        T = dt[k]
         for i in range(3):
-            u[i] = inp.dth[r, k, i]
-        K.apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 1, dth_c, B)
+            u[i] = dth[r, k, i]
+        K.apply_corrections(u, T, p_hat, tg, kd, bs, bz, 1, dth_c, B)
         for i in range(3):
-            u[i] = inp.dvv[r, k, i]
-        K.apply_corrections(u, T, p_hat, spec.tg, spec.kd, spec.bs, spec.bz, 0, dv_c, B)
+            u[i] = dvv[r, k, i]
+        K.apply_corrections(u, T, p_hat, tg, kd, bs, bz, 0, dv_c, B)
         if first and k == 0:
             for i in range(3):
                 dth_cp[i] = dth_c[i]
                 dv_cp[i] = dv_c[i]
-        w_sf = inp.sf_w[k]
-        in_win = inp.sf_win[k] >= 0
+        w_sf = sf_w[k]
+        in_win = sf_win[k] >= 0
         if lead_acc:
             # inputs of F at the start of the step, summed over the GNSS interval
             K.q2c(q, c)
@@ -107,17 +108,16 @@ def _run_steps(spec, inp, r, k0, k1, nav_last, lead_acc, lead, acc, w, st, st_pr
                 fb[i] = dv_c[i] / T
                 wb[i] = dth_c[i] / T
             K.accumulate_interval(c, fb, st, fsum, Csum, navsum)
-            K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, 1.0, Cpl, B)
+            K.accumulate_coupling(c, fb, wb, tg, kd, bs, bz, 1.0, Cpl, B)
             if in_win:
                 for i in range(3):
-                    lead.facc[i] += w_sf * (c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2])
-                K.accumulate_coupling(c, fb, wb, spec.tg, spec.kd, spec.bs, spec.bz, w_sf, lead.Cw, B)
+                    facc[i] += w_sf * (c[i, 0] * fb[0] + c[i, 1] * fb[1] + c[i, 2] * fb[2])
+                K.accumulate_coupling(c, fb, wb, tg, kd, bs, bz, w_sf, Cw, B)
             sums[0] += 1.0
             sums[1] += T
         v0, v1, v2 = st[3], st[4], st[5]
-        href = inp.h_ref[k + 1] if spec.vmode == 1 else inp.h_ref[k]
-        damp = K.sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, spec.vmode,
-                         href, inp.vu_ref[k + 1], spec.gains, damp, g_extra, trig)
+        href = h_ref[k + 1] if vmode == 1 else h_ref[k]
+        damp = K.sd_step(T, dth_c, dv_c, dth_cp, dv_cp, st, st_prev, q, vmode, href, vu_ref[k + 1], gains, damp, g_extra, trig)
         if in_win:
             vacc[0] += w_sf * (st[3] - v0) / T
             vacc[1] += w_sf * (st[4] - v1) / T
@@ -131,4 +131,3 @@ def _run_steps(spec, inp, r, k0, k1, nav_last, lead_acc, lead, acc, w, st, st_pr
             for i in range(4):
                 nav_q[k + 1, i] = q[i]
     return damp
-
