@@ -17,8 +17,8 @@ The epoch, in order:
 4. every run's sensor-error estimates carried by Φ and the AR step (``_carry_estimates``);
 5. per run: its context (``_run_context``), residuals (``_measurement_residuals``), correction
    with the lead's gains (``_run_correction``: NIS and residual records), feedback
-   (``replication.nav._kernels.feedback_nav`` and ``feedback_blocks``), records (``_run_records``)
-   and NEES (``_run_nees``).
+   (``replication.nav._kernels.feedback_nav``, and ``feedback_blocks`` when the model has a
+   lever-arm or gravity block), records (``_run_records``) and NEES (``_run_nees``).
 
 The lead's steps 2 and 3 come before step 4: they read neither the runs' estimates nor anything
 step 4 writes, so the order changes no number.  The followers (``is_lead`` false) skip 2 and 3 and
@@ -38,10 +38,12 @@ not (``spec`` and ``inp`` were 31 an interval), and an array read from a bundle 
 loop for a call is counted at every IMU step (the vertical channel's references and gains, 20 an
 epoch); it takes ``io``, the fifteen inputs, encodings and window sums the steps read, and the run's
 state as views taken once per interval here, and it stores the IMU-rate solution at the top of its
-interval (136 increments a GNSS epoch).  The work arrays are made once per chunk by ``_workspace``,
-compiled inline into :func:`filter_chunk` (the allocations are its own, as when they were written
-out there), and the scratch tuples it returns (``io``; ``acc``: the interval sums; ``tw``: the time
-update's arrays) are unpacked by the helpers that use them.
+interval; ``feedback_blocks``, whose loop holds six arrays, is called only for a model with a
+lever-arm or gravity block (131 increments a GNSS epoch; the epoch written out took 134).  The work
+arrays are made once per chunk by ``_workspace``, compiled inline into :func:`filter_chunk` (the
+allocations are its own, as when they were written out there), and the scratch tuples it returns
+(``io``; ``acc``: the interval sums; ``tw``: the time update's arrays) are unpacked by the helpers
+that use them.
 """
 
 from __future__ import annotations
@@ -82,8 +84,9 @@ def _attitude_error(q, tq, e):
 def _workspace(spec, inp, lead):
     """The chunk's work arrays, made once: the IMU steps' ``w``, the interval sums ``acc``, the time
     update's ``tw``, and the epoch's rows, residuals, estimate, error, scratch, ``Ta`` (T's augmented
-    block) and the last four of ``w`` (C_b^n, a quaternion, ω_ie^n and ω_en^n) it shares; and ``io``,
-    the arrays of the bundles the IMU steps read.  It takes the bundles: it is called once per chunk."""
+    block) and the last four of ``w`` (C_b^n, a quaternion, ω_ie^n and ω_en^n) it shares; ``io``, the
+    arrays of the bundles the IMU steps read; and whether the model has a lever-arm or gravity block
+    (``feedback_blocks`` has work).  It takes the bundles: it is called once per chunk."""
     n, m_max, n_dyn, n_obs, ar_T = spec.fconst.shape[0], spec.m_max, spec.dyn_rows.shape[0], inp.obs.shape[2], spec.ar_T
     c, qtmp, w_ie, w_en = np.empty((3, 3)), np.empty(4), np.empty(3), np.empty(3)
     w = (np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty((3, 6)), c, qtmp, w_ie, w_en)
@@ -95,7 +98,10 @@ def _workspace(spec, inp, lead):
           c, qtmp, w_ie, w_en)
     io = (inp.dt, inp.dth, inp.dvv, inp.h_ref, inp.vu_ref, inp.sf_w, inp.sf_win, spec.tg, spec.kd, spec.bs, spec.bz,
           spec.vmode, spec.gains, lead.facc, lead.Cw)
-    return io, w, acc, tw, ew
+    fbk = False
+    for b in range(spec.tg.shape[0]):
+        fbk = fbk or spec.tg[b] == K.TARGET_LEVER or spec.tg[b] == K.TARGET_GRAVITY
+    return io, w, acc, tw, ew, fbk
 
 
 @njit(inline="always", **_NJ)
@@ -287,7 +293,7 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
         The number of GNSS epochs processed.
     """
     R, n_steps, n_ep = inp.dth.shape[0], inp.dt.shape[0], inp.ep_step.shape[0]
-    io, w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta, c, qtmp, w_ie, w_en) = _workspace(spec, inp, lead)
+    io, w, acc, tw, (H, Rd, z, ctx, xk, e, tmp, hz, dbuf, Ta, c, qtmp, w_ie, w_en), fbk = _workspace(spec, inp, lead)
     k = 0
     for j in range(n_ep + 1):
         has_ep = j < n_ep
@@ -321,7 +327,8 @@ def filter_chunk(spec, inp, batch, lead, gains, out, is_lead):
                                    inp.obs[r, j], ctx, c, z, dbuf)
             _run_correction(z, j, gains.m, gains.H, gains.Kg, gains.s, xk, out.nis, out.innov, out.rec_x, r)
             K.feedback_nav(xk, st_r, batch.st_prev[r], q_r, ph_r, qtmp, e)
-            K.feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, batch.g_extra[r])
+            if fbk:
+                K.feedback_blocks(ph_r, spec.tg, spec.bs, spec.bz, spec.fconst, spec.lever0, lev_r, batch.g_extra[r])
             _run_records(out.st, out.q, out.phat, r, j, st_r, q_r, ph_r)
             if spec.nees:
                 out.nees[r, j] = _run_nees(st_r, q_r, ph_r, inp.truth_st, inp.truth_q, inp.truth_p, gains.nees_L, gains.nees_sd, e, r, j)
