@@ -431,3 +431,11 @@ def test_reading_outcomes_says_what_each_reading_alone_gives_a_row():
     assert stored == whole
     with pytest.raises(rp.RegistryError, match="no row"):
         audit.reading_outcomes(tid, "no such row")
+
+
+def test_the_csv_parse_refuses_text_in_place_of_bytes():
+    from replication.registry.reading import csv_text_frame
+
+    assert list(csv_text_frame(b"a,b\n1,\n")["b"]) == [""]
+    with pytest.raises(TypeError, match="content must be the file's bytes"):
+        csv_text_frame("a,b\n1,2\n")

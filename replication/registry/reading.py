@@ -87,7 +87,14 @@ def csv_text_frame(content: bytes, comment: str | None = None) -> pd.DataFrame:
     -------
     pandas.DataFrame
         Shared between the callers with the same content: not to be changed in place.
+
+    Raises
+    ------
+    TypeError
+        ``content`` is not bytes (read the file with ``Path.read_bytes()``).
     """
+    if not isinstance(content, bytes):
+        raise TypeError(f"content must be the file's bytes (Path.read_bytes()), got {type(content).__name__}")
     return pd.read_csv(io.BytesIO(content), dtype=str, keep_default_na=False, encoding="utf-8", comment=comment)
 
 
